@@ -1,0 +1,27 @@
+// Frame uniforms shared by every pass: camera, lights, ambient, sky.
+// Layout must match `FrameUniforms` in src/renderer.rs (std140).
+#ifndef LUCENT_SCENE_GLSL
+#define LUCENT_SCENE_GLSL
+
+#define MAX_LIGHTS 16
+#define LIGHT_DIRECTIONAL 0
+#define LIGHT_POINT 1
+
+struct Light {
+    vec4 position_type;   // xyz: position (point) or direction the light travels (directional); w: type
+    vec4 radiance_range;  // rgb: colour * intensity; a: range (point lights fade to 0 there)
+};
+
+layout(std140, set = 0, binding = 0) uniform Frame {
+    mat4 view_proj;
+    mat4 inv_view_proj;
+    vec4 camera_pos;      // xyz
+    vec4 ambient;         // rgb
+    vec4 sky;             // rgb: colour of pixels no geometry covers
+    vec4 viewport;        // xy: size in pixels, zw: 1 / size
+    vec4 exposure;        // x: exposure multiplier applied before tonemapping
+    ivec4 light_count;    // x
+    Light lights[MAX_LIGHTS];
+} frame;
+
+#endif

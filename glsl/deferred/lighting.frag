@@ -1,0 +1,32 @@
+#version 450
+// Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
+// only at this pixel through input attachments.
+#include "../common/gbuffer.glsl"
+#include "../common/lighting.glsl"
+
+layout(input_attachment_index = 0, set = 0, binding = 1) uniform subpassInput gb0;
+layout(input_attachment_index = 1, set = 0, binding = 2) uniform subpassInput gb1;
+layout(input_attachment_index = 2, set = 0, binding = 3) uniform subpassInput depth;
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    float d = subpassLoad(depth).r;
+    if (d >= 1.0) {
+        out_color = vec4(frame.sky.rgb, 1.0);
+        return;
+    }
+    Surface s = unpack_gbuffer(subpassLoad(gb0), subpassLoad(gb1));
+    vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
+    vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
+    vec3 pos = world.xyz / world.w;
+    vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
+    vec3 color = frame.ambient.rgb * s.albedo;
+    int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
+    for (int i = 0; i < count; ++i) {
+        color += shade_direct(s, pos, to_eye, frame.lights[i]);
+    }
+    // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).
+    out_color = vec4(min(color, vec3(65504.0)), 1.0);
+}

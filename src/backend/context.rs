@@ -1,0 +1,1087 @@
+//! The one Vulkan context: instance, device, queue, memory allocator and debug tooling.
+//!
+//! Everything else in lucent borrows a [`GpuContext`]. There are two ways to get one:
+//!
+//! - [`GpuContext::new`] owns everything: it loads the Vulkan loader, creates an instance (with
+//!   `VK_LAYER_KHRONOS_validation` and synchronization validation when [`ContextDesc::validation`]
+//!   is set), picks a physical device (or the one matching [`ContextDesc::device_filter`]), probes
+//!   the features lucent needs and creates a device with one graphics + compute queue. Use this for
+//!   the command-line tool, the benchmark and tests.
+//! - [`GpuContext::wrap`] borrows a host engine's instance, device and queue. lucent then creates
+//!   only its own allocator, a command pool for one-shot submits and (when the host enabled
+//!   `VK_EXT_debug_utils`) a debug messenger, and destroys only those on drop.
+//!
+//! Failures are values: a missing loader, a missing driver, a device without a required feature
+//! or a missing validation layer each produce their own [`LucentError`] variant; nothing here
+//! panics. Validation messages go to the `log` crate (target `lucent::vulkan`), and errors are
+//! counted so tests can assert [`GpuContext::validation_error_count`] is zero.
+//!
+//! Debug names ([`GpuContext::set_name`]) and command-buffer labels
+//! ([`GpuContext::begin_label`]) are no-ops when `VK_EXT_debug_utils` is absent; when it is present
+//! they show up in validation messages and in RenderDoc captures.
+
+use std::ffi::{c_void, CStr, CString};
+use std::fmt;
+use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use gpu_allocator::AllocatorDebugSettings;
+
+use crate::error::{LucentError, Result, VkResultExt};
+
+/// Name of the Khronos validation layer.
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+/// How many validation error messages are kept for [`GpuContext::take_validation_messages`].
+const MAX_STORED_MESSAGES: usize = 50;
+/// `log` target of messages coming from the Vulkan debug messenger.
+const LOG_TARGET: &str = "lucent::vulkan";
+
+/// How to create a [`GpuContext`] with [`GpuContext::new`].
+#[derive(Clone, Debug)]
+pub struct ContextDesc {
+    /// Enable `VK_LAYER_KHRONOS_validation` with synchronization validation.
+    pub validation: bool,
+    /// Case-insensitive substring of the device name to pick; `None` picks the best device
+    /// (discrete > integrated > virtual > CPU > other).
+    pub device_filter: Option<String>,
+    /// Application name reported to the driver (and shown by tools such as RenderDoc).
+    pub app_name: String,
+}
+
+impl Default for ContextDesc {
+    fn default() -> Self {
+        Self {
+            validation: false,
+            device_filter: None,
+            app_name: "lucent".to_string(),
+        }
+    }
+}
+
+impl ContextDesc {
+    /// A description for command-line use: validation is on when `validation_flag` is set or the
+    /// environment variable `LUCENT_VALIDATION` is `1` (or `true`/`yes`/`on`).
+    pub fn from_env(validation_flag: bool, device_filter: Option<String>) -> Self {
+        let env_validation = std::env::var("LUCENT_VALIDATION")
+            .map(|v| {
+                matches!(
+                    v.trim().to_ascii_lowercase().as_str(),
+                    "1" | "true" | "yes" | "on"
+                )
+            })
+            .unwrap_or(false);
+        Self {
+            validation: validation_flag || env_validation,
+            device_filter,
+            ..Self::default()
+        }
+    }
+}
+
+/// What lucent knows about the device it runs on.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    /// Device name, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
+    pub name: String,
+    /// Driver name, e.g. `llvmpipe`.
+    pub driver_name: String,
+    /// Driver details, e.g. `Mesa 22.3.6 (LLVM 15.0.6)`.
+    pub driver_info: String,
+    /// Discrete, integrated, virtual, CPU or other.
+    pub device_type: vk::PhysicalDeviceType,
+    /// Vulkan version the device supports (`vk::make_api_version` encoding).
+    pub api_version: u32,
+    /// Nanoseconds per timestamp tick (`limits.timestampPeriod`).
+    pub timestamp_period_ns: f32,
+    /// Valid bits of timestamps written on lucent's queue family.
+    pub timestamp_valid_bits: u32,
+    /// `hostQueryReset` (Vulkan 1.2) is enabled: query pools may be reset from the host.
+    pub host_query_reset: bool,
+    /// `independentBlend` is enabled: colour attachments may use different blend states.
+    pub independent_blend: bool,
+    /// `shaderStorageImageWriteWithoutFormat` is enabled.
+    pub storage_image_write_without_format: bool,
+}
+
+impl DeviceInfo {
+    /// Device name and type, e.g. `llvmpipe (LLVM 15.0.6, 256 bits) [CPU]`.
+    pub fn describe(&self) -> String {
+        format!("{} [{}]", self.name, device_type_name(self.device_type))
+    }
+
+    /// Driver name and details, e.g. `llvmpipe Mesa 22.3.6 (LLVM 15.0.6)`.
+    pub fn driver(&self) -> String {
+        if self.driver_info.is_empty() {
+            self.driver_name.clone()
+        } else {
+            format!("{} {}", self.driver_name, self.driver_info)
+        }
+    }
+
+    /// The device's Vulkan version as text, e.g. `1.3.230`.
+    pub fn api_version_string(&self) -> String {
+        version_string(self.api_version)
+    }
+}
+
+/// Heap state the debug messenger callback writes into. It lives in a `Box` owned by the context
+/// and is dropped only after the messenger (and, for owned contexts, the instance) is destroyed.
+#[derive(Default)]
+struct MessengerState {
+    errors: AtomicU32,
+    messages: Mutex<Vec<String>>,
+}
+
+/// The command pool, command buffer and fence behind [`GpuContext::submit_and_wait`].
+struct OneShot {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+/// The Vulkan context every other part of lucent uses (see the module docs).
+///
+/// Access to [`GpuContext::queue`] must be externally synchronized as Vulkan requires; lucent's
+/// own one-shot submits hold an internal lock while they use it.
+pub struct GpuContext {
+    /// The loaded Vulkan loader.
+    pub entry: ash::Entry,
+    /// The instance (lucent's own, or the host's when wrapped).
+    pub instance: ash::Instance,
+    /// The physical device in use.
+    pub physical_device: vk::PhysicalDevice,
+    /// The logical device (lucent's own, or the host's when wrapped).
+    pub device: ash::Device,
+    /// A queue with graphics, compute and timestamp support.
+    pub queue: vk::Queue,
+    /// The family of [`GpuContext::queue`].
+    pub queue_family: u32,
+    /// Names, versions, limits and enabled optional features of the device.
+    pub info: DeviceInfo,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    debug_device: Option<ash::ext::debug_utils::Device>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    messenger_state: Box<MessengerState>,
+    owns_handles: bool,
+    validation: bool,
+    one_shot: Mutex<OneShot>,
+}
+
+impl fmt::Debug for GpuContext {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("GpuContext")
+            .field("device", &self.info.describe())
+            .field("driver", &self.info.driver())
+            .field("queue_family", &self.queue_family)
+            .field("owns_handles", &self.owns_handles)
+            .field("validation", &self.validation)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GpuContext {
+    /// Creates lucent's own instance and device as described by `desc`.
+    ///
+    /// Errors: [`LucentError::NoVulkanLoader`] without libvulkan, [`LucentError::NoVulkanDriver`]
+    /// without a driver, [`LucentError::NoValidationLayer`] when validation is requested but not
+    /// installed, [`LucentError::NoMatchingDevice`] when no device name contains the filter, and
+    /// [`LucentError::MissingFeature`] when the chosen device lacks something lucent needs.
+    pub fn new(desc: &ContextDesc) -> Result<Self> {
+        // SAFETY: loading libvulkan runs its initialisation code; the system Vulkan loader is
+        // trusted, as in every Vulkan program.
+        let entry = unsafe { ash::Entry::load() }
+            .map_err(|e| LucentError::NoVulkanLoader(e.to_string()))?;
+        // Declared before the instance so it is dropped after it on every path: the instance's
+        // create/destroy-time messenger points at it.
+        let messenger_state = Box::new(MessengerState::default());
+        let created = create_instance(&entry, desc, &messenger_state)?;
+        let CreatedInstance {
+            instance,
+            debug_instance,
+            messenger,
+        } = created;
+
+        let destroy_instance = || {
+            // SAFETY: the messenger (present exactly when debug utils are) and the instance were
+            // created above and nothing else uses them; the messenger goes first.
+            unsafe {
+                if let Some(debug) = &debug_instance {
+                    debug.destroy_debug_utils_messenger(messenger, None);
+                }
+                instance.destroy_instance(None);
+            }
+        };
+
+        let (physical_device, probe) = match pick_device(&instance, desc) {
+            Ok(picked) => picked,
+            Err(e) => {
+                destroy_instance();
+                return Err(e);
+            }
+        };
+        let device = match create_device(&instance, physical_device, &probe) {
+            Ok(device) => device,
+            Err(e) => {
+                destroy_instance();
+                return Err(e);
+            }
+        };
+        let debug_device = debug_instance
+            .as_ref()
+            .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+
+        let parts =
+            match create_owned_parts(&instance, physical_device, &device, probe.queue_family) {
+                Ok(parts) => parts,
+                Err(e) => {
+                    // SAFETY: the device was created above and has no child objects left.
+                    unsafe { device.destroy_device(None) };
+                    destroy_instance();
+                    return Err(e);
+                }
+            };
+        // SAFETY: the queue family was requested with one queue at device creation.
+        let queue = unsafe { device.get_device_queue(probe.queue_family, 0) };
+        log::info!(
+            "lucent device: {} — driver {} — Vulkan {}{}",
+            probe.info.describe(),
+            probe.info.driver(),
+            probe.info.api_version_string(),
+            if desc.validation {
+                " — validation on"
+            } else {
+                ""
+            }
+        );
+        let ctx = Self {
+            entry,
+            instance,
+            physical_device,
+            device,
+            queue,
+            queue_family: probe.queue_family,
+            info: probe.info,
+            allocator: ManuallyDrop::new(Mutex::new(parts.allocator)),
+            debug_instance,
+            debug_device,
+            messenger,
+            messenger_state,
+            owns_handles: true,
+            validation: desc.validation,
+            one_shot: Mutex::new(parts.one_shot),
+        };
+        ctx.name_own_objects();
+        Ok(ctx)
+    }
+
+    /// Wraps a host engine's existing instance, device and queue.
+    ///
+    /// lucent creates only its allocator, a command pool and fence for
+    /// [`GpuContext::submit_and_wait`], and a debug messenger when the instance has
+    /// `VK_EXT_debug_utils` enabled (so validation errors caused by lucent are logged and counted);
+    /// on drop it waits for the device to be idle and destroys only those. The host's handles are
+    /// never destroyed.
+    ///
+    /// The device's support for lucent's requirements (Vulkan 1.3, `synchronization2`,
+    /// `maintenance4`, a graphics + compute queue family with timestamps) is checked and a
+    /// [`LucentError::MissingFeature`] returned otherwise. Whether optional features were enabled
+    /// cannot be queried from a `VkDevice`, so [`DeviceInfo::host_query_reset`],
+    /// [`DeviceInfo::independent_blend`] and [`DeviceInfo::storage_image_write_without_format`]
+    /// start out `false`; a host that enabled them may set them in [`GpuContext::info`].
+    ///
+    /// # Safety
+    ///
+    /// - All handles must be valid, belong together (`device` created from `physical_device` of
+    ///   `instance`, `queue` from family `queue_family` of `device`) and outlive the returned
+    ///   context.
+    /// - `device` must have been created with Vulkan 1.3 and the features `synchronization2` and
+    ///   `maintenance4` enabled.
+    /// - The host must synchronize its own use of `queue` with lucent's (Vulkan requires external
+    ///   synchronization of queue access).
+    pub unsafe fn wrap(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        physical_device: vk::PhysicalDevice,
+        device: ash::Device,
+        queue: vk::Queue,
+        queue_family: u32,
+    ) -> Result<Self> {
+        let mut probe = probe_device(&instance, physical_device)?;
+        let families =
+            // SAFETY: the caller guarantees `physical_device` is a valid handle of `instance`.
+            unsafe { instance.get_physical_device_queue_family_properties(physical_device) };
+        let family = families.get(queue_family as usize).ok_or_else(|| {
+            LucentError::InvalidInput(format!(
+                "queue family {queue_family} does not exist on '{}' ({} families)",
+                probe.info.name,
+                families.len()
+            ))
+        })?;
+        if !queue_family_usable(family) {
+            return Err(LucentError::MissingFeature {
+                device: probe.info.name.clone(),
+                feature: format!(
+                    "queue family {queue_family} with graphics + compute and timestamps"
+                ),
+            });
+        }
+        probe.queue_family = queue_family;
+        probe.info.timestamp_valid_bits = family.timestamp_valid_bits;
+        probe.info.host_query_reset = false;
+        probe.info.independent_blend = false;
+        probe.info.storage_image_write_without_format = false;
+
+        let messenger_state = Box::new(MessengerState::default());
+        // vkGetInstanceProcAddr returns null for debug-utils commands when the instance did not
+        // enable the extension (checked with loader 1.3.239), so that answer decides;
+        // vkGetDeviceProcAddr returns a pointer either way and is only an extra guard.
+        // SAFETY: the caller guarantees `instance` and `device` are valid handles.
+        let (has_instance_debug, has_device_debug) = unsafe {
+            (
+                entry
+                    .get_instance_proc_addr(
+                        instance.handle(),
+                        c"vkCreateDebugUtilsMessengerEXT".as_ptr(),
+                    )
+                    .is_some(),
+                instance
+                    .get_device_proc_addr(device.handle(), c"vkSetDebugUtilsObjectNameEXT".as_ptr())
+                    .is_some(),
+            )
+        };
+        let debug_instance =
+            has_instance_debug.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
+        let debug_device = (has_instance_debug && has_device_debug)
+            .then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+        let messenger = match &debug_instance {
+            Some(debug) => {
+                let info = messenger_create_info(&messenger_state);
+                // SAFETY: the instance has VK_EXT_debug_utils enabled (checked above) and the
+                // user-data pointer stays valid until the messenger is destroyed in `drop`.
+                unsafe { debug.create_debug_utils_messenger(&info, None) }
+                    .vk("vkCreateDebugUtilsMessengerEXT")?
+            }
+            None => vk::DebugUtilsMessengerEXT::null(),
+        };
+
+        let parts = match create_owned_parts(&instance, physical_device, &device, queue_family) {
+            Ok(parts) => parts,
+            Err(e) => {
+                if let Some(debug) = &debug_instance {
+                    // SAFETY: the messenger was created above and is not used elsewhere.
+                    unsafe { debug.destroy_debug_utils_messenger(messenger, None) };
+                }
+                return Err(e);
+            }
+        };
+        log::info!(
+            "lucent wrapping host device: {} — driver {}",
+            probe.info.describe(),
+            probe.info.driver()
+        );
+        let ctx = Self {
+            entry,
+            instance,
+            physical_device,
+            device,
+            queue,
+            queue_family,
+            info: probe.info,
+            allocator: ManuallyDrop::new(Mutex::new(parts.allocator)),
+            debug_instance,
+            debug_device,
+            messenger,
+            messenger_state,
+            owns_handles: false,
+            validation: false,
+            one_shot: Mutex::new(parts.one_shot),
+        };
+        ctx.name_own_objects();
+        Ok(ctx)
+    }
+
+    /// Whether lucent enabled the validation layer. Always `false` for wrapped contexts (the host
+    /// decides); validation errors are still counted there when the host enabled debug utils.
+    pub fn validation_enabled(&self) -> bool {
+        self.validation
+    }
+
+    /// Number of ERROR-severity messages the debug messenger received since creation.
+    pub fn validation_error_count(&self) -> u32 {
+        self.messenger_state.errors.load(Ordering::Relaxed)
+    }
+
+    /// Takes the stored validation error messages (the first 50 since creation or since the last
+    /// call), for printing when a test fails.
+    pub fn take_validation_messages(&self) -> Vec<String> {
+        std::mem::take(&mut *lock(&self.messenger_state.messages))
+    }
+
+    /// Gives `handle` a debug name (shown by validation messages and RenderDoc). No-op without
+    /// `VK_EXT_debug_utils`.
+    pub fn set_name<H: vk::Handle>(&self, handle: H, name: &str) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        let name = c_string(name);
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&name);
+        // SAFETY: `handle` is an object of this device (callers pass their own objects) and the
+        // name outlives the call.
+        if let Err(e) = unsafe { debug.set_debug_utils_object_name(&info) } {
+            log::debug!("vkSetDebugUtilsObjectNameEXT failed: {e:?}");
+        }
+    }
+
+    /// Opens a debug label region in `cmd` (closed by [`GpuContext::end_label`]). No-op without
+    /// `VK_EXT_debug_utils`.
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        let name = c_string(name);
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&name);
+        // SAFETY: `cmd` is a command buffer of this device in the recording state (the caller's
+        // contract for any vkCmd call) and the label outlives the call.
+        unsafe { debug.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+
+    /// Closes the innermost label region opened by [`GpuContext::begin_label`].
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        let Some(debug) = &self.debug_device else {
+            return;
+        };
+        // SAFETY: `cmd` is recording and has an open label region (caller's contract).
+        unsafe { debug.cmd_end_debug_utils_label(cmd) };
+    }
+
+    /// Locks and returns the memory allocator.
+    pub fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        lock(&self.allocator)
+    }
+
+    /// Records commands with `record`, submits them on the queue and waits for completion.
+    ///
+    /// For uploads, readbacks and setup work, not for frames. The command buffer is a primary one
+    /// in the recording state; `record` must not call `submit_and_wait` itself (it would
+    /// deadlock).
+    pub fn submit_and_wait(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let one_shot = lock(&self.one_shot);
+        let cmd = one_shot.cmd;
+        // SAFETY: the pool, command buffer and fence belong to this device and are used only
+        // under the `one_shot` lock; the previous submission was waited for before the lock was
+        // released, so the pool's command buffer is not pending.
+        unsafe {
+            self.device
+                .reset_command_pool(one_shot.pool, vk::CommandPoolResetFlags::empty())
+                .vk("vkResetCommandPool")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            self.device
+                .begin_command_buffer(cmd, &begin)
+                .vk("vkBeginCommandBuffer")?;
+        }
+        record(cmd);
+        // SAFETY: as above; the command buffer is in the recording state, then executable, and
+        // the fence is unsignaled (it is reset after every wait).
+        unsafe {
+            self.device
+                .end_command_buffer(cmd)
+                .vk("vkEndCommandBuffer")?;
+            let cmd_infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmd_infos);
+            self.device
+                .queue_submit2(self.queue, &[submit], one_shot.fence)
+                .vk("vkQueueSubmit2")?;
+            self.device
+                .wait_for_fences(&[one_shot.fence], true, u64::MAX)
+                .vk("vkWaitForFences")?;
+            self.device
+                .reset_fences(&[one_shot.fence])
+                .vk("vkResetFences")?;
+        }
+        Ok(())
+    }
+
+    /// Waits until the device is idle.
+    pub fn wait_idle(&self) -> Result<()> {
+        // SAFETY: the device is valid for the context's lifetime; vkDeviceWaitIdle requires
+        // external synchronization of the queues, which callers provide (see the type docs).
+        unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")
+    }
+
+    /// Names the objects lucent created for itself.
+    fn name_own_objects(&self) {
+        let one_shot = lock(&self.one_shot);
+        self.set_name(one_shot.pool, "lucent one-shot pool");
+        self.set_name(one_shot.cmd, "lucent one-shot commands");
+        self.set_name(one_shot.fence, "lucent one-shot fence");
+        if self.owns_handles {
+            self.set_name(self.queue, "lucent queue");
+        }
+    }
+}
+
+impl Drop for GpuContext {
+    fn drop(&mut self) {
+        // SAFETY: after the device is idle nothing lucent created is in use; each object is
+        // destroyed once, children before parents (allocator memory and pool before the device,
+        // messenger before the instance), and the host's handles are left alone when wrapped.
+        // The messenger state box is dropped after this body, i.e. after the messenger is gone.
+        unsafe {
+            if let Err(e) = self.device.device_wait_idle() {
+                log::error!("vkDeviceWaitIdle failed while dropping the GPU context: {e:?}");
+            }
+            let one_shot = self
+                .one_shot
+                .get_mut()
+                .unwrap_or_else(|poisoned| poisoned.into_inner());
+            self.device.destroy_fence(one_shot.fence, None);
+            self.device.destroy_command_pool(one_shot.pool, None);
+            // Reports leaked allocations (log_leaks_on_shutdown) and frees its memory blocks.
+            ManuallyDrop::drop(&mut self.allocator);
+            if self.owns_handles {
+                self.device.destroy_device(None);
+            }
+            if let Some(debug) = &self.debug_instance {
+                if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                    debug.destroy_debug_utils_messenger(self.messenger, None);
+                }
+            }
+            if self.owns_handles {
+                self.instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+/// Locks a mutex, recovering from poisoning (a panic in another thread does not make the
+/// protected Vulkan state invalid).
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A C string from `s`, dropping interior NULs instead of failing.
+fn c_string(s: &str) -> CString {
+    CString::new(s.replace('\0', "")).unwrap_or_default()
+}
+
+fn version_string(v: u32) -> String {
+    format!(
+        "{}.{}.{}",
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v)
+    )
+}
+
+fn device_type_name(t: vk::PhysicalDeviceType) -> &'static str {
+    match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
+        vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
+        vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
+        vk::PhysicalDeviceType::CPU => "CPU",
+        _ => "other",
+    }
+}
+
+/// Preference order when no filter is given: discrete > integrated > virtual > CPU > other.
+fn device_type_score(t: vk::PhysicalDeviceType) -> u32 {
+    match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 4,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        vk::PhysicalDeviceType::CPU => 1,
+        _ => 0,
+    }
+}
+
+fn messenger_create_info(state: &MessengerState) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    vk::DebugUtilsMessengerCreateInfoEXT::default()
+        // VERBOSE is left out: it is loader chatter.
+        .message_severity(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
+                | vk::DebugUtilsMessageSeverityFlagsEXT::INFO,
+        )
+        .message_type(
+            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+        )
+        .pfn_user_callback(Some(debug_callback))
+        .user_data(state as *const MessengerState as *mut c_void)
+}
+
+/// Routes debug-utils messages to `log` and counts errors in the [`MessengerState`] that
+/// `user_data` points to.
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user_data: *mut c_void,
+) -> vk::Bool32 {
+    // A panic must not unwind into the Vulkan implementation.
+    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        if data.is_null() {
+            return;
+        }
+        // SAFETY: the implementation passes a valid callback-data struct for this call's duration.
+        let data = unsafe { &*data };
+        // SAFETY: the strings are null or valid NUL-terminated strings (Vulkan spec).
+        let (id_name, message) = unsafe {
+            (
+                data.message_id_name_as_c_str()
+                    .map(|s| s.to_string_lossy())
+                    .unwrap_or_default(),
+                data.message_as_c_str()
+                    .map(|s| s.to_string_lossy())
+                    .unwrap_or_default(),
+            )
+        };
+        if severity == vk::DebugUtilsMessageSeverityFlagsEXT::INFO && id_name == "Loader Message" {
+            // The loader reports every layer and driver it looks at: harmless spam.
+            return;
+        }
+        let level = if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+            log::Level::Error
+        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+            log::Level::Warn
+        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::INFO) {
+            log::Level::Info
+        } else {
+            log::Level::Debug
+        };
+        log::log!(target: LOG_TARGET, level, "{message}");
+        if level == log::Level::Error && !user_data.is_null() {
+            // SAFETY: user_data is the address of the context's boxed MessengerState, which
+            // outlives the messenger (see MessengerState).
+            let state = unsafe { &*(user_data as *const MessengerState) };
+            state.errors.fetch_add(1, Ordering::Relaxed);
+            let mut messages = lock(&state.messages);
+            if messages.len() < MAX_STORED_MESSAGES {
+                messages.push(if message.contains(id_name.as_ref()) {
+                    message.into_owned()
+                } else {
+                    format!("[{id_name}] {message}")
+                });
+            }
+        }
+    }));
+    vk::FALSE
+}
+
+struct CreatedInstance {
+    instance: ash::Instance,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+}
+
+fn create_instance(
+    entry: &ash::Entry,
+    desc: &ContextDesc,
+    state: &MessengerState,
+) -> Result<CreatedInstance> {
+    // SAFETY: plain queries of the loaded loader.
+    let loader_version = unsafe { entry.try_enumerate_instance_version() }
+        .vk("vkEnumerateInstanceVersion")?
+        .unwrap_or(vk::API_VERSION_1_0);
+    if loader_version < vk::API_VERSION_1_3 {
+        return Err(LucentError::NoVulkanDriver(format!(
+            " for Vulkan 1.3 (the loader supports {})",
+            version_string(loader_version)
+        )));
+    }
+    // SAFETY: plain queries of the loaded loader.
+    let extensions = unsafe { entry.enumerate_instance_extension_properties(None) }
+        .vk("vkEnumerateInstanceExtensionProperties")?;
+    let has_extension = |list: &[vk::ExtensionProperties], name: &CStr| {
+        list.iter()
+            .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name))
+    };
+
+    let mut layer_extensions = Vec::new();
+    if desc.validation {
+        // SAFETY: plain queries of the loaded loader.
+        let layers = unsafe { entry.enumerate_instance_layer_properties() }
+            .vk("vkEnumerateInstanceLayerProperties")?;
+        if !layers
+            .iter()
+            .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER))
+        {
+            return Err(LucentError::NoValidationLayer);
+        }
+        // SAFETY: the layer name is a valid NUL-terminated string of an installed layer.
+        layer_extensions =
+            unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                .vk("vkEnumerateInstanceExtensionProperties")?;
+    }
+
+    let debug_utils = ash::ext::debug_utils::NAME;
+    let has_debug_utils =
+        has_extension(&extensions, debug_utils) || has_extension(&layer_extensions, debug_utils);
+    if desc.validation && !has_debug_utils {
+        // Without the messenger validation errors could not be seen or counted.
+        return Err(LucentError::Vulkan {
+            call: "vkCreateInstance (VK_EXT_debug_utils)",
+            result: vk::Result::ERROR_EXTENSION_NOT_PRESENT,
+        });
+    }
+    let validation_features = ash::ext::validation_features::NAME;
+    let has_validation_features = desc.validation
+        && (has_extension(&layer_extensions, validation_features)
+            || has_extension(&extensions, validation_features));
+
+    let mut extension_names = Vec::new();
+    if has_debug_utils {
+        extension_names.push(debug_utils.as_ptr());
+    }
+    if has_validation_features {
+        extension_names.push(validation_features.as_ptr());
+    }
+    let layer_names = if desc.validation {
+        vec![VALIDATION_LAYER.as_ptr()]
+    } else {
+        Vec::new()
+    };
+
+    let app_name = c_string(&desc.app_name);
+    let app_info = vk::ApplicationInfo::default()
+        .application_name(&app_name)
+        .application_version(0)
+        .engine_name(c"lucent")
+        .engine_version(vk::make_api_version(0, 0, 1, 0))
+        .api_version(vk::API_VERSION_1_3);
+    let enabled_validation = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features =
+        vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_validation);
+    let mut messenger_info = messenger_create_info(state);
+    let mut create_info = vk::InstanceCreateInfo::default()
+        .application_info(&app_info)
+        .enabled_layer_names(&layer_names)
+        .enabled_extension_names(&extension_names);
+    if has_debug_utils {
+        // Also captures messages from vkCreateInstance / vkDestroyInstance themselves.
+        create_info = create_info.push_next(&mut messenger_info);
+    }
+    if has_validation_features {
+        create_info = create_info.push_next(&mut features);
+    } else if desc.validation {
+        log::warn!("VK_EXT_validation_features missing: synchronization validation is off");
+    }
+
+    // SAFETY: every pointer in `create_info` refers to locals that outlive the call; the
+    // messenger user data points to `state`, which the caller keeps alive past the instance.
+    let instance = match unsafe { entry.create_instance(&create_info, None) } {
+        Ok(instance) => instance,
+        Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
+            return Err(LucentError::NoVulkanDriver(
+                " (vkCreateInstance: ERROR_INCOMPATIBLE_DRIVER)".to_string(),
+            ))
+        }
+        Err(vk::Result::ERROR_LAYER_NOT_PRESENT) => return Err(LucentError::NoValidationLayer),
+        Err(result) => {
+            return Err(LucentError::Vulkan {
+                call: "vkCreateInstance",
+                result,
+            })
+        }
+    };
+
+    let debug_instance =
+        has_debug_utils.then(|| ash::ext::debug_utils::Instance::new(entry, &instance));
+    let messenger = match &debug_instance {
+        Some(debug) => {
+            let info = messenger_create_info(state);
+            // SAFETY: the instance enables VK_EXT_debug_utils; user data outlives the messenger.
+            match unsafe { debug.create_debug_utils_messenger(&info, None) } {
+                Ok(m) => m,
+                Err(result) => {
+                    // SAFETY: the instance was created above and has no children.
+                    unsafe { instance.destroy_instance(None) };
+                    return Err(LucentError::Vulkan {
+                        call: "vkCreateDebugUtilsMessengerEXT",
+                        result,
+                    });
+                }
+            }
+        }
+        None => vk::DebugUtilsMessengerEXT::null(),
+    };
+    Ok(CreatedInstance {
+        instance,
+        debug_instance,
+        messenger,
+    })
+}
+
+/// The result of checking a physical device against lucent's requirements.
+struct Probe {
+    info: DeviceInfo,
+    queue_family: u32,
+}
+
+fn queue_family_usable(family: &vk::QueueFamilyProperties) -> bool {
+    family
+        .queue_flags
+        .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
+        && family.timestamp_valid_bits > 0
+        && family.queue_count > 0
+}
+
+/// Checks that `pd` supports what lucent needs and collects its [`DeviceInfo`]; the optional
+/// feature flags say what is supported (and will be enabled by [`create_device`]).
+fn probe_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<Probe> {
+    // SAFETY: `pd` was enumerated from `instance` (or supplied by a host under wrap's contract).
+    let props = unsafe { instance.get_physical_device_properties(pd) };
+    let name = props
+        .device_name_as_c_str()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|_| "unnamed device".to_string());
+    let missing = |feature: String| LucentError::MissingFeature {
+        device: name.clone(),
+        feature,
+    };
+    if props.api_version < vk::API_VERSION_1_3 {
+        return Err(missing(format!(
+            "Vulkan 1.3 (device supports {})",
+            version_string(props.api_version)
+        )));
+    }
+
+    // SAFETY: as above; the device supports Vulkan 1.3, so the 1.2 driver-properties and the
+    // 1.2/1.3 feature structs are valid in these chains.
+    let (driver, core, v12, v13, families) = unsafe {
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        instance.get_physical_device_properties2(pd, &mut props2);
+
+        let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+        let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut features2 = vk::PhysicalDeviceFeatures2::default()
+            .push_next(&mut v12)
+            .push_next(&mut v13);
+        instance.get_physical_device_features2(pd, &mut features2);
+        let core = features2.features;
+        let families = instance.get_physical_device_queue_family_properties(pd);
+        (driver, core, v12, v13, families)
+    };
+    if v13.synchronization2 == vk::FALSE {
+        return Err(missing("synchronization2 (Vulkan 1.3)".to_string()));
+    }
+    if v13.maintenance4 == vk::FALSE {
+        return Err(missing(
+            "maintenance4 (Vulkan 1.3; SPIR-V for Vulkan 1.3 needs it)".to_string(),
+        ));
+    }
+    let (queue_family, family) = families
+        .iter()
+        .enumerate()
+        .find(|(_, f)| queue_family_usable(f))
+        .ok_or_else(|| {
+            missing(
+                "a queue family with graphics + compute and timestamps (timestampValidBits > 0)"
+                    .to_string(),
+            )
+        })?;
+
+    let text = |s: std::result::Result<&CStr, _>| {
+        s.map(|s: &CStr| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let info = DeviceInfo {
+        name,
+        driver_name: text(driver.driver_name_as_c_str()),
+        driver_info: text(driver.driver_info_as_c_str()),
+        device_type: props.device_type,
+        api_version: props.api_version,
+        timestamp_period_ns: props.limits.timestamp_period,
+        timestamp_valid_bits: family.timestamp_valid_bits,
+        host_query_reset: v12.host_query_reset == vk::TRUE,
+        independent_blend: core.independent_blend == vk::TRUE,
+        storage_image_write_without_format: core.shader_storage_image_write_without_format
+            == vk::TRUE,
+    };
+    Ok(Probe {
+        info,
+        queue_family: queue_family as u32,
+    })
+}
+
+/// Picks the physical device: the best-scored (or filter-matching) device that passes
+/// [`probe_device`]; when none passes, the best candidate's error is returned.
+fn pick_device(
+    instance: &ash::Instance,
+    desc: &ContextDesc,
+) -> Result<(vk::PhysicalDevice, Probe)> {
+    // SAFETY: plain query of a valid instance.
+    let devices = match unsafe { instance.enumerate_physical_devices() } {
+        Ok(devices) => devices,
+        Err(vk::Result::ERROR_INITIALIZATION_FAILED) => {
+            return Err(LucentError::NoVulkanDriver(
+                " (vkEnumeratePhysicalDevices: ERROR_INITIALIZATION_FAILED)".to_string(),
+            ))
+        }
+        Err(result) => {
+            return Err(LucentError::Vulkan {
+                call: "vkEnumeratePhysicalDevices",
+                result,
+            })
+        }
+    };
+    if devices.is_empty() {
+        return Err(LucentError::NoVulkanDriver(
+            " (no physical devices)".to_string(),
+        ));
+    }
+    let mut candidates: Vec<(vk::PhysicalDevice, String, u32)> = devices
+        .iter()
+        .map(|&pd| {
+            // SAFETY: `pd` was just enumerated from `instance`.
+            let props = unsafe { instance.get_physical_device_properties(pd) };
+            let name = props
+                .device_name_as_c_str()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (pd, name, device_type_score(props.device_type))
+        })
+        .collect();
+    if let Some(filter) = &desc.device_filter {
+        let wanted = filter.to_lowercase();
+        let available = candidates
+            .iter()
+            .map(|(_, name, _)| name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        candidates.retain(|(_, name, _)| name.to_lowercase().contains(&wanted));
+        if candidates.is_empty() {
+            return Err(LucentError::NoMatchingDevice {
+                wanted: filter.clone(),
+                available,
+            });
+        }
+    }
+    // Stable sort: equal scores keep the driver's enumeration order.
+    candidates.sort_by_key(|(_, _, score)| std::cmp::Reverse(*score));
+    let mut first_error = None;
+    for (pd, name, _) in &candidates {
+        match probe_device(instance, *pd) {
+            Ok(probe) => return Ok((*pd, probe)),
+            Err(e) => {
+                log::info!("skipping Vulkan device '{name}': {e}");
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_error.unwrap_or_else(|| LucentError::NoVulkanDriver(String::new())))
+}
+
+fn create_device(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    probe: &Probe,
+) -> Result<ash::Device> {
+    let priorities = [1.0f32];
+    let queue_infos = [vk::DeviceQueueCreateInfo::default()
+        .queue_family_index(probe.queue_family)
+        .queue_priorities(&priorities)];
+    let core = vk::PhysicalDeviceFeatures::default()
+        .independent_blend(probe.info.independent_blend)
+        .shader_storage_image_write_without_format(probe.info.storage_image_write_without_format);
+    let mut v12 =
+        vk::PhysicalDeviceVulkan12Features::default().host_query_reset(probe.info.host_query_reset);
+    let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+        .synchronization2(true)
+        .maintenance4(true);
+    let mut features2 = vk::PhysicalDeviceFeatures2::default()
+        .features(core)
+        .push_next(&mut v12)
+        .push_next(&mut v13);
+    let create_info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queue_infos)
+        .push_next(&mut features2);
+    // SAFETY: `pd` belongs to `instance`; every enabled feature was reported as supported by
+    // probe_device, and all pointers refer to locals that outlive the call.
+    unsafe { instance.create_device(pd, &create_info, None) }.vk("vkCreateDevice")
+}
+
+/// What lucent creates on any device, owned or wrapped.
+struct OwnedParts {
+    allocator: Allocator,
+    one_shot: OneShot,
+}
+
+fn create_owned_parts(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    device: &ash::Device,
+    queue_family: u32,
+) -> Result<OwnedParts> {
+    let allocator = Allocator::new(&AllocatorCreateDesc {
+        instance: instance.clone(),
+        device: device.clone(),
+        physical_device: pd,
+        debug_settings: AllocatorDebugSettings {
+            log_leaks_on_shutdown: true,
+            ..Default::default()
+        },
+        buffer_device_address: false,
+        allocation_sizes: Default::default(),
+    })
+    .map_err(|source| LucentError::Allocation {
+        name: "lucent allocator".to_string(),
+        source,
+    })?;
+    let pool_info = vk::CommandPoolCreateInfo::default()
+        .flags(vk::CommandPoolCreateFlags::TRANSIENT)
+        .queue_family_index(queue_family);
+    // SAFETY: `device` is valid and `queue_family` is one of its queue families; each object
+    // created here is destroyed on the error paths below or in GpuContext::drop.
+    unsafe {
+        let pool = device
+            .create_command_pool(&pool_info, None)
+            .vk("vkCreateCommandPool")?;
+        let alloc_info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = match device.allocate_command_buffers(&alloc_info) {
+            Ok(cmds) if !cmds.is_empty() => cmds[0],
+            Ok(_) => {
+                device.destroy_command_pool(pool, None);
+                return Err(LucentError::Vulkan {
+                    call: "vkAllocateCommandBuffers",
+                    result: vk::Result::ERROR_UNKNOWN,
+                });
+            }
+            Err(result) => {
+                device.destroy_command_pool(pool, None);
+                return Err(LucentError::Vulkan {
+                    call: "vkAllocateCommandBuffers",
+                    result,
+                });
+            }
+        };
+        let fence = match device.create_fence(&vk::FenceCreateInfo::default(), None) {
+            Ok(fence) => fence,
+            Err(result) => {
+                device.destroy_command_pool(pool, None);
+                return Err(LucentError::Vulkan {
+                    call: "vkCreateFence",
+                    result,
+                });
+            }
+        };
+        Ok(OwnedParts {
+            allocator,
+            one_shot: OneShot { pool, cmd, fence },
+        })
+    }
+}

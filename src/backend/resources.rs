@@ -1,0 +1,801 @@
+//! GPU images and buffers, their memory, and copies to and from the host.
+//!
+//! Every resource carries a name; the same name goes to the memory allocator (leak reports) and
+//! to the Vulkan object (validation messages, RenderDoc).
+//!
+//! Which API to use:
+//! - [`GpuContext::create_image`] / [`GpuContext::create_buffer`] allocate a resource with its own
+//!   memory; free it with [`GpuContext::destroy_image`] / [`GpuContext::destroy_buffer`]
+//!   (resources are not freed on drop: a forgotten one shows up in the allocator's leak report).
+//! - [`GpuContext::upload_buffer`] puts host data into a device-local buffer (vertices, indices,
+//!   constants) through a staging copy.
+//! - [`GpuContext::read_image`] and [`GpuContext::read_buffer`] copy GPU results back to the host
+//!   (tests, screenshots, reports).
+//! - For memory aliasing (the render graph places images whose lifetimes do not overlap in one
+//!   block): [`GpuContext::create_image_unbound`] gives an image and its memory requirements,
+//!   [`GpuContext::allocate_memory_block`] allocates a block, [`GpuContext::bind_image`] places
+//!   an image at an offset in it and [`GpuContext::create_view`] makes its view. Wrap the result
+//!   in [`GpuImage::from_parts`] to use the other functions on it.
+//!
+//! Setup copies go through [`GpuContext::submit_and_wait`] and end with a full barrier, so later
+//! GPU work sees their results without further synchronization.
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::context::GpuContext;
+use crate::error::{LucentError, Result, VkResultExt};
+
+/// Usages that access an image through a view (VUID-VkImageViewCreateInfo-image-04441).
+const VIEW_USAGES: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
+    vk::ImageUsageFlags::SAMPLED.as_raw()
+        | vk::ImageUsageFlags::STORAGE.as_raw()
+        | vk::ImageUsageFlags::COLOR_ATTACHMENT.as_raw()
+        | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT.as_raw()
+        | vk::ImageUsageFlags::TRANSIENT_ATTACHMENT.as_raw()
+        | vk::ImageUsageFlags::INPUT_ATTACHMENT.as_raw(),
+);
+
+/// A 2D image with one mip level and one layer, in optimal tiling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageDesc {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Texel format.
+    pub format: vk::Format,
+    /// Every way the image will be used.
+    pub usage: vk::ImageUsageFlags,
+    /// `COLOR` or `DEPTH` (the aspect of the view and of copies).
+    pub aspect: vk::ImageAspectFlags,
+}
+
+impl ImageDesc {
+    /// A colour image description.
+    pub fn color(width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
+        Self {
+            width,
+            height,
+            format,
+            usage,
+            aspect: vk::ImageAspectFlags::COLOR,
+        }
+    }
+
+    /// A depth image description.
+    pub fn depth(width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
+        Self {
+            width,
+            height,
+            format,
+            usage,
+            aspect: vk::ImageAspectFlags::DEPTH,
+        }
+    }
+
+    /// The image's extent as a 3D extent with depth 1.
+    pub fn extent(&self) -> vk::Extent3D {
+        vk::Extent3D {
+            width: self.width,
+            height: self.height,
+            depth: 1,
+        }
+    }
+
+    /// The subresource range covering the whole image (one mip, one layer).
+    pub fn subresource_range(&self) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange {
+            aspect_mask: self.aspect,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        }
+    }
+}
+
+/// An image, its view and (unless its memory is owned elsewhere) its memory.
+#[derive(Debug)]
+pub struct GpuImage {
+    /// The image.
+    pub image: vk::Image,
+    /// A 2D view of the whole image with [`ImageDesc::aspect`]; null when the usage allows no
+    /// view (e.g. a transfer-only image).
+    pub view: vk::ImageView,
+    /// What the image was created with.
+    pub desc: ImageDesc,
+    /// Debug name of the image, its view and its memory.
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl GpuImage {
+    /// Wraps an image whose memory is owned elsewhere (e.g. bound into a [`MemoryBlock`] with
+    /// [`GpuContext::bind_image`]). [`GpuContext::destroy_image`] then destroys the view and the
+    /// image but leaves the memory alone.
+    pub fn from_parts(image: vk::Image, view: vk::ImageView, desc: ImageDesc, name: &str) -> Self {
+        Self {
+            image,
+            view,
+            desc,
+            name: name.to_string(),
+            allocation: None,
+        }
+    }
+}
+
+/// A buffer and its memory.
+#[derive(Debug)]
+pub struct GpuBuffer {
+    /// The buffer.
+    pub buffer: vk::Buffer,
+    /// Size in bytes as requested (the allocation may be larger).
+    pub size: u64,
+    /// Debug name of the buffer and its memory.
+    pub name: String,
+    allocation: Option<Allocation>,
+}
+
+impl GpuBuffer {
+    /// The buffer's bytes when its memory is host-visible (`CpuToGpu` / `GpuToCpu`), else `None`.
+    ///
+    /// Memory from those locations is host-coherent; the caller must make sure the GPU is not
+    /// writing the buffer while the slice is read.
+    pub fn mapped_slice(&self) -> Option<&[u8]> {
+        let slice = self.allocation.as_ref()?.mapped_slice()?;
+        slice.get(..usize::try_from(self.size).ok()?)
+    }
+
+    /// Mutable access to the buffer's bytes when its memory is host-visible, else `None`.
+    ///
+    /// The caller must make sure the GPU is not using the buffer while it is written.
+    pub fn mapped_mut(&mut self) -> Option<&mut [u8]> {
+        let size = usize::try_from(self.size).ok()?;
+        let slice = self.allocation.as_mut()?.mapped_slice_mut()?;
+        slice.get_mut(..size)
+    }
+}
+
+/// A block of device-local memory that several resources can be bound into (memory aliasing).
+/// Free it with [`GpuContext::free_memory_block`] after every resource in it is destroyed.
+#[derive(Debug)]
+pub struct MemoryBlock {
+    allocation: Allocation,
+    name: String,
+    memory_type_bits: u32,
+}
+
+impl MemoryBlock {
+    /// The `VkDeviceMemory` the block lives in (shared with other blocks; never free it directly).
+    pub fn memory(&self) -> vk::DeviceMemory {
+        // SAFETY: only the handle is read; gpu-allocator marks this unsafe because freeing or
+        // sub-allocating the memory behind its back would be unsound, which callers must not do.
+        unsafe { self.allocation.memory() }
+    }
+
+    /// Offset of the block inside [`MemoryBlock::memory`]; resource offsets passed to
+    /// [`GpuContext::bind_image`] are relative to it.
+    pub fn offset(&self) -> u64 {
+        self.allocation.offset()
+    }
+
+    /// Size of the block in bytes.
+    pub fn size(&self) -> u64 {
+        self.allocation.size()
+    }
+
+    /// The block's debug name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+/// Bytes per texel of the formats lucent reads back or sizes, or `None` for others.
+pub fn format_texel_size(format: vk::Format) -> Option<u32> {
+    use vk::Format as F;
+    Some(match format {
+        F::R8_UNORM | F::R8_SNORM | F::R8_UINT | F::R8_SINT | F::R8_SRGB | F::S8_UINT => 1,
+        F::R8G8_UNORM
+        | F::R8G8_SNORM
+        | F::R8G8_UINT
+        | F::R8G8_SINT
+        | F::R16_UNORM
+        | F::R16_SNORM
+        | F::R16_UINT
+        | F::R16_SINT
+        | F::R16_SFLOAT
+        | F::D16_UNORM => 2,
+        F::R8G8B8A8_UNORM
+        | F::R8G8B8A8_SNORM
+        | F::R8G8B8A8_UINT
+        | F::R8G8B8A8_SINT
+        | F::R8G8B8A8_SRGB
+        | F::B8G8R8A8_UNORM
+        | F::B8G8R8A8_SNORM
+        | F::B8G8R8A8_UINT
+        | F::B8G8R8A8_SINT
+        | F::B8G8R8A8_SRGB
+        | F::A8B8G8R8_UNORM_PACK32
+        | F::A8B8G8R8_SRGB_PACK32
+        | F::A2B10G10R10_UNORM_PACK32
+        | F::A2R10G10B10_UNORM_PACK32
+        | F::B10G11R11_UFLOAT_PACK32
+        | F::E5B9G9R9_UFLOAT_PACK32
+        | F::R16G16_UNORM
+        | F::R16G16_SNORM
+        | F::R16G16_UINT
+        | F::R16G16_SINT
+        | F::R16G16_SFLOAT
+        | F::R32_UINT
+        | F::R32_SINT
+        | F::R32_SFLOAT
+        | F::D32_SFLOAT
+        | F::X8_D24_UNORM_PACK32 => 4,
+        F::R16G16B16A16_UNORM
+        | F::R16G16B16A16_SNORM
+        | F::R16G16B16A16_UINT
+        | F::R16G16B16A16_SINT
+        | F::R16G16B16A16_SFLOAT
+        | F::R32G32_UINT
+        | F::R32G32_SINT
+        | F::R32G32_SFLOAT => 8,
+        F::R32G32B32_SFLOAT => 12,
+        F::R32G32B32A32_UINT | F::R32G32B32A32_SINT | F::R32G32B32A32_SFLOAT => 16,
+        _ => return None,
+    })
+}
+
+impl GpuContext {
+    /// Creates an image with its own device-local memory and a view of it (no view when the
+    /// usage is transfer-only).
+    pub fn create_image(&self, desc: &ImageDesc, name: &str) -> Result<GpuImage> {
+        let (image, requirements) = self.create_image_unbound(desc, name)?;
+        let allocation = match self.allocate(
+            name,
+            requirements,
+            MemoryLocation::GpuOnly,
+            false,
+            AllocationScheme::GpuAllocatorManaged,
+        ) {
+            Ok(allocation) => allocation,
+            Err(e) => {
+                // SAFETY: the image was created above, is unbound and unused.
+                unsafe { self.device.destroy_image(image, None) };
+                return Err(e);
+            }
+        };
+        // SAFETY: the allocation satisfies `requirements` of this image (gpu-allocator honours
+        // size, alignment and memory type bits) and the image is not yet bound.
+        let bound = unsafe {
+            self.device
+                .bind_image_memory(image, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindImageMemory");
+        let view = bound.and_then(|()| {
+            if desc.usage.intersects(VIEW_USAGES) {
+                self.create_view(image, desc, name)
+            } else {
+                // Vulkan allows views only of images with a usage that reads or writes through
+                // one; a transfer-only image has none.
+                Ok(vk::ImageView::null())
+            }
+        });
+        match view {
+            Ok(view) => Ok(GpuImage {
+                image,
+                view,
+                desc: *desc,
+                name: name.to_string(),
+                allocation: Some(allocation),
+            }),
+            Err(e) => {
+                // SAFETY: the image was created above and is unused; it is destroyed before its
+                // memory is freed.
+                unsafe { self.device.destroy_image(image, None) };
+                self.free_allocation(allocation, name);
+                Err(e)
+            }
+        }
+    }
+
+    /// Destroys an image, its view and (if it owns it) its memory. The GPU must be done with it.
+    pub fn destroy_image(&self, image: GpuImage) {
+        // SAFETY: the caller hands over ownership and guarantees the GPU no longer uses the
+        // image; the view is destroyed before the image, the image before its memory.
+        unsafe {
+            self.device.destroy_image_view(image.view, None);
+            self.device.destroy_image(image.image, None);
+        }
+        if let Some(allocation) = image.allocation {
+            self.free_allocation(allocation, &image.name);
+        }
+    }
+
+    /// Creates a buffer of `size` bytes in `location` (`GpuOnly`, `CpuToGpu` or `GpuToCpu`; the
+    /// last two are mapped, see [`GpuBuffer::mapped_slice`]).
+    pub fn create_buffer(
+        &self,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+        name: &str,
+    ) -> Result<GpuBuffer> {
+        if size == 0 {
+            return Err(LucentError::InvalidInput(format!(
+                "buffer '{name}' has size 0 (Vulkan buffers must not be empty)"
+            )));
+        }
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid create info with non-zero size; the buffer is destroyed on every error
+        // path below or by destroy_buffer.
+        let buffer = unsafe { self.device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
+        self.set_name(buffer, name);
+        // SAFETY: `buffer` was just created from this device.
+        let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
+        let allocation = match self.allocate(
+            name,
+            requirements,
+            location,
+            true,
+            AllocationScheme::GpuAllocatorManaged,
+        ) {
+            Ok(allocation) => allocation,
+            Err(e) => {
+                // SAFETY: the buffer was created above, is unbound and unused.
+                unsafe { self.device.destroy_buffer(buffer, None) };
+                return Err(e);
+            }
+        };
+        // SAFETY: the allocation satisfies the buffer's requirements and the buffer is unbound.
+        let bound = unsafe {
+            self.device
+                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
+        }
+        .vk("vkBindBufferMemory");
+        if let Err(e) = bound {
+            // SAFETY: the buffer is unused; destroyed before its memory is freed.
+            unsafe { self.device.destroy_buffer(buffer, None) };
+            self.free_allocation(allocation, name);
+            return Err(e);
+        }
+        Ok(GpuBuffer {
+            buffer,
+            size,
+            name: name.to_string(),
+            allocation: Some(allocation),
+        })
+    }
+
+    /// Destroys a buffer and frees its memory. The GPU must be done with it.
+    pub fn destroy_buffer(&self, buffer: GpuBuffer) {
+        // SAFETY: the caller hands over ownership and guarantees the GPU no longer uses the
+        // buffer; it is destroyed before its memory is freed.
+        unsafe { self.device.destroy_buffer(buffer.buffer, None) };
+        if let Some(allocation) = buffer.allocation {
+            self.free_allocation(allocation, &buffer.name);
+        }
+    }
+
+    /// Creates a device-local buffer holding `data`, copied through a staging buffer.
+    /// `TRANSFER_DST` is added to `usage`. The copy is complete and visible to all later GPU work
+    /// when this returns.
+    pub fn upload_buffer<T: bytemuck::Pod>(
+        &self,
+        data: &[T],
+        usage: vk::BufferUsageFlags,
+        name: &str,
+    ) -> Result<GpuBuffer> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let size = bytes.len() as u64;
+        if size == 0 {
+            return Err(LucentError::InvalidInput(format!(
+                "upload '{name}' has no data (Vulkan buffers must not be empty)"
+            )));
+        }
+        let mut staging = self.create_buffer(
+            size,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+            &format!("{name} (staging)"),
+        )?;
+        match staging.mapped_mut() {
+            Some(mapped) => mapped.copy_from_slice(bytes),
+            None => {
+                self.destroy_buffer(staging);
+                return Err(LucentError::InvalidInput(format!(
+                    "staging memory for '{name}' is not host-visible"
+                )));
+            }
+        }
+        let buffer = match self.create_buffer(
+            size,
+            usage | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+            name,
+        ) {
+            Ok(buffer) => buffer,
+            Err(e) => {
+                self.destroy_buffer(staging);
+                return Err(e);
+            }
+        };
+        let copied = self.submit_and_wait(|cmd| {
+            self.begin_label(cmd, &format!("upload {name}"));
+            let region = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size,
+            };
+            // The copy's write must be visible to whatever reads the buffer later, in any stage
+            // of any later submission: a full barrier after it.
+            let barrier = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
+            // SAFETY: `cmd` is recording; both buffers are live, large enough for the region and
+            // were created with TRANSFER_SRC / TRANSFER_DST usage.
+            unsafe {
+                self.device
+                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().memory_barriers(&barrier),
+                );
+            }
+            self.end_label(cmd);
+        });
+        self.destroy_buffer(staging);
+        match copied {
+            Ok(()) => Ok(buffer),
+            Err(e) => {
+                self.destroy_buffer(buffer);
+                Err(e)
+            }
+        }
+    }
+
+    /// Copies a whole buffer to host memory. The buffer needs `TRANSFER_SRC` usage; all earlier
+    /// GPU writes to it are waited for.
+    pub fn read_buffer(&self, buffer: &GpuBuffer) -> Result<Vec<u8>> {
+        let readback = self.create_buffer(
+            buffer.size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+            &format!("{} (readback)", buffer.name),
+        )?;
+        let copied = self.submit_and_wait(|cmd| {
+            self.begin_label(cmd, &format!("read back {}", buffer.name));
+            // Earlier writes to the buffer (any stage, any earlier submission) before the copy.
+            let before = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)];
+            let region = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: buffer.size,
+            };
+            let after = [host_read_barrier(readback.buffer)];
+            // SAFETY: `cmd` is recording; both buffers are live and `buffer.size` bytes long.
+            unsafe {
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().memory_barriers(&before),
+                );
+                self.device
+                    .cmd_copy_buffer(cmd, buffer.buffer, readback.buffer, &[region]);
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().buffer_memory_barriers(&after),
+                );
+            }
+            self.end_label(cmd);
+        });
+        let bytes = copied.and_then(|()| {
+            readback.mapped_slice().map(<[u8]>::to_vec).ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "readback memory for '{}' is not host-visible",
+                    buffer.name
+                ))
+            })
+        });
+        self.destroy_buffer(readback);
+        bytes
+    }
+
+    /// Copies a colour (or single-aspect depth) image to host memory: rows tightly packed, raw
+    /// texel bytes in the image's format.
+    ///
+    /// `layout` is the image's current layout; the image is returned to it. All earlier GPU
+    /// writes to the image are waited for. The image needs `TRANSFER_SRC` usage and a format
+    /// known to [`format_texel_size`].
+    pub fn read_image(&self, image: &GpuImage, layout: vk::ImageLayout) -> Result<Vec<u8>> {
+        let desc = &image.desc;
+        if matches!(
+            layout,
+            vk::ImageLayout::UNDEFINED | vk::ImageLayout::PREINITIALIZED
+        ) {
+            return Err(LucentError::InvalidInput(format!(
+                "image '{}' is in layout {layout:?}: its contents are undefined",
+                image.name
+            )));
+        }
+        if !desc.usage.contains(vk::ImageUsageFlags::TRANSFER_SRC) {
+            return Err(LucentError::InvalidInput(format!(
+                "image '{}' cannot be read back: it lacks TRANSFER_SRC usage",
+                image.name
+            )));
+        }
+        if desc.aspect != vk::ImageAspectFlags::COLOR && desc.aspect != vk::ImageAspectFlags::DEPTH
+        {
+            return Err(LucentError::InvalidInput(format!(
+                "image '{}' cannot be read back: aspect {:?} is not COLOR or DEPTH alone",
+                image.name, desc.aspect
+            )));
+        }
+        let texel = format_texel_size(desc.format).ok_or_else(|| {
+            LucentError::InvalidInput(format!(
+                "image '{}' cannot be read back: format {:?} has no known texel size",
+                image.name, desc.format
+            ))
+        })?;
+        let size = u64::from(desc.width) * u64::from(desc.height) * u64::from(texel);
+        let readback = self.create_buffer(
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+            &format!("{} (readback)", image.name),
+        )?;
+        let range = desc.subresource_range();
+        let copied = self.submit_and_wait(|cmd| {
+            self.begin_label(cmd, &format!("read back {}", image.name));
+            // Wait for every earlier write to the image, whatever wrote it, then move it to
+            // TRANSFER_SRC_OPTIMAL (no transition if it is already there).
+            let to_src = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_READ)
+                .old_layout(layout)
+                .new_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(image.image)
+                .subresource_range(range)];
+            let region = vk::BufferImageCopy {
+                buffer_offset: 0,
+                buffer_row_length: 0,
+                buffer_image_height: 0,
+                image_subresource: vk::ImageSubresourceLayers {
+                    aspect_mask: desc.aspect,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                },
+                image_offset: vk::Offset3D::default(),
+                image_extent: desc.extent(),
+            };
+            // Back to the caller's layout. The copy only read the image, so an execution
+            // dependency suffices on the source side; the transition's writes must be visible to
+            // whatever comes next.
+            let back = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::NONE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
+                .old_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                .new_layout(layout)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(image.image)
+                .subresource_range(range)];
+            let to_host = [host_read_barrier(readback.buffer)];
+            // SAFETY: `cmd` is recording; the image is live, in `layout` (caller's contract) and
+            // has TRANSFER_SRC usage; the buffer holds exactly width * height texels.
+            unsafe {
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&to_src),
+                );
+                self.device.cmd_copy_image_to_buffer(
+                    cmd,
+                    image.image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    readback.buffer,
+                    &[region],
+                );
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default()
+                        .image_memory_barriers(&back)
+                        .buffer_memory_barriers(&to_host),
+                );
+            }
+            self.end_label(cmd);
+        });
+        let bytes = copied.and_then(|()| {
+            readback.mapped_slice().map(<[u8]>::to_vec).ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "readback memory for '{}' is not host-visible",
+                    image.name
+                ))
+            })
+        });
+        self.destroy_buffer(readback);
+        bytes
+    }
+
+    /// Creates an image without memory and returns it with its memory requirements, for binding
+    /// into a [`MemoryBlock`] with [`GpuContext::bind_image`]. Destroy it with
+    /// `device.destroy_image` (or through [`GpuImage::from_parts`] and
+    /// [`GpuContext::destroy_image`]).
+    pub fn create_image_unbound(
+        &self,
+        desc: &ImageDesc,
+        name: &str,
+    ) -> Result<(vk::Image, vk::MemoryRequirements)> {
+        if desc.width == 0 || desc.height == 0 {
+            return Err(LucentError::InvalidInput(format!(
+                "image '{name}' has zero size {}x{}",
+                desc.width, desc.height
+            )));
+        }
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(desc.extent())
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid create info (non-zero extent, one mip and layer); the caller owns the
+        // returned image.
+        let image = unsafe { self.device.create_image(&info, None) }.vk("vkCreateImage")?;
+        self.set_name(image, name);
+        // SAFETY: `image` was just created from this device.
+        let requirements = unsafe { self.device.get_image_memory_requirements(image) };
+        Ok((image, requirements))
+    }
+
+    /// Allocates a device-local block satisfying `requirements`, for several resources to share.
+    ///
+    /// For aliasing, pass the largest size (plus offsets), the largest alignment and the
+    /// intersection of the `memory_type_bits` of every resource that will live in the block.
+    /// Free it with [`GpuContext::free_memory_block`].
+    pub fn allocate_memory_block(
+        &self,
+        requirements: vk::MemoryRequirements,
+        name: &str,
+    ) -> Result<MemoryBlock> {
+        let allocation = self.allocate(
+            name,
+            requirements,
+            MemoryLocation::GpuOnly,
+            false,
+            AllocationScheme::GpuAllocatorManaged,
+        )?;
+        Ok(MemoryBlock {
+            allocation,
+            name: name.to_string(),
+            memory_type_bits: requirements.memory_type_bits,
+        })
+    }
+
+    /// Frees a block from [`GpuContext::allocate_memory_block`]. Every resource bound into it must
+    /// be destroyed first (or at least no longer used by the GPU).
+    pub fn free_memory_block(&self, block: MemoryBlock) {
+        self.free_allocation(block.allocation, &block.name);
+    }
+
+    /// Binds `image` at byte `offset` inside `block`. The offset must respect the image's
+    /// alignment, the image must fit in the block and accept one of the block's memory types;
+    /// all three are checked (the last only against the block's requested type bits).
+    pub fn bind_image(&self, image: vk::Image, block: &MemoryBlock, offset: u64) -> Result<()> {
+        // SAFETY: `image` is an image of this device (caller's contract).
+        let requirements = unsafe { self.device.get_image_memory_requirements(image) };
+        let alignment = requirements.alignment.max(1);
+        if !offset.is_multiple_of(alignment) {
+            return Err(LucentError::InvalidInput(format!(
+                "offset {offset} in memory block '{}' is not a multiple of the image's alignment {alignment}",
+                block.name
+            )));
+        }
+        if offset
+            .checked_add(requirements.size)
+            .is_none_or(|end| end > block.size())
+        {
+            return Err(LucentError::InvalidInput(format!(
+                "image of {} bytes at offset {offset} does not fit memory block '{}' of {} bytes",
+                requirements.size,
+                block.name,
+                block.size()
+            )));
+        }
+        if requirements.memory_type_bits & block.memory_type_bits == 0 {
+            return Err(LucentError::InvalidInput(format!(
+                "memory block '{}' (memory types {:#x}) cannot hold the image (memory types {:#x})",
+                block.name, block.memory_type_bits, requirements.memory_type_bits
+            )));
+        }
+        // SAFETY: offset and size were checked against the block and the image's alignment; the
+        // block's memory stays allocated while the image uses it (caller's contract).
+        unsafe {
+            self.device
+                .bind_image_memory(image, block.memory(), block.offset() + offset)
+        }
+        .vk("vkBindImageMemory")
+    }
+
+    /// Creates a 2D view of the whole of `image` with `desc`'s format and aspect.
+    pub fn create_view(
+        &self,
+        image: vk::Image,
+        desc: &ImageDesc,
+        name: &str,
+    ) -> Result<vk::ImageView> {
+        let info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(desc.format)
+            .subresource_range(desc.subresource_range());
+        // SAFETY: `image` is a live 2D image of this device created with `desc` and bound to
+        // memory (caller's contract).
+        let view = unsafe { self.device.create_image_view(&info, None) }.vk("vkCreateImageView")?;
+        self.set_name(view, name);
+        Ok(view)
+    }
+
+    /// Allocates named memory through gpu-allocator.
+    fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+        allocation_scheme: AllocationScheme,
+    ) -> Result<Allocation> {
+        self.allocator()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme,
+            })
+            .map_err(|source| LucentError::Allocation {
+                name: name.to_string(),
+                source,
+            })
+    }
+
+    /// Returns memory to gpu-allocator; a failure (double free) is logged, not fatal.
+    fn free_allocation(&self, allocation: Allocation, name: &str) {
+        if let Err(e) = self.allocator().free(allocation) {
+            log::error!("freeing GPU memory '{name}' failed: {e}");
+        }
+    }
+}
+
+/// Makes a transfer write to `buffer` available to host reads after the fence wait.
+fn host_read_barrier(buffer: vk::Buffer) -> vk::BufferMemoryBarrier2<'static> {
+    vk::BufferMemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(buffer)
+        .offset(0)
+        .size(vk::WHOLE_SIZE)
+}

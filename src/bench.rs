@@ -1,0 +1,447 @@
+//! The benchmark: per-pass GPU times that are proven to add up, and a statement of how they were
+//! taken.
+//!
+//! Two timing modes exist (DESIGN.md, "Facts measured": lavapipe's in-frame timestamps can lie):
+//! - **in-frame**: one command buffer per frame, a timestamp pair around each physical pass.
+//!   Cheap and realistic, but on lavapipe passes chained in one command buffer can report a
+//!   fraction of their cost.
+//! - **isolated**: each physical pass in its own submission with the device idle before it,
+//!   still timed with timestamps. True per-pass cost; it loses overlap between passes.
+//!
+//! The benchmark measures in-frame first and checks that the pass medians add up to the frame's
+//! wall time (submit to fence) within 10%, and with `--isolate` that each pass of 0.5 ms or
+//! more is within 20% of its isolated time. If a check fails it reports the isolated times
+//! instead and says so. If even those do not add up, the report is marked untrusted and the
+//! command exits non-zero.
+
+use serde::Serialize;
+
+use crate::backend::GpuContext;
+use crate::renderer::{FrameRunner, FrameTiming, Renderer};
+use crate::{LucentError, Result};
+
+/// Tolerance of the sum check: pass medians vs frame median.
+pub const SUM_TOLERANCE: f64 = 0.10;
+/// Tolerance of the isolation check, for passes of at least [`ISOLATION_MIN_MS`].
+pub const ISOLATION_TOLERANCE: f64 = 0.20;
+/// Passes shorter than this are too close to timer noise to compare with their isolated time.
+pub const ISOLATION_MIN_MS: f64 = 0.5;
+
+/// What to measure.
+#[derive(Clone, Copy, Debug)]
+pub struct BenchOptions {
+    /// Frames measured.
+    pub frames: usize,
+    /// Frames run first and discarded (lazy shader compilation, caches).
+    pub warmup: usize,
+    /// Also time every pass alone and compare.
+    pub isolate: bool,
+}
+
+/// Median, minimum and maximum of a sample.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct Stats {
+    /// Median.
+    pub median: f64,
+    /// Minimum.
+    pub min: f64,
+    /// Maximum.
+    pub max: f64,
+}
+
+impl Stats {
+    /// Statistics of a non-empty sample (NaNs sort last and never reach the median of a sane
+    /// sample; an empty sample gives zeros).
+    pub fn of(samples: &[f64]) -> Stats {
+        if samples.is_empty() {
+            return Stats {
+                median: 0.0,
+                min: 0.0,
+                max: 0.0,
+            };
+        }
+        let mut sorted = samples.to_vec();
+        sorted.sort_by(|a, b| a.total_cmp(b));
+        let n = sorted.len();
+        let median = if n % 2 == 1 {
+            sorted[n / 2]
+        } else {
+            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+        };
+        Stats {
+            median,
+            min: sorted[0],
+            max: sorted[n - 1],
+        }
+    }
+}
+
+/// One row of the table.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassRow {
+    /// Physical pass name ("a + b" for merged passes).
+    pub name: String,
+    /// Median milliseconds in the reported timing mode.
+    pub median_ms: f64,
+    /// Minimum.
+    pub min_ms: f64,
+    /// Maximum.
+    pub max_ms: f64,
+    /// Median when submitted alone (with `--isolate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub isolated_ms: Option<f64>,
+    /// Median in-frame (timestamps inside one command buffer).
+    pub in_frame_ms: f64,
+    /// Share of the frame's median wall time.
+    pub share: f64,
+}
+
+/// One verification of the timing.
+#[derive(Clone, Debug, Serialize)]
+pub struct Check {
+    /// What was checked.
+    pub name: String,
+    /// Whether it held.
+    pub passed: bool,
+    /// Numbers behind it.
+    pub detail: String,
+}
+
+/// Everything `lucent bench` prints.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// Device name and type.
+    pub device: String,
+    /// Driver name and version.
+    pub driver: String,
+    /// Scene name.
+    pub scene: String,
+    /// Technique name.
+    pub technique: String,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Frames measured.
+    pub frames: usize,
+    /// Warm-up frames discarded.
+    pub warmup: usize,
+    /// Which mode produced the pass numbers, and why.
+    pub timing_mode: String,
+    /// Per-pass rows.
+    pub passes: Vec<PassRow>,
+    /// Wall time of whole frames (submit to fence), in-frame mode.
+    pub frame_ms: Stats,
+    /// Sum of the reported pass medians.
+    pub pass_sum_ms: f64,
+    /// The checks made.
+    pub checks: Vec<Check>,
+    /// Whether the reported numbers passed their checks.
+    pub trusted: bool,
+}
+
+/// Runs the benchmark on a built renderer.
+pub fn run(
+    gpu: &GpuContext,
+    renderer: &Renderer,
+    scene_name: &str,
+    options: &BenchOptions,
+) -> Result<BenchReport> {
+    if options.frames == 0 {
+        return Err(LucentError::InvalidInput(
+            "--frames must be at least 1".into(),
+        ));
+    }
+    let exe = &renderer.executable;
+    let names: Vec<String> = exe.plan.physical.iter().map(|p| p.name.clone()).collect();
+    let mut runner = FrameRunner::new(gpu, names.len())?;
+    let result = measure(gpu, renderer, &mut runner, &names, scene_name, options);
+    runner.destroy(gpu);
+    result
+}
+
+fn collect(samples: &mut [Vec<f64>], timing: &FrameTiming, names: &[String]) -> Result<()> {
+    if timing.passes.len() != names.len() {
+        return Err(LucentError::Timing(format!(
+            "expected {} timestamp scopes, got {}",
+            names.len(),
+            timing.passes.len()
+        )));
+    }
+    for (sample, pass) in samples.iter_mut().zip(&timing.passes) {
+        sample.push(pass.ms);
+    }
+    Ok(())
+}
+
+fn measure(
+    gpu: &GpuContext,
+    renderer: &Renderer,
+    runner: &mut FrameRunner,
+    names: &[String],
+    scene_name: &str,
+    options: &BenchOptions,
+) -> Result<BenchReport> {
+    let exe = &renderer.executable;
+    for _ in 0..options.warmup {
+        runner.run_frame(gpu, exe)?;
+        if options.isolate {
+            runner.run_isolated(gpu, exe)?;
+        }
+    }
+    let mut frame_walls = Vec::with_capacity(options.frames);
+    let mut in_frame: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    let mut isolated: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    // Interleaved, so both modes see the same machine load.
+    for _ in 0..options.frames {
+        let t = runner.run_frame(gpu, exe)?;
+        frame_walls.push(t.wall_ms);
+        collect(&mut in_frame, &t, names)?;
+        if options.isolate {
+            collect(&mut isolated, &runner.run_isolated(gpu, exe)?, names)?;
+        }
+    }
+    let frame = Stats::of(&frame_walls);
+    let in_frame_stats: Vec<Stats> = in_frame.iter().map(|s| Stats::of(s)).collect();
+    let in_frame_sum: f64 = in_frame_stats.iter().map(|s| s.median).sum();
+    let mut checks = vec![sum_check(
+        "in-frame passes sum to frame",
+        in_frame_sum,
+        frame.median,
+    )];
+    if options.isolate {
+        checks.push(isolation_check(names, &in_frame_stats, &isolated));
+    }
+    let in_frame_ok = checks.iter().all(|c| c.passed);
+    if !in_frame_ok && !options.isolate {
+        // The in-frame numbers did not add up: measure the isolated ones to report instead.
+        for _ in 0..options.frames {
+            collect(&mut isolated, &runner.run_isolated(gpu, exe)?, names)?;
+        }
+    }
+    let isolated_stats: Option<Vec<Stats>> = (!isolated[0].is_empty() || names.is_empty())
+        .then(|| isolated.iter().map(|s| Stats::of(s)).collect());
+    let (timing_mode, reported, trusted) = if in_frame_ok {
+        let mode = format!(
+            "in-frame timestamps (verified: passes sum to {:.1}% of frame wall time{})",
+            100.0 * in_frame_sum / frame.median,
+            if options.isolate {
+                format!(
+                    "; every pass of {ISOLATION_MIN_MS} ms or more within {:.0}% of its isolated time",
+                    ISOLATION_TOLERANCE * 100.0
+                )
+            } else {
+                String::new()
+            }
+        );
+        (mode, in_frame_stats.clone(), true)
+    } else {
+        let iso = isolated_stats.clone().unwrap_or_default();
+        let iso_sum: f64 = iso.iter().map(|s| s.median).sum();
+        let check = sum_check("isolated passes sum to frame", iso_sum, frame.median);
+        let trusted = check.passed;
+        let failed: Vec<String> = checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.detail.clone())
+            .collect();
+        checks.push(check);
+        let mode = format!(
+            "isolated per-pass submissions, timestamps (in-frame timestamps rejected: {}){}",
+            failed.join("; "),
+            if trusted {
+                ""
+            } else {
+                " — UNTRUSTED: isolated passes do not add up to the frame either"
+            }
+        );
+        (mode, iso, trusted)
+    };
+    let passes: Vec<PassRow> = names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| PassRow {
+            name: name.clone(),
+            median_ms: reported[i].median,
+            min_ms: reported[i].min,
+            max_ms: reported[i].max,
+            isolated_ms: isolated_stats.as_ref().map(|s| s[i].median),
+            in_frame_ms: in_frame_stats[i].median,
+            share: if frame.median > 0.0 {
+                reported[i].median / frame.median
+            } else {
+                0.0
+            },
+        })
+        .collect();
+    Ok(BenchReport {
+        device: gpu.info.describe(),
+        driver: gpu.info.driver(),
+        scene: scene_name.to_string(),
+        technique: renderer.settings.technique.name().to_string(),
+        width: renderer.settings.width,
+        height: renderer.settings.height,
+        frames: options.frames,
+        warmup: options.warmup,
+        timing_mode,
+        pass_sum_ms: passes.iter().map(|p| p.median_ms).sum(),
+        passes,
+        frame_ms: frame,
+        checks,
+        trusted,
+    })
+}
+
+fn sum_check(name: &str, sum: f64, frame: f64) -> Check {
+    let ratio = if frame > 0.0 { sum / frame } else { 0.0 };
+    Check {
+        name: name.into(),
+        passed: (ratio - 1.0).abs() <= SUM_TOLERANCE,
+        detail: format!(
+            "sum of pass medians {sum:.3} ms is {:.1}% of frame median {frame:.3} ms (allowed {:.0}-{:.0}%)",
+            ratio * 100.0,
+            (1.0 - SUM_TOLERANCE) * 100.0,
+            (1.0 + SUM_TOLERANCE) * 100.0
+        ),
+    }
+}
+
+fn isolation_check(names: &[String], in_frame: &[Stats], isolated: &[Vec<f64>]) -> Check {
+    let mut worst = String::new();
+    let mut passed = true;
+    let mut worst_error = 0.0f64;
+    for (i, name) in names.iter().enumerate() {
+        let alone = Stats::of(&isolated[i]).median;
+        if alone < ISOLATION_MIN_MS {
+            continue;
+        }
+        let error = (in_frame[i].median - alone).abs() / alone;
+        if error > worst_error {
+            worst_error = error;
+            worst = format!(
+                "'{name}' {:.3} ms in-frame vs {alone:.3} ms alone ({:.0}% off)",
+                in_frame[i].median,
+                error * 100.0
+            );
+        }
+        if error > ISOLATION_TOLERANCE {
+            passed = false;
+        }
+    }
+    Check {
+        name: "in-frame passes match isolated".into(),
+        passed,
+        detail: if worst.is_empty() {
+            format!("no pass of {ISOLATION_MIN_MS} ms or more")
+        } else {
+            format!("largest difference: {worst}")
+        },
+    }
+}
+
+impl BenchReport {
+    /// The report as Markdown: a header with device and mode, the table, and the checks.
+    pub fn markdown(&self) -> String {
+        let mut out = format!(
+            "## lucent bench: scene `{}`, technique `{}`, {}x{}\n\n\
+             - device: {}\n- driver: {}\n- frames: {} measured after {} warm-up\n\
+             - timing mode: {}\n\n",
+            self.scene,
+            self.technique,
+            self.width,
+            self.height,
+            self.device,
+            self.driver,
+            self.frames,
+            self.warmup,
+            self.timing_mode
+        );
+        let isolated = self.passes.iter().any(|p| p.isolated_ms.is_some());
+        out.push_str("| pass | median ms | min ms | max ms | share of frame |");
+        out.push_str(if isolated { " isolated ms |\n" } else { "\n" });
+        out.push_str("|---|---:|---:|---:|---:|");
+        out.push_str(if isolated { "---:|\n" } else { "\n" });
+        for p in &self.passes {
+            out.push_str(&format!(
+                "| {} | {:.3} | {:.3} | {:.3} | {:.1}% |",
+                p.name,
+                p.median_ms,
+                p.min_ms,
+                p.max_ms,
+                p.share * 100.0
+            ));
+            if let Some(iso) = p.isolated_ms {
+                out.push_str(&format!(" {iso:.3} |"));
+            } else if isolated {
+                out.push_str(" |");
+            }
+            out.push('\n');
+        }
+        let sum_share = if self.frame_ms.median > 0.0 {
+            self.pass_sum_ms / self.frame_ms.median * 100.0
+        } else {
+            0.0
+        };
+        out.push_str(&format!(
+            "| **sum of passes** | {:.3} | | | {sum_share:.1}% |{}\n",
+            self.pass_sum_ms,
+            if isolated { " |" } else { "" }
+        ));
+        out.push_str(&format!(
+            "| **frame (submit to fence)** | {:.3} | {:.3} | {:.3} | 100.0% |{}\n\n",
+            self.frame_ms.median,
+            self.frame_ms.min,
+            self.frame_ms.max,
+            if isolated { " |" } else { "" }
+        ));
+        for c in &self.checks {
+            out.push_str(&format!(
+                "- check {}: {} ({})\n",
+                c.name,
+                if c.passed { "ok" } else { "FAILED" },
+                c.detail
+            ));
+        }
+        out
+    }
+
+    /// The report as JSON (the shape documented in the README; later fields only extend it).
+    pub fn json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_of_odd_and_even_samples() {
+        assert_eq!(Stats::of(&[3.0, 1.0, 2.0]).median, 2.0);
+        assert_eq!(Stats::of(&[4.0, 1.0, 2.0, 3.0]).median, 2.5);
+        let s = Stats::of(&[5.0, 1.0]);
+        assert_eq!((s.min, s.max), (1.0, 5.0));
+    }
+
+    #[test]
+    fn sum_check_bounds() {
+        assert!(sum_check("s", 9.5, 10.0).passed);
+        assert!(!sum_check("s", 8.0, 10.0).passed);
+        assert!(!sum_check("s", 11.5, 10.0).passed);
+    }
+
+    #[test]
+    fn isolation_check_ignores_short_passes_and_catches_lies() {
+        let names = vec!["blur".to_string(), "tiny".to_string()];
+        let stat = |m| Stats {
+            median: m,
+            min: m,
+            max: m,
+        };
+        // The lavapipe lie: 0.19 ms in-frame for a 9.6 ms blur.
+        let lying = isolation_check(&names, &[stat(0.19), stat(0.1)], &[vec![9.6], vec![0.3]]);
+        assert!(!lying.passed, "{}", lying.detail);
+        let honest = isolation_check(&names, &[stat(9.0), stat(0.01)], &[vec![9.6], vec![0.3]]);
+        assert!(honest.passed, "{}", honest.detail);
+    }
+}

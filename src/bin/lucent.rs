@@ -1,0 +1,329 @@
+//! The `lucent` command: list scenes, render headless, benchmark, print the compiled plan.
+//!
+//! Every failure ends with one line `lucent: error: ...` and a non-zero exit, never a panic.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+use lucent::backend::shader::{PipelineCache, ShaderCompiler};
+use lucent::backend::{ContextDesc, GpuContext};
+use lucent::bench::{self, BenchOptions};
+use lucent::graph::CompileOptions;
+use lucent::renderer::{plan_frame, FrameRunner, FrameSettings, Renderer, Technique};
+use lucent::{output, scene, LucentError, Result};
+
+#[derive(Parser)]
+#[command(
+    name = "lucent",
+    version,
+    about = "Real-time translucency and subsurface scattering on Vulkan, measured honestly"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the built-in scenes.
+    Scenes,
+    /// Render one frame headless and write it as PNG (and optionally EXR).
+    Render {
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        gpu: GpuArgs,
+        /// Output PNG (tonemapped, sRGB). Default: <scene>.png.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Also write the linear HDR frame as OpenEXR (RGBA float).
+        #[arg(long)]
+        exr: Option<PathBuf>,
+    },
+    /// Benchmark: per-pass GPU times, verified to add up, as a Markdown table.
+    Bench {
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        gpu: GpuArgs,
+        /// Frames measured.
+        #[arg(long, default_value_t = 30)]
+        frames: usize,
+        /// Frames run and discarded first (lazy shader compilation).
+        #[arg(long, default_value_t = 5)]
+        warmup: usize,
+        /// Also time each pass submitted alone and compare.
+        #[arg(long)]
+        isolate: bool,
+        /// Write the report as JSON too.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write the frame as PNG after the benchmark.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Print the compiled render graph: passes, merged groups, barriers, lifetimes, memory.
+    Plan {
+        #[command(flatten)]
+        frame: FrameArgs,
+    },
+}
+
+#[derive(Args, Clone)]
+struct FrameArgs {
+    /// Scene name (see `lucent scenes`).
+    #[arg(long, default_value = "smoke")]
+    scene: String,
+    /// Resolution as WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Technique the scene is lit with (`none`: plain deferred lighting).
+    #[arg(long, default_value = "none")]
+    technique: String,
+    /// Do not merge same-pixel passes into subpasses (A/B comparison).
+    #[arg(long)]
+    no_merge: bool,
+    /// Do not alias transient images' memory (A/B comparison).
+    #[arg(long)]
+    no_alias: bool,
+}
+
+#[derive(Args, Clone)]
+struct GpuArgs {
+    /// Pick the first device whose name contains this (case-insensitive).
+    #[arg(long)]
+    device: Option<String>,
+    /// Enable the Khronos validation layer with synchronization validation (also
+    /// LUCENT_VALIDATION=1); any validation error makes the command fail.
+    #[arg(long)]
+    validation: bool,
+}
+
+fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{text}' is not WIDTHxHEIGHT"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&v| (1..=16384).contains(&v))
+            .ok_or_else(|| format!("'{s}' is not a size between 1 and 16384"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+impl FrameArgs {
+    fn settings(&self, export_hdr: bool) -> Result<FrameSettings> {
+        Ok(FrameSettings {
+            width: self.size.0,
+            height: self.size.1,
+            technique: Technique::parse(&self.technique)?,
+            compile: CompileOptions {
+                merge: !self.no_merge,
+                alias: !self.no_alias,
+            },
+            export_hdr,
+        })
+    }
+}
+
+/// The GPU objects every GPU command needs, torn down in order.
+struct Session {
+    gpu: GpuContext,
+    shaders: ShaderCompiler,
+    pipeline_cache: PipelineCache,
+}
+
+impl Session {
+    fn new(args: &GpuArgs) -> Result<Self> {
+        let gpu = GpuContext::new(&ContextDesc::from_env(args.validation, args.device.clone()))?;
+        log::info!("device: {} ({})", gpu.info.describe(), gpu.info.driver());
+        let cache_dir = ShaderCompiler::default_cache_dir();
+        let shaders =
+            ShaderCompiler::new(ShaderCompiler::default_glsl_root(), Some(cache_dir.clone()))?;
+        // SAFETY: the physical device handle belongs to this instance.
+        let properties = unsafe {
+            gpu.instance
+                .get_physical_device_properties(gpu.physical_device)
+        };
+        let pipeline_cache = PipelineCache::load_for_device(
+            &gpu.device,
+            Some(cache_dir.join("pipelines.bin")),
+            &properties,
+        )?;
+        Ok(Self {
+            gpu,
+            shaders,
+            pipeline_cache,
+        })
+    }
+
+    /// Saves the pipeline cache and fails if validation reported errors.
+    fn finish(self) -> Result<()> {
+        if let Err(e) = self.pipeline_cache.save(&self.gpu.device) {
+            log::warn!("pipeline cache not saved: {e}");
+        }
+        let errors = self.gpu.validation_error_count();
+        self.pipeline_cache.destroy(&self.gpu.device);
+        if errors > 0 {
+            // The messages themselves went to the log as they arrived.
+            return Err(LucentError::InvalidInput(format!(
+                "the validation layer reported {errors} error(s)"
+            )));
+        }
+        Ok(())
+    }
+}
+
+fn render(
+    frame: &FrameArgs,
+    gpu_args: &GpuArgs,
+    out: Option<PathBuf>,
+    exr: Option<PathBuf>,
+) -> Result<()> {
+    let scene = scene::builtin(&frame.scene)?;
+    let settings = frame.settings(exr.is_some())?;
+    let session = Session::new(gpu_args)?;
+    let result = (|| {
+        let renderer = Renderer::new(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            &scene,
+            settings,
+        )?;
+        let written = (|| {
+            let mut runner =
+                FrameRunner::new(&session.gpu, renderer.executable.plan.physical.len())?;
+            let timing = runner.run_frame(&session.gpu, &renderer.executable);
+            runner.destroy(&session.gpu);
+            let timing = timing?;
+            let out = out.unwrap_or_else(|| PathBuf::from(format!("{}.png", frame.scene)));
+            let pixels = renderer.read_display(&session.gpu)?;
+            output::write_png_rgba8(&out, settings.width, settings.height, &pixels)?;
+            println!(
+                "wrote {} ({}x{}, frame {:.2} ms on {})",
+                out.display(),
+                settings.width,
+                settings.height,
+                timing.wall_ms,
+                session.gpu.info.describe()
+            );
+            if let Some(exr) = &exr {
+                let hdr = renderer.read_hdr(&session.gpu)?;
+                output::write_exr_rgba32f(exr, settings.width, settings.height, &hdr)?;
+                println!("wrote {}", exr.display());
+            }
+            Ok(())
+        })();
+        session.gpu.wait_idle()?;
+        renderer.destroy(&session.gpu);
+        written
+    })();
+    let finished = session.finish();
+    result.and(finished)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn bench_command(
+    frame: &FrameArgs,
+    gpu_args: &GpuArgs,
+    options: BenchOptions,
+    json: Option<PathBuf>,
+    out: Option<PathBuf>,
+) -> Result<()> {
+    let scene = scene::builtin(&frame.scene)?;
+    let settings = frame.settings(false)?;
+    let session = Session::new(gpu_args)?;
+    let result = (|| {
+        let renderer = Renderer::new(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            &scene,
+            settings,
+        )?;
+        let report = bench::run(&session.gpu, &renderer, &frame.scene, &options);
+        let written = report.and_then(|report| {
+            println!("{}", report.markdown());
+            if let Some(json) = &json {
+                output::write_file_atomic(json, report.json().as_bytes())?;
+                println!("wrote {}", json.display());
+            }
+            if let Some(out) = &out {
+                let pixels = renderer.read_display(&session.gpu)?;
+                output::write_png_rgba8(out, settings.width, settings.height, &pixels)?;
+                println!("wrote {}", out.display());
+            }
+            if report.trusted {
+                Ok(())
+            } else {
+                Err(LucentError::Timing(
+                    "the per-pass times could not be verified (see the checks above)".into(),
+                ))
+            }
+        });
+        session.gpu.wait_idle()?;
+        renderer.destroy(&session.gpu);
+        written
+    })();
+    let finished = session.finish();
+    result.and(finished)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Scenes => {
+            for (name, description) in scene::BUILTIN_SCENES {
+                println!("{name:<12} {description}");
+            }
+            Ok(())
+        }
+        Command::Render {
+            frame,
+            gpu,
+            out,
+            exr,
+        } => render(&frame, &gpu, out, exr),
+        Command::Bench {
+            frame,
+            gpu,
+            frames,
+            warmup,
+            isolate,
+            json,
+            out,
+        } => bench_command(
+            &frame,
+            &gpu,
+            BenchOptions {
+                frames,
+                warmup,
+                isolate,
+            },
+            json,
+            out,
+        ),
+        Command::Plan { frame } => {
+            scene::builtin(&frame.scene)?;
+            let plan = plan_frame(&frame.settings(false)?)?;
+            print!("{}", plan.dump());
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! The one error type of lucent.
+//!
+//! Every fallible function returns [`Result`]. Variants carry enough context to print a one-line
+//! reason a user can act on (which file, which pass, which missing feature, which package to
+//! install); nothing in the library panics on bad input or on a missing driver.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in lucent.
+#[derive(Debug, thiserror::Error)]
+pub enum LucentError {
+    /// The Vulkan loader library (libvulkan) could not be loaded at all.
+    #[error(
+        "Vulkan loader not found ({0}); install it: apt-get install libvulkan1 mesa-vulkan-drivers"
+    )]
+    NoVulkanLoader(String),
+    /// The loader works but no driver (ICD) offers a usable device.
+    #[error("no Vulkan driver found{0}; install one: apt-get install mesa-vulkan-drivers (lavapipe, CPU) or your GPU vendor's driver")]
+    NoVulkanDriver(String),
+    /// No physical device matched `--device SUBSTRING`.
+    #[error("no Vulkan device matches '{wanted}'; available: {available}")]
+    NoMatchingDevice { wanted: String, available: String },
+    /// The chosen device lacks something lucent needs.
+    #[error("device '{device}' lacks required feature: {feature}")]
+    MissingFeature { device: String, feature: String },
+    /// The validation layer was requested but is not installed.
+    #[error("Vulkan validation layer VK_LAYER_KHRONOS_validation not found; install it: apt-get install vulkan-validationlayers")]
+    NoValidationLayer,
+    /// A Vulkan call failed.
+    #[error("Vulkan call {call} failed: {result:?}")]
+    Vulkan {
+        call: &'static str,
+        result: ash::vk::Result,
+    },
+    /// GPU memory allocation failed.
+    #[error("GPU memory allocation '{name}' failed: {source}")]
+    Allocation {
+        name: String,
+        #[source]
+        source: gpu_allocator::AllocationError,
+    },
+    /// A shader failed to compile; `message` carries file:line diagnostics from shaderc.
+    #[error("shader {path} failed to compile:\n{message}")]
+    ShaderCompile { path: String, message: String },
+    /// The render graph is malformed (e.g. a pass reads a resource nothing wrote).
+    #[error("render graph: {0}")]
+    Graph(String),
+    /// A named scene or technique does not exist, or an option is out of range.
+    #[error("{0}")]
+    InvalidInput(String),
+    /// Timing could not be trusted (the benchmark refuses to print numbers it cannot prove).
+    #[error("timing: {0}")]
+    Timing(String),
+    /// Reading or writing a file failed.
+    #[error("{path}: {message}")]
+    File { path: PathBuf, message: String },
+}
+
+/// Result with [`LucentError`].
+pub type Result<T, E = LucentError> = std::result::Result<T, E>;
+
+/// Adds the name of the Vulkan call to an `ash` result: `unsafe { device.f(..) }.vk("vkF")?`.
+pub trait VkResultExt<T> {
+    /// Converts a `VkResult` into a lucent [`Result`] naming `call`.
+    fn vk(self, call: &'static str) -> Result<T>;
+}
+
+impl<T> VkResultExt<T> for std::result::Result<T, ash::vk::Result> {
+    fn vk(self, call: &'static str) -> Result<T> {
+        self.map_err(|result| LucentError::Vulkan { call, result })
+    }
+}
+
+impl LucentError {
+    /// A file error from an `std::io::Error` (or anything displayable), naming the path.
+    pub fn file(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
+        LucentError::File {
+            path: path.into(),
+            message: message.to_string(),
+        }
+    }
+}

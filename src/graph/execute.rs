@@ -1,0 +1,605 @@
+//! Executing a plan: physical images (with aliased memory), render passes and framebuffers, and
+//! recording into any command buffer the caller gives.
+//!
+//! Use [`Executable::record_frame`] for a whole frame in one command buffer, or
+//! [`Executable::record_physical`] once per physical pass when each pass must be submitted on
+//! its own (the benchmark's isolated timing mode), followed by [`Executable::record_exports`].
+
+use ash::vk;
+
+use crate::backend::access::Access;
+use crate::backend::shader::ShaderCompiler;
+use crate::backend::timer::GpuTimer;
+use crate::backend::{GpuContext, GpuImage, ImageDesc, MemoryBlock};
+use crate::error::VkResultExt;
+use crate::{LucentError, Result};
+
+use super::compile::{Barrier, Plan, RenderPassPlan};
+use super::declare::ResourceId;
+use super::PassExec;
+
+/// What a pass needs to create its pipelines.
+pub struct PrepareContext<'a> {
+    /// The context.
+    pub gpu: &'a GpuContext,
+    /// Shader compiler (with its SPIR-V cache).
+    pub shaders: &'a ShaderCompiler,
+    /// Pipeline cache to create pipelines with.
+    pub pipeline_cache: vk::PipelineCache,
+    /// The render pass of the pass's physical group (null for compute and transfer passes).
+    pub render_pass: vk::RenderPass,
+    /// The pass's subpass index in `render_pass`.
+    pub subpass: u32,
+    /// Number of colour attachments the subpass writes (for blend state counts).
+    pub color_attachment_count: u32,
+    /// Render area.
+    pub extent: vk::Extent2D,
+    /// Views of every graph image, by [`ResourceId`] (null for images without memory).
+    pub views: &'a [vk::ImageView],
+}
+
+/// What a pass needs to record itself.
+pub struct RecordContext<'a> {
+    /// The context.
+    pub gpu: &'a GpuContext,
+    /// The command buffer being recorded.
+    pub cmd: vk::CommandBuffer,
+    /// Render area.
+    pub extent: vk::Extent2D,
+    /// Images by [`ResourceId`].
+    pub images: &'a [vk::Image],
+    /// Views by [`ResourceId`].
+    pub views: &'a [vk::ImageView],
+}
+
+/// How a physical image came to be.
+enum Physical {
+    /// No surviving pass uses it: nothing was created.
+    None,
+    /// Its own allocation.
+    Owned(GpuImage),
+    /// Bound into a shared memory slot.
+    Aliased {
+        image: vk::Image,
+        view: vk::ImageView,
+    },
+    /// The host's.
+    Imported,
+}
+
+/// A plan made real on a device, ready to record every frame.
+pub struct Executable {
+    /// The plan being executed.
+    pub plan: Plan,
+    execs: Vec<Box<dyn PassExec>>,
+    physical: Vec<Physical>,
+    images: Vec<vk::Image>,
+    views: Vec<vk::ImageView>,
+    blocks: Vec<MemoryBlock>,
+    render_passes: Vec<vk::RenderPass>,
+    framebuffers: Vec<vk::Framebuffer>,
+}
+
+impl Executable {
+    /// Creates everything the plan needs and lets every pass prepare its pipelines.
+    /// Every surviving pass must have an executor.
+    pub fn new(
+        gpu: &GpuContext,
+        plan: Plan,
+        execs: Vec<Option<Box<dyn PassExec>>>,
+        shaders: &ShaderCompiler,
+        pipeline_cache: vk::PipelineCache,
+    ) -> Result<Self> {
+        let execs = execs
+            .into_iter()
+            .zip(&plan.passes)
+            .map(|(e, p)| {
+                e.ok_or_else(|| {
+                    LucentError::Graph(format!("pass '{}' has no code to execute", p.name))
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut exe = Executable {
+            physical: Vec::new(),
+            images: vec![vk::Image::null(); plan.resources.len()],
+            views: vec![vk::ImageView::null(); plan.resources.len()],
+            blocks: Vec::new(),
+            render_passes: Vec::new(),
+            framebuffers: Vec::new(),
+            execs: Vec::new(),
+            plan,
+        };
+        // On error, whatever was created so far is destroyed by `destroy` below.
+        match exe.create_resources(gpu) {
+            Ok(()) => {}
+            Err(e) => {
+                exe.destroy(gpu);
+                return Err(e);
+            }
+        }
+        exe.execs = execs;
+        if let Err(e) = exe.prepare_passes(gpu, shaders, pipeline_cache) {
+            exe.destroy(gpu);
+            return Err(e);
+        }
+        Ok(exe)
+    }
+
+    fn desc(&self, id: ResourceId) -> ImageDesc {
+        let r = &self.plan.resources[id];
+        ImageDesc {
+            width: r.info.width,
+            height: r.info.height,
+            format: r.info.format,
+            usage: r.usage,
+            aspect: r.info.aspect(),
+        }
+    }
+
+    fn create_resources(&mut self, gpu: &GpuContext) -> Result<()> {
+        let count = self.plan.resources.len();
+        for id in 0..count {
+            let r = &self.plan.resources[id];
+            let physical = if r.lifetime.is_none() {
+                Physical::None
+            } else if let Some(import) = r.import {
+                self.images[id] = import.image;
+                self.views[id] = import.view;
+                Physical::Imported
+            } else if r.slot.is_some() {
+                // Created now, bound below once each slot's block is allocated.
+                let (image, _) = gpu.create_image_unbound(&self.desc(id), &r.name)?;
+                self.images[id] = image;
+                Physical::Aliased {
+                    image,
+                    view: vk::ImageView::null(),
+                }
+            } else {
+                let image = gpu.create_image(&self.desc(id), &r.name)?;
+                self.images[id] = image.image;
+                self.views[id] = image.view;
+                Physical::Owned(image)
+            };
+            self.physical.push(physical);
+        }
+        for (s, slot) in self.plan.slots.clone().iter().enumerate() {
+            // One block serves every image of the slot: large enough for the largest, aligned
+            // for the strictest, of a memory type they all accept.
+            let mut requirements = vk::MemoryRequirements {
+                size: 0,
+                alignment: 1,
+                memory_type_bits: u32::MAX,
+            };
+            for &id in &slot.resources {
+                // SAFETY: the image was created above on this device and is not yet bound.
+                let req = unsafe { gpu.device.get_image_memory_requirements(self.images[id]) };
+                requirements.size = requirements.size.max(req.size);
+                requirements.alignment = requirements.alignment.max(req.alignment);
+                requirements.memory_type_bits &= req.memory_type_bits;
+            }
+            if requirements.memory_type_bits == 0 {
+                return Err(LucentError::Graph(format!(
+                    "memory slot {s}: its images share no memory type; compile with aliasing off"
+                )));
+            }
+            let block = gpu.allocate_memory_block(requirements, &format!("graph slot {s}"))?;
+            for &id in &slot.resources {
+                gpu.bind_image(self.images[id], &block, 0)?;
+                let view = gpu.create_view(
+                    self.images[id],
+                    &self.desc(id),
+                    &self.plan.resources[id].name,
+                )?;
+                self.views[id] = view;
+                if let Physical::Aliased { view: v, .. } = &mut self.physical[id] {
+                    *v = view;
+                }
+            }
+            self.blocks.push(block);
+        }
+        for phys in &self.plan.physical {
+            let (rp, fb) = match &phys.render_pass {
+                Some(plan) => {
+                    let rp = create_render_pass(gpu, plan, &phys.name)?;
+                    self.render_passes.push(rp);
+                    let fb =
+                        create_framebuffer(gpu, plan, rp, &self.views, phys.extent, &phys.name);
+                    match fb {
+                        Ok(fb) => (rp, fb),
+                        Err(e) => {
+                            self.framebuffers.push(vk::Framebuffer::null());
+                            return Err(e);
+                        }
+                    }
+                }
+                None => {
+                    self.render_passes.push(vk::RenderPass::null());
+                    (vk::RenderPass::null(), vk::Framebuffer::null())
+                }
+            };
+            let _ = rp;
+            self.framebuffers.push(fb);
+        }
+        Ok(())
+    }
+
+    fn prepare_passes(
+        &mut self,
+        gpu: &GpuContext,
+        shaders: &ShaderCompiler,
+        pipeline_cache: vk::PipelineCache,
+    ) -> Result<()> {
+        for (g, phys) in self.plan.physical.iter().enumerate() {
+            for (s, &p) in phys.passes.iter().enumerate() {
+                let color_attachment_count = phys
+                    .render_pass
+                    .as_ref()
+                    .map_or(0, |rp| rp.subpasses[s].colors.len() as u32);
+                let ctx = PrepareContext {
+                    gpu,
+                    shaders,
+                    pipeline_cache,
+                    render_pass: self.render_passes[g],
+                    subpass: s as u32,
+                    color_attachment_count,
+                    extent: extent(phys.extent),
+                    views: &self.views,
+                };
+                self.execs[p].prepare(&ctx).map_err(|e| match e {
+                    LucentError::Graph(m) => {
+                        LucentError::Graph(format!("pass '{}': {m}", self.plan.passes[p].name))
+                    }
+                    other => other,
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Records the whole frame: every physical pass (each under its debug label and, with a
+    /// timer, its timestamp pair) and the final transitions to export states.
+    pub fn record_frame(
+        &self,
+        gpu: &GpuContext,
+        cmd: vk::CommandBuffer,
+        mut timer: Option<&mut GpuTimer>,
+    ) {
+        for index in 0..self.plan.physical.len() {
+            self.record_physical(gpu, cmd, index, timer.as_deref_mut());
+        }
+        self.record_exports(gpu, cmd);
+    }
+
+    /// Records one physical pass with the barriers before it. The timestamp pair encloses the
+    /// barriers too, so the per-pass times add up to the frame.
+    pub fn record_physical(
+        &self,
+        gpu: &GpuContext,
+        cmd: vk::CommandBuffer,
+        index: usize,
+        timer: Option<&mut GpuTimer>,
+    ) {
+        let phys = &self.plan.physical[index];
+        gpu.begin_label(cmd, &phys.name);
+        let scope = timer.map(|t| {
+            let s = t.begin(gpu, cmd, &phys.name);
+            (t, s)
+        });
+        self.record_barriers(gpu, cmd, &phys.barriers);
+        let area = extent(phys.extent);
+        let record_ctx = RecordContext {
+            gpu,
+            cmd,
+            extent: area,
+            images: &self.images,
+            views: &self.views,
+        };
+        match &phys.render_pass {
+            Some(rp) => {
+                let clears: Vec<vk::ClearValue> = rp
+                    .attachments
+                    .iter()
+                    .map(|a| {
+                        if crate::backend::access::is_depth_format(a.format) {
+                            vk::ClearValue {
+                                depth_stencil: vk::ClearDepthStencilValue {
+                                    depth: a.clear[0],
+                                    stencil: 0,
+                                },
+                            }
+                        } else {
+                            vk::ClearValue {
+                                color: vk::ClearColorValue { float32: a.clear },
+                            }
+                        }
+                    })
+                    .collect();
+                let begin = vk::RenderPassBeginInfo::default()
+                    .render_pass(self.render_passes[index])
+                    .framebuffer(self.framebuffers[index])
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent: area,
+                    })
+                    .clear_values(&clears);
+                let subpass_begin =
+                    vk::SubpassBeginInfo::default().contents(vk::SubpassContents::INLINE);
+                let subpass_end = vk::SubpassEndInfo::default();
+                // SAFETY: the render pass, framebuffer and command buffer are valid; the command
+                // buffer is in the recording state (caller's contract).
+                unsafe {
+                    gpu.device
+                        .cmd_begin_render_pass2(cmd, &begin, &subpass_begin)
+                };
+                for (s, &p) in phys.passes.iter().enumerate() {
+                    if s > 0 {
+                        // SAFETY: as above; the render pass has this many subpasses.
+                        unsafe {
+                            gpu.device
+                                .cmd_next_subpass2(cmd, &subpass_begin, &subpass_end)
+                        };
+                    }
+                    set_full_viewport(gpu, cmd, area);
+                    gpu.begin_label(cmd, &self.plan.passes[p].name);
+                    self.execs[p].record(&record_ctx);
+                    gpu.end_label(cmd);
+                }
+                // SAFETY: matches the begin above.
+                unsafe { gpu.device.cmd_end_render_pass2(cmd, &subpass_end) };
+            }
+            None => {
+                for &p in &phys.passes {
+                    self.execs[p].record(&record_ctx);
+                }
+            }
+        }
+        if let Some((t, s)) = scope {
+            t.end(gpu, cmd, s);
+        }
+        gpu.end_label(cmd);
+    }
+
+    /// Records the transitions that leave exported images in their promised states.
+    pub fn record_exports(&self, gpu: &GpuContext, cmd: vk::CommandBuffer) {
+        self.record_barriers(gpu, cmd, &self.plan.export_barriers);
+    }
+
+    fn record_barriers(&self, gpu: &GpuContext, cmd: vk::CommandBuffer, barriers: &[Barrier]) {
+        if barriers.is_empty() {
+            return;
+        }
+        let image_barriers: Vec<vk::ImageMemoryBarrier2> = barriers
+            .iter()
+            .map(|b| {
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(b.src_stage)
+                    .src_access_mask(b.src_access)
+                    .dst_stage_mask(b.dst_stage)
+                    .dst_access_mask(b.dst_access)
+                    .old_layout(b.old_layout)
+                    .new_layout(b.new_layout)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .image(self.images[b.resource])
+                    .subresource_range(vk::ImageSubresourceRange {
+                        aspect_mask: self.plan.resources[b.resource].info.aspect(),
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
+            })
+            .collect();
+        let dependency = vk::DependencyInfo::default().image_memory_barriers(&image_barriers);
+        // SAFETY: every image exists (barriers only name images with a lifetime).
+        unsafe { gpu.device.cmd_pipeline_barrier2(cmd, &dependency) };
+    }
+
+    /// The physical image of a resource (null if it has no memory).
+    pub fn image(&self, id: ResourceId) -> vk::Image {
+        self.images[id]
+    }
+
+    /// The owned image of an exported resource (for readback).
+    pub fn owned_image(&self, id: ResourceId) -> Option<&GpuImage> {
+        match self.physical.get(id) {
+            Some(Physical::Owned(image)) => Some(image),
+            _ => None,
+        }
+    }
+
+    /// The layout an exported resource is left in at the end of the frame.
+    pub fn export_layout(&self, id: ResourceId) -> Option<vk::ImageLayout> {
+        self.plan.resources[id]
+            .export
+            .map(|a: Access| a.info().layout)
+    }
+
+    /// Destroys everything this executable created (the host's imported images are untouched).
+    /// The caller makes sure the GPU no longer uses them.
+    pub fn destroy(mut self, gpu: &GpuContext) {
+        self.destroy_in_place(gpu);
+    }
+
+    fn destroy_in_place(&mut self, gpu: &GpuContext) {
+        for exec in &mut self.execs {
+            exec.destroy(gpu);
+        }
+        self.execs.clear();
+        // SAFETY: created by this executable on this device; the caller guarantees idle.
+        unsafe {
+            for fb in self.framebuffers.drain(..) {
+                if fb != vk::Framebuffer::null() {
+                    gpu.device.destroy_framebuffer(fb, None);
+                }
+            }
+            for rp in self.render_passes.drain(..) {
+                if rp != vk::RenderPass::null() {
+                    gpu.device.destroy_render_pass(rp, None);
+                }
+            }
+        }
+        for physical in self.physical.drain(..) {
+            match physical {
+                Physical::Owned(image) => gpu.destroy_image(image),
+                Physical::Aliased { image, view } => {
+                    // SAFETY: as above.
+                    unsafe {
+                        if view != vk::ImageView::null() {
+                            gpu.device.destroy_image_view(view, None);
+                        }
+                        gpu.device.destroy_image(image, None);
+                    }
+                }
+                Physical::None | Physical::Imported => {}
+            }
+        }
+        for block in self.blocks.drain(..) {
+            gpu.free_memory_block(block);
+        }
+    }
+}
+
+fn extent((width, height): (u32, u32)) -> vk::Extent2D {
+    vk::Extent2D { width, height }
+}
+
+fn set_full_viewport(gpu: &GpuContext, cmd: vk::CommandBuffer, area: vk::Extent2D) {
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: area.width as f32,
+        height: area.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent: area,
+    };
+    // SAFETY: every lucent pipeline declares viewport and scissor as dynamic state.
+    unsafe {
+        gpu.device.cmd_set_viewport(cmd, 0, &[viewport]);
+        gpu.device.cmd_set_scissor(cmd, 0, &[scissor]);
+    }
+}
+
+fn create_render_pass(
+    gpu: &GpuContext,
+    plan: &RenderPassPlan,
+    name: &str,
+) -> Result<vk::RenderPass> {
+    let attachments: Vec<vk::AttachmentDescription2> = plan
+        .attachments
+        .iter()
+        .map(|a| {
+            vk::AttachmentDescription2::default()
+                .format(a.format)
+                .samples(vk::SampleCountFlags::TYPE_1)
+                .load_op(a.load)
+                .store_op(a.store)
+                .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+                .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+                .initial_layout(a.initial_layout)
+                .final_layout(a.final_layout)
+        })
+        .collect();
+    let aspect_of = |a: usize| {
+        if crate::backend::access::is_depth_format(plan.attachments[a].format) {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            vk::ImageAspectFlags::COLOR
+        }
+    };
+    let reference = |&(a, layout): &(usize, vk::ImageLayout)| {
+        vk::AttachmentReference2::default()
+            .attachment(a as u32)
+            .layout(layout)
+            .aspect_mask(aspect_of(a))
+    };
+    let colors: Vec<Vec<vk::AttachmentReference2>> = plan
+        .subpasses
+        .iter()
+        .map(|s| s.colors.iter().map(reference).collect())
+        .collect();
+    let inputs: Vec<Vec<vk::AttachmentReference2>> = plan
+        .subpasses
+        .iter()
+        .map(|s| s.inputs.iter().map(reference).collect())
+        .collect();
+    let depths: Vec<Option<vk::AttachmentReference2>> = plan
+        .subpasses
+        .iter()
+        .map(|s| s.depth.as_ref().map(reference))
+        .collect();
+    let subpasses: Vec<vk::SubpassDescription2> = (0..plan.subpasses.len())
+        .map(|i| {
+            let mut d = vk::SubpassDescription2::default()
+                .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+                .color_attachments(&colors[i])
+                .input_attachments(&inputs[i]);
+            if let Some(depth) = &depths[i] {
+                d = d.depth_stencil_attachment(depth);
+            }
+            d
+        })
+        .collect();
+    // Synchronization2 lets each dependency carry 64-bit masks in a chained VkMemoryBarrier2.
+    let mut barriers: Vec<vk::MemoryBarrier2> = plan
+        .dependencies
+        .iter()
+        .map(|d| {
+            vk::MemoryBarrier2::default()
+                .src_stage_mask(d.src_stage)
+                .src_access_mask(d.src_access)
+                .dst_stage_mask(d.dst_stage)
+                .dst_access_mask(d.dst_access)
+        })
+        .collect();
+    let dependencies: Vec<vk::SubpassDependency2> = plan
+        .dependencies
+        .iter()
+        .zip(barriers.iter_mut())
+        .map(|(d, barrier)| {
+            vk::SubpassDependency2::default()
+                .src_subpass(d.src)
+                .dst_subpass(d.dst)
+                .dependency_flags(if d.by_region {
+                    vk::DependencyFlags::BY_REGION
+                } else {
+                    vk::DependencyFlags::empty()
+                })
+                .push_next(barrier)
+        })
+        .collect();
+    let info = vk::RenderPassCreateInfo2::default()
+        .attachments(&attachments)
+        .subpasses(&subpasses)
+        .dependencies(&dependencies);
+    // SAFETY: all arrays referenced by `info` live until the call returns.
+    let rp = unsafe { gpu.device.create_render_pass2(&info, None) }.vk("vkCreateRenderPass2")?;
+    gpu.set_name(rp, name);
+    Ok(rp)
+}
+
+fn create_framebuffer(
+    gpu: &GpuContext,
+    plan: &RenderPassPlan,
+    render_pass: vk::RenderPass,
+    views: &[vk::ImageView],
+    (width, height): (u32, u32),
+    name: &str,
+) -> Result<vk::Framebuffer> {
+    let attachments: Vec<vk::ImageView> =
+        plan.attachments.iter().map(|a| views[a.resource]).collect();
+    let info = vk::FramebufferCreateInfo::default()
+        .render_pass(render_pass)
+        .attachments(&attachments)
+        .width(width)
+        .height(height)
+        .layers(1);
+    // SAFETY: the views exist and match the render pass's attachments.
+    let fb = unsafe { gpu.device.create_framebuffer(&info, None) }.vk("vkCreateFramebuffer")?;
+    gpu.set_name(fb, name);
+    Ok(fb)
+}

@@ -1,0 +1,39 @@
+//! The render graph: declare → compile → execute. It knows nothing about techniques.
+//!
+//! - [`declare`]: a frame's resources and passes, with versioned handles (`&Handle` reads,
+//!   `&mut Handle` writes).
+//! - [`compile`]: turns the declaration into a [`Plan`], plain data: culling, ordering, merging
+//!   into subpasses, aliasing, barriers. No GPU needed, so it is unit-tested on the CPU.
+//! - [`dump`]: the plan as text (`lucent plan`).
+//! - [`execute`]: creates the physical images, render passes and framebuffers of a plan, and
+//!   records it into any command buffer the caller gives, with one debug label and one timestamp
+//!   pair per physical pass under the same name.
+//!
+//! A technique implements [`PassExec`] for each of its passes: `prepare` creates pipelines once
+//! the render pass and subpass are known, `record` draws.
+
+pub mod compile;
+pub mod declare;
+pub mod dump;
+pub mod execute;
+
+pub use compile::{CompileOptions, Plan};
+pub use declare::{
+    Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, PingPong, RenderGraph, ResourceId,
+};
+pub use execute::{Executable, PrepareContext, RecordContext};
+
+use crate::backend::GpuContext;
+use crate::Result;
+
+/// The code behind one pass.
+pub trait PassExec {
+    /// Creates pipelines and descriptor sets, once the plan placed the pass (render pass and
+    /// subpass for raster passes) and the physical images exist.
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()>;
+    /// Records the pass. The executor has already begun the render pass / subpass and set the
+    /// viewport and scissor to the full extent (pipelines use dynamic viewport and scissor).
+    fn record(&self, ctx: &RecordContext<'_>);
+    /// Destroys what `prepare` created.
+    fn destroy(&mut self, gpu: &GpuContext);
+}

@@ -1,0 +1,25 @@
+//! lucent: real-time translucency and subsurface scattering on Vulkan, measured honestly.
+//!
+//! Layers (dependencies point one way, down this list):
+//! - [`passes`]: the techniques, each a struct that adds its passes to a graph.
+//! - [`graph`]: the render graph: declare passes and resources, compile to a plan, execute
+//!   into any command buffer. Knows nothing about techniques.
+//! - [`backend`]: a thin layer over `ash`: context (own or wrapped), memory, images, the one
+//!   access table, debug labels, GPU timer, shader compilation.
+//!
+//! Beside them: [`scene`] (what is drawn), [`reference`] (CPU f64 versions of every shading
+//! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
+//! comparison), [`bench`] (the benchmark and its honest timing modes).
+
+pub mod backend;
+pub mod bench;
+pub mod compare;
+pub mod error;
+pub mod graph;
+pub mod output;
+pub mod passes;
+pub mod reference;
+pub mod renderer;
+pub mod scene;
+
+pub use error::{LucentError, Result};

@@ -1,0 +1,359 @@
+//! Small helpers every pass uses to build its pipeline and descriptor set: one level over ash.
+
+use ash::vk;
+
+use crate::backend::shader::create_shader_module;
+use crate::error::VkResultExt;
+use crate::graph::PrepareContext;
+use crate::Result;
+
+/// What one descriptor binding points at.
+pub enum Binding {
+    /// A uniform buffer (whole range).
+    Uniform(vk::Buffer),
+    /// An input attachment (same-pixel read) in the given layout.
+    InputAttachment(vk::ImageView, vk::ImageLayout),
+    /// A combined image sampler in SHADER_READ_ONLY_OPTIMAL.
+    Sampled(vk::ImageView, vk::Sampler),
+}
+
+/// A descriptor set with its own pool and layout (passes have one set each).
+pub struct DescriptorSet {
+    /// Layout, for the pipeline layout.
+    pub layout: vk::DescriptorSetLayout,
+    /// The set, to bind.
+    pub set: vk::DescriptorSet,
+    pool: vk::DescriptorPool,
+}
+
+impl DescriptorSet {
+    /// Creates and writes a set; binding `i` of the set is `bindings[i]`, visible to `stages`.
+    pub fn new(
+        ctx: &PrepareContext<'_>,
+        bindings: &[Binding],
+        stages: vk::ShaderStageFlags,
+        name: &str,
+    ) -> Result<Self> {
+        let device = &ctx.gpu.device;
+        let kind = |b: &Binding| match b {
+            Binding::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::InputAttachment(..) => vk::DescriptorType::INPUT_ATTACHMENT,
+            Binding::Sampled(..) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        };
+        let layout_bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let stage = if matches!(b, Binding::InputAttachment(..)) {
+                    vk::ShaderStageFlags::FRAGMENT
+                } else {
+                    stages
+                };
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(kind(b))
+                    .descriptor_count(1)
+                    .stage_flags(stage)
+            })
+            .collect();
+        // SAFETY: valid device; arrays outlive each call.
+        let layout = unsafe {
+            device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings),
+                None,
+            )
+        }
+        .vk("vkCreateDescriptorSetLayout")?;
+        let sizes: Vec<vk::DescriptorPoolSize> = bindings
+            .iter()
+            .map(|b| vk::DescriptorPoolSize {
+                ty: kind(b),
+                descriptor_count: 1,
+            })
+            .collect();
+        // SAFETY: as above.
+        let pool = unsafe {
+            device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .vk("vkCreateDescriptorPool");
+        let pool = match pool {
+            Ok(p) => p,
+            Err(e) => {
+                // SAFETY: created above, unused.
+                unsafe { device.destroy_descriptor_set_layout(layout, None) };
+                return Err(e);
+            }
+        };
+        let layouts = [layout];
+        // SAFETY: the pool has room for exactly this set.
+        let set = unsafe {
+            device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .vk("vkAllocateDescriptorSets")?[0];
+        ctx.gpu.set_name(set, name);
+        let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
+            .iter()
+            .map(|b| match b {
+                Binding::Uniform(buffer) => [vk::DescriptorBufferInfo {
+                    buffer: *buffer,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }],
+                _ => [vk::DescriptorBufferInfo::default()],
+            })
+            .collect();
+        let image_infos: Vec<[vk::DescriptorImageInfo; 1]> = bindings
+            .iter()
+            .map(|b| match b {
+                Binding::InputAttachment(view, layout) => [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: *view,
+                    image_layout: *layout,
+                }],
+                Binding::Sampled(view, sampler) => [vk::DescriptorImageInfo {
+                    sampler: *sampler,
+                    image_view: *view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }],
+                Binding::Uniform(_) => [vk::DescriptorImageInfo::default()],
+            })
+            .collect();
+        let writes: Vec<vk::WriteDescriptorSet> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let w = vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(kind(b));
+                match b {
+                    Binding::Uniform(_) => w.buffer_info(&buffer_infos[i]),
+                    _ => w.image_info(&image_infos[i]),
+                }
+            })
+            .collect();
+        // SAFETY: every write names a live set, buffer, view and sampler.
+        unsafe { device.update_descriptor_sets(&writes, &[]) };
+        Ok(Self { layout, set, pool })
+    }
+
+    /// Destroys the pool (and with it the set) and the layout.
+    pub fn destroy(&mut self, device: &ash::Device) {
+        // SAFETY: created by `new` on this device; the caller guarantees the GPU is done.
+        unsafe {
+            device.destroy_descriptor_pool(self.pool, None);
+            device.destroy_descriptor_set_layout(self.layout, None);
+        }
+        self.pool = vk::DescriptorPool::null();
+        self.layout = vk::DescriptorSetLayout::null();
+    }
+}
+
+/// Vertex input of a graphics pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexInput {
+    /// No vertex buffer (fullscreen triangle from `gl_VertexIndex`).
+    None,
+    /// Interleaved position + normal ([`crate::scene::mesh::Vertex`]).
+    PositionNormal,
+}
+
+/// Everything that differs between lucent's graphics pipelines.
+pub struct GraphicsPipelineDesc<'a> {
+    /// Vertex shader path under glsl/.
+    pub vertex: &'a str,
+    /// Fragment shader path under glsl/.
+    pub fragment: &'a str,
+    /// Macro definitions for both stages.
+    pub defines: &'a [(&'a str, &'a str)],
+    /// Vertex buffer layout.
+    pub vertex_input: VertexInput,
+    /// Depth test and write (less).
+    pub depth_test: bool,
+    /// Cull back faces (closed meshes).
+    pub cull_back: bool,
+    /// Descriptor set layouts (set 0, 1, ...).
+    pub set_layouts: &'a [vk::DescriptorSetLayout],
+    /// Push constant bytes visible to vertex and fragment stages.
+    pub push_constant_bytes: u32,
+    /// Name for debug tools.
+    pub name: &'a str,
+}
+
+/// A graphics pipeline and its layout.
+pub struct GraphicsPipeline {
+    /// The pipeline.
+    pub pipeline: vk::Pipeline,
+    /// Its layout.
+    pub layout: vk::PipelineLayout,
+}
+
+impl GraphicsPipeline {
+    /// Compiles the shaders and creates the pipeline for the pass's render pass and subpass.
+    /// Viewport and scissor are dynamic (the executor sets them).
+    pub fn new(ctx: &PrepareContext<'_>, desc: &GraphicsPipelineDesc<'_>) -> Result<Self> {
+        let device = &ctx.gpu.device;
+        let vert = ctx.shaders.compile(desc.vertex, desc.defines)?;
+        let frag = ctx.shaders.compile(desc.fragment, desc.defines)?;
+        let vert_module = create_shader_module(device, &vert.spirv)?;
+        let frag_module = match create_shader_module(device, &frag.spirv) {
+            Ok(m) => m,
+            Err(e) => {
+                // SAFETY: created above, unused.
+                unsafe { device.destroy_shader_module(vert_module, None) };
+                return Err(e);
+            }
+        };
+        let result = Self::create(ctx, desc, vert_module, frag_module);
+        // SAFETY: modules are only needed during pipeline creation.
+        unsafe {
+            device.destroy_shader_module(vert_module, None);
+            device.destroy_shader_module(frag_module, None);
+        }
+        result
+    }
+
+    fn create(
+        ctx: &PrepareContext<'_>,
+        desc: &GraphicsPipelineDesc<'_>,
+        vert: vk::ShaderModule,
+        frag: vk::ShaderModule,
+    ) -> Result<Self> {
+        let device = &ctx.gpu.device;
+        let push_ranges = [vk::PushConstantRange {
+            stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            offset: 0,
+            size: desc.push_constant_bytes,
+        }];
+        let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(desc.set_layouts);
+        if desc.push_constant_bytes > 0 {
+            layout_info = layout_info.push_constant_ranges(&push_ranges);
+        }
+        // SAFETY: valid device and set layouts.
+        let layout = unsafe { device.create_pipeline_layout(&layout_info, None) }
+            .vk("vkCreatePipelineLayout")?;
+        let entry = c"main";
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vert)
+                .name(entry),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(frag)
+                .name(entry),
+        ];
+        let vertex_bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let vertex_attributes = [
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 12,
+            },
+        ];
+        let vertex_input = match desc.vertex_input {
+            VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
+            VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vertex_bindings)
+                .vertex_attribute_descriptions(&vertex_attributes),
+        };
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(if desc.cull_back {
+                vk::CullModeFlags::BACK
+            } else {
+                vk::CullModeFlags::NONE
+            })
+            // Meshes are counter-clockwise seen from outside. The projection flips y
+            // (scene::Camera::projection) and Vulkan's framebuffer y points down: the two flips
+            // cancel, so front faces stay counter-clockwise.
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth_test)
+            .depth_write_enable(desc.depth_test)
+            .depth_compare_op(vk::CompareOp::LESS);
+        let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = (0..ctx
+            .color_attachment_count)
+            .map(|_| {
+                vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            })
+            .collect();
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .render_pass(ctx.render_pass)
+            .subpass(ctx.subpass);
+        // SAFETY: every referenced struct lives until the call returns.
+        let pipelines =
+            unsafe { device.create_graphics_pipelines(ctx.pipeline_cache, &[info], None) };
+        match pipelines {
+            Ok(p) => {
+                ctx.gpu.set_name(p[0], desc.name);
+                Ok(Self {
+                    pipeline: p[0],
+                    layout,
+                })
+            }
+            Err((_, e)) => {
+                // SAFETY: created above, unused.
+                unsafe { device.destroy_pipeline_layout(layout, None) };
+                Err(crate::LucentError::Vulkan {
+                    call: "vkCreateGraphicsPipelines",
+                    result: e,
+                })
+            }
+        }
+    }
+
+    /// Destroys the pipeline and its layout.
+    pub fn destroy(&mut self, device: &ash::Device) {
+        // SAFETY: created by `new`; the caller guarantees the GPU is done.
+        unsafe {
+            device.destroy_pipeline(self.pipeline, None);
+            device.destroy_pipeline_layout(self.layout, None);
+        }
+        self.pipeline = vk::Pipeline::null();
+        self.layout = vk::PipelineLayout::null();
+    }
+}

@@ -1,0 +1,456 @@
+//! Turning a scene and a technique into a compiled frame, and running frames.
+//!
+//! [`declare_frame`] is the one place that decides which passes a frame has; `lucent plan` calls
+//! it without a GPU, [`Renderer`] with one. [`FrameRunner`] submits frames either as one command
+//! buffer (in-frame timestamps) or one submission per physical pass (isolated timing).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use ash::vk;
+
+use crate::backend::access::Access;
+use crate::backend::shader::{PipelineCache, ShaderCompiler};
+use crate::backend::timer::{GpuTimer, ScopeTime};
+use crate::backend::{GpuBuffer, GpuContext};
+use crate::error::VkResultExt;
+use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
+use crate::passes::{deferred, tonemap, SceneGpu};
+use crate::scene::{Light, Scene, MAX_LIGHTS};
+use crate::{LucentError, Result};
+
+/// Which technique lights the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// Plain deferred lighting (no translucency, no SSS).
+    None,
+}
+
+impl Technique {
+    /// Every technique with its command-line name.
+    pub const ALL: &'static [(&'static str, Technique)] = &[("none", Technique::None)];
+
+    /// Parses a command-line name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, t)| t)
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "unknown technique '{name}'; available: {}",
+                    Self::ALL
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })
+    }
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, t)| *t == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+/// How a frame is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameSettings {
+    /// Output width.
+    pub width: u32,
+    /// Output height.
+    pub height: u32,
+    /// Technique.
+    pub technique: Technique,
+    /// Graph compiler switches.
+    pub compile: CompileOptions,
+    /// Also export the linear HDR image (for EXR output); otherwise it stays transient.
+    pub export_hdr: bool,
+}
+
+impl FrameSettings {
+    /// Defaults for a size: technique none, merging and aliasing on, no HDR export.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            technique: Technique::None,
+            compile: CompileOptions::default(),
+            export_hdr: false,
+        }
+    }
+}
+
+/// The images a frame hands out.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOutputs {
+    /// Display image (RGBA8, sRGB-encoded), left in TRANSFER_SRC layout.
+    pub display: ResourceId,
+    /// Linear HDR image (RGBA16F), when exported.
+    pub hdr: Option<ResourceId>,
+}
+
+/// Declares every pass of a frame. `scene_gpu` is `None` for plan-only graphs.
+pub fn declare_frame(
+    graph: &mut RenderGraph,
+    settings: &FrameSettings,
+    scene_gpu: Option<&Arc<SceneGpu>>,
+) -> FrameOutputs {
+    let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, scene_gpu);
+    let hdr = deferred::lighting_pass(graph, &gb, scene_gpu);
+    let display = tonemap::tonemap_pass(graph, &hdr, scene_gpu);
+    graph.export_image(&display, Access::TransferRead);
+    let hdr_id = settings.export_hdr.then(|| {
+        graph.export_image(&hdr, Access::TransferRead);
+        hdr.id()
+    });
+    FrameOutputs {
+        display: display.id(),
+        hdr: hdr_id,
+    }
+}
+
+/// Compiles the plan of a frame without a GPU (for `lucent plan` and tests).
+pub fn plan_frame(settings: &FrameSettings) -> Result<Plan> {
+    let mut graph = RenderGraph::new();
+    declare_frame(&mut graph, settings, None);
+    graph.plan(settings.compile)
+}
+
+/// Frame uniforms, std140 (glsl/common/scene.glsl `Frame`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    view_proj: [[f32; 4]; 4],
+    inv_view_proj: [[f32; 4]; 4],
+    camera_pos: [f32; 4],
+    ambient: [f32; 4],
+    sky: [f32; 4],
+    viewport: [f32; 4],
+    exposure: [f32; 4],
+    light_count: [i32; 4],
+    lights: [[[f32; 4]; 2]; MAX_LIGHTS],
+}
+
+impl FrameUniforms {
+    /// Fills the uniforms from a scene at a size.
+    pub fn new(scene: &Scene, width: u32, height: u32) -> Self {
+        let aspect = width as f32 / height.max(1) as f32;
+        let view_proj = scene.camera.projection(aspect) * scene.camera.view();
+        let mut lights = [[[0.0; 4]; 2]; MAX_LIGHTS];
+        for (slot, light) in lights.iter_mut().zip(&scene.lights) {
+            *slot = match *light {
+                Light::Directional {
+                    direction,
+                    radiance,
+                } => [
+                    direction.extend(0.0).to_array(),
+                    radiance.extend(0.0).to_array(),
+                ],
+                Light::Point {
+                    position,
+                    radiance,
+                    range,
+                } => [
+                    position.extend(1.0).to_array(),
+                    radiance.extend(range).to_array(),
+                ],
+            };
+        }
+        Self {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_pos: scene.camera.eye.extend(1.0).to_array(),
+            ambient: scene.ambient.extend(0.0).to_array(),
+            sky: scene.sky.extend(0.0).to_array(),
+            viewport: [
+                width as f32,
+                height as f32,
+                1.0 / width as f32,
+                1.0 / height as f32,
+            ],
+            exposure: [scene.exposure, 0.0, 0.0, 0.0],
+            light_count: [scene.lights.len().min(MAX_LIGHTS) as i32, 0, 0, 0],
+            lights,
+        }
+    }
+}
+
+/// A scene compiled into an executable frame on a device.
+pub struct Renderer {
+    /// The executable frame.
+    pub executable: Executable,
+    /// Where the outputs are.
+    pub outputs: FrameOutputs,
+    /// The settings it was built with.
+    pub settings: FrameSettings,
+    scene_gpu: Option<Arc<SceneGpu>>,
+    uniforms: Option<GpuBuffer>,
+}
+
+impl Renderer {
+    /// Uploads the scene and compiles its frame.
+    pub fn new(
+        gpu: &GpuContext,
+        shaders: &ShaderCompiler,
+        pipeline_cache: &PipelineCache,
+        scene: &Scene,
+        settings: FrameSettings,
+    ) -> Result<Self> {
+        if settings.width == 0
+            || settings.height == 0
+            || settings.width > 16384
+            || settings.height > 16384
+        {
+            return Err(LucentError::InvalidInput(format!(
+                "size {}x{} is out of range (1..=16384 per side)",
+                settings.width, settings.height
+            )));
+        }
+        if scene.lights.len() > MAX_LIGHTS {
+            return Err(LucentError::InvalidInput(format!(
+                "scene '{}' has {} lights; at most {MAX_LIGHTS} are supported",
+                scene.name,
+                scene.lights.len()
+            )));
+        }
+        let uniforms = gpu.create_buffer(
+            std::mem::size_of::<FrameUniforms>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            gpu_allocator::MemoryLocation::CpuToGpu,
+            "frame uniforms",
+        )?;
+        let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer) {
+            Ok(s) => s,
+            Err(e) => {
+                gpu.destroy_buffer(uniforms);
+                return Err(e);
+            }
+        };
+        let mut graph = RenderGraph::new();
+        let outputs = declare_frame(&mut graph, &settings, Some(&scene_gpu));
+        let compiled = graph.compile(settings.compile).and_then(|(plan, execs)| {
+            Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)
+        });
+        let executable = match compiled {
+            Ok(e) => e,
+            Err(e) => {
+                if let Ok(s) = Arc::try_unwrap(scene_gpu) {
+                    s.destroy(gpu);
+                }
+                gpu.destroy_buffer(uniforms);
+                return Err(e);
+            }
+        };
+        let mut renderer = Self {
+            executable,
+            outputs,
+            settings,
+            scene_gpu: Some(scene_gpu),
+            uniforms: Some(uniforms),
+        };
+        renderer.update(scene)?;
+        Ok(renderer)
+    }
+
+    /// Writes the scene's camera and lights into the frame uniforms. Call between frames: the
+    /// GPU must not be reading them (every frame is waited for before the next update).
+    pub fn update(&mut self, scene: &Scene) -> Result<()> {
+        let uniforms = FrameUniforms::new(scene, self.settings.width, self.settings.height);
+        let mapped = self
+            .uniforms
+            .as_mut()
+            .and_then(|b| b.mapped_mut())
+            .ok_or_else(|| {
+                LucentError::InvalidInput("frame uniform buffer is not host-visible".into())
+            })?;
+        let bytes = bytemuck::bytes_of(&uniforms);
+        mapped[..bytes.len()].copy_from_slice(bytes);
+        Ok(())
+    }
+
+    /// Reads the display image of the last frame: RGBA8, sRGB-encoded, tightly packed.
+    pub fn read_display(&self, gpu: &GpuContext) -> Result<Vec<u8>> {
+        self.read_export(gpu, self.outputs.display)
+    }
+
+    /// Reads the linear HDR image of the last frame as f32 RGBA (needs `export_hdr`).
+    pub fn read_hdr(&self, gpu: &GpuContext) -> Result<Vec<f32>> {
+        let id = self.outputs.hdr.ok_or_else(|| {
+            LucentError::InvalidInput("the HDR image is not exported in this frame".into())
+        })?;
+        Ok(crate::output::f16_bytes_to_f32(&self.read_export(gpu, id)?))
+    }
+
+    fn read_export(&self, gpu: &GpuContext, id: ResourceId) -> Result<Vec<u8>> {
+        let image = self.executable.owned_image(id).ok_or_else(|| {
+            LucentError::Graph(format!(
+                "'{}' has no readable image",
+                self.executable.plan.resources[id].name
+            ))
+        })?;
+        let layout = self
+            .executable
+            .export_layout(id)
+            .unwrap_or(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        gpu.read_image(image, layout)
+    }
+
+    /// Destroys the frame and the scene's GPU data. The GPU must be idle.
+    pub fn destroy(mut self, gpu: &GpuContext) {
+        self.executable.destroy(gpu);
+        if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
+            s.destroy(gpu);
+        }
+        if let Some(u) = self.uniforms.take() {
+            gpu.destroy_buffer(u);
+        }
+    }
+}
+
+/// Times of one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameTiming {
+    /// Wall time from submit to fence signalled, milliseconds.
+    pub wall_ms: f64,
+    /// GPU timestamps per physical pass.
+    pub passes: Vec<ScopeTime>,
+}
+
+/// Submits frames and measures them: owns a command pool, command buffer, fence and timer.
+pub struct FrameRunner {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    timer: GpuTimer,
+}
+
+impl FrameRunner {
+    /// A runner for frames of up to `max_passes` physical passes.
+    pub fn new(gpu: &GpuContext, max_passes: usize) -> Result<Self> {
+        let device = &gpu.device;
+        // SAFETY: valid device and create infos.
+        let pool = unsafe {
+            device.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(gpu.queue_family)
+                    .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+                None,
+            )
+        }
+        .vk("vkCreateCommandPool")?;
+        // SAFETY: the pool was just created.
+        let cmd = unsafe {
+            device.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(1),
+            )
+        }
+        .vk("vkAllocateCommandBuffers")?[0];
+        // SAFETY: valid device.
+        let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }
+            .vk("vkCreateFence")?;
+        let timer = GpuTimer::new(gpu, max_passes as u32 + 1)?;
+        gpu.set_name(cmd, "lucent frame");
+        Ok(Self {
+            pool,
+            cmd,
+            fence,
+            timer,
+        })
+    }
+
+    /// Records with `record`, submits, waits, and reads the timer. Never overlaps frames, so
+    /// the timer's results are always ready (no stall, no drain).
+    fn submit(
+        &mut self,
+        gpu: &GpuContext,
+        record: impl FnOnce(&GpuContext, vk::CommandBuffer, &mut GpuTimer),
+    ) -> Result<FrameTiming> {
+        let device = &gpu.device;
+        // SAFETY: the previous submission of `cmd` finished (we waited on the fence).
+        unsafe {
+            device
+                .reset_command_pool(self.pool, vk::CommandPoolResetFlags::empty())
+                .vk("vkResetCommandPool")?;
+            device
+                .begin_command_buffer(
+                    self.cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .vk("vkBeginCommandBuffer")?;
+        }
+        self.timer.reset(gpu, self.cmd);
+        record(gpu, self.cmd, &mut self.timer);
+        let cmd_infos = [vk::CommandBufferSubmitInfo::default().command_buffer(self.cmd)];
+        let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmd_infos);
+        // SAFETY: recording is complete; the fence is unsignalled.
+        let start = unsafe {
+            device
+                .end_command_buffer(self.cmd)
+                .vk("vkEndCommandBuffer")?;
+            let start = Instant::now();
+            device
+                .queue_submit2(gpu.queue, &[submit], self.fence)
+                .vk("vkQueueSubmit2")?;
+            device
+                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .vk("vkWaitForFences")?;
+            start
+        };
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        // SAFETY: the fence is signalled and not in use.
+        unsafe { device.reset_fences(&[self.fence]) }.vk("vkResetFences")?;
+        let passes = self.timer.results(gpu)?.ok_or_else(|| {
+            LucentError::Timing("timestamps not available after the frame's fence signalled".into())
+        })?;
+        Ok(FrameTiming { wall_ms, passes })
+    }
+
+    /// One whole frame in one command buffer, timestamps around each physical pass.
+    pub fn run_frame(&mut self, gpu: &GpuContext, executable: &Executable) -> Result<FrameTiming> {
+        self.submit(gpu, |gpu, cmd, timer| {
+            executable.record_frame(gpu, cmd, Some(timer))
+        })
+    }
+
+    /// One frame submitted pass by pass: each physical pass alone in its own submission, the
+    /// device idle before it. Returns each pass's timestamp time (and the sum of walls).
+    pub fn run_isolated(
+        &mut self,
+        gpu: &GpuContext,
+        executable: &Executable,
+    ) -> Result<FrameTiming> {
+        let count = executable.plan.physical.len();
+        let mut passes = Vec::with_capacity(count);
+        let mut wall_ms = 0.0;
+        for index in 0..count {
+            let timing = self.submit(gpu, |gpu, cmd, timer| {
+                executable.record_physical(gpu, cmd, index, Some(timer));
+                if index + 1 == count {
+                    executable.record_exports(gpu, cmd);
+                }
+            })?;
+            wall_ms += timing.wall_ms;
+            passes.extend(timing.passes);
+        }
+        Ok(FrameTiming { wall_ms, passes })
+    }
+
+    /// Destroys the runner. The GPU must be done with it.
+    pub fn destroy(self, gpu: &GpuContext) {
+        self.timer.destroy(gpu);
+        // SAFETY: created by `new`; nothing pending (every submit waited).
+        unsafe {
+            gpu.device.destroy_fence(self.fence, None);
+            gpu.device.destroy_command_pool(self.pool, None);
+        }
+    }
+}

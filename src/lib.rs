@@ -7,9 +7,9 @@
 //! - [`backend`]: a thin layer over `ash`: context (own or wrapped), memory, images, the one
 //!   access table, debug labels, GPU timer, shader compilation.
 //!
-//! Beside them: [`scene`] (what is drawn), [`reference`] (CPU f64 versions of every shading
+//! Beside them: [`scene`] (what is drawn), [`reference`](mod@reference) (CPU f64 versions of every shading
 //! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
-//! comparison), [`bench`] (the benchmark and its honest timing modes).
+//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes).
 
 pub mod backend;
 pub mod bench;

@@ -164,7 +164,9 @@ fn same_pixel_reads_merge_into_subpasses_and_sampled_reads_do_not() {
     assert!(dep
         .src_access
         .contains(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE));
-    assert_eq!(dep.dst_access, vk::AccessFlags2::INPUT_ATTACHMENT_READ);
+    assert!(dep
+        .dst_access
+        .contains(vk::AccessFlags2::INPUT_ATTACHMENT_READ));
     // The G-buffer never leaves the render pass: its contents are not stored.
     for a in &rp.attachments {
         let name = &plan.resources[a.resource].name;

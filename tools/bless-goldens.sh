@@ -5,7 +5,8 @@
 #   tools/bless-goldens.sh NAME     # only NAME
 #
 # Each line of tests/golden/LIST is `NAME ARGS...`; this runs
-# `cargo run --release -- ARGS --out tests/golden/NAME.png`. Look at the new images (and at the
+# `cargo run -- ARGS --validation --out tests/golden/NAME.png` (a debug build: the GPU does the
+# rendering, so the image is the same as a release build's). Look at the new images (and at the
 # `git diff`) before committing them. Blank lines and lines starting with # are ignored.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,7 +26,7 @@ while read -r name args; do
     out="tests/golden/$name.png"
     # ARGS are split on whitespace on purpose: LIST holds plain command-line words.
     # shellcheck disable=SC2086
-    cargo run --release -- $args --out "$out" </dev/null
+    cargo run --quiet -- $args --validation --out "$out" </dev/null
     echo "bless-goldens: wrote $out ($args)"
 done <"$list"
 

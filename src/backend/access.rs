@@ -84,16 +84,19 @@ impl Access {
                 U::DEPTH_STENCIL_ATTACHMENT,
                 false,
             ),
+            // An input attachment is also an attachment of its render pass: its load op
+            // (LOAD) reads it in the colour-output stage before the shader does.
             Access::InputAttachmentRead => (
-                S::FRAGMENT_SHADER,
-                A::INPUT_ATTACHMENT_READ,
+                S::FRAGMENT_SHADER | S::COLOR_ATTACHMENT_OUTPUT,
+                A::INPUT_ATTACHMENT_READ | A::COLOR_ATTACHMENT_READ,
                 L::SHADER_READ_ONLY_OPTIMAL,
                 U::INPUT_ATTACHMENT,
                 false,
             ),
+            // Likewise a depth input attachment is loaded in the fragment-test stages.
             Access::DepthInputAttachmentRead => (
-                S::FRAGMENT_SHADER,
-                A::INPUT_ATTACHMENT_READ,
+                S::FRAGMENT_SHADER | depth_tests,
+                A::INPUT_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_READ,
                 L::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
                 U::INPUT_ATTACHMENT,
                 false,

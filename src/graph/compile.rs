@@ -26,6 +26,10 @@ use crate::{LucentError, Result};
 use super::declare::{ImageInfo, LoadOp, PassKind, RenderGraph, ResourceId, Use};
 use super::PassExec;
 
+/// The executors of a plan's passes, in [`Plan::passes`] order (`None` for passes declared
+/// without code).
+pub type PassExecs = Vec<Option<Box<dyn PassExec>>>;
+
 /// Switches for A/B comparisons of the compiler's optimisations.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CompileOptions {
@@ -301,7 +305,7 @@ impl SyncState {
             || aliasing
             || (next.writes && (!write_stage.is_empty() || !self.read_stages.is_empty()))
             || (!next.writes && self.write.is_some() && !already_visible);
-        let barrier = needs.then(|| Barrier {
+        let barrier = needs.then_some(Barrier {
             resource,
             src_stage,
             src_access,
@@ -353,32 +357,16 @@ impl SyncState {
 impl RenderGraph {
     /// Compiles the graph into a plan plus the executors of the surviving passes (indexed like
     /// [`Plan::passes`]).
-    pub fn compile(
-        self,
-        options: CompileOptions,
-    ) -> Result<(Plan, Vec<Option<Box<dyn PassExec>>>)> {
-        let RenderGraph {
-            resources,
-            mut passes,
-        } = self;
-        let graph_view = RenderGraph {
-            resources,
-            passes: Vec::new(),
-        };
-        // Split executors from the data so the plan stays plain data.
-        let mut execs: Vec<Option<Box<dyn PassExec>>> =
-            passes.iter_mut().map(|p| p.exec.take()).collect();
-        let graph = RenderGraph {
-            resources: graph_view.resources,
-            passes,
-        };
-        let plan = compile_plan(&graph, options)?;
-        let ordered_execs = plan
+    pub fn compile(mut self, options: CompileOptions) -> Result<(Plan, PassExecs)> {
+        // Split executors from the declarations so the plan stays plain data.
+        let mut execs: PassExecs = self.passes.iter_mut().map(|p| p.exec.take()).collect();
+        let plan = compile_plan(&self, options)?;
+        let ordered = plan
             .passes
             .iter()
             .map(|p| execs[p.declared_index].take())
             .collect();
-        Ok((plan, ordered_execs))
+        Ok((plan, ordered))
     }
 
     /// Compiles only the plan (graph tests, `lucent plan`).

@@ -86,7 +86,7 @@ impl Executable {
     pub fn new(
         gpu: &GpuContext,
         plan: Plan,
-        execs: Vec<Option<Box<dyn PassExec>>>,
+        execs: super::compile::PassExecs,
         shaders: &ShaderCompiler,
         pipeline_cache: vk::PipelineCache,
     ) -> Result<Self> {

@@ -330,3 +330,30 @@ fn unknown_scene_and_bad_size_are_clear_errors() {
     assert!(!out.status.success());
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }
+
+#[test]
+fn render_writes_png_and_linear_exr() {
+    let dir = output_dir();
+    let (png, exr) = (dir.join("cli-smoke.png"), dir.join("cli-smoke.exr"));
+    let out = lucent_command()
+        .args(["render", "--scene", "smoke", "--size", "96x64", "--out"])
+        .arg(&png)
+        .arg("--exr")
+        .arg(&exr)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (w, h, _) = lucent::output::read_png_rgba8(&png).unwrap();
+    assert_eq!((w, h), (96, 64));
+    let hdr = image::open(&exr).unwrap().into_rgba32f();
+    assert_eq!(hdr.dimensions(), (96, 64));
+    assert!(hdr
+        .pixels()
+        .all(|p| p.0.iter().all(|c| c.is_finite() && *c >= 0.0)));
+    // Linear, not tonemapped: the specular highlight is brighter than display white.
+    assert!(hdr.pixels().any(|p| p.0[0] > 1.0));
+}

@@ -178,56 +178,63 @@ impl Session {
     }
 }
 
+/// Builds the frame of `frame`'s scene, runs `work` with it, and tears everything down in order
+/// whatever `work` returned; validation errors fail the command.
+fn with_renderer(
+    frame: &FrameArgs,
+    gpu_args: &GpuArgs,
+    export_hdr: bool,
+    work: impl FnOnce(&Session, &Renderer) -> Result<()>,
+) -> Result<()> {
+    let scene = scene::builtin(&frame.scene)?;
+    let settings = frame.settings(export_hdr)?;
+    let session = Session::new(gpu_args)?;
+    let result = Renderer::new(
+        &session.gpu,
+        &session.shaders,
+        &session.pipeline_cache,
+        &scene,
+        settings,
+    )
+    .and_then(|renderer| {
+        let worked = work(&session, &renderer);
+        let idle = session.gpu.wait_idle();
+        renderer.destroy(&session.gpu);
+        worked.and(idle)
+    });
+    let finished = session.finish();
+    result.and(finished)
+}
+
 fn render(
     frame: &FrameArgs,
     gpu_args: &GpuArgs,
     out: Option<PathBuf>,
     exr: Option<PathBuf>,
 ) -> Result<()> {
-    let scene = scene::builtin(&frame.scene)?;
-    let settings = frame.settings(exr.is_some())?;
-    let session = Session::new(gpu_args)?;
-    let result = (|| {
-        let renderer = Renderer::new(
-            &session.gpu,
-            &session.shaders,
-            &session.pipeline_cache,
-            &scene,
-            settings,
-        )?;
-        let written = (|| {
-            let mut runner =
-                FrameRunner::new(&session.gpu, renderer.executable.plan.physical.len())?;
-            let timing = runner.run_frame(&session.gpu, &renderer.executable);
-            runner.destroy(&session.gpu);
-            let timing = timing?;
-            let out = out.unwrap_or_else(|| PathBuf::from(format!("{}.png", frame.scene)));
-            let pixels = renderer.read_display(&session.gpu)?;
-            output::write_png_rgba8(&out, settings.width, settings.height, &pixels)?;
-            println!(
-                "wrote {} ({}x{}, frame {:.2} ms on {})",
-                out.display(),
-                settings.width,
-                settings.height,
-                timing.wall_ms,
-                session.gpu.info.describe()
-            );
-            if let Some(exr) = &exr {
-                let hdr = renderer.read_hdr(&session.gpu)?;
-                output::write_exr_rgba32f(exr, settings.width, settings.height, &hdr)?;
-                println!("wrote {}", exr.display());
-            }
-            Ok(())
-        })();
-        session.gpu.wait_idle()?;
-        renderer.destroy(&session.gpu);
-        written
-    })();
-    let finished = session.finish();
-    result.and(finished)
+    with_renderer(frame, gpu_args, exr.is_some(), |session, renderer| {
+        let gpu = &session.gpu;
+        let (width, height) = (renderer.settings.width, renderer.settings.height);
+        let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len())?;
+        let timing = runner.run_frame(gpu, &renderer.executable);
+        runner.destroy(gpu);
+        let timing = timing?;
+        let out = out.unwrap_or_else(|| PathBuf::from(format!("{}.png", frame.scene)));
+        output::write_png_rgba8(&out, width, height, &renderer.read_display(gpu)?)?;
+        println!(
+            "wrote {} ({width}x{height}, frame {:.2} ms on {})",
+            out.display(),
+            timing.wall_ms,
+            gpu.info.describe()
+        );
+        if let Some(exr) = &exr {
+            output::write_exr_rgba32f(exr, width, height, &renderer.read_hdr(gpu)?)?;
+            println!("wrote {}", exr.display());
+        }
+        Ok(())
+    })
 }
 
-#[allow(clippy::too_many_arguments)]
 fn bench_command(
     frame: &FrameArgs,
     gpu_args: &GpuArgs,
@@ -235,43 +242,27 @@ fn bench_command(
     json: Option<PathBuf>,
     out: Option<PathBuf>,
 ) -> Result<()> {
-    let scene = scene::builtin(&frame.scene)?;
-    let settings = frame.settings(false)?;
-    let session = Session::new(gpu_args)?;
-    let result = (|| {
-        let renderer = Renderer::new(
-            &session.gpu,
-            &session.shaders,
-            &session.pipeline_cache,
-            &scene,
-            settings,
-        )?;
-        let report = bench::run(&session.gpu, &renderer, &frame.scene, &options);
-        let written = report.and_then(|report| {
-            println!("{}", report.markdown());
-            if let Some(json) = &json {
-                output::write_file_atomic(json, report.json().as_bytes())?;
-                println!("wrote {}", json.display());
-            }
-            if let Some(out) = &out {
-                let pixels = renderer.read_display(&session.gpu)?;
-                output::write_png_rgba8(out, settings.width, settings.height, &pixels)?;
-                println!("wrote {}", out.display());
-            }
-            if report.trusted {
-                Ok(())
-            } else {
-                Err(LucentError::Timing(
-                    "the per-pass times could not be verified (see the checks above)".into(),
-                ))
-            }
-        });
-        session.gpu.wait_idle()?;
-        renderer.destroy(&session.gpu);
-        written
-    })();
-    let finished = session.finish();
-    result.and(finished)
+    with_renderer(frame, gpu_args, false, |session, renderer| {
+        let gpu = &session.gpu;
+        let report = bench::run(gpu, renderer, &frame.scene, &options)?;
+        println!("{}", report.markdown());
+        if let Some(json) = &json {
+            output::write_file_atomic(json, report.json().as_bytes())?;
+            println!("wrote {}", json.display());
+        }
+        if let Some(out) = &out {
+            let (width, height) = (renderer.settings.width, renderer.settings.height);
+            output::write_png_rgba8(out, width, height, &renderer.read_display(gpu)?)?;
+            println!("wrote {}", out.display());
+        }
+        if report.trusted {
+            Ok(())
+        } else {
+            Err(LucentError::Timing(
+                "the per-pass times could not be verified (see the checks above)".into(),
+            ))
+        }
+    })
 }
 
 fn run(cli: Cli) -> Result<()> {

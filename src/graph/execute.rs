@@ -198,27 +198,19 @@ impl Executable {
             self.blocks.push(block);
         }
         for phys in &self.plan.physical {
-            let (rp, fb) = match &phys.render_pass {
+            let framebuffer = match &phys.render_pass {
                 Some(plan) => {
                     let rp = create_render_pass(gpu, plan, &phys.name)?;
+                    // Kept before the framebuffer is made, so `destroy` frees it on error.
                     self.render_passes.push(rp);
-                    let fb =
-                        create_framebuffer(gpu, plan, rp, &self.views, phys.extent, &phys.name);
-                    match fb {
-                        Ok(fb) => (rp, fb),
-                        Err(e) => {
-                            self.framebuffers.push(vk::Framebuffer::null());
-                            return Err(e);
-                        }
-                    }
+                    create_framebuffer(gpu, plan, rp, &self.views, phys.extent, &phys.name)?
                 }
                 None => {
                     self.render_passes.push(vk::RenderPass::null());
-                    (vk::RenderPass::null(), vk::Framebuffer::null())
+                    vk::Framebuffer::null()
                 }
             };
-            let _ = rp;
-            self.framebuffers.push(fb);
+            self.framebuffers.push(framebuffer);
         }
         Ok(())
     }

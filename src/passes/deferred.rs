@@ -13,7 +13,7 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::util::{Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, VertexInput};
+use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
 /// G-buffer target formats (see glsl/common/gbuffer.glsl).
@@ -60,7 +60,6 @@ pub fn gbuffer_pass(
         Some(scene) => pass.execute(GBufferPass {
             scene: scene.clone(),
             pipeline: None,
-            set: None,
         }),
         None => pass.finish(),
     }
@@ -92,7 +91,6 @@ pub fn lighting_pass(
             scene: scene.clone(),
             inputs,
             pipeline: None,
-            set: None,
         }),
         None => pass.finish(),
     }
@@ -101,20 +99,14 @@ pub fn lighting_pass(
 
 struct GBufferPass {
     scene: Arc<SceneGpu>,
-    pipeline: Option<GraphicsPipeline>,
-    set: Option<DescriptorSet>,
+    pipeline: Option<PassPipeline>,
 }
 
 impl PassExec for GBufferPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let set = DescriptorSet::new(
+        self.pipeline = Some(PassPipeline::new(
             ctx,
             &[Binding::Uniform(self.scene.frame_uniforms)],
-            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            "gbuffer",
-        )?;
-        let pipeline = GraphicsPipeline::new(
-            ctx,
             &GraphicsPipelineDesc {
                 vertex: "deferred/gbuffer.vert",
                 fragment: "deferred/gbuffer.frag",
@@ -122,37 +114,27 @@ impl PassExec for GBufferPass {
                 vertex_input: VertexInput::PositionNormal,
                 depth_test: true,
                 cull_back: true,
-                set_layouts: &[set.layout],
+                set_layouts: &[],
                 push_constant_bytes: std::mem::size_of::<super::ObjectConstants>() as u32,
                 name: "gbuffer",
             },
-        );
-        self.set = Some(set);
-        self.pipeline = Some(pipeline?);
+        )?);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        let (Some(pipeline), Some(set)) = (&self.pipeline, &self.set) else {
+        let Some(pipeline) = &self.pipeline else {
             return;
         };
+        pipeline.bind(ctx);
         let device = &ctx.gpu.device;
-        // SAFETY: pipeline, set and buffers are alive; we are inside this pass's subpass.
+        // SAFETY: the pipeline is bound inside this pass's subpass; buffers are alive.
         unsafe {
-            device.cmd_bind_pipeline(ctx.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-            device.cmd_bind_descriptor_sets(
-                ctx.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                pipeline.layout,
-                0,
-                &[set.set],
-                &[],
-            );
             for draw in &self.scene.draws {
                 let mesh = &self.scene.meshes[draw.mesh];
                 device.cmd_push_constants(
                     ctx.cmd,
-                    pipeline.layout,
+                    pipeline.pipeline.layout,
                     vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                     0,
                     bytemuck::bytes_of(&draw.constants),
@@ -173,17 +155,13 @@ impl PassExec for GBufferPass {
         if let Some(mut p) = self.pipeline.take() {
             p.destroy(&gpu.device);
         }
-        if let Some(mut s) = self.set.take() {
-            s.destroy(&gpu.device);
-        }
     }
 }
 
 struct LightingPass {
     scene: Arc<SceneGpu>,
     inputs: [crate::graph::ResourceId; 3],
-    pipeline: Option<GraphicsPipeline>,
-    set: Option<DescriptorSet>,
+    pipeline: Option<PassPipeline>,
 }
 
 impl PassExec for LightingPass {
@@ -191,7 +169,7 @@ impl PassExec for LightingPass {
         let [gb0, gb1, depth] = self.inputs;
         let color_layout = Access::InputAttachmentRead.info().layout;
         let depth_layout = Access::DepthInputAttachmentRead.info().layout;
-        let set = DescriptorSet::new(
+        self.pipeline = Some(PassPipeline::new(
             ctx,
             &[
                 Binding::Uniform(self.scene.frame_uniforms),
@@ -199,11 +177,6 @@ impl PassExec for LightingPass {
                 Binding::InputAttachment(ctx.views[gb1], color_layout),
                 Binding::InputAttachment(ctx.views[depth], depth_layout),
             ],
-            vk::ShaderStageFlags::FRAGMENT,
-            "lighting",
-        )?;
-        let pipeline = GraphicsPipeline::new(
-            ctx,
             &GraphicsPipelineDesc {
                 vertex: "fullscreen.vert",
                 fragment: "deferred/lighting.frag",
@@ -211,28 +184,23 @@ impl PassExec for LightingPass {
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,
-                set_layouts: &[set.layout],
+                set_layouts: &[],
                 push_constant_bytes: 0,
                 name: "lighting",
             },
-        );
-        self.set = Some(set);
-        self.pipeline = Some(pipeline?);
+        )?);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        if let (Some(pipeline), Some(set)) = (&self.pipeline, &self.set) {
-            super::tonemap::draw_fullscreen(ctx, pipeline, set);
+        if let Some(pipeline) = &self.pipeline {
+            pipeline.draw_fullscreen(ctx);
         }
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
             p.destroy(&gpu.device);
-        }
-        if let Some(mut s) = self.set.take() {
-            s.destroy(&gpu.device);
         }
     }
 }

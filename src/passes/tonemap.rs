@@ -15,7 +15,7 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::util::{Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, VertexInput};
+use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
@@ -43,7 +43,6 @@ pub fn tonemap_pass(
             input: hdr.id(),
             sampler: vk::Sampler::null(),
             pipeline: None,
-            set: None,
         }),
         None => pass.finish(),
     }
@@ -54,8 +53,7 @@ struct TonemapPass {
     scene: Arc<SceneGpu>,
     input: ResourceId,
     sampler: vk::Sampler,
-    pipeline: Option<GraphicsPipeline>,
-    set: Option<DescriptorSet>,
+    pipeline: Option<PassPipeline>,
 }
 
 impl PassExec for TonemapPass {
@@ -69,17 +67,12 @@ impl PassExec for TonemapPass {
         // SAFETY: valid device and create info.
         self.sampler =
             unsafe { ctx.gpu.device.create_sampler(&info, None) }.vk("vkCreateSampler")?;
-        let set = DescriptorSet::new(
+        self.pipeline = Some(PassPipeline::new(
             ctx,
             &[
                 Binding::Uniform(self.scene.frame_uniforms),
                 Binding::Sampled(ctx.views[self.input], self.sampler),
             ],
-            vk::ShaderStageFlags::FRAGMENT,
-            "tonemap",
-        )?;
-        let pipeline = GraphicsPipeline::new(
-            ctx,
             &GraphicsPipelineDesc {
                 vertex: "fullscreen.vert",
                 fragment: "post/tonemap.frag",
@@ -87,19 +80,17 @@ impl PassExec for TonemapPass {
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,
-                set_layouts: &[set.layout],
+                set_layouts: &[],
                 push_constant_bytes: 0,
                 name: "tonemap",
             },
-        );
-        self.set = Some(set);
-        self.pipeline = Some(pipeline?);
+        )?);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        if let (Some(pipeline), Some(set)) = (&self.pipeline, &self.set) {
-            draw_fullscreen(ctx, pipeline, set);
+        if let Some(pipeline) = &self.pipeline {
+            pipeline.draw_fullscreen(ctx);
         }
     }
 
@@ -107,33 +98,8 @@ impl PassExec for TonemapPass {
         if let Some(mut p) = self.pipeline.take() {
             p.destroy(&gpu.device);
         }
-        if let Some(mut s) = self.set.take() {
-            s.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare; the GPU is done (caller's contract).
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
         unsafe { gpu.device.destroy_sampler(self.sampler, None) };
         self.sampler = vk::Sampler::null();
-    }
-}
-
-/// Binds `pipeline` and `set` and draws the fullscreen triangle.
-pub(crate) fn draw_fullscreen(
-    ctx: &RecordContext<'_>,
-    pipeline: &GraphicsPipeline,
-    set: &DescriptorSet,
-) {
-    let device = &ctx.gpu.device;
-    // SAFETY: pipeline and set are alive; the executor began this pass's subpass.
-    unsafe {
-        device.cmd_bind_pipeline(ctx.cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.pipeline);
-        device.cmd_bind_descriptor_sets(
-            ctx.cmd,
-            vk::PipelineBindPoint::GRAPHICS,
-            pipeline.layout,
-            0,
-            &[set.set],
-            &[],
-        );
-        device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
     }
 }

@@ -168,6 +168,7 @@ pub enum VertexInput {
 }
 
 /// Everything that differs between lucent's graphics pipelines.
+#[derive(Clone, Copy)]
 pub struct GraphicsPipelineDesc<'a> {
     /// Vertex shader path under glsl/.
     pub vertex: &'a str,
@@ -181,7 +182,7 @@ pub struct GraphicsPipelineDesc<'a> {
     pub depth_test: bool,
     /// Cull back faces (closed meshes).
     pub cull_back: bool,
-    /// Descriptor set layouts (set 0, 1, ...).
+    /// Descriptor set layouts (set 0, 1, ...); [`PassPipeline::new`] fills in its own.
     pub set_layouts: &'a [vk::DescriptorSetLayout],
     /// Push constant bytes visible to vertex and fragment stages.
     pub push_constant_bytes: u32,
@@ -355,5 +356,76 @@ impl GraphicsPipeline {
         }
         self.pipeline = vk::Pipeline::null();
         self.layout = vk::PipelineLayout::null();
+    }
+}
+
+/// A pass's pipeline together with its descriptor set: what most passes hold after `prepare`.
+pub struct PassPipeline {
+    /// The pipeline.
+    pub pipeline: GraphicsPipeline,
+    /// Its one descriptor set (set 0).
+    pub set: DescriptorSet,
+}
+
+impl PassPipeline {
+    /// Creates the descriptor set from `bindings` (visible to vertex and fragment stages) and
+    /// the pipeline described by `desc` with that set as set 0.
+    pub fn new(
+        ctx: &PrepareContext<'_>,
+        bindings: &[Binding],
+        desc: &GraphicsPipelineDesc<'_>,
+    ) -> Result<Self> {
+        let mut set = DescriptorSet::new(
+            ctx,
+            bindings,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            desc.name,
+        )?;
+        let layouts = [set.layout];
+        let desc = GraphicsPipelineDesc {
+            set_layouts: &layouts,
+            ..*desc
+        };
+        match GraphicsPipeline::new(ctx, &desc) {
+            Ok(pipeline) => Ok(Self { pipeline, set }),
+            Err(e) => {
+                set.destroy(&ctx.gpu.device);
+                Err(e)
+            }
+        }
+    }
+
+    /// Binds the pipeline and its set.
+    pub fn bind(&self, ctx: &crate::graph::RecordContext<'_>) {
+        let device = &ctx.gpu.device;
+        // SAFETY: pipeline and set are alive; the executor began this pass's subpass.
+        unsafe {
+            device.cmd_bind_pipeline(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline.pipeline,
+            );
+            device.cmd_bind_descriptor_sets(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline.layout,
+                0,
+                &[self.set.set],
+                &[],
+            );
+        }
+    }
+
+    /// Binds and draws the fullscreen triangle (glsl/fullscreen.vert).
+    pub fn draw_fullscreen(&self, ctx: &crate::graph::RecordContext<'_>) {
+        self.bind(ctx);
+        // SAFETY: bound above, inside the pass's subpass.
+        unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
+    }
+
+    /// Destroys pipeline and set.
+    pub fn destroy(&mut self, device: &ash::Device) {
+        self.pipeline.destroy(device);
+        self.set.destroy(device);
     }
 }

@@ -11,6 +11,32 @@
 //!
 //! A technique implements [`PassExec`] for each of its passes: `prepare` creates pipelines once
 //! the render pass and subpass are known, `record` draws.
+//!
+//! Declaring and compiling needs no GPU:
+//!
+//! ```
+//! use ash::vk;
+//! use lucent::backend::access::Access;
+//! use lucent::graph::{CompileOptions, ImageInfo, LoadOp, PassKind, RenderGraph};
+//!
+//! let size = |format| ImageInfo { width: 64, height: 64, format };
+//! let mut graph = RenderGraph::new();
+//! let mut albedo = graph.create_image("albedo", size(vk::Format::R8G8B8A8_UNORM));
+//! let mut lit = graph.create_image("lit", size(vk::Format::R16G16B16A16_SFLOAT));
+//! let mut pass = graph.add_pass("gbuffer", PassKind::Raster);
+//! pass.color(&mut albedo, LoadOp::Clear([0.0; 4]));
+//! pass.finish(); // a real pass calls `execute(its PassExec)` instead
+//! let mut pass = graph.add_pass("lighting", PassKind::Raster);
+//! pass.input(&albedo).color(&mut lit, LoadOp::DontCare);
+//! pass.finish();
+//! graph.export_image(&lit, Access::TransferRead);
+//!
+//! let plan = graph.plan(CompileOptions::default()).unwrap();
+//! // Same-pixel read: merged into one render pass with two subpasses.
+//! assert_eq!(plan.physical.len(), 1);
+//! assert_eq!(plan.physical[0].name, "gbuffer + lighting");
+//! println!("{}", plan.dump());
+//! ```
 
 pub mod compile;
 pub mod declare;

@@ -189,43 +189,95 @@ fn measure(
             runner.run_isolated(gpu, exe)?;
         }
     }
-    let mut frame_walls = Vec::with_capacity(options.frames);
-    let mut in_frame: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    let mut isolated: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    let mut samples = Samples {
+        frame_walls: Vec::with_capacity(options.frames),
+        in_frame: vec![Vec::new(); names.len()],
+        isolated: vec![Vec::new(); names.len()],
+    };
     // Interleaved, so both modes see the same machine load.
     for _ in 0..options.frames {
         let t = runner.run_frame(gpu, exe)?;
-        frame_walls.push(t.wall_ms);
-        collect(&mut in_frame, &t, names)?;
+        samples.frame_walls.push(t.wall_ms);
+        collect(&mut samples.in_frame, &t, names)?;
         if options.isolate {
-            collect(&mut isolated, &runner.run_isolated(gpu, exe)?, names)?;
+            collect(
+                &mut samples.isolated,
+                &runner.run_isolated(gpu, exe)?,
+                names,
+            )?;
         }
     }
-    let frame = Stats::of(&frame_walls);
-    let in_frame_stats: Vec<Stats> = in_frame.iter().map(|s| Stats::of(s)).collect();
-    let in_frame_sum: f64 = in_frame_stats.iter().map(|s| s.median).sum();
+    let mut verdict = judge(names, &samples, options.isolate);
+    if verdict.needs_isolated {
+        // The in-frame numbers did not add up: measure the isolated ones to report instead.
+        for _ in 0..options.frames {
+            collect(
+                &mut samples.isolated,
+                &runner.run_isolated(gpu, exe)?,
+                names,
+            )?;
+        }
+        verdict = judge(names, &samples, options.isolate);
+    }
+    Ok(BenchReport {
+        device: gpu.info.describe(),
+        driver: gpu.info.driver(),
+        scene: scene_name.to_string(),
+        technique: renderer.settings.technique.name().to_string(),
+        width: renderer.settings.width,
+        height: renderer.settings.height,
+        frames: options.frames,
+        warmup: options.warmup,
+        timing_mode: verdict.timing_mode,
+        pass_sum_ms: verdict.passes.iter().map(|p| p.median_ms).sum(),
+        passes: verdict.passes,
+        frame_ms: verdict.frame,
+        checks: verdict.checks,
+        trusted: verdict.trusted,
+    })
+}
+
+/// Raw timings: per frame, and per pass per frame in each mode (milliseconds).
+struct Samples {
+    frame_walls: Vec<f64>,
+    in_frame: Vec<Vec<f64>>,
+    isolated: Vec<Vec<f64>>,
+}
+
+/// Which numbers to report, and why.
+struct Verdict {
+    timing_mode: String,
+    passes: Vec<PassRow>,
+    frame: Stats,
+    checks: Vec<Check>,
+    trusted: bool,
+    /// The in-frame numbers failed and no isolated ones were measured yet.
+    needs_isolated: bool,
+}
+
+/// Decides the timing mode from the samples: in-frame numbers when they add up to the frame
+/// (and, when `isolate_checked`, match the isolated ones), isolated numbers otherwise.
+fn judge(names: &[String], samples: &Samples, isolate_checked: bool) -> Verdict {
+    let frame = Stats::of(&samples.frame_walls);
+    let in_frame: Vec<Stats> = samples.in_frame.iter().map(|s| Stats::of(s)).collect();
+    let have_isolated = samples.isolated.iter().all(|s| !s.is_empty()) && !names.is_empty();
+    let isolated: Option<Vec<Stats>> =
+        have_isolated.then(|| samples.isolated.iter().map(|s| Stats::of(s)).collect());
+    let in_frame_sum: f64 = in_frame.iter().map(|s| s.median).sum();
     let mut checks = vec![sum_check(
         "in-frame passes sum to frame",
         in_frame_sum,
         frame.median,
     )];
-    if options.isolate {
-        checks.push(isolation_check(names, &in_frame_stats, &isolated));
+    if isolate_checked && have_isolated {
+        checks.push(isolation_check(names, &in_frame, &samples.isolated));
     }
     let in_frame_ok = checks.iter().all(|c| c.passed);
-    if !in_frame_ok && !options.isolate {
-        // The in-frame numbers did not add up: measure the isolated ones to report instead.
-        for _ in 0..options.frames {
-            collect(&mut isolated, &runner.run_isolated(gpu, exe)?, names)?;
-        }
-    }
-    let isolated_stats: Option<Vec<Stats>> = (!isolated[0].is_empty() || names.is_empty())
-        .then(|| isolated.iter().map(|s| Stats::of(s)).collect());
     let (timing_mode, reported, trusted) = if in_frame_ok {
         let mode = format!(
             "in-frame timestamps (verified: passes sum to {:.1}% of frame wall time{})",
             100.0 * in_frame_sum / frame.median,
-            if options.isolate {
+            if isolate_checked {
                 format!(
                     "; every pass of {ISOLATION_MIN_MS} ms or more within {:.0}% of its isolated time",
                     ISOLATION_TOLERANCE * 100.0
@@ -234,9 +286,8 @@ fn measure(
                 String::new()
             }
         );
-        (mode, in_frame_stats.clone(), true)
-    } else {
-        let iso = isolated_stats.clone().unwrap_or_default();
+        (mode, in_frame.clone(), true)
+    } else if let Some(iso) = &isolated {
         let iso_sum: f64 = iso.iter().map(|s| s.median).sum();
         let check = sum_check("isolated passes sum to frame", iso_sum, frame.median);
         let trusted = check.passed;
@@ -255,9 +306,18 @@ fn measure(
                 " — UNTRUSTED: isolated passes do not add up to the frame either"
             }
         );
-        (mode, iso, trusted)
+        (mode, iso.clone(), trusted)
+    } else {
+        return Verdict {
+            timing_mode: String::new(),
+            passes: Vec::new(),
+            frame,
+            checks,
+            trusted: false,
+            needs_isolated: true,
+        };
     };
-    let passes: Vec<PassRow> = names
+    let passes = names
         .iter()
         .enumerate()
         .map(|(i, name)| PassRow {
@@ -265,8 +325,8 @@ fn measure(
             median_ms: reported[i].median,
             min_ms: reported[i].min,
             max_ms: reported[i].max,
-            isolated_ms: isolated_stats.as_ref().map(|s| s[i].median),
-            in_frame_ms: in_frame_stats[i].median,
+            isolated_ms: isolated.as_ref().map(|s| s[i].median),
+            in_frame_ms: in_frame[i].median,
             share: if frame.median > 0.0 {
                 reported[i].median / frame.median
             } else {
@@ -274,22 +334,14 @@ fn measure(
             },
         })
         .collect();
-    Ok(BenchReport {
-        device: gpu.info.describe(),
-        driver: gpu.info.driver(),
-        scene: scene_name.to_string(),
-        technique: renderer.settings.technique.name().to_string(),
-        width: renderer.settings.width,
-        height: renderer.settings.height,
-        frames: options.frames,
-        warmup: options.warmup,
+    Verdict {
         timing_mode,
-        pass_sum_ms: passes.iter().map(|p| p.median_ms).sum(),
         passes,
-        frame_ms: frame,
+        frame,
         checks,
         trusted,
-    })
+        needs_isolated: false,
+    }
 }
 
 fn sum_check(name: &str, sum: f64, frame: f64) -> Check {
@@ -428,6 +480,84 @@ mod tests {
         assert!(sum_check("s", 9.5, 10.0).passed);
         assert!(!sum_check("s", 8.0, 10.0).passed);
         assert!(!sum_check("s", 11.5, 10.0).passed);
+    }
+
+    /// Samples of two passes over `n` frames with constant values.
+    fn samples(frame: f64, in_frame: [f64; 2], isolated: Option<[f64; 2]>) -> Samples {
+        let n = 5;
+        Samples {
+            frame_walls: vec![frame; n],
+            in_frame: in_frame.iter().map(|&v| vec![v; n]).collect(),
+            isolated: match isolated {
+                Some(iso) => iso.iter().map(|&v| vec![v; n]).collect(),
+                None => vec![Vec::new(); 2],
+            },
+        }
+    }
+
+    fn names() -> Vec<String> {
+        vec!["blur".to_string(), "tonemap".to_string()]
+    }
+
+    #[test]
+    fn honest_in_frame_timestamps_are_reported() {
+        let v = judge(&names(), &samples(12.0, [9.6, 2.0], Some([9.5, 2.1])), true);
+        assert!(v.trusted && !v.needs_isolated);
+        assert!(
+            v.timing_mode.starts_with("in-frame timestamps (verified"),
+            "{}",
+            v.timing_mode
+        );
+        assert_eq!(v.passes[0].median_ms, 9.6);
+        assert_eq!(v.passes[0].isolated_ms, Some(9.5));
+    }
+
+    #[test]
+    fn lying_in_frame_timestamps_fall_back_to_isolated_times() {
+        // The measured lavapipe lie: a 9.6 ms blur reported as 0.19 ms inside the frame.
+        let lie = samples(11.8, [0.19, 2.0], None);
+        let first = judge(&names(), &lie, false);
+        assert!(
+            first.needs_isolated,
+            "a failed sum check asks for isolated times"
+        );
+        let v = judge(
+            &names(),
+            &samples(11.8, [0.19, 2.0], Some([9.6, 2.0])),
+            false,
+        );
+        assert!(v.trusted);
+        assert!(
+            v.timing_mode.starts_with("isolated per-pass submissions"),
+            "{}",
+            v.timing_mode
+        );
+        assert!(
+            v.timing_mode.contains("in-frame timestamps rejected"),
+            "{}",
+            v.timing_mode
+        );
+        assert_eq!(v.passes[0].median_ms, 9.6);
+        assert_eq!(v.passes[0].in_frame_ms, 0.19);
+    }
+
+    #[test]
+    fn sums_that_add_up_but_disagree_with_isolation_are_rejected() {
+        // In-frame shares shifted between passes: the sum holds, the per-pass check does not.
+        let v = judge(&names(), &samples(11.6, [2.0, 9.6], Some([9.6, 2.0])), true);
+        assert!(v.timing_mode.starts_with("isolated"), "{}", v.timing_mode);
+        assert_eq!(v.passes[1].median_ms, 2.0);
+    }
+
+    #[test]
+    fn numbers_that_never_add_up_are_untrusted() {
+        let v = judge(
+            &names(),
+            &samples(50.0, [0.19, 2.0], Some([9.6, 2.0])),
+            true,
+        );
+        assert!(!v.trusted);
+        assert!(v.timing_mode.contains("UNTRUSTED"), "{}", v.timing_mode);
     }
 
     #[test]

@@ -64,8 +64,9 @@ impl SceneGpu {
         let mut meshes: Vec<GpuMesh> = Vec::with_capacity(scene.meshes.len());
         let upload = |gpu: &GpuContext, meshes: &mut Vec<GpuMesh>| -> Result<()> {
             for (i, mesh) in scene.meshes.iter().enumerate() {
+                mesh.validate(&format!("scene '{}' mesh {i}", scene.name))?;
                 let vertices = gpu.upload_buffer(
-                    &mesh.vertices,
+                    &mesh.gpu_vertices(),
                     vk::BufferUsageFlags::VERTEX_BUFFER,
                     &format!("{} mesh {i} vertices", scene.name),
                 )?;

@@ -12,6 +12,7 @@
 //! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes).
 
 pub mod backend;
+pub mod bake;
 pub mod bench;
 pub mod compare;
 pub mod error;

@@ -16,8 +16,9 @@ use crate::backend::{GpuBuffer, GpuContext};
 use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
 use crate::passes::{deferred, tonemap, SceneGpu};
-use crate::scene::{Light, Scene, MAX_LIGHTS};
+use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
+use glam::Vec3;
 
 /// Which technique lights the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,7 +134,7 @@ pub struct FrameUniforms {
     viewport: [f32; 4],
     exposure: [f32; 4],
     light_count: [i32; 4],
-    lights: [[[f32; 4]; 2]; MAX_LIGHTS],
+    lights: [[[f32; 4]; 4]; MAX_LIGHTS],
 }
 
 impl FrameUniforms {
@@ -141,23 +142,37 @@ impl FrameUniforms {
     pub fn new(scene: &Scene, width: u32, height: u32) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
         let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-        let mut lights = [[[0.0; 4]; 2]; MAX_LIGHTS];
+        let mut lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
         for (slot, light) in lights.iter_mut().zip(&scene.lights) {
-            *slot = match *light {
-                Light::Directional {
-                    direction,
-                    radiance,
-                } => [
+            let radiance = light.radiance();
+            let scale = light.translucency_scale;
+            *slot = match light.kind {
+                LightKind::Directional { direction } => [
                     direction.extend(0.0).to_array(),
                     radiance.extend(0.0).to_array(),
+                    [0.0; 4],
+                    [1.0, scale, 0.0, 0.0],
                 ],
-                Light::Point {
-                    position,
-                    radiance,
-                    range,
-                } => [
+                LightKind::Point { position, range } => [
                     position.extend(1.0).to_array(),
                     radiance.extend(range).to_array(),
+                    [0.0; 4],
+                    [1.0, scale, 0.0, 0.0],
+                ],
+                LightKind::Spot {
+                    position,
+                    direction,
+                    range,
+                    inner_degrees,
+                    outer_degrees,
+                } => [
+                    position.extend(2.0).to_array(),
+                    radiance.extend(range).to_array(),
+                    direction
+                        .normalize_or(Vec3::NEG_Y)
+                        .extend(outer_degrees.to_radians().cos())
+                        .to_array(),
+                    [inner_degrees.to_radians().cos(), scale, 0.0, 0.0],
                 ],
             };
         }

@@ -1,5 +1,5 @@
-// Direct lighting: Lambert diffuse + normalised Blinn-Phong specular, point and directional
-// lights. The f64 twin is src/reference/lighting.rs: change both together.
+// Direct lighting: Lambert diffuse + normalised Blinn-Phong specular; point, spot and
+// directional lights. The f64 twin is src/reference/lighting.rs: change both together.
 #ifndef LUCENT_LIGHTING_GLSL
 #define LUCENT_LIGHTING_GLSL
 
@@ -27,6 +27,13 @@ void light_incidence(Light light, vec3 pos, out vec3 to_light, out float attenua
     float ratio = sqrt(dist2) / range;
     float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
     attenuation = window * window / dist2;
+    if (int(light.position_type.w) == LIGHT_SPOT) {
+        // Smooth cone edge; the width is clamped so inner == outer cannot divide by zero.
+        float cos_angle = dot(-to_light, light.spot.xyz);
+        float width = max(light.params.x - light.spot.w, 1e-4);
+        float t = clamp((cos_angle - light.spot.w) / width, 0.0, 1.0);
+        attenuation *= t * t;
+    }
 }
 
 vec3 shade_direct(Surface s, vec3 pos, vec3 to_eye, Light light) {

@@ -6,10 +6,13 @@
 #define MAX_LIGHTS 16
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_POINT 1
+#define LIGHT_SPOT 2
 
 struct Light {
-    vec4 position_type;   // xyz: position (point) or direction the light travels (directional); w: type
-    vec4 radiance_range;  // rgb: colour * intensity; a: range (point lights fade to 0 there)
+    vec4 position_type;   // xyz: position (point, spot) or direction the light travels (directional); w: type
+    vec4 radiance_range;  // rgb: colour * intensity; a: range (point and spot lights fade to 0 there)
+    vec4 spot;            // xyz: unit direction the cone points; w: cos(outer half-angle)
+    vec4 params;          // x: cos(inner half-angle); y: translucency scale (GDC 2011 fLTScale)
 };
 
 layout(std140, set = 0, binding = 0) uniform Frame {

@@ -69,11 +69,39 @@ enum Command {
         #[command(flatten)]
         frame: FrameArgs,
     },
+    /// Load a mesh, texture, MTL or scene file and summarise it (or say what is wrong with it).
+    Inspect {
+        /// The file (.obj, .mtl, .png, .jpg, .tga, .exr, .hdr, .toml).
+        file: PathBuf,
+    },
+    /// Bake a local thickness map (GDC 2011: ambient occlusion with inverted normals).
+    BakeThickness {
+        /// The mesh (OBJ).
+        mesh: PathBuf,
+        /// Write a thickness texture (PNG, grayscale, thin = white; needs UVs).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write the mesh back as OBJ with the thickness as vertex colours (`v x y z r g b`).
+        #[arg(long)]
+        per_vertex: Option<PathBuf>,
+        /// Rays per sample.
+        #[arg(long, default_value_t = 256)]
+        rays: u32,
+        /// Texture size in texels (square).
+        #[arg(long, default_value_t = 512)]
+        size: u32,
+        /// Occlusion distance (default: the mesh's bounding-box diagonal).
+        #[arg(long)]
+        max_distance: Option<f32>,
+        /// Random seed (the bake is deterministic for a seed).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 #[derive(Args, Clone)]
 struct FrameArgs {
-    /// Scene name (see `lucent scenes`).
+    /// Scene: a built-in name (see `lucent scenes`) or a .toml scene file.
     #[arg(long, default_value = "smoke")]
     scene: String,
     /// Resolution as WIDTHxHEIGHT.
@@ -186,7 +214,7 @@ fn with_renderer(
     export_hdr: bool,
     work: impl FnOnce(&Session, &Renderer) -> Result<()>,
 ) -> Result<()> {
-    let scene = scene::builtin(&frame.scene)?;
+    let scene = scene::load_scene(&frame.scene)?;
     let settings = frame.settings(export_hdr)?;
     let session = Session::new(gpu_args)?;
     let result = Renderer::new(
@@ -265,6 +293,59 @@ fn bench_command(
     })
 }
 
+fn bake_thickness(
+    mesh_path: &std::path::Path,
+    out: Option<PathBuf>,
+    per_vertex: Option<PathBuf>,
+    rays: u32,
+    size: u32,
+    max_distance: Option<f32>,
+    seed: u64,
+) -> Result<()> {
+    if out.is_none() && per_vertex.is_none() {
+        return Err(LucentError::InvalidInput(
+            "bake-thickness needs --out FILE.png and/or --per-vertex OUT.obj".into(),
+        ));
+    }
+    if !(1..=1 << 20).contains(&rays) {
+        return Err(LucentError::InvalidInput(format!(
+            "--rays {rays} must be 1..=1048576"
+        )));
+    }
+    if !(1..=16384).contains(&size) {
+        return Err(LucentError::InvalidInput(format!(
+            "--size {size} must be 1..=16384"
+        )));
+    }
+    if max_distance.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+        return Err(LucentError::InvalidInput(
+            "--max-distance must be finite and > 0".into(),
+        ));
+    }
+    let loaded = scene::obj::load_obj(mesh_path)?;
+    let options = lucent::bake::BakeOptions {
+        rays,
+        max_distance,
+        seed,
+        texture_size: size,
+        progress: true,
+    };
+    if let Some(out) = &out {
+        let (map, stats) = lucent::bake::bake_texture(&loaded.mesh, &options)?;
+        map.write_png(out)?;
+        println!("{}", lucent::bake::bake_report(&stats));
+        println!("wrote {} ({size}x{size})", out.display());
+    }
+    if let Some(per_vertex) = &per_vertex {
+        let (values, stats) = lucent::bake::bake_per_vertex(&loaded.mesh, &options)?;
+        let colors: Vec<glam::Vec3> = values.iter().map(|&v| glam::Vec3::splat(v)).collect();
+        scene::obj::write_obj_with_colors(per_vertex, &loaded.mesh, &colors)?;
+        println!("{}", lucent::bake::bake_report(&stats));
+        println!("wrote {} ({} vertices)", per_vertex.display(), values.len());
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scenes => {
@@ -298,8 +379,21 @@ fn run(cli: Cli) -> Result<()> {
             json,
             out,
         ),
+        Command::Inspect { file } => {
+            print!("{}", scene::inspect::inspect_file(&file)?);
+            Ok(())
+        }
+        Command::BakeThickness {
+            mesh,
+            out,
+            per_vertex,
+            rays,
+            size,
+            max_distance,
+            seed,
+        } => bake_thickness(&mesh, out, per_vertex, rays, size, max_distance, seed),
         Command::Plan { frame } => {
-            scene::builtin(&frame.scene)?;
+            scene::load_scene(&frame.scene)?;
             let plan = plan_frame(&frame.settings(false)?)?;
             print!("{}", plan.dump());
             Ok(())

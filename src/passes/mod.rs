@@ -64,6 +64,10 @@ impl SceneGpu {
         let mut meshes: Vec<GpuMesh> = Vec::with_capacity(scene.meshes.len());
         let upload = |gpu: &GpuContext, meshes: &mut Vec<GpuMesh>| -> Result<()> {
             for (i, mesh) in scene.meshes.iter().enumerate() {
+                // A deforming scene is drawn as it stands at t = 0 (per-frame updates come with
+                // the layered-scattering technique that needs them).
+                let deformed = scene.deformation.map(|d| d.apply(mesh, 0.0));
+                let mesh = deformed.as_ref().unwrap_or(mesh);
                 mesh.validate(&format!("scene '{}' mesh {i}", scene.name))?;
                 let vertices = gpu.upload_buffer(
                     &mesh.gpu_vertices(),

@@ -4,6 +4,7 @@
 //! changes, so does its twin. [`raytrace`] renders a whole scene from the analytic shapes its
 //! meshes approximate, as an independent end-to-end reference.
 
+pub mod dipole;
 pub mod lighting;
 pub mod raytrace;
 pub mod tonemap;

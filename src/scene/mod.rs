@@ -4,45 +4,22 @@
 //! reference in [`crate::reference`] can ray-trace the exact surface the GPU rasterises an
 //! approximation of.
 
+pub mod builtin;
+pub mod file;
+pub mod generators;
+pub mod inspect;
+pub mod material;
 pub mod mesh;
+pub mod normals;
+pub mod obj;
+pub mod texture;
 
 use glam::{Mat4, Vec3};
 
+pub use builtin::{builtin, BUILTIN_SCENES};
+pub use file::load_scene;
+pub use material::{Light, LightKind, Material};
 pub use mesh::{Mesh, Shape};
-
-use crate::{LucentError, Result};
-
-/// Surface parameters of the base (opaque) material.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
-    /// Linear albedo, each channel in [0, 1].
-    pub albedo: Vec3,
-    /// Specular intensity in [0, 1].
-    pub specular: f32,
-    /// Roughness in [0, 1] (Blinn-Phong exponent 2^(11 - 10 r)).
-    pub roughness: f32,
-}
-
-/// A light.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Light {
-    /// Parallel light travelling along `direction`.
-    Directional {
-        /// Direction the light travels (need not be normalised).
-        direction: Vec3,
-        /// Linear colour times intensity.
-        radiance: Vec3,
-    },
-    /// Inverse-square light that fades smoothly to zero at `range`.
-    Point {
-        /// World position.
-        position: Vec3,
-        /// Linear colour times intensity.
-        radiance: Vec3,
-        /// Distance at which its contribution reaches zero.
-        range: f32,
-    },
-}
 
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +68,8 @@ pub struct Object {
 pub struct Scene {
     /// Name (built-in scene name or file stem).
     pub name: String,
+    /// The technique the scene is made to show (`None`: plain deferred lighting).
+    pub technique: Option<String>,
     /// Meshes, shared by objects.
     pub meshes: Vec<Mesh>,
     /// Instances.
@@ -105,80 +84,79 @@ pub struct Scene {
     pub sky: Vec3,
     /// Exposure multiplier before tonemapping.
     pub exposure: f32,
+    /// A deformation applied to every object's mesh over time (the `dynamic` scene).
+    pub deformation: Option<Deformation>,
+}
+
+/// A mesh deformation over time, evaluated on the CPU per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Deformation {
+    /// Radial wave: each vertex moves along its normal by
+    /// `amplitude * sin(frequency * y + speed * t)`; normals are recomputed.
+    Wave {
+        /// Displacement amplitude (object units).
+        amplitude: f32,
+        /// Spatial frequency along y (radians per unit).
+        frequency: f32,
+        /// Temporal speed (radians per second).
+        speed: f32,
+    },
+}
+
+impl Deformation {
+    /// The mesh deformed at time `t` seconds (normals recomputed angle-weighted).
+    pub fn apply(&self, mesh: &Mesh, t: f32) -> Mesh {
+        let mut out = mesh.clone();
+        match *self {
+            Deformation::Wave {
+                amplitude,
+                frequency,
+                speed,
+            } => {
+                for (p, n) in out.positions.iter_mut().zip(&mesh.normals) {
+                    *p += *n * (amplitude * (frequency * p.y + speed * t).sin());
+                }
+            }
+        }
+        out.normals = normals::angle_weighted_normals(&out.positions, &out.indices);
+        out.shape = None;
+        out
+    }
 }
 
 /// Lights the shaders loop over at most (glsl/common/scene.glsl).
 pub const MAX_LIGHTS: usize = 16;
 
-/// Built-in scenes: (name, one-line description).
-pub const BUILTIN_SCENES: &[(&str, &str)] = &[(
-    "smoke",
-    "a lit sphere on a ground plane: G-buffer -> deferred lighting -> tonemap",
-)];
-
-/// A built-in scene by name.
-pub fn builtin(name: &str) -> Result<Scene> {
-    match name {
-        "smoke" => Ok(smoke()),
-        _ => Err(LucentError::InvalidInput(format!(
-            "unknown scene '{name}'; built-in scenes: {}",
-            BUILTIN_SCENES
-                .iter()
-                .map(|(n, _)| *n)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))),
+/// Bakes the local thickness (GDC 2011) into the vertex colours of every mesh drawn with a
+/// material whose thickness is `bake`, through the on-disk cache keyed by mesh content, so only
+/// the first load of a mesh pays for the bake.
+pub fn prepare_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crate::Result<()> {
+    let mut wanted: Vec<usize> = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            o.material
+                .translucency
+                .as_ref()
+                .is_some_and(|t| t.thickness == material::ThicknessSource::Bake)
+        })
+        .map(|o| o.mesh)
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let options = crate::bake::BakeOptions {
+        rays: 256,
+        max_distance: None,
+        seed: 1,
+        texture_size: 512,
+        progress: false,
+    };
+    for m in wanted {
+        if !scene.meshes[m].colors.is_empty() {
+            continue; // the mesh brought its own (e.g. an OBJ written by bake-thickness)
+        }
+        let values = crate::bake::cached_per_vertex(&scene.meshes[m], &options, cache_dir)?;
+        scene.meshes[m].colors = values.into_iter().map(Vec3::splat).collect();
     }
-}
-
-/// The vertical slice: a sphere on a plane, a warm key light and a cool directional fill.
-fn smoke() -> Scene {
-    Scene {
-        name: "smoke".into(),
-        meshes: vec![
-            Mesh::generate(Shape::Sphere { radius: 1.0 }, 96, 48),
-            Mesh::generate(Shape::Plane { half_size: 6.0 }, 1, 1),
-        ],
-        objects: vec![
-            Object {
-                mesh: 0,
-                transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
-                material: Material {
-                    albedo: Vec3::new(0.8, 0.3, 0.2),
-                    specular: 0.5,
-                    roughness: 0.35,
-                },
-            },
-            Object {
-                mesh: 1,
-                transform: Mat4::IDENTITY,
-                material: Material {
-                    albedo: Vec3::new(0.6, 0.6, 0.55),
-                    specular: 0.1,
-                    roughness: 0.8,
-                },
-            },
-        ],
-        lights: vec![
-            Light::Point {
-                position: Vec3::new(2.5, 3.5, 2.0),
-                radiance: Vec3::new(30.0, 26.0, 20.0),
-                range: 20.0,
-            },
-            Light::Directional {
-                direction: Vec3::new(0.3, -1.0, -0.6),
-                radiance: Vec3::new(0.35, 0.45, 0.6),
-            },
-        ],
-        camera: Camera {
-            eye: Vec3::new(0.0, 2.2, 5.0),
-            target: Vec3::new(0.0, 0.8, 0.0),
-            fov_y_degrees: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        ambient: Vec3::new(0.03, 0.035, 0.04),
-        sky: Vec3::new(0.15, 0.2, 0.3),
-        exposure: 1.0,
-    }
+    Ok(())
 }

@@ -1,0 +1,462 @@
+//! The built-in scenes, by name. Each renders with no file from outside the repository: meshes
+//! are generated, textures are procedural, thickness is baked at load (and cached).
+
+use glam::{Mat4, Vec3};
+
+use super::generators::{self, Generator};
+use super::material::{
+    LayeredMedium, Light, LightKind, Material, ProceduralTexture, SssProfile, TextureSource,
+    ThicknessSource, Translucency,
+};
+use super::{Camera, Deformation, Mesh, Object, Scene, Shape};
+use crate::{LucentError, Result};
+
+/// Built-in scenes: (name, one-line description).
+pub const BUILTIN_SCENES: &[(&str, &str)] = &[
+    (
+        "smoke",
+        "a lit sphere on a ground plane: G-buffer -> deferred lighting -> tonemap",
+    ),
+    (
+        "cubes",
+        "the GDC 2011 demo: three lights, cubes with baked grayscale thickness, one red-veined cube with a green light inside",
+    ),
+    (
+        "grid125",
+        "5x5x5 translucent cubes filling the screen, three point lights",
+    ),
+    ("teapot", "the Utah teapot in normal-mapped marble (SSS profile)"),
+    ("skin", "spheres with d'Eon's six-Gaussian skin profile"),
+    (
+        "layered",
+        "Li et al.'s Table 1 layered materials on five spheres",
+    ),
+    ("dynamic", "a layered torus deforming every frame"),
+    (
+        "scaling",
+        "one teapot at a chosen triangle count: `scaling` (100k) or `scaling:N`",
+    ),
+];
+
+/// A built-in scene by name (`scaling:N` picks the triangle count of `scaling`).
+pub fn builtin(name: &str) -> Result<Scene> {
+    let (base, parameter) = match name.split_once(':') {
+        Some((b, p)) => (b, Some(p)),
+        None => (name, None),
+    };
+    if parameter.is_some() && base != "scaling" {
+        return Err(LucentError::InvalidInput(format!(
+            "scene '{base}' takes no parameter (only scaling:N does)"
+        )));
+    }
+    match base {
+        "smoke" => Ok(smoke()),
+        "cubes" => cubes(),
+        "grid125" => grid125(),
+        "teapot" => teapot(),
+        "skin" => skin(),
+        "layered" => layered(),
+        "dynamic" => dynamic(),
+        "scaling" => {
+            let triangles = match parameter {
+                None => 100_000,
+                Some(p) => p.parse::<u64>().map_err(|_| {
+                    LucentError::InvalidInput(format!(
+                        "scaling:{p}: the triangle count must be a whole number"
+                    ))
+                })?,
+            };
+            scaling(triangles)
+        }
+        _ => Err(LucentError::InvalidInput(format!(
+            "unknown scene '{name}'; built-in scenes: {}",
+            BUILTIN_SCENES
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
+fn floor() -> (Mesh, Material) {
+    (
+        Mesh::generate(Shape::Plane { half_size: 12.0 }, 1, 1),
+        Material::opaque("floor", Vec3::new(0.55, 0.55, 0.5), 0.1, 0.8),
+    )
+}
+
+fn base_scene(name: &str, technique: Option<&str>, camera: Camera) -> Scene {
+    Scene {
+        name: name.to_string(),
+        technique: technique.map(str::to_string),
+        meshes: Vec::new(),
+        objects: Vec::new(),
+        lights: Vec::new(),
+        camera,
+        ambient: Vec3::new(0.03, 0.035, 0.04),
+        sky: Vec3::new(0.15, 0.2, 0.3),
+        exposure: 1.0,
+        deformation: None,
+    }
+}
+
+fn camera(eye: Vec3, target: Vec3) -> Camera {
+    Camera {
+        eye,
+        target,
+        fov_y_degrees: 45.0,
+        near: 0.1,
+        far: 100.0,
+    }
+}
+
+impl Scene {
+    /// Adds a mesh, returning its index.
+    fn add_mesh(&mut self, mesh: Mesh) -> usize {
+        self.meshes.push(mesh);
+        self.meshes.len() - 1
+    }
+
+    /// Adds an object.
+    fn add(&mut self, mesh: usize, transform: Mat4, material: Material) {
+        self.objects.push(Object {
+            mesh,
+            transform,
+            material,
+        });
+    }
+
+    /// Adds the floor plane at y = 0.
+    fn add_floor(&mut self) {
+        let (mesh, material) = floor();
+        let m = self.add_mesh(mesh);
+        self.add(m, Mat4::IDENTITY, material);
+    }
+}
+
+/// The vertical slice: a sphere on a plane, a warm key light and a cool directional fill.
+fn smoke() -> Scene {
+    let mut s = base_scene(
+        "smoke",
+        None,
+        camera(Vec3::new(0.0, 2.2, 5.0), Vec3::new(0.0, 0.8, 0.0)),
+    );
+    let sphere = s.add_mesh(Mesh::generate(Shape::Sphere { radius: 1.0 }, 96, 48));
+    s.add(
+        sphere,
+        Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+        Material::opaque("clay", Vec3::new(0.8, 0.3, 0.2), 0.5, 0.35),
+    );
+    let (plane, floor_material) = (
+        Mesh::generate(Shape::Plane { half_size: 6.0 }, 1, 1),
+        floor().1,
+    );
+    let plane = s.add_mesh(plane);
+    s.add(plane, Mat4::IDENTITY, floor_material);
+    s.lights = vec![
+        Light::point(
+            Vec3::new(2.5, 3.5, 2.0),
+            Vec3::new(1.0, 26.0 / 30.0, 20.0 / 30.0),
+            30.0,
+            20.0,
+        ),
+        Light::directional(Vec3::new(0.3, -1.0, -0.6), Vec3::new(0.35, 0.45, 0.6), 1.0),
+    ];
+    s
+}
+
+/// A translucent material in the talk's style.
+fn translucent(name: &str, albedo: Vec3, thickness: ThicknessSource, color: Vec3) -> Material {
+    let mut m = Material::opaque(name, albedo, 0.3, 0.4);
+    let mut t = Translucency::new(thickness);
+    t.color = color;
+    t.ambient = 0.1;
+    m.translucency = Some(t);
+    m
+}
+
+/// The talk's demo scene (GDC 2011, slide "3 lights, Frostbite 2 deferred"): a row of cubes with
+/// grayscale baked thickness and one whose thickness is red, lit by a green light inside it.
+fn cubes() -> Result<Scene> {
+    let mut s = base_scene(
+        "cubes",
+        Some("translucency"),
+        camera(Vec3::new(0.0, 2.5, 7.5), Vec3::new(0.0, 0.9, 0.0)),
+    );
+    s.add_floor();
+    let cube = s.add_mesh(generators::generate(Generator::Cube, 6)?);
+    let gray = translucent(
+        "translucent-gray",
+        Vec3::new(0.85, 0.85, 0.8),
+        ThicknessSource::Bake,
+        Vec3::ONE,
+    );
+    for (i, x) in [-3.0f32, -1.0, 1.0].into_iter().enumerate() {
+        let size = 0.6 + 0.15 * i as f32;
+        s.add(
+            cube,
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(size),
+                glam::Quat::from_rotation_y(0.3 * i as f32),
+                Vec3::new(x, size, -0.5 * i as f32),
+            ),
+            gray.clone(),
+        );
+    }
+    let red = translucent(
+        "red-veined",
+        Vec3::new(0.9, 0.85, 0.8),
+        ThicknessSource::Bake,
+        Vec3::new(1.0, 0.1, 0.05),
+    );
+    s.add(
+        cube,
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.8),
+            glam::Quat::from_rotation_y(-0.4),
+            Vec3::new(3.0, 0.8, 0.0),
+        ),
+        red,
+    );
+    s.lights = vec![
+        Light::point(
+            Vec3::new(-2.0, 3.0, -2.5),
+            Vec3::new(1.0, 0.9, 0.7),
+            25.0,
+            15.0,
+        ),
+        Light::point(
+            Vec3::new(0.0, 1.0, -2.0),
+            Vec3::new(0.6, 0.7, 1.0),
+            10.0,
+            8.0,
+        ),
+        // The green light inside the red-veined cube's convex hull.
+        Light::point(Vec3::new(3.0, 0.8, 0.0), Vec3::new(0.1, 1.0, 0.2), 6.0, 4.0),
+    ];
+    Ok(s)
+}
+
+/// 5 x 5 x 5 translucent cubes filling the screen, three point lights.
+fn grid125() -> Result<Scene> {
+    let mut s = base_scene(
+        "grid125",
+        Some("translucency"),
+        camera(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO),
+    );
+    s.sky = Vec3::new(0.02, 0.02, 0.03);
+    let cube = s.add_mesh(generators::generate(Generator::Cube, 1)?);
+    let material = translucent(
+        "grid-translucent",
+        Vec3::new(0.8, 0.75, 0.7),
+        ThicknessSource::Constant(0.7),
+        Vec3::ONE,
+    );
+    for x in 0..5 {
+        for y in 0..5 {
+            for z in 0..5 {
+                let p = Vec3::new(x as f32 - 2.0, y as f32 - 2.0, z as f32 - 2.0) * 1.25;
+                s.add(
+                    cube,
+                    Mat4::from_scale_rotation_translation(
+                        Vec3::splat(0.45),
+                        glam::Quat::IDENTITY,
+                        p,
+                    ),
+                    material.clone(),
+                );
+            }
+        }
+    }
+    s.lights = vec![
+        Light::point(
+            Vec3::new(-1.9, 1.2, 0.6),
+            Vec3::new(1.0, 0.6, 0.3),
+            8.0,
+            6.0,
+        ),
+        Light::point(
+            Vec3::new(1.3, -0.6, -1.2),
+            Vec3::new(0.3, 0.7, 1.0),
+            8.0,
+            6.0,
+        ),
+        Light::point(Vec3::new(0.6, 1.9, 2.4), Vec3::new(0.9, 0.9, 0.9), 8.0, 6.0),
+    ];
+    Ok(s)
+}
+
+fn marble_normal() -> TextureSource {
+    TextureSource::Procedural(ProceduralTexture::MarbleNormal {
+        frequency: 18.0,
+        strength: 0.35,
+    })
+}
+
+/// The thesis's subject: a normal-mapped marble teapot.
+fn teapot() -> Result<Scene> {
+    let mut s = base_scene(
+        "teapot",
+        Some("lbb"),
+        camera(Vec3::new(0.0, 1.6, 3.6), Vec3::new(0.0, 0.6, 0.0)),
+    );
+    s.add_floor();
+    let teapot = s.add_mesh(generators::generate(Generator::Teapot, 4)?);
+    let mut marble = Material::opaque("marble", Vec3::new(0.83, 0.79, 0.75), 0.6, 0.25);
+    marble.normal_texture = Some(marble_normal());
+    marble.sss = Some(SssProfile::preset("marble")?);
+    s.add(teapot, Mat4::IDENTITY, marble);
+    s.lights = vec![
+        Light::point(Vec3::new(2.0, 3.0, 2.0), Vec3::ONE, 25.0, 15.0),
+        Light::directional(Vec3::new(-0.5, -1.0, -0.3), Vec3::new(0.3, 0.35, 0.45), 1.0),
+    ];
+    Ok(s)
+}
+
+/// Three spheres with d'Eon's skin profile.
+fn skin() -> Result<Scene> {
+    let mut s = base_scene(
+        "skin",
+        Some("control"),
+        camera(Vec3::new(0.0, 1.2, 5.0), Vec3::new(0.0, 0.8, 0.0)),
+    );
+    s.add_floor();
+    let sphere = s.add_mesh(generators::generate(Generator::Icosphere, 4)?);
+    for (i, albedo) in [
+        Vec3::new(0.85, 0.62, 0.52),
+        Vec3::new(0.65, 0.43, 0.33),
+        Vec3::new(0.36, 0.22, 0.16),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut m = Material::opaque(&format!("skin-{i}"), albedo, 0.35, 0.45);
+        m.sss = Some(SssProfile::preset("skin")?);
+        s.add(
+            sphere,
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(0.7),
+                glam::Quat::IDENTITY,
+                Vec3::new(-1.6 + 1.6 * i as f32, 0.7, 0.0),
+            ),
+            m,
+        );
+    }
+    s.lights = vec![
+        Light::point(
+            Vec3::new(1.5, 2.5, 2.5),
+            Vec3::new(1.0, 0.95, 0.9),
+            20.0,
+            15.0,
+        ),
+        Light::point(
+            Vec3::new(-2.0, 1.5, -2.0),
+            Vec3::new(0.5, 0.6, 1.0),
+            10.0,
+            10.0,
+        ),
+    ];
+    Ok(s)
+}
+
+/// Li et al.'s Table 1 coefficient sets, one sphere each.
+fn layered() -> Result<Scene> {
+    let mut s = base_scene(
+        "layered",
+        Some("layered"),
+        camera(Vec3::new(0.0, 1.5, 6.5), Vec3::new(0.0, 0.6, 0.0)),
+    );
+    s.add_floor();
+    let sphere = s.add_mesh(generators::generate(Generator::Icosphere, 4)?);
+    for (i, preset) in ["frog", "teapot", "bunny", "buddha", "dragon"]
+        .iter()
+        .enumerate()
+    {
+        let mut m = Material::opaque(preset, Vec3::new(0.8, 0.7, 0.6), 0.3, 0.4);
+        m.layers = Some(LayeredMedium::preset(preset)?);
+        s.add(
+            sphere,
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(0.5),
+                glam::Quat::IDENTITY,
+                Vec3::new(-2.4 + 1.2 * i as f32, 0.5, 0.0),
+            ),
+            m,
+        );
+    }
+    s.lights = vec![
+        Light::point(Vec3::new(0.0, 3.0, 3.0), Vec3::ONE, 25.0, 15.0),
+        Light {
+            kind: LightKind::Spot {
+                position: Vec3::new(0.0, 3.0, -3.0),
+                direction: Vec3::new(0.0, -0.6, 1.0),
+                range: 12.0,
+                inner_degrees: 25.0,
+                outer_degrees: 40.0,
+            },
+            color: Vec3::new(1.0, 0.8, 0.6),
+            intensity: 30.0,
+            translucency_scale: 1.0,
+        },
+    ];
+    Ok(s)
+}
+
+/// A layered torus whose surface ripples every frame (the "dynamic objects" of Li et al.).
+fn dynamic() -> Result<Scene> {
+    let mut s = base_scene(
+        "dynamic",
+        Some("layered"),
+        camera(Vec3::new(0.0, 2.0, 4.5), Vec3::new(0.0, 0.8, 0.0)),
+    );
+    s.add_floor();
+    let torus = s.add_mesh(generators::generate(Generator::Torus, 4)?);
+    let mut m = Material::opaque("jelly", Vec3::new(0.7, 0.8, 0.5), 0.4, 0.3);
+    m.layers = Some(LayeredMedium::preset("bunny")?);
+    s.add(
+        torus,
+        Mat4::from_scale_rotation_translation(
+            Vec3::ONE,
+            glam::Quat::from_rotation_x(0.9),
+            Vec3::new(0.0, 1.0, 0.0),
+        ),
+        m,
+    );
+    s.deformation = Some(Deformation::Wave {
+        amplitude: 0.06,
+        frequency: 9.0,
+        speed: 3.0,
+    });
+    s.lights = vec![
+        Light::point(Vec3::new(1.5, 3.0, 2.0), Vec3::ONE, 20.0, 15.0),
+        Light::point(
+            Vec3::new(-1.5, 1.0, -1.5),
+            Vec3::new(0.4, 0.6, 1.0),
+            8.0,
+            8.0,
+        ),
+    ];
+    Ok(s)
+}
+
+/// One teapot at `triangles` triangles (Li et al.'s table spans 2,900 to 1,084,450).
+fn scaling(triangles: u64) -> Result<Scene> {
+    let mut s = base_scene(
+        "scaling",
+        Some("layered"),
+        camera(Vec3::new(0.0, 1.6, 3.6), Vec3::new(0.0, 0.6, 0.0)),
+    );
+    let (mesh, _) = generators::generate_with_triangles(Generator::Teapot, triangles)?;
+    let teapot = s.add_mesh(mesh);
+    let mut m = Material::opaque("scaling", Vec3::new(0.8, 0.75, 0.7), 0.4, 0.35);
+    m.layers = Some(LayeredMedium::preset("teapot")?);
+    s.add(teapot, Mat4::IDENTITY, m);
+    s.lights = vec![Light::point(
+        Vec3::new(2.0, 3.0, 2.0),
+        Vec3::ONE,
+        25.0,
+        15.0,
+    )];
+    Ok(s)
+}

@@ -1,0 +1,909 @@
+//! Scene files: TOML, read through serde, validated, and turned into a [`Scene`].
+//!
+//! The format is documented by `docs/scene-format.toml`, a commented example that the tests load.
+//! Every error names the file, the line and the key: syntax errors, unknown keys and wrong types
+//! come from the TOML parser (which knows the position); missing files and out-of-range values
+//! are checked here, and the line is found from the section and key.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use serde::Deserialize;
+
+use super::generators::{self, Generator};
+use super::material::{
+    Gaussian, Layer, LayeredMedium, Light, LightKind, Material, PowMode, SssProfile, TextureSource,
+    ThicknessSource, Translucency,
+};
+use super::{Camera, Deformation, Object, Scene, MAX_LIGHTS};
+use crate::{LucentError, Result};
+
+/// Largest file a scene may be (a scene file is a few kilobytes; this refuses binary garbage).
+const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneToml {
+    name: Option<String>,
+    technique: Option<String>,
+    ambient: Option<[f32; 3]>,
+    sky: Option<[f32; 3]>,
+    exposure: Option<f32>,
+    camera: CameraToml,
+    #[serde(default)]
+    mesh: Vec<MeshToml>,
+    #[serde(default)]
+    material: Vec<MaterialToml>,
+    #[serde(default)]
+    object: Vec<ObjectToml>,
+    #[serde(default)]
+    light: Vec<LightToml>,
+    deformation: Option<DeformationToml>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraToml {
+    eye: [f32; 3],
+    target: [f32; 3],
+    fov_y_degrees: Option<f32>,
+    near: Option<f32>,
+    far: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshToml {
+    name: String,
+    obj: Option<PathBuf>,
+    generator: Option<String>,
+    level: Option<u32>,
+    triangles: Option<u64>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ThicknessToml {
+    Value(f32),
+    Named(String),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TranslucencyToml {
+    thickness: ThicknessToml,
+    color: Option<[f32; 3]>,
+    power: Option<f32>,
+    distortion: Option<f32>,
+    ambient: Option<f32>,
+    pow: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SssToml {
+    preset: Option<String>,
+    /// Rows of `[variance_mm2, r, g, b]`.
+    gaussians: Option<Vec<[f32; 4]>>,
+    units_per_mm: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LayerToml {
+    thickness: [f32; 3],
+    scattering: [f32; 3],
+    absorption: [f32; 3],
+    g: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LayersToml {
+    preset: Option<String>,
+    layers: Option<Vec<LayerToml>>,
+    eta: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialToml {
+    name: String,
+    albedo: Option<[f32; 3]>,
+    specular: Option<f32>,
+    roughness: Option<f32>,
+    albedo_texture: Option<PathBuf>,
+    normal_texture: Option<PathBuf>,
+    translucency: Option<TranslucencyToml>,
+    sss: Option<SssToml>,
+    layers: Option<LayersToml>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ScaleToml {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectToml {
+    mesh: String,
+    material: String,
+    translate: Option<[f32; 3]>,
+    rotate_degrees: Option<[f32; 3]>,
+    scale: Option<ScaleToml>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightToml {
+    #[serde(rename = "type")]
+    kind: String,
+    color: Option<[f32; 3]>,
+    intensity: f32,
+    position: Option<[f32; 3]>,
+    direction: Option<[f32; 3]>,
+    range: Option<f32>,
+    inner_degrees: Option<f32>,
+    outer_degrees: Option<f32>,
+    translucency_scale: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DeformationToml {
+    #[serde(rename = "type")]
+    kind: String,
+    amplitude: f32,
+    frequency: f32,
+    speed: f32,
+}
+
+/// Where in the file a value sits: `[[section]]` number `index` (or a plain `[section]` /
+/// top level when `index` is `None`), key `key`. Used to put line numbers on semantic errors.
+struct Locator<'a> {
+    path: &'a Path,
+    source: &'a str,
+}
+
+impl Locator<'_> {
+    /// The 1-based line of `key` inside the `index`-th `[[section]]` (or `[section]`, or the
+    /// top level for an empty section name), if it can be found.
+    fn line(&self, section: &str, index: Option<usize>, key: &str) -> Option<usize> {
+        let mut current: Option<(String, usize)> = Some((String::new(), 0));
+        let mut counts: HashMap<String, usize> = HashMap::new();
+        for (number, raw) in self.source.lines().enumerate() {
+            let line = raw.trim();
+            if let Some(header) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
+                let name = header.trim().to_string();
+                let n = counts.entry(name.clone()).or_insert(0);
+                current = Some((name, *n));
+                *n += 1;
+                continue;
+            }
+            if let Some(header) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
+                current = Some((header.trim().to_string(), 0));
+                continue;
+            }
+            let Some((name, i)) = &current else { continue };
+            let section_matches = name == section
+                || (name.starts_with(section) && name[section.len()..].starts_with('.'));
+            let index_matches = index.is_none_or(|want| *i == want);
+            let key_matches = line
+                .split('=')
+                .next()
+                .is_some_and(|k| k.trim() == key && line.contains('='));
+            if section_matches && index_matches && key_matches {
+                return Some(number + 1);
+            }
+        }
+        None
+    }
+
+    /// An error naming the file, the line (when found) and the key.
+    fn error(
+        &self,
+        section: &str,
+        index: Option<usize>,
+        key: &str,
+        message: impl std::fmt::Display,
+    ) -> LucentError {
+        let full_key = match (section.is_empty(), index) {
+            (true, _) => key.to_string(),
+            (false, Some(i)) => format!("{section}[{i}].{key}"),
+            (false, None) => format!("{section}.{key}"),
+        };
+        let location = match self.line(section, index, key) {
+            Some(line) => format!("line {line}, key `{full_key}`"),
+            None => format!("key `{full_key}`"),
+        };
+        LucentError::file(self.path, format!("{location}: {message}"))
+    }
+}
+
+/// Loads a scene file. Relative paths inside it (OBJ files, textures) are resolved against the
+/// file's directory.
+pub fn load_scene_file(path: &Path) -> Result<Scene> {
+    let metadata = std::fs::metadata(path)
+        .map_err(|e| LucentError::file(path, format!("cannot read scene file: {e}")))?;
+    if metadata.len() > MAX_SCENE_FILE_BYTES {
+        return Err(LucentError::file(
+            path,
+            format!(
+                "{} bytes is too large for a scene file (at most {MAX_SCENE_FILE_BYTES})",
+                metadata.len()
+            ),
+        ));
+    }
+    let bytes = std::fs::read(path)
+        .map_err(|e| LucentError::file(path, format!("cannot read scene file: {e}")))?;
+    let source = String::from_utf8(bytes).map_err(|e| {
+        LucentError::file(
+            path,
+            format!(
+                "not UTF-8 text (byte {}): scene files are UTF-8 TOML",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })?;
+    parse_scene(path, &source)
+}
+
+/// Parses scene TOML `source`; `path` names it in errors and anchors relative paths.
+pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
+    let raw: SceneToml = toml::from_str(source).map_err(|e| {
+        // toml's message carries "line N, column M" and the offending key or value.
+        LucentError::file(path, format!("invalid scene: {}", e.to_string().trim_end()))
+    })?;
+    let at = Locator { path, source };
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let resolve = |p: &Path| {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            base.join(p)
+        }
+    };
+
+    let finite3 = |v: [f32; 3]| v.iter().all(|c| c.is_finite());
+    let check3 = |section: &str,
+                  index: Option<usize>,
+                  key: &str,
+                  v: Option<[f32; 3]>,
+                  min: f32|
+     -> Result<()> {
+        if let Some(v) = v {
+            if !finite3(v) || v.iter().any(|&c| c < min) {
+                return Err(at.error(
+                    section,
+                    index,
+                    key,
+                    format!(
+                        "{v:?} must be finite{}",
+                        if min.is_finite() {
+                            format!(" and >= {min}")
+                        } else {
+                            String::new()
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    };
+
+    // Camera.
+    let cam = &raw.camera;
+    check3("camera", None, "eye", Some(cam.eye), f32::NEG_INFINITY)?;
+    check3(
+        "camera",
+        None,
+        "target",
+        Some(cam.target),
+        f32::NEG_INFINITY,
+    )?;
+    let fov = cam.fov_y_degrees.unwrap_or(45.0);
+    if !(fov > 1.0 && fov < 179.0) {
+        return Err(at.error(
+            "camera",
+            None,
+            "fov_y_degrees",
+            format!("{fov} must be between 1 and 179"),
+        ));
+    }
+    let near = cam.near.unwrap_or(0.1);
+    let far = cam.far.unwrap_or(100.0);
+    if !(near > 0.0 && near.is_finite()) {
+        return Err(at.error("camera", None, "near", format!("{near} must be > 0")));
+    }
+    if !(far > near && far.is_finite()) {
+        return Err(at.error(
+            "camera",
+            None,
+            "far",
+            format!("{far} must be finite and > near ({near})"),
+        ));
+    }
+    if Vec3::from(cam.eye).distance(Vec3::from(cam.target)) < 1e-6 {
+        return Err(at.error("camera", None, "target", "must differ from eye"));
+    }
+
+    // Meshes.
+    let mut meshes = Vec::new();
+    let mut mesh_index: HashMap<&str, usize> = HashMap::new();
+    for (i, m) in raw.mesh.iter().enumerate() {
+        if mesh_index.insert(m.name.as_str(), i).is_some() {
+            return Err(at.error(
+                "mesh",
+                Some(i),
+                "name",
+                format!("mesh '{}' is defined twice", m.name),
+            ));
+        }
+        let mesh = match (&m.obj, &m.generator) {
+            (Some(obj), None) => {
+                let obj_path = resolve(obj);
+                if !obj_path.exists() {
+                    return Err(at.error(
+                        "mesh",
+                        Some(i),
+                        "obj",
+                        format!("mesh file {} not found", obj_path.display()),
+                    ));
+                }
+                super::obj::load_obj(&obj_path)?.mesh
+            }
+            (None, Some(name)) => {
+                let generator = Generator::parse(name)
+                    .map_err(|e| at.error("mesh", Some(i), "generator", e))?;
+                match (m.level, m.triangles) {
+                    (Some(_), Some(_)) => {
+                        return Err(at.error(
+                            "mesh",
+                            Some(i),
+                            "triangles",
+                            "give `level` or `triangles`, not both",
+                        ))
+                    }
+                    (_, Some(t)) => {
+                        generators::generate_with_triangles(generator, t)
+                            .map_err(|e| at.error("mesh", Some(i), "triangles", e))?
+                            .0
+                    }
+                    (level, None) => generators::generate(generator, level.unwrap_or(2))
+                        .map_err(|e| at.error("mesh", Some(i), "level", e))?,
+                }
+            }
+            _ => {
+                return Err(at.error(
+                    "mesh",
+                    Some(i),
+                    "name",
+                    format!(
+                        "mesh '{}' needs exactly one of `obj` or `generator`",
+                        m.name
+                    ),
+                ))
+            }
+        };
+        meshes.push(mesh);
+    }
+
+    // Materials.
+    let mut materials: HashMap<&str, Material> = HashMap::new();
+    for (i, m) in raw.material.iter().enumerate() {
+        let material = build_material(m, i, &at, &resolve)?;
+        if materials.insert(m.name.as_str(), material).is_some() {
+            return Err(at.error(
+                "material",
+                Some(i),
+                "name",
+                format!("material '{}' is defined twice", m.name),
+            ));
+        }
+    }
+
+    // Objects.
+    let mut objects = Vec::new();
+    for (i, o) in raw.object.iter().enumerate() {
+        let mesh = *mesh_index.get(o.mesh.as_str()).ok_or_else(|| {
+            at.error(
+                "object",
+                Some(i),
+                "mesh",
+                format!("no mesh named '{}'", o.mesh),
+            )
+        })?;
+        let material = materials
+            .get(o.material.as_str())
+            .ok_or_else(|| {
+                at.error(
+                    "object",
+                    Some(i),
+                    "material",
+                    format!("no material named '{}'", o.material),
+                )
+            })?
+            .clone();
+        check3(
+            "object",
+            Some(i),
+            "translate",
+            o.translate,
+            f32::NEG_INFINITY,
+        )?;
+        check3(
+            "object",
+            Some(i),
+            "rotate_degrees",
+            o.rotate_degrees,
+            f32::NEG_INFINITY,
+        )?;
+        let scale = match o.scale {
+            None => Vec3::ONE,
+            Some(ScaleToml::Uniform(s)) => Vec3::splat(s),
+            Some(ScaleToml::PerAxis(s)) => Vec3::from(s),
+        };
+        if !(scale.is_finite() && scale.min_element() > 0.0) {
+            return Err(at.error(
+                "object",
+                Some(i),
+                "scale",
+                format!("{scale} must be finite and > 0"),
+            ));
+        }
+        let r = Vec3::from(o.rotate_degrees.unwrap_or_default());
+        let rotation = Quat::from_euler(
+            EulerRot::XYZ,
+            r.x.to_radians(),
+            r.y.to_radians(),
+            r.z.to_radians(),
+        );
+        let transform = Mat4::from_scale_rotation_translation(
+            scale,
+            rotation,
+            Vec3::from(o.translate.unwrap_or_default()),
+        );
+        objects.push(Object {
+            mesh,
+            transform,
+            material,
+        });
+    }
+    if objects.is_empty() {
+        return Err(LucentError::file(
+            path,
+            "the scene has no [[object]]: nothing to draw",
+        ));
+    }
+
+    // Lights.
+    if raw.light.len() > MAX_LIGHTS {
+        return Err(at.error(
+            "light",
+            Some(MAX_LIGHTS),
+            "type",
+            format!(
+                "{} lights; at most {MAX_LIGHTS} are supported",
+                raw.light.len()
+            ),
+        ));
+    }
+    let mut lights = Vec::new();
+    for (i, l) in raw.light.iter().enumerate() {
+        let need = |v: Option<[f32; 3]>, key: &str| -> Result<Vec3> {
+            let v = v.ok_or_else(|| {
+                at.error(
+                    "light",
+                    Some(i),
+                    key,
+                    format!("a {} light needs `{key}`", l.kind),
+                )
+            })?;
+            check3("light", Some(i), key, Some(v), f32::NEG_INFINITY)?;
+            Ok(Vec3::from(v))
+        };
+        let range = l.range.unwrap_or(20.0);
+        let kind = match l.kind.as_str() {
+            "directional" => LightKind::Directional {
+                direction: need(l.direction, "direction")?,
+            },
+            "point" => LightKind::Point {
+                position: need(l.position, "position")?,
+                range,
+            },
+            "spot" => LightKind::Spot {
+                position: need(l.position, "position")?,
+                direction: need(l.direction, "direction")?,
+                range,
+                inner_degrees: l.inner_degrees.unwrap_or(20.0),
+                outer_degrees: l.outer_degrees.unwrap_or(30.0),
+            },
+            other => {
+                return Err(at.error(
+                    "light",
+                    Some(i),
+                    "type",
+                    format!("unknown light type '{other}'; use point, spot or directional"),
+                ))
+            }
+        };
+        check3("light", Some(i), "color", l.color, 0.0)?;
+        let light = Light {
+            kind,
+            color: Vec3::from(l.color.unwrap_or([1.0; 3])),
+            intensity: l.intensity,
+            translucency_scale: l.translucency_scale.unwrap_or(1.0),
+        };
+        // Map the validation failure back to the key it is about.
+        light.validate("light").map_err(|e| {
+            let message = e.to_string();
+            let key = [
+                "intensity",
+                "translucency_scale",
+                "range",
+                "direction",
+                "position",
+                "color",
+            ]
+            .into_iter()
+            .find(|k| message.contains(k))
+            .unwrap_or(if message.contains("angles") {
+                "outer_degrees"
+            } else {
+                "type"
+            });
+            at.error("light", Some(i), key, message.trim_start_matches("light: "))
+        })?;
+        lights.push(light);
+    }
+
+    let deformation = match &raw.deformation {
+        None => None,
+        Some(d) if d.kind == "wave" => {
+            for (key, v) in [
+                ("amplitude", d.amplitude),
+                ("frequency", d.frequency),
+                ("speed", d.speed),
+            ] {
+                if !v.is_finite() {
+                    return Err(at.error("deformation", None, key, format!("{v} must be finite")));
+                }
+            }
+            Some(Deformation::Wave {
+                amplitude: d.amplitude,
+                frequency: d.frequency,
+                speed: d.speed,
+            })
+        }
+        Some(d) => {
+            return Err(at.error(
+                "deformation",
+                None,
+                "type",
+                format!("unknown deformation '{}'; use wave", d.kind),
+            ))
+        }
+    };
+
+    check3("", None, "ambient", raw.ambient, 0.0)?;
+    check3("", None, "sky", raw.sky, 0.0)?;
+    let exposure = raw.exposure.unwrap_or(1.0);
+    if !(exposure.is_finite() && exposure > 0.0) {
+        return Err(at.error(
+            "",
+            None,
+            "exposure",
+            format!("{exposure} must be finite and > 0"),
+        ));
+    }
+    let name = raw.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into())
+    });
+    Ok(Scene {
+        name,
+        technique: raw.technique.clone(),
+        meshes,
+        objects,
+        lights,
+        camera: Camera {
+            eye: Vec3::from(cam.eye),
+            target: Vec3::from(cam.target),
+            fov_y_degrees: fov,
+            near,
+            far,
+        },
+        ambient: Vec3::from(raw.ambient.unwrap_or([0.03; 3])),
+        sky: Vec3::from(raw.sky.unwrap_or([0.15, 0.2, 0.3])),
+        exposure,
+        deformation,
+    })
+}
+
+fn build_material(
+    m: &MaterialToml,
+    i: usize,
+    at: &Locator<'_>,
+    resolve: &dyn Fn(&Path) -> PathBuf,
+) -> Result<Material> {
+    let texture = |p: &Option<PathBuf>, key: &str| -> Result<Option<TextureSource>> {
+        match p {
+            None => Ok(None),
+            Some(p) => {
+                let full = resolve(p);
+                if !full.exists() {
+                    return Err(at.error(
+                        "material",
+                        Some(i),
+                        key,
+                        format!("texture {} not found", full.display()),
+                    ));
+                }
+                Ok(Some(TextureSource::File(full)))
+            }
+        }
+    };
+    let mut material = Material::opaque(
+        &m.name,
+        Vec3::from(m.albedo.unwrap_or([0.8; 3])),
+        m.specular.unwrap_or(0.5),
+        m.roughness.unwrap_or(0.5),
+    );
+    material.albedo_texture = texture(&m.albedo_texture, "albedo_texture")?;
+    material.normal_texture = texture(&m.normal_texture, "normal_texture")?;
+    if let Some(t) = &m.translucency {
+        let thickness = match &t.thickness {
+            ThicknessToml::Value(v) => ThicknessSource::Constant(*v),
+            ThicknessToml::Named(s) if s == "bake" => ThicknessSource::Bake,
+            ThicknessToml::Named(s) if s == "vertex" => ThicknessSource::PerVertex,
+            ThicknessToml::Named(s) => {
+                let full = resolve(Path::new(s));
+                if !full.exists() {
+                    return Err(at.error("material", Some(i), "thickness", format!("thickness texture {} not found (or use a number, \"bake\" or \"vertex\")", full.display())));
+                }
+                ThicknessSource::Texture(TextureSource::File(full))
+            }
+        };
+        let mut translucency = Translucency::new(thickness);
+        if let Some(c) = t.color {
+            translucency.color = Vec3::from(c);
+        }
+        translucency.power = t.power.unwrap_or(translucency.power);
+        translucency.distortion = t.distortion.unwrap_or(translucency.distortion);
+        translucency.ambient = t.ambient.unwrap_or(translucency.ambient);
+        translucency.pow_mode = match t.pow.as_deref() {
+            None | Some("exact") => PowMode::Exact,
+            Some("exp2") => PowMode::SphericalGaussian,
+            Some(other) => {
+                return Err(at.error(
+                    "material",
+                    Some(i),
+                    "pow",
+                    format!("unknown pow mode '{other}'; use exact or exp2"),
+                ))
+            }
+        };
+        material.translucency = Some(translucency);
+    }
+    if let Some(s) = &m.sss {
+        let mut profile = match (&s.preset, &s.gaussians) {
+            (Some(p), None) => {
+                SssProfile::preset(p).map_err(|e| at.error("material", Some(i), "preset", e))?
+            }
+            (None, Some(rows)) => SssProfile {
+                name: "custom".into(),
+                gaussians: rows
+                    .iter()
+                    .map(|r| Gaussian {
+                        variance: r[0],
+                        weight: Vec3::new(r[1], r[2], r[3]),
+                    })
+                    .collect(),
+                units_per_mm: 0.01,
+            },
+            _ => {
+                return Err(at.error(
+                    "material",
+                    Some(i),
+                    "sss",
+                    "give exactly one of `preset` or `gaussians`",
+                ))
+            }
+        };
+        if let Some(u) = s.units_per_mm {
+            profile.units_per_mm = u;
+        }
+        profile.validate().map_err(|e| {
+            at.error(
+                "material",
+                Some(i),
+                if s.gaussians.is_some() {
+                    "gaussians"
+                } else {
+                    "units_per_mm"
+                },
+                e,
+            )
+        })?;
+        material.sss = Some(profile);
+    }
+    if let Some(l) = &m.layers {
+        let mut medium = match (&l.preset, &l.layers) {
+            (Some(p), None) => {
+                LayeredMedium::preset(p).map_err(|e| at.error("material", Some(i), "preset", e))?
+            }
+            (None, Some(layers)) => LayeredMedium {
+                name: "custom".into(),
+                layers: layers
+                    .iter()
+                    .map(|l| Layer {
+                        thickness: Vec3::from(l.thickness),
+                        scattering: Vec3::from(l.scattering),
+                        absorption: Vec3::from(l.absorption),
+                        anisotropy: l.g.unwrap_or(0.0),
+                    })
+                    .collect(),
+                eta: 1.3,
+            },
+            _ => {
+                return Err(at.error(
+                    "material",
+                    Some(i),
+                    "layers",
+                    "give exactly one of `preset` or `layers`",
+                ))
+            }
+        };
+        if let Some(eta) = l.eta {
+            medium.eta = eta;
+        }
+        medium
+            .validate()
+            .map_err(|e| at.error("material", Some(i), "layers", e))?;
+        material.layers = Some(medium);
+    }
+    // Map a range failure to the key it names.
+    material.validate().map_err(|e| {
+        let message = e.to_string();
+        let key = [
+            "albedo",
+            "specular",
+            "roughness",
+            "power",
+            "distortion",
+            "ambient",
+            "thickness",
+            "color",
+        ]
+        .into_iter()
+        .find(|k| message.contains(k))
+        .unwrap_or("name");
+        at.error("material", Some(i), key, message)
+    })?;
+    Ok(material)
+}
+
+/// Loads a scene by built-in name, or from a `.toml` file when `name_or_path` ends in `.toml`
+/// or names an existing file, and bakes the thickness its materials ask for.
+pub fn load_scene(name_or_path: &str) -> Result<Scene> {
+    let path = Path::new(name_or_path);
+    let mut scene = if name_or_path.ends_with(".toml") || path.is_file() {
+        load_scene_file(path)?
+    } else {
+        super::builtin(name_or_path)?
+    };
+    let cache = crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness");
+    super::prepare_thickness(&mut scene, &cache)?;
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(source: &str) -> Result<Scene> {
+        parse_scene(Path::new("test.toml"), source)
+    }
+
+    const MINIMAL: &str = r#"
+[camera]
+eye = [0, 1, 5]
+target = [0, 0, 0]
+
+[[mesh]]
+name = "ball"
+generator = "icosphere"
+level = 1
+
+[[material]]
+name = "red"
+albedo = [0.8, 0.1, 0.1]
+
+[[object]]
+mesh = "ball"
+material = "red"
+"#;
+
+    #[test]
+    fn minimal_scene_loads() {
+        let s = parse(MINIMAL).unwrap();
+        assert_eq!(s.objects.len(), 1);
+        assert_eq!(s.name, "test");
+    }
+
+    /// The 1-based line of the first line of `source` starting with `prefix`.
+    fn line_of(source: &str, prefix: &str) -> usize {
+        source.lines().position(|l| l.starts_with(prefix)).unwrap() + 1
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let bad = MINIMAL.replace(
+            "albedo = [0.8, 0.1, 0.1]",
+            "albedo = [0.8, 0.1, 0.1]\nroughness = 3.0",
+        );
+        let e = parse(&bad).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&bad, "roughness"));
+        assert!(
+            e.contains("test.toml") && e.contains(&line) && e.contains("material[0].roughness"),
+            "{e}"
+        );
+
+        let unknown = MINIMAL.replace("level = 1", "level = 1\ncolour = 3");
+        let e = parse(&unknown).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&unknown, "colour"));
+        assert!(
+            e.contains("test.toml") && e.contains(&line) && e.contains("colour"),
+            "{e}"
+        );
+
+        let wrong_type = MINIMAL.replace("level = 1", "level = \"high\"");
+        let e = parse(&wrong_type).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&wrong_type, "level"));
+        assert!(e.contains(&line) && e.contains("level"), "{e}");
+
+        let missing = MINIMAL.replace(
+            "generator = \"icosphere\"\nlevel = 1",
+            "obj = \"nowhere.obj\"",
+        );
+        let e = parse(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("mesh[0].obj") && e.contains("nowhere.obj") && e.contains("not found"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn lights_are_checked() {
+        let with_light = format!(
+            "{MINIMAL}\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = -5\n"
+        );
+        let e = parse(&with_light).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&with_light, "intensity"));
+        assert!(e.contains("light[0].intensity") && e.contains(&line), "{e}");
+        let spot = format!("{MINIMAL}\n[[light]]\ntype = \"spot\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\nintensity = 5\n");
+        assert!(matches!(
+            parse(&spot).unwrap().lights[0].kind,
+            LightKind::Spot { .. }
+        ));
+    }
+
+    #[test]
+    fn the_documented_example_loads() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scene-format.toml");
+        let scene = load_scene_file(&path).unwrap();
+        assert_eq!(scene.objects.len(), 3);
+        assert_eq!(scene.lights.len(), 3);
+        let jade = &scene.objects[0].material;
+        assert_eq!(
+            jade.translucency.as_ref().unwrap().thickness,
+            ThicknessSource::Bake
+        );
+        assert!(scene.objects[1].material.sss.is_some());
+    }
+}

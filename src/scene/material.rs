@@ -1,0 +1,564 @@
+//! Materials and lights: what a surface is made of and what lights it.
+//!
+//! - [`Material`]: the base (albedo, specular, roughness, optional textures) plus the optional
+//!   parts each technique reads: [`Translucency`] (GDC 2011), [`SssProfile`] (screen-space SSS,
+//!   a sum of Gaussians) and [`LayeredMedium`] (Li et al.'s multi-layer scattering).
+//!   A part that is `None` costs nothing: the frame graph leaves out its passes.
+//! - [`Light`]: point, spot or directional, with colour, intensity, range and the talk's
+//!   per-light translucency scale.
+//!
+//! Presets carry their sources: d'Eon's six-Gaussian skin fit (the thesis's Figure 17) and the
+//! coefficient sets of Li et al.'s Table 1.
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+use crate::{LucentError, Result};
+
+/// Where a texture comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureSource {
+    /// A file (PNG, JPEG, TGA, EXR, HDR), relative paths resolved against the scene file.
+    File(PathBuf),
+    /// Made in code, so built-in scenes need no file from outside the repository.
+    Procedural(ProceduralTexture),
+}
+
+/// Textures lucent can make itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProceduralTexture {
+    /// A tangent-space normal map of marble-like veins: the height field
+    /// `sin(frequency * (x + turbulence(x, y)))`, differentiated.
+    MarbleNormal {
+        /// Vein frequency across the texture.
+        frequency: f32,
+        /// Bump strength (slope scale).
+        strength: f32,
+    },
+}
+
+/// Where the GDC 2011 local thickness comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ThicknessSource {
+    /// The same value everywhere (0 = opaque, 1 = thinnest).
+    Constant(f32),
+    /// A texture (linear data, thin = white), sampled with the mesh's UVs.
+    Texture(TextureSource),
+    /// The mesh's vertex colours (e.g. written by `lucent bake-thickness --per-vertex`).
+    PerVertex,
+    /// Baked at load by [`crate::bake`], cached on disk keyed by mesh content.
+    Bake,
+}
+
+/// How the translucency's view-dependent lobe raises to its power.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PowMode {
+    /// `pow(x, n)`, as in the talk.
+    Exact,
+    /// The spherical-Gaussian form `exp2(n * x - n)` (seed: spherical-gaussian-pow-translucency).
+    SphericalGaussian,
+}
+
+/// Frostbite 2 translucency parameters (GDC 2011), per material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Translucency {
+    /// Local thickness source.
+    pub thickness: ThicknessSource,
+    /// Colour of the light that travels through (white = grayscale thickness).
+    pub color: Vec3,
+    /// `iLTPower`: sharpness of the view-dependent back-lighting lobe.
+    pub power: f32,
+    /// `fLTDistortion`: how much the surface normal bends the inverted light vector.
+    pub distortion: f32,
+    /// `fLTAmbient`: translucency visible from every angle.
+    pub ambient: f32,
+    /// Exact `pow` or the spherical-Gaussian `exp2` form.
+    pub pow_mode: PowMode,
+}
+
+impl Translucency {
+    /// The talk's defaults: power 12 (Fig. 16), distortion 0.2 (Fig. 17), no ambient.
+    pub fn new(thickness: ThicknessSource) -> Self {
+        Self {
+            thickness,
+            color: Vec3::ONE,
+            power: 12.0,
+            distortion: 0.2,
+            ambient: 0.0,
+            pow_mode: PowMode::Exact,
+        }
+    }
+
+    /// Whether the thickness is coloured (not the same in every channel).
+    pub fn is_colored(&self) -> bool {
+        self.color.x != self.color.y || self.color.y != self.color.z
+    }
+}
+
+/// One Gaussian of a diffusion profile: variance in mm² and its RGB weight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gaussian {
+    /// Variance v (the Gaussian is exp(-r²/2v) / 2πv), mm².
+    pub variance: f32,
+    /// Weight per colour channel.
+    pub weight: Vec3,
+}
+
+/// A diffusion profile as a sum of Gaussians (d'Eon and Luebke), used by screen-space SSS.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SssProfile {
+    /// Preset name or "custom".
+    pub name: String,
+    /// The Gaussians, narrowest first.
+    pub gaussians: Vec<Gaussian>,
+    /// World units per millimetre of the profile (scene scale).
+    pub units_per_mm: f32,
+}
+
+/// d'Eon's six-Gaussian fit of human skin (the thesis, Figure 17): (variance mm², R, G, B).
+pub const SKIN_GAUSSIANS: [(f32, [f32; 3]); 6] = [
+    (0.0064, [0.233, 0.455, 0.649]),
+    (0.0484, [0.100, 0.336, 0.344]),
+    (0.187, [0.118, 0.198, 0.0]),
+    (0.567, [0.113, 0.007, 0.007]),
+    (1.99, [0.358, 0.004, 0.0]),
+    (7.41, [0.078, 0.0, 0.0]),
+];
+
+/// Marble: the variances of the skin fit with weights fitted (non-negative least squares, in
+/// `lucent::reference::dipole`) to Jensen et al.'s dipole profile of marble
+/// (σs' = 2.19, 2.62, 3.00 /mm; σa = 0.0021, 0.0041, 0.0071 /mm; η = 1.5), each channel
+/// normalised to sum to 1, fitted over 0 to 10 mm. The fit's relative L2 error is 1.8%, 1.2%
+/// and 2.0% (R, G, B). Checked by the test `marble_preset_matches_its_fit`.
+pub const MARBLE_GAUSSIANS: [(f32, [f32; 3]); 6] = [
+    (0.0064, [0.0001, 0.0027, 0.0074]),
+    (0.0484, [0.0857, 0.1409, 0.1943]),
+    (0.187, [0.2174, 0.2054, 0.1755]),
+    (0.567, [0.1421, 0.1372, 0.1612]),
+    (1.99, [0.1675, 0.2001, 0.2098]),
+    (7.41, [0.3873, 0.3138, 0.2519]),
+];
+
+impl SssProfile {
+    /// A preset by name: `skin` (d'Eon, thesis Figure 17) or `marble`.
+    pub fn preset(name: &str) -> Result<Self> {
+        let table = match name {
+            "skin" => &SKIN_GAUSSIANS,
+            "marble" => &MARBLE_GAUSSIANS,
+            _ => {
+                return Err(LucentError::InvalidInput(format!(
+                    "unknown SSS profile '{name}'; presets: skin, marble"
+                )))
+            }
+        };
+        Ok(Self {
+            name: name.to_string(),
+            gaussians: table
+                .iter()
+                .map(|&(variance, w)| Gaussian {
+                    variance,
+                    weight: Vec3::from(w),
+                })
+                .collect(),
+            units_per_mm: 0.01,
+        })
+    }
+
+    /// Checks the profile can be blurred safely: 1 to 8 Gaussians, finite positive variances,
+    /// finite non-negative weights.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.gaussians.len();
+        if !(1..=8).contains(&n) {
+            return Err(LucentError::InvalidInput(format!(
+                "SSS profile '{}' has {n} Gaussians; 1 to 8 are supported",
+                self.name
+            )));
+        }
+        for (i, g) in self.gaussians.iter().enumerate() {
+            if !(g.variance.is_finite() && g.variance > 0.0) {
+                return Err(LucentError::InvalidInput(format!(
+                    "SSS profile '{}' Gaussian {i}: variance {} must be finite and > 0",
+                    self.name, g.variance
+                )));
+            }
+            if !(g.weight.is_finite() && g.weight.min_element() >= 0.0) {
+                return Err(LucentError::InvalidInput(format!(
+                    "SSS profile '{}' Gaussian {i}: weights must be finite and >= 0",
+                    self.name
+                )));
+            }
+        }
+        if !(self.units_per_mm.is_finite() && self.units_per_mm > 0.0) {
+            return Err(LucentError::InvalidInput(format!(
+                "SSS profile '{}': units_per_mm must be finite and > 0",
+                self.name
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One layer of a layered medium (Li et al.).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layer {
+    /// Thickness per channel, in scene units.
+    pub thickness: Vec3,
+    /// Scattering coefficient σs per channel (1/unit).
+    pub scattering: Vec3,
+    /// Absorption coefficient σa per channel (1/unit).
+    pub absorption: Vec3,
+    /// Henyey-Greenstein anisotropy g, |g| <= 0.99 (guarded where used).
+    pub anisotropy: f32,
+}
+
+/// A stack of layers, outermost first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayeredMedium {
+    /// Preset name or "custom".
+    pub name: String,
+    /// Layers, outermost first.
+    pub layers: Vec<Layer>,
+    /// Relative index of refraction at the surface.
+    pub eta: f32,
+}
+
+/// Li et al.'s Table 1 coefficient sets: (name, scattering per layer, absorption per layer).
+/// The table gives one value per layer (not per channel); they apply to all three channels.
+pub const LI_TABLE1: [(&str, [f32; 3], [f32; 3]); 5] = [
+    ("frog", [2.29, 2.39, 1.97], [0.0030, 0.0034, 0.046]),
+    ("teapot", [0.74, 0.88, 1.01], [0.032, 0.17, 0.18]),
+    ("bunny", [0.15, 0.21, 0.38], [0.015, 0.077, 0.19]),
+    ("buddha", [1.09, 1.59, 1.79], [0.013, 0.070, 0.145]),
+    ("dragon", [0.70, 1.22, 1.90], [0.0014, 0.0025, 0.0142]),
+];
+
+impl LayeredMedium {
+    /// A Table 1 preset (`frog`, `teapot`, `bunny`, `buddha`, `dragon`; the table's goddess and
+    /// monster rows share frog's set, maitreya shares buddha's). Layer thicknesses and g are
+    /// not in the table: ours are 0.05, 0.2 and 1.0 units and g = 0.8 for each layer (forward
+    /// scattering typical of tissue-like media).
+    pub fn preset(name: &str) -> Result<Self> {
+        let (_, scattering, absorption) = LI_TABLE1
+            .iter()
+            .find(|(n, _, _)| *n == name)
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "unknown layered preset '{name}'; presets: {}",
+                    LI_TABLE1.iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
+                ))
+            })?;
+        let thickness = [0.05, 0.2, 1.0];
+        Ok(Self {
+            name: name.to_string(),
+            layers: (0..3)
+                .map(|i| Layer {
+                    thickness: Vec3::splat(thickness[i]),
+                    scattering: Vec3::splat(scattering[i]),
+                    absorption: Vec3::splat(absorption[i]),
+                    anisotropy: 0.8,
+                })
+                .collect(),
+            eta: 1.3,
+        })
+    }
+
+    /// Checks every coefficient is finite and in range (thickness, σs, σa >= 0; |g| < 1;
+    /// η > 0; 1 to 8 layers).
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| {
+            Err(LucentError::InvalidInput(format!(
+                "layered '{}': {m}",
+                self.name
+            )))
+        };
+        if !(1..=8).contains(&self.layers.len()) {
+            return bad(format!(
+                "{} layers; 1 to 8 are supported",
+                self.layers.len()
+            ));
+        }
+        for (i, l) in self.layers.iter().enumerate() {
+            for (what, v) in [
+                ("thickness", l.thickness),
+                ("scattering", l.scattering),
+                ("absorption", l.absorption),
+            ] {
+                if !(v.is_finite() && v.min_element() >= 0.0) {
+                    return bad(format!("layer {i} {what} must be finite and >= 0"));
+                }
+            }
+            if !(l.anisotropy.is_finite() && l.anisotropy.abs() < 1.0) {
+                return bad(format!(
+                    "layer {i} anisotropy g = {} must be in (-1, 1)",
+                    l.anisotropy
+                ));
+            }
+        }
+        if !(self.eta.is_finite() && self.eta > 0.0) {
+            return bad(format!("eta {} must be finite and > 0", self.eta));
+        }
+        Ok(())
+    }
+}
+
+/// What a surface is made of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name (for scene files and errors).
+    pub name: String,
+    /// Linear albedo, each channel in [0, 1].
+    pub albedo: Vec3,
+    /// Specular intensity in [0, 1].
+    pub specular: f32,
+    /// Roughness in [0, 1] (Blinn-Phong exponent 2^(11 - 10 r)).
+    pub roughness: f32,
+    /// Albedo texture (sRGB), multiplied with `albedo`.
+    pub albedo_texture: Option<TextureSource>,
+    /// Tangent-space normal map (linear).
+    pub normal_texture: Option<TextureSource>,
+    /// GDC 2011 translucency, if the material lets light through thin parts.
+    pub translucency: Option<Translucency>,
+    /// Screen-space SSS diffusion profile, if the material scatters below the surface.
+    pub sss: Option<SssProfile>,
+    /// Li et al.'s layered medium, if the material is layered.
+    pub layers: Option<LayeredMedium>,
+}
+
+impl Material {
+    /// A plain opaque material.
+    pub fn opaque(name: &str, albedo: Vec3, specular: f32, roughness: f32) -> Self {
+        Self {
+            name: name.to_string(),
+            albedo,
+            specular,
+            roughness,
+            albedo_texture: None,
+            normal_texture: None,
+            translucency: None,
+            sss: None,
+            layers: None,
+        }
+    }
+
+    /// Checks ranges: albedo, specular and roughness in [0, 1], finite; the optional parts valid.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| {
+            Err(LucentError::InvalidInput(format!(
+                "material '{}': {m}",
+                self.name
+            )))
+        };
+        if !(self.albedo.is_finite()
+            && self.albedo.min_element() >= 0.0
+            && self.albedo.max_element() <= 1.0)
+        {
+            return bad(format!("albedo {} must be in [0, 1]", self.albedo));
+        }
+        for (what, v) in [("specular", self.specular), ("roughness", self.roughness)] {
+            if !(0.0..=1.0).contains(&v) {
+                return bad(format!("{what} {v} must be in [0, 1]"));
+            }
+        }
+        if let Some(t) = &self.translucency {
+            for (what, v, max) in [
+                ("translucency power", t.power, 1e4),
+                ("translucency distortion", t.distortion, 10.0),
+                ("translucency ambient", t.ambient, 1.0),
+            ] {
+                if !(v.is_finite() && (0.0..=max).contains(&v)) {
+                    return bad(format!("{what} {v} must be in [0, {max}]"));
+                }
+            }
+            if !(t.color.is_finite() && t.color.min_element() >= 0.0) {
+                return bad("translucency color must be finite and >= 0".into());
+            }
+            if let ThicknessSource::Constant(c) = t.thickness {
+                if !(0.0..=1.0).contains(&c) {
+                    return bad(format!("thickness {c} must be in [0, 1]"));
+                }
+            }
+        }
+        if let Some(p) = &self.sss {
+            p.validate()?;
+        }
+        if let Some(l) = &self.layers {
+            l.validate()?;
+        }
+        Ok(())
+    }
+}
+
+/// The geometry of a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Parallel light travelling along `direction`.
+    Directional {
+        /// Direction the light travels (need not be normalised).
+        direction: Vec3,
+    },
+    /// Inverse-square light that fades smoothly to zero at `range`.
+    Point {
+        /// World position.
+        position: Vec3,
+        /// Distance at which its contribution reaches zero.
+        range: f32,
+    },
+    /// A point light restricted to a cone, with a smooth edge between the two angles.
+    Spot {
+        /// World position.
+        position: Vec3,
+        /// Direction the cone points (need not be normalised).
+        direction: Vec3,
+        /// Distance at which its contribution reaches zero.
+        range: f32,
+        /// Half-angle of full intensity, degrees.
+        inner_degrees: f32,
+        /// Half-angle where intensity reaches zero, degrees.
+        outer_degrees: f32,
+    },
+}
+
+/// A light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Geometry.
+    pub kind: LightKind,
+    /// Linear colour.
+    pub color: Vec3,
+    /// Intensity multiplier (radiance = colour x intensity).
+    pub intensity: f32,
+    /// The talk's per-light translucency scale (`fLTScale`): how strongly this light shines
+    /// through translucent materials.
+    pub translucency_scale: f32,
+}
+
+impl Light {
+    /// A point light of white-balanced colour.
+    pub fn point(position: Vec3, color: Vec3, intensity: f32, range: f32) -> Self {
+        Self {
+            kind: LightKind::Point { position, range },
+            color,
+            intensity,
+            translucency_scale: 1.0,
+        }
+    }
+
+    /// A directional light.
+    pub fn directional(direction: Vec3, color: Vec3, intensity: f32) -> Self {
+        Self {
+            kind: LightKind::Directional { direction },
+            color,
+            intensity,
+            translucency_scale: 1.0,
+        }
+    }
+
+    /// Colour times intensity.
+    pub fn radiance(&self) -> Vec3 {
+        self.color * self.intensity
+    }
+
+    /// Checks the light is finite and in range.
+    pub fn validate(&self, what: &str) -> Result<()> {
+        let bad = |m: String| Err(LucentError::InvalidInput(format!("{what}: {m}")));
+        if !(self.color.is_finite() && self.color.min_element() >= 0.0) {
+            return bad("color must be finite and >= 0".into());
+        }
+        if !(self.intensity.is_finite() && self.intensity >= 0.0) {
+            return bad(format!(
+                "intensity {} must be finite and >= 0",
+                self.intensity
+            ));
+        }
+        if !(self.translucency_scale.is_finite() && self.translucency_scale >= 0.0) {
+            return bad(format!(
+                "translucency_scale {} must be finite and >= 0",
+                self.translucency_scale
+            ));
+        }
+        match self.kind {
+            LightKind::Directional { direction } => {
+                if !(direction.is_finite() && direction.length_squared() > 1e-12) {
+                    return bad("direction must be a finite non-zero vector".into());
+                }
+            }
+            LightKind::Point { position, range } => {
+                if !(position.is_finite() && range.is_finite() && range > 0.0) {
+                    return bad("position must be finite and range > 0".into());
+                }
+            }
+            LightKind::Spot {
+                position,
+                direction,
+                range,
+                inner_degrees,
+                outer_degrees,
+            } => {
+                if !(position.is_finite() && range.is_finite() && range > 0.0) {
+                    return bad("position must be finite and range > 0".into());
+                }
+                if !(direction.is_finite() && direction.length_squared() > 1e-12) {
+                    return bad("direction must be a finite non-zero vector".into());
+                }
+                if !(0.0 <= inner_degrees && inner_degrees < outer_degrees && outer_degrees <= 90.0)
+                {
+                    return bad(format!(
+                        "spot angles must satisfy 0 <= inner ({inner_degrees}) < outer ({outer_degrees}) <= 90"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn skin_preset_is_the_thesis_table() {
+        let p = SssProfile::preset("skin").unwrap();
+        p.validate().unwrap();
+        assert_eq!(p.gaussians.len(), 6);
+        assert_eq!(p.gaussians[0].variance, 0.0064);
+        assert_eq!(p.gaussians[5].weight, Vec3::new(0.078, 0.0, 0.0));
+        // d'Eon's red weights sum to 1.0 (the table is normalised per channel).
+        let red: f32 = p.gaussians.iter().map(|g| g.weight.x).sum();
+        assert!((red - 1.0).abs() < 1e-3, "{red}");
+    }
+
+    #[test]
+    fn layered_presets_are_table_1() {
+        let m = LayeredMedium::preset("teapot").unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.layers[1].scattering, Vec3::splat(0.88));
+        assert_eq!(m.layers[2].absorption, Vec3::splat(0.18));
+        assert!(LayeredMedium::preset("nope").is_err());
+    }
+
+    #[test]
+    fn out_of_range_values_are_rejected() {
+        let mut m = Material::opaque("m", Vec3::splat(0.5), 0.5, 0.5);
+        m.validate().unwrap();
+        m.roughness = 3.0;
+        assert!(m
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("roughness 3"));
+        let mut l = Light::point(Vec3::ZERO, Vec3::ONE, -1.0, 5.0);
+        assert!(l.validate("light").is_err());
+        l.intensity = 1.0;
+        l.validate("light").unwrap();
+        l.kind = LightKind::Spot {
+            position: Vec3::ZERO,
+            direction: Vec3::NEG_Y,
+            range: 5.0,
+            inner_degrees: 40.0,
+            outer_degrees: 30.0,
+        };
+        assert!(l.validate("light").is_err());
+    }
+}

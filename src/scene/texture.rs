@@ -1,0 +1,433 @@
+//! Texture loading: image files to linear-space floating-point texels with a full mip chain.
+//!
+//! [`load_texture`] reads PNG, JPEG, TGA, OpenEXR and Radiance HDR through the `image` crate
+//! and returns a [`Texture`] whose texels are linear `f32` RGBA, whatever the file stored:
+//!
+//! - [`TextureUsage::Color`] (albedo and other colours): 8- and 16-bit files are sRGB-encoded,
+//!   so their RGB is decoded to linear (alpha stays linear). EXR and HDR files are already
+//!   linear and are taken as stored.
+//! - [`TextureUsage::Data`] (normal maps, thickness, roughness): values are taken as stored,
+//!   8/16-bit ones mapped to [0, 1]. Decoding a normal map as sRGB would bend every normal.
+//!
+//! Float texels that are NaN or infinite are replaced by 0 and counted in a warning. Mip levels
+//! go down to 1x1 with a 2x2 box filter; an odd size is filtered by area (a texel of the smaller
+//! level covers 2.5 texels of a 5-wide level, with weights 1, 1, 0.5), so every level keeps the
+//! image's mean exactly. Errors name the file: "not found", "corrupt or unsupported", or larger
+//! than [`MAX_TEXTURE_SIZE`] per side.
+
+use std::path::Path;
+
+use image::{DynamicImage, ImageReader, Limits};
+use rayon::prelude::*;
+
+use crate::{LucentError, Result};
+
+/// Largest width or height accepted (the minimum `maxImageDimension2D` Vulkan devices commonly
+/// offer, and already 4 GiB of `f32` RGBA texels).
+pub const MAX_TEXTURE_SIZE: u32 = 16384;
+
+/// How a texture's values are interpreted, which decides whether sRGB is decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TextureUsage {
+    /// A colour (albedo, tint): 8/16-bit files are sRGB-encoded and decoded to linear.
+    Color,
+    /// Linear data (normal maps, thickness, roughness): values are used as stored.
+    Data,
+}
+
+/// A decoded texture: linear RGBA `f32` texels and its mip chain.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// Width of level 0 in texels.
+    pub width: u32,
+    /// Height of level 0 in texels.
+    pub height: u32,
+    /// How the values were interpreted when decoding.
+    pub usage: TextureUsage,
+    /// Mip levels, row-major, top row first: level 0 is full resolution, each next level is
+    /// `max(1, size / 2)` per side, the last is 1x1. All values are finite and linear.
+    pub mips: Vec<Vec<[f32; 4]>>,
+}
+
+impl Texture {
+    /// Builds a texture from level-0 linear texels (row-major, top row first): replaces
+    /// non-finite values by 0 and generates the mip chain. `what` names the source in errors
+    /// and warnings.
+    pub fn from_texels(
+        what: &str,
+        width: u32,
+        height: u32,
+        usage: TextureUsage,
+        mut texels: Vec<[f32; 4]>,
+    ) -> Result<Texture> {
+        if width == 0 || height == 0 {
+            return Err(LucentError::InvalidInput(format!(
+                "{what}: image has no texels ({width}x{height})"
+            )));
+        }
+        if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+            return Err(LucentError::InvalidInput(format!(
+                "{what}: image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"
+            )));
+        }
+        if texels.len() != width as usize * height as usize {
+            return Err(LucentError::InvalidInput(format!(
+                "{what}: {} texels for a {width}x{height} image",
+                texels.len()
+            )));
+        }
+        let replaced = sanitize(&mut texels);
+        if replaced > 0 {
+            log::warn!("{what}: replaced {replaced} NaN or infinite texel values with 0");
+        }
+        let mut mips = vec![texels];
+        let (mut w, mut h) = (width as usize, height as usize);
+        while w > 1 || h > 1 {
+            let (next, nw, nh) = downsample(mips.last().map_or(&[][..], |v| v), w, h);
+            mips.push(next);
+            (w, h) = (nw, nh);
+        }
+        Ok(Texture {
+            width,
+            height,
+            usage,
+            mips,
+        })
+    }
+
+    /// Number of mip levels (`floor(log2(max(width, height))) + 1`).
+    pub fn level_count(&self) -> usize {
+        self.mips.len()
+    }
+
+    /// Width and height of mip `level`.
+    pub fn level_size(&self, level: usize) -> (u32, u32) {
+        let shift = level.min(31) as u32;
+        ((self.width >> shift).max(1), (self.height >> shift).max(1))
+    }
+}
+
+/// Loads an image file as a linear-float texture with mips; see the module docs for how
+/// `usage` decides sRGB decoding.
+///
+/// Errors name the file and say whether it was not found, is empty, is corrupt or unsupported,
+/// or is larger than [`MAX_TEXTURE_SIZE`] per side.
+pub fn load_texture(path: &Path, usage: TextureUsage) -> Result<Texture> {
+    let err = |message: String| LucentError::file(path, message);
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(err("texture not found".into()))
+        }
+        Err(e) => return Err(err(format!("cannot read texture: {e}"))),
+        Ok(m) if m.is_dir() => return Err(err("is a directory, not an image".into())),
+        Ok(m) if m.len() == 0 => return Err(err("image file is empty (0 bytes)".into())),
+        Ok(_) => {}
+    }
+    let open = || -> Result<ImageReader<std::io::BufReader<std::fs::File>>> {
+        let reader = ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| err(format!("cannot read texture: {e}")))?;
+        if reader.format().is_none() {
+            return Err(err(
+                "corrupt or unsupported image: format not recognised (supported: PNG, JPEG, TGA, \
+                 EXR, HDR)"
+                    .into(),
+            ));
+        }
+        Ok(reader)
+    };
+    let corrupt = |e: image::ImageError| err(format!("corrupt or unsupported image: {e}"));
+
+    // Read the header alone first, so an absurd size is refused before anything is allocated.
+    let (width, height) = open()?.into_dimensions().map_err(corrupt)?;
+    if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+        return Err(err(format!(
+            "image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"
+        )));
+    }
+    let mut reader = open()?;
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIZE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIZE);
+    // The decoded image of the largest accepted size in the widest format (RGBA f32).
+    limits.max_alloc = Some(u64::from(MAX_TEXTURE_SIZE).pow(2) * 16);
+    reader.limits(limits);
+    let image = reader.decode().map_err(corrupt)?;
+
+    // Float formats (EXR, HDR) store linear values; 8/16-bit ones store sRGB for colours.
+    let stored_linear = matches!(
+        image,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    let decode_srgb = usage == TextureUsage::Color && !stored_linear;
+    let (width, height) = (image.width(), image.height());
+    let rgba = image.into_rgba32f();
+    let texels: Vec<[f32; 4]> = rgba
+        .as_raw()
+        .chunks_exact(4)
+        .map(|c| {
+            if decode_srgb {
+                [
+                    srgb_to_linear(c[0]),
+                    srgb_to_linear(c[1]),
+                    srgb_to_linear(c[2]),
+                    c[3],
+                ]
+            } else {
+                [c[0], c[1], c[2], c[3]]
+            }
+        })
+        .collect();
+    Texture::from_texels(&path.display().to_string(), width, height, usage, texels)
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1), encoded [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Replaces every NaN or infinite component by 0; returns how many were replaced.
+///
+/// This happens at load, before filtering, because one NaN poisons every filter tap that touches
+/// it: each mip level down would spread it to more texels, and on the GPU bilinear filtering and
+/// blurs spread it across the screen. Infinity does the same (inf - inf, inf * 0).
+fn sanitize(texels: &mut [[f32; 4]]) -> usize {
+    let mut replaced = 0;
+    for c in texels.iter_mut().flatten() {
+        if !c.is_finite() {
+            *c = 0.0;
+            replaced += 1;
+        }
+    }
+    replaced
+}
+
+/// For each texel of a `m`-texel axis downsampled from `n` texels: the source texels it covers
+/// and their weights (overlap / footprint), summing to 1.
+fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
+    (0..m)
+        .map(|i| {
+            let start = i as f64 * n as f64 / m as f64;
+            let end = (i + 1) as f64 * n as f64 / m as f64;
+            let width = end - start; // >= 1 because m <= n
+            (start.floor() as usize..(end.ceil() as usize).min(n))
+                .filter_map(|j| {
+                    let overlap = end.min(j as f64 + 1.0) - start.max(j as f64);
+                    (overlap > 0.0).then(|| (j, (overlap / width) as f32))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// One mip step: `w x h` to `max(1, w/2) x max(1, h/2)` with an area-weighted box filter.
+fn downsample(src: &[[f32; 4]], w: usize, h: usize) -> (Vec<[f32; 4]>, usize, usize) {
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let wx = axis_weights(w, nw);
+    let wy = axis_weights(h, nh);
+    let mut rows = vec![[0.0f32; 4]; nw * h];
+    rows.par_chunks_mut(nw).enumerate().for_each(|(y, row)| {
+        let src_row = &src[y * w..(y + 1) * w];
+        for (out, taps) in row.iter_mut().zip(&wx) {
+            for &(j, weight) in taps {
+                for c in 0..4 {
+                    out[c] += src_row[j][c] * weight;
+                }
+            }
+        }
+    });
+    let mut dst = vec![[0.0f32; 4]; nw * nh];
+    dst.par_chunks_mut(nw).enumerate().for_each(|(y, row)| {
+        for &(j, weight) in &wy[y] {
+            let src_row = &rows[j * nw..(j + 1) * nw];
+            for (out, s) in row.iter_mut().zip(src_row) {
+                for c in 0..4 {
+                    out[c] += s[c] * weight;
+                }
+            }
+        }
+    });
+    (dst, nw, nh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::{ImageFormat, Rgb32FImage, RgbImage, Rgba32FImage};
+    use std::path::PathBuf;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("lucent-texture-test-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn solid_rgb8(w: u32, h: u32, rgb: [u8; 3]) -> DynamicImage {
+        DynamicImage::ImageRgb8(RgbImage::from_pixel(w, h, image::Rgb(rgb)))
+    }
+
+    fn mean(level: &[[f32; 4]]) -> [f64; 4] {
+        let mut m = [0.0f64; 4];
+        for t in level {
+            for c in 0..4 {
+                m[c] += t[c] as f64 / level.len() as f64;
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn png_color_is_srgb_decoded_and_data_is_not() {
+        let dir = temp_dir("png");
+        let path = dir.join("grey.png");
+        solid_rgb8(4, 2, [128, 128, 128]).save(&path).unwrap();
+        let color = load_texture(&path, TextureUsage::Color).unwrap();
+        let data = load_texture(&path, TextureUsage::Data).unwrap();
+        assert_eq!((color.width, color.height), (4, 2));
+        // sRGB 128/255 is 0.2159 linear.
+        assert!((color.mips[0][0][0] - 0.2159).abs() < 1e-3);
+        assert!((data.mips[0][0][0] - 128.0 / 255.0).abs() < 1e-6);
+        assert_eq!(color.mips[0][0][3], 1.0);
+        assert_eq!(color.level_count(), 3); // 4x2, 2x1, 1x1
+        assert_eq!(color.level_size(1), (2, 1));
+        assert_eq!(color.level_size(2), (1, 1));
+        assert_eq!(color.mips[2].len(), 1);
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn jpeg_and_tga_load() {
+        let dir = temp_dir("jpg-tga");
+        let jpg = dir.join("red.jpg");
+        let tga = dir.join("blue.tga");
+        solid_rgb8(16, 8, [255, 0, 0]).save(&jpg).unwrap();
+        solid_rgb8(3, 5, [0, 0, 255]).save(&tga).unwrap();
+        let t = load_texture(&jpg, TextureUsage::Data).unwrap();
+        assert_eq!((t.width, t.height, t.level_count()), (16, 8, 5));
+        // JPEG is lossy: allow a little chroma error.
+        assert!(t.mips[0][0][0] > 0.9 && t.mips[0][0][1] < 0.1);
+        let t = load_texture(&tga, TextureUsage::Color).unwrap();
+        assert_eq!((t.width, t.height, t.level_count()), (3, 5, 3));
+        assert_eq!(t.mips[0][7], [0.0, 0.0, 1.0, 1.0]);
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn exr_keeps_linear_values_and_sanitizes_nan_and_inf() {
+        let dir = temp_dir("exr");
+        let path = dir.join("nan.exr");
+        let mut img = Rgba32FImage::from_pixel(2, 2, image::Rgba([2.5, 0.25, 0.5, 1.0]));
+        img.put_pixel(1, 0, image::Rgba([f32::NAN, f32::INFINITY, 1.0, 1.0]));
+        DynamicImage::ImageRgba32F(img)
+            .save_with_format(&path, ImageFormat::OpenExr)
+            .unwrap();
+        // Colour usage does not sRGB-decode float formats.
+        let t = load_texture(&path, TextureUsage::Color).unwrap();
+        assert_eq!(t.mips[0][0], [2.5, 0.25, 0.5, 1.0]);
+        assert_eq!(t.mips[0][1], [0.0, 0.0, 1.0, 1.0]);
+        assert!(t.mips.iter().flatten().flatten().all(|v| v.is_finite()));
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn hdr_loads_linear_floats() {
+        let dir = temp_dir("hdr");
+        let path = dir.join("sky.hdr");
+        let img = Rgb32FImage::from_pixel(3, 3, image::Rgb([4.0, 1.0, 0.5]));
+        DynamicImage::ImageRgb32F(img)
+            .save_with_format(&path, ImageFormat::Hdr)
+            .unwrap();
+        let t = load_texture(&path, TextureUsage::Color).unwrap();
+        assert_eq!((t.width, t.height, t.level_count()), (3, 3, 2));
+        // RGBE keeps about 8 bits of mantissa.
+        let p = t.mips[0][4];
+        assert!((p[0] - 4.0).abs() < 0.05 && (p[1] - 1.0).abs() < 0.02);
+        assert_eq!(p[3], 1.0);
+        std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn odd_sizes_keep_the_mean_down_to_one_texel() {
+        let (w, h) = (5u32, 3u32);
+        let texels: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| [i as f32, (i * i) as f32, 1.0, (i % 2) as f32])
+            .collect();
+        let want = mean(&texels);
+        let t = Texture::from_texels("test", w, h, TextureUsage::Data, texels).unwrap();
+        assert_eq!(t.level_count(), 3); // 5x3, 2x1, 1x1
+        for (level, texels) in t.mips.iter().enumerate() {
+            let (lw, lh) = t.level_size(level);
+            assert_eq!(texels.len(), (lw * lh) as usize);
+            let got = mean(texels);
+            for c in 0..4 {
+                assert!((got[c] - want[c]).abs() < 1e-4, "level {level}: {got:?}");
+            }
+        }
+        // An even level is an exact 2x2 average.
+        let t = Texture::from_texels(
+            "even",
+            2,
+            2,
+            TextureUsage::Data,
+            vec![[0.0; 4], [1.0; 4], [2.0; 4], [5.0; 4]],
+        )
+        .unwrap();
+        assert_eq!(t.mips[1], vec![[2.0; 4]]);
+    }
+
+    #[test]
+    fn sanitize_counts_and_replaces() {
+        let mut t = vec![[f32::NAN, 1.0, f32::NEG_INFINITY, 0.5], [0.0; 4]];
+        assert_eq!(sanitize(&mut t), 2);
+        assert_eq!(t[0], [0.0, 1.0, 0.0, 0.5]);
+    }
+
+    #[test]
+    fn errors_name_the_file_and_the_problem() {
+        let dir = temp_dir("errors");
+        let missing = dir.join("missing.png");
+        let e = load_texture(&missing, TextureUsage::Color)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing.png") && e.contains("not found"), "{e}");
+
+        let corrupt = dir.join("corrupt.png");
+        std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
+        let e = load_texture(&corrupt, TextureUsage::Color)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("corrupt.png") && e.contains("corrupt or unsupported"),
+            "{e}"
+        );
+
+        let empty = dir.join("empty.png");
+        std::fs::write(&empty, b"").unwrap();
+        let e = load_texture(&empty, TextureUsage::Data)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("empty.png") && e.contains("empty"), "{e}");
+
+        let wide = dir.join("wide.png");
+        solid_rgb8(MAX_TEXTURE_SIZE + 1, 1, [1, 2, 3])
+            .save(&wide)
+            .unwrap();
+        let e = load_texture(&wide, TextureUsage::Data)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("wide.png") && e.contains("16385x1"), "{e}");
+
+        let text = dir.join("notes.txt");
+        std::fs::write(&text, b"hello").unwrap();
+        let e = load_texture(&text, TextureUsage::Data)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("corrupt or unsupported"), "{e}");
+        std::fs::remove_dir_all(dir).ok();
+    }
+}

@@ -375,12 +375,6 @@ fn validate_options(options: &BakeOptions) -> Result<()> {
             ));
         }
     }
-    if options.texture_size == 0 || options.texture_size > MAX_TEXTURE_SIZE {
-        return bad(format!(
-            "texture size {} (must be 1 to {MAX_TEXTURE_SIZE})",
-            options.texture_size
-        ));
-    }
     Ok(())
 }
 
@@ -405,12 +399,15 @@ mod tests {
                 max_distance: Some(-1.0),
                 ..Default::default()
             },
-            BakeOptions {
-                texture_size: 0,
-                ..Default::default()
-            },
         ] {
             assert!(bake_per_vertex(&sphere, &options).is_err(), "{options:?}");
+        }
+        for texture_size in [0, MAX_TEXTURE_SIZE + 1] {
+            let options = BakeOptions {
+                texture_size,
+                ..Default::default()
+            };
+            assert!(bake_texture(&sphere, &options).is_err(), "{options:?}");
         }
         let mut flat = sphere.clone();
         flat.positions.iter_mut().for_each(|p| *p = Vec3::ONE);

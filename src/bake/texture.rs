@@ -99,6 +99,12 @@ impl ThicknessMap {
 /// [`BakeStats::samples`] counts covered texels.
 pub fn bake_texture(mesh: &Mesh, options: &BakeOptions) -> Result<(ThicknessMap, BakeStats)> {
     let start = Instant::now();
+    let size = options.texture_size;
+    if size == 0 || size > MAX_TEXTURE_SIZE {
+        return Err(LucentError::InvalidInput(format!(
+            "thickness texture bake: texture size {size} (must be 1 to {MAX_TEXTURE_SIZE})"
+        )));
+    }
     let baker = Baker::new(mesh, options)?;
     if mesh.uvs.is_empty() {
         return Err(LucentError::InvalidInput(
@@ -107,7 +113,6 @@ pub fn bake_texture(mesh: &Mesh, options: &BakeOptions) -> Result<(ThicknessMap,
                 .into(),
         ));
     }
-    let size = options.texture_size;
     let (texels, points) = rasterize(mesh, size);
     let (baked, stats) = baker.run(&points, start);
     let n = (size as usize).pow(2);

@@ -252,12 +252,37 @@ pub fn load_scene_file(path: &Path) -> Result<Scene> {
     parse_scene(path, &source)
 }
 
+/// A TOML parse or type error as one line: `FILE: line L, column C: MESSAGE`. toml's own
+/// `Display` spreads over several lines (a source excerpt with a caret), which would break the
+/// one-line `lucent: error:` contract; its message already names the key or value at fault.
+fn toml_error(path: &Path, source: &str, error: &toml::de::Error) -> LucentError {
+    let message = error
+        .message()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let location = error.span().and_then(|span| {
+        let before = source.get(..span.start)?;
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        // A type error's message names the expected type but not the key: take the key from
+        // the text before `=` on the offending line.
+        let text = source.lines().nth(line - 1).unwrap_or_default();
+        let key = text
+            .split_once('=')
+            .map(|(k, _)| format!(", key `{}`", k.trim()))
+            .unwrap_or_default();
+        Some(format!("line {line}, column {column}{key}: "))
+    });
+    LucentError::file(
+        path,
+        format!("invalid scene: {}{message}", location.unwrap_or_default()),
+    )
+}
+
 /// Parses scene TOML `source`; `path` names it in errors and anchors relative paths.
 pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
-    let raw: SceneToml = toml::from_str(source).map_err(|e| {
-        // toml's message carries "line N, column M" and the offending key or value.
-        LucentError::file(path, format!("invalid scene: {}", e.to_string().trim_end()))
-    })?;
+    let raw: SceneToml = toml::from_str(source).map_err(|e| toml_error(path, source, &e))?;
     let at = Locator { path, source };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolve = |p: &Path| {

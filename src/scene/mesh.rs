@@ -141,14 +141,15 @@ impl Mesh {
     /// Tessellates `shape`: `segments` around and `rings` from pole to pole for a sphere; a plane
     /// is split into `segments` x `segments` quads (`rings` unused).
     pub fn generate(shape: Shape, segments: u32, rings: u32) -> Mesh {
-        let segments = segments.max(3);
-        let rings = rings.max(2);
         let mut mesh = Mesh {
             shape: Some(shape),
             ..Mesh::default()
         };
         match shape {
             Shape::Sphere { radius } => {
+                // Fewer than 3 segments or 2 rings encloses no volume.
+                let segments = segments.max(3);
+                let rings = rings.max(2);
                 for ring in 0..=rings {
                     let theta = std::f32::consts::PI * ring as f32 / rings as f32;
                     for seg in 0..=segments {
@@ -182,7 +183,7 @@ impl Mesh {
                 }
             }
             Shape::Plane { half_size } => {
-                let n = segments.min(4096);
+                let n = segments.clamp(1, 4096);
                 for z in 0..=n {
                     for x in 0..=n {
                         let u = x as f32 / n as f32;

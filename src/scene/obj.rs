@@ -124,7 +124,6 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // Last resort: the line checks above cover every panic known in tobj 4.0.5, but a panic in a
     // dependency must still end as an error naming the file, never as a crash.

@@ -20,6 +20,11 @@ fn output_dir() -> PathBuf {
 
 /// Renders one frame of a built-in scene with validation on; returns (display RGBA8, HDR f32).
 fn render(scene_name: &str, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32>>) {
+    render_scene(&scene::builtin(scene_name).unwrap(), settings)
+}
+
+/// Renders one frame of `scene` with validation on; returns (display RGBA8, HDR f32).
+fn render_scene(scene: &scene::Scene, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32>>) {
     let gpu = GpuContext::new(&ContextDesc {
         validation: true,
         ..ContextDesc::default()
@@ -31,8 +36,7 @@ fn render(scene_name: &str, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32
     )
     .unwrap();
     let cache = PipelineCache::load(&gpu.device, None).unwrap();
-    let scene = scene::builtin(scene_name).unwrap();
-    let renderer = Renderer::new(&gpu, &shaders, &cache, &scene, settings).unwrap();
+    let renderer = Renderer::new(&gpu, &shaders, &cache, scene, settings).unwrap();
     let mut runner = FrameRunner::new(&gpu, renderer.executable.plan.physical.len()).unwrap();
     // Two frames: the second must find every resource in the state the first left it.
     runner.run_frame(&gpu, &renderer.executable).unwrap();
@@ -54,6 +58,30 @@ fn render(scene_name: &str, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32
         gpu.take_validation_messages().join("\n")
     );
     (display, hdr)
+}
+
+#[test]
+fn every_builtin_scene_renders_finite_and_validation_clean() {
+    // Loaded as the command loads them (thickness baked through the cache), nothing read from
+    // outside the repository.
+    for &(name, _) in scene::BUILTIN_SCENES {
+        let scene = scene::load_scene(name).unwrap();
+        let settings = FrameSettings {
+            export_hdr: true,
+            ..FrameSettings::new(96, 72)
+        };
+        let (display, hdr) = render_scene(&scene, settings);
+        let hdr = hdr.unwrap();
+        let bad = hdr.iter().filter(|v| !v.is_finite()).count();
+        assert_eq!(bad, 0, "{name}: {bad} non-finite HDR values");
+        // Something is drawn and lit: not every pixel is the sky, and not all black.
+        let distinct: std::collections::HashSet<&[u8]> = display.chunks(4).collect();
+        assert!(
+            distinct.len() > 16,
+            "{name}: only {} distinct colours",
+            distinct.len()
+        );
+    }
 }
 
 #[test]

@@ -15,6 +15,8 @@ use crate::backend::timer::{GpuTimer, ScopeTime};
 use crate::backend::{GpuBuffer, GpuContext};
 use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
+use crate::passes::deferred::{GBufferLayout, GBufferPrecision};
+use crate::passes::translucency::{MaterialTable, ThicknessPacking};
 use crate::passes::{deferred, tonemap, SceneGpu};
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
@@ -25,11 +27,16 @@ use glam::Vec3;
 pub enum Technique {
     /// Plain deferred lighting (no translucency, no SSS).
     None,
+    /// Deferred lighting plus GDC 2011 thickness-based translucency for translucent materials.
+    Translucency,
 }
 
 impl Technique {
     /// Every technique with its command-line name.
-    pub const ALL: &'static [(&'static str, Technique)] = &[("none", Technique::None)];
+    pub const ALL: &'static [(&'static str, Technique)] = &[
+        ("none", Technique::None),
+        ("translucency", Technique::Translucency),
+    ];
 
     /// Parses a command-line name.
     pub fn parse(name: &str) -> Result<Self> {
@@ -71,6 +78,13 @@ pub struct FrameSettings {
     pub compile: CompileOptions,
     /// Also export the linear HDR image (for EXR output); otherwise it stays transient.
     pub export_hdr: bool,
+    /// Also export the G-buffer (for the CPU reference); otherwise it stays transient.
+    pub export_gbuffer: bool,
+    /// Precision of the G-buffer's colour targets.
+    pub gbuffer: GBufferPrecision,
+    /// Write coloured thickness as grayscale (its luminance) even when the scene has colour:
+    /// the talk's one-channel G-buffer, for A/B comparisons.
+    pub force_grayscale: bool,
 }
 
 impl FrameSettings {
@@ -82,8 +96,62 @@ impl FrameSettings {
             technique: Technique::None,
             compile: CompileOptions::default(),
             export_hdr: false,
+            export_gbuffer: false,
+            gbuffer: GBufferPrecision::Compact,
+            force_grayscale: false,
         }
     }
+}
+
+/// What a frame of a scene needs beyond the plain deferred path: derived once from the scene
+/// and the settings, so the graph declares only what the scene uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameFeatures {
+    /// The translucent materials and GB2's packing, when the technique is `translucency` and
+    /// some object is translucent.
+    pub translucency: Option<(MaterialTable, ThicknessPacking)>,
+}
+
+impl FrameFeatures {
+    /// The features `scene` needs under `settings`.
+    pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
+        let translucency = match settings.technique {
+            Technique::None => None,
+            Technique::Translucency => {
+                let table = MaterialTable::new(scene)?;
+                let packing = if settings.force_grayscale {
+                    ThicknessPacking::Grayscale
+                } else {
+                    table.packing()
+                };
+                (!table.is_empty()).then_some((table, packing))
+            }
+        };
+        Ok(Self { translucency })
+    }
+
+    /// The G-buffer layout these features and `settings` call for.
+    pub fn gbuffer_layout(&self, settings: &FrameSettings) -> GBufferLayout {
+        GBufferLayout {
+            precision: settings.gbuffer,
+            translucency: self.translucency.as_ref().map(|(_, p)| *p),
+        }
+    }
+}
+
+/// The G-buffer images a frame hands out when asked to (`export_gbuffer`).
+#[derive(Clone, Copy, Debug)]
+pub struct GBufferOutputs {
+    /// Albedo + specular.
+    pub gb0: ResourceId,
+    /// Normal + roughness.
+    pub gb1: ResourceId,
+    /// Thickness + material ID (frames with translucency).
+    pub gb2: Option<ResourceId>,
+    /// Depth.
+    pub depth: ResourceId,
+    /// Its layout.
+    pub layout: GBufferLayout,
 }
 
 /// The images a frame hands out.
@@ -93,15 +161,19 @@ pub struct FrameOutputs {
     pub display: ResourceId,
     /// Linear HDR image (RGBA16F), when exported.
     pub hdr: Option<ResourceId>,
+    /// The G-buffer, when exported.
+    pub gbuffer: Option<GBufferOutputs>,
 }
 
 /// Declares every pass of a frame. `scene_gpu` is `None` for plan-only graphs.
 pub fn declare_frame(
     graph: &mut RenderGraph,
     settings: &FrameSettings,
+    features: &FrameFeatures,
     scene_gpu: Option<&Arc<SceneGpu>>,
 ) -> FrameOutputs {
-    let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, scene_gpu);
+    let layout = features.gbuffer_layout(settings);
+    let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
     let hdr = deferred::lighting_pass(graph, &gb, scene_gpu);
     let display = tonemap::tonemap_pass(graph, &hdr, scene_gpu);
     graph.export_image(&display, Access::TransferRead);
@@ -109,16 +181,32 @@ pub fn declare_frame(
         graph.export_image(&hdr, Access::TransferRead);
         hdr.id()
     });
+    let gbuffer = settings.export_gbuffer.then(|| {
+        for image in [&gb.gb0, &gb.gb1, &gb.depth]
+            .into_iter()
+            .chain(gb.gb2.as_ref())
+        {
+            graph.export_image(image, Access::TransferRead);
+        }
+        GBufferOutputs {
+            gb0: gb.gb0.id(),
+            gb1: gb.gb1.id(),
+            gb2: gb.gb2.as_ref().map(|h| h.id()),
+            depth: gb.depth.id(),
+            layout,
+        }
+    });
     FrameOutputs {
         display: display.id(),
         hdr: hdr_id,
+        gbuffer,
     }
 }
 
 /// Compiles the plan of a frame without a GPU (for `lucent plan` and tests).
-pub fn plan_frame(settings: &FrameSettings) -> Result<Plan> {
+pub fn plan_frame(settings: &FrameSettings, features: &FrameFeatures) -> Result<Plan> {
     let mut graph = RenderGraph::new();
-    declare_frame(&mut graph, settings, None);
+    declare_frame(&mut graph, settings, features, None);
     graph.plan(settings.compile)
 }
 
@@ -239,7 +327,15 @@ impl Renderer {
             gpu_allocator::MemoryLocation::CpuToGpu,
             "frame uniforms",
         )?;
-        let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer) {
+        let features = match FrameFeatures::new(scene, &settings) {
+            Ok(f) => f,
+            Err(e) => {
+                gpu.destroy_buffer(uniforms);
+                return Err(e);
+            }
+        };
+        let translucency = features.translucency.as_ref().map(|(t, p)| (t, *p));
+        let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer, translucency) {
             Ok(s) => s,
             Err(e) => {
                 gpu.destroy_buffer(uniforms);
@@ -247,7 +343,7 @@ impl Renderer {
             }
         };
         let mut graph = RenderGraph::new();
-        let outputs = declare_frame(&mut graph, &settings, Some(&scene_gpu));
+        let outputs = declare_frame(&mut graph, &settings, &features, Some(&scene_gpu));
         let compiled = graph.compile(settings.compile).and_then(|(plan, execs)| {
             Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)
         });
@@ -301,6 +397,26 @@ impl Renderer {
         Ok(crate::output::f16_bytes_to_f32(&self.read_export(gpu, id)?))
     }
 
+    /// Reads the G-buffer of the last frame, decoded to f32 (needs `export_gbuffer`).
+    pub fn read_gbuffer(&self, gpu: &GpuContext) -> Result<GBufferReadback> {
+        let outputs = self.outputs.gbuffer.ok_or_else(|| {
+            LucentError::InvalidInput("the G-buffer is not exported in this frame".into())
+        })?;
+        let read = |id: ResourceId| -> Result<Vec<[f32; 4]>> {
+            let format = self.executable.plan.resources[id].info.format;
+            decode_texels(&self.read_export(gpu, id)?, format)
+        };
+        Ok(GBufferReadback {
+            width: self.settings.width,
+            height: self.settings.height,
+            gb0: read(outputs.gb0)?,
+            gb1: read(outputs.gb1)?,
+            gb2: outputs.gb2.map(read).transpose()?,
+            depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
+            layout: outputs.layout,
+        })
+    }
+
     fn read_export(&self, gpu: &GpuContext, id: ResourceId) -> Result<Vec<u8>> {
         let image = self.executable.owned_image(id).ok_or_else(|| {
             LucentError::Graph(format!(
@@ -325,6 +441,66 @@ impl Renderer {
             gpu.destroy_buffer(u);
         }
     }
+}
+
+/// A G-buffer read back and decoded: one `[f32; 4]` per pixel and target (missing channels
+/// are 0), rows top first.
+#[derive(Clone, Debug)]
+pub struct GBufferReadback {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Albedo rgb + specular.
+    pub gb0: Vec<[f32; 4]>,
+    /// Normal xyz + roughness.
+    pub gb1: Vec<[f32; 4]>,
+    /// Thickness + material ID as stored (see glsl/common/gbuffer.glsl).
+    pub gb2: Option<Vec<[f32; 4]>>,
+    /// Device depth.
+    pub depth: Vec<f32>,
+    /// The layout the frame used.
+    pub layout: GBufferLayout,
+}
+
+/// Decodes tightly packed texels of the formats lucent's G-buffer uses to f32.
+pub fn decode_texels(bytes: &[u8], format: vk::Format) -> Result<Vec<[f32; 4]>> {
+    let (channels, kind) = match format {
+        vk::Format::R8G8_UNORM => (2, 0),
+        vk::Format::R8G8B8A8_UNORM => (4, 0),
+        vk::Format::R16G16_SFLOAT => (2, 1),
+        vk::Format::R16G16B16A16_SFLOAT => (4, 1),
+        vk::Format::R32G32_SFLOAT => (2, 2),
+        vk::Format::R32G32B32A32_SFLOAT | vk::Format::D32_SFLOAT => (
+            if format == vk::Format::D32_SFLOAT {
+                1
+            } else {
+                4
+            },
+            2,
+        ),
+        other => {
+            return Err(LucentError::InvalidInput(format!(
+                "cannot decode texels of format {other:?}"
+            )))
+        }
+    };
+    let values: Vec<f32> = match kind {
+        0 => bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
+        1 => crate::output::f16_bytes_to_f32(bytes),
+        _ => bytes
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+    };
+    Ok(values
+        .chunks_exact(channels)
+        .map(|c| {
+            let mut t = [0.0; 4];
+            t[..channels].copy_from_slice(c);
+            t
+        })
+        .collect())
 }
 
 /// Times of one frame.

@@ -36,10 +36,8 @@ void light_incidence(Light light, vec3 pos, out vec3 to_light, out float attenua
     }
 }
 
-vec3 shade_direct(Surface s, vec3 pos, vec3 to_eye, Light light) {
-    vec3 to_light;
-    float attenuation;
-    light_incidence(light, pos, to_light, attenuation);
+// Diffuse + specular from one light whose direction and attenuation are known.
+vec3 shade_incident(Surface s, vec3 to_eye, vec3 to_light, float attenuation, Light light) {
     float n_dot_l = max(dot(s.normal, to_light), 0.0);
     vec3 h = to_light + to_eye;
     // to_light == -to_eye gives h = 0: no highlight rather than a NaN.
@@ -49,6 +47,13 @@ vec3 shade_direct(Surface s, vec3 pos, vec3 to_eye, Light light) {
     float spec = (n + 8.0) / (8.0 * PI) * pow(max(dot(s.normal, h), 0.0), n);
     vec3 brdf = s.albedo / PI + vec3(s.specular * spec);
     return brdf * light.radiance_range.rgb * (n_dot_l * attenuation);
+}
+
+vec3 shade_direct(Surface s, vec3 pos, vec3 to_eye, Light light) {
+    vec3 to_light;
+    float attenuation;
+    light_incidence(light, pos, to_light, attenuation);
+    return shade_incident(s, to_eye, to_light, attenuation, light);
 }
 
 #endif

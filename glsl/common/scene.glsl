@@ -3,7 +3,7 @@
 #ifndef LUCENT_SCENE_GLSL
 #define LUCENT_SCENE_GLSL
 
-#define MAX_LIGHTS 16
+#define MAX_LIGHTS 64
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_POINT 1
 #define LIGHT_SPOT 2

@@ -1,13 +1,14 @@
 #version 450
+// permutation: LUCENT_TRANSLUCENCY
+// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS
 #include "../common/gbuffer.glsl"
+#include "object.glsl"
 
 layout(location = 0) in vec3 in_normal;
-
-layout(push_constant) uniform Object {
-    mat4 model;
-    vec4 albedo_specular;
-    vec4 roughness;
-} object;
+#ifdef LUCENT_TRANSLUCENCY
+layout(location = 1) in vec3 in_thickness;
+layout(location = 2) out vec4 out_gb2;
+#endif
 
 layout(location = 0) out vec4 out_gb0;
 layout(location = 1) out vec4 out_gb1;
@@ -20,4 +21,7 @@ void main() {
     s.roughness = object.roughness.x;
     out_gb0 = pack_gb0(s);
     out_gb1 = pack_gb1(s);
+#ifdef LUCENT_TRANSLUCENCY
+    out_gb2 = pack_gb2(in_thickness, int(object.thickness.w + 0.5));
+#endif
 }

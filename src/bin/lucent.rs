@@ -11,7 +11,10 @@ use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bench::{self, BenchOptions};
 use lucent::graph::CompileOptions;
-use lucent::renderer::{plan_frame, FrameRunner, FrameSettings, Renderer, Technique};
+use lucent::passes::deferred::GBufferPrecision;
+use lucent::renderer::{
+    plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
+};
 use lucent::{output, scene, LucentError, Result};
 
 #[derive(Parser)]
@@ -116,6 +119,21 @@ struct FrameArgs {
     /// Do not alias transient images' memory (A/B comparison).
     #[arg(long)]
     no_alias: bool,
+    /// Precision of the G-buffer's colour targets: compact (RGBA8 albedo and translucency,
+    /// fp16 normal), half (all RGBA16F) or full (all RGBA32F).
+    #[arg(long, default_value = "compact", value_parser = parse_precision)]
+    gbuffer: GBufferPrecision,
+    /// Store coloured thickness as grayscale (its luminance), the talk's one-channel G-buffer.
+    #[arg(long)]
+    grayscale: bool,
+}
+
+fn parse_precision(text: &str) -> std::result::Result<GBufferPrecision, String> {
+    GBufferPrecision::ALL
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|&(_, p)| p)
+        .ok_or_else(|| format!("'{text}' is not one of compact, half, full"))
 }
 
 #[derive(Args, Clone)]
@@ -154,6 +172,9 @@ impl FrameArgs {
                 alias: !self.no_alias,
             },
             export_hdr,
+            export_gbuffer: false,
+            gbuffer: self.gbuffer,
+            force_grayscale: self.grayscale,
         })
     }
 }
@@ -393,8 +414,9 @@ fn run(cli: Cli) -> Result<()> {
             seed,
         } => bake_thickness(&mesh, out, per_vertex, rays, size, max_distance, seed),
         Command::Plan { frame } => {
-            scene::load_scene(&frame.scene)?;
-            let plan = plan_frame(&frame.settings(false)?)?;
+            let scene = scene::load_scene(&frame.scene)?;
+            let settings = frame.settings(false)?;
+            let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings)?)?;
             print!("{}", plan.dump());
             Ok(())
         }

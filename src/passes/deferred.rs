@@ -1,5 +1,7 @@
 //! Deferred shading: the MRT G-buffer pass and the lighting pass that reads it at the same pixel
-//! (input attachments), so the graph merges the two into subpasses of one render pass.
+//! (input attachments), so the graph merges the two into subpasses of one render pass. With
+//! translucency (GDC 2011) the G-buffer gains GB2 and the lighting pass evaluates the talk's
+//! per-light term beside diffuse and specular, only for pixels whose material ID says so.
 //! G-buffer layout and bit budget: glsl/common/gbuffer.glsl.
 
 use std::sync::Arc;
@@ -9,21 +11,102 @@ use ash::vk;
 use crate::backend::access::Access;
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph,
+    RenderGraph, ResourceId,
 };
 use crate::Result;
 
+use super::translucency::ThicknessPacking;
 use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
-/// G-buffer target formats (see glsl/common/gbuffer.glsl).
-pub const GB0_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
-/// Normal + roughness.
-pub const GB1_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Depth.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Lit HDR colour.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// Precision of the G-buffer's colour targets (the report measures what each costs and how
+/// far its image is from the f64 reference).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GBufferPrecision {
+    /// The production layout: albedo and translucency 8 bits per channel, normal fp16.
+    #[default]
+    Compact,
+    /// Every colour target RGBA16F.
+    Half,
+    /// Every colour target RGBA32F: the input of the f64 reference, not for rendering.
+    Full,
+}
+
+impl GBufferPrecision {
+    /// Every precision with its command-line name.
+    pub const ALL: &'static [(&'static str, GBufferPrecision)] = &[
+        ("compact", GBufferPrecision::Compact),
+        ("half", GBufferPrecision::Half),
+        ("full", GBufferPrecision::Full),
+    ];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, p)| *p == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+/// The G-buffer's targets: formats, and whether (and how) it carries translucency.
+/// Layout and bit budget: glsl/common/gbuffer.glsl.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GBufferLayout {
+    /// Target precision.
+    pub precision: GBufferPrecision,
+    /// GB2's thickness packing; `None`: the frame has no translucency and no GB2.
+    pub translucency: Option<ThicknessPacking>,
+}
+
+impl GBufferLayout {
+    /// GB0: albedo rgb + specular.
+    pub fn gb0_format(&self) -> vk::Format {
+        match self.precision {
+            GBufferPrecision::Compact => vk::Format::R8G8B8A8_UNORM,
+            GBufferPrecision::Half => vk::Format::R16G16B16A16_SFLOAT,
+            GBufferPrecision::Full => vk::Format::R32G32B32A32_SFLOAT,
+        }
+    }
+
+    /// GB1: world normal xyz + roughness.
+    pub fn gb1_format(&self) -> vk::Format {
+        match self.precision {
+            GBufferPrecision::Compact | GBufferPrecision::Half => vk::Format::R16G16B16A16_SFLOAT,
+            GBufferPrecision::Full => vk::Format::R32G32B32A32_SFLOAT,
+        }
+    }
+
+    /// GB2: local thickness + material ID (grayscale: two channels; coloured: four).
+    pub fn gb2_format(&self) -> Option<vk::Format> {
+        let packing = self.translucency?;
+        Some(match (self.precision, packing) {
+            (GBufferPrecision::Compact, ThicknessPacking::Grayscale) => vk::Format::R8G8_UNORM,
+            (GBufferPrecision::Compact, ThicknessPacking::Colored) => vk::Format::R8G8B8A8_UNORM,
+            (GBufferPrecision::Half, ThicknessPacking::Grayscale) => vk::Format::R16G16_SFLOAT,
+            (GBufferPrecision::Half, ThicknessPacking::Colored) => vk::Format::R16G16B16A16_SFLOAT,
+            (GBufferPrecision::Full, ThicknessPacking::Grayscale) => vk::Format::R32G32_SFLOAT,
+            (GBufferPrecision::Full, ThicknessPacking::Colored) => vk::Format::R32G32B32A32_SFLOAT,
+        })
+    }
+
+    /// Shader defines selecting the translucency code and its packing.
+    fn defines(&self) -> &'static [(&'static str, &'static str)] {
+        match self.translucency {
+            None => &[],
+            Some(ThicknessPacking::Grayscale) => &[("LUCENT_TRANSLUCENCY", "1")],
+            Some(ThicknessPacking::Colored) => &[
+                ("LUCENT_TRANSLUCENCY", "1"),
+                ("LUCENT_COLORED_THICKNESS", "1"),
+            ],
+        }
+    }
+}
 
 /// The G-buffer's handles.
 pub struct GBuffer {
@@ -31,8 +114,12 @@ pub struct GBuffer {
     pub gb0: Handle<Image>,
     /// Normal + roughness.
     pub gb1: Handle<Image>,
+    /// Local thickness + material ID, in frames with translucency.
+    pub gb2: Option<Handle<Image>>,
     /// Depth.
     pub depth: Handle<Image>,
+    /// The layout it was declared with.
+    pub layout: GBufferLayout,
 }
 
 /// Declares the G-buffer pass. `scene` is `None` for plan-only graphs (`lucent plan`).
@@ -40,6 +127,7 @@ pub fn gbuffer_pass(
     graph: &mut RenderGraph,
     width: u32,
     height: u32,
+    layout: GBufferLayout,
     scene: Option<&Arc<SceneGpu>>,
 ) -> GBuffer {
     let image = |format| ImageInfo {
@@ -48,17 +136,26 @@ pub fn gbuffer_pass(
         format,
     };
     let mut gb = GBuffer {
-        gb0: graph.create_image("gbuffer.albedo", image(GB0_FORMAT)),
-        gb1: graph.create_image("gbuffer.normal", image(GB1_FORMAT)),
+        gb0: graph.create_image("gbuffer.albedo", image(layout.gb0_format())),
+        gb1: graph.create_image("gbuffer.normal", image(layout.gb1_format())),
+        gb2: layout
+            .gb2_format()
+            .map(|f| graph.create_image("gbuffer.translucency", image(f))),
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
+        layout,
     };
     let mut pass = graph.add_pass("gbuffer", PassKind::Raster);
     pass.color(&mut gb.gb0, LoadOp::Clear([0.0; 4]))
-        .color(&mut gb.gb1, LoadOp::Clear([0.0, 1.0, 0.0, 1.0]))
-        .depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
+        .color(&mut gb.gb1, LoadOp::Clear([0.0, 1.0, 0.0, 1.0]));
+    if let Some(gb2) = &mut gb.gb2 {
+        // Cleared to material ID 0: sky and opaque pixels skip the translucency math.
+        pass.color(gb2, LoadOp::Clear([0.0; 4]));
+    }
+    pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {
         Some(scene) => pass.execute(GBufferPass {
             scene: scene.clone(),
+            layout,
             pipeline: None,
         }),
         None => pass.finish(),
@@ -81,15 +178,22 @@ pub fn lighting_pass(
         },
     );
     let mut pass = graph.add_pass("lighting", PassKind::Raster);
-    pass.input(&gb.gb0)
-        .input(&gb.gb1)
-        .input(&gb.depth)
-        .color(&mut hdr, LoadOp::DontCare);
-    let inputs = [gb.gb0.id(), gb.gb1.id(), gb.depth.id()];
+    pass.input(&gb.gb0).input(&gb.gb1).input(&gb.depth);
+    if let Some(gb2) = &gb.gb2 {
+        pass.input(gb2);
+    }
+    pass.color(&mut hdr, LoadOp::DontCare);
+    let inputs = LightingInputs {
+        gb0: gb.gb0.id(),
+        gb1: gb.gb1.id(),
+        depth: gb.depth.id(),
+        gb2: gb.gb2.as_ref().map(|h| h.id()),
+    };
     match scene {
         Some(scene) => pass.execute(LightingPass {
             scene: scene.clone(),
             inputs,
+            layout: gb.layout,
             pipeline: None,
         }),
         None => pass.finish(),
@@ -99,6 +203,7 @@ pub fn lighting_pass(
 
 struct GBufferPass {
     scene: Arc<SceneGpu>,
+    layout: GBufferLayout,
     pipeline: Option<PassPipeline>,
 }
 
@@ -110,8 +215,12 @@ impl PassExec for GBufferPass {
             &GraphicsPipelineDesc {
                 vertex: "deferred/gbuffer.vert",
                 fragment: "deferred/gbuffer.frag",
-                defines: &[],
-                vertex_input: VertexInput::PositionNormal,
+                defines: self.layout.defines(),
+                vertex_input: if self.layout.translucency.is_some() {
+                    VertexInput::PositionNormalThickness
+                } else {
+                    VertexInput::PositionNormal
+                },
                 depth_test: true,
                 cull_back: true,
                 set_layouts: &[],
@@ -140,6 +249,9 @@ impl PassExec for GBufferPass {
                     bytemuck::bytes_of(&draw.constants),
                 );
                 device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[mesh.vertices.buffer], &[0]);
+                if let (Some(thickness), Some(_)) = (&mesh.thickness, self.layout.translucency) {
+                    device.cmd_bind_vertex_buffers(ctx.cmd, 1, &[thickness.buffer], &[0]);
+                }
                 device.cmd_bind_index_buffer(
                     ctx.cmd,
                     mesh.indices.buffer,
@@ -158,29 +270,45 @@ impl PassExec for GBufferPass {
     }
 }
 
+/// The G-buffer images the lighting pass reads.
+struct LightingInputs {
+    gb0: ResourceId,
+    gb1: ResourceId,
+    depth: ResourceId,
+    gb2: Option<ResourceId>,
+}
+
 struct LightingPass {
     scene: Arc<SceneGpu>,
-    inputs: [crate::graph::ResourceId; 3],
+    inputs: LightingInputs,
+    layout: GBufferLayout,
     pipeline: Option<PassPipeline>,
 }
 
 impl PassExec for LightingPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let [gb0, gb1, depth] = self.inputs;
+        let inputs = &self.inputs;
         let color_layout = Access::InputAttachmentRead.info().layout;
         let depth_layout = Access::DepthInputAttachmentRead.info().layout;
+        // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency
+        // (glsl/deferred/lighting.frag).
+        let mut bindings = vec![
+            Binding::Uniform(self.scene.frame_uniforms),
+            Binding::InputAttachment(ctx.views[inputs.gb0], color_layout),
+            Binding::InputAttachment(ctx.views[inputs.gb1], color_layout),
+            Binding::InputAttachment(ctx.views[inputs.depth], depth_layout),
+        ];
+        if let (Some(gb2), Some(t)) = (inputs.gb2, &self.scene.translucency) {
+            bindings.push(Binding::InputAttachment(ctx.views[gb2], color_layout));
+            bindings.push(Binding::Uniform(t.materials.buffer));
+        }
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[
-                Binding::Uniform(self.scene.frame_uniforms),
-                Binding::InputAttachment(ctx.views[gb0], color_layout),
-                Binding::InputAttachment(ctx.views[gb1], color_layout),
-                Binding::InputAttachment(ctx.views[depth], depth_layout),
-            ],
+            &bindings,
             &GraphicsPipelineDesc {
                 vertex: "fullscreen.vert",
                 fragment: "deferred/lighting.frag",
-                defines: &[],
+                defines: self.layout.defines(),
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,

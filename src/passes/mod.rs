@@ -2,11 +2,14 @@
 //! handles in, handles out.
 //!
 //! - [`deferred`]: the MRT G-buffer and per-light deferred lighting (merged as subpasses).
+//! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
+//!   packing (its shading runs inside the deferred lighting pass).
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 
 pub mod deferred;
 pub mod tonemap;
+pub mod translucency;
 pub mod util;
 
 use std::sync::Arc;
@@ -16,6 +19,8 @@ use ash::vk;
 use crate::backend::{GpuBuffer, GpuContext};
 use crate::scene::Scene;
 use crate::Result;
+
+use translucency::{thickness_factor, MaterialTable, ThicknessPacking};
 
 /// One draw: which mesh, with which per-object constants.
 #[derive(Clone, Copy, Debug)]
@@ -36,6 +41,9 @@ pub struct ObjectConstants {
     pub albedo_specular: [f32; 4],
     /// Roughness in x.
     pub roughness: [f32; 4],
+    /// Translucency: thickness factor rgb (tint x constant thickness), material ID in w
+    /// (0: not translucent). Zero when the frame has no translucency.
+    pub thickness: [f32; 4],
 }
 
 /// A mesh on the GPU.
@@ -46,6 +54,16 @@ pub struct GpuMesh {
     pub indices: GpuBuffer,
     /// Number of indices.
     pub index_count: u32,
+    /// Per-vertex RGB thickness (vertex colours, or white), only in frames with translucency.
+    pub thickness: Option<GpuBuffer>,
+}
+
+/// What the translucency technique keeps on the GPU (absent from frames without it).
+pub struct TranslucencyGpu {
+    /// The material table uniform buffer ([`translucency::MaterialTableGpu`]).
+    pub materials: GpuBuffer,
+    /// How GB2 packs thickness.
+    pub packing: ThicknessPacking,
 }
 
 /// The scene's GPU data the passes share: meshes, draws, and the frame uniform buffer.
@@ -56,13 +74,33 @@ pub struct SceneGpu {
     pub draws: Vec<Draw>,
     /// Frame uniform buffer (camera, lights), owned and written by the renderer.
     pub frame_uniforms: vk::Buffer,
+    /// Translucency data, when the frame shades translucency.
+    pub translucency: Option<TranslucencyGpu>,
 }
 
 impl SceneGpu {
-    /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer.
-    pub fn new(gpu: &GpuContext, scene: &Scene, frame_uniforms: vk::Buffer) -> Result<Arc<Self>> {
+    /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer. With
+    /// `translucency` (the frame's material table and packing), also each mesh's thickness
+    /// stream and the material table.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &Scene,
+        frame_uniforms: vk::Buffer,
+        translucency: Option<(&MaterialTable, ThicknessPacking)>,
+    ) -> Result<Arc<Self>> {
         let mut meshes: Vec<GpuMesh> = Vec::with_capacity(scene.meshes.len());
-        let upload = |gpu: &GpuContext, meshes: &mut Vec<GpuMesh>| -> Result<()> {
+        let mut materials: Option<GpuBuffer> = None;
+        let upload = |gpu: &GpuContext,
+                      meshes: &mut Vec<GpuMesh>,
+                      materials: &mut Option<GpuBuffer>|
+         -> Result<()> {
+            if let Some((table, _)) = translucency {
+                *materials = Some(gpu.upload_buffer(
+                    std::slice::from_ref(&table.gpu()),
+                    vk::BufferUsageFlags::UNIFORM_BUFFER,
+                    &format!("{} translucency materials", scene.name),
+                )?);
+            }
             for (i, mesh) in scene.meshes.iter().enumerate() {
                 // A deforming scene is drawn as it stands at t = 0 (per-frame updates come with
                 // the layered-scattering technique that needs them).
@@ -85,45 +123,88 @@ impl SceneGpu {
                         return Err(e);
                     }
                 };
-                meshes.push(GpuMesh {
+                let mut gpu_mesh = GpuMesh {
                     vertices,
                     indices,
                     index_count: mesh.indices.len() as u32,
-                });
+                    thickness: None,
+                };
+                if translucency.is_some() {
+                    // Meshes without vertex colours are uniformly "thin": the material's
+                    // constant thickness then carries the value.
+                    let colors: Vec<[f32; 3]> = if mesh.colors.is_empty() {
+                        vec![[1.0; 3]; mesh.positions.len()]
+                    } else {
+                        mesh.colors.iter().map(|c| c.to_array()).collect()
+                    };
+                    match gpu.upload_buffer(
+                        &colors,
+                        vk::BufferUsageFlags::VERTEX_BUFFER,
+                        &format!("{} mesh {i} thickness", scene.name),
+                    ) {
+                        Ok(b) => gpu_mesh.thickness = Some(b),
+                        Err(e) => {
+                            meshes.push(gpu_mesh);
+                            return Err(e);
+                        }
+                    }
+                }
+                meshes.push(gpu_mesh);
             }
             Ok(())
         };
-        if let Err(e) = upload(gpu, &mut meshes) {
-            for m in meshes {
-                gpu.destroy_buffer(m.vertices);
-                gpu.destroy_buffer(m.indices);
-            }
+        if let Err(e) = upload(gpu, &mut meshes, &mut materials) {
+            Self::free(gpu, meshes, materials);
             return Err(e);
         }
         let draws = scene
             .objects
             .iter()
-            .map(|o| Draw {
-                mesh: o.mesh,
-                constants: ObjectConstants {
-                    model: o.transform.to_cols_array_2d(),
-                    albedo_specular: o.material.albedo.extend(o.material.specular).to_array(),
-                    roughness: [o.material.roughness, 0.0, 0.0, 0.0],
-                },
+            .enumerate()
+            .map(|(index, o)| {
+                let thickness = match (translucency, &o.material.translucency) {
+                    (Some((table, _)), Some(t)) => thickness_factor(t)
+                        .extend(f32::from(table.object_ids[index]))
+                        .to_array(),
+                    _ => [0.0; 4],
+                };
+                Draw {
+                    mesh: o.mesh,
+                    constants: ObjectConstants {
+                        model: o.transform.to_cols_array_2d(),
+                        albedo_specular: o.material.albedo.extend(o.material.specular).to_array(),
+                        roughness: [o.material.roughness, 0.0, 0.0, 0.0],
+                        thickness,
+                    },
+                }
             })
             .collect();
         Ok(Arc::new(Self {
             meshes,
             draws,
             frame_uniforms,
+            translucency: materials.map(|materials| TranslucencyGpu {
+                materials,
+                packing: translucency.map_or(ThicknessPacking::Grayscale, |(_, p)| p),
+            }),
         }))
+    }
+
+    fn free(gpu: &GpuContext, meshes: Vec<GpuMesh>, materials: Option<GpuBuffer>) {
+        for m in meshes {
+            gpu.destroy_buffer(m.vertices);
+            gpu.destroy_buffer(m.indices);
+            if let Some(t) = m.thickness {
+                gpu.destroy_buffer(t);
+            }
+        }
+        if let Some(b) = materials {
+            gpu.destroy_buffer(b);
+        }
     }
 
     /// Frees the GPU memory. The GPU must be done with it.
     pub fn destroy(self, gpu: &GpuContext) {
-        for m in self.meshes {
-            gpu.destroy_buffer(m.vertices);
-            gpu.destroy_buffer(m.indices);
-        }
+        Self::free(gpu, self.meshes, self.translucency.map(|t| t.materials));
     }
 }

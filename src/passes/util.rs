@@ -165,6 +165,9 @@ pub enum VertexInput {
     None,
     /// Interleaved position + normal ([`crate::scene::mesh::Vertex`]).
     PositionNormal,
+    /// Position + normal (binding 0) and a second stream of RGB thickness colours (binding 1,
+    /// location 2), for G-buffers that carry translucency.
+    PositionNormalThickness,
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -253,11 +256,20 @@ impl GraphicsPipeline {
                 .module(frag)
                 .name(entry),
         ];
-        let vertex_bindings = [vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
+        let vertex_bindings = [
+            vk::VertexInputBindingDescription {
+                binding: 0,
+                stride: std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
+                input_rate: vk::VertexInputRate::VERTEX,
+            },
+            // The thickness colour stream, a buffer of its own so frames without translucency
+            // neither store nor fetch it.
+            vk::VertexInputBindingDescription {
+                binding: 1,
+                stride: 12,
+                input_rate: vk::VertexInputRate::VERTEX,
+            },
+        ];
         let vertex_attributes = [
             vk::VertexInputAttributeDescription {
                 location: 0,
@@ -271,12 +283,23 @@ impl GraphicsPipeline {
                 format: vk::Format::R32G32B32_SFLOAT,
                 offset: 12,
             },
+            vk::VertexInputAttributeDescription {
+                location: 2,
+                binding: 1,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
         ];
         let vertex_input = match desc.vertex_input {
             VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
             VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&vertex_bindings)
-                .vertex_attribute_descriptions(&vertex_attributes),
+                .vertex_binding_descriptions(&vertex_bindings[..1])
+                .vertex_attribute_descriptions(&vertex_attributes[..2]),
+            VertexInput::PositionNormalThickness => {
+                vk::PipelineVertexInputStateCreateInfo::default()
+                    .vertex_binding_descriptions(&vertex_bindings)
+                    .vertex_attribute_descriptions(&vertex_attributes)
+            }
         };
         let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
             .topology(vk::PrimitiveTopology::TRIANGLE_LIST);

@@ -23,7 +23,7 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     (
         "grid125",
-        "5x5x5 translucent cubes filling the screen, three point lights",
+        "5x5x5 translucent cubes filling the screen, three point lights (`grid125:P`: P% translucent)",
     ),
     ("teapot", "the Utah teapot in normal-mapped marble (SSS profile)"),
     ("skin", "spheres with d'Eon's six-Gaussian skin profile"),
@@ -44,15 +44,25 @@ pub fn builtin(name: &str) -> Result<Scene> {
         Some((b, p)) => (b, Some(p)),
         None => (name, None),
     };
-    if parameter.is_some() && base != "scaling" {
+    if parameter.is_some() && base != "scaling" && base != "grid125" {
         return Err(LucentError::InvalidInput(format!(
-            "scene '{base}' takes no parameter (only scaling:N does)"
+            "scene '{base}' takes no parameter (only scaling:N and grid125:PERCENT do)"
         )));
     }
     match base {
         "smoke" => Ok(smoke()),
         "cubes" => cubes(),
-        "grid125" => grid125(),
+        "grid125" => {
+            let percent = match parameter {
+                None => 100,
+                Some(p) => p.parse::<u32>().ok().filter(|&p| p <= 100).ok_or_else(|| {
+                    LucentError::InvalidInput(format!(
+                        "grid125:{p}: the translucent share must be a whole percentage 0 to 100"
+                    ))
+                })?,
+            };
+            grid125(percent)
+        }
         "teapot" => teapot(),
         "skin" => skin(),
         "layered" => layered(),
@@ -240,8 +250,12 @@ fn cubes() -> Result<Scene> {
     Ok(s)
 }
 
-/// 5 x 5 x 5 translucent cubes filling the screen, three point lights.
-fn grid125() -> Result<Scene> {
+/// 5 x 5 x 5 cubes filling the screen, three point lights; `percent` of the cubes of every layer
+/// are translucent (spread evenly, so about that share of the screen is), the rest opaque with
+/// the same base material. With 0% one translucent cube sits behind the camera: the frame keeps
+/// its translucency G-buffer target and material-ID test while no pixel is translucent, which is
+/// what the "0% of the screen" measurement needs.
+fn grid125(percent: u32) -> Result<Scene> {
     let mut s = base_scene(
         "grid125",
         Some("translucency"),
@@ -255,21 +269,25 @@ fn grid125() -> Result<Scene> {
         ThicknessSource::Constant(0.7),
         Vec3::ONE,
     );
+    let mut opaque = material.clone();
+    opaque.name = "grid-opaque".into();
+    opaque.translucency = None;
+    let cube_at =
+        |p: Vec3| Mat4::from_scale_rotation_translation(Vec3::splat(0.45), glam::Quat::IDENTITY, p);
     for x in 0..5 {
         for y in 0..5 {
+            // Cube k of a layer is translucent when the running share crosses a whole cube.
+            let k = x * 5 + y;
+            let translucent = (k + 1) * percent / 100 > k * percent / 100;
             for z in 0..5 {
                 let p = Vec3::new(x as f32 - 2.0, y as f32 - 2.0, z as f32 - 2.0) * 1.25;
-                s.add(
-                    cube,
-                    Mat4::from_scale_rotation_translation(
-                        Vec3::splat(0.45),
-                        glam::Quat::IDENTITY,
-                        p,
-                    ),
-                    material.clone(),
-                );
+                let m = if translucent { &material } else { &opaque };
+                s.add(cube, cube_at(p), m.clone());
             }
         }
+    }
+    if percent == 0 {
+        s.add(cube, cube_at(Vec3::new(0.0, 0.0, 20.0)), material);
     }
     s.lights = vec![
         Light::point(

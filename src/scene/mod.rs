@@ -125,7 +125,7 @@ impl Deformation {
 }
 
 /// Lights the shaders loop over at most (glsl/common/scene.glsl).
-pub const MAX_LIGHTS: usize = 16;
+pub const MAX_LIGHTS: usize = 64;
 
 /// Bakes the local thickness (GDC 2011) into the vertex colours of every mesh drawn with a
 /// material whose thickness is `bake`, through the on-disk cache keyed by mesh content, so only

@@ -1,0 +1,12 @@
+// Per-object push constants of the G-buffer pass (`ObjectConstants` in src/passes/mod.rs).
+#ifndef LUCENT_OBJECT_GLSL
+#define LUCENT_OBJECT_GLSL
+
+layout(push_constant) uniform Object {
+    mat4 model;
+    vec4 albedo_specular;
+    vec4 roughness;   // x
+    vec4 thickness;   // rgb: tint x constant thickness; w: translucency material ID (0: none)
+} object;
+
+#endif

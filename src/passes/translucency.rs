@@ -1,0 +1,196 @@
+//! GDC 2011 thickness-based translucency (Frostbite 2, Barré-Brisebois and Bouchard): what the
+//! G-buffer and the deferred lighting pass need beyond plain shading.
+//!
+//! The technique adds no pass of its own. It adds one G-buffer target (`GB2`: local thickness
+//! and material ID, layout in `glsl/common/gbuffer.glsl`), a thickness stream per mesh, and a
+//! material table the lighting pass indexes by material ID; the per-light scale travels with the
+//! light. A frame whose scene has no translucent object (or whose technique is not
+//! `translucency`) declares none of it: no target, no vertex stream, no table, no shader code.
+//!
+//! This module is the CPU side: which materials get which ID ([`MaterialTable`]), the table's
+//! GPU layout ([`MaterialTableGpu`]), and how thickness is packed ([`ThicknessPacking`]).
+
+use glam::Vec3;
+
+use crate::scene::material::{PowMode, ThicknessSource, Translucency};
+use crate::scene::Scene;
+use crate::{LucentError, Result};
+
+/// Material IDs are stored in 8 bits; 0 means "not translucent", so 255 translucent materials
+/// fit in one frame.
+pub const MAX_TRANSLUCENT_MATERIALS: usize = 255;
+
+/// How local thickness is packed into `GB2`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ThicknessPacking {
+    /// One channel (the talk's Fig. 20): `R8G8` = thickness, material ID. A coloured
+    /// thickness is reduced to its Rec. 709 luminance.
+    Grayscale,
+    /// Three channels (the talk's coloured variant, unpacked): `R8G8B8A8` = thickness RGB,
+    /// material ID.
+    Colored,
+}
+
+impl ThicknessPacking {
+    /// Shader define value and name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ThicknessPacking::Grayscale => "grayscale",
+            ThicknessPacking::Colored => "colored",
+        }
+    }
+}
+
+/// Rec. 709 luminance: how a coloured thickness becomes grayscale.
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// One material table row as the lighting pass reads it (`glsl/common/translucency.glsl`):
+/// x power, y distortion, z ambient, w pow mode (0 exact, 1 spherical Gaussian).
+pub type MaterialRow = [f32; 4];
+
+/// The translucent materials of a scene, each with its ID (row `id - 1`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialTable {
+    /// Distinct translucency parameter sets, in order of first use.
+    pub rows: Vec<MaterialRow>,
+    /// Per scene object: its material ID (0 = not translucent).
+    pub object_ids: Vec<u8>,
+    /// Whether any translucent object's thickness is coloured (tint or vertex colours).
+    pub any_colored: bool,
+}
+
+impl MaterialTable {
+    /// Assigns IDs to the distinct translucency parameters of `scene`'s objects.
+    pub fn new(scene: &Scene) -> Result<Self> {
+        let mut rows: Vec<MaterialRow> = Vec::new();
+        let mut object_ids = Vec::with_capacity(scene.objects.len());
+        let mut any_colored = false;
+        for object in &scene.objects {
+            let Some(t) = &object.material.translucency else {
+                object_ids.push(0);
+                continue;
+            };
+            let row = material_row(t);
+            let index = match rows.iter().position(|r| *r == row) {
+                Some(i) => i,
+                None => {
+                    if rows.len() == MAX_TRANSLUCENT_MATERIALS {
+                        return Err(LucentError::InvalidInput(format!(
+                            "scene '{}' has more than {MAX_TRANSLUCENT_MATERIALS} distinct \
+                             translucent materials (material IDs are 8 bits)",
+                            scene.name
+                        )));
+                    }
+                    rows.push(row);
+                    rows.len() - 1
+                }
+            };
+            object_ids.push(index as u8 + 1);
+            let mesh_colored = scene.meshes[object.mesh]
+                .colors
+                .iter()
+                .any(|c| c.x != c.y || c.y != c.z);
+            any_colored |= t.is_colored() || mesh_colored;
+        }
+        Ok(Self {
+            rows,
+            object_ids,
+            any_colored,
+        })
+    }
+
+    /// Whether the frame needs translucency at all.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// The packing a frame uses: coloured only when some thickness is coloured.
+    pub fn packing(&self) -> ThicknessPacking {
+        if self.any_colored {
+            ThicknessPacking::Colored
+        } else {
+            ThicknessPacking::Grayscale
+        }
+    }
+
+    /// The uniform buffer contents.
+    pub fn gpu(&self) -> MaterialTableGpu {
+        let mut gpu = MaterialTableGpu {
+            rows: [[0.0; 4]; MAX_TRANSLUCENT_MATERIALS + 1],
+        };
+        for (i, row) in self.rows.iter().enumerate() {
+            gpu.rows[i + 1] = *row;
+        }
+        gpu
+    }
+}
+
+/// The table row of one material's parameters.
+pub fn material_row(t: &Translucency) -> MaterialRow {
+    [
+        t.power,
+        t.distortion,
+        t.ambient,
+        match t.pow_mode {
+            PowMode::Exact => 0.0,
+            PowMode::SphericalGaussian => 1.0,
+        },
+    ]
+}
+
+/// The material table uniform block (std140: an array of vec4), indexed by material ID; row 0
+/// is unused (ID 0 is "not translucent").
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MaterialTableGpu {
+    /// Rows by material ID.
+    pub rows: [MaterialRow; MAX_TRANSLUCENT_MATERIALS + 1],
+}
+
+/// The constant part of an object's thickness, multiplied in the G-buffer pass with the mesh's
+/// thickness stream (its vertex colours, or white): the material's tint times its constant
+/// thickness (1 for per-vertex, baked or texture thickness, which live in the stream).
+pub fn thickness_factor(t: &Translucency) -> Vec3 {
+    let constant = match t.thickness {
+        ThicknessSource::Constant(c) => c,
+        _ => 1.0,
+    };
+    t.color * constant
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    #[test]
+    fn ids_are_shared_by_equal_parameters_and_zero_for_opaque() {
+        let scene = builtin("grid125:50").unwrap();
+        let table = MaterialTable::new(&scene).unwrap();
+        assert_eq!(table.rows.len(), 1);
+        assert!(table.object_ids.contains(&0) && table.object_ids.contains(&1));
+        assert_eq!(table.packing(), ThicknessPacking::Grayscale);
+        assert_eq!(table.gpu().rows[1], table.rows[0]);
+        assert_eq!(table.gpu().rows[0], [0.0; 4]);
+    }
+
+    #[test]
+    fn a_coloured_tint_selects_the_coloured_packing() {
+        let scene = builtin("cubes").unwrap();
+        let table = MaterialTable::new(&scene).unwrap();
+        assert_eq!(table.packing(), ThicknessPacking::Colored);
+        assert_eq!(
+            table.rows.len(),
+            1,
+            "gray and red share power/distortion/ambient"
+        );
+    }
+
+    #[test]
+    fn scenes_without_translucency_need_no_table() {
+        let scene = builtin("smoke").unwrap();
+        assert!(MaterialTable::new(&scene).unwrap().is_empty());
+    }
+}

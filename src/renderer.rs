@@ -397,6 +397,24 @@ impl Renderer {
         Ok(crate::output::f16_bytes_to_f32(&self.read_export(gpu, id)?))
     }
 
+    /// Runs one frame in one command buffer and reads back everything it exports.
+    pub fn render_once(&self, gpu: &GpuContext) -> Result<FrameImages> {
+        let mut runner = FrameRunner::new(gpu, self.executable.plan.physical.len())?;
+        let timing = runner.run_frame(gpu, &self.executable);
+        runner.destroy(gpu);
+        let timing = timing?;
+        Ok(FrameImages {
+            display: self.read_display(gpu)?,
+            hdr: self.outputs.hdr.map(|_| self.read_hdr(gpu)).transpose()?,
+            gbuffer: self
+                .outputs
+                .gbuffer
+                .map(|_| self.read_gbuffer(gpu))
+                .transpose()?,
+            timing,
+        })
+    }
+
     /// Reads the G-buffer of the last frame, decoded to f32 (needs `export_gbuffer`).
     pub fn read_gbuffer(&self, gpu: &GpuContext) -> Result<GBufferReadback> {
         let outputs = self.outputs.gbuffer.ok_or_else(|| {
@@ -441,6 +459,19 @@ impl Renderer {
             gpu.destroy_buffer(u);
         }
     }
+}
+
+/// One frame's read-back images.
+#[derive(Clone, Debug)]
+pub struct FrameImages {
+    /// Display image, RGBA8 sRGB.
+    pub display: Vec<u8>,
+    /// Linear HDR RGBA f32, when exported.
+    pub hdr: Option<Vec<f32>>,
+    /// The G-buffer, when exported.
+    pub gbuffer: Option<GBufferReadback>,
+    /// The frame's times.
+    pub timing: FrameTiming,
 }
 
 /// A G-buffer read back and decoded: one `[f32; 4]` per pixel and target (missing channels

@@ -8,6 +8,7 @@ pub mod dipole;
 pub mod lighting;
 pub mod raytrace;
 pub mod tonemap;
+pub mod translucency;
 
 /// A 3-vector of f64 (the reference never rounds to f32 until the end).
 pub type DVec3 = glam::DVec3;

@@ -1,0 +1,192 @@
+//! GDC 2011 thickness-based translucency in f64 (twin of glsl/common/translucency.glsl), and the
+//! whole deferred lighting pass evaluated from a read-back G-buffer (twin of
+//! glsl/deferred/lighting.frag), so a test can prove every lit pixel right.
+
+use glam::{DMat4, DVec4};
+
+use super::lighting::{light_incidence, radiance, shade_direct};
+use super::DVec3;
+use crate::passes::translucency::{MaterialRow, ThicknessPacking};
+use crate::renderer::GBufferReadback;
+use crate::scene::{Light, Material, Scene};
+
+/// `x^n` for `x` in [0, 1]: exact `pow` (mode 0) or the spherical-Gaussian `exp2(n x - n)`
+/// (mode 1). The base is clamped as in the shader so `n = 0` gives 1, never NaN.
+pub fn translucency_lobe(x: f64, n: f64, mode: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    if mode == 1.0 {
+        (n * (x - 1.0)).exp2()
+    } else {
+        x.max(1e-30).powf(n)
+    }
+}
+
+/// The talk's per-light term: `albedo * lightColour * attenuation * (pow(saturate(dot(V,
+/// -(L + N d))), p) * scale + ambient) * thickness`.
+#[allow(clippy::too_many_arguments)]
+pub fn translucency_term(
+    albedo: DVec3,
+    normal: DVec3,
+    to_eye: DVec3,
+    to_light: DVec3,
+    attenuation: f64,
+    light_radiance: DVec3,
+    scale: f64,
+    material: MaterialRow,
+    thickness: DVec3,
+) -> DVec3 {
+    let [power, distortion, ambient, mode] = material.map(f64::from);
+    let lt_light = to_light + normal * distortion;
+    let lobe = translucency_lobe(to_eye.dot(-lt_light), power, mode) * scale;
+    albedo * light_radiance * (attenuation * (lobe + ambient)) * thickness
+}
+
+/// A G-buffer normal as the shader sanitises it: unit length, +Y when degenerate.
+fn sanitize_normal(n: DVec3) -> DVec3 {
+    let len2 = n.length_squared();
+    if !(len2 > 1e-12) || !len2.is_finite() {
+        DVec3::Y
+    } else {
+        n / len2.sqrt()
+    }
+}
+
+/// What the lighting pass needs besides the G-buffer.
+pub struct LightingInputs<'a> {
+    /// The scene (camera, lights, ambient, sky).
+    pub scene: &'a Scene,
+    /// Translucency material rows by material ID - 1, and the packing of GB2.
+    pub translucency: Option<(&'a [MaterialRow], ThicknessPacking)>,
+}
+
+/// Evaluates the deferred lighting pass in f64 for every pixel of `gbuffer`: linear HDR RGB per
+/// pixel, rows top first, clamped to the fp16 maximum as the shader does.
+pub fn shade_gbuffer(gbuffer: &GBufferReadback, inputs: &LightingInputs<'_>) -> Vec<DVec3> {
+    let (w, h) = (gbuffer.width as usize, gbuffer.height as usize);
+    let scene = inputs.scene;
+    let aspect = gbuffer.width as f32 / gbuffer.height.max(1) as f32;
+    // The shader's matrix is the f32 product; invert it in f64.
+    let view_proj = scene.camera.projection(aspect) * scene.camera.view();
+    let inv_view_proj: DMat4 = view_proj.as_dmat4().inverse();
+    let eye = scene.camera.eye.as_dvec3();
+    let ambient = scene.ambient.as_dvec3();
+    let mut out = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let d = f64::from(gbuffer.depth[i]);
+            if d >= 1.0 {
+                out.push(scene.sky.as_dvec3());
+                continue;
+            }
+            let ndc_x = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+            let ndc_y = (y as f64 + 0.5) / h as f64 * 2.0 - 1.0;
+            let world = inv_view_proj * DVec4::new(ndc_x, ndc_y, d, 1.0);
+            let pos = world.truncate() / world.w;
+            let [ar, ag, ab, specular] = gbuffer.gb0[i];
+            let [nx, ny, nz, roughness] = gbuffer.gb1[i];
+            let normal = sanitize_normal(DVec3::new(nx.into(), ny.into(), nz.into()));
+            let albedo_f32 = glam::Vec3::new(ar, ag, ab);
+            let material = Material::opaque("gbuffer", albedo_f32, specular, roughness);
+            let albedo = albedo_f32.as_dvec3();
+            let to_eye = (eye - pos).normalize();
+            let mut color = ambient * albedo;
+            let translucent = inputs.translucency.and_then(|(rows, packing)| {
+                let t = gbuffer.gb2.as_ref()?[i];
+                let (thickness, id) = match packing {
+                    ThicknessPacking::Colored => {
+                        (DVec3::new(t[0].into(), t[1].into(), t[2].into()), t[3])
+                    }
+                    ThicknessPacking::Grayscale => (DVec3::splat(t[0].into()), t[1]),
+                };
+                let id = (f64::from(id) * 255.0 + 0.5) as usize;
+                (id > 0).then(|| (rows.get(id - 1).copied().unwrap_or([0.0; 4]), thickness))
+            });
+            for light in &scene.lights {
+                color += shade_direct(&material, normal, pos, to_eye, light);
+                if let Some((row, thickness)) = translucent {
+                    color += light_translucency(albedo, normal, pos, to_eye, light, row, thickness);
+                }
+            }
+            out.push(color.min(DVec3::splat(65504.0)));
+        }
+    }
+    out
+}
+
+/// The translucency of one light at `pos` (direction and attenuation as for diffuse).
+pub fn light_translucency(
+    albedo: DVec3,
+    normal: DVec3,
+    pos: DVec3,
+    to_eye: DVec3,
+    light: &Light,
+    material: MaterialRow,
+    thickness: DVec3,
+) -> DVec3 {
+    let (to_light, attenuation) = light_incidence(light, pos);
+    translucency_term(
+        albedo,
+        normal,
+        to_eye,
+        to_light,
+        attenuation,
+        radiance(light),
+        f64::from(light.translucency_scale),
+        material,
+        thickness,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lobe_is_finite_and_bounded_at_the_extremes() {
+        for n in [0.0, 1e-3, 1.0, 12.0, 1e4] {
+            for x in [-5.0, 0.0, 1e-9, 0.5, 1.0, 11.0] {
+                for mode in [0.0, 1.0] {
+                    let v = translucency_lobe(x, n, mode);
+                    assert!(
+                        v.is_finite() && (0.0..=1.0).contains(&v),
+                        "{x} {n} {mode}: {v}"
+                    );
+                }
+            }
+        }
+        assert_eq!(translucency_lobe(0.0, 0.0, 0.0), 1.0, "x^0 = 1, even at 0");
+        assert_eq!(translucency_lobe(1.0, 1e4, 1.0), 1.0);
+    }
+
+    #[test]
+    fn spherical_gaussian_approaches_pow_for_large_powers_near_one() {
+        // exp2(n(x-1)) vs x^n = exp2(n log2 x): log2 x ~ (x-1)/ln 2 near 1, so they differ by
+        // the factor 1/ln 2 in the exponent; both peak at 1 with value 1 and vanish away.
+        let (n, x): (f64, f64) = (12.0, 0.99);
+        let exact = translucency_lobe(x, n, 0.0);
+        let sg = translucency_lobe(x, n, 1.0);
+        assert!((exact - x.powf(n)).abs() < 1e-15);
+        assert!((sg - (n * (x - 1.0)).exp2()).abs() < 1e-15);
+        assert!((exact - sg).abs() < 0.05, "{exact} vs {sg}");
+    }
+
+    #[test]
+    fn back_light_through_a_thin_surface_matches_the_formula() {
+        // View straight at the surface, light straight behind it: V . -L = 1, full lobe.
+        let row = [12.0, 0.0, 0.1, 0.0];
+        let c = translucency_term(
+            DVec3::ONE,
+            DVec3::Z,
+            DVec3::Z,
+            -DVec3::Z,
+            0.5,
+            DVec3::splat(2.0),
+            3.0,
+            row,
+            DVec3::new(1.0, 0.5, 0.0),
+        );
+        let expected = 2.0 * 0.5 * (1.0 * 3.0 + 0.1);
+        assert!((c - DVec3::new(expected, expected * 0.5, 0.0)).length() < 1e-12);
+    }
+}

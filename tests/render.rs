@@ -9,7 +9,7 @@ use lucent::backend::{ContextDesc, GpuContext};
 use lucent::compare::{compare_with_golden, flip_rgba8, FlipThresholds};
 use lucent::graph::CompileOptions;
 use lucent::reference::raytrace;
-use lucent::renderer::{FrameRunner, FrameSettings, Renderer};
+use lucent::renderer::{FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::scene;
 
 fn output_dir() -> PathBuf {
@@ -87,11 +87,29 @@ fn every_builtin_scene_renders_finite_and_validation_clean() {
 #[test]
 fn smoke_matches_its_golden() {
     // Same settings as tests/golden/LIST's `smoke` line.
-    let (w, h) = (320, 240);
-    let (display, _) = render("smoke", FrameSettings::new(w, h));
-    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/smoke.png");
+    check_golden("smoke", FrameSettings::new(320, 240));
+}
+
+#[test]
+fn translucent_cubes_and_grid125_match_their_goldens() {
+    // Same settings as tests/golden/LIST's `cubes` and `grid125` lines.
+    for name in ["cubes", "grid125"] {
+        let settings = FrameSettings {
+            technique: Technique::Translucency,
+            ..FrameSettings::new(320, 240)
+        };
+        check_golden(name, settings);
+    }
+}
+
+/// Renders built-in scene `name` (loaded as the command loads it) and compares it with
+/// tests/golden/NAME.png.
+fn check_golden(name: &str, settings: FrameSettings) {
+    let (w, h) = (settings.width, settings.height);
+    let (display, _) = render_scene(&scene::load_scene(name).unwrap(), settings);
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
     let outcome = compare_with_golden(
-        "smoke",
+        name,
         &golden,
         &display,
         w,
@@ -102,7 +120,7 @@ fn smoke_matches_its_golden() {
     .unwrap();
     assert!(
         outcome.passed,
-        "smoke differs from its golden: mean FLIP {:.4}, {:.3}% of pixels above threshold; see {:?} and {:?}",
+        "{name} differs from its golden: mean FLIP {:.4}, {:.3}% of pixels above threshold; see {:?} and {:?}",
         outcome.result.mean,
         outcome.result.fraction_above * 100.0,
         outcome.actual_path,

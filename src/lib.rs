@@ -19,8 +19,10 @@ pub mod error;
 pub mod graph;
 pub mod output;
 pub mod passes;
+pub mod plot;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
+pub mod sweep;
 
 pub use error::{LucentError, Result};

@@ -14,6 +14,7 @@ packages=(
     libvulkan-dev
     xvfb
     vulkan-tools
+    fonts-dejavu-core
 )
 
 if ! command -v dpkg-query >/dev/null 2>&1; then

@@ -34,30 +34,32 @@ void main() {
     vec3 color = frame.ambient.rgb * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
 #ifdef LUCENT_TRANSLUCENCY
+    // One loop for every pixel: diffuse and specular, plus the talk's term where the material
+    // ID says translucent (sharing the light's direction and attenuation). The test sits
+    // inside the loop rather than around a second copy of it: a GPU skips the term for
+    // coherent opaque pixels, and a SIMD CPU driver (lavapipe runs both sides of a branch)
+    // pays only for the term, never for two loops. Opaque pixels read row 0 and thickness 0.
     vec4 t = subpassLoad(gb2);
     int material_id = unpack_material_id(t);
-    if (material_id > 0) {
-        // Translucent pixel: the talk's term beside diffuse and specular, sharing the light's
-        // direction and attenuation.
-        vec4 material = translucency_materials.rows[clamp(material_id, 0, 255)];
-        vec3 thickness = unpack_thickness(t);
-        for (int i = 0; i < count; ++i) {
-            Light light = frame.lights[i];
-            vec3 to_light;
-            float attenuation;
-            light_incidence(light, pos, to_light, attenuation);
-            color += shade_incident(s, to_eye, to_light, attenuation, light);
+    vec4 material = translucency_materials.rows[clamp(material_id, 0, 255)];
+    vec3 thickness = unpack_thickness(t);
+    for (int i = 0; i < count; ++i) {
+        Light light = frame.lights[i];
+        vec3 to_light;
+        float attenuation;
+        light_incidence(light, pos, to_light, attenuation);
+        color += shade_incident(s, to_eye, to_light, attenuation, light);
+        if (material_id > 0) {
             color += translucency_term(s.albedo, s.normal, to_eye, to_light, attenuation,
                                        light.radiance_range.rgb, light.params.y, material,
                                        thickness);
         }
-        out_color = vec4(min(color, vec3(65504.0)), 1.0);
-        return;
     }
-#endif
+#else
     for (int i = 0; i < count; ++i) {
         color += shade_direct(s, pos, to_eye, frame.lights[i]);
     }
+#endif
     // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).
     out_color = vec4(min(color, vec3(65504.0)), 1.0);
 }

@@ -22,6 +22,7 @@ pub mod passes;
 pub mod plot;
 pub mod reference;
 pub mod renderer;
+pub mod report;
 pub mod scene;
 pub mod sweep;
 

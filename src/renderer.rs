@@ -15,8 +15,10 @@ use crate::backend::timer::{GpuTimer, ScopeTime};
 use crate::backend::{GpuBuffer, GpuContext};
 use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
-use crate::passes::deferred::{GBufferLayout, GBufferPrecision};
-use crate::passes::translucency::{MaterialTable, ThicknessPacking};
+use crate::passes::deferred::{GBufferLayout, GBufferPrecision, TranslucencyLayout};
+use crate::passes::translucency::{
+    mesh_bounds, tile_buffer, tile_buffer_size, translucent_tiles, MaterialTable, ThicknessPacking,
+};
 use crate::passes::{deferred, tonemap, SceneGpu};
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
@@ -134,7 +136,14 @@ impl FrameFeatures {
     pub fn gbuffer_layout(&self, settings: &FrameSettings) -> GBufferLayout {
         GBufferLayout {
             precision: settings.gbuffer,
-            translucency: self.translucency.as_ref().map(|(_, p)| *p),
+            translucency: self
+                .translucency
+                .as_ref()
+                .map(|(table, packing)| TranslucencyLayout {
+                    packing: *packing,
+                    pow_modes: table.pow_modes(),
+                    single_material: table.rows.len() == 1,
+                }),
         }
     }
 }
@@ -293,6 +302,10 @@ pub struct Renderer {
     pub settings: FrameSettings,
     scene_gpu: Option<Arc<SceneGpu>>,
     uniforms: Option<GpuBuffer>,
+    /// The lighting pass's tile buffer (frames with translucency).
+    tiles: Option<GpuBuffer>,
+    /// Object-space bounds per mesh, for the translucent tiles (frames with translucency).
+    mesh_bounds: Vec<(Vec3, Vec3)>,
 }
 
 impl Renderer {
@@ -321,24 +334,44 @@ impl Renderer {
                 scene.lights.len()
             )));
         }
+        let features = FrameFeatures::new(scene, &settings)?;
         let uniforms = gpu.create_buffer(
             std::mem::size_of::<FrameUniforms>() as u64,
             vk::BufferUsageFlags::UNIFORM_BUFFER,
             gpu_allocator::MemoryLocation::CpuToGpu,
             "frame uniforms",
         )?;
-        let features = match FrameFeatures::new(scene, &settings) {
-            Ok(f) => f,
-            Err(e) => {
-                gpu.destroy_buffer(uniforms);
-                return Err(e);
+        // The lighting pass's screen tiles (frames with translucency), rewritten every frame.
+        let tiles = match &features.translucency {
+            None => None,
+            Some(_) => match gpu.create_buffer(
+                tile_buffer_size(settings.width, settings.height),
+                vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER,
+                gpu_allocator::MemoryLocation::CpuToGpu,
+                "lighting tiles",
+            ) {
+                Ok(b) => Some(b),
+                Err(e) => {
+                    gpu.destroy_buffer(uniforms);
+                    return Err(e);
+                }
+            },
+        };
+        let free_host = |uniforms: GpuBuffer, tiles: Option<GpuBuffer>| {
+            gpu.destroy_buffer(uniforms);
+            if let Some(t) = tiles {
+                gpu.destroy_buffer(t);
             }
         };
-        let translucency = features.translucency.as_ref().map(|(t, p)| (t, *p));
+        let translucency = features
+            .translucency
+            .as_ref()
+            .zip(tiles.as_ref())
+            .map(|((t, p), tiles)| (t, *p, tiles.buffer));
         let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer, translucency) {
             Ok(s) => s,
             Err(e) => {
-                gpu.destroy_buffer(uniforms);
+                free_host(uniforms, tiles);
                 return Err(e);
             }
         };
@@ -353,9 +386,14 @@ impl Renderer {
                 if let Ok(s) = Arc::try_unwrap(scene_gpu) {
                     s.destroy(gpu);
                 }
-                gpu.destroy_buffer(uniforms);
+                free_host(uniforms, tiles);
                 return Err(e);
             }
+        };
+        let mesh_bounds = if tiles.is_some() {
+            mesh_bounds(scene)
+        } else {
+            Vec::new()
         };
         let mut renderer = Self {
             executable,
@@ -363,6 +401,8 @@ impl Renderer {
             settings,
             scene_gpu: Some(scene_gpu),
             uniforms: Some(uniforms),
+            tiles,
+            mesh_bounds,
         };
         renderer.update(scene)?;
         Ok(renderer)
@@ -381,6 +421,15 @@ impl Renderer {
             })?;
         let bytes = bytemuck::bytes_of(&uniforms);
         mapped[..bytes.len()].copy_from_slice(bytes);
+        if let Some(tiles) = self.tiles.as_mut() {
+            let (width, height) = (self.settings.width, self.settings.height);
+            let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
+            let bytes = tile_buffer(width, height, columns, &marked);
+            let mapped = tiles.mapped_mut().ok_or_else(|| {
+                LucentError::InvalidInput("lighting tile buffer is not host-visible".into())
+            })?;
+            mapped[..bytes.len()].copy_from_slice(&bytes);
+        }
         Ok(())
     }
 
@@ -458,6 +507,9 @@ impl Renderer {
         if let Some(u) = self.uniforms.take() {
             gpu.destroy_buffer(u);
         }
+        if let Some(t) = self.tiles.take() {
+            gpu.destroy_buffer(t);
+        }
     }
 }
 
@@ -502,14 +554,9 @@ pub fn decode_texels(bytes: &[u8], format: vk::Format) -> Result<Vec<[f32; 4]>> 
         vk::Format::R16G16_SFLOAT => (2, 1),
         vk::Format::R16G16B16A16_SFLOAT => (4, 1),
         vk::Format::R32G32_SFLOAT => (2, 2),
-        vk::Format::R32G32B32A32_SFLOAT | vk::Format::D32_SFLOAT => (
-            if format == vk::Format::D32_SFLOAT {
-                1
-            } else {
-                4
-            },
-            2,
-        ),
+        vk::Format::R32G32B32A32_SFLOAT => (4, 2),
+        // Depth-stencil images read back their depth aspect, 32-bit float.
+        vk::Format::D32_SFLOAT | vk::Format::D32_SFLOAT_S8_UINT => (1, 2),
         other => {
             return Err(LucentError::InvalidInput(format!(
                 "cannot decode texels of format {other:?}"

@@ -333,6 +333,7 @@ pub fn markdown(rows: &[SweepRow], width: u32, height: u32, device: &str) -> Str
             match p.pow_mode {
                 PowMode::Exact => "pow",
                 PowMode::SphericalGaussian => "exp2",
+                PowMode::SphericalGaussianScaled => "exp2-scaled",
             },
             p.power,
             p.distortion,

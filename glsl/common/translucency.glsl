@@ -17,13 +17,20 @@ layout(std140, set = 0, binding = 5) uniform TranslucencyMaterials {
 // x^n for x in [0, 1], n >= 0. pow(0, 0) is undefined in GLSL (and pow(x, y) for x <= 0 in
 // general): the base is clamped to a tiny positive value, so n = 0 gives exactly 1 and large n
 // underflow to 0 instead of NaN.
+// LUCENT_POW_MODES says which forms the frame's materials use (1 exact, 2 exp2, 3 both): a
+// frame compiles only its forms, because a SIMD CPU driver evaluates both sides of a branch.
+// exp2(n*x - n) = exp2(n (x - 1)) <= 1: no overflow for any n >= 0.
 float translucency_lobe(float x, float n, float mode) {
     x = clamp(x, 0.0, 1.0);
-    if (mode == float(POW_SPHERICAL_GAUSSIAN)) {
-        // exp2(n*x - n) = exp2(n (x - 1)) <= 1: no overflow for any n >= 0.
-        return exp2(n * (x - 1.0));
-    }
+#if LUCENT_POW_MODES == 1
     return pow(max(x, 1e-30), n);
+#elif LUCENT_POW_MODES == 2
+    return exp2(n * (x - 1.0));
+#else
+    // Both forms are exp2 of n times an exponent: choose the exponent, not the function.
+    float e = mode == float(POW_SPHERICAL_GAUSSIAN) ? x - 1.0 : log2(max(x, 1e-30));
+    return exp2(n * e);
+#endif
 }
 
 // The talk's per-light term:
@@ -38,6 +45,28 @@ vec3 translucency_term(vec3 albedo, vec3 normal, vec3 to_eye, vec3 to_light, flo
     float lobe = translucency_lobe(dot(to_eye, -lt_light), material.x, material.w) * scale;
     vec3 lt = attenuation * (lobe + material.z) * thickness;
     return albedo * radiance * lt;
+}
+
+// Diffuse + specular + the talk's term from one light, sharing what they have in common: the
+// term is albedo * radiance * attenuation * (lobe + ambient) * thickness and diffuse is
+// albedo * radiance * attenuation * n_dot_l / pi, so the term joins diffuse as one more factor.
+// Equal (up to rounding) to shade_incident(...) + translucency_term(...).
+// `v_dot_n` is dot(to_eye, s.normal), the same for every light: dot(V, -(L + N d)) is
+// -(dot(V, L) + d dot(V, N)), so the distorted light vector is never built.
+vec3 shade_incident_translucent(Surface s, vec3 to_eye, float v_dot_n, vec3 to_light,
+                                float attenuation, Light light, vec4 material,
+                                vec3 thickness) {
+    float n_dot_l = max(dot(s.normal, to_light), 0.0);
+    vec3 h = to_light + to_eye;
+    // to_light == -to_eye gives h = 0: no highlight rather than a NaN.
+    float h_len2 = dot(h, h);
+    h = h_len2 > 1e-12 ? h * inversesqrt(h_len2) : s.normal;
+    float n = shininess(s.roughness);
+    float spec = (n + 8.0) / (8.0 * PI) * pow(max(dot(s.normal, h), 0.0), n);
+    float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
+    float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
+    vec3 diffuse = s.albedo * (n_dot_l / PI + (lobe + material.z) * thickness);
+    return (diffuse + vec3(s.specular * spec * n_dot_l)) * light.radiance_range.rgb * attenuation;
 }
 
 #endif

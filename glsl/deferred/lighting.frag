@@ -1,9 +1,12 @@
 #version 450
 // permutation: LUCENT_TRANSLUCENCY
-// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS
+// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=1
+// permutation: LUCENT_TRANSLUCENCY LUCENT_POW_MODES=2 LUCENT_SINGLE_MATERIAL
+// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
-// only at this pixel through input attachments. With LUCENT_TRANSLUCENCY, adds GDC 2011's
-// per-light translucency for pixels whose material ID is translucent; the others skip it.
+// only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
+// for translucent pixels (stencil-selected): GDC 2011's per-light term joins diffuse and
+// specular.
 #include "../common/gbuffer.glsl"
 #include "../common/lighting.glsl"
 #ifdef LUCENT_TRANSLUCENCY
@@ -34,26 +37,23 @@ void main() {
     vec3 color = frame.ambient.rgb * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
 #ifdef LUCENT_TRANSLUCENCY
-    // One loop for every pixel: diffuse and specular, plus the talk's term where the material
-    // ID says translucent (sharing the light's direction and attenuation). The test sits
-    // inside the loop rather than around a second copy of it: a GPU skips the term for
-    // coherent opaque pixels, and a SIMD CPU driver (lavapipe runs both sides of a branch)
-    // pays only for the term, never for two loops. Opaque pixels read row 0 and thickness 0.
+    // This variant runs only where the G-buffer's stencil marked the pixel translucent (the
+    // plain variant shades the rest), so it never tests the material ID to skip work.
     vec4 t = subpassLoad(gb2);
-    int material_id = unpack_material_id(t);
-    vec4 material = translucency_materials.rows[clamp(material_id, 0, 255)];
+#ifdef LUCENT_SINGLE_MATERIAL
+    vec4 material = translucency_materials.rows[1];
+#else
+    vec4 material = translucency_materials.rows[clamp(unpack_material_id(t), 0, 255)];
+#endif
     vec3 thickness = unpack_thickness(t);
+    float v_dot_n = dot(to_eye, s.normal);
     for (int i = 0; i < count; ++i) {
         Light light = frame.lights[i];
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
-        color += shade_incident(s, to_eye, to_light, attenuation, light);
-        if (material_id > 0) {
-            color += translucency_term(s.albedo, s.normal, to_eye, to_light, attenuation,
-                                       light.radiance_range.rgb, light.params.y, material,
-                                       thickness);
-        }
+        color += shade_incident_translucent(s, to_eye, v_dot_n, to_light, attenuation, light,
+                                            material, thickness);
     }
 #else
     for (int i = 0; i < count; ++i) {

@@ -188,6 +188,16 @@ impl Access {
     }
 }
 
+/// Whether a depth format also has a stencil aspect.
+pub fn has_stencil(format: vk::Format) -> bool {
+    matches!(
+        format,
+        vk::Format::D24_UNORM_S8_UINT
+            | vk::Format::D32_SFLOAT_S8_UINT
+            | vk::Format::D16_UNORM_S8_UINT
+    )
+}
+
 /// Whether `format` is a depth format (decides the image aspect).
 pub fn is_depth_format(format: vk::Format) -> bool {
     matches!(

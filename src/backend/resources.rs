@@ -533,14 +533,26 @@ impl GpuContext {
                 image.name
             )));
         }
-        if desc.aspect != vk::ImageAspectFlags::COLOR && desc.aspect != vk::ImageAspectFlags::DEPTH
+        // Depth-stencil images read back their depth aspect (copied as 32 bits per texel for
+        // the combined formats).
+        let copy_aspect = if desc.aspect.contains(vk::ImageAspectFlags::DEPTH) {
+            vk::ImageAspectFlags::DEPTH
+        } else {
+            desc.aspect
+        };
+        if copy_aspect != vk::ImageAspectFlags::COLOR && copy_aspect != vk::ImageAspectFlags::DEPTH
         {
             return Err(LucentError::InvalidInput(format!(
-                "image '{}' cannot be read back: aspect {:?} is not COLOR or DEPTH alone",
+                "image '{}' cannot be read back: aspect {:?} has neither COLOR nor DEPTH",
                 image.name, desc.aspect
             )));
         }
-        let texel = format_texel_size(desc.format).ok_or_else(|| {
+        let texel = if crate::backend::access::has_stencil(desc.format) {
+            Some(4)
+        } else {
+            format_texel_size(desc.format)
+        };
+        let texel = texel.ok_or_else(|| {
             LucentError::InvalidInput(format!(
                 "image '{}' cannot be read back: format {:?} has no known texel size",
                 image.name, desc.format
@@ -574,7 +586,7 @@ impl GpuContext {
                 buffer_row_length: 0,
                 buffer_image_height: 0,
                 image_subresource: vk::ImageSubresourceLayers {
-                    aspect_mask: desc.aspect,
+                    aspect_mask: copy_aspect,
                     mip_level: 0,
                     base_array_layer: 0,
                     layer_count: 1,

@@ -86,6 +86,26 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
+    /// Error against run time: every approximation of a technique timed (round-robin, same
+    /// run) and compared with the exact f64 reference; writes a Markdown table and a PNG plot.
+    Report {
+        /// The technique to report on (`translucency`).
+        technique: String,
+        /// Output directory.
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+        /// Resolution as WIDTHxHEIGHT.
+        #[arg(long, default_value = "1024x768", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Measured rounds (one frame of every variant per round).
+        #[arg(long, default_value_t = 15)]
+        rounds: usize,
+        /// Discarded rounds first.
+        #[arg(long, default_value_t = 3)]
+        warmup: usize,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Load a mesh, texture, MTL or scene file and summarise it (or say what is wrong with it).
     Inspect {
         /// The file (.obj, .mtl, .png, .jpg, .tga, .exr, .hdr, .toml).
@@ -421,6 +441,40 @@ fn sweep_command(
     Ok(())
 }
 
+fn report_command(
+    technique: &str,
+    out: &std::path::Path,
+    options: lucent::report::ReportOptions,
+    gpu_args: &GpuArgs,
+) -> Result<()> {
+    if technique != "translucency" {
+        return Err(LucentError::InvalidInput(format!(
+            "report: unknown technique '{technique}'; available: translucency"
+        )));
+    }
+    if options.rounds == 0 {
+        return Err(LucentError::InvalidInput(
+            "report: --rounds must be at least 1".into(),
+        ));
+    }
+    let session = Session::new(gpu_args)?;
+    let written = lucent::report::write_translucency_report(
+        &session.gpu,
+        &session.shaders,
+        &session.pipeline_cache,
+        out,
+        &options,
+    );
+    let finished = session.finish();
+    let (text, files) = written?;
+    finished?;
+    println!("{text}");
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Scenes => {
@@ -460,6 +514,24 @@ fn run(cli: Cli) -> Result<()> {
             out,
             gpu,
         } => sweep_command(&technique, size, out, &gpu),
+        Command::Report {
+            technique,
+            out,
+            size,
+            rounds,
+            warmup,
+            gpu,
+        } => report_command(
+            &technique,
+            &out,
+            lucent::report::ReportOptions {
+                width: size.0,
+                height: size.1,
+                rounds,
+                warmup,
+            },
+            &gpu,
+        ),
         Command::Inspect { file } => {
             print!("{}", scene::inspect::inspect_file(&file)?);
             Ok(())

@@ -802,18 +802,30 @@ fn plan_render_pass(
                 rp.attachments.len() - 1
             });
             rp.attachments[a].final_layout = info.layout;
-            let already = sub.colors.iter().any(|&(x, _)| x == a)
-                || sub.inputs.iter().any(|&(x, _)| x == a)
-                || sub.depth.is_some_and(|(x, _)| x == a);
-            if already {
-                continue;
-            }
+            // Each role once per attachment. A depth image may hold two roles in one subpass:
+            // read-only depth-stencil attachment (tests) and depth input attachment, both in the
+            // read-only layout.
             match u.access {
-                Access::ColorAttachmentWrite => sub.colors.push((a, info.layout)),
-                Access::DepthAttachmentWrite | Access::DepthAttachmentRead => {
-                    sub.depth = Some((a, info.layout))
+                Access::ColorAttachmentWrite => {
+                    if sub.colors.iter().any(|&(x, _)| x == a) {
+                        continue;
+                    }
+                    sub.colors.push((a, info.layout));
                 }
-                _ => sub.inputs.push((a, info.layout)),
+                Access::DepthAttachmentWrite | Access::DepthAttachmentRead => {
+                    if sub.depth.is_some_and(|(x, _)| x == a) {
+                        continue;
+                    }
+                    sub.depth = Some((a, info.layout));
+                }
+                _ => {
+                    if sub.inputs.iter().any(|&(x, _)| x == a)
+                        || sub.colors.iter().any(|&(x, _)| x == a)
+                    {
+                        continue;
+                    }
+                    sub.inputs.push((a, info.layout));
+                }
             }
             if let Some(&(prev, prev_access)) = last_use.get(&u.resource) {
                 if prev != s {

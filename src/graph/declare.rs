@@ -8,7 +8,7 @@ use std::marker::PhantomData;
 
 use ash::vk;
 
-use crate::backend::access::{is_depth_format, Access};
+use crate::backend::access::{has_stencil, is_depth_format, Access};
 
 use super::PassExec;
 
@@ -57,7 +57,9 @@ pub struct ImageInfo {
 impl ImageInfo {
     /// Aspect implied by the format.
     pub fn aspect(&self) -> vk::ImageAspectFlags {
-        if is_depth_format(self.format) {
+        if has_stencil(self.format) {
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+        } else if is_depth_format(self.format) {
             vk::ImageAspectFlags::DEPTH
         } else {
             vk::ImageAspectFlags::COLOR
@@ -281,7 +283,10 @@ impl PassBuilder<'_> {
     /// Reads the image only at the pixel being shaded (`subpassLoad`); lets the graph merge this
     /// pass with the one that wrote the image. Binding = order of `input` calls.
     pub fn input(&mut self, handle: &Handle<Image>) -> &mut Self {
-        let depth = self.graph.resources[handle.id].info.aspect() == vk::ImageAspectFlags::DEPTH;
+        let depth = self.graph.resources[handle.id]
+            .info
+            .aspect()
+            .contains(vk::ImageAspectFlags::DEPTH);
         let access = if depth {
             Access::DepthInputAttachmentRead
         } else {

@@ -7,7 +7,7 @@
 
 use ash::vk;
 
-use crate::backend::access::Access;
+use crate::backend::access::{has_stencil, Access};
 use crate::backend::shader::ShaderCompiler;
 use crate::backend::timer::GpuTimer;
 use crate::backend::{GpuContext, GpuImage, ImageDesc, MemoryBlock};
@@ -36,6 +36,10 @@ pub struct PrepareContext<'a> {
     pub extent: vk::Extent2D,
     /// Views of every graph image, by [`ResourceId`] (null for images without memory).
     pub views: &'a [vk::ImageView],
+    /// Views for descriptors (input attachments, sampling), by [`ResourceId`]: the same as
+    /// `views` except for depth-stencil images, whose descriptor view must name one aspect
+    /// (depth) while the framebuffer's names both.
+    pub descriptor_views: &'a [vk::ImageView],
 }
 
 /// What a pass needs to record itself.
@@ -75,6 +79,10 @@ pub struct Executable {
     physical: Vec<Physical>,
     images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
+    /// Depth-only views of depth-stencil images (null for every other image).
+    depth_views: Vec<vk::ImageView>,
+    /// `views` with `depth_views` where those exist: what descriptors point at.
+    descriptor_views: Vec<vk::ImageView>,
     blocks: Vec<MemoryBlock>,
     render_passes: Vec<vk::RenderPass>,
     framebuffers: Vec<vk::Framebuffer>,
@@ -103,6 +111,8 @@ impl Executable {
             physical: Vec::new(),
             images: vec![vk::Image::null(); plan.resources.len()],
             views: vec![vk::ImageView::null(); plan.resources.len()],
+            depth_views: vec![vk::ImageView::null(); plan.resources.len()],
+            descriptor_views: Vec::new(),
             blocks: Vec::new(),
             render_passes: Vec::new(),
             framebuffers: Vec::new(),
@@ -197,6 +207,28 @@ impl Executable {
             }
             self.blocks.push(block);
         }
+        // Depth-stencil images that descriptors read get a depth-only view as well.
+        for id in 0..count {
+            let desc = self.desc(id);
+            let owned = matches!(
+                self.physical[id],
+                Physical::Owned(_) | Physical::Aliased { .. }
+            );
+            if owned && has_stencil(desc.format) {
+                let depth_only = ImageDesc {
+                    aspect: vk::ImageAspectFlags::DEPTH,
+                    ..desc
+                };
+                let name = format!("{} (depth)", self.plan.resources[id].name);
+                self.depth_views[id] = gpu.create_view(self.images[id], &depth_only, &name)?;
+            }
+        }
+        self.descriptor_views = self
+            .views
+            .iter()
+            .zip(&self.depth_views)
+            .map(|(&v, &d)| if d == vk::ImageView::null() { v } else { d })
+            .collect();
         for phys in &self.plan.physical {
             let framebuffer = match &phys.render_pass {
                 Some(plan) => {
@@ -236,6 +268,7 @@ impl Executable {
                     color_attachment_count,
                     extent: extent(phys.extent),
                     views: &self.views,
+                    descriptor_views: &self.descriptor_views,
                 };
                 self.execs[p].prepare(&ctx).map_err(|e| match e {
                     LucentError::Graph(m) => {
@@ -431,6 +464,12 @@ impl Executable {
                 }
             }
         }
+        for view in self.depth_views.drain(..) {
+            if view != vk::ImageView::null() {
+                // SAFETY: created by `create_resources`; the GPU is done with it.
+                unsafe { gpu.device.destroy_image_view(view, None) };
+            }
+        }
         for physical in self.physical.drain(..) {
             match physical {
                 Physical::Owned(image) => gpu.destroy_image(image),
@@ -490,8 +529,17 @@ fn create_render_pass(
                 .samples(vk::SampleCountFlags::TYPE_1)
                 .load_op(a.load)
                 .store_op(a.store)
-                .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-                .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+                // A stencil aspect is loaded and stored like its depth.
+                .stencil_load_op(if has_stencil(a.format) {
+                    a.load
+                } else {
+                    vk::AttachmentLoadOp::DONT_CARE
+                })
+                .stencil_store_op(if has_stencil(a.format) {
+                    a.store
+                } else {
+                    vk::AttachmentStoreOp::DONT_CARE
+                })
                 .initial_layout(a.initial_layout)
                 .final_layout(a.final_layout)
         })

@@ -1,7 +1,13 @@
 //! Deferred shading: the MRT G-buffer pass and the lighting pass that reads it at the same pixel
-//! (input attachments), so the graph merges the two into subpasses of one render pass. With
-//! translucency (GDC 2011) the G-buffer gains GB2 and the lighting pass evaluates the talk's
-//! per-light term beside diffuse and specular, only for pixels whose material ID says so.
+//! (input attachments), so the graph merges the two into subpasses of one render pass.
+//!
+//! With translucency (GDC 2011) the G-buffer gains GB2 (thickness + material ID), and the
+//! lighting pass is drawn as screen tiles in two draws: tiles that translucent objects may cover
+//! (their projected bounding boxes, on the CPU each frame) get the shader with the talk's
+//! per-light term, the others the plain shader. Only rasterisation reliably skips work on every
+//! driver: lavapipe shades both sides of a per-pixel branch, and it runs input-attachment
+//! shaders with late depth/stencil tests, so neither a material-ID branch nor a stencil mask
+//! saves anything there (measured in docs/translucency.md).
 //! G-buffer layout and bit budget: glsl/common/gbuffer.glsl.
 
 use std::sync::Arc;
@@ -15,8 +21,8 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::translucency::ThicknessPacking;
-use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::translucency::{ThicknessPacking, TILE_HEADER_BYTES};
+use super::util::{Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
 /// Depth.
@@ -60,8 +66,20 @@ impl GBufferPrecision {
 pub struct GBufferLayout {
     /// Target precision.
     pub precision: GBufferPrecision,
-    /// GB2's thickness packing; `None`: the frame has no translucency and no GB2.
-    pub translucency: Option<ThicknessPacking>,
+    /// `None`: the frame has no translucency and no GB2.
+    pub translucency: Option<TranslucencyLayout>,
+}
+
+/// How a frame's translucency is stored and shaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TranslucencyLayout {
+    /// GB2's thickness packing.
+    pub packing: ThicknessPacking,
+    /// The pow forms the frame's materials use (bit 0 exact, bit 1 `exp2`): the shader
+    /// compiles only those.
+    pub pow_modes: u8,
+    /// Only one translucent material: the shader reads its row without the per-pixel ID.
+    pub single_material: bool,
 }
 
 impl GBufferLayout {
@@ -84,7 +102,7 @@ impl GBufferLayout {
 
     /// GB2: local thickness + material ID (grayscale: two channels; coloured: four).
     pub fn gb2_format(&self) -> Option<vk::Format> {
-        let packing = self.translucency?;
+        let packing = self.translucency?.packing;
         Some(match (self.precision, packing) {
             (GBufferPrecision::Compact, ThicknessPacking::Grayscale) => vk::Format::R8G8_UNORM,
             (GBufferPrecision::Compact, ThicknessPacking::Colored) => vk::Format::R8G8B8A8_UNORM,
@@ -95,16 +113,28 @@ impl GBufferLayout {
         })
     }
 
-    /// Shader defines selecting the translucency code and its packing.
-    fn defines(&self) -> &'static [(&'static str, &'static str)] {
-        match self.translucency {
-            None => &[],
-            Some(ThicknessPacking::Grayscale) => &[("LUCENT_TRANSLUCENCY", "1")],
-            Some(ThicknessPacking::Colored) => &[
-                ("LUCENT_TRANSLUCENCY", "1"),
-                ("LUCENT_COLORED_THICKNESS", "1"),
-            ],
+    /// Shader defines selecting the translucency code, its packing, pow forms and material
+    /// lookup (nothing for frames without translucency).
+    fn defines(&self) -> Vec<(&'static str, &'static str)> {
+        let Some(t) = self.translucency else {
+            return Vec::new();
+        };
+        let mut defines = vec![("LUCENT_TRANSLUCENCY", "1")];
+        if t.packing == ThicknessPacking::Colored {
+            defines.push(("LUCENT_COLORED_THICKNESS", "1"));
         }
+        defines.push((
+            "LUCENT_POW_MODES",
+            match t.pow_modes {
+                1 => "1",
+                2 => "2",
+                _ => "3",
+            },
+        ));
+        if t.single_material {
+            defines.push(("LUCENT_SINGLE_MATERIAL", "1"));
+        }
+        defines
     }
 }
 
@@ -195,6 +225,7 @@ pub fn lighting_pass(
             inputs,
             layout: gb.layout,
             pipeline: None,
+            translucent: None,
         }),
         None => pass.finish(),
     }
@@ -215,7 +246,7 @@ impl PassExec for GBufferPass {
             &GraphicsPipelineDesc {
                 vertex: "deferred/gbuffer.vert",
                 fragment: "deferred/gbuffer.frag",
-                defines: self.layout.defines(),
+                defines: &self.layout.defines(),
                 vertex_input: if self.layout.translucency.is_some() {
                     VertexInput::PositionNormalThickness
                 } else {
@@ -282,7 +313,11 @@ struct LightingPass {
     scene: Arc<SceneGpu>,
     inputs: LightingInputs,
     layout: GBufferLayout,
+    /// The plain shader: every pixel, or with translucency the tiles no translucent object
+    /// touches.
     pipeline: Option<PassPipeline>,
+    /// With translucency: the translucency shader for the other tiles (same set).
+    translucent: Option<GraphicsPipeline>,
 }
 
 impl PassExec for LightingPass {
@@ -290,44 +325,97 @@ impl PassExec for LightingPass {
         let inputs = &self.inputs;
         let color_layout = Access::InputAttachmentRead.info().layout;
         let depth_layout = Access::DepthInputAttachmentRead.info().layout;
+        let views = ctx.descriptor_views;
         // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency
         // (glsl/deferred/lighting.frag).
         let mut bindings = vec![
             Binding::Uniform(self.scene.frame_uniforms),
-            Binding::InputAttachment(ctx.views[inputs.gb0], color_layout),
-            Binding::InputAttachment(ctx.views[inputs.gb1], color_layout),
-            Binding::InputAttachment(ctx.views[inputs.depth], depth_layout),
+            Binding::InputAttachment(views[inputs.gb0], color_layout),
+            Binding::InputAttachment(views[inputs.gb1], color_layout),
+            Binding::InputAttachment(views[inputs.depth], depth_layout),
         ];
         if let (Some(gb2), Some(t)) = (inputs.gb2, &self.scene.translucency) {
-            bindings.push(Binding::InputAttachment(ctx.views[gb2], color_layout));
+            bindings.push(Binding::InputAttachment(views[gb2], color_layout));
             bindings.push(Binding::Uniform(t.materials.buffer));
         }
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: "deferred/lighting.frag",
-                defines: self.layout.defines(),
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
-                set_layouts: &[],
-                push_constant_bytes: 0,
-                name: "lighting",
+        let tiled = self.layout.translucency.is_some();
+        let plain = GraphicsPipelineDesc {
+            vertex: if tiled {
+                "deferred/tiles.vert"
+            } else {
+                "fullscreen.vert"
             },
-        )?);
+            fragment: "deferred/lighting.frag",
+            defines: &[],
+            vertex_input: if tiled {
+                VertexInput::Tiles
+            } else {
+                VertexInput::None
+            },
+            depth_test: false,
+            cull_back: false,
+            set_layouts: &[],
+            push_constant_bytes: 0,
+            name: "lighting",
+        };
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &plain)?;
+        if self.layout.translucency.is_some() {
+            let defines = self.layout.defines();
+            let layouts = [pipeline.set.layout];
+            let translucent = GraphicsPipeline::new(
+                ctx,
+                &GraphicsPipelineDesc {
+                    defines: &defines,
+                    set_layouts: &layouts,
+                    name: "lighting (translucent)",
+                    ..plain
+                },
+            );
+            match translucent {
+                Ok(p) => self.translucent = Some(p),
+                Err(e) => {
+                    pipeline.destroy(&ctx.gpu.device);
+                    return Err(e);
+                }
+            }
+        }
+        self.pipeline = Some(pipeline);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        let (Some(translucent), Some(t)) = (&self.translucent, &self.scene.translucency) else {
             pipeline.draw_fullscreen(ctx);
+            return;
+        };
+        let device = &ctx.gpu.device;
+        let stride = std::mem::size_of::<vk::DrawIndirectCommand>() as u64;
+        pipeline.bind(ctx);
+        // SAFETY: both pipelines were made for this subpass with the bound set's layout; the
+        // tile buffer holds two draw commands and the vertices they name (written by the
+        // renderer before the frame was submitted).
+        unsafe {
+            device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[t.tiles], &[TILE_HEADER_BYTES]);
+            // Draw 1: tiles no translucent object touches, plain shader.
+            device.cmd_draw_indirect(ctx.cmd, t.tiles, stride, 1, stride as u32);
+            device.cmd_bind_pipeline(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                translucent.pipeline,
+            );
+            // Draw 0: the translucent tiles.
+            device.cmd_draw_indirect(ctx.cmd, t.tiles, 0, 1, stride as u32);
         }
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.translucent.take() {
             p.destroy(&gpu.device);
         }
     }

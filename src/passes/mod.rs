@@ -64,6 +64,9 @@ pub struct TranslucencyGpu {
     pub materials: GpuBuffer,
     /// How GB2 packs thickness.
     pub packing: ThicknessPacking,
+    /// The lighting pass's screen tiles and their two indirect draws
+    /// ([`translucency::tile_buffer`]), owned and written by the renderer every frame.
+    pub tiles: vk::Buffer,
 }
 
 /// The scene's GPU data the passes share: meshes, draws, and the frame uniform buffer.
@@ -80,13 +83,13 @@ pub struct SceneGpu {
 
 impl SceneGpu {
     /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer. With
-    /// `translucency` (the frame's material table and packing), also each mesh's thickness
-    /// stream and the material table.
+    /// `translucency` (the frame's material table, packing and the renderer's tile buffer),
+    /// also each mesh's thickness stream and the material table.
     pub fn new(
         gpu: &GpuContext,
         scene: &Scene,
         frame_uniforms: vk::Buffer,
-        translucency: Option<(&MaterialTable, ThicknessPacking)>,
+        translucency: Option<(&MaterialTable, ThicknessPacking, vk::Buffer)>,
     ) -> Result<Arc<Self>> {
         let mut meshes: Vec<GpuMesh> = Vec::with_capacity(scene.meshes.len());
         let mut materials: Option<GpuBuffer> = None;
@@ -94,7 +97,7 @@ impl SceneGpu {
                       meshes: &mut Vec<GpuMesh>,
                       materials: &mut Option<GpuBuffer>|
          -> Result<()> {
-            if let Some((table, _)) = translucency {
+            if let Some((table, _, _)) = translucency {
                 *materials = Some(gpu.upload_buffer(
                     std::slice::from_ref(&table.gpu()),
                     vk::BufferUsageFlags::UNIFORM_BUFFER,
@@ -163,7 +166,7 @@ impl SceneGpu {
             .enumerate()
             .map(|(index, o)| {
                 let thickness = match (translucency, &o.material.translucency) {
-                    (Some((table, _)), Some(t)) => thickness_factor(t)
+                    (Some((table, _, _)), Some(t)) => thickness_factor(t)
                         .extend(f32::from(table.object_ids[index]))
                         .to_array(),
                     _ => [0.0; 4],
@@ -183,10 +186,13 @@ impl SceneGpu {
             meshes,
             draws,
             frame_uniforms,
-            translucency: materials.map(|materials| TranslucencyGpu {
-                materials,
-                packing: translucency.map_or(ThicknessPacking::Grayscale, |(_, p)| p),
-            }),
+            translucency: materials
+                .zip(translucency)
+                .map(|(materials, (_, packing, tiles))| TranslucencyGpu {
+                    materials,
+                    packing,
+                    tiles,
+                }),
         }))
     }
 

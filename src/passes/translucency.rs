@@ -115,6 +115,15 @@ impl MaterialTable {
         }
     }
 
+    /// Which pow forms the materials use: bit 0 exact, bit 1 spherical Gaussian (the lighting
+    /// shader compiles only the forms a frame needs).
+    pub fn pow_modes(&self) -> u8 {
+        self.rows
+            .iter()
+            .map(|r| if r[3] == 1.0 { 2 } else { 1 })
+            .fold(0, |a, b| a | b)
+    }
+
     /// The uniform buffer contents.
     pub fn gpu(&self) -> MaterialTableGpu {
         let mut gpu = MaterialTableGpu {
@@ -129,15 +138,17 @@ impl MaterialTable {
 
 /// The table row of one material's parameters.
 pub fn material_row(t: &Translucency) -> MaterialRow {
-    [
-        t.power,
-        t.distortion,
-        t.ambient,
-        match t.pow_mode {
-            PowMode::Exact => 0.0,
-            PowMode::SphericalGaussian => 1.0,
-        },
-    ]
+    match t.pow_mode {
+        PowMode::Exact => [t.power, t.distortion, t.ambient, 0.0],
+        PowMode::SphericalGaussian => [t.power, t.distortion, t.ambient, 1.0],
+        // The seed's scale and bias, "handled offline": the shader runs the plain exp2 form.
+        PowMode::SphericalGaussianScaled => [
+            (t.power + 1.0) * std::f32::consts::LOG2_E,
+            t.distortion,
+            t.ambient,
+            1.0,
+        ],
+    }
 }
 
 /// The material table uniform block (std140: an array of vec4), indexed by material ID; row 0
@@ -158,6 +169,139 @@ pub fn thickness_factor(t: &Translucency) -> Vec3 {
         _ => 1.0,
     };
     t.color * constant
+}
+
+/// Side of the screen tiles the lighting pass is split into, in pixels.
+pub const TILE_SIZE: u32 = 64;
+
+/// Bytes of the two `VkDrawIndirectCommand`s at the start of the tile buffer: draw 0 covers
+/// the translucent tiles, draw 1 the others.
+pub const TILE_HEADER_BYTES: u64 = 32;
+
+/// Which screen tiles translucent objects may cover: each translucent object's bounding box
+/// (object space, `bounds[mesh]`) is projected, and every tile its screen rectangle touches is
+/// marked. Conservative: a box crossing the near plane marks every tile, one wholly behind the
+/// camera or outside the frustum marks none. Row-major, `columns x rows` tiles of
+/// [`TILE_SIZE`].
+pub fn translucent_tiles(
+    scene: &Scene,
+    bounds: &[(Vec3, Vec3)],
+    width: u32,
+    height: u32,
+) -> (u32, u32, Vec<bool>) {
+    let (columns, rows) = (width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE));
+    let mut tiles = vec![false; (columns * rows) as usize];
+    let aspect = width as f32 / height.max(1) as f32;
+    let view_proj = scene.camera.projection(aspect) * scene.camera.view();
+    for object in scene
+        .objects
+        .iter()
+        .filter(|o| o.material.translucency.is_some())
+    {
+        let (lo, hi) = bounds[object.mesh];
+        let clip_from_object = view_proj * object.transform;
+        let corners = (0..8).map(|i| {
+            let p = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            clip_from_object * p.extend(1.0)
+        });
+        let corners: Vec<glam::Vec4> = corners.collect();
+        // Clip-space w is the view depth: <= 0 is behind the eye.
+        let behind = corners.iter().filter(|c| c.w <= 1e-6).count();
+        if behind == corners.len() {
+            continue;
+        }
+        let (mut min, mut max) = (glam::Vec2::splat(-1.0), glam::Vec2::splat(1.0));
+        if behind == 0 {
+            let ndc = corners.iter().map(|c| c.truncate().truncate() / c.w);
+            let (lo, hi) = ndc.fold(
+                (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN)),
+                |(lo, hi), p| (lo.min(p), hi.max(p)),
+            );
+            if hi.x < -1.0 || hi.y < -1.0 || lo.x > 1.0 || lo.y > 1.0 {
+                continue;
+            }
+            (min, max) = (
+                lo.max(glam::Vec2::splat(-1.0)),
+                hi.min(glam::Vec2::splat(1.0)),
+            );
+        }
+        // NDC to pixels (Vulkan: y = -1 is the top row), one pixel of margin for rasterisation.
+        let to_px = |v: f32, size: u32| ((v + 1.0) * 0.5 * size as f32).clamp(0.0, size as f32);
+        let x0 = (to_px(min.x, width) - 1.0).max(0.0) as u32 / TILE_SIZE;
+        let x1 = ((to_px(max.x, width) + 1.0) as u32).min(width - 1) / TILE_SIZE;
+        let y0 = (to_px(min.y, height) - 1.0).max(0.0) as u32 / TILE_SIZE;
+        let y1 = ((to_px(max.y, height) + 1.0) as u32).min(height - 1) / TILE_SIZE;
+        for y in y0..=y1.min(rows - 1) {
+            for x in x0..=x1.min(columns - 1) {
+                tiles[(y * columns + x) as usize] = true;
+            }
+        }
+    }
+    (columns, rows, tiles)
+}
+
+/// The most bytes [`tile_buffer`] writes for a `width` x `height` frame.
+pub fn tile_buffer_size(width: u32, height: u32) -> u64 {
+    let tiles = u64::from(width.div_ceil(TILE_SIZE) * height.div_ceil(TILE_SIZE));
+    TILE_HEADER_BYTES + tiles * 6 * 8
+}
+
+/// The lighting pass's tile buffer: two indirect draw commands (translucent tiles, then the
+/// rest), then two triangles per run of equal tiles along a row as NDC `vec2`s, translucent
+/// runs first.
+pub fn tile_buffer(width: u32, height: u32, columns: u32, tiles: &[bool]) -> Vec<u8> {
+    let mut translucent: Vec<[f32; 2]> = Vec::new();
+    let mut plain: Vec<[f32; 2]> = Vec::new();
+    let ndc = |v: u32, size: u32| v.min(size) as f32 / size as f32 * 2.0 - 1.0;
+    // Runs of equal tiles along a row become one quad: fewer triangles, and whole rasteriser
+    // bins covered (lavapipe shades fully covered 64x64 bins on a fast path).
+    for (ty, row) in tiles.chunks(columns as usize).enumerate() {
+        let ty = ty as u32;
+        let mut start = 0usize;
+        while start < row.len() {
+            let marked = row[start];
+            let end = row[start..]
+                .iter()
+                .position(|&t| t != marked)
+                .map_or(row.len(), |n| start + n);
+            let (x0, x1) = (
+                ndc(start as u32 * TILE_SIZE, width),
+                ndc(end as u32 * TILE_SIZE, width),
+            );
+            let (y0, y1) = (
+                ndc(ty * TILE_SIZE, height),
+                ndc((ty + 1) * TILE_SIZE, height),
+            );
+            let quad = [[x0, y0], [x1, y0], [x1, y1], [x0, y0], [x1, y1], [x0, y1]];
+            if marked { &mut translucent } else { &mut plain }.extend_from_slice(&quad);
+            start = end;
+        }
+    }
+    let (n_translucent, n_plain) = (translucent.len() as u32, plain.len() as u32);
+    // VkDrawIndirectCommand: vertexCount, instanceCount, firstVertex, firstInstance.
+    let header: [u32; 8] = [n_translucent, 1, 0, 0, n_plain, 1, n_translucent, 0];
+    let mut bytes = bytemuck::cast_slice(&header).to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(&translucent));
+    bytes.extend_from_slice(bytemuck::cast_slice(&plain));
+    bytes
+}
+
+/// Object-space bounding box of each mesh.
+pub fn mesh_bounds(scene: &Scene) -> Vec<(Vec3, Vec3)> {
+    scene
+        .meshes
+        .iter()
+        .map(|m| {
+            m.positions.iter().fold(
+                (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+                |(lo, hi), &p| (lo.min(p), hi.max(p)),
+            )
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -186,6 +330,29 @@ mod tests {
             1,
             "gray and red share power/distortion/ambient"
         );
+    }
+
+    #[test]
+    fn tiles_cover_translucent_objects_and_nothing_behind_the_camera() {
+        let (w, h) = (320, 240);
+        let full = builtin("grid125").unwrap();
+        let (columns, rows, tiles) = translucent_tiles(&full, &mesh_bounds(&full), w, h);
+        assert_eq!((columns, rows), (5, 4));
+        assert!(tiles.iter().filter(|&&t| t).count() > tiles.len() * 3 / 4);
+        let none = builtin("grid125:0").unwrap();
+        let (_, _, tiles) = translucent_tiles(&none, &mesh_bounds(&none), w, h);
+        assert!(
+            tiles.iter().all(|&t| !t),
+            "the cube behind the camera marks no tile"
+        );
+        let bytes = tile_buffer(w, h, columns, &tiles);
+        assert!(bytes.len() as u64 <= tile_buffer_size(w, h));
+        let header: Vec<u32> = bytes[..32]
+            .chunks(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        assert_eq!(header[0], 0);
+        assert_eq!(header[4], 6 * 4, "one quad per row of plain tiles");
     }
 
     #[test]

@@ -23,7 +23,7 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     (
         "grid125",
-        "5x5x5 translucent cubes filling the screen, three point lights (`grid125:P`: P% translucent)",
+        "5x5x5 translucent cubes (exp2 pow) filling the screen, three point lights (`grid125:P`: P% translucent)",
     ),
     ("teapot", "the Utah teapot in normal-mapped marble (SSS profile)"),
     ("skin", "spheres with d'Eon's six-Gaussian skin profile"),
@@ -263,12 +263,18 @@ fn grid125(percent: u32) -> Result<Scene> {
     );
     s.sky = Vec3::new(0.02, 0.02, 0.03);
     let cube = s.add_mesh(generators::generate(Generator::Cube, 1)?);
-    let material = translucent(
+    let mut material = translucent(
         "grid-translucent",
         Vec3::new(0.8, 0.75, 0.7),
         ThicknessSource::Constant(0.7),
         Vec3::ONE,
     );
+    // The grid is the spherical-Gaussian seed's own test scene (5x5x5 cubes): it uses the
+    // seed's exp2 form, the one meant for covering the screen; `lucent report translucency`
+    // measures exact pow beside it.
+    if let Some(t) = &mut material.translucency {
+        t.pow_mode = crate::scene::material::PowMode::SphericalGaussian;
+    }
     let mut opaque = material.clone();
     opaque.name = "grid-opaque".into();
     opaque.translucency = None;

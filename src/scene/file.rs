@@ -704,12 +704,13 @@ fn build_material(
         translucency.pow_mode = match t.pow.as_deref() {
             None | Some("exact") => PowMode::Exact,
             Some("exp2") => PowMode::SphericalGaussian,
+            Some("exp2-scaled") => PowMode::SphericalGaussianScaled,
             Some(other) => {
                 return Err(at.error(
                     "material",
                     Some(i),
                     "pow",
-                    format!("unknown pow mode '{other}'; use exact or exp2"),
+                    format!("unknown pow mode '{other}'; use exact, exp2 or exp2-scaled"),
                 ))
             }
         };

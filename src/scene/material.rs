@@ -56,8 +56,13 @@ pub enum ThicknessSource {
 pub enum PowMode {
     /// `pow(x, n)`, as in the talk.
     Exact,
-    /// The spherical-Gaussian form `exp2(n * x - n)` (seed: spherical-gaussian-pow-translucency).
+    /// The seed's simplified spherical-Gaussian form `exp2(n * x - n)`, without the scale and
+    /// bias (spherical-gaussian-pow-translucency: artists tune `n` by eye, so it need not
+    /// match `pow`'s exponent).
     SphericalGaussian,
+    /// The full spherical-Gaussian approximation of `pow(x, n)`: `exp2(n' x - n')` with
+    /// `n' = (n + 1) / ln 2`, the scale and bias applied once on the CPU.
+    SphericalGaussianScaled,
 }
 
 /// Frostbite 2 translucency parameters (GDC 2011), per material.

@@ -17,7 +17,7 @@ use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
 use crate::passes::deferred::{GBufferLayout, GBufferPrecision, TranslucencyLayout};
 use crate::passes::translucency::{
-    mesh_bounds, tile_buffer, tile_buffer_size, translucent_tiles, MaterialTable, ThicknessPacking,
+    mesh_bounds, tile_rects, translucent_tiles, MaterialTable, ThicknessPacking,
 };
 use crate::passes::{deferred, tonemap, SceneGpu};
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
@@ -302,8 +302,6 @@ pub struct Renderer {
     pub settings: FrameSettings,
     scene_gpu: Option<Arc<SceneGpu>>,
     uniforms: Option<GpuBuffer>,
-    /// The lighting pass's tile buffer (frames with translucency).
-    tiles: Option<GpuBuffer>,
     /// Object-space bounds per mesh, for the translucent tiles (frames with translucency).
     mesh_bounds: Vec<(Vec3, Vec3)>,
 }
@@ -341,37 +339,11 @@ impl Renderer {
             gpu_allocator::MemoryLocation::CpuToGpu,
             "frame uniforms",
         )?;
-        // The lighting pass's screen tiles (frames with translucency), rewritten every frame.
-        let tiles = match &features.translucency {
-            None => None,
-            Some(_) => match gpu.create_buffer(
-                tile_buffer_size(settings.width, settings.height),
-                vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER,
-                gpu_allocator::MemoryLocation::CpuToGpu,
-                "lighting tiles",
-            ) {
-                Ok(b) => Some(b),
-                Err(e) => {
-                    gpu.destroy_buffer(uniforms);
-                    return Err(e);
-                }
-            },
-        };
-        let free_host = |uniforms: GpuBuffer, tiles: Option<GpuBuffer>| {
-            gpu.destroy_buffer(uniforms);
-            if let Some(t) = tiles {
-                gpu.destroy_buffer(t);
-            }
-        };
-        let translucency = features
-            .translucency
-            .as_ref()
-            .zip(tiles.as_ref())
-            .map(|((t, p), tiles)| (t, *p, tiles.buffer));
+        let translucency = features.translucency.as_ref().map(|(t, p)| (t, *p));
         let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer, translucency) {
             Ok(s) => s,
             Err(e) => {
-                free_host(uniforms, tiles);
+                gpu.destroy_buffer(uniforms);
                 return Err(e);
             }
         };
@@ -386,11 +358,11 @@ impl Renderer {
                 if let Ok(s) = Arc::try_unwrap(scene_gpu) {
                     s.destroy(gpu);
                 }
-                free_host(uniforms, tiles);
+                gpu.destroy_buffer(uniforms);
                 return Err(e);
             }
         };
-        let mesh_bounds = if tiles.is_some() {
+        let mesh_bounds = if features.translucency.is_some() {
             mesh_bounds(scene)
         } else {
             Vec::new()
@@ -401,7 +373,6 @@ impl Renderer {
             settings,
             scene_gpu: Some(scene_gpu),
             uniforms: Some(uniforms),
-            tiles,
             mesh_bounds,
         };
         renderer.update(scene)?;
@@ -421,14 +392,10 @@ impl Renderer {
             })?;
         let bytes = bytemuck::bytes_of(&uniforms);
         mapped[..bytes.len()].copy_from_slice(bytes);
-        if let Some(tiles) = self.tiles.as_mut() {
+        if let Some(scene_gpu) = self.scene_gpu.as_ref().filter(|s| s.translucency.is_some()) {
             let (width, height) = (self.settings.width, self.settings.height);
             let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
-            let bytes = tile_buffer(width, height, columns, &marked);
-            let mapped = tiles.mapped_mut().ok_or_else(|| {
-                LucentError::InvalidInput("lighting tile buffer is not host-visible".into())
-            })?;
-            mapped[..bytes.len()].copy_from_slice(&bytes);
+            scene_gpu.set_tiles(tile_rects(columns, &marked, width, height));
         }
         Ok(())
     }
@@ -506,9 +473,6 @@ impl Renderer {
         }
         if let Some(u) = self.uniforms.take() {
             gpu.destroy_buffer(u);
-        }
-        if let Some(t) = self.tiles.take() {
-            gpu.destroy_buffer(t);
         }
     }
 }

@@ -206,7 +206,7 @@ pub fn translucency_variants(opts: &ReportOptions) -> Result<Vec<Variant>> {
         let lit = with_lights(&exact, n);
         variants.push(Variant {
             knob: "lights".into(),
-            name: format!("{n} lights"),
+            name: format!("{n} light{}", if n == 1 { "" } else { "s" }),
             scene: lit.clone(),
             settings: t,
             reference: Some(lit),

@@ -198,3 +198,55 @@ fn stability_sweep_has_no_nan_or_inf_in_any_case() {
     assert!(rows.iter().any(|r| r.fp16_overflow > 0));
     gpu.finish();
 }
+
+#[test]
+fn report_measures_every_knob_and_writes_table_and_plot() {
+    let gpu = Gpu::new();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-translucency");
+    let _ = std::fs::remove_dir_all(&dir);
+    let options = lucent::report::ReportOptions {
+        width: 96,
+        height: 72,
+        rounds: 2,
+        warmup: 1,
+    };
+    let (text, files) = lucent::report::write_translucency_report(
+        &gpu.gpu,
+        &gpu.shaders,
+        &gpu.cache,
+        &dir,
+        &options,
+    )
+    .unwrap();
+    for knob in [
+        "exact pow",
+        "exp2 (spherical Gaussian)",
+        "grayscale",
+        "RGBA16F",
+        "32 lights",
+    ] {
+        assert!(text.contains(knob), "report lacks '{knob}':\n{text}");
+    }
+    assert!(text.contains("100% translucent"));
+    for f in &files {
+        assert!(
+            std::fs::metadata(f).unwrap().len() > 0,
+            "{} is empty",
+            f.display()
+        );
+    }
+    // The exact variant is the reference's own configuration at 8 bits: its error is the
+    // G-buffer's quantisation, far below the exp2 approximation's.
+    let row = |name: &str| {
+        text.lines()
+            .find(|l| l.contains(&format!("| {name} |")))
+            .unwrap_or_else(|| panic!("no row {name}"))
+            .split('|')
+            .map(str::trim)
+            .collect::<Vec<_>>()
+    };
+    let max_abs = |name: &str| row(name)[7].parse::<f64>().unwrap();
+    assert!(max_abs("exact pow") < max_abs("exp2 (spherical Gaussian)"));
+    assert!(max_abs("RGBA16F") <= max_abs("RGBA8"));
+    gpu.finish();
+}

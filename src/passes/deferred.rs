@@ -2,9 +2,9 @@
 //! (input attachments), so the graph merges the two into subpasses of one render pass.
 //!
 //! With translucency (GDC 2011) the G-buffer gains GB2 (thickness + material ID), and the
-//! lighting pass is drawn as screen tiles in two draws: tiles that translucent objects may cover
-//! (their projected bounding boxes, on the CPU each frame) get the shader with the talk's
-//! per-light term, the others the plain shader. Only rasterisation reliably skips work on every
+//! lighting pass is drawn as scissored rectangles of screen tiles: tiles that translucent objects
+//! may cover (their projected bounding boxes, on the CPU each frame) get the shader with the
+//! talk's per-light term, the others the plain shader. Only rasterisation reliably skips work on every
 //! driver: lavapipe shades both sides of a per-pixel branch, and it runs input-attachment
 //! shaders with late depth/stencil tests, so neither a material-ID branch nor a stencil mask
 //! saves anything there (measured in docs/translucency.md).
@@ -21,7 +21,7 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::translucency::{ThicknessPacking, TILE_HEADER_BYTES};
+use super::translucency::ThicknessPacking;
 use super::util::{Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
@@ -338,20 +338,11 @@ impl PassExec for LightingPass {
             bindings.push(Binding::InputAttachment(views[gb2], color_layout));
             bindings.push(Binding::Uniform(t.materials.buffer));
         }
-        let tiled = self.layout.translucency.is_some();
         let plain = GraphicsPipelineDesc {
-            vertex: if tiled {
-                "deferred/tiles.vert"
-            } else {
-                "fullscreen.vert"
-            },
+            vertex: "fullscreen.vert",
             fragment: "deferred/lighting.frag",
             defines: &[],
-            vertex_input: if tiled {
-                VertexInput::Tiles
-            } else {
-                VertexInput::None
-            },
+            vertex_input: VertexInput::None,
             depth_test: false,
             cull_back: false,
             set_layouts: &[],
@@ -392,22 +383,42 @@ impl PassExec for LightingPass {
             return;
         };
         let device = &ctx.gpu.device;
-        let stride = std::mem::size_of::<vk::DrawIndirectCommand>() as u64;
+        let rects = t.tiles.lock().unwrap_or_else(|e| e.into_inner()).clone();
         pipeline.bind(ctx);
-        // SAFETY: both pipelines were made for this subpass with the bound set's layout; the
-        // tile buffer holds two draw commands and the vertices they name (written by the
-        // renderer before the frame was submitted).
+        // SAFETY: both pipelines were made for this subpass with the bound set's layout;
+        // scissor is dynamic state, restored to the render area at the end.
         unsafe {
-            device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[t.tiles], &[TILE_HEADER_BYTES]);
-            // Draw 1: tiles no translucent object touches, plain shader.
-            device.cmd_draw_indirect(ctx.cmd, t.tiles, stride, 1, stride as u32);
-            device.cmd_bind_pipeline(
+            for translucent_pass in [false, true] {
+                if translucent_pass {
+                    device.cmd_bind_pipeline(
+                        ctx.cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        translucent.pipeline,
+                    );
+                }
+                for r in rects.iter().filter(|r| r.translucent == translucent_pass) {
+                    let scissor = vk::Rect2D {
+                        offset: vk::Offset2D {
+                            x: r.x as i32,
+                            y: r.y as i32,
+                        },
+                        extent: vk::Extent2D {
+                            width: r.width,
+                            height: r.height,
+                        },
+                    };
+                    device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
+                    device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
+                }
+            }
+            device.cmd_set_scissor(
                 ctx.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                translucent.pipeline,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: ctx.extent,
+                }],
             );
-            // Draw 0: the translucent tiles.
-            device.cmd_draw_indirect(ctx.cmd, t.tiles, 0, 1, stride as u32);
         }
     }
 

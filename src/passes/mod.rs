@@ -64,9 +64,9 @@ pub struct TranslucencyGpu {
     pub materials: GpuBuffer,
     /// How GB2 packs thickness.
     pub packing: ThicknessPacking,
-    /// The lighting pass's screen tiles and their two indirect draws
-    /// ([`translucency::tile_buffer`]), owned and written by the renderer every frame.
-    pub tiles: vk::Buffer,
+    /// The lighting pass's rectangles for this frame ([`translucency::tile_rects`]), written
+    /// by the renderer before each frame is recorded.
+    pub tiles: std::sync::Mutex<Vec<translucency::TileRect>>,
 }
 
 /// The scene's GPU data the passes share: meshes, draws, and the frame uniform buffer.
@@ -83,13 +83,13 @@ pub struct SceneGpu {
 
 impl SceneGpu {
     /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer. With
-    /// `translucency` (the frame's material table, packing and the renderer's tile buffer),
-    /// also each mesh's thickness stream and the material table.
+    /// `translucency` (the frame's material table and packing), also each mesh's thickness
+    /// stream and the material table.
     pub fn new(
         gpu: &GpuContext,
         scene: &Scene,
         frame_uniforms: vk::Buffer,
-        translucency: Option<(&MaterialTable, ThicknessPacking, vk::Buffer)>,
+        translucency: Option<(&MaterialTable, ThicknessPacking)>,
     ) -> Result<Arc<Self>> {
         let mut meshes: Vec<GpuMesh> = Vec::with_capacity(scene.meshes.len());
         let mut materials: Option<GpuBuffer> = None;
@@ -97,7 +97,7 @@ impl SceneGpu {
                       meshes: &mut Vec<GpuMesh>,
                       materials: &mut Option<GpuBuffer>|
          -> Result<()> {
-            if let Some((table, _, _)) = translucency {
+            if let Some((table, _)) = translucency {
                 *materials = Some(gpu.upload_buffer(
                     std::slice::from_ref(&table.gpu()),
                     vk::BufferUsageFlags::UNIFORM_BUFFER,
@@ -166,7 +166,7 @@ impl SceneGpu {
             .enumerate()
             .map(|(index, o)| {
                 let thickness = match (translucency, &o.material.translucency) {
-                    (Some((table, _, _)), Some(t)) => thickness_factor(t)
+                    (Some((table, _)), Some(t)) => thickness_factor(t)
                         .extend(f32::from(table.object_ids[index]))
                         .to_array(),
                     _ => [0.0; 4],
@@ -188,12 +188,20 @@ impl SceneGpu {
             frame_uniforms,
             translucency: materials
                 .zip(translucency)
-                .map(|(materials, (_, packing, tiles))| TranslucencyGpu {
+                .map(|(materials, (_, packing))| TranslucencyGpu {
                     materials,
                     packing,
-                    tiles,
+                    tiles: std::sync::Mutex::new(Vec::new()),
                 }),
         }))
+    }
+
+    /// Sets the lighting pass's rectangles for the next frames (frames with translucency).
+    pub fn set_tiles(&self, rects: Vec<translucency::TileRect>) {
+        if let Some(t) = &self.translucency {
+            // A poisoned lock only means a recording thread panicked; the data is plain.
+            *t.tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
+        }
     }
 
     fn free(gpu: &GpuContext, meshes: Vec<GpuMesh>, materials: Option<GpuBuffer>) {

@@ -174,10 +174,6 @@ pub fn thickness_factor(t: &Translucency) -> Vec3 {
 /// Side of the screen tiles the lighting pass is split into, in pixels.
 pub const TILE_SIZE: u32 = 64;
 
-/// Bytes of the two `VkDrawIndirectCommand`s at the start of the tile buffer: draw 0 covers
-/// the translucent tiles, draw 1 the others.
-pub const TILE_HEADER_BYTES: u64 = 32;
-
 /// Which screen tiles translucent objects may cover: each translucent object's bounding box
 /// (object space, `bounds[mesh]`) is projected, and every tile its screen rectangle touches is
 /// marked. Conservative: a box crossing the near plane marks every tile, one wholly behind the
@@ -244,50 +240,63 @@ pub fn translucent_tiles(
     (columns, rows, tiles)
 }
 
-/// The most bytes [`tile_buffer`] writes for a `width` x `height` frame.
-pub fn tile_buffer_size(width: u32, height: u32) -> u64 {
-    let tiles = u64::from(width.div_ceil(TILE_SIZE) * height.div_ceil(TILE_SIZE));
-    TILE_HEADER_BYTES + tiles * 6 * 8
+/// A rectangle of the lighting pass in pixels, shaded with the translucency variant or not.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileRect {
+    /// Left column.
+    pub x: u32,
+    /// Top row.
+    pub y: u32,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Whether translucent objects may cover it.
+    pub translucent: bool,
 }
 
-/// The lighting pass's tile buffer: two indirect draw commands (translucent tiles, then the
-/// rest), then two triangles per run of equal tiles along a row as NDC `vec2`s, translucent
-/// runs first.
-pub fn tile_buffer(width: u32, height: u32, columns: u32, tiles: &[bool]) -> Vec<u8> {
-    let mut translucent: Vec<[f32; 2]> = Vec::new();
-    let mut plain: Vec<[f32; 2]> = Vec::new();
-    let ndc = |v: u32, size: u32| v.min(size) as f32 / size as f32 * 2.0 - 1.0;
-    // Runs of equal tiles along a row become one quad: fewer triangles, and whole rasteriser
-    // bins covered (lavapipe shades fully covered 64x64 bins on a fast path).
-    for (ty, row) in tiles.chunks(columns as usize).enumerate() {
-        let ty = ty as u32;
+/// Merges marked tiles into few rectangles (runs along each row, then equal runs of
+/// consecutive rows), clipped to `width` x `height`. Each rectangle is drawn as the fullscreen
+/// triangle under a scissor: whole rasteriser bins stay fully covered, so a frame without
+/// translucent pixels costs what one fullscreen draw costs (two triangles per tile would split
+/// every bin along the diagonal, onto lavapipe's slower partial-coverage path).
+pub fn tile_rects(columns: u32, tiles: &[bool], width: u32, height: u32) -> Vec<TileRect> {
+    let mut runs: Vec<(u32, u32, u32, bool)> = Vec::new(); // (row, first column, end column, class)
+    for (row, cells) in tiles.chunks(columns.max(1) as usize).enumerate() {
         let mut start = 0usize;
-        while start < row.len() {
-            let marked = row[start];
-            let end = row[start..]
+        while start < cells.len() {
+            let marked = cells[start];
+            let end = cells[start..]
                 .iter()
                 .position(|&t| t != marked)
-                .map_or(row.len(), |n| start + n);
-            let (x0, x1) = (
-                ndc(start as u32 * TILE_SIZE, width),
-                ndc(end as u32 * TILE_SIZE, width),
-            );
-            let (y0, y1) = (
-                ndc(ty * TILE_SIZE, height),
-                ndc((ty + 1) * TILE_SIZE, height),
-            );
-            let quad = [[x0, y0], [x1, y0], [x1, y1], [x0, y0], [x1, y1], [x0, y1]];
-            if marked { &mut translucent } else { &mut plain }.extend_from_slice(&quad);
+                .map_or(cells.len(), |n| start + n);
+            runs.push((row as u32, start as u32, end as u32, marked));
             start = end;
         }
     }
-    let (n_translucent, n_plain) = (translucent.len() as u32, plain.len() as u32);
-    // VkDrawIndirectCommand: vertexCount, instanceCount, firstVertex, firstInstance.
-    let header: [u32; 8] = [n_translucent, 1, 0, 0, n_plain, 1, n_translucent, 0];
-    let mut bytes = bytemuck::cast_slice(&header).to_vec();
-    bytes.extend_from_slice(bytemuck::cast_slice(&translucent));
-    bytes.extend_from_slice(bytemuck::cast_slice(&plain));
-    bytes
+    let mut rects: Vec<(u32, u32, u32, u32, bool)> = Vec::new(); // (row0, row1, c0, c1, class)
+    for (row, c0, c1, marked) in runs {
+        match rects
+            .iter_mut()
+            .find(|r| r.1 == row && r.2 == c0 && r.3 == c1 && r.4 == marked)
+        {
+            Some(r) => r.1 = row + 1,
+            None => rects.push((row, row + 1, c0, c1, marked)),
+        }
+    }
+    rects
+        .into_iter()
+        .map(|(r0, r1, c0, c1, translucent)| {
+            let (x, y) = (c0 * TILE_SIZE, r0 * TILE_SIZE);
+            TileRect {
+                x,
+                y,
+                width: (c1 * TILE_SIZE).min(width) - x,
+                height: (r1 * TILE_SIZE).min(height) - y,
+                translucent,
+            }
+        })
+        .collect()
 }
 
 /// Object-space bounding box of each mesh.
@@ -345,14 +354,33 @@ mod tests {
             tiles.iter().all(|&t| !t),
             "the cube behind the camera marks no tile"
         );
-        let bytes = tile_buffer(w, h, columns, &tiles);
-        assert!(bytes.len() as u64 <= tile_buffer_size(w, h));
-        let header: Vec<u32> = bytes[..32]
-            .chunks(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        assert_eq!(header[0], 0);
-        assert_eq!(header[4], 6 * 4, "one quad per row of plain tiles");
+        let rects = tile_rects(columns, &tiles, w, h);
+        assert_eq!(
+            rects,
+            vec![TileRect {
+                x: 0,
+                y: 0,
+                width: w,
+                height: h,
+                translucent: false
+            }],
+            "no translucent tile: one rectangle, the whole screen"
+        );
+        // A marked tile in the middle splits the screen into rectangles that cover every
+        // pixel exactly once.
+        let mut one = vec![false; (columns * rows) as usize];
+        one[(columns + 2) as usize] = true;
+        let rects = tile_rects(columns, &one, w, h);
+        let mut covered = vec![0u8; (w * h) as usize];
+        for r in &rects {
+            for y in r.y..r.y + r.height {
+                for x in r.x..r.x + r.width {
+                    covered[(y * w + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1));
+        assert_eq!(rects.iter().filter(|r| r.translucent).count(), 1);
     }
 
     #[test]

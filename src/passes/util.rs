@@ -168,8 +168,6 @@ pub enum VertexInput {
     /// Position + normal (binding 0) and a second stream of RGB thickness colours (binding 1,
     /// location 2), for G-buffers that carry translucency.
     PositionNormalThickness,
-    /// Screen tiles: one NDC `vec2` per vertex (binding 0, location 0; glsl/deferred/tiles.vert).
-    Tiles,
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -292,25 +290,11 @@ impl GraphicsPipeline {
                 offset: 0,
             },
         ];
-        let tile_bindings = [vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: 8,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        let tile_attributes = [vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32_SFLOAT,
-            offset: 0,
-        }];
         let vertex_input = match desc.vertex_input {
             VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
             VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&vertex_bindings[..1])
                 .vertex_attribute_descriptions(&vertex_attributes[..2]),
-            VertexInput::Tiles => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&tile_bindings)
-                .vertex_attribute_descriptions(&tile_attributes),
             VertexInput::PositionNormalThickness => {
                 vk::PipelineVertexInputStateCreateInfo::default()
                     .vertex_binding_descriptions(&vertex_bindings)

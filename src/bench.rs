@@ -575,3 +575,115 @@ mod tests {
         assert!(honest.passed, "{}", honest.detail);
     }
 }
+
+/// Two frames of the same scene measured against each other in one run: `a` and `b` alternate
+/// frame by frame (after `warmup` frames each), so a noisy, shared machine slows both alike and
+/// the ratio between them holds where separate runs would not (on the project's 2-core machine,
+/// separate `bench` runs of one configuration differ by up to 15%).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    /// Names of the two sides (their techniques).
+    pub names: [String; 2],
+    /// Per physical pass name: the median of each side (`None` where a side lacks the pass).
+    pub passes: Vec<(String, [Option<Stats>; 2])>,
+    /// Frame wall time of each side.
+    pub frame: [Stats; 2],
+    /// Frames measured per side.
+    pub frames: usize,
+}
+
+/// Measures `a` against `b`, alternating frames.
+pub fn compare(
+    gpu: &GpuContext,
+    sides: [(&str, &Renderer); 2],
+    frames: usize,
+    warmup: usize,
+) -> Result<Comparison> {
+    if frames == 0 {
+        return Err(LucentError::InvalidInput(
+            "--frames must be at least 1".into(),
+        ));
+    }
+    let names: [Vec<String>; 2] = sides.map(|(_, r)| {
+        r.executable
+            .plan
+            .physical
+            .iter()
+            .map(|p| p.name.clone())
+            .collect()
+    });
+    let mut runners = Vec::new();
+    let result = (|| -> Result<Comparison> {
+        for side_names in &names {
+            runners.push(FrameRunner::new(gpu, side_names.len())?);
+        }
+        let mut in_frame: [Vec<Vec<f64>>; 2] = [
+            vec![Vec::new(); names[0].len()],
+            vec![Vec::new(); names[1].len()],
+        ];
+        let mut walls: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+        for frame in 0..warmup + frames {
+            for side in 0..2 {
+                let t = runners[side].run_frame(gpu, &sides[side].1.executable)?;
+                if frame >= warmup {
+                    collect(&mut in_frame[side], &t, &names[side])?;
+                    walls[side].push(t.wall_ms);
+                }
+            }
+        }
+        let mut passes: Vec<(String, [Option<Stats>; 2])> = Vec::new();
+        for side in 0..2 {
+            for (name, samples) in names[side].iter().zip(&in_frame[side]) {
+                let stats = Stats::of(samples);
+                match passes.iter_mut().find(|(n, _)| n == name) {
+                    Some((_, s)) => s[side] = Some(stats),
+                    None => {
+                        let mut s = [None, None];
+                        s[side] = Some(stats);
+                        passes.push((name.clone(), s));
+                    }
+                }
+            }
+        }
+        Ok(Comparison {
+            names: sides.map(|(n, _)| n.to_string()),
+            passes,
+            frame: [Stats::of(&walls[0]), Stats::of(&walls[1])],
+            frames,
+        })
+    })();
+    for runner in runners {
+        runner.destroy(gpu);
+    }
+    result
+}
+
+impl Comparison {
+    /// The comparison as a Markdown table: each pass's medians and the ratio b / a.
+    pub fn markdown(&self, device: &str) -> String {
+        let [a, b] = &self.names;
+        let mut out = format!(
+            "## lucent bench: `{b}` against `{a}`, alternating frames\n\n- device: {device}\n\
+             - frames: {} per side, alternating; in-frame timestamps\n\n\
+             | pass | `{a}` median ms | `{b}` median ms | `{b}` / `{a}` |\n|---|---:|---:|---:|\n",
+            self.frames
+        );
+        let ratio = |x: f64, y: f64| format!("{:+.1}%", (y / x.max(1e-9) - 1.0) * 100.0);
+        for (name, [sa, sb]) in &self.passes {
+            let cell =
+                |s: &Option<Stats>| s.map_or("-".to_string(), |s| format!("{:.3}", s.median));
+            let r = match (sa, sb) {
+                (Some(x), Some(y)) => ratio(x.median, y.median),
+                _ => "-".into(),
+            };
+            out.push_str(&format!("| {name} | {} | {} | {r} |\n", cell(sa), cell(sb)));
+        }
+        out.push_str(&format!(
+            "| **frame (submit to fence)** | {:.3} | {:.3} | {} |\n",
+            self.frame[0].median,
+            self.frame[1].median,
+            ratio(self.frame[0].median, self.frame[1].median)
+        ));
+        out
+    }
+}

@@ -403,3 +403,51 @@ fn render_writes_png_and_linear_exr() {
     // Linear, not tonemapped: the specular highlight is brighter than display white.
     assert!(hdr.pixels().any(|p| p.0[0] > 1.0));
 }
+
+#[test]
+fn bench_against_another_technique_prints_both_sides_and_the_ratio() {
+    let out = lucent_command()
+        .args([
+            "bench",
+            "--scene",
+            "grid125:50",
+            "--size",
+            "96x72",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--technique",
+            "translucency",
+            "--against",
+            "none",
+            "--no-merge",
+            "--validation",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        // Tiny frames on a shared machine may fail the timing checks: only that is allowed.
+        assert!(stderr.contains("lucent: error: timing:"), "{stderr}");
+    }
+    assert!(
+        stdout.contains("`translucency` against `none`, alternating frames"),
+        "{stdout}"
+    );
+    let comparison = stdout
+        .split("alternating frames")
+        .nth(1)
+        .unwrap_or_default();
+    let row = comparison
+        .lines()
+        .find(|l| l.starts_with("| lighting |"))
+        .unwrap_or_else(|| panic!("no lighting row:\n{stdout}"));
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    assert!(
+        cells[2].parse::<f64>().is_ok() && cells[3].parse::<f64>().is_ok(),
+        "{row}"
+    );
+    assert!(cells[4].ends_with('%'), "{row}");
+}

@@ -66,6 +66,10 @@ enum Command {
         /// Write the frame as PNG after the benchmark.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Also measure the same scene under this technique, alternating frames with the
+        /// main one, and print both side by side with the ratio (e.g. `--against none`).
+        #[arg(long)]
+        against: Option<String>,
     },
     /// Print the compiled render graph: passes, merged groups, barriers, lifetimes, memory.
     Plan {
@@ -324,11 +328,39 @@ fn bench_command(
     options: BenchOptions,
     json: Option<PathBuf>,
     out: Option<PathBuf>,
+    against: Option<String>,
 ) -> Result<()> {
+    let against = against.map(|t| Technique::parse(&t)).transpose()?;
     with_renderer(frame, gpu_args, false, |session, renderer| {
         let gpu = &session.gpu;
         let report = bench::run(gpu, renderer, &frame.scene, &options)?;
         println!("{}", report.markdown());
+        if let Some(technique) = against {
+            let scene = scene::load_scene(&frame.scene)?;
+            let other = Renderer::new(
+                gpu,
+                &session.shaders,
+                &session.pipeline_cache,
+                &scene,
+                FrameSettings {
+                    technique,
+                    ..renderer.settings
+                },
+            )?;
+            let compared = bench::compare(
+                gpu,
+                [
+                    (technique.name(), &other),
+                    (renderer.settings.technique.name(), renderer),
+                ],
+                options.frames,
+                options.warmup,
+            );
+            let idle = gpu.wait_idle();
+            other.destroy(gpu);
+            idle?;
+            println!("{}", compared?.markdown(&gpu.info.describe()));
+        }
         if let Some(json) = &json {
             output::write_file_atomic(json, report.json().as_bytes())?;
             println!("wrote {}", json.display());
@@ -497,6 +529,7 @@ fn run(cli: Cli) -> Result<()> {
             isolate,
             json,
             out,
+            against,
         } => bench_command(
             &frame,
             &gpu,
@@ -507,6 +540,7 @@ fn run(cli: Cli) -> Result<()> {
             },
             json,
             out,
+            against,
         ),
         Command::Sweep {
             technique,

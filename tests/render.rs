@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use lucent::backend::shader::{PipelineCache, ShaderCompiler};
-use lucent::backend::{ContextDesc, GpuContext};
+mod common;
+
+use common::TestGpu;
 use lucent::compare::{compare_with_golden, flip_rgba8, FlipThresholds};
 use lucent::graph::CompileOptions;
 use lucent::reference::raytrace;
@@ -25,38 +26,20 @@ fn render(scene_name: &str, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32
 
 /// Renders one frame of `scene` with validation on; returns (display RGBA8, HDR f32).
 fn render_scene(scene: &scene::Scene, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32>>) {
-    let gpu = GpuContext::new(&ContextDesc {
-        validation: true,
-        ..ContextDesc::default()
-    })
-    .expect("a Vulkan device (run tools/setup.sh for lavapipe)");
-    let shaders = ShaderCompiler::new(
-        ShaderCompiler::default_glsl_root(),
-        Some(ShaderCompiler::default_cache_dir()),
-    )
-    .unwrap();
-    let cache = PipelineCache::load(&gpu.device, None).unwrap();
-    let renderer = Renderer::new(&gpu, &shaders, &cache, scene, settings).unwrap();
-    let mut runner = FrameRunner::new(&gpu, renderer.executable.plan.physical.len()).unwrap();
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
+    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
     // Two frames: the second must find every resource in the state the first left it.
-    runner.run_frame(&gpu, &renderer.executable).unwrap();
-    runner.run_frame(&gpu, &renderer.executable).unwrap();
-    runner.run_isolated(&gpu, &renderer.executable).unwrap();
-    let display = renderer.read_display(&gpu).unwrap();
-    let hdr = settings
-        .export_hdr
-        .then(|| renderer.read_hdr(&gpu).unwrap());
+    runner.run_frame(gpu, &renderer.executable).unwrap();
+    runner.run_frame(gpu, &renderer.executable).unwrap();
+    runner.run_isolated(gpu, &renderer.executable).unwrap();
+    let display = renderer.read_display(gpu).unwrap();
+    let hdr = settings.export_hdr.then(|| renderer.read_hdr(gpu).unwrap());
     gpu.wait_idle().unwrap();
-    runner.destroy(&gpu);
-    renderer.destroy(&gpu);
-    cache.destroy(&gpu.device);
-    let errors = gpu.validation_error_count();
-    assert_eq!(
-        errors,
-        0,
-        "validation errors:\n{}",
-        gpu.take_validation_messages().join("\n")
-    );
+    runner.destroy(gpu);
+    renderer.destroy(gpu);
+    test.finish();
     (display, hdr)
 }
 

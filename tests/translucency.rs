@@ -2,59 +2,25 @@
 //! image against the f64 reference evaluated from the read-back G-buffer, the material-ID skip,
 //! leaving translucency out of scenes that do not use it, and the stability sweep.
 
-use lucent::backend::shader::{PipelineCache, ShaderCompiler};
-use lucent::backend::{ContextDesc, GpuContext};
 use lucent::passes::deferred::GBufferPrecision;
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
 use lucent::renderer::{FrameFeatures, FrameImages, FrameSettings, Renderer, Technique};
 use lucent::scene::{self, Scene};
 
-struct Gpu {
-    gpu: GpuContext,
-    shaders: ShaderCompiler,
-    cache: PipelineCache,
-}
+mod common;
 
-impl Gpu {
-    fn new() -> Self {
-        let gpu = GpuContext::new(&ContextDesc {
-            validation: true,
-            ..ContextDesc::default()
-        })
-        .expect("a Vulkan device (run tools/setup.sh for lavapipe)");
-        let shaders = ShaderCompiler::new(
-            ShaderCompiler::default_glsl_root(),
-            Some(ShaderCompiler::default_cache_dir()),
-        )
-        .unwrap();
-        let cache = PipelineCache::load(&gpu.device, None).unwrap();
-        Self {
-            gpu,
-            shaders,
-            cache,
-        }
-    }
+use common::TestGpu;
 
-    fn render(&self, scene: &Scene, settings: FrameSettings) -> (FrameImages, usize) {
-        let renderer =
-            Renderer::new(&self.gpu, &self.shaders, &self.cache, scene, settings).unwrap();
-        let images = renderer.render_once(&self.gpu).unwrap();
-        let passes = renderer.executable.plan.passes.len();
-        self.gpu.wait_idle().unwrap();
-        renderer.destroy(&self.gpu);
-        (images, passes)
-    }
-
-    fn finish(self) {
-        self.cache.destroy(&self.gpu.device);
-        let errors = self.gpu.validation_error_count();
-        assert_eq!(
-            errors,
-            0,
-            "validation errors:\n{}",
-            self.gpu.take_validation_messages().join("\n")
-        );
-    }
+/// Renders one frame of `scene` and reads back everything it exports; also returns how many
+/// passes its plan kept.
+fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> (FrameImages, usize) {
+    let gpu = &test.gpu;
+    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
+    let images = renderer.render_once(gpu).unwrap();
+    let passes = renderer.executable.plan.passes.len();
+    gpu.wait_idle().unwrap();
+    renderer.destroy(gpu);
+    (images, passes)
 }
 
 fn translucency_settings(w: u32, h: u32) -> FrameSettings {
@@ -100,14 +66,14 @@ fn compare_with_reference(
 
 #[test]
 fn cubes_match_the_f64_reference_evaluated_from_the_gbuffer() {
-    let gpu = Gpu::new();
+    let gpu = TestGpu::new();
     let scene = scene::load_scene("cubes").unwrap();
     for precision in [GBufferPrecision::Compact, GBufferPrecision::Full] {
         let settings = FrameSettings {
             gbuffer: precision,
             ..translucency_settings(320, 240)
         };
-        let (images, _) = gpu.render(&scene, settings);
+        let (images, _) = render(&gpu, &scene, settings);
         let (max, peak) = compare_with_reference(&scene, &settings, &images);
         eprintln!(
             "cubes ({}): max |GPU - f64 reference| = {max:.3e} = {:.3e} of peak {peak:.3}",
@@ -126,7 +92,7 @@ fn cubes_match_the_f64_reference_evaluated_from_the_gbuffer() {
 
 #[test]
 fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() {
-    let gpu = Gpu::new();
+    let gpu = TestGpu::new();
     let size = (160, 120);
     // Half the grid translucent: translucent pixels brighten, opaque ones are untouched.
     let half = scene::load_scene("grid125:50").unwrap();
@@ -135,8 +101,8 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
         export_gbuffer: true,
         ..FrameSettings::new(size.0, size.1)
     };
-    let (off, _) = gpu.render(&half, plain);
-    let (on, _) = gpu.render(&half, translucency_settings(size.0, size.1));
+    let (off, _) = render(&gpu, &half, plain);
+    let (on, _) = render(&gpu, &half, translucency_settings(size.0, size.1));
     let gb2 = on.gbuffer.as_ref().unwrap().gb2.as_ref().unwrap();
     let (hdr_off, hdr_on) = (off.hdr.unwrap(), on.hdr.unwrap());
     let (mut translucent, mut changed_opaque, mut brighter) = (0, 0, 0);
@@ -165,8 +131,9 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
         .unwrap()
         .translucency
         .is_none());
-    let (with, passes_with) = gpu.render(&smoke, settings);
-    let (without, passes_without) = gpu.render(
+    let (with, passes_with) = render(&gpu, &smoke, settings);
+    let (without, passes_without) = render(
+        &gpu,
         &smoke,
         FrameSettings {
             technique: Technique::None,
@@ -181,7 +148,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
 
 #[test]
 fn stability_sweep_has_no_nan_or_inf_in_any_case() {
-    let gpu = Gpu::new();
+    let gpu = TestGpu::new();
     let cases = lucent::sweep::translucency_cases();
     let rows = lucent::sweep::run_translucency(&gpu.gpu, &gpu.shaders, &gpu.cache, 32, 24, &cases)
         .unwrap();
@@ -201,7 +168,7 @@ fn stability_sweep_has_no_nan_or_inf_in_any_case() {
 
 #[test]
 fn report_measures_every_knob_and_writes_table_and_plot() {
-    let gpu = Gpu::new();
+    let gpu = TestGpu::new();
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-translucency");
     let _ = std::fs::remove_dir_all(&dir);
     let options = lucent::report::ReportOptions {

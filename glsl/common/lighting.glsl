@@ -36,16 +36,20 @@ void light_incidence(Light light, vec3 pos, out vec3 to_light, out float attenua
     }
 }
 
-// Diffuse + specular from one light whose direction and attenuation are known.
-vec3 shade_incident(Surface s, vec3 to_eye, vec3 to_light, float attenuation, Light light) {
-    float n_dot_l = max(dot(s.normal, to_light), 0.0);
+// The normalised Blinn-Phong lobe (without the surface's specular intensity).
+float blinn_phong(Surface s, vec3 to_eye, vec3 to_light) {
     vec3 h = to_light + to_eye;
     // to_light == -to_eye gives h = 0: no highlight rather than a NaN.
     float h_len2 = dot(h, h);
     h = h_len2 > 1e-12 ? h * inversesqrt(h_len2) : s.normal;
     float n = shininess(s.roughness);
-    float spec = (n + 8.0) / (8.0 * PI) * pow(max(dot(s.normal, h), 0.0), n);
-    vec3 brdf = s.albedo / PI + vec3(s.specular * spec);
+    return (n + 8.0) / (8.0 * PI) * pow(max(dot(s.normal, h), 0.0), n);
+}
+
+// Diffuse + specular from one light whose direction and attenuation are known.
+vec3 shade_incident(Surface s, vec3 to_eye, vec3 to_light, float attenuation, Light light) {
+    float n_dot_l = max(dot(s.normal, to_light), 0.0);
+    vec3 brdf = s.albedo / PI + vec3(s.specular * blinn_phong(s, to_eye, to_light));
     return brdf * light.radiance_range.rgb * (n_dot_l * attenuation);
 }
 

@@ -1,9 +1,13 @@
 // GDC 2011 thickness-based translucency (Barre-Brisebois and Bouchard, Frostbite 2), the talk's
 // formula exactly, with its pow either exact or in the spherical-Gaussian form exp2(n*x - n)
-// (seeds/spherical-gaussian-pow-translucency.txt). The f64 twin is src/reference/translucency.rs:
-// change both together.
+// (seeds/spherical-gaussian-pow-translucency.txt). The f64 twins are in
+// src/reference/translucency.rs (translucency_lobe, and translucency_term + shade_direct for
+// shade_incident_translucent): change both together.
 #ifndef LUCENT_TRANSLUCENCY_GLSL
 #define LUCENT_TRANSLUCENCY_GLSL
+
+#include "gbuffer.glsl"
+#include "lighting.glsl"
 
 #define POW_EXACT 0
 #define POW_SPHERICAL_GAUSSIAN 1
@@ -33,36 +37,21 @@ float translucency_lobe(float x, float n, float mode) {
 #endif
 }
 
-// The talk's per-light term:
+// Diffuse + specular + the talk's per-light term from one light:
 //   vLTLight = L + N * distortion
 //   dot = pow(saturate(dot(V, -vLTLight)), power) * scale
 //   lt = attenuation * (dot + ambient) * thickness
 //   colour += albedo * lightColour * lt
-// `to_light` is L, `to_eye` V, `radiance` the light's colour times intensity.
-vec3 translucency_term(vec3 albedo, vec3 normal, vec3 to_eye, vec3 to_light, float attenuation,
-                       vec3 radiance, float scale, vec4 material, vec3 thickness) {
-    vec3 lt_light = to_light + normal * material.y;
-    float lobe = translucency_lobe(dot(to_eye, -lt_light), material.x, material.w) * scale;
-    vec3 lt = attenuation * (lobe + material.z) * thickness;
-    return albedo * radiance * lt;
-}
-
-// Diffuse + specular + the talk's term from one light, sharing what they have in common: the
-// term is albedo * radiance * attenuation * (lobe + ambient) * thickness and diffuse is
-// albedo * radiance * attenuation * n_dot_l / pi, so the term joins diffuse as one more factor.
-// Equal (up to rounding) to shade_incident(...) + translucency_term(...).
-// `v_dot_n` is dot(to_eye, s.normal), the same for every light: dot(V, -(L + N d)) is
-// -(dot(V, L) + d dot(V, N)), so the distorted light vector is never built.
+// computed with what the terms share: diffuse is albedo * lightColour * attenuation *
+// n_dot_l / pi, so the talk's term joins it as one more factor of albedo. And `v_dot_n` is
+// dot(V, N), the same for every light: dot(V, -(L + N d)) = -(dot(V, L) + d dot(V, N)), so the
+// distorted light vector is never built. Equal, up to rounding, to shade_incident plus the
+// talk's term (the reference evaluates them separately).
 vec3 shade_incident_translucent(Surface s, vec3 to_eye, float v_dot_n, vec3 to_light,
                                 float attenuation, Light light, vec4 material,
                                 vec3 thickness) {
     float n_dot_l = max(dot(s.normal, to_light), 0.0);
-    vec3 h = to_light + to_eye;
-    // to_light == -to_eye gives h = 0: no highlight rather than a NaN.
-    float h_len2 = dot(h, h);
-    h = h_len2 > 1e-12 ? h * inversesqrt(h_len2) : s.normal;
-    float n = shininess(s.roughness);
-    float spec = (n + 8.0) / (8.0 * PI) * pow(max(dot(s.normal, h), 0.0), n);
+    float spec = blinn_phong(s, to_eye, to_light);
     float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
     float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
     vec3 diffuse = s.albedo * (n_dot_l / PI + (lobe + material.z) * thickness);

@@ -105,6 +105,29 @@ impl Texture {
         let shift = level.min(31) as u32;
         ((self.width >> shift).max(1), (self.height >> shift).max(1))
     }
+
+    /// Bilinear sample of level 0 at `uv` (0..1, v = 0 the top row), wrapping like a `REPEAT`
+    /// sampler. A non-finite `uv` samples texel (0, 0) rather than propagating NaN.
+    pub fn sample_bilinear(&self, uv: glam::Vec2) -> [f32; 4] {
+        let uv = if uv.is_finite() { uv } else { glam::Vec2::ZERO };
+        let (w, h) = (self.width as f32, self.height as f32);
+        let x = uv.x * w - 0.5;
+        let y = uv.y * h - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |tx: f32, ty: f32| {
+            let tx = (tx as i64).rem_euclid(i64::from(self.width)) as usize;
+            let ty = (ty as i64).rem_euclid(i64::from(self.height)) as usize;
+            self.mips[0][ty * self.width as usize + tx]
+        };
+        let (a, b) = (texel(x0, y0), texel(x0 + 1.0, y0));
+        let (c, d) = (texel(x0, y0 + 1.0), texel(x0 + 1.0, y0 + 1.0));
+        std::array::from_fn(|i| {
+            let top = a[i] + (b[i] - a[i]) * fx;
+            let bottom = c[i] + (d[i] - c[i]) * fx;
+            top + (bottom - top) * fy
+        })
+    }
 }
 
 /// Loads an image file as a linear-float texture with mips; see the module docs for how

@@ -376,3 +376,44 @@ fn plan_snapshot() {
         );
     }
 }
+
+#[test]
+fn a_depth_image_can_be_depth_tested_and_read_as_input_in_one_subpass() {
+    // E.g. a lighting subpass that stencil- or depth-tests against the G-buffer's depth while
+    // reconstructing positions from it: both roles, one read-only layout.
+    let mut g = RenderGraph::new();
+    let mut depth = g.create_image("depth", info(64, 64, vk::Format::D32_SFLOAT_S8_UINT));
+    let mut hdr = g.create_image("hdr", info(64, 64, RGBA16F));
+    let mut p = g.add_pass("gbuffer", PassKind::Raster);
+    p.depth(&mut depth, LoadOp::Clear([1.0; 4]));
+    p.finish();
+    let mut p = g.add_pass("lighting", PassKind::Raster);
+    p.input(&depth).depth_read(&depth).color(&mut hdr, CLEAR);
+    p.finish();
+    g.export_image(&hdr, Access::TransferRead);
+    g.export_image(&depth, Access::TransferRead);
+    let plan = g.plan(CompileOptions::default()).unwrap();
+    let rp = plan.physical[0].render_pass.as_ref().unwrap();
+    let lighting = &rp.subpasses[1];
+    let (depth_attachment, depth_layout) = lighting.depth.unwrap();
+    assert_eq!(lighting.inputs, vec![(depth_attachment, depth_layout)]);
+    assert_eq!(
+        depth_layout,
+        vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+    );
+    // Its aspect covers depth and stencil, and the export waits for the store op's write.
+    assert_eq!(
+        plan.resources[rp.attachments[depth_attachment].resource]
+            .info
+            .aspect(),
+        vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+    );
+    let export = plan
+        .export_barriers
+        .iter()
+        .find(|b| plan.resources[b.resource].name == "depth")
+        .unwrap();
+    assert!(export
+        .src_access
+        .contains(vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE));
+}

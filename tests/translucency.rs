@@ -1,6 +1,7 @@
 //! GDC 2011 translucency on lavapipe (validation and synchronization validation on): the lit
-//! image against the f64 reference evaluated from the read-back G-buffer, the material-ID skip,
-//! leaving translucency out of scenes that do not use it, and the stability sweep.
+//! image against the f64 reference evaluated from the read-back G-buffer, translucency lighting
+//! only translucent pixels, leaving it out of scenes that do not use it, the stability sweep,
+//! and the error-against-time report.
 
 use lucent::passes::deferred::GBufferPrecision;
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};

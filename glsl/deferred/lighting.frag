@@ -5,8 +5,9 @@
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
-// for translucent pixels (stencil-selected): GDC 2011's per-light term joins diffuse and
-// specular.
+// drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
+// GDC 2011's per-light term joins diffuse and specular; opaque pixels in those tiles read
+// thickness 0 and get none of it.
 #include "../common/gbuffer.glsl"
 #include "../common/lighting.glsl"
 #ifdef LUCENT_TRANSLUCENCY
@@ -37,8 +38,8 @@ void main() {
     vec3 color = frame.ambient.rgb * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
 #ifdef LUCENT_TRANSLUCENCY
-    // This variant runs only where the G-buffer's stencil marked the pixel translucent (the
-    // plain variant shades the rest), so it never tests the material ID to skip work.
+    // This variant runs only on tiles translucent objects may cover (the plain variant shades
+    // the rest), so it never branches on the material ID to skip work.
     vec4 t = subpassLoad(gb2);
 #ifdef LUCENT_SINGLE_MATERIAL
     vec4 material = translucency_materials.rows[1];

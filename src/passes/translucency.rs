@@ -8,7 +8,10 @@
 //! `translucency`) declares none of it: no target, no vertex stream, no table, no shader code.
 //!
 //! This module is the CPU side: which materials get which ID ([`MaterialTable`]), the table's
-//! GPU layout ([`MaterialTableGpu`]), and how thickness is packed ([`ThicknessPacking`]).
+//! GPU layout ([`MaterialTableGpu`]), how thickness is packed ([`ThicknessPacking`]), and which
+//! screen tiles the lighting pass shades with the translucency variant ([`translucent_tiles`],
+//! [`tile_rects`]): the projected bounds of translucent objects, recomputed every frame, so
+//! pixels no translucent object can cover never run its code.
 
 use glam::Vec3;
 

@@ -19,7 +19,8 @@ use crate::passes::deferred::{GBufferLayout, GBufferPrecision, TranslucencyLayou
 use crate::passes::translucency::{
     mesh_bounds, tile_rects, translucent_tiles, MaterialTable, ThicknessPacking,
 };
-use crate::passes::{deferred, tonemap, SceneGpu};
+use crate::passes::{deferred, sss, tonemap, SceneGpu};
+use crate::scene::material::SssProfile;
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
 use glam::Vec3;
@@ -31,6 +32,9 @@ pub enum Technique {
     None,
     /// Deferred lighting plus GDC 2011 thickness-based translucency for translucent materials.
     Translucency,
+    /// Screen-space SSS, the thesis's control: Jimenez's separable sum-of-Gaussians blur of the
+    /// lit diffuse light for materials with an SSS profile.
+    Control,
 }
 
 impl Technique {
@@ -38,6 +42,7 @@ impl Technique {
     pub const ALL: &'static [(&'static str, Technique)] = &[
         ("none", Technique::None),
         ("translucency", Technique::Translucency),
+        ("control", Technique::Control),
     ];
 
     /// Parses a command-line name.
@@ -112,13 +117,20 @@ pub struct FrameFeatures {
     /// The translucent materials and GB2's packing, when the technique is `translucency` and
     /// some object is translucent.
     pub translucency: Option<(MaterialTable, ThicknessPacking)>,
+    /// The diffusion profile the SSS blurs use, when the technique is an SSS one and some
+    /// object has a profile (the first such object's).
+    pub sss: Option<SssProfile>,
 }
 
 impl FrameFeatures {
     /// The features `scene` needs under `settings`.
     pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
+        let sss = match settings.technique {
+            Technique::Control => scene.objects.iter().find_map(|o| o.material.sss.clone()),
+            _ => None,
+        };
         let translucency = match settings.technique {
-            Technique::None => None,
+            Technique::None | Technique::Control => None,
             Technique::Translucency => {
                 let table = MaterialTable::new(scene)?;
                 let packing = if settings.force_grayscale {
@@ -129,7 +141,7 @@ impl FrameFeatures {
                 (!table.is_empty()).then_some((table, packing))
             }
         };
-        Ok(Self { translucency })
+        Ok(Self { translucency, sss })
     }
 
     /// The G-buffer layout these features and `settings` call for.
@@ -144,6 +156,7 @@ impl FrameFeatures {
                     pow_modes: table.pow_modes(),
                     single_material: table.rows.len() == 1,
                 }),
+            sss: self.sss.is_some(),
         }
     }
 }
@@ -157,6 +170,8 @@ pub struct GBufferOutputs {
     pub gb1: ResourceId,
     /// Thickness + material ID (frames with translucency).
     pub gb2: Option<ResourceId>,
+    /// Screen-space SSS strength (frames with SSS).
+    pub sss: Option<ResourceId>,
     /// Depth.
     pub depth: ResourceId,
     /// Its layout.
@@ -183,7 +198,13 @@ pub fn declare_frame(
 ) -> FrameOutputs {
     let layout = features.gbuffer_layout(settings);
     let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
-    let hdr = deferred::lighting_pass(graph, &gb, scene_gpu);
+    let lit = deferred::lighting_pass(graph, &gb, scene_gpu);
+    let hdr = match (&features.sss, &lit.specular, &gb.sss) {
+        (Some(profile), Some(specular), Some(strength)) => sss::control_passes(
+            graph, &lit.color, specular, &gb.depth, strength, profile, scene_gpu,
+        ),
+        _ => lit.color,
+    };
     let display = tonemap::tonemap_pass(graph, &hdr, scene_gpu);
     graph.export_image(&display, Access::TransferRead);
     let hdr_id = settings.export_hdr.then(|| {
@@ -194,6 +215,7 @@ pub fn declare_frame(
         for image in [&gb.gb0, &gb.gb1, &gb.depth]
             .into_iter()
             .chain(gb.gb2.as_ref())
+            .chain(gb.sss.as_ref())
         {
             graph.export_image(image, Access::TransferRead);
         }
@@ -201,6 +223,7 @@ pub fn declare_frame(
             gb0: gb.gb0.id(),
             gb1: gb.gb1.id(),
             gb2: gb.gb2.as_ref().map(|h| h.id()),
+            sss: gb.sss.as_ref().map(|h| h.id()),
             depth: gb.depth.id(),
             layout,
         }
@@ -231,6 +254,7 @@ pub struct FrameUniforms {
     viewport: [f32; 4],
     exposure: [f32; 4],
     light_count: [i32; 4],
+    camera: [f32; 4],
     lights: [[[f32; 4]; 4]; MAX_LIGHTS],
 }
 
@@ -287,6 +311,12 @@ impl FrameUniforms {
             ],
             exposure: [scene.exposure, 0.0, 0.0, 0.0],
             light_count: [scene.lights.len().min(MAX_LIGHTS) as i32, 0, 0, 0],
+            camera: [
+                scene.camera.near,
+                scene.camera.far,
+                height as f32 / (2.0 * (scene.camera.fov_y_degrees.to_radians() * 0.5).tan()),
+                0.0,
+            ],
             lights,
         }
     }
@@ -446,6 +476,10 @@ impl Renderer {
             gb0: read(outputs.gb0)?,
             gb1: read(outputs.gb1)?,
             gb2: outputs.gb2.map(read).transpose()?,
+            sss: outputs
+                .sss
+                .map(|id| read(id).map(|t| t.into_iter().map(|v| v[0]).collect()))
+                .transpose()?,
             depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
             layout: outputs.layout,
         })
@@ -504,6 +538,8 @@ pub struct GBufferReadback {
     pub gb1: Vec<[f32; 4]>,
     /// Thickness + material ID as stored (see glsl/common/gbuffer.glsl).
     pub gb2: Option<Vec<[f32; 4]>>,
+    /// Screen-space SSS strength per pixel (frames with SSS).
+    pub sss: Option<Vec<f32>>,
     /// Device depth.
     pub depth: Vec<f32>,
     /// The layout the frame used.
@@ -513,6 +549,7 @@ pub struct GBufferReadback {
 /// Decodes tightly packed texels of the formats lucent's G-buffer uses to f32.
 pub fn decode_texels(bytes: &[u8], format: vk::Format) -> Result<Vec<[f32; 4]>> {
     let (channels, kind) = match format {
+        vk::Format::R8_UNORM => (1, 0),
         vk::Format::R8G8_UNORM => (2, 0),
         vk::Format::R8G8B8A8_UNORM => (4, 0),
         vk::Format::R16G16_SFLOAT => (2, 1),

@@ -24,7 +24,15 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 viewport;        // xy: size in pixels, zw: 1 / size
     vec4 exposure;        // x: exposure multiplier applied before tonemapping
     ivec4 light_count;    // x
+    vec4 camera;          // x: near, y: far, z: focal length in pixels (height / 2 tan(fov / 2))
     Light lights[MAX_LIGHTS];
 } frame;
+
+// View-space distance along the view axis from a device depth in [0, 1] (glam's right-handed
+// perspective, depth 0 at the near plane). Clamped away from the far plane's singularity.
+float linear_depth(float device_depth) {
+    float n = frame.camera.x, f = frame.camera.y;
+    return n * f / max(f - device_depth * (f - n), 1e-6);
+}
 
 #endif

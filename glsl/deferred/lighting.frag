@@ -3,6 +3,7 @@
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=1
 // permutation: LUCENT_TRANSLUCENCY LUCENT_POW_MODES=2 LUCENT_SINGLE_MATERIAL
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
+// permutation: LUCENT_SPLIT_SPECULAR
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
@@ -23,11 +24,19 @@ layout(input_attachment_index = 3, set = 0, binding = 4) uniform subpassInput gb
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
+#ifdef LUCENT_SPLIT_SPECULAR
+// Screen-space SSS blurs the diffuse light only: specular goes to its own target, added back
+// after the blur (out_color is then the diffuse part).
+layout(location = 1) out vec4 out_specular;
+#endif
 
 void main() {
     float d = subpassLoad(depth).r;
     if (d >= 1.0) {
         out_color = vec4(frame.sky.rgb, 1.0);
+#ifdef LUCENT_SPLIT_SPECULAR
+        out_specular = vec4(0.0);
+#endif
         return;
     }
     Surface s = unpack_gbuffer(subpassLoad(gb0), subpassLoad(gb1));
@@ -56,6 +65,19 @@ void main() {
         color += shade_incident_translucent(s, to_eye, v_dot_n, to_light, attenuation, light,
                                             material, thickness);
     }
+#elif defined(LUCENT_SPLIT_SPECULAR)
+    vec3 specular = vec3(0.0);
+    for (int i = 0; i < count; ++i) {
+        Light light = frame.lights[i];
+        vec3 to_light;
+        float attenuation;
+        light_incidence(light, pos, to_light, attenuation);
+        float n_dot_l = max(dot(s.normal, to_light), 0.0);
+        vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation);
+        color += s.albedo / PI * incident;
+        specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
+    }
+    out_specular = vec4(min(specular, vec3(65504.0)), 1.0);
 #else
     for (int i = 0; i < count; ++i) {
         color += shade_direct(s, pos, to_eye, frame.lights[i]);

@@ -839,23 +839,21 @@ fn plan_render_pass(
         }
         rp.subpasses.push(sub);
     }
-    // A stored attachment's last access is the store operation, a write in the attachment
-    // stage at the end of the render pass, even when its last use inside was an input
-    // attachment read: later barriers must wait for and make available that write.
+    // An attachment's last access is its store operation, STORE and DONT_CARE alike (both are
+    // writes in the attachment stage at the end of the render pass), even when its last use
+    // inside was an input-attachment read: later barriers (an export, or an image taking over
+    // its aliased memory) must wait for and make available that write.
     for attachment in &rp.attachments {
-        if attachment.store == vk::AttachmentStoreOp::STORE {
-            let info = if planned[attachment.resource].info.aspect() == vk::ImageAspectFlags::COLOR
-            {
-                Access::ColorAttachmentWrite.info()
-            } else {
-                Access::DepthAttachmentWrite.info()
-            };
-            let s = &mut state[attachment.resource];
-            s.write = Some((info.stage, info.access));
-            s.read_stages = vk::PipelineStageFlags2::NONE;
-            s.visible_stages = vk::PipelineStageFlags2::NONE;
-            s.visible_access = vk::AccessFlags2::NONE;
-        }
+        let info = if planned[attachment.resource].info.aspect() == vk::ImageAspectFlags::COLOR {
+            Access::ColorAttachmentWrite.info()
+        } else {
+            Access::DepthAttachmentWrite.info()
+        };
+        let s = &mut state[attachment.resource];
+        s.write = Some((info.stage, info.access));
+        s.read_stages = vk::PipelineStageFlags2::NONE;
+        s.visible_stages = vk::PipelineStageFlags2::NONE;
+        s.visible_access = vk::AccessFlags2::NONE;
     }
     rp.dependencies = deps.into_values().collect();
     rp

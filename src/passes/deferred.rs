@@ -29,6 +29,8 @@ use super::SceneGpu;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Lit HDR colour.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// Screen-space SSS strength per pixel.
+pub const SSS_STRENGTH_FORMAT: vk::Format = vk::Format::R8_UNORM;
 
 /// Precision of the G-buffer's colour targets (the report measures what each costs and how
 /// far its image is from the f64 reference).
@@ -68,6 +70,9 @@ pub struct GBufferLayout {
     pub precision: GBufferPrecision,
     /// `None`: the frame has no translucency and no GB2.
     pub translucency: Option<TranslucencyLayout>,
+    /// Screen-space SSS: the G-buffer stores each pixel's SSS strength (R8) and the lighting
+    /// pass writes diffuse and specular to separate targets, so the blur sees diffuse only.
+    pub sss: bool,
 }
 
 /// How a frame's translucency is stored and shaded.
@@ -113,6 +118,15 @@ impl GBufferLayout {
         })
     }
 
+    /// G-buffer pass defines.
+    fn gbuffer_defines(&self) -> Vec<(&'static str, &'static str)> {
+        let mut defines = self.defines();
+        if self.sss {
+            defines.push(("LUCENT_SSS_STRENGTH", "1"));
+        }
+        defines
+    }
+
     /// Shader defines selecting the translucency code, its packing, pow forms and material
     /// lookup (nothing for frames without translucency).
     fn defines(&self) -> Vec<(&'static str, &'static str)> {
@@ -146,6 +160,8 @@ pub struct GBuffer {
     pub gb1: Handle<Image>,
     /// Local thickness + material ID, in frames with translucency.
     pub gb2: Option<Handle<Image>>,
+    /// Screen-space SSS strength per pixel, in frames with SSS.
+    pub sss: Option<Handle<Image>>,
     /// Depth.
     pub depth: Handle<Image>,
     /// The layout it was declared with.
@@ -171,6 +187,9 @@ pub fn gbuffer_pass(
         gb2: layout
             .gb2_format()
             .map(|f| graph.create_image("gbuffer.translucency", image(f))),
+        sss: layout
+            .sss
+            .then(|| graph.create_image("gbuffer.sss", image(SSS_STRENGTH_FORMAT))),
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
         layout,
     };
@@ -180,6 +199,10 @@ pub fn gbuffer_pass(
     if let Some(gb2) = &mut gb.gb2 {
         // Cleared to material ID 0: sky and opaque pixels skip the translucency math.
         pass.color(gb2, LoadOp::Clear([0.0; 4]));
+    }
+    if let Some(sss) = &mut gb.sss {
+        // Cleared to 0: sky and non-scattering pixels are left alone by the blurs.
+        pass.color(sss, LoadOp::Clear([0.0; 4]));
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {
@@ -193,26 +216,43 @@ pub fn gbuffer_pass(
     gb
 }
 
-/// Declares the lighting pass: reads the G-buffer at the same pixel, writes lit HDR colour.
-pub fn lighting_pass(
-    graph: &mut RenderGraph,
-    gb: &GBuffer,
-    scene: Option<&Arc<SceneGpu>>,
-) -> Handle<Image> {
+/// What the lighting pass writes.
+pub struct Lit {
+    /// Lit HDR colour; with SSS, the diffuse part only.
+    pub color: Handle<Image>,
+    /// With SSS: the specular part, added back after the blurs.
+    pub specular: Option<Handle<Image>>,
+}
+
+/// Declares the lighting pass: reads the G-buffer at the same pixel, writes lit HDR colour
+/// (with SSS: diffuse and specular apart).
+pub fn lighting_pass(graph: &mut RenderGraph, gb: &GBuffer, scene: Option<&Arc<SceneGpu>>) -> Lit {
     let info = graph.resources()[gb.gb0.id()].info;
+    let hdr_info = ImageInfo {
+        format: HDR_FORMAT,
+        ..info
+    };
     let mut hdr = graph.create_image(
-        "hdr",
-        ImageInfo {
-            format: HDR_FORMAT,
-            ..info
+        if gb.layout.sss {
+            "lighting.diffuse"
+        } else {
+            "hdr"
         },
+        hdr_info,
     );
+    let mut specular = gb
+        .layout
+        .sss
+        .then(|| graph.create_image("lighting.specular", hdr_info));
     let mut pass = graph.add_pass("lighting", PassKind::Raster);
     pass.input(&gb.gb0).input(&gb.gb1).input(&gb.depth);
     if let Some(gb2) = &gb.gb2 {
         pass.input(gb2);
     }
     pass.color(&mut hdr, LoadOp::DontCare);
+    if let Some(specular) = &mut specular {
+        pass.color(specular, LoadOp::DontCare);
+    }
     let inputs = LightingInputs {
         gb0: gb.gb0.id(),
         gb1: gb.gb1.id(),
@@ -229,7 +269,10 @@ pub fn lighting_pass(
         }),
         None => pass.finish(),
     }
-    hdr
+    Lit {
+        color: hdr,
+        specular,
+    }
 }
 
 struct GBufferPass {
@@ -246,7 +289,7 @@ impl PassExec for GBufferPass {
             &GraphicsPipelineDesc {
                 vertex: "deferred/gbuffer.vert",
                 fragment: "deferred/gbuffer.frag",
-                defines: &self.layout.defines(),
+                defines: &self.layout.gbuffer_defines(),
                 vertex_input: if self.layout.translucency.is_some() {
                     VertexInput::PositionNormalThickness
                 } else {
@@ -254,6 +297,7 @@ impl PassExec for GBufferPass {
                 },
                 depth_test: true,
                 cull_back: true,
+                additive_attachments: 0,
                 set_layouts: &[],
                 push_constant_bytes: std::mem::size_of::<super::ObjectConstants>() as u32,
                 name: "gbuffer",
@@ -338,13 +382,15 @@ impl PassExec for LightingPass {
             bindings.push(Binding::InputAttachment(views[gb2], color_layout));
             bindings.push(Binding::Uniform(t.materials.buffer));
         }
+        let split: &[(&str, &str)] = &[("LUCENT_SPLIT_SPECULAR", "1")];
         let plain = GraphicsPipelineDesc {
             vertex: "fullscreen.vert",
             fragment: "deferred/lighting.frag",
-            defines: &[],
+            defines: if self.layout.sss { split } else { &[] },
             vertex_input: VertexInput::None,
             depth_test: false,
             cull_back: false,
+            additive_attachments: 0,
             set_layouts: &[],
             push_constant_bytes: 0,
             name: "lighting",

@@ -4,10 +4,12 @@
 //! - [`deferred`]: the MRT G-buffer and per-light deferred lighting (merged as subpasses).
 //! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
 //!   packing (its shading runs inside the deferred lighting pass).
+//! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 
 pub mod deferred;
+pub mod sss;
 pub mod tonemap;
 pub mod translucency;
 pub mod util;
@@ -176,7 +178,13 @@ impl SceneGpu {
                     constants: ObjectConstants {
                         model: o.transform.to_cols_array_2d(),
                         albedo_specular: o.material.albedo.extend(o.material.specular).to_array(),
-                        roughness: [o.material.roughness, 0.0, 0.0, 0.0],
+                        // y: screen-space SSS strength (read only by SSS frames).
+                        roughness: [
+                            o.material.roughness,
+                            if o.material.sss.is_some() { 1.0 } else { 0.0 },
+                            0.0,
+                            0.0,
+                        ],
                         thickness,
                     },
                 }

@@ -80,6 +80,7 @@ impl PassExec for TonemapPass {
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,
+                additive_attachments: 0,
                 set_layouts: &[],
                 push_constant_bytes: 0,
                 name: "tonemap",

@@ -185,6 +185,9 @@ pub struct GraphicsPipelineDesc<'a> {
     pub depth_test: bool,
     /// Cull back faces (closed meshes).
     pub cull_back: bool,
+    /// Colour attachments (bit i = attachment i) that add the shader's output to their
+    /// contents instead of replacing them.
+    pub additive_attachments: u32,
     /// Descriptor set layouts (set 0, 1, ...); [`PassPipeline::new`] fills in its own.
     pub set_layouts: &'a [vk::DescriptorSetLayout],
     /// Push constant bytes visible to vertex and fragment stages.
@@ -326,9 +329,21 @@ impl GraphicsPipeline {
             .depth_compare_op(vk::CompareOp::LESS);
         let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = (0..ctx
             .color_attachment_count)
-            .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
+            .map(|i| {
+                let state = vk::PipelineColorBlendAttachmentState::default()
+                    .color_write_mask(vk::ColorComponentFlags::RGBA);
+                if desc.additive_attachments & (1 << i) == 0 {
+                    return state;
+                }
+                // dst += src: accumulation into a target loaded with its previous contents.
+                state
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ONE)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(vk::BlendOp::ADD)
             })
             .collect();
         let blend =

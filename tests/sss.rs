@@ -1,0 +1,97 @@
+//! Screen-space SSS, the control technique (Jimenez's separable sum-of-Gaussians blur), on
+//! lavapipe with validation and synchronization validation on: the passes it declares (and
+//! leaves out), non-scattering pixels untouched, scattering pixels blurred with their energy
+//! kept, and every output finite.
+
+mod common;
+
+use common::TestGpu;
+use lucent::renderer::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
+use lucent::scene::{self, Scene};
+
+fn settings(technique: Technique) -> FrameSettings {
+    FrameSettings {
+        technique,
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(160, 120)
+    }
+}
+
+fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::renderer::FrameImages {
+    let gpu = &test.gpu;
+    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
+    let images = renderer.render_once(gpu).unwrap();
+    gpu.wait_idle().unwrap();
+    renderer.destroy(gpu);
+    images
+}
+
+#[test]
+fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
+    let skin = scene::load_scene("skin").unwrap();
+    let s = settings(Technique::Control);
+    let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
+    let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
+    let mut expected = vec!["gbuffer + lighting".to_string()];
+    for i in 1..=6 {
+        expected.push(format!("horizontal blur #{i}"));
+        expected.push(format!("vertical blur #{i}"));
+    }
+    expected.extend(["combine".to_string(), "tonemap".to_string()]);
+    assert_eq!(names, expected);
+    // No SSS material: no blur passes, no SSS targets.
+    let smoke = scene::load_scene("smoke").unwrap();
+    let plan = plan_frame(&s, &FrameFeatures::new(&smoke, &s).unwrap()).unwrap();
+    let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["gbuffer + lighting", "tonemap"]);
+    assert!(plan.resources.iter().all(|r| !r.name.starts_with("sss.")));
+}
+
+#[test]
+fn control_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
+    let test = TestGpu::new();
+    for name in ["skin", "teapot"] {
+        let scene = scene::load_scene(name).unwrap();
+        let plain = render(&test, &scene, settings(Technique::None));
+        let blurred = render(&test, &scene, settings(Technique::Control));
+        let (a, b) = (plain.hdr.unwrap(), blurred.hdr.unwrap());
+        assert!(b.iter().all(|v| v.is_finite()), "{name}: non-finite output");
+        // Which pixels scatter: the G-buffer's SSS strength says.
+        let gb = blurred.gbuffer.unwrap();
+        let strength = gb.sss.as_ref().expect("SSS frames store the strength");
+        let (mut changed_far, mut sum_a, mut sum_b, mut scattering) = (0usize, 0.0, 0.0, 0usize);
+        for (i, s) in strength.iter().enumerate() {
+            let pa = &a[i * 4..i * 4 + 3];
+            let pb = &b[i * 4..i * 4 + 3];
+            let diff: f32 = pa.iter().zip(pb).map(|(x, y)| (x - y).abs()).sum();
+            let peak = pa.iter().fold(1e-3f32, |m, v| m.max(v.abs()));
+            // Sky and the floor (no profile) must come out as without SSS, up to fp16
+            // rounding of diffuse and specular stored apart.
+            if *s == 0.0 {
+                if diff > 4e-3 * peak.max(1.0) {
+                    changed_far += 1;
+                }
+            } else {
+                scattering += 1;
+                sum_a += pa.iter().sum::<f32>() as f64;
+                sum_b += pb.iter().sum::<f32>() as f64;
+            }
+        }
+        assert!(scattering > 500, "{name}: {scattering} scattering pixels");
+        assert!(
+            changed_far * 100 < gb.depth.len(),
+            "{name}: {changed_far} non-scattering pixels changed"
+        );
+        let ratio = sum_b / sum_a;
+        assert!(
+            (0.9..1.1).contains(&ratio),
+            "{name}: scattering pixels' energy ratio {ratio:.3}"
+        );
+        assert_ne!(
+            plain.display, blurred.display,
+            "{name}: the blur changed nothing"
+        );
+    }
+    test.finish();
+}

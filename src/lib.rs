@@ -24,6 +24,7 @@ pub mod reference;
 pub mod renderer;
 pub mod report;
 pub mod scene;
+pub mod seeds;
 pub mod sweep;
 
 pub use error::{LucentError, Result};

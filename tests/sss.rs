@@ -95,3 +95,77 @@ fn control_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
     }
     test.finish();
 }
+
+#[test]
+fn extreme_profiles_stay_finite_and_bounded() {
+    let test = TestGpu::new();
+    let base = scene::load_scene("skin").unwrap();
+    let plain = render(&test, &base, settings(Technique::None)).hdr.unwrap();
+    let peak = plain.iter().fold(0.0f32, |m, v| m.max(*v));
+    for (what, units_per_mm, variance) in [
+        ("huge strength (1e6 units per mm)", 1e6f32, None),
+        ("zero-width kernel (variances 1e-30)", 0.01, Some(1e-30f32)),
+        ("one huge Gaussian", 0.01, Some(1e6)),
+    ] {
+        let mut scene = base.clone();
+        for o in &mut scene.objects {
+            if let Some(p) = &mut o.material.sss {
+                p.units_per_mm = units_per_mm;
+                if let Some(v) = variance {
+                    p.gaussians.iter_mut().for_each(|g| g.variance = v);
+                }
+            }
+        }
+        let hdr = render(&test, &scene, settings(Technique::Control))
+            .hdr
+            .unwrap();
+        let bad = hdr.iter().filter(|v| !v.is_finite()).count();
+        assert_eq!(bad, 0, "{what}: {bad} non-finite values");
+        // A blur only averages: nothing brighter than the brightest unblurred pixel.
+        let max = hdr.iter().fold(0.0f32, |m, v| m.max(*v));
+        assert!(
+            max <= peak * 1.01 + 1e-3,
+            "{what}: max {max} above the unblurred peak {peak}"
+        );
+    }
+    test.finish();
+}
+
+#[test]
+fn bench_prints_the_control_beside_the_thesis_table_2() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "bench",
+            "--scene",
+            "teapot",
+            "--technique",
+            "control",
+            "--size",
+            "96x72",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+            "--compare-thesis",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        // Tiny frames on a shared machine may fail the timing checks: only that is allowed.
+        assert!(stderr.contains("lucent: error: timing:"), "{stderr}");
+    }
+    assert!(
+        stdout.contains("Beside LEAN-mapping SSS thesis"),
+        "{stdout}"
+    );
+    for row in [
+        "| Lighting calculations | 0.052 |",
+        "| Vertical Blur #4 | 0.210 |",
+    ] {
+        assert!(stdout.contains(row), "missing {row}:\n{stdout}");
+    }
+    assert!(stdout.contains("| horizontal blur #1 |"));
+    assert!(stdout.contains("Thesis LBB / control: 3.38x"));
+}

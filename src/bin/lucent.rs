@@ -70,6 +70,10 @@ enum Command {
         /// main one, and print both side by side with the ratio (e.g. `--against none`).
         #[arg(long)]
         against: Option<String>,
+        /// Print the per-pass table beside the LEAN-mapping thesis's (Table 2 for `control`,
+        /// Table 1 for `lbb`), each row as a share of its frame.
+        #[arg(long)]
+        compare_thesis: bool,
     },
     /// Print the compiled render graph: passes, merged groups, barriers, lifetimes, memory.
     Plan {
@@ -329,12 +333,27 @@ fn bench_command(
     json: Option<PathBuf>,
     out: Option<PathBuf>,
     against: Option<String>,
+    compare_thesis: bool,
 ) -> Result<()> {
     let against = against.map(|t| Technique::parse(&t)).transpose()?;
+    let thesis_table = match (compare_thesis, Technique::parse(&frame.technique)?) {
+        (false, _) => None,
+        (true, Technique::Control) => Some(lucent::seeds::THESIS_TABLE_2_CONTROL),
+        (true, other) => {
+            return Err(LucentError::InvalidInput(format!(
+                "--compare-thesis needs --technique control (the thesis's Table 2); '{}' has no \
+                 table in the thesis",
+                other.name()
+            )))
+        }
+    };
     with_renderer(frame, gpu_args, false, |session, renderer| {
         let gpu = &session.gpu;
         let report = bench::run(gpu, renderer, &frame.scene, &options)?;
         println!("{}", report.markdown());
+        if let Some(table) = &thesis_table {
+            println!("{}", lucent::seeds::beside(&report, table));
+        }
         if let Some(technique) = against {
             let scene = scene::load_scene(&frame.scene)?;
             let other = Renderer::new(
@@ -530,6 +549,7 @@ fn run(cli: Cli) -> Result<()> {
             json,
             out,
             against,
+            compare_thesis,
         } => bench_command(
             &frame,
             &gpu,
@@ -541,6 +561,7 @@ fn run(cli: Cli) -> Result<()> {
             json,
             out,
             against,
+            compare_thesis,
         ),
         Command::Sweep {
             technique,

@@ -17,7 +17,7 @@ use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
 use crate::passes::deferred::{GBufferLayout, GBufferPrecision, TranslucencyLayout};
 use crate::passes::translucency::{
-    mesh_bounds, tile_rects, translucent_tiles, MaterialTable, ThicknessPacking,
+    mesh_bounds, object_tiles, tile_rects, translucent_tiles, MaterialTable, ThicknessPacking,
 };
 use crate::passes::{deferred, sss, tonemap, SceneGpu};
 use crate::scene::material::SssProfile;
@@ -92,6 +92,9 @@ pub struct FrameSettings {
     /// Write coloured thickness as grayscale (its luminance) even when the scene has colour:
     /// the talk's one-channel G-buffer, for A/B comparisons.
     pub force_grayscale: bool,
+    /// Run the SSS blurs only over the screen rectangles of objects with a profile (off: the
+    /// whole screen, for A/B comparisons).
+    pub sss_tiles: bool,
 }
 
 impl FrameSettings {
@@ -106,6 +109,7 @@ impl FrameSettings {
             export_gbuffer: false,
             gbuffer: GBufferPrecision::Compact,
             force_grayscale: false,
+            sss_tiles: true,
         }
     }
 }
@@ -332,8 +336,10 @@ pub struct Renderer {
     pub settings: FrameSettings,
     scene_gpu: Option<Arc<SceneGpu>>,
     uniforms: Option<GpuBuffer>,
-    /// Object-space bounds per mesh, for the translucent tiles (frames with translucency).
+    /// Object-space bounds per mesh, for the screen tiles (frames with translucency or SSS).
     mesh_bounds: Vec<(Vec3, Vec3)>,
+    /// Whether the frame blurs SSS.
+    sss: bool,
 }
 
 impl Renderer {
@@ -392,7 +398,7 @@ impl Renderer {
                 return Err(e);
             }
         };
-        let mesh_bounds = if features.translucency.is_some() {
+        let mesh_bounds = if features.translucency.is_some() || features.sss.is_some() {
             mesh_bounds(scene)
         } else {
             Vec::new()
@@ -404,6 +410,7 @@ impl Renderer {
             scene_gpu: Some(scene_gpu),
             uniforms: Some(uniforms),
             mesh_bounds,
+            sss: features.sss.is_some(),
         };
         renderer.update(scene)?;
         Ok(renderer)
@@ -426,6 +433,20 @@ impl Renderer {
             let (width, height) = (self.settings.width, self.settings.height);
             let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
             scene_gpu.set_tiles(tile_rects(columns, &marked, width, height));
+        }
+        if let Some(scene_gpu) = &self.scene_gpu {
+            let (width, height) = (self.settings.width, self.settings.height);
+            let tiles = (self.sss && self.settings.sss_tiles).then(|| {
+                let (columns, _, marked) =
+                    object_tiles(scene, &self.mesh_bounds, width, height, |o| {
+                        o.material.sss.as_ref().map(sss::profile_reach)
+                    });
+                tile_rects(columns, &marked, width, height)
+                    .into_iter()
+                    .filter(|r| r.translucent)
+                    .collect()
+            });
+            scene_gpu.set_sss_tiles(tiles);
         }
         Ok(())
     }

@@ -169,3 +169,25 @@ fn bench_prints_the_control_beside_the_thesis_table_2() {
     assert!(stdout.contains("| horizontal blur #1 |"));
     assert!(stdout.contains("Thesis LBB / control: 3.38x"));
 }
+
+#[test]
+fn blurring_only_the_profiles_rectangles_gives_the_whole_screen_result() {
+    let test = TestGpu::new();
+    for name in ["skin", "teapot"] {
+        let scene = scene::load_scene(name).unwrap();
+        let tiled = render(&test, &scene, settings(Technique::Control));
+        let whole = render(
+            &test,
+            &scene,
+            FrameSettings {
+                sss_tiles: false,
+                ..settings(Technique::Control)
+            },
+        );
+        assert_eq!(
+            tiled.hdr, whole.hdr,
+            "{name}: tiled blurs differ from whole-screen ones"
+        );
+    }
+    test.finish();
+}

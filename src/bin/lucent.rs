@@ -168,6 +168,10 @@ struct FrameArgs {
     /// Store coloured thickness as grayscale (its luminance), the talk's one-channel G-buffer.
     #[arg(long)]
     grayscale: bool,
+    /// Run the SSS blurs over the whole screen instead of only the rectangles of objects with
+    /// a profile (A/B comparison).
+    #[arg(long)]
+    no_sss_tiles: bool,
 }
 
 fn parse_precision(text: &str) -> std::result::Result<GBufferPrecision, String> {
@@ -217,6 +221,7 @@ impl FrameArgs {
             export_gbuffer: false,
             gbuffer: self.gbuffer,
             force_grayscale: self.grayscale,
+            sss_tiles: !self.no_sss_tiles,
         })
     }
 }

@@ -428,44 +428,18 @@ impl PassExec for LightingPass {
             pipeline.draw_fullscreen(ctx);
             return;
         };
-        let device = &ctx.gpu.device;
         let rects = t.tiles.lock().unwrap_or_else(|e| e.into_inner()).clone();
         pipeline.bind(ctx);
-        // SAFETY: both pipelines were made for this subpass with the bound set's layout;
-        // scissor is dynamic state, restored to the render area at the end.
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
+        // SAFETY: made for this subpass with the bound set's layout.
         unsafe {
-            for translucent_pass in [false, true] {
-                if translucent_pass {
-                    device.cmd_bind_pipeline(
-                        ctx.cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        translucent.pipeline,
-                    );
-                }
-                for r in rects.iter().filter(|r| r.translucent == translucent_pass) {
-                    let scissor = vk::Rect2D {
-                        offset: vk::Offset2D {
-                            x: r.x as i32,
-                            y: r.y as i32,
-                        },
-                        extent: vk::Extent2D {
-                            width: r.width,
-                            height: r.height,
-                        },
-                    };
-                    device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
-                    device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
-                }
-            }
-            device.cmd_set_scissor(
+            ctx.gpu.device.cmd_bind_pipeline(
                 ctx.cmd,
-                0,
-                &[vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: ctx.extent,
-                }],
+                vk::PipelineBindPoint::GRAPHICS,
+                translucent.pipeline,
             );
         }
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {

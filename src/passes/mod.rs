@@ -81,6 +81,10 @@ pub struct SceneGpu {
     pub frame_uniforms: vk::Buffer,
     /// Translucency data, when the frame shades translucency.
     pub translucency: Option<TranslucencyGpu>,
+    /// The screen rectangles the SSS blurs run in this frame (objects with a profile, widened
+    /// by the profile's reach), written by the renderer before each frame; `None`: the blurs
+    /// cover the whole screen.
+    pub sss_tiles: std::sync::Mutex<Option<Vec<translucency::TileRect>>>,
 }
 
 impl SceneGpu {
@@ -194,6 +198,7 @@ impl SceneGpu {
             meshes,
             draws,
             frame_uniforms,
+            sss_tiles: std::sync::Mutex::new(None),
             translucency: materials
                 .zip(translucency)
                 .map(|(materials, (_, packing))| TranslucencyGpu {
@@ -210,6 +215,12 @@ impl SceneGpu {
             // A poisoned lock only means a recording thread panicked; the data is plain.
             *t.tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
         }
+    }
+
+    /// Sets the SSS blurs' rectangles for the next frames (`None`: whole screen).
+    pub fn set_sss_tiles(&self, rects: Option<Vec<translucency::TileRect>>) {
+        // A poisoned lock only means a recording thread panicked; the data is plain.
+        *self.sss_tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
     }
 
     fn free(gpu: &GpuContext, meshes: Vec<GpuMesh>, materials: Option<GpuBuffer>) {

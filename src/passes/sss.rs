@@ -12,7 +12,9 @@
 //! (`horizontal blur #1`, `vertical blur #1`, ...).
 //!
 //! A frame blurs with one profile: the first SSS material's (the scenes use one profile each);
-//! the per-pixel strength (0 = not SSS, from the G-buffer) scales the kernel width.
+//! the per-pixel strength (0 = not SSS, from the G-buffer) scales the kernel width. With tiles
+//! on (the default), the blurs draw only over the screen rectangles of objects with a profile,
+//! widened by the profile's reach ([`profile_reach`]).
 
 use std::sync::Arc;
 
@@ -74,6 +76,16 @@ pub fn blur_steps(profile: &SssProfile) -> Vec<BlurStep> {
         });
     }
     steps
+}
+
+/// How far (world units) the blurs of `profile` spread light: the kernel spans 3 sigma of the
+/// widest Gaussian (the iterative steps' variances add up to it).
+pub fn profile_reach(profile: &SssProfile) -> f32 {
+    let widest = profile
+        .gaussians
+        .iter()
+        .fold(0.0f32, |m, g| m.max(g.variance));
+    3.0 * widest.max(0.0).sqrt() * profile.units_per_mm
 }
 
 /// Declares the control technique's passes after the lighting pass: blurs of `diffuse`
@@ -247,7 +259,18 @@ impl PassExec for BlurPass {
                 bytemuck::bytes_of(&self.constants),
             );
         }
-        pipeline.draw_fullscreen(ctx);
+        let tiles = self.scene.as_ref().and_then(|s| {
+            s.sss_tiles
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .clone()
+        });
+        match tiles {
+            // Only where objects with a profile (and their blur's reach) can be: every pixel a
+            // tap of a scattering pixel reads is written; the rest is never read.
+            Some(rects) => PassPipeline::draw_fullscreen_in(ctx, &rects),
+            None => pipeline.draw_fullscreen(ctx),
+        }
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {

@@ -188,15 +188,32 @@ pub fn translucent_tiles(
     width: u32,
     height: u32,
 ) -> (u32, u32, Vec<bool>) {
+    object_tiles(scene, bounds, width, height, |o| {
+        o.material.translucency.as_ref().map(|_| 0.0)
+    })
+}
+
+/// The tiles objects may cover, for the objects `reach` selects: it returns how far (world
+/// units, at the object) their effect spreads beyond their surface, which widens their
+/// rectangles by that distance projected at the object's nearest point (clamped to a quarter
+/// of the screen, as the SSS blur clamps its reach). See [`translucent_tiles`].
+pub fn object_tiles(
+    scene: &Scene,
+    bounds: &[(Vec3, Vec3)],
+    width: u32,
+    height: u32,
+    reach: impl Fn(&crate::scene::Object) -> Option<f32>,
+) -> (u32, u32, Vec<bool>) {
     let (columns, rows) = (width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE));
     let mut tiles = vec![false; (columns * rows) as usize];
     let aspect = width as f32 / height.max(1) as f32;
     let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-    for object in scene
-        .objects
-        .iter()
-        .filter(|o| o.material.translucency.is_some())
-    {
+    let focal_px = height as f32 / (2.0 * (scene.camera.fov_y_degrees.to_radians() * 0.5).tan());
+    let max_margin = 0.25 * width.max(height) as f32;
+    for object in &scene.objects {
+        let Some(reach_world) = reach(object) else {
+            continue;
+        };
         let (lo, hi) = bounds[object.mesh];
         let clip_from_object = view_proj * object.transform;
         let corners = (0..8).map(|i| {
@@ -213,6 +230,7 @@ pub fn translucent_tiles(
         if behind == corners.len() {
             continue;
         }
+        // A box crossing the near plane covers the whole screen.
         let (mut min, mut max) = (glam::Vec2::splat(-1.0), glam::Vec2::splat(1.0));
         if behind == 0 {
             let ndc = corners.iter().map(|c| c.truncate().truncate() / c.w);
@@ -220,12 +238,26 @@ pub fn translucent_tiles(
                 (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN)),
                 |(lo, hi), p| (lo.min(p), hi.max(p)),
             );
-            if hi.x < -1.0 || hi.y < -1.0 || lo.x > 1.0 || lo.y > 1.0 {
+            let nearest = corners.iter().fold(f32::MAX, |m, c| m.min(c.w));
+            // Guarded: a non-finite reach counts as the largest.
+            let margin = (reach_world * focal_px / nearest).clamp(0.0, max_margin);
+            let margin = if margin.is_finite() {
+                margin
+            } else {
+                max_margin
+            };
+            let ndc_margin =
+                glam::Vec2::new(2.0 * margin / width as f32, 2.0 * margin / height as f32);
+            if hi.x + ndc_margin.x < -1.0
+                || hi.y + ndc_margin.y < -1.0
+                || lo.x - ndc_margin.x > 1.0
+                || lo.y - ndc_margin.y > 1.0
+            {
                 continue;
             }
             (min, max) = (
-                lo.max(glam::Vec2::splat(-1.0)),
-                hi.min(glam::Vec2::splat(1.0)),
+                (lo - ndc_margin).max(glam::Vec2::splat(-1.0)),
+                (hi + ndc_margin).min(glam::Vec2::splat(1.0)),
             );
         }
         // NDC to pixels (Vulkan: y = -1 is the top row), one pixel of margin for rasterisation.

@@ -461,6 +461,41 @@ impl PassPipeline {
         unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
     }
 
+    /// Draws the fullscreen triangle once per rectangle, each under its own scissor (the
+    /// pipeline must be bound), then restores the scissor to the render area.
+    pub fn draw_fullscreen_in<'r>(
+        ctx: &crate::graph::RecordContext<'_>,
+        rects: impl IntoIterator<Item = &'r super::translucency::TileRect>,
+    ) {
+        let device = &ctx.gpu.device;
+        // SAFETY: scissor is dynamic state of every lucent pipeline; called inside a subpass
+        // with a pipeline bound.
+        unsafe {
+            for r in rects {
+                let scissor = vk::Rect2D {
+                    offset: vk::Offset2D {
+                        x: r.x as i32,
+                        y: r.y as i32,
+                    },
+                    extent: vk::Extent2D {
+                        width: r.width,
+                        height: r.height,
+                    },
+                };
+                device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
+                device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
+            }
+            device.cmd_set_scissor(
+                ctx.cmd,
+                0,
+                &[vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent: ctx.extent,
+                }],
+            );
+        }
+    }
+
     /// Destroys pipeline and set.
     pub fn destroy(&mut self, device: &ash::Device) {
         self.pipeline.destroy(device);

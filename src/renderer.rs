@@ -124,6 +124,8 @@ pub struct FrameFeatures {
     /// The diffusion profile the SSS blurs use, when the technique is an SSS one and some
     /// object has a profile (the first such object's).
     pub sss: Option<SssProfile>,
+    /// Some object has a normal map.
+    pub normal_maps: bool,
 }
 
 impl FrameFeatures {
@@ -145,7 +147,15 @@ impl FrameFeatures {
                 (!table.is_empty()).then_some((table, packing))
             }
         };
-        Ok(Self { translucency, sss })
+        let normal_maps = scene
+            .objects
+            .iter()
+            .any(|o| o.material.normal_texture.is_some());
+        Ok(Self {
+            translucency,
+            sss,
+            normal_maps,
+        })
     }
 
     /// The G-buffer layout these features and `settings` call for.
@@ -161,6 +171,7 @@ impl FrameFeatures {
                     single_material: table.rows.len() == 1,
                 }),
             sss: self.sss.is_some(),
+            normal_maps: self.normal_maps,
         }
     }
 }

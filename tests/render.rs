@@ -434,3 +434,24 @@ fn bench_against_another_technique_prints_both_sides_and_the_ratio() {
     );
     assert!(cells[4].ends_with('%'), "{row}");
 }
+
+#[test]
+fn normal_maps_bend_the_shading_and_stay_validation_clean() {
+    let mapped = scene::load_scene("teapot").unwrap();
+    let mut flat = mapped.clone();
+    for o in &mut flat.objects {
+        o.material.normal_texture = None;
+    }
+    let settings = FrameSettings {
+        export_hdr: true,
+        ..FrameSettings::new(160, 120)
+    };
+    let (a, hdr_a) = render_scene(&mapped, settings);
+    let (b, _) = render_scene(&flat, settings);
+    assert!(hdr_a.unwrap().iter().all(|v| v.is_finite()));
+    let changed = a.chunks(4).zip(b.chunks(4)).filter(|(x, y)| x != y).count();
+    assert!(
+        changed > 500,
+        "the normal map changed only {changed} pixels of the teapot"
+    );
+}

@@ -2,10 +2,32 @@
 // permutation: LUCENT_TRANSLUCENCY
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS
 // permutation: LUCENT_SSS_STRENGTH
+// permutation: LUCENT_NORMAL_MAP
+// permutation: LUCENT_SSS_STRENGTH LUCENT_NORMAL_MAP
 #include "../common/gbuffer.glsl"
 #include "object.glsl"
 
 layout(location = 0) in vec3 in_normal;
+#ifdef LUCENT_NORMAL_MAP
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) in vec4 in_tangent;
+// Tangent-space normal map, stored as n * 0.5 + 0.5 (binding 0 is the frame uniforms).
+layout(set = 0, binding = 1) uniform sampler2D normal_map;
+
+// The shading normal: the map's normal in the interpolated tangent frame. A degenerate frame
+// (zero tangent, or one parallel to the normal) falls back to the vertex normal.
+vec3 mapped_normal(vec3 n) {
+    vec3 t = in_tangent.xyz - n * dot(n, in_tangent.xyz);
+    float t_len2 = dot(t, t);
+    if (!(t_len2 > 1e-12)) {
+        return n;
+    }
+    t *= inversesqrt(t_len2);
+    vec3 b = cross(n, t) * (in_tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 m = texture(normal_map, in_uv).xyz * 2.0 - 1.0;
+    return t * m.x + b * m.y + n * m.z;
+}
+#endif
 #ifdef LUCENT_TRANSLUCENCY
 layout(location = 1) in vec3 in_thickness;
 layout(location = 2) out vec4 out_gb2;
@@ -22,7 +44,11 @@ void main() {
     Surface s;
     s.albedo = object.albedo_specular.rgb;
     s.specular = object.albedo_specular.a;
+#ifdef LUCENT_NORMAL_MAP
+    s.normal = mapped_normal(sanitize_normal(in_normal));
+#else
     s.normal = in_normal;
+#endif
     s.roughness = object.roughness.x;
     out_gb0 = pack_gb0(s);
     out_gb1 = pack_gb1(s);

@@ -37,7 +37,7 @@ const VIEW_USAGES: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
         | vk::ImageUsageFlags::INPUT_ATTACHMENT.as_raw(),
 );
 
-/// A 2D image with one mip level and one layer, in optimal tiling.
+/// A 2D image with one layer (and `mip_levels` levels), in optimal tiling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ImageDesc {
     /// Width in texels.
@@ -50,6 +50,8 @@ pub struct ImageDesc {
     pub usage: vk::ImageUsageFlags,
     /// `COLOR` or `DEPTH` (the aspect of the view and of copies).
     pub aspect: vk::ImageAspectFlags,
+    /// Mip levels (1 for render targets).
+    pub mip_levels: u32,
 }
 
 impl ImageDesc {
@@ -61,6 +63,7 @@ impl ImageDesc {
             format,
             usage,
             aspect: vk::ImageAspectFlags::COLOR,
+            mip_levels: 1,
         }
     }
 
@@ -72,6 +75,7 @@ impl ImageDesc {
             format,
             usage,
             aspect: vk::ImageAspectFlags::DEPTH,
+            mip_levels: 1,
         }
     }
 
@@ -84,12 +88,12 @@ impl ImageDesc {
         }
     }
 
-    /// The subresource range covering the whole image (one mip, one layer).
+    /// The subresource range covering the whole image (every mip, one layer).
     pub fn subresource_range(&self) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange {
             aspect_mask: self.aspect,
             base_mip_level: 0,
-            level_count: 1,
+            level_count: self.mip_levels.max(1),
             base_array_layer: 0,
             layer_count: 1,
         }
@@ -460,6 +464,135 @@ impl GpuContext {
         }
     }
 
+    /// Creates a sampled image and fills every mip level from `levels` (tightly packed texels
+    /// of `desc.format`, level 0 first, each level half the size of the previous, at least 1),
+    /// through a staging buffer. The image is left in `SHADER_READ_ONLY_OPTIMAL`, its contents
+    /// visible to every later GPU read.
+    pub fn upload_image(
+        &self,
+        desc: &ImageDesc,
+        levels: &[Vec<u8>],
+        name: &str,
+    ) -> Result<GpuImage> {
+        if levels.len() != desc.mip_levels.max(1) as usize {
+            return Err(LucentError::InvalidInput(format!(
+                "upload '{name}': {} levels of data for {} mip levels",
+                levels.len(),
+                desc.mip_levels
+            )));
+        }
+        let bytes: Vec<u8> = levels.concat();
+        if bytes.is_empty() {
+            return Err(LucentError::InvalidInput(format!(
+                "upload '{name}' has no data"
+            )));
+        }
+        let mut staging = self.create_buffer(
+            bytes.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+            &format!("{name} (staging)"),
+        )?;
+        match staging.mapped_mut() {
+            Some(mapped) => mapped.copy_from_slice(&bytes),
+            None => {
+                self.destroy_buffer(staging);
+                return Err(LucentError::InvalidInput(format!(
+                    "staging memory for '{name}' is not host-visible"
+                )));
+            }
+        }
+        let desc = ImageDesc {
+            usage: desc.usage | vk::ImageUsageFlags::TRANSFER_DST,
+            ..*desc
+        };
+        let image = match self.create_image(&desc, name) {
+            Ok(image) => image,
+            Err(e) => {
+                self.destroy_buffer(staging);
+                return Err(e);
+            }
+        };
+        let mut regions = Vec::with_capacity(levels.len());
+        let mut offset = 0u64;
+        for (level, data) in levels.iter().enumerate() {
+            let shift = level as u32;
+            regions.push(vk::BufferImageCopy {
+                buffer_offset: offset,
+                buffer_row_length: 0,
+                buffer_image_height: 0,
+                image_subresource: vk::ImageSubresourceLayers {
+                    aspect_mask: desc.aspect,
+                    mip_level: shift,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                },
+                image_offset: vk::Offset3D::default(),
+                image_extent: vk::Extent3D {
+                    width: (desc.width >> shift).max(1),
+                    height: (desc.height >> shift).max(1),
+                    depth: 1,
+                },
+            });
+            offset += data.len() as u64;
+        }
+        let range = desc.subresource_range();
+        let copied = self.submit_and_wait(|cmd| {
+            self.begin_label(cmd, &format!("upload {name}"));
+            let to_dst = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::NONE)
+                .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .old_layout(vk::ImageLayout::UNDEFINED)
+                .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(image.image)
+                .subresource_range(range)];
+            // The copy's writes must be visible to any later read, in any stage of any later
+            // submission.
+            let to_read = [vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ)
+                .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(image.image)
+                .subresource_range(range)];
+            // SAFETY: `cmd` is recording; the image and staging buffer are live, the regions lie
+            // inside both, and the image has TRANSFER_DST usage.
+            unsafe {
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&to_dst),
+                );
+                self.device.cmd_copy_buffer_to_image(
+                    cmd,
+                    staging.buffer,
+                    image.image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &regions,
+                );
+                self.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&to_read),
+                );
+            }
+            self.end_label(cmd);
+        });
+        self.destroy_buffer(staging);
+        match copied {
+            Ok(()) => Ok(image),
+            Err(e) => {
+                self.destroy_image(image);
+                Err(e)
+            }
+        }
+    }
+
     /// Copies a whole buffer to host memory. The buffer needs `TRANSFER_SRC` usage; all earlier
     /// GPU writes to it are waited for.
     pub fn read_buffer(&self, buffer: &GpuBuffer) -> Result<Vec<u8>> {
@@ -663,7 +796,7 @@ impl GpuContext {
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
             .extent(desc.extent())
-            .mip_levels(1)
+            .mip_levels(desc.mip_levels.max(1))
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)

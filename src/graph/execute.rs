@@ -143,6 +143,7 @@ impl Executable {
             format: r.info.format,
             usage: r.usage,
             aspect: r.info.aspect(),
+            mip_levels: 1,
         }
     }
 

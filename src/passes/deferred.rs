@@ -22,7 +22,9 @@ use crate::graph::{
 use crate::Result;
 
 use super::translucency::ThicknessPacking;
-use super::util::{Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::{
+    Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+};
 use super::SceneGpu;
 
 /// Depth.
@@ -73,6 +75,8 @@ pub struct GBufferLayout {
     /// Screen-space SSS: the G-buffer stores each pixel's SSS strength (R8) and the lighting
     /// pass writes diffuse and specular to separate targets, so the blur sees diffuse only.
     pub sss: bool,
+    /// Some object has a normal map: the G-buffer pass reads UVs and tangents and samples it.
+    pub normal_maps: bool,
 }
 
 /// How a frame's translucency is stored and shaded.
@@ -123,6 +127,9 @@ impl GBufferLayout {
         let mut defines = self.defines();
         if self.sss {
             defines.push(("LUCENT_SSS_STRENGTH", "1"));
+        }
+        if self.normal_maps {
+            defines.push(("LUCENT_NORMAL_MAP", "1"));
         }
         defines
     }
@@ -210,6 +217,7 @@ pub fn gbuffer_pass(
             scene: scene.clone(),
             layout,
             pipeline: None,
+            map_sets: Vec::new(),
         }),
         None => pass.finish(),
     }
@@ -279,21 +287,34 @@ struct GBufferPass {
     scene: Arc<SceneGpu>,
     layout: GBufferLayout,
     pipeline: Option<PassPipeline>,
+    /// Normal-mapped frames: one set per normal map after the first (which is the pipeline's
+    /// own), each `frame uniforms + that map`, bound per draw.
+    map_sets: Vec<DescriptorSet>,
+}
+
+impl GBufferPass {
+    /// Set 0's bindings with normal map `index` (glsl/deferred/gbuffer.frag).
+    fn bindings(&self, index: usize) -> Vec<Binding> {
+        let mut bindings = vec![Binding::Uniform(self.scene.frame_uniforms)];
+        if let Some(maps) = &self.scene.normal_maps {
+            bindings.push(Binding::Sampled(maps.images[index].view, maps.sampler));
+        }
+        bindings
+    }
 }
 
 impl PassExec for GBufferPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[Binding::Uniform(self.scene.frame_uniforms)],
+            &self.bindings(0),
             &GraphicsPipelineDesc {
                 vertex: "deferred/gbuffer.vert",
                 fragment: "deferred/gbuffer.frag",
                 defines: &self.layout.gbuffer_defines(),
-                vertex_input: if self.layout.translucency.is_some() {
-                    VertexInput::PositionNormalThickness
-                } else {
-                    VertexInput::PositionNormal
+                vertex_input: VertexInput::Mesh {
+                    thickness: self.layout.translucency.is_some(),
+                    surface: self.layout.normal_maps,
                 },
                 depth_test: true,
                 cull_back: true,
@@ -303,6 +324,21 @@ impl PassExec for GBufferPass {
                 name: "gbuffer",
             },
         )?);
+        let maps = self
+            .scene
+            .normal_maps
+            .as_ref()
+            .map_or(0, |m| m.images.len());
+        for index in 1..maps {
+            // Identically defined layouts are compatible: these sets bind to the pipeline's.
+            let set = DescriptorSet::new(
+                ctx,
+                &self.bindings(index),
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                "gbuffer normal map",
+            )?;
+            self.map_sets.push(set);
+        }
         Ok(())
     }
 
@@ -312,10 +348,26 @@ impl PassExec for GBufferPass {
         };
         pipeline.bind(ctx);
         let device = &ctx.gpu.device;
-        // SAFETY: the pipeline is bound inside this pass's subpass; buffers are alive.
+        let mut bound_map = 0usize;
+        // SAFETY: the pipeline is bound inside this pass's subpass; buffers and sets are alive.
         unsafe {
             for draw in &self.scene.draws {
                 let mesh = &self.scene.meshes[draw.mesh];
+                if draw.normal_map != bound_map {
+                    let set = match draw.normal_map {
+                        0 => pipeline.set.set,
+                        i => self.map_sets[i - 1].set,
+                    };
+                    device.cmd_bind_descriptor_sets(
+                        ctx.cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        pipeline.pipeline.layout,
+                        0,
+                        &[set],
+                        &[],
+                    );
+                    bound_map = draw.normal_map;
+                }
                 device.cmd_push_constants(
                     ctx.cmd,
                     pipeline.pipeline.layout,
@@ -326,6 +378,9 @@ impl PassExec for GBufferPass {
                 device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[mesh.vertices.buffer], &[0]);
                 if let (Some(thickness), Some(_)) = (&mesh.thickness, self.layout.translucency) {
                     device.cmd_bind_vertex_buffers(ctx.cmd, 1, &[thickness.buffer], &[0]);
+                }
+                if let (Some(surface), true) = (&mesh.surface, self.layout.normal_maps) {
+                    device.cmd_bind_vertex_buffers(ctx.cmd, 2, &[surface.buffer], &[0]);
                 }
                 device.cmd_bind_index_buffer(
                     ctx.cmd,
@@ -341,6 +396,9 @@ impl PassExec for GBufferPass {
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
             p.destroy(&gpu.device);
+        }
+        for mut set in self.map_sets.drain(..) {
+            set.destroy(&gpu.device);
         }
     }
 }

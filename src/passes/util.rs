@@ -163,11 +163,16 @@ impl DescriptorSet {
 pub enum VertexInput {
     /// No vertex buffer (fullscreen triangle from `gl_VertexIndex`).
     None,
-    /// Interleaved position + normal ([`crate::scene::mesh::Vertex`]).
-    PositionNormal,
-    /// Position + normal (binding 0) and a second stream of RGB thickness colours (binding 1,
-    /// location 2), for G-buffers that carry translucency.
-    PositionNormalThickness,
+    /// A mesh: interleaved position + normal ([`crate::scene::mesh::Vertex`], binding 0),
+    /// optionally the RGB thickness stream (binding 1, location 2) of G-buffers that carry
+    /// translucency, and the UV + tangent stream (binding 2, locations 3 and 4) of
+    /// normal-mapped frames.
+    Mesh {
+        /// Thickness stream.
+        thickness: bool,
+        /// UV + tangent stream.
+        surface: bool,
+    },
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -259,51 +264,45 @@ impl GraphicsPipeline {
                 .module(frag)
                 .name(entry),
         ];
-        let vertex_bindings = [
-            vk::VertexInputBindingDescription {
-                binding: 0,
-                stride: std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
-                input_rate: vk::VertexInputRate::VERTEX,
-            },
-            // The thickness colour stream, a buffer of its own so frames without translucency
-            // neither store nor fetch it.
-            vk::VertexInputBindingDescription {
-                binding: 1,
-                stride: 12,
-                input_rate: vk::VertexInputRate::VERTEX,
-            },
-        ];
-        let vertex_attributes = [
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 12,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 2,
-                binding: 1,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-        ];
-        let vertex_input = match desc.vertex_input {
-            VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
-            VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&vertex_bindings[..1])
-                .vertex_attribute_descriptions(&vertex_attributes[..2]),
-            VertexInput::PositionNormalThickness => {
-                vk::PipelineVertexInputStateCreateInfo::default()
-                    .vertex_binding_descriptions(&vertex_bindings)
-                    .vertex_attribute_descriptions(&vertex_attributes)
-            }
+        // Mesh streams: binding 0 position + normal (locations 0, 1); binding 1 the thickness
+        // colour (location 2), a buffer of its own so frames without translucency neither
+        // store nor fetch it; binding 2 UV + tangent (locations 3, 4) for normal mapping.
+        let mut vertex_bindings = Vec::new();
+        let mut vertex_attributes = Vec::new();
+        let attribute = |location, binding, format, offset| vk::VertexInputAttributeDescription {
+            location,
+            binding,
+            format,
+            offset,
         };
+        let binding = |binding, stride| vk::VertexInputBindingDescription {
+            binding,
+            stride,
+            input_rate: vk::VertexInputRate::VERTEX,
+        };
+        if let VertexInput::Mesh { thickness, surface } = desc.vertex_input {
+            let vec2 = vk::Format::R32G32_SFLOAT;
+            let vec3 = vk::Format::R32G32B32_SFLOAT;
+            let vec4 = vk::Format::R32G32B32A32_SFLOAT;
+            vertex_bindings.push(binding(
+                0,
+                std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
+            ));
+            vertex_attributes.push(attribute(0, 0, vec3, 0));
+            vertex_attributes.push(attribute(1, 0, vec3, 12));
+            if thickness {
+                vertex_bindings.push(binding(1, 12));
+                vertex_attributes.push(attribute(2, 1, vec3, 0));
+            }
+            if surface {
+                vertex_bindings.push(binding(2, 24));
+                vertex_attributes.push(attribute(3, 2, vec2, 0));
+                vertex_attributes.push(attribute(4, 2, vec4, 8));
+            }
+        }
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vertex_bindings)
+            .vertex_attribute_descriptions(&vertex_attributes);
         let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
             .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default()

@@ -130,6 +130,49 @@ impl Texture {
     }
 }
 
+/// Makes a procedural texture at `size` x `size` (linear data, with mips).
+///
+/// `MarbleNormal`: the tileable height field `h = sin(2 pi (f x + t(x, y)))` with a periodic
+/// turbulence `t`, differentiated by central differences (wrapping) into a tangent-space normal
+/// `normalize(-s dh/dx, -s dh/dy, 1)`, stored as a normal map file would store it
+/// (`n * 0.5 + 0.5`).
+pub fn procedural_texture(
+    texture: &super::material::ProceduralTexture,
+    size: u32,
+) -> Result<Texture> {
+    let super::material::ProceduralTexture::MarbleNormal {
+        frequency,
+        strength,
+    } = *texture;
+    let n = size.max(1) as usize;
+    let tau = std::f32::consts::TAU;
+    let height = |x: usize, y: usize| {
+        let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
+        let turbulence = 0.35 * (tau * (2.0 * v + 0.6 * (tau * u).sin())).sin()
+            + 0.15 * (tau * (5.0 * (u + v))).sin()
+            + 0.08 * (tau * (11.0 * u - 7.0 * v)).sin();
+        (tau * (frequency * u + turbulence)).sin()
+    };
+    let mut texels = Vec::with_capacity(n * n);
+    for y in 0..n {
+        for x in 0..n {
+            // Central differences per texel, wrapped: the map tiles.
+            let dx = (height((x + 1) % n, y) - height((x + n - 1) % n, y)) * 0.5;
+            let dy = (height(x, (y + 1) % n) - height(x, (y + n - 1) % n)) * 0.5;
+            let normal = glam::Vec3::new(-strength * dx, -strength * dy, 1.0).normalize();
+            let e = normal * 0.5 + glam::Vec3::splat(0.5);
+            texels.push([e.x, e.y, e.z, 1.0]);
+        }
+    }
+    Texture::from_texels(
+        "procedural marble normal map",
+        size.max(1),
+        size.max(1),
+        TextureUsage::Data,
+        texels,
+    )
+}
+
 /// Loads an image file as a linear-float texture with mips; see the module docs for how
 /// `usage` decides sRGB decoding.
 ///
@@ -282,6 +325,28 @@ mod tests {
     use super::*;
     use image::{ImageFormat, Rgb32FImage, RgbImage, Rgba32FImage};
     use std::path::PathBuf;
+
+    #[test]
+    fn procedural_marble_normals_are_unit_tangent_space_and_tile() {
+        let p = crate::scene::material::ProceduralTexture::MarbleNormal {
+            frequency: 18.0,
+            strength: 0.35,
+        };
+        let t = procedural_texture(&p, 64).unwrap();
+        assert_eq!((t.width, t.height), (64, 64));
+        assert_eq!(t.level_count(), 7);
+        let mut tilted = 0;
+        for texel in &t.mips[0] {
+            let n = glam::Vec3::new(texel[0], texel[1], texel[2]) * 2.0 - glam::Vec3::ONE;
+            assert!((n.length() - 1.0).abs() < 1e-4, "{n}");
+            assert!(n.z > 0.0, "points out of the surface: {n}");
+            tilted += usize::from(n.z < 0.999);
+        }
+        assert!(
+            tilted > 64 * 64 / 2,
+            "a normal map that bends almost nothing"
+        );
+    }
 
     fn temp_dir(name: &str) -> PathBuf {
         let dir =

@@ -7,6 +7,7 @@
 pub mod dipole;
 pub mod lighting;
 pub mod raytrace;
+pub mod sss;
 pub mod tonemap;
 pub mod translucency;
 

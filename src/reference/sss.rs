@@ -1,0 +1,192 @@
+//! Screen-space SSS in f64: the diffusion profile applied as a brute-force convolution over
+//! the visible surface, from a read-back G-buffer. It is the reference every screen-space
+//! blur (the control, LCB, LBB) is measured against.
+//!
+//! For each scattering pixel `p` (SSS strength > 0), the outgoing diffuse light is
+//! `sum_q R(|x_p - x_q|) A_q E_q / sum_q R(|x_p - x_q|) A_q` over the scattering pixels `q`,
+//! where `x` is the world position rebuilt from depth, `A_q` the world area the pixel covers,
+//! `E_q` its lit diffuse (ambient + Lambert, as the lighting pass computes it) and
+//! `R(r) = sum_i w_i G(v_i, r)` the profile with `r` in millimetres. The normalisation keeps
+//! energy, as the blurs' normalised weights do; specular is added unblurred. Non-scattering
+//! pixels keep their lighting. Cost is quadratic in scattering pixels: use small frames.
+
+use glam::{DMat4, DVec4};
+
+use super::lighting::{light_incidence, radiance, shininess};
+use super::DVec3;
+use crate::renderer::GBufferReadback;
+use crate::scene::material::SssProfile;
+use crate::scene::Scene;
+
+/// `R(r)` of a profile at `r_mm` millimetres, per channel, with weights normalised per channel
+/// to sum to 1 (as the blurs normalise them).
+pub fn profile_value(profile: &SssProfile, r_mm: f64) -> DVec3 {
+    let total = profile
+        .gaussians
+        .iter()
+        .fold(DVec3::ZERO, |acc, g| acc + g.weight.as_dvec3());
+    let mut sum = DVec3::ZERO;
+    for g in &profile.gaussians {
+        let v = f64::from(g.variance).max(1e-12);
+        let gauss = (-r_mm * r_mm / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v);
+        let w = g.weight.as_dvec3();
+        // A channel whose weights are all zero keeps its light where it is: a delta.
+        sum += DVec3::select(
+            total.cmpgt(DVec3::ZERO),
+            w / total.max(DVec3::splat(1e-300)) * gauss,
+            DVec3::ZERO,
+        );
+    }
+    sum
+}
+
+/// One pixel of the read-back frame, in world space.
+struct SurfacePixel {
+    index: usize,
+    position: DVec3,
+    area: f64,
+    diffuse: DVec3,
+}
+
+/// The reference HDR image (RGB per pixel, rows top first) of the SSS frame whose G-buffer is
+/// `gbuffer` (it must carry the SSS strength), blurring with `profile`.
+pub fn reference_image(
+    scene: &Scene,
+    gbuffer: &GBufferReadback,
+    profile: &SssProfile,
+) -> Vec<DVec3> {
+    let (w, h) = (gbuffer.width as usize, gbuffer.height as usize);
+    let aspect = gbuffer.width as f32 / gbuffer.height.max(1) as f32;
+    let view_proj = scene.camera.projection(aspect) * scene.camera.view();
+    let inv_view_proj: DMat4 = view_proj.as_dmat4().inverse();
+    let eye = scene.camera.eye.as_dvec3();
+    let focal = f64::from(gbuffer.height)
+        / (2.0 * (f64::from(scene.camera.fov_y_degrees).to_radians() * 0.5).tan());
+    let ambient = scene.ambient.as_dvec3();
+    let strength = gbuffer.sss.as_deref().unwrap_or(&[]);
+    let mut out = vec![DVec3::ZERO; w * h];
+    let mut scattering: Vec<SurfacePixel> = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let d = f64::from(gbuffer.depth[i]);
+            if d >= 1.0 {
+                out[i] = scene.sky.as_dvec3();
+                continue;
+            }
+            let ndc = DVec4::new(
+                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
+                (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
+                d,
+                1.0,
+            );
+            let world = inv_view_proj * ndc;
+            let pos = world.truncate() / world.w;
+            let [ar, ag, ab, specular] = gbuffer.gb0[i].map(f64::from);
+            let [nx, ny, nz, roughness] = gbuffer.gb1[i].map(f64::from);
+            let n = DVec3::new(nx, ny, nz);
+            let normal = if n.length_squared() > 1e-12 && n.is_finite() {
+                n.normalize()
+            } else {
+                DVec3::Y
+            };
+            let albedo = DVec3::new(ar, ag, ab);
+            let to_eye = (eye - pos).normalize();
+            let (mut diffuse, mut spec) = (ambient * albedo, DVec3::ZERO);
+            for light in &scene.lights {
+                let (to_light, attenuation) = light_incidence(light, pos);
+                let incident = radiance(light) * (normal.dot(to_light).max(0.0) * attenuation);
+                diffuse += albedo / std::f64::consts::PI * incident;
+                let half = to_light + to_eye;
+                let half = if half.length_squared() > 1e-12 {
+                    half.normalize()
+                } else {
+                    normal
+                };
+                let exponent = shininess(roughness);
+                let lobe = (exponent + 8.0) / (8.0 * std::f64::consts::PI)
+                    * normal.dot(half).max(0.0).powf(exponent);
+                spec += specular * lobe * incident;
+            }
+            out[i] = spec;
+            if strength.get(i).is_some_and(|&s| s > 0.0) {
+                let distance = (pos - eye).length();
+                let cos = normal.dot(to_eye).abs().max(0.1);
+                scattering.push(SurfacePixel {
+                    index: i,
+                    position: pos,
+                    area: (distance / focal).powi(2) / cos,
+                    diffuse,
+                });
+            } else {
+                out[i] += diffuse;
+            }
+        }
+    }
+    let mm_per_unit = 1.0 / f64::from(profile.units_per_mm).max(1e-12);
+    // Each Gaussian is convolved and normalised on its own, then weighted: a Gaussian narrower
+    // than a pixel then keeps its light in the pixel (point-sampling it at its peak and
+    // normalising the whole profile at once would let it swamp the wide ones).
+    let total = profile
+        .gaussians
+        .iter()
+        .fold(DVec3::ZERO, |acc, g| acc + g.weight.as_dvec3());
+    let weights: Vec<DVec3> = profile
+        .gaussians
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            let w = g.weight.as_dvec3();
+            // A channel whose weights are all 0 keeps its light: the first Gaussian takes it.
+            DVec3::select(
+                total.cmpgt(DVec3::ZERO),
+                w / total.max(DVec3::splat(1e-300)),
+                DVec3::splat(if i == 0 { 1.0 } else { 0.0 }),
+            )
+        })
+        .collect();
+    let variances: Vec<f64> = profile
+        .gaussians
+        .iter()
+        .map(|g| f64::from(g.variance).max(1e-12))
+        .collect();
+    let mut sums = vec![(DVec3::ZERO, 0.0f64); variances.len()];
+    for p in &scattering {
+        sums.iter_mut().for_each(|s| *s = (DVec3::ZERO, 0.0));
+        for q in &scattering {
+            let r2 = (p.position - q.position).length_squared() * mm_per_unit * mm_per_unit;
+            for (sum, v) in sums.iter_mut().zip(&variances) {
+                let k = (-r2 / (2.0 * v)).exp() * q.area;
+                sum.0 += k * q.diffuse;
+                sum.1 += k;
+            }
+        }
+        // The pixel itself always contributes (k = area > 0), so no sum is 0.
+        let blurred = sums
+            .iter()
+            .zip(&weights)
+            .fold(DVec3::ZERO, |acc, ((sum, k), w)| {
+                acc + *w * (*sum / k.max(1e-300))
+            });
+        out[p.index] += blurred;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn profile_integrates_to_one_per_channel() {
+        // The 2D integral of each normalised Gaussian is 1, so R integrates to 1.
+        let skin = SssProfile::preset("skin").unwrap();
+        let (mut total, dr) = (DVec3::ZERO, 0.001);
+        let mut r = dr / 2.0;
+        while r < 40.0 {
+            total += profile_value(&skin, r) * (2.0 * std::f64::consts::PI * r * dr);
+            r += dr;
+        }
+        assert!((total - DVec3::ONE).abs().max_element() < 1e-3, "{total}");
+    }
+}

@@ -8,6 +8,7 @@ pub mod builtin;
 pub mod file;
 pub mod generators;
 pub mod inspect;
+pub mod lean;
 pub mod material;
 pub mod mesh;
 pub mod normals;

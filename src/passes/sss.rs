@@ -20,7 +20,6 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::error::VkResultExt;
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
     RenderGraph, ResourceId,
@@ -29,7 +28,7 @@ use crate::scene::material::SssProfile;
 use crate::Result;
 
 use super::deferred::HDR_FORMAT;
-use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
 /// Depth correction of the control blur: a tap whose linear depth differs from the centre's by
@@ -183,17 +182,6 @@ struct BlurConstants {
     weight: [f32; 4],
 }
 
-fn create_sampler(ctx: &PrepareContext<'_>, filter: vk::Filter) -> Result<vk::Sampler> {
-    let info = vk::SamplerCreateInfo::default()
-        .mag_filter(filter)
-        .min_filter(filter)
-        .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
-    // SAFETY: valid device and create info.
-    unsafe { ctx.gpu.device.create_sampler(&info, None) }.vk("vkCreateSampler")
-}
-
 struct BlurPass {
     scene: Option<Arc<SceneGpu>>,
     /// Colour to blur, depth, SSS strength.
@@ -214,8 +202,8 @@ impl PassExec for BlurPass {
         let Some(scene) = &self.scene else {
             return Ok(());
         };
-        self.sampler = create_sampler(ctx, vk::Filter::LINEAR)?;
-        self.nearest = create_sampler(ctx, vk::Filter::NEAREST)?;
+        self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
+        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
         let [color, depth, strength] = self.inputs;
         let accumulate: &[(&str, &str)] = &[("LUCENT_SSS_ACCUMULATE", "1")];
@@ -295,7 +283,7 @@ struct CombinePass {
 
 impl PassExec for CombinePass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.sampler = create_sampler(ctx, vk::Filter::NEAREST)?;
+        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
         let mut bindings = vec![Binding::Uniform(self.scene.frame_uniforms)];
         bindings.extend(

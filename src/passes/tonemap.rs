@@ -8,14 +8,13 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::error::VkResultExt;
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
     RenderGraph, ResourceId,
 };
 use crate::Result;
 
-use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use super::SceneGpu;
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
@@ -58,15 +57,7 @@ struct TonemapPass {
 
 impl PassExec for TonemapPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let info = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::NEAREST)
-            .min_filter(vk::Filter::NEAREST)
-            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
-        // SAFETY: valid device and create info.
-        self.sampler =
-            unsafe { ctx.gpu.device.create_sampler(&info, None) }.vk("vkCreateSampler")?;
+        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &[

@@ -7,6 +7,19 @@ use crate::error::VkResultExt;
 use crate::graph::PrepareContext;
 use crate::Result;
 
+/// A sampler that clamps to the edge with `filter` for magnification and minification (what the
+/// fullscreen passes sample their inputs with).
+pub fn clamp_sampler(ctx: &PrepareContext<'_>, filter: vk::Filter) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(filter)
+        .min_filter(filter)
+        .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+    // SAFETY: valid device and create info.
+    unsafe { ctx.gpu.device.create_sampler(&info, None) }.vk("vkCreateSampler")
+}
+
 /// What one descriptor binding points at.
 pub enum Binding {
     /// A uniform buffer (whole range).

@@ -95,6 +95,20 @@ pub struct FrameSettings {
     /// Run the SSS blurs only over the screen rectangles of objects with a profile (off: the
     /// whole screen, for A/B comparisons).
     pub sss_tiles: bool,
+    /// Robustness tests: the lighting pass writes this value into one pixel, so tests can
+    /// prove that later passes keep it from spreading.
+    pub fault: Option<Fault>,
+}
+
+/// A value injected into one pixel of the lit image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fault {
+    /// Column.
+    pub x: u32,
+    /// Row.
+    pub y: u32,
+    /// NaN (true) or +Inf (false).
+    pub nan: bool,
 }
 
 impl FrameSettings {
@@ -110,6 +124,7 @@ impl FrameSettings {
             gbuffer: GBufferPrecision::Compact,
             force_grayscale: false,
             sss_tiles: true,
+            fault: None,
         }
     }
 }
@@ -172,6 +187,7 @@ impl FrameFeatures {
                 }),
             sss: self.sss.is_some(),
             normal_maps: self.normal_maps,
+            fault_injection: settings.fault.is_some(),
         }
     }
 }
@@ -270,6 +286,7 @@ pub struct FrameUniforms {
     exposure: [f32; 4],
     light_count: [i32; 4],
     camera: [f32; 4],
+    fault: [i32; 4],
     lights: [[[f32; 4]; 4]; MAX_LIGHTS],
 }
 
@@ -332,6 +349,7 @@ impl FrameUniforms {
                 height as f32 / (2.0 * (scene.camera.fov_y_degrees.to_radians() * 0.5).tan()),
                 0.0,
             ],
+            fault: [0; 4],
             lights,
         }
     }
@@ -430,7 +448,10 @@ impl Renderer {
     /// Writes the scene's camera and lights into the frame uniforms. Call between frames: the
     /// GPU must not be reading them (every frame is waited for before the next update).
     pub fn update(&mut self, scene: &Scene) -> Result<()> {
-        let uniforms = FrameUniforms::new(scene, self.settings.width, self.settings.height);
+        let mut uniforms = FrameUniforms::new(scene, self.settings.width, self.settings.height);
+        if let Some(f) = self.settings.fault {
+            uniforms.fault = [f.x as i32, f.y as i32, if f.nan { 1 } else { 2 }, 0];
+        }
         let mapped = self
             .uniforms
             .as_mut()

@@ -254,3 +254,57 @@ fn control_is_closer_to_the_brute_force_reference_than_no_blur() {
     }
     test.finish();
 }
+
+#[test]
+fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
+    use lucent::renderer::Fault;
+    let test = TestGpu::new();
+    let scene = scene::load_scene("skin").unwrap();
+    let clean = render(&test, &scene, settings(Technique::Control));
+    let clean_hdr = clean.hdr.unwrap();
+    let strength = clean.gbuffer.unwrap().sss.unwrap();
+    // A scattering pixel in the middle of a sphere, so the blur's taps all around read it.
+    let (w, h) = (160usize, 120usize);
+    let target = (0..w * h)
+        .filter(|&i| strength[i] > 0.0)
+        .min_by_key(|&i| {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            (x - w as i64 / 2).pow(2) + (y - 60).pow(2)
+        })
+        .unwrap();
+    for nan in [true, false] {
+        let fault = Fault {
+            x: (target % w) as u32,
+            y: (target / w) as u32,
+            nan,
+        };
+        let s = FrameSettings {
+            fault: Some(fault),
+            ..settings(Technique::Control)
+        };
+        let hdr = render(&test, &scene, s).hdr.unwrap();
+        let bad = hdr.iter().filter(|v| !v.is_finite()).count();
+        assert_eq!(bad, 0, "{fault:?}: {bad} non-finite values in the output");
+        // Only the blur's reach around the pixel may differ from the clean frame.
+        let far_changed = (0..w * h)
+            .filter(|&i| {
+                let (dx, dy) = (
+                    (i % w) as i64 - (target % w) as i64,
+                    (i / w) as i64 - (target / w) as i64,
+                );
+                dx.abs() > 8 || dy.abs() > 8
+            })
+            .filter(|&i| (0..3).any(|c| hdr[i * 4 + c] != clean_hdr[i * 4 + c]))
+            .count();
+        assert_eq!(
+            far_changed, 0,
+            "{fault:?}: pixels beyond the blur's reach changed"
+        );
+        // And the fault did land: the poisoned pixel itself differs from the clean frame.
+        assert!(
+            (0..3).any(|c| hdr[target * 4 + c] != clean_hdr[target * 4 + c]),
+            "{fault:?}: the injected pixel is unchanged"
+        );
+    }
+    test.finish();
+}

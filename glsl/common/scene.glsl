@@ -25,6 +25,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 exposure;        // x: exposure multiplier applied before tonemapping
     ivec4 light_count;    // x
     vec4 camera;          // x: near, y: far, z: focal length in pixels (height / 2 tan(fov / 2))
+    ivec4 fault;          // robustness tests (LUCENT_FAULT_INJECTION): x, y pixel; z 1 NaN, 2 +Inf
     Light lights[MAX_LIGHTS];
 } frame;
 

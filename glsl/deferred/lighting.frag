@@ -4,6 +4,7 @@
 // permutation: LUCENT_TRANSLUCENCY LUCENT_POW_MODES=2 LUCENT_SINGLE_MATERIAL
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_FAULT_INJECTION
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
@@ -85,4 +86,11 @@ void main() {
 #endif
     // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).
     out_color = vec4(min(color, vec3(65504.0)), 1.0);
+#ifdef LUCENT_FAULT_INJECTION
+    // Robustness tests: one poisoned pixel, to prove later passes keep it from spreading.
+    if (all(equal(ivec2(gl_FragCoord.xy), frame.fault.xy)) && frame.fault.z != 0) {
+        float bad = uintBitsToFloat(frame.fault.z == 1 ? 0x7fc00000u : 0x7f800000u);
+        out_color = vec4(vec3(bad), 1.0);
+    }
+#endif
 }

@@ -222,6 +222,7 @@ impl FrameArgs {
             gbuffer: self.gbuffer,
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,
+            fault: None,
         })
     }
 }

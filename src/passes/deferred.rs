@@ -77,6 +77,8 @@ pub struct GBufferLayout {
     pub sss: bool,
     /// Some object has a normal map: the G-buffer pass reads UVs and tangents and samples it.
     pub normal_maps: bool,
+    /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
+    pub fault_injection: bool,
 }
 
 /// How a frame's translucency is stored and shaded.
@@ -440,11 +442,17 @@ impl PassExec for LightingPass {
             bindings.push(Binding::InputAttachment(views[gb2], color_layout));
             bindings.push(Binding::Uniform(t.materials.buffer));
         }
-        let split: &[(&str, &str)] = &[("LUCENT_SPLIT_SPECULAR", "1")];
+        let mut plain_defines: Vec<(&str, &str)> = Vec::new();
+        if self.layout.sss {
+            plain_defines.push(("LUCENT_SPLIT_SPECULAR", "1"));
+        }
+        if self.layout.fault_injection {
+            plain_defines.push(("LUCENT_FAULT_INJECTION", "1"));
+        }
         let plain = GraphicsPipelineDesc {
             vertex: "fullscreen.vert",
             fragment: "deferred/lighting.frag",
-            defines: if self.layout.sss { split } else { &[] },
+            defines: &plain_defines,
             vertex_input: VertexInput::None,
             depth_test: false,
             cull_back: false,

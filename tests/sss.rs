@@ -308,3 +308,44 @@ fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
     }
     test.finish();
 }
+
+#[test]
+fn edge_quality_of_the_control_is_measured_on_the_edges_scene() {
+    let test = TestGpu::new();
+    let scene = scene::load_scene("edges").unwrap();
+    let s = FrameSettings {
+        technique: Technique::Control,
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(128, 96)
+    };
+    let control = render(&test, &scene, s);
+    let plain = render(
+        &test,
+        &scene,
+        FrameSettings {
+            technique: Technique::None,
+            ..s
+        },
+    );
+    let gbuffer = control.gbuffer.as_ref().unwrap();
+    let profile = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+    let reference = lucent::reference::sss::reference_image(&scene, gbuffer, &profile);
+    let strength = gbuffer.sss.as_ref().unwrap();
+    let m = lucent::reference::sss::edge_metrics(
+        128,
+        strength,
+        plain.hdr.as_ref().unwrap(),
+        control.hdr.as_ref().unwrap(),
+        &reference,
+        2,
+    );
+    eprintln!("edges, control: {m:?}");
+    assert!(m.edge_pixels > 100 && m.interior_pixels > 100, "{m:?}");
+    // The control writes the blur only where the pixel scatters: no halo by construction.
+    assert_eq!(m.halo_pixels, 0, "{m:?}");
+    assert!(m.edge_error.is_finite() && m.interior_error.is_finite());
+    // Bleeding: the silhouette band is further from the reference than the interior.
+    assert!(m.edge_error > m.interior_error, "{m:?}");
+    test.finish();
+}

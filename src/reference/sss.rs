@@ -173,6 +173,84 @@ pub fn reference_image(
     out
 }
 
+/// Edge quality of a screen-space SSS image (the thesis, section 3.1: halos and background
+/// bleeding), against the same frame without SSS and against [`reference_image`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeMetrics {
+    /// Non-scattering pixels the SSS passes changed (by more than fp16 rounding).
+    pub halo_pixels: usize,
+    /// Largest change of a non-scattering pixel (linear HDR, any channel).
+    pub halo_max: f64,
+    /// Scattering pixels within the band of a non-scattering one (the silhouette, where
+    /// background light bleeds in).
+    pub edge_pixels: usize,
+    /// Mean |SSS - reference| over the edge band (per channel).
+    pub edge_error: f64,
+    /// Scattering pixels farther in.
+    pub interior_pixels: usize,
+    /// Mean |SSS - reference| over the interior.
+    pub interior_error: f64,
+}
+
+/// Measures halo and bleed: `strength` is the frame's SSS strength per pixel, `plain` and `sss`
+/// its HDR (RGBA) without and with SSS, `reference` the f64 reference; the edge band is `band`
+/// pixels wide.
+pub fn edge_metrics(
+    width: usize,
+    strength: &[f32],
+    plain: &[f32],
+    sss: &[f32],
+    reference: &[DVec3],
+    band: i64,
+) -> EdgeMetrics {
+    let height = strength.len() / width.max(1);
+    let scatters = |x: i64, y: i64| {
+        (0..width as i64).contains(&x)
+            && (0..height as i64).contains(&y)
+            && strength[y as usize * width + x as usize] > 0.0
+    };
+    let mut m = EdgeMetrics {
+        halo_pixels: 0,
+        halo_max: 0.0,
+        edge_pixels: 0,
+        edge_error: 0.0,
+        interior_pixels: 0,
+        interior_error: 0.0,
+    };
+    for i in 0..strength.len() {
+        let (x, y) = ((i % width) as i64, (i / width) as i64);
+        let rgb = |img: &[f32]| {
+            DVec3::new(
+                img[i * 4].into(),
+                img[i * 4 + 1].into(),
+                img[i * 4 + 2].into(),
+            )
+        };
+        if strength[i] <= 0.0 {
+            let (a, b) = (rgb(plain), rgb(sss));
+            let change = (a - b).abs().max_element();
+            // fp16 rounding of diffuse and specular stored apart is not a halo.
+            if change > 2e-3 * a.abs().max_element().max(1.0) {
+                m.halo_pixels += 1;
+            }
+            m.halo_max = m.halo_max.max(change);
+            continue;
+        }
+        let error = (rgb(sss) - reference[i]).abs().element_sum() / 3.0;
+        let near_edge = (-band..=band).any(|dy| (-band..=band).any(|dx| !scatters(x + dx, y + dy)));
+        if near_edge {
+            m.edge_pixels += 1;
+            m.edge_error += error;
+        } else {
+            m.interior_pixels += 1;
+            m.interior_error += error;
+        }
+    }
+    m.edge_error /= m.edge_pixels.max(1) as f64;
+    m.interior_error /= m.interior_pixels.max(1) as f64;
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -28,6 +28,10 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ("teapot", "the Utah teapot in normal-mapped marble (SSS profile)"),
     ("skin", "spheres with d'Eon's six-Gaussian skin profile"),
     (
+        "edges",
+        "SSS edge quality: a skin sphere before a bright wall, a thin skin slab before a dark pillar",
+    ),
+    (
         "layered",
         "Li et al.'s Table 1 layered materials on five spheres",
     ),
@@ -65,6 +69,7 @@ pub fn builtin(name: &str) -> Result<Scene> {
         }
         "teapot" => teapot(),
         "skin" => skin(),
+        "edges" => edges(),
         "layered" => layered(),
         "dynamic" => dynamic(),
         "scaling" => {
@@ -341,6 +346,71 @@ fn teapot() -> Result<Scene> {
 }
 
 /// Three spheres with d'Eon's skin profile.
+/// Where screen-space SSS goes wrong (thesis section 3.1): a skin sphere in front of a bright
+/// wall (halo and background bleeding at its silhouette) and a thin slab of skin in front of a
+/// dark pillar (the pillar seen around and through thin parts). The profile is four times as
+/// wide as the preset so the blur spans pixels at test sizes.
+fn edges() -> Result<Scene> {
+    let mut s = base_scene(
+        "edges",
+        Some("control"),
+        camera(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 0.9, 0.0)),
+    );
+    s.sky = Vec3::new(0.05, 0.05, 0.06);
+    let wall = s.add_mesh(Mesh::generate(Shape::Plane { half_size: 3.0 }, 1, 1));
+    s.add(
+        wall,
+        Mat4::from_rotation_translation(
+            glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+            Vec3::new(0.0, 1.0, -2.0),
+        ),
+        Material::opaque("bright wall", Vec3::new(0.95, 0.95, 0.9), 0.0, 1.0),
+    );
+    let mut skin = Material::opaque("skin", Vec3::new(0.85, 0.62, 0.52), 0.35, 0.45);
+    let mut profile = SssProfile::preset("skin")?;
+    profile.units_per_mm *= 4.0;
+    skin.sss = Some(profile);
+    let sphere = s.add_mesh(generators::generate(Generator::Icosphere, 4)?);
+    s.add(
+        sphere,
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.6),
+            glam::Quat::IDENTITY,
+            Vec3::new(-0.9, 1.0, 0.0),
+        ),
+        skin.clone(),
+    );
+    let cube = s.add_mesh(generators::generate(Generator::Cube, 2)?);
+    s.add(
+        cube,
+        Mat4::from_scale_rotation_translation(
+            Vec3::new(0.35, 1.6, 0.35),
+            glam::Quat::IDENTITY,
+            Vec3::new(1.0, 0.8, -1.0),
+        ),
+        Material::opaque("dark pillar", Vec3::new(0.05, 0.05, 0.06), 0.1, 0.6),
+    );
+    s.add(
+        cube,
+        Mat4::from_scale_rotation_translation(
+            Vec3::new(0.9, 1.1, 0.04),
+            glam::Quat::from_rotation_y(0.3),
+            Vec3::new(0.9, 1.0, 0.3),
+        ),
+        skin,
+    );
+    s.lights = vec![
+        Light::point(Vec3::new(0.5, 2.5, 3.0), Vec3::ONE, 25.0, 15.0),
+        Light::point(
+            Vec3::new(0.0, 2.0, -1.2),
+            Vec3::new(1.0, 0.95, 0.9),
+            12.0,
+            6.0,
+        ),
+    ];
+    Ok(s)
+}
+
 fn skin() -> Result<Scene> {
     let mut s = base_scene(
         "skin",

@@ -346,7 +346,7 @@ impl FrameUniforms {
             camera: [
                 scene.camera.near,
                 scene.camera.far,
-                height as f32 / (2.0 * (scene.camera.fov_y_degrees.to_radians() * 0.5).tan()),
+                scene.camera.focal_px(height),
                 0.0,
             ],
             fault: [0; 4],

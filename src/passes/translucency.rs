@@ -208,7 +208,7 @@ pub fn object_tiles(
     let mut tiles = vec![false; (columns * rows) as usize];
     let aspect = width as f32 / height.max(1) as f32;
     let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-    let focal_px = height as f32 / (2.0 * (scene.camera.fov_y_degrees.to_radians() * 0.5).tan());
+    let focal_px = scene.camera.focal_px(height);
     let max_margin = 0.25 * width.max(height) as f32;
     for object in &scene.objects {
         let Some(reach_world) = reach(object) else {

@@ -52,8 +52,21 @@ pub fn shade_direct(
     to_eye: DVec3,
     light: &Light,
 ) -> DVec3 {
+    let (diffuse, specular) = shade_direct_split(material, normal, pos, to_eye, light);
+    diffuse + specular
+}
+
+/// [`shade_direct`]'s diffuse and specular parts apart (the SSS frames' lighting pass writes
+/// them to separate targets; only diffuse is blurred).
+pub fn shade_direct_split(
+    material: &Material,
+    normal: DVec3,
+    pos: DVec3,
+    to_eye: DVec3,
+    light: &Light,
+) -> (DVec3, DVec3) {
     let (to_light, attenuation) = light_incidence(light, pos);
-    let n_dot_l = normal.dot(to_light).max(0.0);
+    let incident = radiance(light) * (normal.dot(to_light).max(0.0) * attenuation);
     let h = to_light + to_eye;
     let h = if h.length_squared() > 1e-12 {
         h.normalize()
@@ -62,9 +75,8 @@ pub fn shade_direct(
     };
     let n = shininess(f64::from(material.roughness));
     let spec = (n + 8.0) / (8.0 * std::f64::consts::PI) * normal.dot(h).max(0.0).powf(n);
-    let albedo = material.albedo.as_dvec3();
-    let brdf = albedo / std::f64::consts::PI + DVec3::splat(f64::from(material.specular) * spec);
-    brdf * radiance(light) * (n_dot_l * attenuation)
+    let diffuse = material.albedo.as_dvec3() / std::f64::consts::PI * incident;
+    (diffuse, f64::from(material.specular) * spec * incident)
 }
 
 /// Ambient plus every light, as the deferred lighting pass computes it.

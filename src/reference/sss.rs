@@ -10,34 +10,44 @@
 //! energy, as the blurs' normalised weights do; specular is added unblurred. Non-scattering
 //! pixels keep their lighting. Cost is quadratic in scattering pixels: use small frames.
 
-use glam::{DMat4, DVec4};
-
-use super::lighting::{light_incidence, radiance, shininess};
-use super::DVec3;
+use super::lighting::shade_direct_split;
+use super::{gbuffer_pixels, DVec3};
 use crate::renderer::GBufferReadback;
 use crate::scene::material::SssProfile;
 use crate::scene::Scene;
 
-/// `R(r)` of a profile at `r_mm` millimetres, per channel, with weights normalised per channel
-/// to sum to 1 (as the blurs normalise them).
-pub fn profile_value(profile: &SssProfile, r_mm: f64) -> DVec3 {
+/// Each Gaussian's weight, normalised per channel so the weights sum to 1 (as the blurs
+/// normalise them); a channel whose weights are all 0 keeps its light where it is, which the
+/// first Gaussian then takes whole.
+pub fn normalized_weights(profile: &SssProfile) -> Vec<DVec3> {
     let total = profile
         .gaussians
         .iter()
         .fold(DVec3::ZERO, |acc, g| acc + g.weight.as_dvec3());
-    let mut sum = DVec3::ZERO;
-    for g in &profile.gaussians {
-        let v = f64::from(g.variance).max(1e-12);
-        let gauss = (-r_mm * r_mm / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v);
-        let w = g.weight.as_dvec3();
-        // A channel whose weights are all zero keeps its light where it is: a delta.
-        sum += DVec3::select(
-            total.cmpgt(DVec3::ZERO),
-            w / total.max(DVec3::splat(1e-300)) * gauss,
-            DVec3::ZERO,
-        );
-    }
-    sum
+    profile
+        .gaussians
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            DVec3::select(
+                total.cmpgt(DVec3::ZERO),
+                g.weight.as_dvec3() / total.max(DVec3::splat(1e-300)),
+                DVec3::splat(if i == 0 { 1.0 } else { 0.0 }),
+            )
+        })
+        .collect()
+}
+
+/// `R(r)` of a profile at `r_mm` millimetres, per channel, with [`normalized_weights`].
+pub fn profile_value(profile: &SssProfile, r_mm: f64) -> DVec3 {
+    profile
+        .gaussians
+        .iter()
+        .zip(normalized_weights(profile))
+        .fold(DVec3::ZERO, |sum, (g, w)| {
+            let v = f64::from(g.variance).max(1e-12);
+            sum + w * ((-r_mm * r_mm / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v))
+        })
 }
 
 /// One pixel of the read-back frame, in world space.
@@ -55,96 +65,43 @@ pub fn reference_image(
     gbuffer: &GBufferReadback,
     profile: &SssProfile,
 ) -> Vec<DVec3> {
-    let (w, h) = (gbuffer.width as usize, gbuffer.height as usize);
-    let aspect = gbuffer.width as f32 / gbuffer.height.max(1) as f32;
-    let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-    let inv_view_proj: DMat4 = view_proj.as_dmat4().inverse();
     let eye = scene.camera.eye.as_dvec3();
-    let focal = f64::from(gbuffer.height)
-        / (2.0 * (f64::from(scene.camera.fov_y_degrees).to_radians() * 0.5).tan());
+    let focal = f64::from(scene.camera.focal_px(gbuffer.height));
     let ambient = scene.ambient.as_dvec3();
     let strength = gbuffer.sss.as_deref().unwrap_or(&[]);
-    let mut out = vec![DVec3::ZERO; w * h];
+    let pixels = gbuffer_pixels(gbuffer, &scene.camera);
+    let mut out = vec![DVec3::ZERO; pixels.len()];
     let mut scattering: Vec<SurfacePixel> = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let d = f64::from(gbuffer.depth[i]);
-            if d >= 1.0 {
-                out[i] = scene.sky.as_dvec3();
-                continue;
-            }
-            let ndc = DVec4::new(
-                (x as f64 + 0.5) / w as f64 * 2.0 - 1.0,
-                (y as f64 + 0.5) / h as f64 * 2.0 - 1.0,
-                d,
-                1.0,
-            );
-            let world = inv_view_proj * ndc;
-            let pos = world.truncate() / world.w;
-            let [ar, ag, ab, specular] = gbuffer.gb0[i].map(f64::from);
-            let [nx, ny, nz, roughness] = gbuffer.gb1[i].map(f64::from);
-            let n = DVec3::new(nx, ny, nz);
-            let normal = if n.length_squared() > 1e-12 && n.is_finite() {
-                n.normalize()
-            } else {
-                DVec3::Y
-            };
-            let albedo = DVec3::new(ar, ag, ab);
-            let to_eye = (eye - pos).normalize();
-            let (mut diffuse, mut spec) = (ambient * albedo, DVec3::ZERO);
-            for light in &scene.lights {
-                let (to_light, attenuation) = light_incidence(light, pos);
-                let incident = radiance(light) * (normal.dot(to_light).max(0.0) * attenuation);
-                diffuse += albedo / std::f64::consts::PI * incident;
-                let half = to_light + to_eye;
-                let half = if half.length_squared() > 1e-12 {
-                    half.normalize()
-                } else {
-                    normal
-                };
-                let exponent = shininess(roughness);
-                let lobe = (exponent + 8.0) / (8.0 * std::f64::consts::PI)
-                    * normal.dot(half).max(0.0).powf(exponent);
-                spec += specular * lobe * incident;
-            }
-            out[i] = spec;
-            if strength.get(i).is_some_and(|&s| s > 0.0) {
-                let distance = (pos - eye).length();
-                let cos = normal.dot(to_eye).abs().max(0.1);
-                scattering.push(SurfacePixel {
-                    index: i,
-                    position: pos,
-                    area: (distance / focal).powi(2) / cos,
-                    diffuse,
-                });
-            } else {
-                out[i] += diffuse;
-            }
+    for (i, pixel) in pixels.iter().enumerate() {
+        let Some(p) = pixel else {
+            out[i] = scene.sky.as_dvec3();
+            continue;
+        };
+        let to_eye = (eye - p.position).normalize();
+        let mut diffuse = ambient * p.material.albedo.as_dvec3();
+        for light in &scene.lights {
+            let (d, s) = shade_direct_split(&p.material, p.normal, p.position, to_eye, light);
+            diffuse += d;
+            out[i] += s;
+        }
+        if strength.get(i).is_some_and(|&s| s > 0.0) {
+            let distance = (p.position - eye).length();
+            let cos = p.normal.dot(to_eye).abs().max(0.1);
+            scattering.push(SurfacePixel {
+                index: i,
+                position: p.position,
+                area: (distance / focal).powi(2) / cos,
+                diffuse,
+            });
+        } else {
+            out[i] += diffuse;
         }
     }
     let mm_per_unit = 1.0 / f64::from(profile.units_per_mm).max(1e-12);
     // Each Gaussian is convolved and normalised on its own, then weighted: a Gaussian narrower
     // than a pixel then keeps its light in the pixel (point-sampling it at its peak and
     // normalising the whole profile at once would let it swamp the wide ones).
-    let total = profile
-        .gaussians
-        .iter()
-        .fold(DVec3::ZERO, |acc, g| acc + g.weight.as_dvec3());
-    let weights: Vec<DVec3> = profile
-        .gaussians
-        .iter()
-        .enumerate()
-        .map(|(i, g)| {
-            let w = g.weight.as_dvec3();
-            // A channel whose weights are all 0 keeps its light: the first Gaussian takes it.
-            DVec3::select(
-                total.cmpgt(DVec3::ZERO),
-                w / total.max(DVec3::splat(1e-300)),
-                DVec3::splat(if i == 0 { 1.0 } else { 0.0 }),
-            )
-        })
-        .collect();
+    let weights = normalized_weights(profile);
     let variances: Vec<f64> = profile
         .gaussians
         .iter()

@@ -2,13 +2,11 @@
 //! whole deferred lighting pass evaluated from a read-back G-buffer (twin of
 //! glsl/deferred/lighting.frag), so a test can prove every lit pixel right.
 
-use glam::{DMat4, DVec4};
-
 use super::lighting::{light_incidence, radiance, shade_direct};
-use super::DVec3;
+use super::{gbuffer_pixels, DVec3};
 use crate::passes::translucency::{MaterialRow, ThicknessPacking};
 use crate::renderer::GBufferReadback;
-use crate::scene::{Light, Material, Scene};
+use crate::scene::{Light, Scene};
 
 /// `x^n` for `x` in [0, 1]: exact `pow` (mode 0) or the spherical-Gaussian `exp2(n x - n)`
 /// (mode 1). The base is clamped as in the shader so `n = 0` gives 1, never NaN.
@@ -41,17 +39,6 @@ pub fn translucency_term(
     albedo * light_radiance * (attenuation * (lobe + ambient)) * thickness
 }
 
-/// A G-buffer normal as the shader sanitises it: unit length, +Y when degenerate.
-fn sanitize_normal(n: DVec3) -> DVec3 {
-    let len2 = n.length_squared();
-    // NaN fails both tests, like the shader's `!(len2 > 1e-12)`.
-    if !(len2.is_finite() && len2 > 1e-12) {
-        DVec3::Y
-    } else {
-        n / len2.sqrt()
-    }
-}
-
 /// What the lighting pass needs besides the G-buffer.
 pub struct LightingInputs<'a> {
     /// The scene (camera, lights, ambient, sky).
@@ -63,37 +50,20 @@ pub struct LightingInputs<'a> {
 /// Evaluates the deferred lighting pass in f64 for every pixel of `gbuffer`: linear HDR RGB per
 /// pixel, rows top first, clamped to the fp16 maximum as the shader does.
 pub fn shade_gbuffer(gbuffer: &GBufferReadback, inputs: &LightingInputs<'_>) -> Vec<DVec3> {
-    let (w, h) = (gbuffer.width as usize, gbuffer.height as usize);
     let scene = inputs.scene;
-    let aspect = gbuffer.width as f32 / gbuffer.height.max(1) as f32;
-    // The shader's matrix is the f32 product; invert it in f64.
-    let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-    let inv_view_proj: DMat4 = view_proj.as_dmat4().inverse();
     let eye = scene.camera.eye.as_dvec3();
     let ambient = scene.ambient.as_dvec3();
-    let mut out = Vec::with_capacity(w * h);
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let d = f64::from(gbuffer.depth[i]);
-            if d >= 1.0 {
-                out.push(scene.sky.as_dvec3());
-                continue;
-            }
-            let ndc_x = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
-            let ndc_y = (y as f64 + 0.5) / h as f64 * 2.0 - 1.0;
-            let world = inv_view_proj * DVec4::new(ndc_x, ndc_y, d, 1.0);
-            let pos = world.truncate() / world.w;
-            let [ar, ag, ab, specular] = gbuffer.gb0[i];
-            let [nx, ny, nz, roughness] = gbuffer.gb1[i];
-            let normal = sanitize_normal(DVec3::new(nx.into(), ny.into(), nz.into()));
-            let albedo_f32 = glam::Vec3::new(ar, ag, ab);
-            let material = Material::opaque("gbuffer", albedo_f32, specular, roughness);
-            let albedo = albedo_f32.as_dvec3();
-            let to_eye = (eye - pos).normalize();
+    gbuffer_pixels(gbuffer, &scene.camera)
+        .into_iter()
+        .map(|pixel| {
+            let Some(p) = pixel else {
+                return scene.sky.as_dvec3();
+            };
+            let albedo = p.material.albedo.as_dvec3();
+            let to_eye = (eye - p.position).normalize();
             let mut color = ambient * albedo;
             let translucent = inputs.translucency.and_then(|(rows, packing)| {
-                let t = gbuffer.gb2.as_ref()?[i];
+                let t = gbuffer.gb2.as_ref()?[p.index];
                 let (thickness, id) = match packing {
                     ThicknessPacking::Colored => {
                         (DVec3::new(t[0].into(), t[1].into(), t[2].into()), t[3])
@@ -104,15 +74,16 @@ pub fn shade_gbuffer(gbuffer: &GBufferReadback, inputs: &LightingInputs<'_>) -> 
                 (id > 0).then(|| (rows.get(id - 1).copied().unwrap_or([0.0; 4]), thickness))
             });
             for light in &scene.lights {
-                color += shade_direct(&material, normal, pos, to_eye, light);
+                color += shade_direct(&p.material, p.normal, p.position, to_eye, light);
                 if let Some((row, thickness)) = translucent {
-                    color += light_translucency(albedo, normal, pos, to_eye, light, row, thickness);
+                    color += light_translucency(
+                        albedo, p.normal, p.position, to_eye, light, row, thickness,
+                    );
                 }
             }
-            out.push(color.min(DVec3::splat(65504.0)));
-        }
-    }
-    out
+            color.min(DVec3::splat(65504.0))
+        })
+        .collect()
 }
 
 /// The translucency of one light at `pos` (direction and attenuation as for diffuse).

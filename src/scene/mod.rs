@@ -43,6 +43,12 @@ impl Camera {
         Mat4::look_at_rh(self.eye, self.target, Vec3::Y)
     }
 
+    /// Focal length in pixels of an image `height` pixels tall: how many pixels one world unit
+    /// spans at one unit of view depth.
+    pub fn focal_px(&self, height: u32) -> f32 {
+        height as f32 / (2.0 * (self.fov_y_degrees.to_radians() * 0.5).tan())
+    }
+
     /// View → Vulkan clip space (depth 0..1, y down in NDC flipped so +y is up on screen).
     pub fn projection(&self, aspect: f32) -> Mat4 {
         let mut p =

@@ -129,20 +129,21 @@ pub fn control_passes(
         pass.sample(depth)
             .sample(strength)
             .color(&mut temp, LoadOp::DontCare);
-        let blur = |direction: [f32; 2], accumulate: bool, source: ResourceId| BlurPass {
-            scene: scene.cloned(),
-            inputs: [source, depth.id(), strength.id()],
-            constants: BlurConstants {
-                step: [direction[0], direction[1], step.sigma, DEPTH_CORRECTION],
-                weight: [step.weight[0], step.weight[1], step.weight[2], 0.0],
-            },
-            accumulate,
-            sampler: vk::Sampler::null(),
-            nearest: vk::Sampler::null(),
-            pipeline: None,
-        };
+        let blur =
+            |scene: &Arc<SceneGpu>, direction: [f32; 2], accumulate: bool, source| BlurPass {
+                scene: scene.clone(),
+                inputs: [source, depth.id(), strength.id()],
+                constants: BlurConstants {
+                    step: [direction[0], direction[1], step.sigma, DEPTH_CORRECTION],
+                    weight: [step.weight[0], step.weight[1], step.weight[2], 0.0],
+                },
+                accumulate,
+                sampler: vk::Sampler::null(),
+                nearest: vk::Sampler::null(),
+                pipeline: None,
+            };
         match scene {
-            Some(_) => pass.execute(blur([1.0, 0.0], false, source)),
+            Some(scene) => pass.execute(blur(scene, [1.0, 0.0], false, source)),
             None => pass.finish(),
         }
         // Vertical: back into the current result, and its weighted share into the sum.
@@ -160,7 +161,7 @@ pub fn control_passes(
                 },
             );
         match scene {
-            Some(_) => pass.execute(blur([0.0, 1.0], true, temp.id())),
+            Some(scene) => pass.execute(blur(scene, [0.0, 1.0], true, temp.id())),
             None => pass.finish(),
         }
     }
@@ -192,7 +193,7 @@ struct BlurConstants {
 }
 
 struct BlurPass {
-    scene: Option<Arc<SceneGpu>>,
+    scene: Arc<SceneGpu>,
     /// Colour to blur, depth, SSS strength.
     inputs: [ResourceId; 3],
     constants: BlurConstants,
@@ -208,9 +209,7 @@ struct BlurPass {
 
 impl PassExec for BlurPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let Some(scene) = &self.scene else {
-            return Ok(());
-        };
+        let scene = &self.scene;
         self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
         self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
@@ -256,12 +255,12 @@ impl PassExec for BlurPass {
                 bytemuck::bytes_of(&self.constants),
             );
         }
-        let tiles = self.scene.as_ref().and_then(|s| {
-            s.sss_tiles
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .clone()
-        });
+        let tiles = self
+            .scene
+            .sss_tiles
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
         match tiles {
             // Only where objects with a profile (and their blur's reach) can be: every pixel a
             // tap of a scattering pixel reads is written; the rest is never read.

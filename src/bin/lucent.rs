@@ -285,22 +285,30 @@ fn with_renderer(
 ) -> Result<()> {
     let scene = scene::load_scene(&frame.scene)?;
     let settings = frame.settings(export_hdr)?;
-    let session = Session::new(gpu_args)?;
-    let result = Renderer::new(
-        &session.gpu,
-        &session.shaders,
-        &session.pipeline_cache,
-        &scene,
-        settings,
-    )
-    .and_then(|renderer| {
-        let worked = work(&session, &renderer);
+    with_session(gpu_args, |session| {
+        let renderer = Renderer::new(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            &scene,
+            settings,
+        )?;
+        let worked = work(session, &renderer);
         let idle = session.gpu.wait_idle();
         renderer.destroy(&session.gpu);
         worked.and(idle)
-    });
+    })
+}
+
+/// Opens a session, runs `work` with it, and closes it whatever `work` returned; `work`'s error
+/// comes first, then validation errors fail the command.
+fn with_session<T>(gpu_args: &GpuArgs, work: impl FnOnce(&Session) -> Result<T>) -> Result<T> {
+    let session = Session::new(gpu_args)?;
+    let result = work(&session);
     let finished = session.finish();
-    result.and(finished)
+    let value = result?;
+    finished?;
+    Ok(value)
 }
 
 fn render(
@@ -469,20 +477,18 @@ fn sweep_command(
             "sweep: unknown technique '{technique}'; available: translucency"
         )));
     }
-    let session = Session::new(gpu_args)?;
     let cases = lucent::sweep::translucency_cases();
-    let rows = lucent::sweep::run_translucency(
-        &session.gpu,
-        &session.shaders,
-        &session.pipeline_cache,
-        width,
-        height,
-        &cases,
-    );
-    let device = session.gpu.info.describe();
-    let finished = session.finish();
-    let rows = rows?;
-    finished?;
+    let (rows, device) = with_session(gpu_args, |session| {
+        let rows = lucent::sweep::run_translucency(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            width,
+            height,
+            &cases,
+        )?;
+        Ok((rows, session.gpu.info.describe()))
+    })?;
     let table = lucent::sweep::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
@@ -514,17 +520,15 @@ fn report_command(
             "report: --rounds must be at least 1".into(),
         ));
     }
-    let session = Session::new(gpu_args)?;
-    let written = lucent::report::write_translucency_report(
-        &session.gpu,
-        &session.shaders,
-        &session.pipeline_cache,
-        out,
-        &options,
-    );
-    let finished = session.finish();
-    let (text, files) = written?;
-    finished?;
+    let (text, files) = with_session(gpu_args, |session| {
+        lucent::report::write_translucency_report(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            out,
+            &options,
+        )
+    })?;
     println!("{text}");
     for f in files {
         println!("wrote {}", f.display());

@@ -77,6 +77,26 @@ pub const THESIS_TABLE_2_CONTROL: SeedTable = SeedTable {
     ],
 };
 
+/// The thesis's LBB / control cost ratio beside ours, when `compared` measured a LEAN technique
+/// (`lbb` or `lcb`) against `control` in one run (alternating frames).
+pub fn thesis_ratio_line(compared: &crate::bench::Comparison) -> Option<String> {
+    let [a, b] = &compared.names;
+    let (lean, control) = match (a.as_str(), b.as_str()) {
+        ("control", "lbb" | "lcb") => (1, 0),
+        ("lbb" | "lcb", "control") => (0, 1),
+        _ => return None,
+    };
+    let theirs = THESIS_TABLE_1_LBB.total() / THESIS_TABLE_2_CONTROL.total();
+    let ours = compared.frame[lean].median / compared.frame[control].median.max(1e-9);
+    Some(format!(
+        "\n**{} / control, frame total:** ours {ours:.3}x (same run, alternating frames); the \
+         thesis's LBB / control {theirs:.2}x (sums of its Tables 1 and 2: {:.3} / {:.3} ms)\n",
+        compared.names[lean],
+        THESIS_TABLE_1_LBB.total(),
+        THESIS_TABLE_2_CONTROL.total()
+    ))
+}
+
 /// lucent's pass for a thesis row: blurs by name (case-insensitive), the lighting rows by role.
 fn matching_pass<'a>(report: &'a BenchReport, seed_row: &str) -> Option<&'a crate::bench::PassRow> {
     let wanted = seed_row.to_ascii_lowercase();

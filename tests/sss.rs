@@ -6,6 +6,7 @@
 mod common;
 
 use common::TestGpu;
+use lucent::reference::sss::ReferenceSpecular;
 use lucent::renderer::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
 use lucent::scene::{self, Scene};
 
@@ -213,8 +214,13 @@ fn control_is_closer_to_the_brute_force_reference_than_no_blur() {
             },
         );
         let gbuffer = control.gbuffer.as_ref().unwrap();
-        let profile = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
-        let reference = lucent::reference::sss::reference_image(&scene, gbuffer, &profile);
+        let (profile, _) = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+        let reference = lucent::reference::sss::reference_image(
+            &scene,
+            gbuffer,
+            &profile,
+            ReferenceSpecular::BlinnPhong,
+        );
         let strength = gbuffer.sss.as_ref().unwrap();
         let (w, h) = (128i64, 96i64);
         // Interior: the pixel and every pixel within 4 of it scatter (away from silhouettes,
@@ -329,8 +335,13 @@ fn edge_quality_of_the_control_is_measured_on_the_edges_scene() {
         },
     );
     let gbuffer = control.gbuffer.as_ref().unwrap();
-    let profile = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
-    let reference = lucent::reference::sss::reference_image(&scene, gbuffer, &profile);
+    let (profile, _) = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+    let reference = lucent::reference::sss::reference_image(
+        &scene,
+        gbuffer,
+        &profile,
+        ReferenceSpecular::BlinnPhong,
+    );
     let strength = gbuffer.sss.as_ref().unwrap();
     let m = lucent::reference::sss::edge_metrics(
         128,

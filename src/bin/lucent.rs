@@ -12,6 +12,7 @@ use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bench::{self, BenchOptions};
 use lucent::graph::CompileOptions;
 use lucent::passes::deferred::GBufferPrecision;
+use lucent::passes::sss::{SssKnobs, SssPrecision};
 use lucent::renderer::{
     plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
 };
@@ -172,6 +173,24 @@ struct FrameArgs {
     /// a profile (A/B comparison).
     #[arg(long)]
     no_sss_tiles: bool,
+    /// Refit the SSS profile with this many Gaussians (1-8): fewer blur pairs, at the fit
+    /// error `lucent plan` and the report print.
+    #[arg(long)]
+    sss_gaussians: Option<usize>,
+    /// Precision of the SSS sum-of-Gaussians targets: half (RGBA16F) or full (RGBA32F).
+    #[arg(long, default_value = "full", value_parser = parse_sss_precision)]
+    sss_precision: SssPrecision,
+    /// Bilateral blur (LBB): sensitivity to depth differences, per world unit.
+    #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
+    sensitivity: f32,
+}
+
+fn parse_sss_precision(text: &str) -> std::result::Result<SssPrecision, String> {
+    SssPrecision::ALL
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|&(_, p)| p)
+        .ok_or_else(|| format!("'{text}' is not one of half, full"))
 }
 
 fn parse_precision(text: &str) -> std::result::Result<GBufferPrecision, String> {
@@ -223,6 +242,18 @@ impl FrameArgs {
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,
             fault: None,
+            sss: SssKnobs {
+                gaussians: self.sss_gaussians,
+                precision: self.sss_precision,
+                sensitivity: if self.sensitivity.is_finite() && self.sensitivity >= 0.0 {
+                    self.sensitivity
+                } else {
+                    return Err(LucentError::InvalidInput(format!(
+                        "--sensitivity {}: must be finite and >= 0",
+                        self.sensitivity
+                    )));
+                },
+            },
         })
     }
 }
@@ -353,10 +384,12 @@ fn bench_command(
     let thesis_table = match (compare_thesis, Technique::parse(&frame.technique)?) {
         (false, _) => None,
         (true, Technique::Control) => Some(lucent::seeds::THESIS_TABLE_2_CONTROL),
+        // The thesis times only LBB (Table 1); LCB runs the same pipeline with the control's blur.
+        (true, Technique::Lbb | Technique::Lcb) => Some(lucent::seeds::THESIS_TABLE_1_LBB),
         (true, other) => {
             return Err(LucentError::InvalidInput(format!(
-                "--compare-thesis needs --technique control (the thesis's Table 2); '{}' has no \
-                 table in the thesis",
+                "--compare-thesis needs --technique control, lcb or lbb (the thesis's Tables 1 \
+                 and 2); '{}' has no table in the thesis",
                 other.name()
             )))
         }
@@ -392,7 +425,13 @@ fn bench_command(
             let idle = gpu.wait_idle();
             other.destroy(gpu);
             idle?;
-            println!("{}", compared?.markdown(&gpu.info.describe()));
+            let compared = compared?;
+            println!("{}", compared.markdown(&gpu.info.describe()));
+            if thesis_table.is_some() {
+                if let Some(line) = lucent::seeds::thesis_ratio_line(&compared) {
+                    println!("{line}");
+                }
+            }
         }
         if let Some(json) = &json {
             output::write_file_atomic(json, report.json().as_bytes())?;

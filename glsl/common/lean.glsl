@@ -34,7 +34,9 @@ vec3 lean_covariance(vec2 b, vec3 m) {
 // of mean `b` and covariance `c`, turned into a half-vector density (1 / h.z^4), times Schlick's
 // Fresnel for `v_dot_h` from normal-incidence reflectance `f0`, over 4 n.v (n.v >= 0.1 so
 // silhouettes cannot blow up). The thesis uses F0 = 0.028 (skin); lucent takes the material's
-// specular intensity, which the lighting pass's Blinn-Phong lobe scales the same way. A tiny
+// specular intensity, which the lighting pass's Blinn-Phong lobe scales the same way, and a
+// material without specular (f0 = 0) reflects nothing, as in the lighting pass (Schlick's
+// grazing term would otherwise add a reflection to a material that declares none). A tiny
 // variance floor keeps the determinant > 0 for a perfectly flat, perfectly smooth surface.
 float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float f0) {
     c.xy += vec2(1e-5);
@@ -45,7 +47,7 @@ float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float
     float density = exp(-0.5 * e) / (2.0 * PI * sqrt(det));
     float f = 1.0 - clamp(v_dot_h, 0.0, 1.0);
     float f2 = f * f;
-    float fresnel = f0 + (1.0 - f0) * (f2 * f2 * f);
+    float fresnel = f0 > 0.0 ? f0 + (1.0 - f0) * (f2 * f2 * f) : 0.0;
     return fresnel * density / (4.0 * hz * hz * hz * hz * max(n_dot_v, 0.1));
 }
 

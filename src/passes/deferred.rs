@@ -227,8 +227,9 @@ pub fn gbuffer_pass(
         pass.color(sss, LoadOp::Clear([0.0; 4]));
     }
     if let Some(lean) = &mut gb.lean {
-        // Location 3 of glsl/deferred/gbuffer.frag; sky pixels are never read (strength 0).
-        pass.color(lean, LoadOp::DontCare);
+        // Location 3 of glsl/deferred/gbuffer.frag. Cleared: the control-style blur's bilinear
+        // taps straddle silhouettes and would filter undefined sky texels into the moments.
+        pass.color(lean, LoadOp::Clear([0.0; 4]));
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {

@@ -79,7 +79,7 @@ pub fn lean_covariance(b: DVec2, m: DVec3) -> DVec3 {
 
 /// The LEAN specular lobe (glsl `lean_lobe`): the slope-space Gaussian of mean `b`, covariance
 /// `c` at the unit view-space half vector `h`, as a half-vector density, times Schlick's
-/// Fresnel from `f0`, over 4 n.v (n.v >= 0.1).
+/// Fresnel from `f0` (none at all for `f0 = 0`), over 4 n.v (n.v >= 0.1).
 pub fn lean_lobe(b: DVec2, c: DVec3, h: DVec3, v_dot_h: f64, n_dot_v: f64, f0: f64) -> f64 {
     let (cx, cy) = (c.x + 1e-5, c.y + 1e-5);
     let det = (cx * cy - c.z * c.z).max(1e-10);
@@ -88,7 +88,11 @@ pub fn lean_lobe(b: DVec2, c: DVec3, h: DVec3, v_dot_h: f64, n_dot_v: f64, f0: f
     let e = (x.x * x.x * cy + x.y * x.y * cx - 2.0 * x.x * x.y * c.z) / det;
     let density = (-0.5 * e).exp() / (2.0 * std::f64::consts::PI * det.sqrt());
     let f = 1.0 - v_dot_h.clamp(0.0, 1.0);
-    let fresnel = f0 + (1.0 - f0) * f.powi(5);
+    let fresnel = if f0 > 0.0 {
+        f0 + (1.0 - f0) * f.powi(5)
+    } else {
+        0.0
+    };
     fresnel * density / (4.0 * hz.powi(4) * n_dot_v.max(0.1))
 }
 
@@ -140,7 +144,8 @@ pub fn view_plane_lean(
     let b_v = DVec2::new(u.x, u.y) / z;
     let column = |c: DVec3| (DVec2::new(c.x, c.y) * z - DVec2::new(u.x, u.y) * c.z) / (z * z);
     let j = glam::DMat2::from_cols(column(t_v), column(bt_v));
-    let c = j * glam::DMat2::from_cols(DVec2::new(c_t.x, c_t.z), DVec2::new(c_t.z, c_t.y))
+    let c = j
+        * glam::DMat2::from_cols(DVec2::new(c_t.x, c_t.z), DVec2::new(c_t.z, c_t.y))
         * j.transpose();
     let m_v = DVec3::new(
         c.x_axis.x + b_v.x * b_v.x,

@@ -532,10 +532,9 @@ impl Renderer {
                     object_tiles(scene, &self.mesh_bounds, width, height, |o| {
                         o.material.sss.as_ref().map(sss::profile_reach)
                     });
+                // All rectangles: the blurs draw the marked ones, LCB's and LBB's final pass
+                // its LEAN variant there and the pass-through variant elsewhere.
                 tile_rects(columns, &marked, width, height)
-                    .into_iter()
-                    .filter(|r| r.translucent)
-                    .collect()
             });
             scene_gpu.set_sss_tiles(tiles);
         }

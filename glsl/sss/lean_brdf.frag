@@ -1,4 +1,5 @@
 #version 450
+// permutation: LUCENT_SSS_PASSTHROUGH
 // LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): where the
 // pixel scatters, the blurred diffuse light plus LEAN specular with Fresnel evaluated on the
 // blurred view-plane slopes and moments, for every light; elsewhere the lighting pass's
@@ -19,7 +20,12 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef LUCENT_SSS_PASSTHROUGH
+    // Drawn on the screen rectangles no scattering object can touch.
+    float strength = 0.0;
+#else
     float strength = texelFetch(strength_tex, px, 0).r;
+#endif
     vec3 color;
     if (strength > 0.0) {
         vec4 s0 = texelFetch(sum_tex, px, 0);

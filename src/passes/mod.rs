@@ -105,9 +105,9 @@ pub struct SceneGpu {
     pub translucency: Option<TranslucencyGpu>,
     /// Normal maps, when some object has one.
     pub normal_maps: Option<NormalMaps>,
-    /// The screen rectangles the SSS blurs run in this frame (objects with a profile, widened
-    /// by the profile's reach), written by the renderer before each frame; `None`: the blurs
-    /// cover the whole screen.
+    /// The screen's rectangles for the SSS passes this frame, marked (`translucent`) where
+    /// objects with a profile (widened by the profile's reach) may be: the blurs run only in
+    /// those. Written by the renderer before each frame; `None`: everything is blurred.
     pub sss_tiles: std::sync::Mutex<Option<Vec<translucency::TileRect>>>,
 }
 

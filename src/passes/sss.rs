@@ -87,6 +87,9 @@ pub fn profile_reach(profile: &SssProfile) -> f32 {
     3.0 * widest.max(0.0).sqrt() * profile.units_per_mm
 }
 
+/// LCB's and LBB's final lighting pass.
+const LEAN_FINAL_SHADER: &str = "sss/lean_brdf.frag";
+
 /// Which screen-space blur a frame runs (the technique decides: control, LCB, LBB).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SssBlur {
@@ -402,7 +405,7 @@ pub fn sss_passes(
                 inputs.gb0.id(),
             ];
             match scene {
-                Some(scene) => pass.execute(FinalPass::new(scene, ids, "sss/lean_brdf.frag")),
+                Some(scene) => pass.execute(FinalPass::new(scene, ids, LEAN_FINAL_SHADER)),
                 None => pass.finish(),
             }
         }
@@ -515,7 +518,9 @@ impl PassExec for BlurPass {
         match tiles {
             // Only where objects with a profile (and their blur's reach) can be: every pixel a
             // tap of a scattering pixel reads is written; the rest is never read.
-            Some(rects) => PassPipeline::draw_fullscreen_in(ctx, &rects),
+            Some(rects) => {
+                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
+            }
             None => pipeline.draw_fullscreen(ctx),
         }
     }
@@ -533,13 +538,18 @@ impl PassExec for BlurPass {
 }
 
 /// The pass after the blurs: `combine` (control) or `final lighting` (LCB, LBB, with LEAN
-/// specular): every input sampled at its own pixel, in the shader's binding order.
+/// specular): every input sampled at its own pixel, in the shader's binding order. With SSS
+/// tiles, `final lighting` evaluates LEAN only on the rectangles that may scatter and draws the
+/// pass-through variant (diffuse + specular) on the others: lavapipe shades both sides of the
+/// shader's per-pixel branch, rasterisation it does skip.
 struct FinalPass {
     scene: Arc<SceneGpu>,
     inputs: Vec<ResourceId>,
     fragment: &'static str,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
+    /// LCB, LBB: the pass-through variant for rectangles nothing scatters in.
+    passthrough: Option<crate::passes::util::GraphicsPipeline>,
 }
 
 impl FinalPass {
@@ -550,6 +560,7 @@ impl FinalPass {
             fragment,
             sampler: vk::Sampler::null(),
             pipeline: None,
+            passthrough: None,
         }
     }
 }
@@ -564,33 +575,75 @@ impl PassExec for FinalPass {
                 .iter()
                 .map(|&id| Binding::Sampled(views[id], self.sampler)),
         );
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: self.fragment,
-                defines: &[],
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                push_constant_bytes: 0,
-                name: self.fragment,
-            },
-        )?);
+        let desc = GraphicsPipelineDesc {
+            vertex: "fullscreen.vert",
+            fragment: self.fragment,
+            defines: &[],
+            vertex_input: VertexInput::None,
+            depth_test: false,
+            cull_back: false,
+            additive_attachments: 0,
+            set_layouts: &[],
+            push_constant_bytes: 0,
+            name: self.fragment,
+        };
+        let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        if self.fragment == LEAN_FINAL_SHADER {
+            let layouts = [pipeline.set.layout];
+            let passthrough = crate::passes::util::GraphicsPipeline::new(
+                ctx,
+                &GraphicsPipelineDesc {
+                    defines: &[("LUCENT_SSS_PASSTHROUGH", "1")],
+                    set_layouts: &layouts,
+                    name: "final lighting (pass-through)",
+                    ..desc
+                },
+            );
+            match passthrough {
+                Ok(p) => self.passthrough = Some(p),
+                Err(e) => {
+                    let mut pipeline = pipeline;
+                    pipeline.destroy(&ctx.gpu.device);
+                    return Err(e);
+                }
+            }
+        }
+        self.pipeline = Some(pipeline);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        let tiles = self
+            .scene
+            .sss_tiles
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let (Some(passthrough), Some(rects)) = (&self.passthrough, tiles) else {
             pipeline.draw_fullscreen(ctx);
+            return;
+        };
+        pipeline.bind(ctx);
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
+        // SAFETY: made for this subpass with the bound set's layout.
+        unsafe {
+            ctx.gpu.device.cmd_bind_pipeline(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                passthrough.pipeline,
+            );
         }
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.passthrough.take() {
             p.destroy(&gpu.device);
         }
         // SAFETY: created by `prepare`; the GPU is done with it.

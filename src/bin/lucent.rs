@@ -183,6 +183,22 @@ struct FrameArgs {
     /// Bilateral blur (LBB): sensitivity to depth differences, per world unit.
     #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
     sensitivity: f32,
+    /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
+    /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
+    #[arg(long)]
+    sss_packed: bool,
+    /// LBB: bilateral taps per direction (3, 5 or 7).
+    #[arg(long, default_value_t = 7, value_parser = parse_taps)]
+    sss_taps: u32,
+}
+
+fn parse_taps(text: &str) -> std::result::Result<u32, String> {
+    match text {
+        "3" => Ok(3),
+        "5" => Ok(5),
+        "7" => Ok(7),
+        _ => Err(format!("'{text}' is not one of 3, 5, 7")),
+    }
 }
 
 fn parse_sss_precision(text: &str) -> std::result::Result<SssPrecision, String> {
@@ -245,6 +261,8 @@ impl FrameArgs {
             sss: SssKnobs {
                 gaussians: self.sss_gaussians,
                 precision: self.sss_precision,
+                packed: self.sss_packed,
+                taps: self.sss_taps,
                 sensitivity: if self.sensitivity.is_finite() && self.sensitivity >= 0.0 {
                     self.sensitivity
                 } else {

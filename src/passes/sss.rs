@@ -87,6 +87,9 @@ pub fn profile_reach(profile: &SssProfile) -> f32 {
     3.0 * widest.max(0.0).sqrt() * profile.units_per_mm
 }
 
+/// LBB's packed ping-pong texel: eight fp16 halves (glsl/sss/blur.frag `pack_texels`).
+pub const PACKED_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+
 /// LCB's and LBB's final lighting pass.
 const LEAN_FINAL_SHADER: &str = "sss/lean_brdf.frag";
 
@@ -161,6 +164,14 @@ pub struct SssKnobs {
     pub precision: SssPrecision,
     /// Bilateral blur: sensitivity to depth differences, per world unit.
     pub sensitivity: f32,
+    /// LBB: carry the two blurred texels (light + slope x, slope y + moments) between passes
+    /// as one RGBA32UI texel of eight fp16 halves, so each tap is one fetch and each pass one
+    /// write. Needs point taps: LCB's bilinear taps keep two RGBA16F targets. Off by default:
+    /// measured on lavapipe, unpacking costs more than the fetch it saves (docs/sss.md).
+    pub packed: bool,
+    /// LBB: taps per direction, 3, 5 or 7 (the thesis's 7): spaced 3 sigma / ((taps - 1) / 2)
+    /// apart, weighted where they land. The control's kernel is Jimenez's 7 taps.
+    pub taps: u32,
 }
 
 impl Default for SssKnobs {
@@ -169,6 +180,8 @@ impl Default for SssKnobs {
             gaussians: None,
             precision: SssPrecision::Full,
             sensitivity: DEFAULT_SENSITIVITY,
+            packed: false,
+            taps: 7,
         }
     }
 }
@@ -276,12 +289,23 @@ pub fn sss_passes(
         _ => None,
     };
     let targets = if lean.is_some() { 2 } else { 1 };
+    let packed = lean.is_some() && blur.bilateral() && knobs.packed;
     let names = ["", ".lean"];
-    let mut temp: Vec<Handle<Image>> = (0..targets)
-        .map(|t| graph.create_image(&format!("sss.temp{}", names[t]), info))
+    // The ping-pong targets: one packed RGBA32UI texel, or one RGBA16F per blurred texel.
+    let (pingpong, pingpong_info) = if packed {
+        let packed_info = ImageInfo {
+            format: PACKED_FORMAT,
+            ..info
+        };
+        (1, packed_info)
+    } else {
+        (targets, info)
+    };
+    let mut temp: Vec<Handle<Image>> = (0..pingpong)
+        .map(|t| graph.create_image(&format!("sss.temp{}", names[t]), pingpong_info))
         .collect();
-    let mut current: Vec<Handle<Image>> = (0..targets)
-        .map(|t| graph.create_image(&format!("sss.current{}", names[t]), info))
+    let mut current: Vec<Handle<Image>> = (0..pingpong)
+        .map(|t| graph.create_image(&format!("sss.current{}", names[t]), pingpong_info))
         .collect();
     let mut sum: Vec<Handle<Image>> = (0..targets)
         .map(|t| graph.create_image(&format!("sss.sum{}", names[t]), sum_info))
@@ -326,12 +350,16 @@ pub fn sss_passes(
         let exec =
             |constants, accumulate, colors: Vec<ResourceId>, scene: &Arc<SceneGpu>| BlurPass {
                 scene: scene.clone(),
+                // The first pass reads the lighting pass's and the G-buffer's own targets.
+                packed_in: packed && colors.len() == 1,
+                packed_out: packed,
+                sums: if accumulate { targets } else { 0 },
+                taps: knobs.taps,
                 colors,
                 depth: inputs.depth.id(),
                 strength: inputs.strength.id(),
                 constants,
                 blur,
-                accumulate,
                 sampler: vk::Sampler::null(),
                 nearest: vk::Sampler::null(),
                 pipeline: None,
@@ -429,7 +457,14 @@ struct BlurPass {
     strength: ResourceId,
     constants: BlurConstants,
     blur: SssBlur,
-    accumulate: bool,
+    /// LBB packed: the input is one RGBA32UI texel (after the first pass).
+    packed_in: bool,
+    /// LBB packed: the result is written as one RGBA32UI texel.
+    packed_out: bool,
+    /// Sum-of-Gaussians targets accumulated after the result (vertical passes), else 0.
+    sums: usize,
+    /// Bilateral taps per direction.
+    taps: u32,
     /// Linear filtering for the control's taps between texels (its offsets are fractional).
     sampler: vk::Sampler,
     /// Nearest, for depth and strength and the bilateral blur's whole-texel taps (read with
@@ -460,21 +495,37 @@ impl PassExec for BlurPass {
             bindings.push(Binding::Sampled(views[lean], color_sampler));
         }
         let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.blur.bilateral() {
+            defines.push((
+                "LUCENT_SSS_HALF_TAPS",
+                match self.taps {
+                    3 => "1",
+                    5 => "2",
+                    _ => "3",
+                },
+            ));
+        }
         if self.blur.lean() {
             defines.push(("LUCENT_SSS_LEAN", "1"));
         }
         if self.blur.bilateral() {
             defines.push(("LUCENT_SSS_BILATERAL", "1"));
         }
-        if self.accumulate {
+        if self.packed_in {
+            defines.push(("LUCENT_SSS_PACKED_IN", "1"));
+        }
+        if self.packed_out {
+            defines.push(("LUCENT_SSS_PACKED_OUT", "1"));
+        }
+        if self.sums > 0 {
             defines.push(("LUCENT_SSS_ACCUMULATE", "1"));
         }
-        // The sums follow the current results: attachments 1 (control) or 2 and 3 (LEAN).
-        let additive = match (self.accumulate, self.colors.len()) {
-            (false, _) => 0,
-            (true, 1) => 0b10,
-            (true, _) => 0b1100,
+        // The sums follow the results (one packed attachment, or one per blurred texel).
+        let results = match (self.packed_out, self.blur.lean()) {
+            (true, _) | (false, false) => 1,
+            (false, true) => 2,
         };
+        let additive = ((1u32 << self.sums) - 1) << results;
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &bindings,

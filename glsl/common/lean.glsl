@@ -32,13 +32,16 @@ vec3 lean_covariance(vec2 b, vec3 m) {
 
 // The LEAN specular lobe for half vector `h_view` (unit, view space): the slope-space Gaussian
 // of mean `b` and covariance `c`, turned into a half-vector density (1 / h.z^4), times Schlick's
-// Fresnel for `v_dot_h` from normal-incidence reflectance `f0`, over 4 n.v (n.v >= 0.1 so
-// silhouettes cannot blow up). The thesis uses F0 = 0.028 (skin); lucent takes the material's
+// Fresnel for `v_dot_h` from normal-incidence reflectance `f0`, times Cook-Torrance's
+// shadowing-masking term (without it, grazing views light every silhouette as a rim), over
+// 4 n.v (n.v >= 0.1 so silhouettes cannot blow up); the n.l of the microfacet BRDF cancels
+// against the irradiance's. The thesis uses F0 = 0.028 (skin); lucent takes the material's
 // specular intensity, which the lighting pass's Blinn-Phong lobe scales the same way, and a
 // material without specular (f0 = 0) reflects nothing, as in the lighting pass (Schlick's
 // grazing term would otherwise add a reflection to a material that declares none). A tiny
 // variance floor keeps the determinant > 0 for a perfectly flat, perfectly smooth surface.
-float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float f0) {
+float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float n_dot_l,
+                float n_dot_h, float f0) {
     c.xy += vec2(1e-5);
     float det = max(c.x * c.y - c.z * c.z, 1e-10);
     float hz = max(h_view.z, LEAN_MIN_NZ);
@@ -48,7 +51,9 @@ float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float
     float f = 1.0 - clamp(v_dot_h, 0.0, 1.0);
     float f2 = f * f;
     float fresnel = f0 > 0.0 ? f0 + (1.0 - f0) * (f2 * f2 * f) : 0.0;
-    return fresnel * density / (4.0 * hz * hz * hz * hz * max(n_dot_v, 0.1));
+    float vh = max(v_dot_h, 1e-4);
+    float g = min(1.0, 2.0 * max(n_dot_h, 0.0) * min(max(n_dot_v, 0.0), max(n_dot_l, 0.0)) / vh);
+    return fresnel * g * density / (4.0 * hz * hz * hz * hz * max(n_dot_v, 0.1));
 }
 
 // The base variance of the material's own roughness (the thesis adds 1 / (s + 2) for

@@ -52,11 +52,12 @@ void main() {
             vec3 h = l + to_eye;
             float h_len2 = dot(h, h);
             // Light exactly behind the surface point as seen from the eye: no half vector.
-            if (!(h_len2 > 1e-12) || dot(n, l) <= 0.0) {
+            float n_dot_l = dot(n, l);
+            if (!(h_len2 > 1e-12) || n_dot_l <= 0.0) {
                 continue;
             }
             h *= inversesqrt(h_len2);
-            float lobe = lean_lobe(b, c, h, dot(to_eye, h), n_dot_v, ks);
+            float lobe = lean_lobe(b, c, h, dot(to_eye, h), n_dot_v, n_dot_l, dot(n, h), ks);
             specular += lobe * light.radiance_range.rgb * attenuation;
         }
         color = s0.rgb + specular;

@@ -79,8 +79,19 @@ pub fn lean_covariance(b: DVec2, m: DVec3) -> DVec3 {
 
 /// The LEAN specular lobe (glsl `lean_lobe`): the slope-space Gaussian of mean `b`, covariance
 /// `c` at the unit view-space half vector `h`, as a half-vector density, times Schlick's
-/// Fresnel from `f0` (none at all for `f0 = 0`), over 4 n.v (n.v >= 0.1).
-pub fn lean_lobe(b: DVec2, c: DVec3, h: DVec3, v_dot_h: f64, n_dot_v: f64, f0: f64) -> f64 {
+/// Fresnel from `f0` (none at all for `f0 = 0`), times Cook-Torrance's shadowing-masking term,
+/// over 4 n.v (n.v >= 0.1).
+#[allow(clippy::too_many_arguments)]
+pub fn lean_lobe(
+    b: DVec2,
+    c: DVec3,
+    h: DVec3,
+    v_dot_h: f64,
+    n_dot_v: f64,
+    n_dot_l: f64,
+    n_dot_h: f64,
+    f0: f64,
+) -> f64 {
     let (cx, cy) = (c.x + 1e-5, c.y + 1e-5);
     let det = (cx * cy - c.z * c.z).max(1e-10);
     let hz = h.z.max(LEAN_MIN_NZ);
@@ -93,7 +104,9 @@ pub fn lean_lobe(b: DVec2, c: DVec3, h: DVec3, v_dot_h: f64, n_dot_v: f64, f0: f
     } else {
         0.0
     };
-    fresnel * density / (4.0 * hz.powi(4) * n_dot_v.max(0.1))
+    let g = (2.0 * n_dot_h.max(0.0) * n_dot_v.max(0.0).min(n_dot_l.max(0.0)) / v_dot_h.max(1e-4))
+        .min(1.0);
+    fresnel * g * density / (4.0 * hz.powi(4) * n_dot_v.max(0.1))
 }
 
 /// LEAN specular at a surface point from every light (glsl/sss/lean_brdf.frag): view-plane
@@ -115,11 +128,13 @@ pub fn lean_specular(
         let (to_light, attenuation) = light_incidence(light, position);
         let l = view * to_light;
         let h = l + to_eye;
-        if h.length_squared() <= 1e-12 || n.dot(l) <= 0.0 {
+        let n_dot_l = n.dot(l);
+        if h.length_squared() <= 1e-12 || n_dot_l <= 0.0 {
             continue;
         }
         let h = h.normalize();
-        out += lean_lobe(b, c, h, to_eye.dot(h), n_dot_v, ks) * radiance(light) * attenuation;
+        let lobe = lean_lobe(b, c, h, to_eye.dot(h), n_dot_v, n_dot_l, n.dot(h), ks);
+        out += lobe * radiance(light) * attenuation;
     }
     out
 }

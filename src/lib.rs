@@ -25,6 +25,7 @@ pub mod renderer;
 pub mod report;
 pub mod scene;
 pub mod seeds;
+pub mod sss_report;
 pub mod sweep;
 
 pub use error::{LucentError, Result};

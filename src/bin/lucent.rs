@@ -98,7 +98,7 @@ enum Command {
     /// Error against run time: every approximation of a technique timed (round-robin, same
     /// run) and compared with the exact f64 reference; writes a Markdown table and a PNG plot.
     Report {
-        /// The technique to report on (`translucency`).
+        /// The technique to report on (`translucency` or `sss`).
         technique: String,
         /// Output directory.
         #[arg(long, default_value = "report")]
@@ -567,18 +567,22 @@ fn report_command(
     options: lucent::report::ReportOptions,
     gpu_args: &GpuArgs,
 ) -> Result<()> {
-    if technique != "translucency" {
-        return Err(LucentError::InvalidInput(format!(
-            "report: unknown technique '{technique}'; available: translucency"
-        )));
-    }
+    let write = match technique {
+        "translucency" => lucent::report::write_translucency_report,
+        "sss" => lucent::sss_report::write_sss_report,
+        _ => {
+            return Err(LucentError::InvalidInput(format!(
+                "report: unknown technique '{technique}'; available: translucency, sss"
+            )))
+        }
+    };
     if options.rounds == 0 {
         return Err(LucentError::InvalidInput(
             "report: --rounds must be at least 1".into(),
         ));
     }
     let (text, files) = with_session(gpu_args, |session| {
-        lucent::report::write_translucency_report(
+        write(
             &session.gpu,
             &session.shaders,
             &session.pipeline_cache,

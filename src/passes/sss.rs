@@ -723,6 +723,31 @@ mod tests {
     }
 
     #[test]
+    fn fitting_fewer_gaussians_reports_a_growing_error() {
+        let skin = SssProfile::preset("skin").unwrap();
+        let (same, e) = fit_profile(&skin, 6).unwrap();
+        assert_eq!(same, skin);
+        assert_eq!(e, [0.0; 3]);
+        let mut previous = 0.0;
+        for n in [4, 3, 2, 1] {
+            let (fit, e) = fit_profile(&skin, n).unwrap();
+            assert_eq!(fit.gaussians.len(), n);
+            fit.validate().unwrap();
+            let worst = e.iter().fold(0.0f64, |a, &b| a.max(b));
+            assert!(worst.is_finite() && worst >= previous - 1e-9, "{n}: {e:?}");
+            previous = worst;
+            for c in 0..3 {
+                let total: f32 = fit.gaussians.iter().map(|g| g.weight[c]).sum();
+                assert!((total - 1.0).abs() < 1e-4, "{n} channel {c}: {total}");
+            }
+        }
+        // Four Gaussians (the thesis's count) fit d'Eon's six within a few percent.
+        let (_, e4) = fit_profile(&skin, 4).unwrap();
+        assert!(e4.iter().all(|&e| e < 0.05), "{e4:?}");
+        assert!(fit_profile(&skin, 0).is_err() && fit_profile(&skin, 9).is_err());
+    }
+
+    #[test]
     fn equal_variances_and_empty_channels_stay_finite() {
         let mut p = SssProfile::preset("skin").unwrap();
         p.gaussians[1].variance = p.gaussians[0].variance;

@@ -180,7 +180,8 @@ struct FrameArgs {
     /// Precision of the SSS sum-of-Gaussians targets: half (RGBA16F) or full (RGBA32F).
     #[arg(long, default_value = "full", value_parser = parse_sss_precision)]
     sss_precision: SssPrecision,
-    /// Bilateral blur (LBB): sensitivity to depth differences, per world unit.
+    /// Bilateral blur (LBB): sensitivity to depth differences, relative to each profile
+    /// Gaussian's width (1: weights follow the taps' 3D distance).
     #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
     sensitivity: f32,
     /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16

@@ -260,6 +260,7 @@ impl FrameArgs {
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,
             fault: None,
+            debug_view: None,
         })
     }
 }

@@ -267,6 +267,8 @@ pub enum Action {
     PreviousTechnique,
     /// Next pow form (exact, exp2, scaled exp2) of the translucent materials.
     CyclePow,
+    /// Next debug view (off, then the views the frame has).
+    CycleDebugView,
     /// Selects knob N (index into [`KNOBS`]).
     SelectKnob(usize),
     /// Raises the selected knob one step.
@@ -318,6 +320,12 @@ pub const KEYS: &[KeyBinding] = &[
         name: "P",
         action: Action::CyclePow,
         help: "translucency pow form: exact / exp2 / scaled exp2",
+    },
+    KeyBinding {
+        name: "V",
+        action: Action::CycleDebugView,
+        help:
+            "debug view: off / albedo / normal / depth / thickness / material ID / SSS before blur",
     },
     KeyBinding {
         name: "1",

@@ -34,7 +34,8 @@ use winit::window::{Window, WindowId};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{ContextDesc, GpuContext};
-use crate::renderer::{FrameSettings, Renderer, Technique};
+use crate::passes::debug_view::DebugView;
+use crate::renderer::{FrameFeatures, FrameSettings, Renderer, Technique};
 use crate::scene::Scene;
 use crate::{output, LucentError, Result};
 
@@ -121,7 +122,17 @@ pub fn run(options: DemoOptions) -> Result<()> {
         Some(cache_dir.join("pipelines.bin")),
         &properties,
     )?;
-    let text = match crate::plot::font_file().and_then(|p| TextRenderer::load(&p)) {
+    // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
+    // the timing columns line up.
+    let font = crate::plot::font_file().map(|p| {
+        let mono = p.with_file_name("DejaVuSansMono.ttf");
+        if mono.is_file() {
+            mono
+        } else {
+            p
+        }
+    });
+    let text = match font.and_then(|p| TextRenderer::load(&p)) {
         Ok(t) => Some(t),
         Err(e) => {
             log::warn!("no on-screen text: {e}");
@@ -145,6 +156,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
         watcher: ShaderWatcher::new(shaders.glsl_root()),
         text,
         technique,
+        debug_view: None,
         scene,
         orbit,
         script,
@@ -158,6 +170,8 @@ pub fn run(options: DemoOptions) -> Result<()> {
         stats: Stats::new(),
         tick: 0,
         presented: 0,
+        minimized_ticks: 0,
+        recreations: 0,
         minimized_by_script: false,
         window_zero: false,
         resize_pending: false,
@@ -287,6 +301,7 @@ struct Demo<'a> {
     watcher: ShaderWatcher,
     text: Option<TextRenderer>,
     technique: Technique,
+    debug_view: Option<DebugView>,
     scene: Scene,
     orbit: OrbitCamera,
     script: Option<Script>,
@@ -301,6 +316,10 @@ struct Demo<'a> {
     /// Script clock: presented frames plus idle ticks while minimized.
     tick: u64,
     presented: u64,
+    /// Script ticks spent minimized (nothing presented).
+    minimized_ticks: u64,
+    /// Swapchain recreations after the first.
+    recreations: u64,
     minimized_by_script: bool,
     window_zero: bool,
     resize_pending: bool,
@@ -477,6 +496,10 @@ impl Demo<'_> {
                 }
                 None => self.say("no translucent material in this scene".into(), false),
             },
+            Action::CycleDebugView => {
+                self.debug_view = self.next_debug_view();
+                self.rebuild_pending = true;
+            }
             Action::SelectKnob(i) => self.view.knob = i.min(KNOBS.len() - 1),
             Action::KnobUp | Action::KnobDown => {
                 let knob = &KNOBS[self.view.knob];
@@ -610,6 +633,14 @@ impl Demo<'_> {
             if let Some(p) = self.presenter.as_mut() {
                 let old = p.extent;
                 p.recreate(self.gpu, size)?;
+                self.recreations += 1;
+                log::info!(
+                    "swapchain recreated: {}x{} -> {}x{}",
+                    old.width,
+                    old.height,
+                    p.extent.width,
+                    p.extent.height
+                );
                 if p.extent != old && !p.is_zero_sized() {
                     self.rebuild_pending = true;
                 }
@@ -669,6 +700,7 @@ impl Demo<'_> {
         if self.last_idle_tick.elapsed() >= IDLE_TICK {
             self.last_idle_tick = Instant::now();
             self.tick += 1;
+            self.minimized_ticks += 1;
         }
         let script_done = self.script.as_ref().is_none_or(Script::finished);
         if script_done && since.elapsed() > MINIMIZED_LIMIT {
@@ -715,6 +747,7 @@ impl Demo<'_> {
             width: presenter.extent.width,
             height: presenter.extent.height,
             technique: self.technique,
+            debug_view: self.debug_view.filter(|v| self.view_available(*v)),
             ..self.options.base
         };
         self.orbit.apply(&mut self.scene.camera);
@@ -754,6 +787,36 @@ impl Demo<'_> {
             }
             Err(e) => Err(e),
         }
+    }
+
+    /// Whether the current frame has what `view` shows (GB2 for thickness and material ID,
+    /// the split lighting for the pre-blur view).
+    fn view_available(&self, view: DebugView) -> bool {
+        let settings = FrameSettings {
+            technique: self.technique,
+            ..self.options.base
+        };
+        let Ok(features) = FrameFeatures::new(&self.scene, &settings) else {
+            return false;
+        };
+        match view {
+            DebugView::Thickness | DebugView::MaterialId => features.translucency.is_some(),
+            DebugView::LitBeforeSss => features.sss.is_some(),
+            DebugView::Albedo | DebugView::Normal | DebugView::Depth => true,
+        }
+    }
+
+    /// The debug view after the current one among those the frame has (`None`: the frame).
+    fn next_debug_view(&self) -> Option<DebugView> {
+        let all = DebugView::ALL;
+        let start = match self.debug_view {
+            None => 0,
+            Some(v) => all.iter().position(|(_, a)| *a == v).map_or(0, |i| i + 1),
+        };
+        all[start.min(all.len())..]
+            .iter()
+            .map(|(_, v)| *v)
+            .find(|v| self.view_available(*v))
     }
 
     fn write_screenshot(&mut self, path: &std::path::Path) -> Result<()> {
@@ -851,6 +914,11 @@ impl Demo<'_> {
             ),
             Tone::Normal,
         ));
+        let shown = self.renderer.as_ref().and_then(|r| r.settings.debug_view);
+        lines.push((
+            format!("view (V): {}", shown.map_or("frame", DebugView::name)),
+            Tone::Normal,
+        ));
         if let Some(mode) = controls::pow_mode(&self.scene) {
             let name = controls::POW_MODES
                 .iter()
@@ -890,8 +958,11 @@ impl Demo<'_> {
             if let Some(r) = &self.renderer {
                 let c = &self.scene.camera;
                 println!(
-                    "demo: {} frames presented; last frame {}x{} technique {} camera eye {:.4} {:.4} {:.4} target {:.4} {:.4} {:.4}",
+                    "demo: {} frames presented, {} ticks minimized, {} swapchain recreations; \
+                     last frame {}x{} technique {} camera eye {:.4} {:.4} {:.4} target {:.4} {:.4} {:.4}",
                     self.presented,
+                    self.minimized_ticks,
+                    self.recreations,
                     r.settings.width,
                     r.settings.height,
                     r.settings.technique.name(),
@@ -928,6 +999,7 @@ fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::KeyT if shift => "Shift+T",
         KeyCode::KeyT => "T",
         KeyCode::KeyP => "P",
+        KeyCode::KeyV => "V",
         KeyCode::Digit1 | KeyCode::Numpad1 => "1",
         KeyCode::Digit2 | KeyCode::Numpad2 => "2",
         KeyCode::Digit3 | KeyCode::Numpad3 => "3",

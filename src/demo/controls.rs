@@ -285,6 +285,8 @@ pub enum Action {
     Screenshot,
     /// Rebuilds every pipeline from the shaders on disk now.
     ReloadShaders,
+    /// Switches the timing mode: in-frame timestamps or isolated passes (as `bench --isolate`).
+    ToggleTiming,
     /// Ends the demo.
     Quit,
 }
@@ -371,6 +373,11 @@ pub const KEYS: &[KeyBinding] = &[
         name: "H",
         action: Action::ToggleOverlay,
         help: "hide / show the overlay",
+    },
+    KeyBinding {
+        name: "I",
+        action: Action::ToggleTiming,
+        help: "timing mode: in-frame timestamps / each pass isolated (as bench)",
     },
     KeyBinding {
         name: "F5",

@@ -35,7 +35,7 @@ use winit::window::{Window, WindowId};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{ContextDesc, GpuContext};
 use crate::passes::debug_view::DebugView;
-use crate::renderer::{FrameFeatures, FrameSettings, Renderer, Technique};
+use crate::renderer::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::scene::Scene;
 use crate::{output, LucentError, Result};
 
@@ -157,6 +157,8 @@ pub fn run(options: DemoOptions) -> Result<()> {
         text,
         technique,
         debug_view: None,
+        isolated: false,
+        runner: None,
         scene,
         orbit,
         script,
@@ -175,6 +177,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
         minimized_by_script: false,
         window_zero: false,
         resize_pending: false,
+        swapchain_stale: false,
         rebuild_pending: false,
         screenshot_pending: Vec::new(),
         screenshots_taken: 0,
@@ -302,6 +305,10 @@ struct Demo<'a> {
     text: Option<TextRenderer>,
     technique: Technique,
     debug_view: Option<DebugView>,
+    /// Isolated timing (each physical pass its own submission) instead of in-frame.
+    isolated: bool,
+    /// Runs the isolated frames (sized for the current renderer's passes).
+    runner: Option<FrameRunner>,
     scene: Scene,
     orbit: OrbitCamera,
     script: Option<Script>,
@@ -323,6 +330,8 @@ struct Demo<'a> {
     minimized_by_script: bool,
     window_zero: bool,
     resize_pending: bool,
+    /// The swapchain reported OUT_OF_DATE or SUBOPTIMAL: recreate before the next frame.
+    swapchain_stale: bool,
     rebuild_pending: bool,
     screenshot_pending: Vec<PathBuf>,
     screenshots_taken: u32,
@@ -527,6 +536,10 @@ impl Demo<'_> {
                 )));
             }
             Action::ReloadShaders => self.rebuild_pending = true,
+            Action::ToggleTiming => {
+                self.isolated = !self.isolated;
+                self.stats.clear();
+            }
             Action::Quit => {
                 self.done = true;
                 event_loop.exit();
@@ -627,10 +640,18 @@ impl Demo<'_> {
         }
         self.fly(dt);
 
-        if self.resize_pending {
-            self.resize_pending = false;
+        if self.resize_pending || self.swapchain_stale {
             let size = self.window_size();
-            if let Some(p) = self.presenter.as_mut() {
+            let same = self
+                .presenter
+                .as_ref()
+                .is_some_and(|p| (p.extent.width, p.extent.height) == size);
+            // A Resized event to the size the swapchain already has needs nothing; a stale
+            // swapchain (OUT_OF_DATE, SUBOPTIMAL) is recreated whatever the size.
+            let needed = self.swapchain_stale || !same;
+            self.resize_pending = false;
+            self.swapchain_stale = false;
+            if let Some(p) = self.presenter.as_mut().filter(|_| needed) {
                 let old = p.extent;
                 p.recreate(self.gpu, size)?;
                 self.recreations += 1;
@@ -666,15 +687,20 @@ impl Demo<'_> {
             return Ok(());
         };
         let started = Instant::now();
-        match presenter.draw(self.gpu, renderer, panel.as_ref())? {
-            Drawn::OutOfDate => self.resize_pending = true,
+        let isolated = match (self.isolated, self.runner.as_mut()) {
+            (true, Some(runner)) => Some(runner.run_isolated(self.gpu, &renderer.executable)?),
+            _ => None,
+        };
+        match presenter.draw(self.gpu, renderer, panel.as_ref(), isolated.is_none())? {
+            Drawn::OutOfDate => self.swapchain_stale = true,
             Drawn::Presented { passes, stale } => {
+                let passes = isolated.map_or(passes, |t| t.passes);
                 self.stats
                     .add(&passes, started.elapsed().as_secs_f64() * 1e3);
                 self.presented += 1;
                 self.tick += 1;
                 if stale {
-                    self.resize_pending = true;
+                    self.swapchain_stale = true;
                 }
                 for path in std::mem::take(&mut self.screenshot_pending) {
                     self.write_screenshot(&path)?;
@@ -761,9 +787,14 @@ impl Demo<'_> {
         ) {
             Ok(new) => {
                 self.gpu.wait_idle()?;
+                let runner = FrameRunner::new(self.gpu, new.executable.plan.physical.len());
+                if let Some(old) = self.runner.take() {
+                    old.destroy(self.gpu);
+                }
                 if let Some(old) = self.renderer.replace(new) {
                     old.destroy(self.gpu);
                 }
+                self.runner = Some(runner?);
                 self.stats.clear();
                 if self.view.message.as_ref().is_some_and(|(_, error)| *error) {
                     self.view.message = None;
@@ -876,7 +907,12 @@ impl Demo<'_> {
         ));
         lines.push((
             format!(
-                "GPU ms per pass, in-frame timestamps, mean of {} frames:",
+                "GPU ms per pass, {} (I), mean of {} frames:",
+                if self.isolated {
+                    "isolated: each pass its own submission"
+                } else {
+                    "in-frame timestamps"
+                },
                 self.stats.shown_frames
             ),
             Tone::Normal,
@@ -981,6 +1017,9 @@ impl Demo<'_> {
             }
         }
         let idle = self.gpu.wait_idle();
+        if let Some(r) = self.runner.take() {
+            r.destroy(self.gpu);
+        }
         if let Some(r) = self.renderer.take() {
             r.destroy(self.gpu);
         }
@@ -1009,6 +1048,7 @@ fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Minus | KeyCode::NumpadSubtract | KeyCode::PageDown => "-",
         KeyCode::KeyR => "R",
         KeyCode::KeyH => "H",
+        KeyCode::KeyI => "I",
         KeyCode::F5 => "F5",
         KeyCode::F12 => "F12",
         KeyCode::Escape => "Esc",

@@ -36,6 +36,9 @@ pub const ACQUIRE_TIMEOUT_NS: u64 = 5_000_000_000;
 pub const FRAME_TIMEOUT_NS: u64 = 60_000_000_000;
 
 /// What a frame did.
+///
+/// (With isolated timing the caller renders the frame pass by pass before [`Presenter::draw`];
+/// `passes` is then empty.)
 #[derive(Debug)]
 pub enum Drawn {
     /// Presented. `passes`: the GPU times of its passes (in-frame timestamps); `stale`: the
@@ -304,12 +307,15 @@ impl Presenter {
     }
 
     /// Renders `renderer`'s frame onto the next swapchain image with `overlay` on top, and
-    /// presents it. The GPU is idle when it returns.
+    /// presents it. With `render` false the frame was already rendered (isolated timing: pass
+    /// by pass, by the caller) and only its display image is put on screen. The GPU is idle
+    /// when it returns.
     pub fn draw(
         &mut self,
         gpu: &GpuContext,
         renderer: &Renderer,
         overlay: Option<&Panel>,
+        render: bool,
     ) -> Result<Drawn> {
         if self.is_zero_sized() {
             return Ok(Drawn::OutOfDate);
@@ -352,7 +358,7 @@ impl Presenter {
             Some(p) => self.upload_overlay(gpu, p)?,
             None => None,
         };
-        self.record(gpu, renderer, image, panel)?;
+        self.record(gpu, renderer, image, panel, render)?;
         let device = &gpu.device;
         let waits = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.acquired)
@@ -398,9 +404,9 @@ impl Presenter {
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
             Err(e) => return Err(LucentError::vulkan("vkQueuePresentKHR", e)),
         };
-        let passes = match &self.timer {
-            Some((timer, _)) => timer.results(gpu)?.unwrap_or_default(),
-            None => Vec::new(),
+        let passes = match (&self.timer, render) {
+            (Some((timer, _)), true) => timer.results(gpu)?.unwrap_or_default(),
+            _ => Vec::new(),
         };
         Ok(Drawn::Presented { passes, stale })
     }
@@ -450,6 +456,7 @@ impl Presenter {
         renderer: &Renderer,
         target: vk::Image,
         panel: Option<(u32, u32)>,
+        render: bool,
     ) -> Result<()> {
         let device = &gpu.device;
         let cmd = self.cmd;
@@ -475,12 +482,14 @@ impl Presenter {
                 )
                 .vk("vkBeginCommandBuffer")?;
         }
-        let timer = self.timer.as_mut().map(|(t, _)| t);
-        if let Some(t) = timer {
-            t.reset(gpu, cmd);
-            renderer.executable.record_frame(gpu, cmd, Some(t));
-        } else {
-            renderer.executable.record_frame(gpu, cmd, None);
+        if render {
+            let timer = self.timer.as_mut().map(|(t, _)| t);
+            if let Some(t) = timer {
+                t.reset(gpu, cmd);
+                renderer.executable.record_frame(gpu, cmd, Some(t));
+            } else {
+                renderer.executable.record_frame(gpu, cmd, None);
+            }
         }
         gpu.begin_label(cmd, "present");
         let color = vk::ImageSubresourceRange::default()

@@ -1,6 +1,16 @@
 #version 450
 // Debug views of the G-buffer and of the lit image before screen-space SSS (src/passes/debug_view.rs).
 // One permutation per view (LUCENT_VIEW_*); the result is written sRGB-encoded like the tonemap's.
+// permutations-only
+// permutation: LUCENT_VIEW_ALBEDO
+// permutation: LUCENT_VIEW_NORMAL
+// permutation: LUCENT_VIEW_DEPTH
+// permutation: LUCENT_VIEW_THICKNESS
+// permutation: LUCENT_VIEW_THICKNESS LUCENT_COLORED_THICKNESS
+// permutation: LUCENT_VIEW_MATERIAL
+// permutation: LUCENT_VIEW_MATERIAL LUCENT_COLORED_THICKNESS
+// permutation: LUCENT_VIEW_LIT
+// permutation: LUCENT_VIEW_LIT LUCENT_VIEW_SECOND
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 #include "../common/gbuffer.glsl"

@@ -86,6 +86,11 @@ pub struct DemoOptions {
 /// `quit`. Errors: no display, no device that can present, a bad script, a device or surface
 /// lost, validation errors (when validation is on).
 pub fn run(options: DemoOptions) -> Result<()> {
+    if options.frames == Some(0) {
+        return Err(LucentError::InvalidInput(
+            "--frames must be at least 1".into(),
+        ));
+    }
     let script = options.script.as_deref().map(Script::load).transpose()?;
     let mut scene = crate::scene::load_scene(&options.scene)?;
     let event_loop = EventLoop::new().map_err(|e| {

@@ -51,6 +51,15 @@ pub enum LucentError {
     /// Timing could not be trusted (the benchmark refuses to print numbers it cannot prove).
     #[error("timing: {0}")]
     Timing(String),
+    /// The GPU stopped answering (driver crash, reset, hang): nothing on it can be trusted or
+    /// continued. Commands exit non-zero instead of retrying.
+    #[error(
+        "the GPU device was lost during {call} (driver crash or reset); lucent cannot continue"
+    )]
+    DeviceLost { call: &'static str },
+    /// The window's surface went away (the window system closed it or the display died).
+    #[error("the window surface was lost during {call} (the display or window went away)")]
+    SurfaceLost { call: &'static str },
     /// Reading or writing a file failed.
     #[error("{path}: {message}")]
     File { path: PathBuf, message: String },
@@ -67,11 +76,21 @@ pub trait VkResultExt<T> {
 
 impl<T> VkResultExt<T> for std::result::Result<T, ash::vk::Result> {
     fn vk(self, call: &'static str) -> Result<T> {
-        self.map_err(|result| LucentError::Vulkan { call, result })
+        self.map_err(|result| LucentError::vulkan(call, result))
     }
 }
 
 impl LucentError {
+    /// The error for a failed Vulkan call: device and surface loss get their own variants (a
+    /// clear message, never a retry), everything else is [`LucentError::Vulkan`].
+    pub fn vulkan(call: &'static str, result: ash::vk::Result) -> Self {
+        match result {
+            ash::vk::Result::ERROR_DEVICE_LOST => LucentError::DeviceLost { call },
+            ash::vk::Result::ERROR_SURFACE_LOST_KHR => LucentError::SurfaceLost { call },
+            result => LucentError::Vulkan { call, result },
+        }
+    }
+
     /// A file error from an `std::io::Error` (or anything displayable), naming the path.
     pub fn file(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
         LucentError::File {

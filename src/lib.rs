@@ -9,12 +9,15 @@
 //!
 //! Beside them: [`scene`] (what is drawn), [`reference`](mod@reference) (CPU f64 versions of every shading
 //! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
-//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes).
+//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes), and, with the
+//! `window` feature, `demo` (the interactive window; it sits above the renderer and passes).
 
 pub mod backend;
 pub mod bake;
 pub mod bench;
 pub mod compare;
+#[cfg(feature = "window")]
+pub mod demo;
 pub mod error;
 pub mod graph;
 pub mod output;

@@ -173,6 +173,30 @@ fn load_font() -> std::result::Result<(), (PathBuf, String)> {
     ))
 }
 
+/// The font file text is drawn with elsewhere (the demo's overlay): the file named by
+/// `LUCENT_PLOT_FONT` when set, else the first of the system candidates above that exists.
+/// Errors say what was looked for and how to install one.
+pub fn font_file() -> Result<PathBuf> {
+    if let Some(wanted) = std::env::var_os(FONT_ENV).filter(|v| !v.is_empty()) {
+        return Ok(PathBuf::from(wanted));
+    }
+    FONT_CANDIDATES
+        .iter()
+        .map(Path::new)
+        .find(|p| p.is_file())
+        .map(Path::to_path_buf)
+        .ok_or_else(|| {
+            LucentError::file(
+                FONT_CANDIDATES[0],
+                format!(
+                    "no font found (looked for {}); install one: apt-get install \
+                     fonts-dejavu-core, or set {FONT_ENV} to a .ttf file",
+                    FONT_CANDIDATES.join(", ")
+                ),
+            )
+        })
+}
+
 /// Reads `path` and registers it as "sans-serif". The bytes are leaked only after they were read.
 fn register(path: &Path) -> std::result::Result<(), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read font: {e}"))?;

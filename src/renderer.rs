@@ -15,6 +15,7 @@ use crate::backend::timer::{GpuTimer, ScopeTime};
 use crate::backend::{GpuBuffer, GpuContext};
 use crate::error::VkResultExt;
 use crate::graph::{CompileOptions, Executable, Plan, RenderGraph, ResourceId};
+use crate::passes::debug_view::{self, DebugView};
 use crate::passes::deferred::{GBufferLayout, GBufferPrecision, TranslucencyLayout};
 use crate::passes::translucency::{
     mesh_bounds, object_tiles, tile_rects, translucent_tiles, MaterialTable, ThicknessPacking,
@@ -119,6 +120,9 @@ pub struct FrameSettings {
     pub fault: Option<Fault>,
     /// Screen-space SSS knobs (Gaussian count, precision, bilateral sensitivity).
     pub sss: sss::SssKnobs,
+    /// Show a G-buffer target (or the lit image before SSS) instead of the frame, when the
+    /// frame has it (the demo's debug views).
+    pub debug_view: Option<DebugView>,
 }
 
 /// A value injected into one pixel of the lit image.
@@ -147,6 +151,7 @@ impl FrameSettings {
             sss_tiles: true,
             fault: None,
             sss: sss::SssKnobs::default(),
+            debug_view: None,
         }
     }
 }
@@ -267,6 +272,9 @@ pub fn declare_frame(
     let layout = features.gbuffer_layout(settings);
     let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
     let lit = deferred::lighting_pass(graph, &gb, scene_gpu);
+    let debug_display = settings
+        .debug_view
+        .and_then(|view| debug_view::debug_view_pass(graph, view, &gb, &lit, scene_gpu));
     let hdr = match (&features.sss, &lit.specular, &gb.sss) {
         (Some((profile, blur)), Some(specular), Some(strength)) => sss::sss_passes(
             graph,
@@ -285,7 +293,7 @@ pub fn declare_frame(
         ),
         _ => lit.color,
     };
-    let display = tonemap::tonemap_pass(graph, &hdr, scene_gpu);
+    let display = debug_display.unwrap_or_else(|| tonemap::tonemap_pass(graph, &hdr, scene_gpu));
     graph.export_image(&display, Access::TransferRead);
     let hdr_id = settings.export_hdr.then(|| {
         graph.export_image(&hdr, Access::TransferRead);

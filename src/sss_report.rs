@@ -91,7 +91,7 @@ pub fn sss_variants() -> Vec<SssVariant> {
             });
         }
     }
-    for taps in [5, 3] {
+    for taps in [7, 3] {
         let mut s = base(Technique::Lbb);
         s.sss.taps = taps;
         v.push(SssVariant {
@@ -120,14 +120,6 @@ pub fn sss_variants() -> Vec<SssVariant> {
         knob: "LBB screen tiles",
         name: "lbb whole screen".into(),
         settings: whole,
-    });
-    let mut fast = base(Technique::Lbb);
-    fast.sss.gaussians = Some(4);
-    fast.sss.taps = 5;
-    v.push(SssVariant {
-        knob: "LBB combined",
-        name: "lbb 4 Gaussians, 5 taps".into(),
-        settings: fast,
     });
     v
 }

@@ -14,6 +14,7 @@ fn desc(filter: Option<&str>) -> ContextDesc {
         validation: true,
         device_filter: filter.map(str::to_string),
         app_name: "lucent tests".to_string(),
+        ..ContextDesc::default()
     }
 }
 

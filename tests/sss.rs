@@ -164,11 +164,17 @@ fn extreme_profiles_stay_finite_and_bounded() {
             let what = format!("{} {what}", technique.name());
             let bad = hdr.iter().filter(|v| !v.is_finite()).count();
             assert_eq!(bad, 0, "{what}: {bad} non-finite values");
-            // A blur only averages: nothing brighter than the brightest unblurred pixel.
+            // A blur only averages: nothing brighter than the brightest unblurred pixel. LCB's
+            // and LBB's specular is evaluated on blurred slopes and moments, which can tilt a
+            // lobe towards a light it missed: not an average, but bounded (no blow-up).
+            let bound = match technique {
+                Technique::Control => peak * 1.01 + 1e-3,
+                _ => peak * 1.5,
+            };
             let max = hdr.iter().fold(0.0f32, |m, v| m.max(*v));
             assert!(
-                max <= peak * 1.01 + 1e-3,
-                "{what}: max {max} above the unblurred peak {peak}"
+                max <= bound,
+                "{what}: max {max} above {bound} (unblurred peak {peak})"
             );
         }
     }

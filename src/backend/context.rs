@@ -49,6 +49,12 @@ pub struct ContextDesc {
     pub device_filter: Option<String>,
     /// Application name reported to the driver (and shown by tools such as RenderDoc).
     pub app_name: String,
+    /// Instance extensions to enable beyond lucent's own, e.g. the surface extensions a window
+    /// system needs (`ash_window::enumerate_required_extensions`). Each must be present.
+    pub instance_extensions: Vec<CString>,
+    /// Enable `VK_KHR_swapchain` on the device, for presenting to a window; devices without it
+    /// are skipped. Off for headless use.
+    pub swapchain: bool,
 }
 
 impl Default for ContextDesc {
@@ -57,6 +63,8 @@ impl Default for ContextDesc {
             validation: false,
             device_filter: None,
             app_name: "lucent".to_string(),
+            instance_extensions: Vec::new(),
+            swapchain: false,
         }
     }
 }
@@ -104,6 +112,8 @@ pub struct DeviceInfo {
     pub independent_blend: bool,
     /// `shaderStorageImageWriteWithoutFormat` is enabled.
     pub storage_image_write_without_format: bool,
+    /// `VK_KHR_swapchain` is enabled (asked for with [`ContextDesc::swapchain`]).
+    pub swapchain: bool,
 }
 
 impl DeviceInfo {
@@ -310,7 +320,7 @@ impl GpuContext {
         queue: vk::Queue,
         queue_family: u32,
     ) -> Result<Self> {
-        let mut probe = probe_device(&instance, physical_device)?;
+        let mut probe = probe_device(&instance, physical_device, false)?;
         let families =
             // SAFETY: the caller guarantees `physical_device` is a valid handle of `instance`.
             unsafe { instance.get_physical_device_queue_family_properties(physical_device) };
@@ -334,6 +344,7 @@ impl GpuContext {
         probe.info.host_query_reset = false;
         probe.info.independent_blend = false;
         probe.info.storage_image_write_without_format = false;
+        probe.info.swapchain = false;
 
         let messenger_state = Box::new(MessengerState::default());
         // vkGetInstanceProcAddr returns null for debug-utils commands when the instance did not
@@ -740,6 +751,18 @@ fn create_instance(
             || has_extension(&extensions, validation_features));
 
     let mut extension_names = Vec::new();
+    for wanted in &desc.instance_extensions {
+        if !has_extension(&extensions, wanted) {
+            return Err(LucentError::MissingFeature {
+                device: "the Vulkan loader".to_string(),
+                feature: format!(
+                    "instance extension {} (asked for by the window system)",
+                    wanted.to_string_lossy()
+                ),
+            });
+        }
+        extension_names.push(wanted.as_ptr());
+    }
     if has_debug_utils {
         extension_names.push(debug_utils.as_ptr());
     }
@@ -836,9 +859,14 @@ fn queue_family_usable(family: &vk::QueueFamilyProperties) -> bool {
         && family.queue_count > 0
 }
 
-/// Checks that `pd` supports what lucent needs and collects its [`DeviceInfo`]; the optional
-/// feature flags say what is supported (and will be enabled by [`create_device`]).
-fn probe_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<Probe> {
+/// Checks that `pd` supports what lucent needs (and `VK_KHR_swapchain` when `swapchain`) and
+/// collects its [`DeviceInfo`]; the optional feature flags say what is supported (and will be
+/// enabled by [`create_device`]).
+fn probe_device(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    swapchain: bool,
+) -> Result<Probe> {
     // SAFETY: `pd` was enumerated from `instance` (or supplied by a host under wrap's contract).
     let props = unsafe { instance.get_physical_device_properties(pd) };
     let name = props
@@ -892,6 +920,20 @@ fn probe_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<Prob
             )
         })?;
 
+    if swapchain {
+        // SAFETY: plain query of a physical device of `instance`.
+        let extensions = unsafe { instance.enumerate_device_extension_properties(pd) }
+            .vk("vkEnumerateDeviceExtensionProperties")?;
+        if !extensions.iter().any(|e| {
+            e.extension_name_as_c_str()
+                .is_ok_and(|n| n == ash::khr::swapchain::NAME)
+        }) {
+            return Err(missing(
+                "VK_KHR_swapchain (presenting to a window)".to_string(),
+            ));
+        }
+    }
+
     let text = |s: std::result::Result<&CStr, _>| {
         s.map(|s: &CStr| s.to_string_lossy().into_owned())
             .unwrap_or_default()
@@ -908,6 +950,7 @@ fn probe_device(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Result<Prob
         independent_blend: core.independent_blend == vk::TRUE,
         storage_image_write_without_format: core.shader_storage_image_write_without_format
             == vk::TRUE,
+        swapchain,
     };
     Ok(Probe {
         info,
@@ -972,7 +1015,7 @@ fn pick_device(
     candidates.sort_by_key(|(_, _, score)| std::cmp::Reverse(*score));
     let mut first_error = None;
     for (pd, name, _) in &candidates {
-        match probe_device(instance, *pd) {
+        match probe_device(instance, *pd, desc.swapchain) {
             Ok(probe) => return Ok((*pd, probe)),
             Err(e) => {
                 log::info!("skipping Vulkan device '{name}': {e}");
@@ -1004,8 +1047,14 @@ fn create_device(
         .features(core)
         .push_next(&mut v12)
         .push_next(&mut v13);
+    let extensions = if probe.info.swapchain {
+        vec![ash::khr::swapchain::NAME.as_ptr()]
+    } else {
+        Vec::new()
+    };
     let create_info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_infos)
+        .enabled_extension_names(&extensions)
         .push_next(&mut features2);
     // SAFETY: `pd` belongs to `instance`; every enabled feature was reported as supported by
     // probe_device, and all pointers refer to locals that outlive the call.

@@ -76,6 +76,34 @@ enum Command {
         #[arg(long)]
         compare_thesis: bool,
     },
+    /// Open the interactive demo: a window to fly around a scene in, switch techniques, turn
+    /// knobs and watch per-pass GPU times (needs a display; see the README's "Demo").
+    #[cfg(feature = "window")]
+    Demo {
+        /// Scene: a built-in name (see `lucent scenes`) or a .toml scene file.
+        #[arg(long, default_value = "cubes")]
+        scene: String,
+        /// Technique at start (default: the one the scene is made for).
+        #[arg(long)]
+        technique: Option<String>,
+        /// Window size as WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Vertical sync: on (FIFO) or off (MAILBOX or IMMEDIATE when available, else FIFO).
+        #[arg(long, default_value = "on", value_parser = parse_on_off, action = clap::ArgAction::Set)]
+        vsync: bool,
+        /// Exit after this many presented frames.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Scripted input (see the README's "Demo" for the format).
+        #[arg(long)]
+        script: Option<PathBuf>,
+        /// On exit, write the last frame (without the overlay) as PNG.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Print the compiled render graph: passes, merged groups, barriers, lifetimes, memory.
     Plan {
         #[command(flatten)]
@@ -188,8 +216,8 @@ struct FrameArgs {
     /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
     #[arg(long)]
     sss_packed: bool,
-    /// LBB: bilateral taps per direction (3, 5 or 7).
-    #[arg(long, default_value_t = 7, value_parser = parse_taps)]
+    /// LBB: bilateral taps per direction (3, 5 or 7; the thesis's shader has 7).
+    #[arg(long, default_value_t = 5, value_parser = parse_taps)]
     sss_taps: u32,
 }
 
@@ -227,6 +255,15 @@ struct GpuArgs {
     /// LUCENT_VALIDATION=1); any validation error makes the command fail.
     #[arg(long)]
     validation: bool,
+}
+
+#[cfg(feature = "window")]
+fn parse_on_off(text: &str) -> std::result::Result<bool, String> {
+    match text {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        other => Err(format!("'{other}' is not on or off")),
+    }
 }
 
 fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
@@ -273,6 +310,7 @@ impl FrameArgs {
                     )));
                 },
             },
+            debug_view: None,
         })
     }
 }
@@ -672,6 +710,28 @@ fn run(cli: Cli) -> Result<()> {
             max_distance,
             seed,
         } => bake_thickness(&mesh, out, per_vertex, rays, size, max_distance, seed),
+        #[cfg(feature = "window")]
+        Command::Demo {
+            scene,
+            technique,
+            size,
+            vsync,
+            frames,
+            script,
+            screenshot,
+            gpu,
+        } => lucent::demo::run(lucent::demo::DemoOptions {
+            scene,
+            technique: technique.as_deref().map(Technique::parse).transpose()?,
+            size,
+            vsync,
+            frames,
+            script,
+            screenshot,
+            validation: gpu.validation,
+            device: gpu.device,
+            base: FrameSettings::new(size.0, size.1),
+        }),
         Command::Plan { frame } => {
             let scene = scene::load_scene(&frame.scene)?;
             let settings = frame.settings(false)?;

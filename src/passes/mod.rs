@@ -6,8 +6,10 @@
 //!   packing (its shading runs inside the deferred lighting pass).
 //! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
+//! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 
+pub mod debug_view;
 pub mod deferred;
 pub mod sss;
 pub mod tonemap;

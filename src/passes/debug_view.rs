@@ -1,0 +1,182 @@
+//! Debug views: a G-buffer target or the lit image before screen-space SSS, written into the
+//! display image in place of the tonemapped frame (`FrameSettings::debug_view`).
+//!
+//! The pass samples its source like the tonemap does, so it is one physical pass of its own;
+//! the passes whose results it does not show are culled by the graph (a depth view runs only
+//! the G-buffer pass and itself).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::graph::{
+    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
+    RenderGraph, ResourceId,
+};
+use crate::Result;
+
+use super::deferred::{GBuffer, Lit};
+use super::tonemap::LDR_FORMAT;
+use super::translucency::ThicknessPacking;
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::SceneGpu;
+
+/// What a debug view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DebugView {
+    /// Albedo (GB0 rgb), sRGB-encoded.
+    Albedo,
+    /// World normal (GB1 xyz) mapped to [0, 1].
+    Normal,
+    /// Depth: log of the view distance between the near and far planes (near white).
+    Depth,
+    /// Local thickness (GB2), frames with translucency only.
+    Thickness,
+    /// Material ID (GB2) as a colour, frames with translucency only.
+    MaterialId,
+    /// The lit frame before the SSS blurs (diffuse + specular, tonemapped), frames with SSS
+    /// only; the ordinary frame is the one after.
+    LitBeforeSss,
+}
+
+impl DebugView {
+    /// Every view with its name, in the order the demo cycles through them.
+    pub const ALL: &'static [(&'static str, DebugView)] = &[
+        ("albedo", DebugView::Albedo),
+        ("normal", DebugView::Normal),
+        ("depth", DebugView::Depth),
+        ("thickness", DebugView::Thickness),
+        ("material ID", DebugView::MaterialId),
+        ("SSS before blur", DebugView::LitBeforeSss),
+    ];
+
+    /// Display name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, v)| *v == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    fn define(self) -> &'static str {
+        match self {
+            DebugView::Albedo => "LUCENT_VIEW_ALBEDO",
+            DebugView::Normal => "LUCENT_VIEW_NORMAL",
+            DebugView::Depth => "LUCENT_VIEW_DEPTH",
+            DebugView::Thickness => "LUCENT_VIEW_THICKNESS",
+            DebugView::MaterialId => "LUCENT_VIEW_MATERIAL",
+            DebugView::LitBeforeSss => "LUCENT_VIEW_LIT",
+        }
+    }
+}
+
+/// Declares the debug view pass and returns its display image, or `None` when the frame does
+/// not have what the view shows (thickness and material ID without GB2, the pre-blur image
+/// without SSS); the caller then uses the ordinary tonemapped frame.
+pub fn debug_view_pass(
+    graph: &mut RenderGraph,
+    view: DebugView,
+    gb: &GBuffer,
+    lit: &Lit,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Option<Handle<Image>> {
+    let (source, second) = match view {
+        DebugView::Albedo => (&gb.gb0, None),
+        DebugView::Normal => (&gb.gb1, None),
+        DebugView::Depth => (&gb.depth, None),
+        DebugView::Thickness | DebugView::MaterialId => (gb.gb2.as_ref()?, None),
+        DebugView::LitBeforeSss => {
+            gb.sss.as_ref()?;
+            (&lit.color, lit.specular.as_ref())
+        }
+    };
+    let info = graph.resources()[gb.gb0.id()].info;
+    let mut ldr = graph.create_image(
+        "display",
+        ImageInfo {
+            format: LDR_FORMAT,
+            ..info
+        },
+    );
+    let mut pass = graph.add_pass("debug view", PassKind::Raster);
+    pass.sample(source);
+    if let Some(s) = second {
+        pass.sample(s);
+    }
+    pass.color(&mut ldr, LoadOp::DontCare);
+    let colored = gb
+        .layout
+        .translucency
+        .is_some_and(|t| t.packing == ThicknessPacking::Colored);
+    match scene {
+        Some(scene) => pass.execute(DebugViewPass {
+            scene: scene.clone(),
+            view,
+            colored,
+            inputs: (source.id(), second.map(|s| s.id())),
+            sampler: vk::Sampler::null(),
+            pipeline: None,
+        }),
+        None => pass.finish(),
+    }
+    Some(ldr)
+}
+
+struct DebugViewPass {
+    scene: Arc<SceneGpu>,
+    view: DebugView,
+    colored: bool,
+    inputs: (ResourceId, Option<ResourceId>),
+    sampler: vk::Sampler,
+    pipeline: Option<PassPipeline>,
+}
+
+impl PassExec for DebugViewPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
+        let mut bindings = vec![
+            Binding::Uniform(self.scene.frame_uniforms),
+            Binding::Sampled(ctx.views[self.inputs.0], self.sampler),
+        ];
+        let mut defines = vec![(self.view.define(), "1")];
+        if let Some(second) = self.inputs.1 {
+            bindings.push(Binding::Sampled(ctx.views[second], self.sampler));
+            defines.push(("LUCENT_VIEW_SECOND", "1"));
+        }
+        if self.colored {
+            defines.push(("LUCENT_COLORED_THICKNESS", "1"));
+        }
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &bindings,
+            &GraphicsPipelineDesc {
+                vertex: "fullscreen.vert",
+                fragment: "debug/view.frag",
+                defines: &defines,
+                vertex_input: VertexInput::None,
+                depth_test: false,
+                cull_back: false,
+                additive_attachments: 0,
+                set_layouts: &[],
+                push_constant_bytes: 0,
+                name: "debug view",
+            },
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        if let Some(pipeline) = &self.pipeline {
+            pipeline.draw_fullscreen(ctx);
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
+        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
+        self.sampler = vk::Sampler::null();
+    }
+}

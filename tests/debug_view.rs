@@ -1,0 +1,183 @@
+//! The debug views (`FrameSettings::debug_view`, the demo's V key) against the G-buffer read
+//! back from the same frame, validation on.
+
+mod common;
+
+use common::TestGpu;
+use lucent::passes::debug_view::DebugView;
+use lucent::passes::translucency::ThicknessPacking;
+use lucent::renderer::{FrameRunner, FrameSettings, GBufferReadback, Renderer, Technique};
+use lucent::scene;
+
+/// The display image of one frame, and its G-buffer.
+fn frame(
+    test: &TestGpu,
+    scene: &scene::Scene,
+    settings: FrameSettings,
+) -> (Vec<u8>, GBufferReadback) {
+    let gpu = &test.gpu;
+    let settings = FrameSettings {
+        export_gbuffer: true,
+        ..settings
+    };
+    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
+    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
+    runner.run_frame(gpu, &renderer.executable).unwrap();
+    runner.run_frame(gpu, &renderer.executable).unwrap();
+    let display = renderer.read_display(gpu).unwrap();
+    let gbuffer = renderer.read_gbuffer(gpu).unwrap();
+    gpu.wait_idle().unwrap();
+    runner.destroy(gpu);
+    renderer.destroy(gpu);
+    (display, gbuffer)
+}
+
+fn srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Largest per-channel difference (RGB) between the display and `expected` (0..1 values).
+fn worst(display: &[u8], expected: impl Iterator<Item = [f32; 3]>) -> u8 {
+    display
+        .chunks_exact(4)
+        .zip(expected)
+        .flat_map(|(px, e)| (0..3).map(move |c| px[c].abs_diff((e[c] * 255.0).round() as u8)))
+        .max()
+        .unwrap()
+}
+
+#[test]
+fn gbuffer_views_show_what_the_gbuffer_holds() {
+    let test = TestGpu::new();
+    let cubes = scene::load_scene("cubes").unwrap();
+    let base = FrameSettings {
+        technique: Technique::Translucency,
+        ..FrameSettings::new(160, 120)
+    };
+    let view = |v| FrameSettings {
+        debug_view: Some(v),
+        ..base
+    };
+    let (final_frame, _) = frame(&test, &cubes, base);
+
+    let (albedo, gb) = frame(&test, &cubes, view(DebugView::Albedo));
+    let w = worst(
+        &albedo,
+        gb.gb0.iter().map(|t| [srgb(t[0]), srgb(t[1]), srgb(t[2])]),
+    );
+    assert!(w <= 1, "albedo view off by {w}/255");
+
+    let (normal, gb) = frame(&test, &cubes, view(DebugView::Normal));
+    let expected = gb.gb1.iter().map(|t| {
+        let n = glam::Vec3::new(t[0], t[1], t[2]);
+        if n.length_squared() < 1e-6 {
+            [0.0; 3]
+        } else {
+            (n.normalize() * 0.5 + 0.5).to_array()
+        }
+    });
+    let w = worst(&normal, expected);
+    assert!(w <= 1, "normal view off by {w}/255");
+
+    let (depth, gb) = frame(&test, &cubes, view(DebugView::Depth));
+    let (n, f) = (cubes.camera.near, cubes.camera.far);
+    let expected = gb.depth.iter().map(|&d| {
+        if d >= 1.0 {
+            return [0.0; 3];
+        }
+        let linear = n * f / (f - d * (f - n)).max(1e-6);
+        [(1.0 - (linear.max(n) / n).ln() / (f / n).ln()).clamp(0.0, 1.0); 3]
+    });
+    let w = worst(&depth, expected);
+    assert!(w <= 2, "depth view off by {w}/255");
+
+    let (thickness, gb) = frame(&test, &cubes, view(DebugView::Thickness));
+    let gb2 = gb.gb2.expect("translucency frames have GB2");
+    // GB2: (thickness rgb, material ID / 255) coloured, (thickness, material ID / 255) gray.
+    let packing = gb.layout.translucency.unwrap().packing;
+    let colored = packing == ThicknessPacking::Colored;
+    assert!(
+        colored,
+        "cubes has a coloured thickness (its red-veined cube)"
+    );
+    let w = worst(
+        &thickness,
+        gb2.iter().map(|t| [srgb(t[0]), srgb(t[1]), srgb(t[2])]),
+    );
+    assert!(w <= 1, "thickness view off by {w}/255");
+
+    let (material, gb) = frame(&test, &cubes, view(DebugView::MaterialId));
+    let gb2 = gb.gb2.unwrap();
+    for (px, t) in material.chunks_exact(4).zip(&gb2) {
+        let id = (t[3] * 255.0).round() as u32;
+        let black = px[..3] == [0, 0, 0];
+        assert_eq!(black, id == 0, "material {id} shown as {px:?}");
+    }
+    assert!(material.chunks_exact(4).any(|p| p[..3] != [0, 0, 0]));
+
+    // A view the frame cannot show (no SSS here) is the ordinary frame, exactly.
+    let (fallback, _) = frame(&test, &cubes, view(DebugView::LitBeforeSss));
+    assert_eq!(fallback, final_frame);
+    test.finish();
+}
+
+#[test]
+fn pre_blur_view_is_the_unblurred_lighting_and_the_blur_changes_it() {
+    let test = TestGpu::new();
+    // `edges`: a skin profile four times as wide, so the blur reaches over several pixels.
+    let edges = scene::load_scene("edges").unwrap();
+    let base = FrameSettings {
+        technique: Technique::Control,
+        ..FrameSettings::new(320, 240)
+    };
+    let (after, gb) = frame(&test, &edges, base);
+    let (before, _) = frame(
+        &test,
+        &edges,
+        FrameSettings {
+            debug_view: Some(DebugView::LitBeforeSss),
+            ..base
+        },
+    );
+    // Diffuse + specular lit apart and summed is the plain deferred frame (technique none).
+    let (plain, _) = frame(
+        &test,
+        &edges,
+        FrameSettings {
+            technique: Technique::None,
+            ..base
+        },
+    );
+    let to_unit = |p: &[u8]| [p[0], p[1], p[2]].map(|v| f32::from(v) / 255.0);
+    let w = worst(&before, plain.chunks_exact(4).map(to_unit));
+    assert!(
+        w <= 2,
+        "pre-blur view differs from the unblurred frame by {w}/255"
+    );
+    // The blur moves light only at scattering pixels.
+    let strength = gb.sss.expect("SSS frames export the SSS strength");
+    let (mut changed, mut changed_elsewhere) = (0, 0);
+    for ((a, b), s) in after
+        .chunks_exact(4)
+        .zip(before.chunks_exact(4))
+        .zip(&strength)
+    {
+        let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+        if d > 2 {
+            if *s > 0.0 {
+                changed += 1;
+            } else {
+                changed_elsewhere += 1;
+            }
+        }
+    }
+    eprintln!("blur changed {changed} scattering pixels by > 2/255, {changed_elsewhere} others");
+    assert!(changed > 50, "the blur changed only {changed} pixels");
+    assert_eq!(changed_elsewhere, 0);
+    test.finish();
+}

@@ -226,6 +226,10 @@ impl FrameFeatures {
                 }),
             sss: self.sss.is_some(),
             lean: self.sss.as_ref().is_some_and(|(_, blur)| blur.lean()),
+            lean_clear: self
+                .sss
+                .as_ref()
+                .is_some_and(|(_, blur)| blur.lean() && !blur.bilateral()),
             normal_maps: self.normal_maps,
             fault_injection: settings.fault.is_some(),
         }

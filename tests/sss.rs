@@ -451,7 +451,7 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
         s.sss.gaussians = gaussians;
         let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
         let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
-        let mut expected = vec!["gbuffer + lighting".to_string()];
+        let mut expected = vec!["projection + lighting".to_string()];
         for i in 1..=gaussians.unwrap_or(6) {
             expected.push(format!("horizontal blur #{i}"));
             expected.push(format!("vertical blur #{i}"));

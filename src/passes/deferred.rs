@@ -80,6 +80,8 @@ pub struct GBufferLayout {
     /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
     /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
     pub lean: bool,
+    /// LCB: the LEAN target is cleared first (see [`gbuffer_pass`]).
+    pub lean_clear: bool,
     /// Some object has a normal map: the G-buffer pass reads UVs and tangents and samples it.
     pub normal_maps: bool,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
@@ -215,7 +217,9 @@ pub fn gbuffer_pass(
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
         layout,
     };
-    let mut pass = graph.add_pass("gbuffer", PassKind::Raster);
+    // LCB and LBB: the G-buffer pass is the thesis's projection pass (its Table 1's first row).
+    let name = if layout.lean { "projection" } else { "gbuffer" };
+    let mut pass = graph.add_pass(name, PassKind::Raster);
     pass.color(&mut gb.gb0, LoadOp::Clear([0.0; 4]))
         .color(&mut gb.gb1, LoadOp::Clear([0.0, 1.0, 0.0, 1.0]));
     if let Some(gb2) = &mut gb.gb2 {
@@ -227,9 +231,16 @@ pub fn gbuffer_pass(
         pass.color(sss, LoadOp::Clear([0.0; 4]));
     }
     if let Some(lean) = &mut gb.lean {
-        // Location 3 of glsl/deferred/gbuffer.frag. Cleared: the control-style blur's bilinear
-        // taps straddle silhouettes and would filter undefined sky texels into the moments.
-        pass.color(lean, LoadOp::Clear([0.0; 4]));
+        // Location 3 of glsl/deferred/gbuffer.frag. LCB clears it: the control-style blur's
+        // bilinear taps straddle silhouettes and would filter undefined sky texels into the
+        // moments. LBB's point taps give sky texels zero weight (depth) and replace non-finite
+        // ones, so it skips the clear.
+        let load = if layout.lean_clear {
+            LoadOp::Clear([0.0; 4])
+        } else {
+            LoadOp::DontCare
+        };
+        pass.color(lean, load);
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {

@@ -181,3 +181,55 @@ fn pre_blur_view_is_the_unblurred_lighting_and_the_blur_changes_it() {
     assert_eq!(changed_elsewhere, 0);
     test.finish();
 }
+
+#[test]
+fn translucency_term_view_is_the_difference_translucency_makes() {
+    // The lighting pass adds the talk's term to diffuse + specular: the term view must be the
+    // translucency frame's HDR minus the plain frame's, tonemapped alike.
+    let test = TestGpu::new();
+    let cubes = scene::load_scene("cubes").unwrap();
+    let hdr = |technique| {
+        let gpu = &test.gpu;
+        let settings = FrameSettings {
+            technique,
+            export_hdr: true,
+            ..FrameSettings::new(160, 120)
+        };
+        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &cubes, settings).unwrap();
+        let images = renderer.render_once(gpu).unwrap();
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        images.hdr.unwrap()
+    };
+    let (with, without) = (hdr(Technique::Translucency), hdr(Technique::None));
+    let (term, gb) = frame(
+        &test,
+        &cubes,
+        FrameSettings {
+            technique: Technique::Translucency,
+            debug_view: Some(DebugView::TranslucencyTerm),
+            ..FrameSettings::new(160, 120)
+        },
+    );
+    let exposure = f64::from(cubes.exposure);
+    let mut worst_diff = 0u8;
+    for (i, px) in term.chunks_exact(4).enumerate() {
+        let d = glam::DVec3::from_array(std::array::from_fn(|c| {
+            f64::from(with[i * 4 + c] - without[i * 4 + c]).max(0.0)
+        }));
+        let expected = lucent::reference::tonemap::display_rgba8(d, exposure);
+        for c in 0..3 {
+            worst_diff = worst_diff.max(px[c].abs_diff(expected[c]));
+        }
+    }
+    // fp16 rounding of the two lit frames (the difference of two rounded values).
+    assert!(worst_diff <= 3, "term view off by {worst_diff}/255");
+    let gb2 = gb.gb2.unwrap();
+    let lit = term
+        .chunks_exact(4)
+        .zip(&gb2)
+        .filter(|(px, t)| px[..3] != [0, 0, 0] && (t[3] * 255.0).round() as u32 != 0)
+        .count();
+    assert!(lit > 500, "only {lit} pixels show a translucency term");
+    test.finish();
+}

@@ -11,9 +11,19 @@
 // permutation: LUCENT_VIEW_MATERIAL LUCENT_COLORED_THICKNESS
 // permutation: LUCENT_VIEW_LIT
 // permutation: LUCENT_VIEW_LIT LUCENT_VIEW_SECOND
+// permutation: LUCENT_VIEW_TERM LUCENT_POW_MODES=3
+// permutation: LUCENT_VIEW_TERM LUCENT_POW_MODES=3 LUCENT_COLORED_THICKNESS
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 #include "../common/gbuffer.glsl"
+#ifdef LUCENT_VIEW_TERM
+// The GDC 2011 translucency term alone: `source` is GB0, then GB1, GB2 and depth; binding 5 is
+// the material table (glsl/common/translucency.glsl).
+#include "../common/translucency.glsl"
+layout(set = 0, binding = 2) uniform sampler2D gb1_tex;
+layout(set = 0, binding = 3) uniform sampler2D gb2_tex;
+layout(set = 0, binding = 4) uniform sampler2D depth_tex;
+#endif
 
 layout(set = 0, binding = 1) uniform sampler2D source;
 #ifdef LUCENT_VIEW_SECOND
@@ -50,6 +60,35 @@ void main() {
 #ifdef LUCENT_VIEW_SECOND
     hdr += texelFetch(second, p, 0).rgb;
 #endif
+    c = linear_to_srgb(tonemap_aces(hdr * frame.exposure.x));
+#elif defined(LUCENT_VIEW_TERM)
+    // Sum over the lights of the talk's term (lobe + ambient) x thickness x albedo x light,
+    // without diffuse and specular, tonemapped like the frame.
+    float d = texelFetch(depth_tex, p, 0).r;
+    vec3 hdr = vec3(0.0);
+    vec4 g2 = texelFetch(gb2_tex, p, 0);
+    int id = clamp(unpack_material_id(g2), 0, 255);
+    if (d < 1.0 && id != 0) {
+        Surface s = unpack_gbuffer(t, texelFetch(gb1_tex, p, 0));
+        vec4 material = translucency_materials.rows[id];
+        vec3 thickness = unpack_thickness(g2);
+        vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
+        vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
+        vec3 pos = world.xyz / world.w;
+        vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
+        float v_dot_n = dot(to_eye, s.normal);
+        int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
+        for (int i = 0; i < count; ++i) {
+            Light light = frame.lights[i];
+            vec3 to_light;
+            float attenuation;
+            light_incidence(light, pos, to_light, attenuation);
+            float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
+            float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
+            hdr += s.albedo * (lobe + material.z) * thickness * light.radiance_range.rgb
+                   * attenuation;
+        }
+    }
     c = linear_to_srgb(tonemap_aces(hdr * frame.exposure.x));
 #else
 #error "no LUCENT_VIEW_* defined"

@@ -342,7 +342,7 @@ pub const KEYS: &[KeyBinding] = &[
         name: "V",
         action: Action::CycleDebugView,
         help:
-            "debug view: off / albedo / normal / depth / thickness / material ID / SSS before blur",
+            "debug view: off / albedo / normal / depth / thickness / material ID / translucency term / SSS before blur",
     },
     KeyBinding {
         name: "1",

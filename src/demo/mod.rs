@@ -836,7 +836,9 @@ impl Demo<'_> {
             return false;
         };
         match view {
-            DebugView::Thickness | DebugView::MaterialId => features.translucency.is_some(),
+            DebugView::Thickness | DebugView::MaterialId | DebugView::TranslucencyTerm => {
+                features.translucency.is_some()
+            }
             DebugView::LitBeforeSss => features.sss.is_some(),
             DebugView::Albedo | DebugView::Normal | DebugView::Depth => true,
         }

@@ -37,6 +37,9 @@ pub enum DebugView {
     /// The lit frame before the SSS blurs (diffuse + specular, tonemapped), frames with SSS
     /// only; the ordinary frame is the one after.
     LitBeforeSss,
+    /// The GDC 2011 translucency term alone (every light, tonemapped), frames with
+    /// translucency only.
+    TranslucencyTerm,
 }
 
 impl DebugView {
@@ -47,6 +50,7 @@ impl DebugView {
         ("depth", DebugView::Depth),
         ("thickness", DebugView::Thickness),
         ("material ID", DebugView::MaterialId),
+        ("translucency term", DebugView::TranslucencyTerm),
         ("SSS before blur", DebugView::LitBeforeSss),
     ];
 
@@ -66,6 +70,7 @@ impl DebugView {
             DebugView::Thickness => "LUCENT_VIEW_THICKNESS",
             DebugView::MaterialId => "LUCENT_VIEW_MATERIAL",
             DebugView::LitBeforeSss => "LUCENT_VIEW_LIT",
+            DebugView::TranslucencyTerm => "LUCENT_VIEW_TERM",
         }
     }
 }
@@ -89,6 +94,15 @@ pub fn debug_view_pass(
             gb.sss.as_ref()?;
             (&lit.color, lit.specular.as_ref())
         }
+        DebugView::TranslucencyTerm => {
+            gb.gb2.as_ref()?;
+            (&gb.gb0, Some(&gb.gb1))
+        }
+    };
+    // The term also reads GB2 and depth (and the material table).
+    let term_inputs = match (view, &gb.gb2) {
+        (DebugView::TranslucencyTerm, Some(gb2)) => Some((gb2, &gb.depth)),
+        _ => None,
     };
     let info = graph.resources()[gb.gb0.id()].info;
     let mut ldr = graph.create_image(
@@ -103,6 +117,9 @@ pub fn debug_view_pass(
     if let Some(s) = second {
         pass.sample(s);
     }
+    if let Some((gb2, depth)) = term_inputs {
+        pass.sample(gb2).sample(depth);
+    }
     pass.color(&mut ldr, LoadOp::DontCare);
     let colored = gb
         .layout
@@ -114,6 +131,7 @@ pub fn debug_view_pass(
             view,
             colored,
             inputs: (source.id(), second.map(|s| s.id())),
+            term: term_inputs.map(|(g, d)| (g.id(), d.id())),
             sampler: vk::Sampler::null(),
             pipeline: None,
         }),
@@ -127,6 +145,8 @@ struct DebugViewPass {
     view: DebugView,
     colored: bool,
     inputs: (ResourceId, Option<ResourceId>),
+    /// The translucency term's GB2 and depth.
+    term: Option<(ResourceId, ResourceId)>,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
 }
@@ -139,9 +159,20 @@ impl PassExec for DebugViewPass {
             Binding::Sampled(ctx.views[self.inputs.0], self.sampler),
         ];
         let mut defines = vec![(self.view.define(), "1")];
-        if let Some(second) = self.inputs.1 {
-            bindings.push(Binding::Sampled(ctx.views[second], self.sampler));
-            defines.push(("LUCENT_VIEW_SECOND", "1"));
+        match (self.inputs.1, self.term, &self.scene.translucency) {
+            (Some(gb1), Some((gb2, depth)), Some(t)) => {
+                for id in [gb1, gb2] {
+                    bindings.push(Binding::Sampled(ctx.views[id], self.sampler));
+                }
+                bindings.push(Binding::Sampled(ctx.descriptor_views[depth], self.sampler));
+                bindings.push(Binding::Uniform(t.materials.buffer));
+                defines.push(("LUCENT_POW_MODES", "3"));
+            }
+            (Some(second), _, _) => {
+                bindings.push(Binding::Sampled(ctx.views[second], self.sampler));
+                defines.push(("LUCENT_VIEW_SECOND", "1"));
+            }
+            _ => {}
         }
         if self.colored {
             defines.push(("LUCENT_COLORED_THICKNESS", "1"));

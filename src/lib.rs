@@ -9,7 +9,9 @@
 //!
 //! Beside them: [`scene`] (what is drawn), [`reference`](mod@reference) (CPU f64 versions of every shading
 //! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
-//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes).
+//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes), [`speed_of_light`] (each pass's
+//! copy floor), [`scaling`] (time against triangles, resolution, lights), [`suite`] (`lucent
+//! report`: everything above written as one report with plots).
 
 pub mod backend;
 pub mod bake;
@@ -23,8 +25,11 @@ pub mod plot;
 pub mod reference;
 pub mod renderer;
 pub mod report;
+pub mod scaling;
 pub mod scene;
 pub mod seeds;
+pub mod speed_of_light;
+pub mod suite;
 pub mod sweep;
 
 pub use error::{LucentError, Result};

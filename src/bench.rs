@@ -14,7 +14,7 @@
 //! instead and says so. If even those do not add up, the report is marked untrusted and the
 //! command exits non-zero.
 //!
-//! With a [`CopyFrame`](crate::speed_of_light::CopyFrame) the same run also times every pass's
+//! With a [`CopyFrame`] the same run also times every pass's
 //! speed-of-light copy, alternating with the frames, and the report gains the pass / copy table.
 //! Output: [`BenchReport::markdown`], [`BenchReport::csv`], [`BenchReport::json`]. Runs longer
 //! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal.

@@ -619,8 +619,8 @@ fn draw_curves(
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.6))
         .border_style(RGBColor(160, 160, 160))
         .label_font(("sans-serif", 14))
         .draw()
@@ -695,12 +695,7 @@ pub fn write_bars_png(
             chart
                 .configure_mesh()
                 .x_desc(x_label)
-                .y_labels(rows.len().max(1))
-                .y_label_formatter(&|v| {
-                    // Rows are drawn top to bottom; tick v names the row whose band holds v.
-                    let i = (n - v).floor() as usize;
-                    labels.get(i).cloned().unwrap_or_default()
-                })
+                .y_labels(0)
                 .x_label_formatter(&|v| format_tick(*v))
                 .axis_desc_style(("sans-serif", 17))
                 .label_style(("sans-serif", 13))
@@ -708,6 +703,17 @@ pub fn write_bars_png(
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()
                 .map_err(err)?;
+            // Row labels by hand, centred on each row's pair of bars, right-aligned left of
+            // the axis (the mesh's own ticks would not sit on the rows).
+            let label_style = ("sans-serif", 13)
+                .into_font()
+                .color(&RGBColor(40, 40, 40))
+                .pos(Pos::new(HPos::Right, VPos::Center));
+            for (i, label) in labels.iter().enumerate() {
+                let (px, py) = chart.backend_coord(&(0.0, n - i as f64 - 0.5));
+                root.draw(&Text::new(label.clone(), (px - 8, py), label_style.clone()))
+                    .map_err(err)?;
+            }
             let colour = COLOURS[0];
             let grey = RGBColor(150, 150, 150);
             for (i, r) in rows.iter().enumerate() {
@@ -728,18 +734,16 @@ pub fn write_bars_png(
                         .map_err(err)?;
                 }
             }
-            // Legend by hand: one swatch per colour in the upper right.
-            let (w, _) = chart.plotting_area().dim_in_pixel();
-            let area = chart.plotting_area().strip_coord_spec();
+            // Legend by hand, below the x axis at the right, clear of the bars.
             for (k, (name, c)) in [(value_name, colour), (floor_name, grey)]
                 .iter()
                 .enumerate()
             {
-                let y = 12 + 22 * k as i32;
-                let x = w as i32 - 150;
-                area.draw(&Rectangle::new([(x, y), (x + 16, y + 12)], c.filled()))
+                let y = HEIGHT as i32 - 22;
+                let x = WIDTH as i32 - 330 + 150 * k as i32;
+                root.draw(&Rectangle::new([(x, y), (x + 16, y + 12)], c.filled()))
                     .map_err(err)?;
-                area.draw(&Text::new(
+                root.draw(&Text::new(
                     name.to_string(),
                     (x + 22, y),
                     ("sans-serif", 14).into_font(),
@@ -774,8 +778,9 @@ mod tests {
         ];
         write_curves_png(&curves, "time against triangles", "triangles", "ms", &data).unwrap();
         check_png(&curves);
-        write_curves_png(&curves, "empty", "x", "y", &[]).unwrap();
-        check_png(&curves);
+        let empty = dir.join("curves-empty.png");
+        write_curves_png(&empty, "empty", "x", "y", &[]).unwrap();
+        check_png(&empty);
         let bars = dir.join("bars.png");
         let rows = [
             BarRow {
@@ -791,8 +796,9 @@ mod tests {
         ];
         write_bars_png(&bars, "passes", "ms", "pass", "copy", &rows).unwrap();
         check_png(&bars);
-        write_bars_png(&bars, "no rows", "ms", "pass", "copy", &[]).unwrap();
-        check_png(&bars);
+        let empty = dir.join("bars-empty.png");
+        write_bars_png(&empty, "no rows", "ms", "pass", "copy", &[]).unwrap();
+        check_png(&empty);
     }
 
     fn temp_dir(name: &str) -> PathBuf {

@@ -490,8 +490,8 @@ pub fn write_translucency_report(
 }
 
 /// The translucency report as a section of the suite: written beside `report.md`, and its
-/// tables embedded one heading level down. Full run: 512x384, 10 rounds (the f64 reference of
-/// each of its 11 measured variants is computed on the CPU); quick: 128x96, 2 rounds.
+/// tables embedded one heading level down. Full run: 1024x768 (the size of the technique
+/// tables), the suite's rounds; quick: 128x96, 2 rounds.
 pub fn translucency_section(
     ctx: &crate::suite::SuiteContext<'_>,
 ) -> Result<crate::suite::SectionOutput> {
@@ -504,8 +504,8 @@ pub fn translucency_section(
         }
     } else {
         ReportOptions {
-            width: 512,
-            height: 384,
+            width: ctx.options.width,
+            height: ctx.options.height,
             rounds: ctx.options.frames,
             warmup: ctx.options.warmup,
         }

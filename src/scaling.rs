@@ -176,6 +176,7 @@ impl Growth {
     /// The exponent in words.
     pub fn verdict(&self) -> &'static str {
         match self.exponent {
+            s if s >= 1.3 => "grows faster than in proportion",
             s if s >= 0.75 => "grows in proportion",
             s if s >= 0.35 => "grows, less than in proportion",
             s if s >= 0.1 => "grows weakly",
@@ -247,7 +248,7 @@ pub fn markdown(axis: &str, unit: &str, points: &[Measured]) -> String {
         .first()
         .map(|p| p.passes.iter().map(|(n, _)| n.clone()).collect())
         .unwrap_or_default();
-    let _ = write!(out, "| {unit} | triangles |");
+    let _ = write!(out, "| {unit} | triangles drawn |");
     for n in &names {
         let _ = write!(out, " {n} ms |");
     }
@@ -274,7 +275,7 @@ pub fn markdown(axis: &str, unit: &str, points: &[Measured]) -> String {
     }
     let _ = writeln!(
         out,
-        "\nGrowth along {axis} (exponent s of a fit ms = a * x^s; 1: in proportion, 0: flat):\n"
+        "\nGrowth along {axis} (x: {unit}; exponent s of a fit ms = a * x^s; 1: in proportion, 0: flat):\n"
     );
     for g in growth(points) {
         let _ = writeln!(

@@ -446,11 +446,11 @@ pub fn markdown(rows: &[FloorRow]) -> String {
         .filter(|r| r.far_above)
         .map(|r| format!("`{}` ({:.1}x)", r.pass, r.ratio.unwrap_or(0.0)))
         .collect();
-    out.push_str(&format!(
+    out.push_str(
         "\nCopy: a fullscreen pass fetching one texel of each image the pass reads and writing \
          every format it writes, same resolution, timed alone (device idle), alternating with \
-         the frames. Taps: declared by the pass, or \"(reads)\": one per image read. "
-    ));
+         the frames. Taps: declared by the pass, or \"(reads)\": one per image read. ",
+    );
     if far.is_empty() {
         out.push_str(&format!(
             "No pass is more than {FAR_ABOVE_FLOOR}x its copy.\n"

@@ -53,8 +53,8 @@ impl SuiteOptions {
             quick: false,
             width: 1024,
             height: 768,
-            frames: 10,
-            warmup: 2,
+            frames: 25,
+            warmup: 3,
         }
     }
 
@@ -546,13 +546,13 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     let skin = crate::scene::load_scene("skin")?;
     axes.push((
         "resolution",
-        "pixels per side",
+        "pixels",
         "`skin`, technique `control`, square frames".into(),
         sides
             .iter()
             .map(|&s| Config {
                 label: format!("{s}x{s}"),
-                x: f64::from(s),
+                x: f64::from(s) * f64::from(s),
                 scene: skin.clone(),
                 settings: crate::scaling::settings(Technique::Control, s, s),
             })

@@ -117,10 +117,10 @@ enum Command {
         /// --quick 256x192).
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
-        /// Measured rounds or frames (section default 15; suite 10, --quick 3).
+        /// Measured rounds or frames (section default 15; suite 25, --quick 3).
         #[arg(long)]
         rounds: Option<usize>,
-        /// Discarded rounds first (section default 3; suite 2, --quick 1).
+        /// Discarded rounds first (section default 3; suite 3, --quick 1).
         #[arg(long)]
         warmup: Option<usize>,
         #[command(flatten)]

@@ -526,6 +526,6 @@ pub fn translucency_section(
     Ok(crate::suite::SectionOutput {
         markdown: format!("{markdown}\n"),
         files,
-        warnings: Vec::new(),
+        ..Default::default()
     })
 }

@@ -170,6 +170,10 @@ pub struct Growth {
     pub exponent: f64,
     /// Time at the last point over time at the first.
     pub last_over_first: f64,
+    /// Least-squares line `base + per_unit * x`: the time at x = 0, ms.
+    pub base: f64,
+    /// The line's slope: ms per unit of x.
+    pub per_unit: f64,
 }
 
 impl Growth {
@@ -206,6 +210,29 @@ pub fn log_log_slope(points: &[(f64, f64)]) -> Option<f64> {
     (sxx > 1e-12).then(|| sxy / sxx)
 }
 
+/// Least-squares line `(intercept, slope)` through the finite points (`None` with fewer than two
+/// or no spread in x).
+pub fn linear_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    // Guarded: all points at one x have no slope.
+    (sxx > 1e-12).then(|| {
+        let slope = sxy / sxx;
+        (my - slope * mx, slope)
+    })
+}
+
 /// Growth of every pass present at every point, and of the frame.
 pub fn growth(points: &[Measured]) -> Vec<Growth> {
     let Some(first) = points.first() else {
@@ -230,12 +257,15 @@ pub fn growth(points: &[Measured]) -> Vec<Growth> {
             };
             let xy: Vec<(f64, f64)> = points.iter().map(|p| (p.x, ms(p))).collect();
             let exponent = log_log_slope(&xy)?;
+            let (base, per_unit) = linear_fit(&xy)?;
             let last = points.last().map(ms).unwrap_or(0.0);
             let first_ms = ms(first);
             Some(Growth {
                 pass: name,
                 exponent,
                 last_over_first: if first_ms > 0.0 { last / first_ms } else { 0.0 },
+                base,
+                per_unit,
             })
         })
         .collect()
@@ -277,14 +307,23 @@ pub fn markdown(axis: &str, unit: &str, points: &[Measured]) -> String {
         out,
         "\nGrowth along {axis} (x: {unit}; exponent s of a fit ms = a * x^s; 1: in proportion, 0: flat):\n"
     );
+    // The line's slope in a unit that reads well on this axis.
+    let (scale, per) = match unit {
+        "triangles" => (1e5, "per 100k triangles"),
+        "pixels" => (1e6, "per megapixel"),
+        "lights" => (1.0, "per light"),
+        _ => (1.0, "per unit"),
+    };
     for g in growth(points) {
         let _ = writeln!(
             out,
-            "- `{}`: s = {:.2}, {} (last / first {:.2}x)",
+            "- `{}`: s = {:.2}, {} (last / first {:.2}x); line: {:.3} ms {:+.3} ms {per}",
             g.pass,
             g.exponent,
             g.verdict(),
-            g.last_over_first
+            g.last_over_first,
+            g.base,
+            g.per_unit * scale,
         );
     }
     out
@@ -326,10 +365,16 @@ mod tests {
         assert_eq!(g[0].verdict(), "grows in proportion");
         assert_eq!(g[1].verdict(), "flat");
         assert_eq!(g[2].pass, "frame");
-        let text = markdown("triangles", "triangles", &points);
+        let text = markdown("lights", "lights", &points);
         assert!(
-            text.contains("`gbuffer`: s = 1.00, grows in proportion"),
+            text.contains(
+                "`gbuffer`: s = 1.00, grows in proportion (last / first 16.00x); \
+                 line: 0.000 ms +1.000 ms per light"
+            ),
             "{text}"
         );
+        let (a, b) = linear_fit(&[(1.0, 3.0), (2.0, 5.0), (4.0, 9.0)]).unwrap();
+        assert!((a - 1.0).abs() < 1e-9 && (b - 2.0).abs() < 1e-9);
+        assert_eq!(linear_fit(&[(1.0, 1.0), (1.0, 2.0)]), None);
     }
 }

@@ -227,8 +227,8 @@ pub fn gdc_beside(ours: &TranslucencyCost) -> String {
     let _ = writeln!(
         out,
         "## Beside GDC 2011's translucency cost (full-screen coverage)\n\n\
-         - theirs: the talk's \"Performance\" slide (Xbox 360, PS3 on SPUs, PC DX11 compute);\
-          it gives no lighting-pass or frame time, so their cost is shown against a 33.3 ms\
+         - theirs: the talk's \"Performance\" slide (Xbox 360, PS3 on SPUs, PC DX11 compute); \
+          it gives no lighting-pass or frame time, so their cost is shown against a 33.3 ms \
           (30 Hz) frame\n- ours: {}, {}; technique `none` and `translucency` alternating frames\n\n\
          | platform | full-screen ms | instructions | share of a 33.3 ms frame |\n|---|---:|---:|---:|",
         ours.device, ours.setup
@@ -316,12 +316,12 @@ pub fn li_beside(device: &str, technique: &str, ours: &[LiOurs]) -> String {
         out,
         "## Beside Li et al.'s Table 1 (FPS against triangles)\n\n\
          - theirs: {LI_DEVICE}; 512 and 1024 are their dynamic-texture resolutions\n\
-         - ours: {device}; `scaling:N` (a procedural teapot at N triangles) under technique\
-          `{technique}` at 512x512 and 1024x1024 output. **Li et al.'s layered dynamic-texture\
-          technique is not implemented in lucent yet**: these are the frames of the techniques\
+         - ours: {device}; `scaling:N` (a procedural teapot at N triangles) under technique \
+          `{technique}` at 512x512 and 1024x1024 output. **Li et al.'s layered dynamic-texture \
+          technique is not implemented in lucent yet**: these are the frames of the techniques \
           we have, at the same triangle counts and resolutions\n\
-         - \"x first\": frame time over the first row's (theirs from 1000 / FPS), so the growth\
-          with triangles compares without comparing devices; \"1024 / 512\": the frame-time ratio\
+         - \"x first\": frame time over the first row's (theirs from 1000 / FPS), so the growth \
+          with triangles compares without comparing devices; \"1024 / 512\": the frame-time ratio \
           between the two resolutions\n\n\
          | object | triangles | theirs FPS 512 | theirs FPS 1024 | theirs ms 512 | theirs x first | theirs 1024 / 512 | ours triangles | ours ms 512 | ours ms 1024 | ours x first | ours 1024 / 512 |\n\
          |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"

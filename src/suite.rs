@@ -93,6 +93,8 @@ pub struct SectionOutput {
     pub files: Vec<PathBuf>,
     /// Problems to list in the summary (e.g. untrusted timing).
     pub warnings: Vec<String>,
+    /// Findings to list in the summary at the top.
+    pub summary: Vec<String>,
 }
 
 /// One section of the suite.
@@ -174,6 +176,7 @@ pub fn run(
     let mut body = String::new();
     let mut files = Vec::new();
     let mut warnings = Vec::new();
+    let mut summary = Vec::new();
     for (i, (name, f)) in steps.iter().enumerate() {
         eprintln!(
             "report: [{}/{}] {name} ({:.0} s so far)",
@@ -186,6 +189,7 @@ pub fn run(
         body.push('\n');
         files.extend(out.files);
         warnings.extend(out.warnings);
+        summary.extend(out.summary);
     }
     let mut text = String::new();
     let _ = writeln!(
@@ -212,6 +216,13 @@ pub fn run(
     } else {
         for w in &warnings {
             let _ = writeln!(text, "- **warning**: {w}");
+        }
+        text.push('\n');
+    }
+    if !summary.is_empty() {
+        text.push_str("Findings:\n\n");
+        for line in &summary {
+            let _ = writeln!(text, "- {line}");
         }
         text.push('\n');
     }
@@ -283,6 +294,32 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
             out.warnings.push(format!(
                 "`{name}` on `{scene}`: the per-pass times could not be verified ({})",
                 report.timing_mode
+            ));
+        }
+        if let Some(rows) = &report.speed_of_light {
+            let far: Vec<String> = rows
+                .iter()
+                .filter(|r| r.far_above)
+                .map(|r| format!("`{}` {:.1}x", r.pass, r.ratio.unwrap_or(0.0)))
+                .collect();
+            let closest = rows
+                .iter()
+                .filter_map(|r| r.ratio.map(|x| (x, &r.pass)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            out.summary.push(format!(
+                "`{name}` on `{scene}`: frame {:.2} ms; {}{}",
+                report.frame_ms.median,
+                if far.is_empty() {
+                    format!(
+                        "no pass above {}x its copy",
+                        crate::speed_of_light::FAR_ABOVE_FLOOR
+                    )
+                } else {
+                    format!("far above their copy: {}", far.join(", "))
+                },
+                closest.map_or(String::new(), |(x, p)| format!(
+                    "; closest to its floor: `{p}` {x:.2}x"
+                ))
             ));
         }
         let md = report.markdown().replacen("## ", "### ", 1);
@@ -372,26 +409,17 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     );
     // GDC 2011: grid125 all translucent, none against translucency, lighting separate.
     let (w, h) = (ctx.options.width, ctx.options.height);
-    let grid = crate::scene::load_scene("grid125")?;
-    let configs: Vec<Config> = [Technique::None, Technique::Translucency]
-        .iter()
-        .map(|&t| Config {
-            label: t.name().into(),
-            x: 1.0,
-            scene: grid.clone(),
-            settings: crate::scaling::settings(t, w, h),
-        })
-        .collect();
-    let m = measure_with_progress(ctx, "GDC 2011 cost", &configs)?;
-    let lighting = |p: &Measured| p.pass_ms("lighting").unwrap_or(0.0);
+    let cost = gdc_cost(
+        ctx.gpu,
+        ctx.shaders,
+        ctx.pipeline_cache,
+        &crate::scene::load_scene("grid125")?,
+        "`grid125` (all 125 cubes translucent, 3 point lights)",
+        (w, h),
+        (ctx.options.frames, ctx.options.warmup),
+    )?;
     out.markdown
-        .push_str(&crate::seeds::gdc_beside(&TranslucencyCost {
-            device: device.clone(),
-            setup: format!("`grid125` (all 125 cubes translucent, 3 point lights), {w}x{h}, lighting pass unmerged, medians of {} round-robin frames", ctx.options.frames),
-            lighting_none_ms: lighting(&m[0]),
-            lighting_translucency_ms: lighting(&m[1]),
-            frame_ms: [m[0].frame.median, m[1].frame.median],
-        }).replacen("## ", "### ", 1));
+        .push_str(&crate::seeds::gdc_beside(&cost).replacen("## ", "### ", 1));
     out.markdown.push('\n');
     // Li et al.: scaling:N at their counts, 512x512 and 1024x1024.
     let li = li_points(ctx)?;
@@ -448,6 +476,49 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     );
     out.files.push(png);
     Ok(out)
+}
+
+/// The cost of GDC 2011 translucency on `scene`: techniques `none` and `translucency`
+/// round-robin at `size`, subpasses unmerged so the lighting pass has its own time, medians of
+/// `frames` after `warmup` (both counts in `rounds`).
+pub fn gdc_cost(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    scene: &crate::scene::Scene,
+    scene_label: &str,
+    (width, height): (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<TranslucencyCost> {
+    let configs: Vec<Config> = [Technique::None, Technique::Translucency]
+        .iter()
+        .map(|&t| Config {
+            label: t.name().into(),
+            x: 1.0,
+            scene: scene.clone(),
+            settings: crate::scaling::settings(t, width, height),
+        })
+        .collect();
+    let m = crate::scaling::measure(
+        gpu,
+        shaders,
+        pipeline_cache,
+        &configs,
+        frames,
+        warmup,
+        |_, _| {},
+    )?;
+    let lighting = |p: &Measured| p.pass_ms("lighting").unwrap_or(0.0);
+    Ok(TranslucencyCost {
+        device: gpu.info.describe(),
+        setup: format!(
+            "{scene_label}, {width}x{height}, lighting pass unmerged, medians of {frames} \
+             round-robin frames"
+        ),
+        lighting_none_ms: lighting(&m[0]),
+        lighting_translucency_ms: lighting(&m[1]),
+        frame_ms: [m[0].frame.median, m[1].frame.median],
+    })
 }
 
 /// `scaling:N` at Li et al.'s counts, at 512x512 and 1024x1024 (one round-robin run each).
@@ -582,6 +653,21 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     for (axis, unit, setup, configs) in axes {
         eprintln!("report:   scaling with {axis}");
         let points = measure_with_progress(ctx, &format!("scaling: {axis}"), &configs)?;
+        let grows: Vec<String> = crate::scaling::growth(&points)
+            .iter()
+            .filter(|g| g.pass != "frame" && g.exponent >= 0.35)
+            .map(|g| format!("`{}` (s = {:.2})", g.pass, g.exponent))
+            .collect();
+        out.summary.push(format!(
+            "with {axis} ({}): {}",
+            setup.replace('`', ""),
+            if grows.is_empty() {
+                "no pass grows".to_string()
+            } else {
+                let verb = if grows.len() == 1 { "grows" } else { "grow" };
+                format!("{} {verb}", grows.join(", "))
+            }
+        ));
         let _ = writeln!(out.markdown, "### Against {axis}: {setup}\n");
         out.markdown
             .push_str(&crate::scaling::markdown(axis, unit, &points));

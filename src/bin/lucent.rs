@@ -77,8 +77,11 @@ enum Command {
         /// main one, and print both side by side with the ratio (e.g. `--against none`).
         #[arg(long)]
         against: Option<String>,
-        /// Print the per-pass table beside the LEAN-mapping thesis's (Table 2 for `control`,
-        /// Table 1 for `lbb`), each row as a share of its frame. Alias: --compare-seeds.
+        /// Print the seeds' published numbers beside ours: the LEAN-mapping thesis's Table 2
+        /// (`control`) or Table 1 (`lbb`), each row as a share of its frame; for
+        /// `translucency`, GDC 2011's full-screen cost beside the extra cost of translucency
+        /// in this scene's lighting pass (measured against `none`, alternating frames).
+        /// Alias: --compare-seeds.
         #[arg(long, alias = "compare-seeds")]
         compare_thesis: bool,
     },
@@ -369,21 +372,17 @@ fn bench_command(
     let format = bench::Format::parse(&format)?;
     let against = against.map(|t| Technique::parse(&t)).transpose()?;
     let technique = Technique::parse(&frame.technique)?;
-    let thesis_table = match (
-        compare_thesis,
-        lucent::seeds::thesis_table(technique.name()),
-    ) {
-        (false, _) => None,
-        (true, Some(table)) => Some(table),
-        (true, None) => {
-            return Err(LucentError::InvalidInput(format!(
-                "--compare-thesis needs --technique control (the thesis's Table 2) or lbb (Table \
-                 1); '{}' has no table in the thesis",
-                technique.name()
-            )))
-        }
-    };
-    if format != bench::Format::Markdown && (thesis_table.is_some() || against.is_some()) {
+    let thesis_table = lucent::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
+    let gdc = compare_thesis && technique == Technique::Translucency;
+    if compare_thesis && thesis_table.is_none() && !gdc {
+        return Err(LucentError::InvalidInput(format!(
+            "--compare-seeds needs --technique control (the thesis's Table 2), lbb (its Table \
+             1) or translucency (GDC 2011's cost); '{}' has no published table (Li et al.'s \
+             Table 1 is in `lucent report`)",
+            technique.name()
+        )));
+    }
+    if format != bench::Format::Markdown && (compare_thesis || against.is_some()) {
         return Err(LucentError::InvalidInput(
             "--compare-thesis and --against print Markdown tables; use them with --format markdown"
                 .into(),
@@ -421,6 +420,18 @@ fn bench_command(
         }
         if let Some(table) = &thesis_table {
             println!("{}", lucent::seeds::beside(&report, table));
+        }
+        if gdc {
+            let cost = lucent::suite::gdc_cost(
+                gpu,
+                &session.shaders,
+                &session.pipeline_cache,
+                &scene::load_scene(&frame.scene)?,
+                &format!("`{}`", frame.scene),
+                (renderer.settings.width, renderer.settings.height),
+                (options.frames, options.warmup),
+            )?;
+            println!("{}", lucent::seeds::gdc_beside(&cost));
         }
         if let Some(technique) = against {
             let scene = scene::load_scene(&frame.scene)?;

@@ -35,6 +35,13 @@ pub enum Technique {
     /// Screen-space SSS, the thesis's control: Jimenez's separable sum-of-Gaussians blur of the
     /// lit diffuse light for materials with an SSS profile.
     Control,
+    /// The thesis's LEAN pipeline with the control's blur: LEAN maps projected to the view
+    /// plane, the lit diffuse and the LEAN moments blurred with Jimenez's kernel, LEAN specular
+    /// with Fresnel evaluated on the blurred moments.
+    Lcb,
+    /// The thesis's technique: the LEAN pipeline with a separable bilateral (depth-weighted)
+    /// blur of the projected G-buffer in ping-pong targets.
+    Lbb,
 }
 
 impl Technique {
@@ -43,6 +50,8 @@ impl Technique {
         ("none", Technique::None),
         ("translucency", Technique::Translucency),
         ("control", Technique::Control),
+        ("lcb", Technique::Lcb),
+        ("lbb", Technique::Lbb),
     ];
 
     /// Parses a command-line name.
@@ -70,10 +79,20 @@ impl Technique {
             .find(|(_, t)| *t == self)
             .map_or("?", |(n, _)| n)
     }
+
+    /// The screen-space SSS blur this technique runs, if any.
+    pub fn sss_blur(self) -> Option<sss::SssBlur> {
+        match self {
+            Technique::None | Technique::Translucency => None,
+            Technique::Control => Some(sss::SssBlur::Control),
+            Technique::Lcb => Some(sss::SssBlur::LeanControl),
+            Technique::Lbb => Some(sss::SssBlur::LeanBilateral),
+        }
+    }
 }
 
 /// How a frame is built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameSettings {
     /// Output width.
     pub width: u32,
@@ -98,6 +117,8 @@ pub struct FrameSettings {
     /// Robustness tests: the lighting pass writes this value into one pixel, so tests can
     /// prove that later passes keep it from spreading.
     pub fault: Option<Fault>,
+    /// Screen-space SSS knobs (Gaussian count, precision, bilateral sensitivity).
+    pub sss: sss::SssKnobs,
 }
 
 /// A value injected into one pixel of the lit image.
@@ -125,6 +146,7 @@ impl FrameSettings {
             force_grayscale: false,
             sss_tiles: true,
             fault: None,
+            sss: sss::SssKnobs::default(),
         }
     }
 }
@@ -137,8 +159,9 @@ pub struct FrameFeatures {
     /// some object is translucent.
     pub translucency: Option<(MaterialTable, ThicknessPacking)>,
     /// The diffusion profile the SSS blurs use, when the technique is an SSS one and some
-    /// object has a profile (the first such object's).
-    pub sss: Option<SssProfile>,
+    /// object has a profile (the first such object's; refitted to `SssKnobs::gaussians` when
+    /// that is set), and the blur.
+    pub sss: Option<(SssProfile, sss::SssBlur)>,
     /// Some object has a normal map.
     pub normal_maps: bool,
 }
@@ -146,12 +169,23 @@ pub struct FrameFeatures {
 impl FrameFeatures {
     /// The features `scene` needs under `settings`.
     pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
-        let sss = match settings.technique {
-            Technique::Control => scene.objects.iter().find_map(|o| o.material.sss.clone()),
-            _ => None,
+        let sss = match settings.technique.sss_blur() {
+            Some(blur) => scene
+                .objects
+                .iter()
+                .find_map(|o| o.material.sss.clone())
+                .map(|p| -> Result<_> {
+                    let profile = match settings.sss.gaussians {
+                        Some(n) => sss::fit_profile(&p, n)?.0,
+                        None => p,
+                    };
+                    Ok((profile, blur))
+                })
+                .transpose()?,
+            None => None,
         };
         let translucency = match settings.technique {
-            Technique::None | Technique::Control => None,
+            Technique::None | Technique::Control | Technique::Lcb | Technique::Lbb => None,
             Technique::Translucency => {
                 let table = MaterialTable::new(scene)?;
                 let packing = if settings.force_grayscale {
@@ -186,6 +220,7 @@ impl FrameFeatures {
                     single_material: table.rows.len() == 1,
                 }),
             sss: self.sss.is_some(),
+            lean: self.sss.as_ref().is_some_and(|(_, blur)| blur.lean()),
             normal_maps: self.normal_maps,
             fault_injection: settings.fault.is_some(),
         }
@@ -203,6 +238,8 @@ pub struct GBufferOutputs {
     pub gb2: Option<ResourceId>,
     /// Screen-space SSS strength (frames with SSS).
     pub sss: Option<ResourceId>,
+    /// View-plane LEAN slope y and second moments (LCB and LBB frames).
+    pub lean: Option<ResourceId>,
     /// Depth.
     pub depth: ResourceId,
     /// Its layout.
@@ -231,8 +268,20 @@ pub fn declare_frame(
     let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
     let lit = deferred::lighting_pass(graph, &gb, scene_gpu);
     let hdr = match (&features.sss, &lit.specular, &gb.sss) {
-        (Some(profile), Some(specular), Some(strength)) => sss::control_passes(
-            graph, &lit.color, specular, &gb.depth, strength, profile, scene_gpu,
+        (Some((profile, blur)), Some(specular), Some(strength)) => sss::sss_passes(
+            graph,
+            &sss::SssInputs {
+                diffuse: &lit.color,
+                specular,
+                depth: &gb.depth,
+                strength,
+                lean: gb.lean.as_ref(),
+                gb0: &gb.gb0,
+            },
+            profile,
+            *blur,
+            &settings.sss,
+            scene_gpu,
         ),
         _ => lit.color,
     };
@@ -247,6 +296,7 @@ pub fn declare_frame(
             .into_iter()
             .chain(gb.gb2.as_ref())
             .chain(gb.sss.as_ref())
+            .chain(gb.lean.as_ref())
         {
             graph.export_image(image, Access::TransferRead);
         }
@@ -255,6 +305,7 @@ pub fn declare_frame(
             gb1: gb.gb1.id(),
             gb2: gb.gb2.as_ref().map(|h| h.id()),
             sss: gb.sss.as_ref().map(|h| h.id()),
+            lean: gb.lean.as_ref().map(|h| h.id()),
             depth: gb.depth.id(),
             layout,
         }
@@ -279,6 +330,7 @@ pub fn plan_frame(settings: &FrameSettings, features: &FrameFeatures) -> Result<
 pub struct FrameUniforms {
     view_proj: [[f32; 4]; 4],
     inv_view_proj: [[f32; 4]; 4],
+    view: [[f32; 4]; 4],
     camera_pos: [f32; 4],
     ambient: [f32; 4],
     sky: [f32; 4],
@@ -332,6 +384,7 @@ impl FrameUniforms {
         Self {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            view: scene.camera.view().to_cols_array_2d(),
             camera_pos: scene.camera.eye.extend(1.0).to_array(),
             ambient: scene.ambient.extend(0.0).to_array(),
             sky: scene.sky.extend(0.0).to_array(),
@@ -405,7 +458,13 @@ impl Renderer {
             "frame uniforms",
         )?;
         let translucency = features.translucency.as_ref().map(|(t, p)| (t, *p));
-        let scene_gpu = match SceneGpu::new(gpu, scene, uniforms.buffer, translucency) {
+        let scene_gpu = match SceneGpu::new(
+            gpu,
+            scene,
+            uniforms.buffer,
+            translucency,
+            features.sss.as_ref().is_some_and(|(_, blur)| blur.lean()),
+        ) {
             Ok(s) => s,
             Err(e) => {
                 gpu.destroy_buffer(uniforms);
@@ -473,10 +532,9 @@ impl Renderer {
                     object_tiles(scene, &self.mesh_bounds, width, height, |o| {
                         o.material.sss.as_ref().map(sss::profile_reach)
                     });
+                // All rectangles: the blurs draw the marked ones, LCB's and LBB's final pass
+                // its LEAN variant there and the pass-through variant elsewhere.
                 tile_rects(columns, &marked, width, height)
-                    .into_iter()
-                    .filter(|r| r.translucent)
-                    .collect()
             });
             scene_gpu.set_sss_tiles(tiles);
         }
@@ -533,6 +591,7 @@ impl Renderer {
                 .sss
                 .map(|id| read(id).map(|t| t.into_iter().map(|v| v[0]).collect()))
                 .transpose()?,
+            lean: outputs.lean.map(read).transpose()?,
             depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
             layout: outputs.layout,
         })
@@ -593,6 +652,8 @@ pub struct GBufferReadback {
     pub gb2: Option<Vec<[f32; 4]>>,
     /// Screen-space SSS strength per pixel (frames with SSS).
     pub sss: Option<Vec<f32>>,
+    /// View-plane LEAN slope y and second moments xx, yy, xy (LCB and LBB frames).
+    pub lean: Option<Vec<[f32; 4]>>,
     /// Device depth.
     pub depth: Vec<f32>,
     /// The layout the frame used.

@@ -86,13 +86,34 @@ pub const THESIS_TABLE_2_CONTROL: SeedTable = SeedTable {
 };
 
 /// The thesis's table for a technique, by command-line name: Table 2 for `control`, Table 1
-/// for `lbb`.
+/// for `lbb` and `lcb` (the thesis times only LBB; LCB runs the same pipeline with the
+/// control's blur).
 pub fn thesis_table(technique: &str) -> Option<SeedTable> {
     match technique {
         "control" => Some(THESIS_TABLE_2_CONTROL),
-        "lbb" => Some(THESIS_TABLE_1_LBB),
+        "lbb" | "lcb" => Some(THESIS_TABLE_1_LBB),
         _ => None,
     }
+}
+
+/// The thesis's LBB / control cost ratio beside ours, when `compared` measured a LEAN technique
+/// (`lbb` or `lcb`) against `control` in one run (alternating frames).
+pub fn thesis_ratio_line(compared: &crate::bench::Comparison) -> Option<String> {
+    let [a, b] = &compared.names;
+    let (lean, control) = match (a.as_str(), b.as_str()) {
+        ("control", "lbb" | "lcb") => (1, 0),
+        ("lbb" | "lcb", "control") => (0, 1),
+        _ => return None,
+    };
+    let theirs = THESIS_TABLE_1_LBB.total() / THESIS_TABLE_2_CONTROL.total();
+    let ours = compared.frame[lean].median / compared.frame[control].median.max(1e-9);
+    Some(format!(
+        "\n**{} / control, frame total:** ours {ours:.3}x (same run, alternating frames); the \
+         thesis's LBB / control {theirs:.2}x (sums of its Tables 1 and 2: {:.3} / {:.3} ms)\n",
+        compared.names[lean],
+        THESIS_TABLE_1_LBB.total(),
+        THESIS_TABLE_2_CONTROL.total()
+    ))
 }
 
 /// lucent's pass for a thesis row: blurs by name (case-insensitive), the lighting rows by role.

@@ -70,7 +70,7 @@ fn every_builtin_scene_renders_finite_and_validation_clean() {
 #[test]
 fn smoke_matches_its_golden() {
     // Same settings as tests/golden/LIST's `smoke` line.
-    check_golden("smoke", FrameSettings::new(320, 240));
+    check_golden("smoke", "smoke", FrameSettings::new(320, 240));
 }
 
 #[test]
@@ -81,15 +81,33 @@ fn translucent_cubes_and_grid125_match_their_goldens() {
             technique: Technique::Translucency,
             ..FrameSettings::new(320, 240)
         };
-        check_golden(name, settings);
+        check_golden(name, name, settings);
     }
 }
 
-/// Renders built-in scene `name` (loaded as the command loads it) and compares it with
+#[test]
+fn sss_scenes_match_their_goldens_under_every_sss_technique() {
+    // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
+    for scene_name in ["skin", "teapot"] {
+        for technique in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+            let settings = FrameSettings {
+                technique,
+                ..FrameSettings::new(320, 240)
+            };
+            check_golden(
+                &format!("{scene_name}-{}", technique.name()),
+                scene_name,
+                settings,
+            );
+        }
+    }
+}
+
+/// Renders built-in scene `scene_name` (loaded as the command loads it) and compares it with
 /// tests/golden/NAME.png.
-fn check_golden(name: &str, settings: FrameSettings) {
+fn check_golden(name: &str, scene_name: &str, settings: FrameSettings) {
     let (w, h) = (settings.width, settings.height);
-    let (display, _) = render_scene(&scene::load_scene(name).unwrap(), settings);
+    let (display, _) = render_scene(&scene::load_scene(scene_name).unwrap(), settings);
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
     let outcome = compare_with_golden(
         name,

@@ -18,6 +18,7 @@ struct Light {
 layout(std140, set = 0, binding = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
+    mat4 view;            // world to view space (right-handed, the camera looks down -z)
     vec4 camera_pos;      // xyz
     vec4 ambient;         // rgb
     vec4 sky;             // rgb: colour of pixels no geometry covers

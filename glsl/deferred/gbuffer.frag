@@ -4,8 +4,16 @@
 // permutation: LUCENT_SSS_STRENGTH
 // permutation: LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_STRENGTH LUCENT_NORMAL_MAP
+// permutation: LUCENT_SSS_STRENGTH LUCENT_LEAN
+// permutation: LUCENT_SSS_STRENGTH LUCENT_LEAN LUCENT_NORMAL_MAP
 #include "../common/gbuffer.glsl"
 #include "object.glsl"
+#ifdef LUCENT_LEAN
+#include "../common/lean.glsl"
+// LCB and LBB: the view-plane LEAN slope y and moments xx, yy, xy (slope x travels in the
+// lighting pass's diffuse alpha: the blurs read both targets as two RGBA texels).
+layout(location = 3) out vec4 out_lean;
+#endif
 
 layout(location = 0) in vec3 in_normal;
 #ifdef LUCENT_NORMAL_MAP
@@ -27,6 +35,12 @@ vec3 mapped_normal(vec3 n) {
     vec3 m = texture(normal_map, in_uv).xyz * 2.0 - 1.0;
     return t * m.x + b * m.y + n * m.z;
 }
+#ifdef LUCENT_LEAN
+// In LEAN frames binding 1 holds LEAN map 1 (slope mean xy, moments xx yy) instead of the
+// normal map, and binding 2 LEAN map 2 (moment xy), mip-filtered like any texture: filtering
+// moments is what LEAN mapping is for.
+layout(set = 0, binding = 2) uniform sampler2D lean2_map;
+#endif
 #endif
 #ifdef LUCENT_TRANSLUCENCY
 layout(location = 1) in vec3 in_thickness;
@@ -44,7 +58,37 @@ void main() {
     Surface s;
     s.albedo = object.albedo_specular.rgb;
     s.specular = object.albedo_specular.a;
+#if defined(LUCENT_LEAN)
+    vec3 n = sanitize_normal(in_normal);
+    vec3 t, bt;
+    vec2 b_t = vec2(0.0);
+    vec3 m_t = vec3(0.0);
 #ifdef LUCENT_NORMAL_MAP
+    t = in_tangent.xyz - n * dot(n, in_tangent.xyz);
+    bool frame_ok = dot(t, t) > 1e-12;
+    if (frame_ok) {
+        vec4 lean1 = texture(normal_map, in_uv);
+        b_t = lean1.xy;
+        m_t = vec3(lean1.zw, texture(lean2_map, in_uv).x);
+    }
+#else
+    t = vec3(0.0);
+    bool frame_ok = false;
+#endif
+    // Without a map (or a usable tangent) any frame around n serves: the slopes are 0 and the
+    // roughness variance is isotropic.
+    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    t = frame_ok ? normalize(t) : normalize(cross(helper, n));
+    bt = cross(n, t);
+#ifdef LUCENT_NORMAL_MAP
+    bt *= in_tangent.w < 0.0 ? -1.0 : 1.0;
+#endif
+    vec2 b_v;
+    vec3 m_v;
+    view_plane_lean(n, t, bt, b_t, m_t, roughness_variance(object.roughness.x), s.normal, b_v,
+                    m_v);
+    out_lean = vec4(b_v.y, m_v);
+#elif defined(LUCENT_NORMAL_MAP)
     s.normal = mapped_normal(sanitize_normal(in_normal));
 #else
     s.normal = in_normal;

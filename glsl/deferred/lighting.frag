@@ -5,6 +5,8 @@
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_FAULT_INJECTION
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_FAULT_INJECTION
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
@@ -14,6 +16,9 @@
 #include "../common/lighting.glsl"
 #ifdef LUCENT_TRANSLUCENCY
 #include "../common/translucency.glsl"
+#endif
+#ifdef LUCENT_LEAN
+#include "../common/lean.glsl"
 #endif
 
 layout(input_attachment_index = 0, set = 0, binding = 1) uniform subpassInput gb0;
@@ -79,13 +84,22 @@ void main() {
         specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
     }
     out_specular = vec4(min(specular, vec3(65504.0)), 1.0);
+#ifdef LUCENT_LEAN
+    // LCB and LBB blur (diffuse.rgb, view slope x) as one texel: the G-buffer's LEAN target
+    // holds the rest. The slope is the mean normal's, as the G-buffer pass computed it.
+    float slope_x = view_slope(mat3(frame.view) * s.normal).x;
+#endif
 #else
     for (int i = 0; i < count; ++i) {
         color += shade_direct(s, pos, to_eye, frame.lights[i]);
     }
 #endif
     // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).
+#ifdef LUCENT_LEAN
+    out_color = vec4(min(color, vec3(65504.0)), slope_x);
+#else
     out_color = vec4(min(color, vec3(65504.0)), 1.0);
+#endif
 #ifdef LUCENT_FAULT_INJECTION
     // Robustness tests: one poisoned pixel, to prove later passes keep it from spreading.
     if (all(equal(ivec2(gl_FragCoord.xy), frame.fault.xy)) && frame.fault.z != 0) {

@@ -12,6 +12,7 @@ use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bench::{self, BenchOptions};
 use lucent::graph::CompileOptions;
 use lucent::passes::deferred::GBufferPrecision;
+use lucent::passes::sss::{SssKnobs, SssPrecision};
 use lucent::renderer::{
     plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
 };
@@ -187,6 +188,40 @@ struct FrameArgs {
     /// a profile (A/B comparison).
     #[arg(long)]
     no_sss_tiles: bool,
+    /// Refit the SSS profile with this many Gaussians (1-8): fewer blur pairs, at the fit
+    /// error `lucent plan` and the report print.
+    #[arg(long)]
+    sss_gaussians: Option<usize>,
+    /// Precision of the SSS sum-of-Gaussians targets: half (RGBA16F) or full (RGBA32F).
+    #[arg(long, default_value = "full", value_parser = parse_sss_precision)]
+    sss_precision: SssPrecision,
+    /// Bilateral blur (LBB): sensitivity to depth differences, per world unit.
+    #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
+    sensitivity: f32,
+    /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
+    /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
+    #[arg(long)]
+    sss_packed: bool,
+    /// LBB: bilateral taps per direction (3, 5 or 7).
+    #[arg(long, default_value_t = 7, value_parser = parse_taps)]
+    sss_taps: u32,
+}
+
+fn parse_taps(text: &str) -> std::result::Result<u32, String> {
+    match text {
+        "3" => Ok(3),
+        "5" => Ok(5),
+        "7" => Ok(7),
+        _ => Err(format!("'{text}' is not one of 3, 5, 7")),
+    }
+}
+
+fn parse_sss_precision(text: &str) -> std::result::Result<SssPrecision, String> {
+    SssPrecision::ALL
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|&(_, p)| p)
+        .ok_or_else(|| format!("'{text}' is not one of half, full"))
 }
 
 fn parse_precision(text: &str) -> std::result::Result<GBufferPrecision, String> {
@@ -238,6 +273,20 @@ impl FrameArgs {
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,
             fault: None,
+            sss: SssKnobs {
+                gaussians: self.sss_gaussians,
+                precision: self.sss_precision,
+                packed: self.sss_packed,
+                taps: self.sss_taps,
+                sensitivity: if self.sensitivity.is_finite() && self.sensitivity >= 0.0 {
+                    self.sensitivity
+                } else {
+                    return Err(LucentError::InvalidInput(format!(
+                        "--sensitivity {}: must be finite and >= 0",
+                        self.sensitivity
+                    )));
+                },
+            },
         })
     }
 }
@@ -376,9 +425,9 @@ fn bench_command(
     let gdc = compare_thesis && technique == Technique::Translucency;
     if compare_thesis && thesis_table.is_none() && !gdc {
         return Err(LucentError::InvalidInput(format!(
-            "--compare-seeds needs --technique control (the thesis's Table 2), lbb (its Table \
-             1) or translucency (GDC 2011's cost); '{}' has no published table (Li et al.'s \
-             Table 1 is in `lucent report`)",
+            "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
+             Table 1) or translucency (GDC 2011's cost); '{}' has no published table (Li et \
+             al.'s Table 1 is in `lucent report`)",
             technique.name()
         )));
     }
@@ -457,7 +506,13 @@ fn bench_command(
             let idle = gpu.wait_idle();
             other.destroy(gpu);
             idle?;
-            println!("{}", compared?.markdown(&gpu.info.describe()));
+            let compared = compared?;
+            println!("{}", compared.markdown(&gpu.info.describe()));
+            if thesis_table.is_some() {
+                if let Some(line) = lucent::seeds::thesis_ratio_line(&compared) {
+                    println!("{line}");
+                }
+            }
         }
         if let Some(json) = &json {
             output::write_file_atomic(json, report.json().as_bytes())?;

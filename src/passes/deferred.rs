@@ -33,6 +33,8 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Screen-space SSS strength per pixel.
 pub const SSS_STRENGTH_FORMAT: vk::Format = vk::Format::R8_UNORM;
+/// LCB and LBB: view-plane LEAN slope y and moments (blurred, so at least fp16).
+pub const LEAN_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 /// Precision of the G-buffer's colour targets (the report measures what each costs and how
 /// far its image is from the f64 reference).
@@ -75,6 +77,9 @@ pub struct GBufferLayout {
     /// Screen-space SSS: the G-buffer stores each pixel's SSS strength (R8) and the lighting
     /// pass writes diffuse and specular to separate targets, so the blur sees diffuse only.
     pub sss: bool,
+    /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
+    /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
+    pub lean: bool,
     /// Some object has a normal map: the G-buffer pass reads UVs and tangents and samples it.
     pub normal_maps: bool,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
@@ -133,6 +138,9 @@ impl GBufferLayout {
         if self.normal_maps {
             defines.push(("LUCENT_NORMAL_MAP", "1"));
         }
+        if self.lean {
+            defines.push(("LUCENT_LEAN", "1"));
+        }
         defines
     }
 
@@ -171,6 +179,8 @@ pub struct GBuffer {
     pub gb2: Option<Handle<Image>>,
     /// Screen-space SSS strength per pixel, in frames with SSS.
     pub sss: Option<Handle<Image>>,
+    /// View-plane LEAN slope y + moments, in LCB and LBB frames.
+    pub lean: Option<Handle<Image>>,
     /// Depth.
     pub depth: Handle<Image>,
     /// The layout it was declared with.
@@ -199,6 +209,9 @@ pub fn gbuffer_pass(
         sss: layout
             .sss
             .then(|| graph.create_image("gbuffer.sss", image(SSS_STRENGTH_FORMAT))),
+        lean: layout
+            .lean
+            .then(|| graph.create_image("gbuffer.lean", image(LEAN_FORMAT))),
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
         layout,
     };
@@ -212,6 +225,11 @@ pub fn gbuffer_pass(
     if let Some(sss) = &mut gb.sss {
         // Cleared to 0: sky and non-scattering pixels are left alone by the blurs.
         pass.color(sss, LoadOp::Clear([0.0; 4]));
+    }
+    if let Some(lean) = &mut gb.lean {
+        // Location 3 of glsl/deferred/gbuffer.frag. Cleared: the control-style blur's bilinear
+        // taps straddle silhouettes and would filter undefined sky texels into the moments.
+        pass.color(lean, LoadOp::Clear([0.0; 4]));
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {
@@ -300,6 +318,10 @@ impl GBufferPass {
         let mut bindings = vec![Binding::Uniform(self.scene.frame_uniforms)];
         if let Some(maps) = &self.scene.normal_maps {
             bindings.push(Binding::Sampled(maps.images[index].view, maps.sampler));
+            // LEAN frames: binding 2 is the second LEAN map.
+            if let Some(lean2) = maps.lean2.get(index) {
+                bindings.push(Binding::Sampled(lean2.view, maps.sampler));
+            }
         }
         bindings
     }
@@ -445,6 +467,9 @@ impl PassExec for LightingPass {
         let mut plain_defines: Vec<(&str, &str)> = Vec::new();
         if self.layout.sss {
             plain_defines.push(("LUCENT_SPLIT_SPECULAR", "1"));
+        }
+        if self.layout.lean {
+            plain_defines.push(("LUCENT_LEAN", "1"));
         }
         if self.layout.fault_injection {
             plain_defines.push(("LUCENT_FAULT_INJECTION", "1"));

@@ -79,9 +79,13 @@ pub struct TranslucencyGpu {
 }
 
 /// Normal maps of a normal-mapped frame: image 0 is a flat 1x1 map for objects without one.
+/// In LEAN frames (LCB, LBB) each normal map is uploaded as its two LEAN maps instead
+/// ([`crate::scene::lean`]): `images` holds LEAN map 1, `lean2` LEAN map 2.
 pub struct NormalMaps {
     /// Sampled images (RGBA16F, mipmapped), in `SHADER_READ_ONLY_OPTIMAL`.
     pub images: Vec<GpuImage>,
+    /// LEAN frames: the second LEAN map of each entry of `images` (empty otherwise).
+    pub lean2: Vec<GpuImage>,
     /// Trilinear, repeating sampler.
     pub sampler: vk::Sampler,
 }
@@ -101,9 +105,9 @@ pub struct SceneGpu {
     pub translucency: Option<TranslucencyGpu>,
     /// Normal maps, when some object has one.
     pub normal_maps: Option<NormalMaps>,
-    /// The screen rectangles the SSS blurs run in this frame (objects with a profile, widened
-    /// by the profile's reach), written by the renderer before each frame; `None`: the blurs
-    /// cover the whole screen.
+    /// The screen's rectangles for the SSS passes this frame, marked (`translucent`) where
+    /// objects with a profile (widened by the profile's reach) may be: the blurs run only in
+    /// those. Written by the renderer before each frame; `None`: everything is blurred.
     pub sss_tiles: std::sync::Mutex<Option<Vec<translucency::TileRect>>>,
 }
 
@@ -135,12 +139,13 @@ impl SceneGpu {
     /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer. With
     /// `translucency` (the frame's material table and packing), also each mesh's thickness
     /// stream and the material table; when some object has a normal map, each mesh's UV +
-    /// tangent stream and the normal maps.
+    /// tangent stream and the normal maps (with `lean`, their LEAN maps).
     pub fn new(
         gpu: &GpuContext,
         scene: &Scene,
         frame_uniforms: vk::Buffer,
         translucency: Option<(&MaterialTable, ThicknessPacking)>,
+        lean: bool,
     ) -> Result<Arc<Self>> {
         let mut out = Self {
             meshes: Vec::with_capacity(scene.meshes.len()),
@@ -151,7 +156,7 @@ impl SceneGpu {
             sss_tiles: std::sync::Mutex::new(None),
         };
         // Everything created so far is freed by `destroy` if a later step fails.
-        match out.upload(gpu, scene, translucency) {
+        match out.upload(gpu, scene, translucency, lean) {
             Ok(()) => Ok(Arc::new(out)),
             Err(e) => {
                 out.destroy(gpu);
@@ -165,6 +170,7 @@ impl SceneGpu {
         gpu: &GpuContext,
         scene: &Scene,
         translucency: Option<(&MaterialTable, ThicknessPacking)>,
+        lean: bool,
     ) -> Result<()> {
         if let Some((table, packing)) = translucency {
             let materials = gpu.upload_buffer(
@@ -191,6 +197,7 @@ impl SceneGpu {
         if normal_mapped {
             self.normal_maps = Some(NormalMaps {
                 images: Vec::with_capacity(sources.len() + 1),
+                lean2: Vec::new(),
                 sampler: create_repeat_sampler(gpu)?,
             });
             let flat = Texture::from_texels(
@@ -201,18 +208,25 @@ impl SceneGpu {
                 vec![[0.5, 0.5, 1.0, 1.0]],
             )?;
             let maps = self.normal_maps.as_mut().expect("just set");
-            maps.images
-                .push(upload_texture(gpu, &flat, "flat normal map")?);
+            let push = |maps: &mut NormalMaps, texture: &Texture, name: &str| -> Result<()> {
+                if lean {
+                    let (lean1, lean2) = crate::scene::lean::lean_maps(texture)?;
+                    maps.images
+                        .push(upload_texture(gpu, &lean1, &format!("{name} LEAN 1"))?);
+                    maps.lean2
+                        .push(upload_texture(gpu, &lean2, &format!("{name} LEAN 2"))?);
+                } else {
+                    maps.images.push(upload_texture(gpu, texture, name)?);
+                }
+                Ok(())
+            };
+            push(maps, &flat, "flat normal map")?;
             for (i, source) in sources.iter().enumerate() {
                 let texture = match source {
                     TextureSource::File(path) => load_texture(path, TextureUsage::Data)?,
                     TextureSource::Procedural(p) => procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?,
                 };
-                maps.images.push(upload_texture(
-                    gpu,
-                    &texture,
-                    &format!("{} normal map {i}", scene.name),
-                )?);
+                push(maps, &texture, &format!("{} normal map {i}", scene.name))?;
             }
         }
         for (i, mesh) in scene.meshes.iter().enumerate() {
@@ -338,7 +352,7 @@ impl SceneGpu {
             gpu.destroy_buffer(t.materials);
         }
         if let Some(maps) = self.normal_maps {
-            for image in maps.images {
+            for image in maps.images.into_iter().chain(maps.lean2) {
                 gpu.destroy_image(image);
             }
             // SAFETY: created by `create_repeat_sampler`; the GPU is done with it.

@@ -87,104 +87,361 @@ pub fn profile_reach(profile: &SssProfile) -> f32 {
     3.0 * widest.max(0.0).sqrt() * profile.units_per_mm
 }
 
-/// Declares the control technique's passes after the lighting pass: blurs of `diffuse`
-/// (reading `depth` and the SSS `strength`), then the composite with `specular`. Returns the
-/// final HDR image.
-pub fn control_passes(
+/// LBB's packed ping-pong texel: eight fp16 halves (glsl/sss/blur.frag `pack_texels`).
+pub const PACKED_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+
+/// LCB's and LBB's final lighting pass.
+const LEAN_FINAL_SHADER: &str = "sss/lean_brdf.frag";
+
+/// Which screen-space blur a frame runs (the technique decides: control, LCB, LBB).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SssBlur {
+    /// Jimenez's blur of the lit diffuse light (the thesis's control, C).
+    Control,
+    /// The LEAN pipeline with Jimenez's blur (LCB).
+    LeanControl,
+    /// The LEAN pipeline with the bilateral blur (LBB).
+    LeanBilateral,
+}
+
+impl SssBlur {
+    /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
+    pub fn lean(self) -> bool {
+        self != SssBlur::Control
+    }
+
+    /// Whether taps are weighted by a depth-difference Gaussian (else lerped back by depth).
+    pub fn bilateral(self) -> bool {
+        self == SssBlur::LeanBilateral
+    }
+}
+
+/// Precision of the sum-of-Gaussians targets.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SssPrecision {
+    /// RGBA16F sums (half the bandwidth of the accumulating writes).
+    Half,
+    /// RGBA32F sums: one rounded addition per Gaussian in fp16 costs about 4e-4 of the
+    /// diffuse light against the f64 reference (measured, six Gaussians); f32 keeps the sum
+    /// exact to the blur's own error.
+    #[default]
+    Full,
+}
+
+impl SssPrecision {
+    /// Every precision with its command-line name.
+    pub const ALL: &'static [(&'static str, SssPrecision)] =
+        &[("half", SssPrecision::Half), ("full", SssPrecision::Full)];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, p)| *p == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    fn format(self) -> vk::Format {
+        match self {
+            SssPrecision::Half => vk::Format::R16G16B16A16_SFLOAT,
+            SssPrecision::Full => vk::Format::R32G32B32A32_SFLOAT,
+        }
+    }
+}
+
+/// Default bilateral sensitivity, per world unit of depth difference: a tap 1/40 unit (2.5 mm
+/// at the scenes' 0.01 units per mm) nearer or farther keeps 61% of its weight, one 1/10 unit
+/// away 0.03%.
+pub const DEFAULT_SENSITIVITY: f32 = 40.0;
+
+/// The screen-space SSS knobs a frame is built with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SssKnobs {
+    /// Refit the profile with this many Gaussians (fewer blur pairs; [`fit_profile`] reports
+    /// the error it costs). `None`: the material's own profile.
+    pub gaussians: Option<usize>,
+    /// Precision of the sum targets.
+    pub precision: SssPrecision,
+    /// Bilateral blur: sensitivity to depth differences, per world unit.
+    pub sensitivity: f32,
+    /// LBB: carry the two blurred texels (light + slope x, slope y + moments) between passes
+    /// as one RGBA32UI texel of eight fp16 halves, so each tap is one fetch and each pass one
+    /// write. Needs point taps: LCB's bilinear taps keep two RGBA16F targets. Off by default:
+    /// measured on lavapipe, unpacking costs more than the fetch it saves (docs/sss.md).
+    pub packed: bool,
+    /// LBB: taps per direction, 3, 5 or 7 (the thesis's 7): spaced 3 sigma / ((taps - 1) / 2)
+    /// apart, weighted where they land. The control's kernel is Jimenez's 7 taps.
+    pub taps: u32,
+}
+
+impl Default for SssKnobs {
+    fn default() -> Self {
+        Self {
+            gaussians: None,
+            precision: SssPrecision::Full,
+            sensitivity: DEFAULT_SENSITIVITY,
+            packed: false,
+            taps: 7,
+        }
+    }
+}
+
+/// `profile` refitted with `n` Gaussians (1 to 8): variances spaced geometrically between the
+/// profile's narrowest and widest, weights per channel by non-negative least squares against
+/// the profile's radial shape (area-weighted, out to 4 sigma of the widest), normalised per
+/// channel. Returns it with the fit's relative L2 error per channel. `n` at or above the
+/// profile's own count returns the profile unchanged (error 0).
+pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 3])> {
+    if !(1..=8).contains(&n) {
+        return Err(crate::LucentError::InvalidInput(format!(
+            "--sss-gaussians {n}: 1 to 8 Gaussians are supported"
+        )));
+    }
+    if n >= profile.gaussians.len() {
+        return Ok((profile.clone(), [0.0; 3]));
+    }
+    let variances: Vec<f64> = profile
+        .gaussians
+        .iter()
+        .map(|g| f64::from(g.variance).max(1e-9))
+        .collect();
+    let (lo, hi) = variances
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let fitted: Vec<f64> = (0..n)
+        .map(|k| {
+            if n == 1 {
+                (lo * hi).sqrt()
+            } else {
+                (lo.ln() + (hi.ln() - lo.ln()) * k as f64 / (n - 1) as f64).exp()
+            }
+        })
+        .collect();
+    let r_max = 4.0 * hi.sqrt();
+    let mut weights = vec![glam::Vec3::ZERO; n];
+    let mut errors = [0.0; 3];
+    for c in 0..3 {
+        let target = |r: f64| crate::reference::sss::profile_value(profile, r)[c];
+        let (w, err) = crate::reference::dipole::fit_sum_of_gaussians(&fitted, target, r_max);
+        let total: f64 = w.iter().sum();
+        for (i, wi) in w.iter().enumerate() {
+            weights[i][c] = if total > 0.0 {
+                (wi / total) as f32
+            } else {
+                0.0
+            };
+        }
+        errors[c] = err;
+    }
+    let refit = SssProfile {
+        name: format!("{} ({n} Gaussians)", profile.name),
+        gaussians: fitted
+            .iter()
+            .zip(weights)
+            .map(|(&v, weight)| crate::scene::material::Gaussian {
+                variance: v as f32,
+                weight,
+            })
+            .collect(),
+        units_per_mm: profile.units_per_mm,
+    };
+    Ok((refit, errors))
+}
+
+/// The images the SSS passes read.
+pub struct SssInputs<'a> {
+    /// Lit diffuse (LCB, LBB: alpha holds the view-plane slope x).
+    pub diffuse: &'a Handle<Image>,
+    /// Lit specular, added back where the pixel does not scatter (everywhere for the control).
+    pub specular: &'a Handle<Image>,
+    /// Depth.
+    pub depth: &'a Handle<Image>,
+    /// SSS strength per pixel.
+    pub strength: &'a Handle<Image>,
+    /// LCB, LBB: the G-buffer's view-plane LEAN target (slope y, moments).
+    pub lean: Option<&'a Handle<Image>>,
+    /// G-buffer albedo + specular intensity (LEAN specular).
+    pub gb0: &'a Handle<Image>,
+}
+
+/// Declares the SSS passes after the lighting pass: one horizontal + vertical blur pair per
+/// Gaussian of `profile`, then the final pass (`combine` for the control, `final lighting`
+/// with LEAN specular for LCB and LBB). Returns the final HDR image.
+pub fn sss_passes(
     graph: &mut RenderGraph,
-    diffuse: &Handle<Image>,
-    specular: &Handle<Image>,
-    depth: &Handle<Image>,
-    strength: &Handle<Image>,
+    inputs: &SssInputs<'_>,
     profile: &SssProfile,
+    blur: SssBlur,
+    knobs: &SssKnobs,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
     let info = ImageInfo {
         format: HDR_FORMAT,
-        ..graph.resources()[diffuse.id()].info
+        ..graph.resources()[inputs.diffuse.id()].info
     };
-    let mut temp = graph.create_image("sss.temp", info);
-    let mut current = graph.create_image("sss.current", info);
-    // The sum takes one rounded addition per Gaussian: in fp16 that alone costs about 4e-4 of
-    // the diffuse light against the f64 reference (measured, six Gaussians); f32 keeps it exact
-    // to the blur's own error.
-    let mut sum = graph.create_image(
-        "sss.sum",
-        ImageInfo {
-            format: vk::Format::R32G32B32A32_SFLOAT,
+    let sum_info = ImageInfo {
+        format: knobs.precision.format(),
+        ..info
+    };
+    // LCB and LBB blur two texels per pixel (light + slope x, slope y + moments), the control one.
+    let lean = match (blur.lean(), inputs.lean) {
+        (true, Some(l)) => Some(l),
+        _ => None,
+    };
+    let targets = if lean.is_some() { 2 } else { 1 };
+    let packed = lean.is_some() && blur.bilateral() && knobs.packed;
+    let names = ["", ".lean"];
+    // The ping-pong targets: one packed RGBA32UI texel, or one RGBA16F per blurred texel.
+    let (pingpong, pingpong_info) = if packed {
+        let packed_info = ImageInfo {
+            format: PACKED_FORMAT,
             ..info
-        },
-    );
+        };
+        (1, packed_info)
+    } else {
+        (targets, info)
+    };
+    let mut temp: Vec<Handle<Image>> = (0..pingpong)
+        .map(|t| graph.create_image(&format!("sss.temp{}", names[t]), pingpong_info))
+        .collect();
+    let mut current: Vec<Handle<Image>> = (0..pingpong)
+        .map(|t| graph.create_image(&format!("sss.current{}", names[t]), pingpong_info))
+        .collect();
+    let mut sum: Vec<Handle<Image>> = (0..targets)
+        .map(|t| graph.create_image(&format!("sss.sum{}", names[t]), sum_info))
+        .collect();
+    let first: Vec<ResourceId> = std::iter::once(inputs.diffuse.id())
+        .chain(lean.map(|l| l.id()))
+        .collect();
+    let depth_term = if blur.bilateral() {
+        knobs.sensitivity.max(0.0)
+    } else {
+        DEPTH_CORRECTION
+    };
     let steps = blur_steps(profile);
     for (i, step) in steps.iter().enumerate() {
         let n = i + 1;
+        let mean_weight = step.weight.iter().sum::<f32>() / 3.0;
+        let constants = |direction: [f32; 2]| BlurConstants {
+            step: [direction[0], direction[1], step.sigma, depth_term],
+            weight: [step.weight[0], step.weight[1], step.weight[2], mean_weight],
+        };
         // Horizontal: the previous result (the lit diffuse the first time) into the temporary.
-        let source = if i == 0 { diffuse.id() } else { current.id() };
+        let sources: Vec<ResourceId> = if i == 0 {
+            first.clone()
+        } else {
+            current.iter().map(|h| h.id()).collect()
+        };
         let mut pass = graph.add_pass(&format!("horizontal blur #{n}"), PassKind::Raster);
         if i == 0 {
-            pass.sample(diffuse);
+            pass.sample(inputs.diffuse);
+            if let Some(l) = lean {
+                pass.sample(l);
+            }
         } else {
-            pass.sample(&current);
+            for c in &current {
+                pass.sample(c);
+            }
         }
-        pass.sample(depth)
-            .sample(strength)
-            .color(&mut temp, LoadOp::DontCare);
-        let blur =
-            |scene: &Arc<SceneGpu>, direction: [f32; 2], accumulate: bool, source| BlurPass {
+        pass.sample(inputs.depth).sample(inputs.strength);
+        for t in &mut temp {
+            pass.color(t, LoadOp::DontCare);
+        }
+        let exec =
+            |constants, accumulate, colors: Vec<ResourceId>, scene: &Arc<SceneGpu>| BlurPass {
                 scene: scene.clone(),
-                inputs: [source, depth.id(), strength.id()],
-                constants: BlurConstants {
-                    step: [direction[0], direction[1], step.sigma, DEPTH_CORRECTION],
-                    weight: [step.weight[0], step.weight[1], step.weight[2], 0.0],
-                },
-                accumulate,
+                // The first pass reads the lighting pass's and the G-buffer's own targets.
+                packed_in: packed && colors.len() == 1,
+                packed_out: packed,
+                sums: if accumulate { targets } else { 0 },
+                taps: knobs.taps,
+                colors,
+                depth: inputs.depth.id(),
+                strength: inputs.strength.id(),
+                constants,
+                blur,
                 sampler: vk::Sampler::null(),
                 nearest: vk::Sampler::null(),
                 pipeline: None,
             };
         match scene {
-            Some(scene) => pass.execute(blur(scene, [1.0, 0.0], false, source)),
+            Some(scene) => pass.execute(exec(constants([1.0, 0.0]), false, sources, scene)),
             None => pass.finish(),
         }
         // Vertical: back into the current result, and its weighted share into the sum.
         let mut pass = graph.add_pass(&format!("vertical blur #{n}"), PassKind::Raster);
-        pass.sample(&temp)
-            .sample(depth)
-            .sample(strength)
-            .color(&mut current, LoadOp::DontCare)
-            .color(
-                &mut sum,
+        for t in &temp {
+            pass.sample(t);
+        }
+        pass.sample(inputs.depth).sample(inputs.strength);
+        for c in &mut current {
+            pass.color(c, LoadOp::DontCare);
+        }
+        for s in &mut sum {
+            pass.color(
+                s,
                 if i == 0 {
                     LoadOp::Clear([0.0; 4])
                 } else {
                     LoadOp::Load
                 },
             );
+        }
+        let temps = temp.iter().map(|h| h.id()).collect();
         match scene {
-            Some(scene) => pass.execute(blur(scene, [0.0, 1.0], true, temp.id())),
+            Some(scene) => pass.execute(exec(constants([0.0, 1.0]), true, temps, scene)),
             None => pass.finish(),
         }
     }
     let mut hdr = graph.create_image("hdr", info);
-    let mut pass = graph.add_pass("combine", PassKind::Raster);
-    pass.sample(&sum)
-        .sample(diffuse)
-        .sample(specular)
-        .sample(strength)
-        .color(&mut hdr, LoadOp::DontCare);
-    match scene {
-        Some(scene) => pass.execute(CombinePass {
-            scene: scene.clone(),
-            inputs: [sum.id(), diffuse.id(), specular.id(), strength.id()],
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-        }),
-        None => pass.finish(),
+    match lean {
+        None => {
+            let mut pass = graph.add_pass("combine", PassKind::Raster);
+            pass.sample(&sum[0])
+                .sample(inputs.diffuse)
+                .sample(inputs.specular)
+                .sample(inputs.strength)
+                .color(&mut hdr, LoadOp::DontCare);
+            let ids = vec![
+                sum[0].id(),
+                inputs.diffuse.id(),
+                inputs.specular.id(),
+                inputs.strength.id(),
+            ];
+            match scene {
+                Some(scene) => pass.execute(FinalPass::new(scene, ids, "sss/combine.frag")),
+                None => pass.finish(),
+            }
+        }
+        Some(_) => {
+            let mut pass = graph.add_pass("final lighting", PassKind::Raster);
+            pass.sample(&sum[0])
+                .sample(&sum[1])
+                .sample(inputs.diffuse)
+                .sample(inputs.specular)
+                .sample(inputs.strength)
+                .sample(inputs.depth)
+                .sample(inputs.gb0)
+                .color(&mut hdr, LoadOp::DontCare);
+            let ids = vec![
+                sum[0].id(),
+                sum[1].id(),
+                inputs.diffuse.id(),
+                inputs.specular.id(),
+                inputs.strength.id(),
+                inputs.depth.id(),
+                inputs.gb0.id(),
+            ];
+            match scene {
+                Some(scene) => pass.execute(FinalPass::new(scene, ids, LEAN_FINAL_SHADER)),
+                None => pass.finish(),
+            }
+        }
     }
     hdr
 }
 
-/// Push constants of glsl/sss/control_blur.frag.
+/// Push constants of glsl/sss/blur.frag.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct BlurConstants {
@@ -194,15 +451,24 @@ struct BlurConstants {
 
 struct BlurPass {
     scene: Arc<SceneGpu>,
-    /// Colour to blur, depth, SSS strength.
-    inputs: [ResourceId; 3],
+    /// The texels to blur: the light (LCB, LBB: and the LEAN target).
+    colors: Vec<ResourceId>,
+    depth: ResourceId,
+    strength: ResourceId,
     constants: BlurConstants,
-    accumulate: bool,
-    /// Linear filtering for the colour taps between texels (the kernel's offsets are
-    /// fractional).
+    blur: SssBlur,
+    /// LBB packed: the input is one RGBA32UI texel (after the first pass).
+    packed_in: bool,
+    /// LBB packed: the result is written as one RGBA32UI texel.
+    packed_out: bool,
+    /// Sum-of-Gaussians targets accumulated after the result (vertical passes), else 0.
+    sums: usize,
+    /// Bilateral taps per direction.
+    taps: u32,
+    /// Linear filtering for the control's taps between texels (its offsets are fractional).
     sampler: vk::Sampler,
-    /// Nearest, for depth and strength (read with texelFetch; depth formats need not support
-    /// linear filtering).
+    /// Nearest, for depth and strength and the bilateral blur's whole-texel taps (read with
+    /// texelFetch; depth formats need not support linear filtering).
     nearest: vk::Sampler,
     pipeline: Option<PassPipeline>,
 }
@@ -213,28 +479,67 @@ impl PassExec for BlurPass {
         self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
         self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
-        let [color, depth, strength] = self.inputs;
-        let accumulate: &[(&str, &str)] = &[("LUCENT_SSS_ACCUMULATE", "1")];
+        let color_sampler = if self.blur.bilateral() {
+            self.nearest
+        } else {
+            self.sampler
+        };
+        // Bindings as glsl/sss/blur.frag declares them: 4 is the LEAN texel.
+        let mut bindings = vec![
+            Binding::Uniform(scene.frame_uniforms),
+            Binding::Sampled(views[self.colors[0]], color_sampler),
+            Binding::Sampled(views[self.depth], self.nearest),
+            Binding::Sampled(views[self.strength], self.nearest),
+        ];
+        if let Some(&lean) = self.colors.get(1) {
+            bindings.push(Binding::Sampled(views[lean], color_sampler));
+        }
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.blur.bilateral() {
+            defines.push((
+                "LUCENT_SSS_HALF_TAPS",
+                match self.taps {
+                    3 => "1",
+                    5 => "2",
+                    _ => "3",
+                },
+            ));
+        }
+        if self.blur.lean() {
+            defines.push(("LUCENT_SSS_LEAN", "1"));
+        }
+        if self.blur.bilateral() {
+            defines.push(("LUCENT_SSS_BILATERAL", "1"));
+        }
+        if self.packed_in {
+            defines.push(("LUCENT_SSS_PACKED_IN", "1"));
+        }
+        if self.packed_out {
+            defines.push(("LUCENT_SSS_PACKED_OUT", "1"));
+        }
+        if self.sums > 0 {
+            defines.push(("LUCENT_SSS_ACCUMULATE", "1"));
+        }
+        // The sums follow the results (one packed attachment, or one per blurred texel).
+        let results = match (self.packed_out, self.blur.lean()) {
+            (true, _) | (false, false) => 1,
+            (false, true) => 2,
+        };
+        let additive = ((1u32 << self.sums) - 1) << results;
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[
-                Binding::Uniform(scene.frame_uniforms),
-                Binding::Sampled(views[color], self.sampler),
-                Binding::Sampled(views[depth], self.nearest),
-                Binding::Sampled(views[strength], self.nearest),
-            ],
+            &bindings,
             &GraphicsPipelineDesc {
                 vertex: "fullscreen.vert",
-                fragment: "sss/control_blur.frag",
-                defines: if self.accumulate { accumulate } else { &[] },
+                fragment: "sss/blur.frag",
+                defines: &defines,
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,
-                // The sum (attachment 1 of the vertical pass) accumulates.
-                additive_attachments: if self.accumulate { 0b10 } else { 0 },
+                additive_attachments: additive,
                 set_layouts: &[],
                 push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-                name: "control blur",
+                name: "sss blur",
             },
         )?);
         Ok(())
@@ -264,7 +569,9 @@ impl PassExec for BlurPass {
         match tiles {
             // Only where objects with a profile (and their blur's reach) can be: every pixel a
             // tap of a scattering pixel reads is written; the rest is never read.
-            Some(rects) => PassPipeline::draw_fullscreen_in(ctx, &rects),
+            Some(rects) => {
+                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
+            }
             None => pipeline.draw_fullscreen(ctx),
         }
     }
@@ -281,15 +588,35 @@ impl PassExec for BlurPass {
     }
 }
 
-struct CombinePass {
+/// The pass after the blurs: `combine` (control) or `final lighting` (LCB, LBB, with LEAN
+/// specular): every input sampled at its own pixel, in the shader's binding order. With SSS
+/// tiles, `final lighting` evaluates LEAN only on the rectangles that may scatter and draws the
+/// pass-through variant (diffuse + specular) on the others: lavapipe shades both sides of the
+/// shader's per-pixel branch, rasterisation it does skip.
+struct FinalPass {
     scene: Arc<SceneGpu>,
-    /// Sum of Gaussians, lit diffuse, specular, SSS strength.
-    inputs: [ResourceId; 4],
+    inputs: Vec<ResourceId>,
+    fragment: &'static str,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
+    /// LCB, LBB: the pass-through variant for rectangles nothing scatters in.
+    passthrough: Option<crate::passes::util::GraphicsPipeline>,
 }
 
-impl PassExec for CombinePass {
+impl FinalPass {
+    fn new(scene: &Arc<SceneGpu>, inputs: Vec<ResourceId>, fragment: &'static str) -> Self {
+        Self {
+            scene: scene.clone(),
+            inputs,
+            fragment,
+            sampler: vk::Sampler::null(),
+            pipeline: None,
+            passthrough: None,
+        }
+    }
+}
+
+impl PassExec for FinalPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
@@ -299,33 +626,75 @@ impl PassExec for CombinePass {
                 .iter()
                 .map(|&id| Binding::Sampled(views[id], self.sampler)),
         );
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: "sss/combine.frag",
-                defines: &[],
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                push_constant_bytes: 0,
-                name: "sss combine",
-            },
-        )?);
+        let desc = GraphicsPipelineDesc {
+            vertex: "fullscreen.vert",
+            fragment: self.fragment,
+            defines: &[],
+            vertex_input: VertexInput::None,
+            depth_test: false,
+            cull_back: false,
+            additive_attachments: 0,
+            set_layouts: &[],
+            push_constant_bytes: 0,
+            name: self.fragment,
+        };
+        let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        if self.fragment == LEAN_FINAL_SHADER {
+            let layouts = [pipeline.set.layout];
+            let passthrough = crate::passes::util::GraphicsPipeline::new(
+                ctx,
+                &GraphicsPipelineDesc {
+                    defines: &[("LUCENT_SSS_PASSTHROUGH", "1")],
+                    set_layouts: &layouts,
+                    name: "final lighting (pass-through)",
+                    ..desc
+                },
+            );
+            match passthrough {
+                Ok(p) => self.passthrough = Some(p),
+                Err(e) => {
+                    let mut pipeline = pipeline;
+                    pipeline.destroy(&ctx.gpu.device);
+                    return Err(e);
+                }
+            }
+        }
+        self.pipeline = Some(pipeline);
         Ok(())
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        let tiles = self
+            .scene
+            .sss_tiles
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let (Some(passthrough), Some(rects)) = (&self.passthrough, tiles) else {
             pipeline.draw_fullscreen(ctx);
+            return;
+        };
+        pipeline.bind(ctx);
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
+        // SAFETY: made for this subpass with the bound set's layout.
+        unsafe {
+            ctx.gpu.device.cmd_bind_pipeline(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                passthrough.pipeline,
+            );
         }
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.passthrough.take() {
             p.destroy(&gpu.device);
         }
         // SAFETY: created by `prepare`; the GPU is done with it.

@@ -10,7 +10,9 @@
 //! energy, as the blurs' normalised weights do; specular is added unblurred. Non-scattering
 //! pixels keep their lighting. Cost is quadratic in scattering pixels: use small frames.
 
-use super::lighting::shade_direct_split;
+use glam::{DMat3, DVec2};
+
+use super::lighting::{light_incidence, radiance, shade_direct_split, shininess};
 use super::{gbuffer_pixels, DVec3};
 use crate::renderer::GBufferReadback;
 use crate::scene::material::SssProfile;
@@ -58,13 +60,142 @@ struct SurfacePixel {
     diffuse: DVec3,
 }
 
+/// Smallest view-space n.z (relative to |n|) a slope is taken from (glsl/common/lean.glsl).
+pub const LEAN_MIN_NZ: f64 = 0.05;
+
+/// Slope of a view-space direction (glsl `view_slope`).
+pub fn view_slope(n_view: DVec3) -> DVec2 {
+    let z = n_view.z.max(LEAN_MIN_NZ * n_view.length());
+    DVec2::new(n_view.x, n_view.y) / z
+}
+
+/// Covariance (xx, yy, xy) of moments `m` about mean `b`, clamped as the shader clamps it.
+pub fn lean_covariance(b: DVec2, m: DVec3) -> DVec3 {
+    let xx = (m.x - b.x * b.x).max(0.0);
+    let yy = (m.y - b.y * b.y).max(0.0);
+    let limit = (xx * yy).sqrt();
+    DVec3::new(xx, yy, (m.z - b.x * b.y).clamp(-limit, limit))
+}
+
+/// The LEAN specular lobe (glsl `lean_lobe`): the slope-space Gaussian of mean `b`, covariance
+/// `c` at the unit view-space half vector `h`, as a half-vector density, times Schlick's
+/// Fresnel from `f0` (none at all for `f0 = 0`), times Cook-Torrance's shadowing-masking term,
+/// over 4 n.v (n.v >= 0.1).
+#[allow(clippy::too_many_arguments)]
+pub fn lean_lobe(
+    b: DVec2,
+    c: DVec3,
+    h: DVec3,
+    v_dot_h: f64,
+    n_dot_v: f64,
+    n_dot_l: f64,
+    n_dot_h: f64,
+    f0: f64,
+) -> f64 {
+    let (cx, cy) = (c.x + 1e-5, c.y + 1e-5);
+    let det = (cx * cy - c.z * c.z).max(1e-10);
+    let hz = h.z.max(LEAN_MIN_NZ);
+    let x = DVec2::new(h.x, h.y) / hz - b;
+    let e = (x.x * x.x * cy + x.y * x.y * cx - 2.0 * x.x * x.y * c.z) / det;
+    let density = (-0.5 * e).exp() / (2.0 * std::f64::consts::PI * det.sqrt());
+    let f = 1.0 - v_dot_h.clamp(0.0, 1.0);
+    let fresnel = if f0 > 0.0 {
+        f0 + (1.0 - f0) * f.powi(5)
+    } else {
+        0.0
+    };
+    let g = (2.0 * n_dot_h.max(0.0) * n_dot_v.max(0.0).min(n_dot_l.max(0.0)) / v_dot_h.max(1e-4))
+        .min(1.0);
+    fresnel * g * density / (4.0 * hz.powi(4) * n_dot_v.max(0.1))
+}
+
+/// LEAN specular at a surface point from every light (glsl/sss/lean_brdf.frag): view-plane
+/// slope mean `b` and moments `m`, specular intensity `ks`, `view` the world-to-view rotation.
+pub fn lean_specular(
+    scene: &Scene,
+    view: DMat3,
+    position: DVec3,
+    b: DVec2,
+    m: DVec3,
+    ks: f64,
+) -> DVec3 {
+    let c = lean_covariance(b, m);
+    let to_eye = view * (scene.camera.eye.as_dvec3() - position).normalize();
+    let n = DVec3::new(b.x, b.y, 1.0).normalize();
+    let n_dot_v = n.dot(to_eye);
+    let mut out = DVec3::ZERO;
+    for light in &scene.lights {
+        let (to_light, attenuation) = light_incidence(light, position);
+        let l = view * to_light;
+        let h = l + to_eye;
+        let n_dot_l = n.dot(l);
+        if h.length_squared() <= 1e-12 || n_dot_l <= 0.0 {
+            continue;
+        }
+        let h = h.normalize();
+        let lobe = lean_lobe(b, c, h, to_eye.dot(h), n_dot_v, n_dot_l, n.dot(h), ks);
+        out += lobe * radiance(light) * attenuation;
+    }
+    out
+}
+
+/// A pixel's LEAN data projected to the view plane (glsl `view_plane_lean`): `n` the unit
+/// world geometric normal, `t`, `bt` a world tangent frame around it, `b_t`, `m_t` tangent-space
+/// slope mean and moments, `base` the roughness variance, `view` the world-to-view rotation.
+/// Returns the mean world normal, the view-plane slope mean and moments.
+pub fn view_plane_lean(
+    view: DMat3,
+    frame: [DVec3; 3],
+    b_t: DVec2,
+    m_t: DVec3,
+    base: f64,
+) -> (DVec3, DVec2, DVec3) {
+    let [t, bt, n] = frame;
+    let c_t = lean_covariance(b_t, m_t) + DVec3::new(base, base, 0.0);
+    let (t_v, bt_v, n_v) = (view * t, view * bt, view * n);
+    let u = t_v * b_t.x + bt_v * b_t.y + n_v;
+    let n_world = (t * b_t.x + bt * b_t.y + n).normalize();
+    let z = u.z.max(LEAN_MIN_NZ * u.length());
+    let b_v = DVec2::new(u.x, u.y) / z;
+    let column = |c: DVec3| (DVec2::new(c.x, c.y) * z - DVec2::new(u.x, u.y) * c.z) / (z * z);
+    let j = glam::DMat2::from_cols(column(t_v), column(bt_v));
+    let c = j
+        * glam::DMat2::from_cols(DVec2::new(c_t.x, c_t.z), DVec2::new(c_t.z, c_t.y))
+        * j.transpose();
+    let m_v = DVec3::new(
+        c.x_axis.x + b_v.x * b_v.x,
+        c.y_axis.y + b_v.y * b_v.y,
+        c.x_axis.y + b_v.x * b_v.y,
+    );
+    (n_world, b_v, m_v)
+}
+
+/// The base slope variance of a roughness (glsl `roughness_variance`): 1 / (s + 2) for the
+/// lighting pass's Blinn-Phong exponent s.
+pub fn roughness_variance(roughness: f64) -> f64 {
+    1.0 / (shininess(roughness) + 2.0)
+}
+
+/// The specular the reference adds to scattering pixels (each technique's own model).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ReferenceSpecular {
+    /// The lighting pass's Blinn-Phong (the control).
+    BlinnPhong,
+    /// LEAN specular of the unblurred view-plane LEAN data (LCB, LBB): needs the G-buffer's
+    /// LEAN target; slope x comes from the stored normal, as the lighting pass computes it.
+    Lean,
+}
+
 /// The reference HDR image (RGB per pixel, rows top first) of the SSS frame whose G-buffer is
-/// `gbuffer` (it must carry the SSS strength), blurring with `profile`.
+/// `gbuffer` (it must carry the SSS strength), blurring with `profile`; scattering pixels get
+/// `specular`'s model, unblurred (specular reflection happens at the surface).
 pub fn reference_image(
     scene: &Scene,
     gbuffer: &GBufferReadback,
     profile: &SssProfile,
+    specular: ReferenceSpecular,
 ) -> Vec<DVec3> {
+    let view = DMat3::from_mat4(scene.camera.view().as_dmat4());
     let eye = scene.camera.eye.as_dvec3();
     let focal = f64::from(scene.camera.focal_px(gbuffer.height));
     let ambient = scene.ambient.as_dvec3();
@@ -79,12 +210,23 @@ pub fn reference_image(
         };
         let to_eye = (eye - p.position).normalize();
         let mut diffuse = ambient * p.material.albedo.as_dvec3();
+        let mut blinn_phong = DVec3::ZERO;
         for light in &scene.lights {
             let (d, s) = shade_direct_split(&p.material, p.normal, p.position, to_eye, light);
             diffuse += d;
-            out[i] += s;
+            blinn_phong += s;
         }
-        if strength.get(i).is_some_and(|&s| s > 0.0) {
+        let scatters = strength.get(i).is_some_and(|&s| s > 0.0);
+        out[i] += match (specular, gbuffer.lean.as_ref()) {
+            (ReferenceSpecular::Lean, Some(lean)) if scatters => {
+                let [by, mxx, myy, mxy] = lean[i].map(f64::from);
+                let b = DVec2::new(view_slope(view * p.normal).x, by);
+                let ks = f64::from(p.material.specular);
+                lean_specular(scene, view, p.position, b, DVec3::new(mxx, myy, mxy), ks)
+            }
+            _ => blinn_phong,
+        };
+        if scatters {
             let distance = (p.position - eye).length();
             let cos = p.normal.dot(to_eye).abs().max(0.1);
             scattering.push(SurfacePixel {

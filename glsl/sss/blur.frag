@@ -1,0 +1,196 @@
+#version 450
+// permutation: LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=1 LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_OUT
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT LUCENT_SSS_ACCUMULATE
+// One direction of a separable screen-space SSS blur (src/passes/sss.rs), for one Gaussian of
+// the profile. The Gaussian's world-space sigma is projected to the screen at the pixel's depth
+// (wider up close) and scaled by the pixel's SSS strength; non-SSS pixels come out unchanged.
+//
+// - Control (Jimenez et al. 2009 as the LEAN-mapping thesis gives it, section 3.2.2): a 7-tap
+//   kernel at fractional offsets (bilinear taps); a tap across a large depth difference is
+//   lerped back to the centre colour.
+// - LUCENT_SSS_BILATERAL (the thesis's LBB, section 4.3.2): 2 LUCENT_SSS_HALF_TAPS + 1 point
+//   taps (default 7, the thesis's) spaced 3 sigma / LUCENT_SSS_HALF_TAPS apart at whole-texel offsets
+//   around the centre, each weighted by the spatial Gaussian at its actual offset times a
+//   depth-difference Gaussian (`sensitivity` per world unit), normalised by the weights' sum.
+// - LUCENT_SSS_LEAN (LCB and LBB): two texels are blurred with the same weights, the lit
+//   diffuse + view slope x and the G-buffer's LEAN slope y + moments.
+// - LUCENT_SSS_PACKED_IN / _OUT (LBB): the two texels travel between passes as one RGBA32UI
+//   texel of eight fp16 halves: one fetch per tap and one write per pass instead of two.
+// The vertical pass (LUCENT_SSS_ACCUMULATE) also adds its result times the Gaussian's weight
+// into the sum-of-Gaussians targets (additive blending): RGB weights for the diffuse light, their
+// mean (which sums to 1 over the profile too) for the LEAN moments.
+#include "../common/scene.glsl"
+
+#ifdef LUCENT_SSS_PACKED_IN
+layout(set = 0, binding = 1) uniform usampler2D packed_tex;  // both texels, packed (nearest)
+#else
+layout(set = 0, binding = 1) uniform sampler2D color_tex;    // linear filtering, clamp to edge
+#endif
+layout(set = 0, binding = 2) uniform sampler2D depth_tex;    // device depth, read with texelFetch
+layout(set = 0, binding = 3) uniform sampler2D strength_tex; // SSS strength, 0 = not SSS
+#if defined(LUCENT_SSS_LEAN) && !defined(LUCENT_SSS_PACKED_IN)
+layout(set = 0, binding = 4) uniform sampler2D lean_tex;     // slope y, moments (same filter)
+#endif
+
+layout(push_constant) uniform Blur {
+    vec4 step;    // xy: direction (1,0) or (0,1); z: this step's sigma, world units;
+                  // w: control: depth correction; bilateral: sensitivity (per world unit)
+    vec4 weight;  // rgb: the Gaussian's weight in the sum (vertical pass); a: their mean
+} blur;
+
+layout(location = 0) in vec2 in_uv;
+#ifdef LUCENT_SSS_PACKED_OUT
+layout(location = 0) out uvec4 out_packed;
+#define SUM_LOCATION 1
+#else
+layout(location = 0) out vec4 out_color;
+#ifdef LUCENT_SSS_LEAN
+layout(location = 1) out vec4 out_lean;
+#define SUM_LOCATION 2
+#endif
+#endif
+#ifdef LUCENT_SSS_ACCUMULATE
+#ifdef LUCENT_SSS_LEAN
+layout(location = SUM_LOCATION) out vec4 out_sum;
+layout(location = SUM_LOCATION + 1) out vec4 out_lean_sum;
+#else
+layout(location = 1) out vec4 out_sum;
+#endif
+#endif
+
+// A NaN or Inf sample would poison every tap that reads it: replace it where it is read.
+vec4 finite_or(vec4 c, vec4 fallback) {
+    bool bad = any(isnan(c)) || any(isinf(c));
+    return bad ? fallback : c;
+}
+
+#ifdef LUCENT_SSS_PACKED_IN
+// Both texels at `p` from the packed target.
+void fetch_texels(ivec2 p, out vec4 color, out vec4 lean) {
+    uvec4 u = texelFetch(packed_tex, p, 0);
+    color = vec4(unpackHalf2x16(u.x), unpackHalf2x16(u.y));
+    lean = vec4(unpackHalf2x16(u.z), unpackHalf2x16(u.w));
+}
+#elif defined(LUCENT_SSS_LEAN)
+void fetch_texels(ivec2 p, out vec4 color, out vec4 lean) {
+    color = texelFetch(color_tex, p, 0);
+    lean = texelFetch(lean_tex, p, 0);
+}
+#endif
+
+void main() {
+    ivec2 size = textureSize(depth_tex, 0);
+    ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef LUCENT_SSS_LEAN
+    vec4 center, center_lean;
+    fetch_texels(px, center, center_lean);
+    center = finite_or(center, vec4(0.0));
+    center_lean = finite_or(center_lean, vec4(0.0));
+#else
+    vec4 center = finite_or(texelFetch(color_tex, px, 0), vec4(0.0));
+#endif
+    float device_depth = texelFetch(depth_tex, px, 0).r;
+    float strength = clamp(texelFetch(strength_tex, px, 0).r, 0.0, 1.0);
+    // Sky pixels have no surface to scatter in.
+    strength = device_depth < 1.0 ? strength : 0.0;
+    float depth_m = linear_depth(device_depth);
+    float sigma_px = blur.step.z * frame.camera.z / max(depth_m, 1e-4) * strength;
+    // Clamp the reach (3 sigma) to a quarter of the screen: an extreme strength or a surface at
+    // the near plane must not sample across the whole image.
+    sigma_px = min(sigma_px, 0.25 / 3.0 * float(max(size.x, size.y)));
+#ifdef LUCENT_SSS_BILATERAL
+#ifndef LUCENT_SSS_HALF_TAPS
+#define LUCENT_SSS_HALF_TAPS 3
+#endif
+    // Point taps at k * spacing (k = -h..h, spacing 3 sigma / h) rounded to whole texels,
+    // weighted where they land. Below half a texel every tap rounds onto the centre: the pixel
+    // stays as it is.
+    float sigma = sigma_px < 0.5 ? 0.0 : sigma_px;
+    float spacing = sigma * (3.0 / float(LUCENT_SSS_HALF_TAPS));
+    vec4 sum = vec4(0.0);
+#ifdef LUCENT_SSS_LEAN
+    vec4 sum_lean = vec4(0.0);
+#endif
+    float total = 0.0;
+    for (int k = -LUCENT_SSS_HALF_TAPS; k <= LUCENT_SSS_HALF_TAPS; ++k) {
+        float offset = round(float(k) * spacing);
+        ivec2 tap = clamp(px + ivec2(blur.step.xy * offset), ivec2(0), size - 1);
+        float dz = (linear_depth(texelFetch(depth_tex, tap, 0).r) - depth_m) * blur.step.w;
+        float r = sigma > 0.0 ? offset / sigma : 0.0;
+        float w = exp(-0.5 * (r * r + dz * dz));
+        // A NaN depth would poison the sum: such a tap gets no weight.
+        w = w >= 0.0 ? w : 0.0;
+#ifdef LUCENT_SSS_LEAN
+        vec4 color, lean;
+        fetch_texels(tap, color, lean);
+        sum += w * finite_or(color, center);
+        sum_lean += w * finite_or(lean, center_lean);
+#else
+        sum += w * finite_or(texelFetch(color_tex, tap, 0), center);
+#endif
+        total += w;
+    }
+    // The centre tap has weight 1 (offset 0, no depth difference): total >= 1.
+    vec4 blurred = sum / max(total, 1e-6);
+#ifdef LUCENT_SSS_LEAN
+    vec4 blurred_lean = sum_lean / max(total, 1e-6);
+#endif
+#else
+    // Jimenez's kernel: centre 0.382, six taps at +-1/3, +-2/3, +-1 of the reach (sums to 1).
+    const float w[6] = float[](0.006, 0.061, 0.242, 0.242, 0.061, 0.006);
+    const float o[6] = float[](-1.0, -0.6667, -0.3333, 0.3333, 0.6667, 1.0);
+    // A Gaussian narrower than a pixel is about a delta at this resolution: blurring it anyway
+    // would only add the bilinear taps' own filtering (measured against the brute-force
+    // reference: twelve such passes end further from it than no blur at all).
+    float reach_px = sigma_px < 1.0 ? 0.0 : 3.0 * sigma_px;
+    vec2 final_step = blur.step.xy * reach_px * frame.viewport.zw;
+    vec2 uv = (vec2(px) + 0.5) * frame.viewport.zw;
+    vec4 blurred = center * 0.382;
+#ifdef LUCENT_SSS_LEAN
+    vec4 blurred_lean = center_lean * 0.382;
+#endif
+    for (int i = 0; i < 6; ++i) {
+        vec2 offset = uv + o[i] * final_step;
+        ivec2 tap = clamp(ivec2(offset * frame.viewport.xy), ivec2(0), size - 1);
+        float depth = linear_depth(texelFetch(depth_tex, tap, 0).r);
+        // A huge depth difference (another object, the background): back to the centre colour.
+        float s = min(blur.step.w * abs(depth_m - depth), 1.0);
+        blurred += w[i] * mix(finite_or(textureLod(color_tex, offset, 0.0), center), center, s);
+#ifdef LUCENT_SSS_LEAN
+        blurred_lean +=
+            w[i] * mix(finite_or(textureLod(lean_tex, offset, 0.0), center_lean), center_lean, s);
+#endif
+    }
+#endif
+    // fp16 targets: keep them finite.
+    blurred = clamp(blurred, vec4(-65504.0), vec4(65504.0));
+#ifdef LUCENT_SSS_LEAN
+    blurred_lean = clamp(blurred_lean, vec4(-65504.0), vec4(65504.0));
+#endif
+#ifdef LUCENT_SSS_PACKED_OUT
+    out_packed = uvec4(packHalf2x16(blurred.xy), packHalf2x16(blurred.zw),
+                       packHalf2x16(blurred_lean.xy), packHalf2x16(blurred_lean.zw));
+#else
+    out_color = blurred;
+#ifdef LUCENT_SSS_LEAN
+    out_lean = blurred_lean;
+#endif
+#endif
+#ifdef LUCENT_SSS_ACCUMULATE
+#ifdef LUCENT_SSS_LEAN
+    out_sum = vec4(blurred.rgb * blur.weight.rgb, blurred.a * blur.weight.a);
+    out_lean_sum = blurred_lean * blur.weight.a;
+#else
+    out_sum = vec4(blurred.rgb * blur.weight.rgb, 0.0);
+#endif
+#endif
+}

@@ -1,0 +1,70 @@
+#version 450
+// permutation: LUCENT_SSS_PASSTHROUGH
+// LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): where the
+// pixel scatters, the blurred diffuse light plus LEAN specular with Fresnel evaluated on the
+// blurred view-plane slopes and moments, for every light; elsewhere the lighting pass's
+// diffuse + specular. Half vectors come from the depth (no position or half-vector targets:
+// the thesis stored both; the depth buffer already holds what they encode).
+#include "../common/lean.glsl"
+
+layout(set = 0, binding = 1) uniform sampler2D sum_tex;       // blurred diffuse rgb + slope x
+layout(set = 0, binding = 2) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
+layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
+layout(set = 0, binding = 4) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
+layout(set = 0, binding = 5) uniform sampler2D strength_tex;
+layout(set = 0, binding = 6) uniform sampler2D depth_tex;
+layout(set = 0, binding = 7) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef LUCENT_SSS_PASSTHROUGH
+    // Drawn on the screen rectangles no scattering object can touch.
+    float strength = 0.0;
+#else
+    float strength = texelFetch(strength_tex, px, 0).r;
+#endif
+    vec3 color;
+    if (strength > 0.0) {
+        vec4 s0 = texelFetch(sum_tex, px, 0);
+        vec4 s1 = texelFetch(lean_sum_tex, px, 0);
+        vec2 b = vec2(s0.a, s1.x);
+        vec3 c = lean_covariance(b, s1.yzw);
+        float ks = texelFetch(albedo_tex, px, 0).a;
+        float d = texelFetch(depth_tex, px, 0).r;
+        vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
+        vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
+        vec3 pos = world.xyz / world.w;
+        mat3 view = mat3(frame.view);
+        vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
+        vec3 n = normalize(vec3(b, 1.0));
+        float n_dot_v = dot(n, to_eye);
+        vec3 specular = vec3(0.0);
+        int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
+        for (int i = 0; i < count; ++i) {
+            Light light = frame.lights[i];
+            vec3 to_light;
+            float attenuation;
+            light_incidence(light, pos, to_light, attenuation);
+            vec3 l = view * to_light;
+            vec3 h = l + to_eye;
+            float h_len2 = dot(h, h);
+            // Light exactly behind the surface point as seen from the eye: no half vector.
+            float n_dot_l = dot(n, l);
+            if (!(h_len2 > 1e-12) || n_dot_l <= 0.0) {
+                continue;
+            }
+            h *= inversesqrt(h_len2);
+            float lobe = lean_lobe(b, c, h, dot(to_eye, h), n_dot_v, n_dot_l, dot(n, h), ks);
+            specular += lobe * light.radiance_range.rgb * attenuation;
+        }
+        color = s0.rgb + specular;
+    } else {
+        color = texelFetch(diffuse_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb;
+    }
+    // Into fp16's range; a NaN (which clamp need not catch) becomes black.
+    color = any(isnan(color)) ? vec3(0.0) : clamp(color, vec3(0.0), vec3(65504.0));
+    out_color = vec4(color, 1.0);
+}

@@ -29,6 +29,7 @@ pub mod scaling;
 pub mod scene;
 pub mod seeds;
 pub mod speed_of_light;
+pub mod sss_report;
 pub mod suite;
 pub mod sweep;
 

@@ -627,3 +627,30 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
     );
     test.finish();
 }
+
+#[test]
+fn sss_report_writes_its_table_and_plot() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("sss-report");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "report", "sss", "--size", "128x96", "--rounds", "1", "--warmup", "0",
+        ])
+        .arg("--out")
+        .arg(&dir)
+        .arg("--validation")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let md = std::fs::read_to_string(dir.join("sss.md")).unwrap();
+    for variant in lucent::sss_report::sss_variants() {
+        let row = md
+            .lines()
+            .find(|l| l.contains(&format!("| {} |", variant.name)))
+            .unwrap_or_else(|| panic!("no row for {}:\n{md}", variant.name));
+        assert!(!row.contains("NaN") && !row.contains("inf"), "{row}");
+    }
+    let png = std::fs::metadata(dir.join("sss-error-vs-time.png")).unwrap();
+    assert!(png.len() > 10_000, "plot of {} bytes", png.len());
+}

@@ -20,7 +20,9 @@
 // - LUCENT_SSS_BILATERAL (the thesis's LBB, section 4.3.2): 2 LUCENT_SSS_HALF_TAPS + 1 point
 //   taps (default 7, the thesis's) spaced 3 sigma / LUCENT_SSS_HALF_TAPS apart at whole-texel offsets
 //   around the centre, each weighted by the spatial Gaussian at its actual offset times a
-//   depth-difference Gaussian (`sensitivity` per world unit), normalised by the weights' sum.
+//   depth-difference Gaussian (sensitivity over the completed profile Gaussian's width, per world
+//   unit: at sensitivity 1 the weight is the profile Gaussian of the tap's 3D distance),
+//   normalised by the weights' sum.
 // - LUCENT_SSS_LEAN (LCB and LBB): two texels are blurred with the same weights, the lit
 //   diffuse + view slope x and the G-buffer's LEAN slope y + moments.
 // - LUCENT_SSS_PACKED_IN / _OUT (LBB): the two texels travel between passes as one RGBA32UI
@@ -43,7 +45,7 @@ layout(set = 0, binding = 4) uniform sampler2D lean_tex;     // slope y, moments
 
 layout(push_constant) uniform Blur {
     vec4 step;    // xy: direction (1,0) or (0,1); z: this step's sigma, world units;
-                  // w: control: depth correction; bilateral: sensitivity (per world unit)
+                  // w: control: depth correction; bilateral: depth sensitivity (per world unit)
     vec4 weight;  // rgb: the Gaussian's weight in the sum (vertical pass); a: their mean
 } blur;
 

@@ -107,9 +107,11 @@ enum Command {
     },
     /// The report suite: every technique's passes beside their speed-of-light copies, the
     /// seeds' tables beside ours, scaling curves and error against time, as DIR/report.md with
-    /// PNG plots. With a section name (`translucency`), only that error-against-time section.
+    /// PNG plots. With a section name (`translucency`, `sss`), only that error-against-time
+    /// section.
     Report {
-        /// Only this error-against-time section (`translucency`); default: the whole suite.
+        /// Only this error-against-time section (`translucency` or `sss`); default: the whole
+        /// suite.
         technique: Option<String>,
         /// Output directory.
         #[arg(long, default_value = "report")]
@@ -195,7 +197,8 @@ struct FrameArgs {
     /// Precision of the SSS sum-of-Gaussians targets: half (RGBA16F) or full (RGBA32F).
     #[arg(long, default_value = "full", value_parser = parse_sss_precision)]
     sss_precision: SssPrecision,
-    /// Bilateral blur (LBB): sensitivity to depth differences, per world unit.
+    /// Bilateral blur (LBB): sensitivity to depth differences, relative to each profile
+    /// Gaussian's width (1: weights follow the taps' 3D distance).
     #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
     sensitivity: f32,
     /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
@@ -652,12 +655,16 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
     }
     let (text, files) = match &args.technique {
         Some(technique) => {
-            if technique != "translucency" {
-                return Err(LucentError::InvalidInput(format!(
-                    "report: unknown section '{technique}'; available: translucency (or no \
-                     section: the whole suite)"
-                )));
-            }
+            let write = match technique.as_str() {
+                "translucency" => lucent::report::write_translucency_report,
+                "sss" => lucent::sss_report::write_sss_report,
+                _ => {
+                    return Err(LucentError::InvalidInput(format!(
+                        "report: unknown section '{technique}'; available: translucency, sss (or \
+                         no section: the whole suite)"
+                    )))
+                }
+            };
             let (width, height) = args.size.unwrap_or((1024, 768));
             let options = lucent::report::ReportOptions {
                 width,
@@ -666,7 +673,7 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
                 warmup: args.warmup.unwrap_or(3),
             };
             with_session(gpu_args, |session| {
-                lucent::report::write_translucency_report(
+                write(
                     &session.gpu,
                     &session.shaders,
                     &session.pipeline_cache,

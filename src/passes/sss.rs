@@ -149,10 +149,12 @@ impl SssPrecision {
     }
 }
 
-/// Default bilateral sensitivity, per world unit of depth difference: a tap 1/40 unit (2.5 mm
-/// at the scenes' 0.01 units per mm) nearer or farther keeps 61% of its weight, one 1/10 unit
-/// away 0.03%.
-pub const DEFAULT_SENSITIVITY: f32 = 40.0;
+/// Default bilateral sensitivity: the depth-difference Gaussian of each blur step has the
+/// standard deviation of the profile Gaussian the step completes, divided by the sensitivity.
+/// At 1 the bilateral weight is the profile Gaussian of the tap's 3D distance (screen offset and
+/// depth difference alike), which is what the brute-force reference convolves with: a surface
+/// curving away is blurred by its true distance, a background a few sigma behind gets nothing.
+pub const DEFAULT_SENSITIVITY: f32 = 1.0;
 
 /// The screen-space SSS knobs a frame is built with.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,7 +164,8 @@ pub struct SssKnobs {
     pub gaussians: Option<usize>,
     /// Precision of the sum targets.
     pub precision: SssPrecision,
-    /// Bilateral blur: sensitivity to depth differences, per world unit.
+    /// Bilateral blur: sensitivity to depth differences, relative to each Gaussian's own
+    /// width ([`DEFAULT_SENSITIVITY`]).
     pub sensitivity: f32,
     /// LBB: carry the two blurred texels (light + slope x, slope y + moments) between passes
     /// as one RGBA32UI texel of eight fp16 halves, so each tap is one fetch and each pass one
@@ -313,14 +316,19 @@ pub fn sss_passes(
     let first: Vec<ResourceId> = std::iter::once(inputs.diffuse.id())
         .chain(lean.map(|l| l.id()))
         .collect();
-    let depth_term = if blur.bilateral() {
-        knobs.sensitivity.max(0.0)
-    } else {
-        DEPTH_CORRECTION
-    };
     let steps = blur_steps(profile);
+    let mut completed_variance = 0.0f32;
     for (i, step) in steps.iter().enumerate() {
         let n = i + 1;
+        completed_variance += step.sigma * step.sigma;
+        // Bilateral: per world unit of depth difference, the sensitivity over the width of the
+        // Gaussian this step completes (guarded: a zero-width profile rejects every neighbour,
+        // which leaves the pixel as it is).
+        let depth_term = if blur.bilateral() {
+            knobs.sensitivity.max(0.0) / completed_variance.sqrt().max(1e-9)
+        } else {
+            DEPTH_CORRECTION
+        };
         let mean_weight = step.weight.iter().sum::<f32>() / 3.0;
         let constants = |direction: [f32; 2]| BlurConstants {
             step: [direction[0], direction[1], step.sigma, depth_term],
@@ -720,6 +728,31 @@ mod tests {
             let total: f32 = steps.iter().map(|s| s.weight[c]).sum();
             assert!((total - 1.0).abs() < 1e-5, "channel {c}: {total}");
         }
+    }
+
+    #[test]
+    fn fitting_fewer_gaussians_reports_a_growing_error() {
+        let skin = SssProfile::preset("skin").unwrap();
+        let (same, e) = fit_profile(&skin, 6).unwrap();
+        assert_eq!(same, skin);
+        assert_eq!(e, [0.0; 3]);
+        let mut previous = 0.0;
+        for n in [4, 3, 2, 1] {
+            let (fit, e) = fit_profile(&skin, n).unwrap();
+            assert_eq!(fit.gaussians.len(), n);
+            fit.validate().unwrap();
+            let worst = e.iter().fold(0.0f64, |a, &b| a.max(b));
+            assert!(worst.is_finite() && worst >= previous - 1e-9, "{n}: {e:?}");
+            previous = worst;
+            for c in 0..3 {
+                let total: f32 = fit.gaussians.iter().map(|g| g.weight[c]).sum();
+                assert!((total - 1.0).abs() < 1e-4, "{n} channel {c}: {total}");
+            }
+        }
+        // Four Gaussians (the thesis's count) fit d'Eon's six within a few percent.
+        let (_, e4) = fit_profile(&skin, 4).unwrap();
+        assert!(e4.iter().all(|&e| e < 0.05), "{e4:?}");
+        assert!(fit_profile(&skin, 0).is_err() && fit_profile(&skin, 9).is_err());
     }
 
     #[test]

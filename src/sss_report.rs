@@ -1,0 +1,418 @@
+//! Error against run time for screen-space SSS: `lucent report sss --out DIR`.
+//!
+//! The three techniques (the control, LCB, LBB) and every LBB knob (Gaussian count, taps, sum
+//! precision, packed ping-pong, screen tiles) are measured two ways:
+//! - **time**: frames of the `teapot` scene at the report's size, taken round-robin (one frame
+//!   of each variant per round, after warm-up rounds), so a shared, noisy machine slows every
+//!   variant alike; medians of the frame and of the SSS passes (blurs + final pass).
+//! - **error**: the `edges` scene (an SSS sphere before a bright wall, a thin SSS slab before a
+//!   dark pillar) at a quarter of the report's size per side with the profiles widened 4x, so
+//!   the blurs span as many pixels as at full size, against the brute-force f64 reference
+//!   (the profile convolved over the visible surface, [`crate::reference::sss`]); the SSS
+//!   objects' specular is off, so every technique is judged on diffusion alone (LCB and LBB
+//!   also blur their highlights, which a physical reference never does). Reported: mean error
+//!   over scattering pixels, split into the silhouette band (bleed) and the interior, and
+//!   halo pixels (non-scattering pixels the SSS passes changed).
+//!
+//! Writes `sss.md` and `sss-error-vs-time.png`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::backend::shader::{PipelineCache, ShaderCompiler};
+use crate::backend::GpuContext;
+use crate::bench::Stats;
+use crate::passes::sss::{fit_profile, SssPrecision};
+use crate::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
+use crate::renderer::{
+    FrameFeatures, FrameImages, FrameRunner, FrameSettings, Renderer, Technique,
+};
+use crate::report::ReportOptions;
+use crate::scene::{self, Scene};
+use crate::{LucentError, Result};
+
+/// One configuration to measure.
+#[derive(Clone, Debug)]
+pub struct SssVariant {
+    /// Which knob it turns (the plot's series).
+    pub knob: &'static str,
+    /// Its setting.
+    pub name: String,
+    /// Frame settings (size is set per measurement).
+    pub settings: FrameSettings,
+}
+
+/// What one variant measured.
+#[derive(Clone, Debug)]
+pub struct SssResult {
+    /// The variant.
+    pub variant: SssVariant,
+    /// Whole frame (submit to fence), ms.
+    pub frame: Stats,
+    /// The SSS passes (blurs and the final pass), ms: medians of per-frame sums.
+    pub sss: Stats,
+    /// Blur pairs in the frame.
+    pub blur_pairs: usize,
+    /// Edge and interior error, halo, against the brute-force reference.
+    pub edges: EdgeMetrics,
+    /// Mean error over all scattering pixels.
+    pub mean_error: f64,
+    /// Relative L2 error of the profile fit (largest channel), when the Gaussians were refit.
+    pub fit_error: Option<f64>,
+}
+
+/// Every variant: the three techniques at their defaults, then one LBB knob at a time.
+pub fn sss_variants() -> Vec<SssVariant> {
+    let base = |technique| FrameSettings {
+        technique,
+        ..FrameSettings::new(1, 1)
+    };
+    let mut v = Vec::new();
+    for t in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+        v.push(SssVariant {
+            knob: "technique",
+            name: t.name().into(),
+            settings: base(t),
+        });
+    }
+    for n in [4, 3, 2] {
+        for t in [Technique::Control, Technique::Lbb] {
+            let mut s = base(t);
+            s.sss.gaussians = Some(n);
+            v.push(SssVariant {
+                knob: if t == Technique::Lbb {
+                    "LBB Gaussians"
+                } else {
+                    "control Gaussians"
+                },
+                name: format!("{} {n} Gaussians", t.name()),
+                settings: s,
+            });
+        }
+    }
+    for taps in [5, 3] {
+        let mut s = base(Technique::Lbb);
+        s.sss.taps = taps;
+        v.push(SssVariant {
+            knob: "LBB taps",
+            name: format!("lbb {taps} taps"),
+            settings: s,
+        });
+    }
+    let mut half = base(Technique::Lbb);
+    half.sss.precision = SssPrecision::Half;
+    v.push(SssVariant {
+        knob: "LBB sum precision",
+        name: "lbb fp16 sums".into(),
+        settings: half,
+    });
+    let mut packed = base(Technique::Lbb);
+    packed.sss.packed = true;
+    v.push(SssVariant {
+        knob: "LBB packed ping-pong",
+        name: "lbb packed".into(),
+        settings: packed,
+    });
+    let mut whole = base(Technique::Lbb);
+    whole.sss_tiles = false;
+    v.push(SssVariant {
+        knob: "LBB screen tiles",
+        name: "lbb whole screen".into(),
+        settings: whole,
+    });
+    let mut fast = base(Technique::Lbb);
+    fast.sss.gaussians = Some(4);
+    fast.sss.taps = 5;
+    v.push(SssVariant {
+        knob: "LBB combined",
+        name: "lbb 4 Gaussians, 5 taps".into(),
+        settings: fast,
+    });
+    v
+}
+
+fn sized(settings: &FrameSettings, width: u32, height: u32) -> FrameSettings {
+    FrameSettings {
+        width,
+        height,
+        ..*settings
+    }
+}
+
+/// `scene` with its profiles widened by `factor` and, with `no_specular`, its SSS objects'
+/// specular off.
+fn error_scene(scene: &Scene, factor: f32, no_specular: bool) -> Scene {
+    let mut s = scene.clone();
+    for o in &mut s.objects {
+        if let Some(p) = &mut o.material.sss {
+            p.units_per_mm *= factor;
+            if no_specular {
+                o.material.specular = 0.0;
+            }
+        }
+    }
+    s
+}
+
+fn render_once(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    scene: &Scene,
+    settings: FrameSettings,
+) -> Result<FrameImages> {
+    let renderer = Renderer::new(gpu, shaders, cache, scene, settings)?;
+    let images = renderer.render_once(gpu);
+    let idle = gpu.wait_idle();
+    renderer.destroy(gpu);
+    idle?;
+    images
+}
+
+/// Whether a physical pass belongs to the SSS technique (blurs, combine, final lighting).
+fn is_sss_pass(name: &str) -> bool {
+    name.contains("blur #") || name == "combine" || name == "final lighting"
+}
+
+/// Measures every variant: times on `teapot` at the options' size, errors on `edges`.
+pub fn run(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    variants: &[SssVariant],
+    opts: &ReportOptions,
+) -> Result<Vec<SssResult>> {
+    if opts.rounds == 0 {
+        return Err(LucentError::InvalidInput(
+            "report: --rounds must be at least 1".into(),
+        ));
+    }
+    // Errors first (small frames); the widened profile keeps the blur's pixel footprint.
+    let (ew, eh) = ((opts.width / 4).max(64), (opts.height / 4).max(48));
+    let edges = scene::load_scene("edges")?;
+    let edges = error_scene(&edges, 4.0, true);
+    let reference_frame = FrameSettings {
+        technique: Technique::Lbb,
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(ew, eh)
+    };
+    let frame = render_once(gpu, shaders, cache, &edges, reference_frame)?;
+    let gbuffer = frame
+        .gbuffer
+        .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
+    let (profile, _) = FrameFeatures::new(&edges, &reference_frame)?
+        .sss
+        .ok_or_else(|| LucentError::InvalidInput("the edges scene has no SSS profile".into()))?;
+    // Specular is off on the SSS objects: both specular models add nothing there.
+    let reference = reference_image(&edges, &gbuffer, &profile, ReferenceSpecular::Lean);
+    let strength = gbuffer.sss.clone().unwrap_or_default();
+    let plain = render_once(
+        gpu,
+        shaders,
+        cache,
+        &edges,
+        FrameSettings {
+            technique: Technique::None,
+            ..reference_frame
+        },
+    )?
+    .hdr
+    .unwrap_or_default();
+    let mut errors = Vec::with_capacity(variants.len());
+    for v in variants {
+        let settings = FrameSettings {
+            export_hdr: true,
+            ..sized(&v.settings, ew, eh)
+        };
+        let hdr = render_once(gpu, shaders, cache, &edges, settings)?
+            .hdr
+            .unwrap_or_default();
+        let m = edge_metrics(ew as usize, &strength, &plain, &hdr, &reference, 2);
+        let n = (m.edge_pixels + m.interior_pixels).max(1) as f64;
+        let mean =
+            (m.edge_error * m.edge_pixels as f64 + m.interior_error * m.interior_pixels as f64) / n;
+        let fit = v
+            .settings
+            .sss
+            .gaussians
+            .map(|g| fit_profile(&profile, g).map(|(_, e)| e.iter().fold(0.0f64, |a, &b| a.max(b))))
+            .transpose()?;
+        errors.push((m, mean, fit));
+    }
+    // Times: every variant's frames round-robin.
+    let teapot = scene::load_scene("teapot")?;
+    let mut renderers = Vec::with_capacity(variants.len());
+    let mut runners = Vec::with_capacity(variants.len());
+    let timed = (|| -> Result<Vec<(Stats, Stats, usize)>> {
+        for v in variants {
+            let r = Renderer::new(
+                gpu,
+                shaders,
+                cache,
+                &teapot,
+                sized(&v.settings, opts.width, opts.height),
+            )?;
+            runners.push(FrameRunner::new(gpu, r.executable.plan.physical.len())?);
+            renderers.push(r);
+        }
+        let mut samples = vec![(Vec::new(), Vec::new()); variants.len()];
+        for round in 0..opts.warmup + opts.rounds {
+            for (i, (renderer, runner)) in renderers.iter().zip(&mut runners).enumerate() {
+                let t = runner.run_frame(gpu, &renderer.executable)?;
+                if round >= opts.warmup {
+                    samples[i].0.push(t.wall_ms);
+                    samples[i].1.push(
+                        t.passes
+                            .iter()
+                            .filter(|p| is_sss_pass(&p.name))
+                            .map(|p| p.ms)
+                            .sum(),
+                    );
+                }
+            }
+        }
+        Ok(samples
+            .iter()
+            .zip(&renderers)
+            .map(|((frame, sss), r)| {
+                let pairs = r
+                    .executable
+                    .plan
+                    .physical
+                    .iter()
+                    .filter(|p| p.name.starts_with("vertical blur #"))
+                    .count();
+                (Stats::of(frame), Stats::of(sss), pairs)
+            })
+            .collect())
+    })();
+    let idle = gpu.wait_idle();
+    for runner in runners {
+        runner.destroy(gpu);
+    }
+    for renderer in renderers {
+        renderer.destroy(gpu);
+    }
+    idle?;
+    Ok(variants
+        .iter()
+        .zip(timed?)
+        .zip(errors)
+        .map(
+            |((v, (frame, sss, blur_pairs)), (edges, mean_error, fit_error))| SssResult {
+                variant: v.clone(),
+                frame,
+                sss,
+                blur_pairs,
+                edges,
+                mean_error,
+                fit_error,
+            },
+        )
+        .collect())
+}
+
+/// The report as Markdown.
+pub fn markdown(results: &[SssResult], opts: &ReportOptions, device: &str) -> String {
+    let mut out = String::new();
+    let control = results
+        .iter()
+        .find(|r| r.variant.name == "control")
+        .map_or(f64::NAN, |r| r.frame.median);
+    let (ew, eh) = ((opts.width / 4).max(64), (opts.height / 4).max(48));
+    let _ = writeln!(
+        out,
+        "# Screen-space SSS: error against run time\n\n\
+         - device: {device}\n\
+         - time: scene `teapot`, {}x{}, {} rounds round-robin after {} warm-up rounds, in-frame \
+         timestamps; frame = submit to fence\n\
+         - error: scene `edges`, {ew}x{eh}, profiles widened so the blurs span the pixels they \
+         span at {}x{}; SSS objects' specular off (diffusion only); against the brute-force f64 \
+         convolution of the profile over the visible surface\n\
+         - generated by `lucent report sss --out DIR --size {}x{} --rounds {} --warmup {}`\n",
+        opts.width,
+        opts.height,
+        opts.rounds,
+        opts.warmup,
+        opts.width,
+        opts.height,
+        opts.width,
+        opts.height,
+        opts.rounds,
+        opts.warmup
+    );
+    let _ = writeln!(
+        out,
+        "| knob | variant | blur pairs | frame ms | / control | SSS passes ms | mean error | \
+         silhouette band | interior | halo px | profile fit error |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in results {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.2} | {:.3}x | {:.2} | {:.3e} | {:.3e} | {:.3e} | {} | {} |",
+            r.variant.knob,
+            r.variant.name,
+            r.blur_pairs,
+            r.frame.median,
+            r.frame.median / control,
+            r.sss.median,
+            r.mean_error,
+            r.edges.edge_error,
+            r.edges.interior_error,
+            r.edges.halo_pixels,
+            r.fit_error
+                .map_or("-".into(), |e| format!("{:.1}%", e * 100.0)),
+        );
+    }
+    out.push_str(
+        "\nRatios are against the control (Jimenez, d'Eon's six Gaussians) measured in the same \
+         run. Silhouette band: scattering pixels within 2 pixels of a non-scattering one (where \
+         background light bleeds in); halo: non-scattering pixels the SSS passes changed.\n",
+    );
+    out
+}
+
+/// Runs the SSS report and writes `sss.md` and `sss-error-vs-time.png` into `out`. Returns the
+/// Markdown and the files written.
+pub fn write_sss_report(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    out: &Path,
+    opts: &ReportOptions,
+) -> Result<(String, Vec<PathBuf>)> {
+    let results = run(gpu, shaders, cache, &sss_variants(), opts)?;
+    let text = markdown(&results, opts, &gpu.info.describe());
+    std::fs::create_dir_all(out)
+        .map_err(|e| LucentError::InvalidInput(format!("{}: {e}", out.display())))?;
+    let md = out.join("sss.md");
+    crate::output::write_file_atomic(&md, text.as_bytes())?;
+    let mut series: Vec<PlotSeries> = Vec::new();
+    for r in &results {
+        let point = PlotPoint {
+            label: r.variant.name.clone(),
+            x: r.frame.median,
+            y: r.mean_error,
+        };
+        match series.iter_mut().find(|s| s.name == r.variant.knob) {
+            Some(s) => s.points.push(point),
+            None => series.push(PlotSeries {
+                name: r.variant.knob.into(),
+                points: vec![point],
+            }),
+        }
+    }
+    let png = out.join("sss-error-vs-time.png");
+    write_scatter_png(
+        &png,
+        "Screen-space SSS: error against frame time",
+        "frame ms (teapot)",
+        "mean |GPU - brute-force reference| (edges, diffusion)",
+        &series,
+        true,
+    )?;
+    Ok((text, vec![md, png]))
+}

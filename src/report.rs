@@ -512,19 +512,8 @@ pub fn translucency_section(
     };
     let (text, files) =
         write_translucency_report(ctx.gpu, ctx.shaders, ctx.pipeline_cache, ctx.dir, &opts)?;
-    let markdown = text
-        .lines()
-        .map(|l| {
-            if l.starts_with('#') {
-                format!("#{l}")
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n");
     Ok(crate::suite::SectionOutput {
-        markdown: format!("{markdown}\n"),
+        markdown: crate::suite::embed(&text),
         files,
         ..Default::default()
     })

@@ -101,10 +101,74 @@ pub struct SectionOutput {
 pub type SectionFn = fn(&SuiteContext<'_>) -> Result<SectionOutput>;
 
 /// The error-against-time sections, one per technique with approximation knobs, in report order.
-pub const ERROR_SECTIONS: &[(&str, SectionFn)] = &[(
-    "translucency",
-    crate::report::translucency_section as SectionFn,
-)];
+pub const ERROR_SECTIONS: &[(&str, SectionFn)] = &[
+    (
+        "translucency",
+        crate::report::translucency_section as SectionFn,
+    ),
+    ("sss", sss_section as SectionFn),
+];
+
+/// A section's own Markdown file embedded in `report.md`: every heading one level down.
+pub fn embed(text: &str) -> String {
+    let mut out: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with('#') {
+                format!("#{l}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    out.push('\n');
+    out
+}
+
+/// The SSS error-against-time report ([`crate::sss_report`]) as a section, written beside
+/// `report.md`. Full run: the suite's size, 5 rounds after 1 warm-up (as `docs/report/sss.md`
+/// was first measured); quick: 128x96, 1 round, no warm-up.
+pub fn sss_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
+    let opts = if ctx.options.quick {
+        crate::report::ReportOptions {
+            width: 128,
+            height: 96,
+            rounds: 1,
+            warmup: 0,
+        }
+    } else {
+        crate::report::ReportOptions {
+            width: ctx.options.width,
+            height: ctx.options.height,
+            rounds: 5,
+            warmup: 1,
+        }
+    };
+    let (text, files) = crate::sss_report::write_sss_report(
+        ctx.gpu,
+        ctx.shaders,
+        ctx.pipeline_cache,
+        ctx.dir,
+        &opts,
+    )?;
+    let mut markdown = embed(&text);
+    // Its plot, linked where the section's own Markdown does not link it.
+    for png in files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "png"))
+    {
+        let name = file_name(png);
+        if !text.contains(&format!("]({name})")) {
+            let _ = writeln!(markdown, "\n![SSS error against time]({name})\n");
+        }
+    }
+    Ok(SectionOutput {
+        markdown,
+        files,
+        ..Default::default()
+    })
+}
 
 /// The built-in scene a technique is measured on: the first made for it (its `technique`), else
 /// the first whose frame under the technique differs from plain deferred lighting (the

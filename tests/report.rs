@@ -99,6 +99,7 @@ fn quick_report_has_every_table_and_plot() {
         "### Against lights",
         "Growth along lights",
         "error against run time",
+        "Screen-space SSS: error against run time",
     ] {
         assert!(report.contains(needle), "missing '{needle}'");
     }
@@ -112,6 +113,7 @@ fn quick_report_has_every_table_and_plot() {
             plots += 1;
         }
     }
-    // Bars per technique, Li et al., three scaling axes, translucency error against time.
-    assert!(plots >= Technique::ALL.len() + 5, "{plots} plots");
+    // Bars per technique, Li et al., three scaling axes, translucency and SSS error against
+    // time.
+    assert!(plots >= Technique::ALL.len() + 6, "{plots} plots");
 }

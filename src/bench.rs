@@ -13,12 +13,23 @@
 //! more is within 20% of its isolated time. If a check fails it reports the isolated times
 //! instead and says so. If even those do not add up, the report is marked untrusted and the
 //! command exits non-zero.
+//!
+//! With a [`CopyFrame`] the same run also times every pass's
+//! speed-of-light copy, alternating with the frames, and the report gains the pass / copy table.
+//! Output: [`BenchReport::markdown`], [`BenchReport::csv`], [`BenchReport::json`]. Runs longer
+//! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal.
+
+use std::io::IsTerminal as _;
 
 use serde::Serialize;
 
 use crate::backend::GpuContext;
 use crate::renderer::{FrameRunner, FrameTiming, Renderer};
+use crate::speed_of_light::{CopyFrame, FloorRow};
 use crate::{LucentError, Result};
+
+/// Estimated run time (from the warm-up) above which a progress bar is drawn.
+pub const PROGRESS_AFTER_S: f64 = 3.0;
 
 /// Tolerance of the sum check: pass medians vs frame median.
 pub const SUM_TOLERANCE: f64 = 0.10;
@@ -138,12 +149,60 @@ pub struct BenchReport {
     pub checks: Vec<Check>,
     /// Whether the reported numbers passed their checks.
     pub trusted: bool,
+    /// Each pass against its speed-of-light copy, when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed_of_light: Option<Vec<FloorRow>>,
+}
+
+/// The report formats `lucent bench --format` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Header, table and checks.
+    Markdown,
+    /// One row per pass plus the frame, with a header line.
+    Csv,
+    /// The documented JSON object.
+    Json,
+}
+
+impl Format {
+    /// Every format with its command-line name.
+    pub const ALL: &'static [(&'static str, Format)] = &[
+        ("markdown", Format::Markdown),
+        ("csv", Format::Csv),
+        ("json", Format::Json),
+    ];
+
+    /// Parses a command-line name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, f)| f)
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "unknown format '{name}'; available: markdown, csv, json"
+                ))
+            })
+    }
 }
 
 /// Runs the benchmark on a built renderer.
 pub fn run(
     gpu: &GpuContext,
     renderer: &Renderer,
+    scene_name: &str,
+    options: &BenchOptions,
+) -> Result<BenchReport> {
+    run_with_floor(gpu, renderer, None, scene_name, options)
+}
+
+/// [`run`], and with `copies` (built from the renderer's plan) each pass's speed-of-light copy
+/// timed in the same run, one copy frame after each measured frame.
+pub fn run_with_floor(
+    gpu: &GpuContext,
+    renderer: &Renderer,
+    copies: Option<&mut CopyFrame>,
     scene_name: &str,
     options: &BenchOptions,
 ) -> Result<BenchReport> {
@@ -155,9 +214,36 @@ pub fn run(
     let exe = &renderer.executable;
     let names: Vec<String> = exe.plan.physical.iter().map(|p| p.name.clone()).collect();
     let mut runner = FrameRunner::new(gpu, names.len())?;
-    let result = measure(gpu, renderer, &mut runner, &names, scene_name, options);
+    let result = measure(
+        gpu,
+        renderer,
+        &mut runner,
+        copies,
+        &names,
+        scene_name,
+        options,
+    );
     runner.destroy(gpu);
     result
+}
+
+/// A progress bar on stderr for `total` steps, drawn only when stderr is a terminal and the run
+/// is expected to take longer than [`PROGRESS_AFTER_S`].
+pub fn progress_bar(total: u64, expected_s: f64, what: &str) -> indicatif::ProgressBar {
+    if !std::io::stderr().is_terminal() || expected_s < PROGRESS_AFTER_S {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(total),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
 }
 
 fn collect(samples: &mut [Vec<f64>], timing: &FrameTiming, names: &[String]) -> Result<()> {
@@ -178,17 +264,30 @@ fn measure(
     gpu: &GpuContext,
     renderer: &Renderer,
     runner: &mut FrameRunner,
+    mut copies: Option<&mut CopyFrame>,
     names: &[String],
     scene_name: &str,
     options: &BenchOptions,
 ) -> Result<BenchReport> {
     let exe = &renderer.executable;
+    let warm_start = std::time::Instant::now();
     for _ in 0..options.warmup {
         runner.run_frame(gpu, exe)?;
         if options.isolate {
             runner.run_isolated(gpu, exe)?;
         }
+        if let Some(c) = copies.as_deref_mut() {
+            c.measure(gpu, false)?;
+        }
     }
+    // Warm-up frames are the slow ones (lazy compilation): an overestimate, which only shows
+    // the bar a little early.
+    let per_frame_s = warm_start.elapsed().as_secs_f64() / options.warmup.max(1) as f64;
+    let bar = progress_bar(
+        options.frames as u64,
+        per_frame_s * options.frames as f64,
+        "bench",
+    );
     let mut samples = Samples {
         frame_walls: Vec::with_capacity(options.frames),
         in_frame: vec![Vec::new(); names.len()],
@@ -206,7 +305,12 @@ fn measure(
                 names,
             )?;
         }
+        if let Some(c) = copies.as_deref_mut() {
+            c.measure(gpu, true)?;
+        }
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let mut verdict = judge(names, &samples, options.isolate);
     if verdict.needs_isolated {
         // The in-frame numbers did not add up: measure the isolated ones to report instead.
@@ -219,6 +323,15 @@ fn measure(
         }
         verdict = judge(names, &samples, options.isolate);
     }
+    let speed_of_light = copies.map(|c| {
+        crate::speed_of_light::rows(&c.floors, &c.medians(), |name| {
+            verdict
+                .passes
+                .iter()
+                .find(|p| p.name == name)
+                .map(|p| p.median_ms)
+        })
+    });
     Ok(BenchReport {
         device: gpu.info.describe(),
         driver: gpu.info.driver(),
@@ -234,6 +347,7 @@ fn measure(
         frame_ms: verdict.frame,
         checks: verdict.checks,
         trusted: verdict.trusted,
+        speed_of_light,
     })
 }
 
@@ -454,7 +568,69 @@ impl BenchReport {
                 c.detail
             ));
         }
+        if let Some(rows) = &self.speed_of_light {
+            out.push_str("\n### Speed of light: each pass against a copy of the same formats\n\n");
+            out.push_str(&crate::speed_of_light::markdown(rows));
+        }
         out
+    }
+
+    /// The report as CSV: a header line, one line per pass and one for the frame. Every line
+    /// repeats the run's scene, technique, size, device and timing mode, so files from several
+    /// runs concatenate into one table.
+    pub fn csv(&self) -> String {
+        let mode = if self.timing_mode.starts_with("in-frame") {
+            "in-frame"
+        } else {
+            "isolated"
+        };
+        let mut out = String::from(
+            "scene,technique,width,height,device,timing_mode,trusted,pass,median_ms,min_ms,max_ms,\
+             isolated_ms,share,copy_ms,pass_per_copy,taps,ms_per_tap\n",
+        );
+        let prefix = format!(
+            "{},{},{},{},{},{mode},{}",
+            csv_field(&self.scene),
+            csv_field(&self.technique),
+            self.width,
+            self.height,
+            csv_field(&self.device),
+            self.trusted
+        );
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
+        for p in &self.passes {
+            let floor = self
+                .speed_of_light
+                .as_ref()
+                .and_then(|rows| rows.iter().find(|r| r.pass == p.name));
+            out.push_str(&format!(
+                "{prefix},{},{:.6},{:.6},{:.6},{},{:.6},{},{},{},{}\n",
+                csv_field(&p.name),
+                p.median_ms,
+                p.min_ms,
+                p.max_ms,
+                opt(p.isolated_ms),
+                p.share,
+                opt(floor.and_then(|f| f.copy_ms)),
+                opt(floor.and_then(|f| f.ratio)),
+                floor.map_or(String::new(), |f| f.taps.to_string()),
+                opt(floor.and_then(|f| f.ms_per_tap)),
+            ));
+        }
+        out.push_str(&format!(
+            "{prefix},frame,{:.6},{:.6},{:.6},,1.000000,,,,\n",
+            self.frame_ms.median, self.frame_ms.min, self.frame_ms.max
+        ));
+        out
+    }
+
+    /// The report in `format`.
+    pub fn format(&self, format: Format) -> String {
+        match format {
+            Format::Markdown => self.markdown(),
+            Format::Csv => self.csv(),
+            Format::Json => self.json(),
+        }
     }
 
     /// The report as JSON (the shape documented in the README; later fields only extend it).
@@ -463,9 +639,35 @@ impl BenchReport {
     }
 }
 
+/// One CSV field: quoted (with quotes doubled) when it holds a comma, quote or line break.
+pub fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn csv_fields_are_quoted_only_when_needed() {
+        assert_eq!(csv_field("gbuffer + lighting"), "gbuffer + lighting");
+        assert_eq!(
+            csv_field("llvmpipe (LLVM 15, 256 bits)"),
+            "\"llvmpipe (LLVM 15, 256 bits)\""
+        );
+        assert_eq!(csv_field("a\"b"), "\"a\"\"b\"");
+    }
+
+    #[test]
+    fn formats_parse_and_refuse_unknown_names() {
+        assert_eq!(Format::parse("csv").unwrap(), Format::Csv);
+        let e = Format::parse("xml").unwrap_err().to_string();
+        assert!(e.contains("markdown, csv, json"), "{e}");
+    }
 
     #[test]
     fn stats_of_odd_and_even_samples() {

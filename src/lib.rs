@@ -9,8 +9,10 @@
 //!
 //! Beside them: [`scene`] (what is drawn), [`reference`](mod@reference) (CPU f64 versions of every shading
 //! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
-//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes), and, with the
-//! `window` feature, `demo` (the interactive window; it sits above the renderer and passes).
+//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes), [`speed_of_light`] (each pass's
+//! copy floor), [`scaling`] (time against triangles, resolution, lights), [`suite`] (`lucent
+//! report`: everything above written as one report with plots), and, with the `window`
+//! feature, `demo` (the interactive window; it sits above the renderer and passes).
 
 pub mod backend;
 pub mod bake;
@@ -26,9 +28,12 @@ pub mod plot;
 pub mod reference;
 pub mod renderer;
 pub mod report;
+pub mod scaling;
 pub mod scene;
 pub mod seeds;
+pub mod speed_of_light;
 pub mod sss_report;
+pub mod suite;
 pub mod sweep;
 
 pub use error::{LucentError, Result};

@@ -1,4 +1,9 @@
-//! Scatter plots for benchmark reports: "error against run time", one PNG per plot.
+//! Plots for benchmark reports, one PNG per plot: scatter ("error against run time"), curves
+//! on log-log axes (scaling: time against triangles, resolution, lights) and paired horizontal
+//! bars (each pass beside its speed-of-light copy).
+//!
+//! [`write_curves_png`] joins each series' points in x order on log-log axes;
+//! [`write_bars_png`] draws one pair of bars per row (value and its floor).
 //!
 //! [`write_scatter_png`] draws labelled points (e.g. each variant of a technique's knobs: x = its
 //! lighting pass time, y = its max abs error against the reference) in one colour per
@@ -521,9 +526,304 @@ where
     Ok(())
 }
 
+/// Writes curves on log-log axes: each series' finite, positive points joined in x order, with
+/// a marker per point, a legend and axis titles. 960x640 pixels. Points with a coordinate <= 0
+/// or not finite cannot sit on a log axis: they are left out and counted in the title.
+///
+/// Errors as [`write_scatter_png`]. Never panics.
+pub fn write_curves_png(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[PlotSeries],
+) -> Result<()> {
+    ensure_font()?;
+    let usable = |p: &&PlotPoint| p.x.is_finite() && p.y.is_finite() && p.x > 0.0 && p.y > 0.0;
+    let total: usize = series.iter().map(|s| s.points.len()).sum();
+    let mut kept: Vec<(&str, Vec<(f64, f64)>)> = series
+        .iter()
+        .map(|s| {
+            let mut pts: Vec<(f64, f64)> =
+                s.points.iter().filter(usable).map(|p| (p.x, p.y)).collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            (s.name.as_str(), pts)
+        })
+        .collect();
+    kept.retain(|(_, pts)| !pts.is_empty());
+    let drawn: usize = kept.iter().map(|(_, p)| p.len()).sum();
+    let mut caption = title.to_string();
+    if drawn < total {
+        caption += &format!(" ({} point(s) <= 0 or non-finite left out)", total - drawn);
+    }
+    let mut rgb = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let backend = BitMapBackend::<RGBPixel>::with_buffer_and_format(&mut rgb, (WIDTH, HEIGHT))
+            .map_err(|e| LucentError::file(path, format!("cannot set up plot: {e}")))?;
+        let root = backend.into_drawing_area();
+        let drawn = draw_curves(&root, &kept, &caption, x_label, y_label)
+            .and_then(|()| root.present().map_err(|e| e.to_string()));
+        drawn.map_err(|e| LucentError::file(path, format!("cannot draw plot: {e}")))?;
+    }
+    encode_png(path, &rgb)
+}
+
+fn encode_png(path: &Path, rgb: &[u8]) -> Result<()> {
+    let mut encoded = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut encoded)
+        .write_image(rgb, WIDTH, HEIGHT, ExtendedColorType::Rgb8)
+        .map_err(|e| LucentError::file(path, format!("PNG encoding failed: {e}")))?;
+    crate::output::write_file_atomic(path, &encoded)
+}
+
+fn draw_curves(
+    root: &Area<'_>,
+    series: &[(&str, Vec<(f64, f64)>)],
+    caption: &str,
+    x_label: &str,
+    y_label: &str,
+) -> std::result::Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let xs = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.0));
+    let ys = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.1));
+    let x_range = log_range(xs)?;
+    let y_range = log_range(ys)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(caption, ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range.log_scale(), y_range.log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&|v| format_tick(*v))
+        .y_label_formatter(&|v| format_tick(*v))
+        .axis_desc_style(("sans-serif", 17))
+        .label_style(("sans-serif", 14))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    if series.is_empty() {
+        let (w, h) = chart.plotting_area().dim_in_pixel();
+        let style = ("sans-serif", 28)
+            .into_font()
+            .color(&RGBColor(110, 110, 110))
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        chart
+            .plotting_area()
+            .strip_coord_spec()
+            .draw(&Text::new("no data", (w as i32 / 2, h as i32 / 2), style))
+            .map_err(err)?;
+        return Ok(());
+    }
+    for (i, (name, points)) in series.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        let line = chart
+            .draw_series(std::iter::once(PathElement::new(
+                points.clone(),
+                colour.stroke_width(2),
+            )))
+            .map_err(err)?;
+        if !name.is_empty() {
+            line.label(name.to_string()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+            });
+        }
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 4, colour.filled())),
+            )
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.6))
+        .border_style(RGBColor(160, 160, 160))
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// One row of a bar plot: a value and the floor it is measured against.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarRow {
+    /// Row label (a pass name).
+    pub label: String,
+    /// The measured value (pass ms).
+    pub value: f64,
+    /// Its floor (copy ms), if any.
+    pub floor: Option<f64>,
+}
+
+/// Writes horizontal bars, one pair per row: `value_name` (e.g. "pass") in the first colour and
+/// `floor_name` (e.g. "copy") in grey below it, x axis `x_label` from 0. 960x640 pixels; more
+/// than about 30 rows get thin bars. Non-finite or negative values are drawn as 0 and counted
+/// in the title.
+///
+/// Errors as [`write_scatter_png`]. Never panics.
+pub fn write_bars_png(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    value_name: &str,
+    floor_name: &str,
+    rows: &[BarRow],
+) -> Result<()> {
+    ensure_font()?;
+    let clean = |v: f64| if v.is_finite() && v >= 0.0 { v } else { 0.0 };
+    let bad = rows
+        .iter()
+        .flat_map(|r| std::iter::once(r.value).chain(r.floor))
+        .filter(|v| !(v.is_finite() && *v >= 0.0))
+        .count();
+    let mut caption = title.to_string();
+    if bad > 0 {
+        caption += &format!(" ({bad} value(s) not finite or < 0 drawn as 0)");
+    }
+    let max = rows
+        .iter()
+        .flat_map(|r| std::iter::once(clean(r.value)).chain(r.floor.map(clean)))
+        .fold(0.0f64, f64::max);
+    let x_max = if max > 0.0 { max * 1.08 } else { 1.0 };
+    let mut rgb = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let backend = BitMapBackend::<RGBPixel>::with_buffer_and_format(&mut rgb, (WIDTH, HEIGHT))
+            .map_err(|e| LucentError::file(path, format!("cannot set up plot: {e}")))?;
+        let root = backend.into_drawing_area();
+        let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+        let drawn = (|| -> std::result::Result<(), String> {
+            root.fill(&WHITE).map_err(|e| e.to_string())?;
+            let n = rows.len().max(1) as f64;
+            let labels: Vec<String> = rows.iter().map(|r| r.label.clone()).collect();
+            let label_width = labels
+                .iter()
+                .map(|l| l.len())
+                .max()
+                .unwrap_or(4)
+                .clamp(4, 40);
+            let mut chart = ChartBuilder::on(&root)
+                .caption(&caption, ("sans-serif", 22))
+                .margin(16)
+                .x_label_area_size(48)
+                .y_label_area_size((label_width * 7 + 16) as u32)
+                .build_cartesian_2d(0.0..x_max, 0.0..n)
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc(x_label)
+                .y_labels(0)
+                .x_label_formatter(&|v| format_tick(*v))
+                .axis_desc_style(("sans-serif", 17))
+                .label_style(("sans-serif", 13))
+                .disable_y_mesh()
+                .light_line_style(RGBColor(235, 235, 235))
+                .draw()
+                .map_err(err)?;
+            // Row labels by hand, centred on each row's pair of bars, right-aligned left of
+            // the axis (the mesh's own ticks would not sit on the rows).
+            let label_style = ("sans-serif", 13)
+                .into_font()
+                .color(&RGBColor(40, 40, 40))
+                .pos(Pos::new(HPos::Right, VPos::Center));
+            for (i, label) in labels.iter().enumerate() {
+                let (px, py) = chart.backend_coord(&(0.0, n - i as f64 - 0.5));
+                root.draw(&Text::new(label.clone(), (px - 8, py), label_style.clone()))
+                    .map_err(err)?;
+            }
+            let colour = COLOURS[0];
+            let grey = RGBColor(150, 150, 150);
+            for (i, r) in rows.iter().enumerate() {
+                let top = n - i as f64;
+                let value = clean(r.value);
+                chart
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(0.0, top - 0.1), (value, top - 0.5)],
+                        colour.filled(),
+                    )))
+                    .map_err(err)?;
+                if let Some(f) = r.floor {
+                    chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [(0.0, top - 0.5), (clean(f), top - 0.9)],
+                            grey.filled(),
+                        )))
+                        .map_err(err)?;
+                }
+            }
+            // Legend by hand, below the x axis at the right, clear of the bars.
+            for (k, (name, c)) in [(value_name, colour), (floor_name, grey)]
+                .iter()
+                .enumerate()
+            {
+                let y = HEIGHT as i32 - 22;
+                let x = WIDTH as i32 - 330 + 150 * k as i32;
+                root.draw(&Rectangle::new([(x, y), (x + 16, y + 12)], c.filled()))
+                    .map_err(err)?;
+                root.draw(&Text::new(
+                    name.to_string(),
+                    (x + 22, y),
+                    ("sans-serif", 14).into_font(),
+                ))
+                .map_err(err)?;
+            }
+            Ok(())
+        })()
+        .and_then(|()| root.present().map_err(|e| e.to_string()));
+        drawn.map_err(|e| LucentError::file(path, format!("cannot draw plot: {e}")))?;
+    }
+    encode_png(path, &rgb)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn curves_and_bars_decode_and_are_not_blank() {
+        let dir = temp_dir("curves");
+        let curves = dir.join("curves.png");
+        let data = [
+            series(
+                "gbuffer",
+                &[("", 3e3, 0.5), ("", 1e5, 4.0), ("", 1e6, 30.0)],
+            ),
+            series(
+                "tonemap",
+                &[("", 3e3, 1.0), ("", 1e5, 1.0), ("", 1e6, -1.0)],
+            ),
+        ];
+        write_curves_png(&curves, "time against triangles", "triangles", "ms", &data).unwrap();
+        check_png(&curves);
+        let empty = dir.join("curves-empty.png");
+        write_curves_png(&empty, "empty", "x", "y", &[]).unwrap();
+        check_png(&empty);
+        let bars = dir.join("bars.png");
+        let rows = [
+            BarRow {
+                label: "gbuffer + lighting".into(),
+                value: 12.0,
+                floor: Some(3.0),
+            },
+            BarRow {
+                label: "tonemap".into(),
+                value: f64::NAN,
+                floor: None,
+            },
+        ];
+        write_bars_png(&bars, "passes", "ms", "pass", "copy", &rows).unwrap();
+        check_png(&bars);
+        let empty = dir.join("bars-empty.png");
+        write_bars_png(&empty, "no rows", "ms", "pass", "copy", &[]).unwrap();
+        check_png(&empty);
+    }
 
     fn temp_dir(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("lucent-plot-{}-{name}", std::process::id()));

@@ -9,7 +9,8 @@
 //! as separate render passes so each has its own timestamp pair.
 //!
 //! The report writes `translucency.md` (tables) and `translucency-error-vs-time.png` (max abs
-//! error against lighting ms, one colour per knob).
+//! error against lighting ms, one colour per knob). [`translucency_section`] is the same as one
+//! section of the full suite ([`crate::suite`]).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -486,4 +487,34 @@ pub fn write_translucency_report(
     );
     crate::output::write_file_atomic(&md, text.as_bytes())?;
     Ok((text, vec![md, png]))
+}
+
+/// The translucency report as a section of the suite: written beside `report.md`, and its
+/// tables embedded one heading level down. Full run: 1024x768 (the size of the technique
+/// tables), the suite's rounds; quick: 128x96, 2 rounds.
+pub fn translucency_section(
+    ctx: &crate::suite::SuiteContext<'_>,
+) -> Result<crate::suite::SectionOutput> {
+    let opts = if ctx.options.quick {
+        ReportOptions {
+            width: 128,
+            height: 96,
+            rounds: 2,
+            warmup: 1,
+        }
+    } else {
+        ReportOptions {
+            width: ctx.options.width,
+            height: ctx.options.height,
+            rounds: ctx.options.frames,
+            warmup: ctx.options.warmup,
+        }
+    };
+    let (text, files) =
+        write_translucency_report(ctx.gpu, ctx.shaders, ctx.pipeline_cache, ctx.dir, &opts)?;
+    Ok(crate::suite::SectionOutput {
+        markdown: crate::suite::embed(&text),
+        files,
+        ..Default::default()
+    })
 }

@@ -61,7 +61,14 @@ enum Command {
         /// Also time each pass submitted alone and compare.
         #[arg(long)]
         isolate: bool,
-        /// Write the report as JSON too.
+        /// Output format on stdout: markdown, csv or json.
+        #[arg(long, default_value = "markdown")]
+        format: String,
+        /// Also time every pass's speed-of-light copy (a pass reading and writing the same
+        /// formats, nothing else) in the same run, and print pass / copy and ms per tap.
+        #[arg(long)]
+        speed_of_light: bool,
+        /// Write the report as JSON to this file too.
         #[arg(long)]
         json: Option<PathBuf>,
         /// Write the frame as PNG after the benchmark.
@@ -71,9 +78,12 @@ enum Command {
         /// main one, and print both side by side with the ratio (e.g. `--against none`).
         #[arg(long)]
         against: Option<String>,
-        /// Print the per-pass table beside the LEAN-mapping thesis's (Table 2 for `control`,
-        /// Table 1 for `lbb`), each row as a share of its frame.
-        #[arg(long)]
+        /// Print the seeds' published numbers beside ours: the LEAN-mapping thesis's Table 2
+        /// (`control`) or Table 1 (`lbb`), each row as a share of its frame; for
+        /// `translucency`, GDC 2011's full-screen cost beside the extra cost of translucency
+        /// in this scene's lighting pass (measured against `none`, alternating frames).
+        /// Alias: --compare-seeds.
+        #[arg(long, alias = "compare-seeds")]
         compare_thesis: bool,
     },
     /// Open the interactive demo: a window to fly around a scene in, switch techniques, turn
@@ -123,23 +133,30 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
-    /// Error against run time: every approximation of a technique timed (round-robin, same
-    /// run) and compared with the exact f64 reference; writes a Markdown table and a PNG plot.
+    /// The report suite: every technique's passes beside their speed-of-light copies, the
+    /// seeds' tables beside ours, scaling curves and error against time, as DIR/report.md with
+    /// PNG plots. With a section name (`translucency`, `sss`), only that error-against-time
+    /// section.
     Report {
-        /// The technique to report on (`translucency` or `sss`).
-        technique: String,
+        /// Only this error-against-time section (`translucency` or `sss`); default: the whole
+        /// suite.
+        technique: Option<String>,
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// Resolution as WIDTHxHEIGHT.
-        #[arg(long, default_value = "1024x768", value_parser = parse_size)]
-        size: (u32, u32),
-        /// Measured rounds (one frame of every variant per round).
-        #[arg(long, default_value_t = 15)]
-        rounds: usize,
-        /// Discarded rounds first.
-        #[arg(long, default_value_t = 3)]
-        warmup: usize,
+        /// The small preset (under 2 minutes on lavapipe).
+        #[arg(long)]
+        quick: bool,
+        /// Resolution as WIDTHxHEIGHT (suite: of the per-technique tables; default 1024x768,
+        /// --quick 256x192).
+        #[arg(long, value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+        /// Measured rounds or frames (section default 15; suite 25, --quick 3).
+        #[arg(long)]
+        rounds: Option<usize>,
+        /// Discarded rounds first (section default 3; suite 3, --quick 1).
+        #[arg(long)]
+        warmup: Option<usize>,
         #[command(flatten)]
         gpu: GpuArgs,
     },
@@ -432,31 +449,79 @@ fn bench_command(
     frame: &FrameArgs,
     gpu_args: &GpuArgs,
     options: BenchOptions,
-    json: Option<PathBuf>,
-    out: Option<PathBuf>,
-    against: Option<String>,
-    compare_thesis: bool,
+    output: BenchOutput,
 ) -> Result<()> {
+    let BenchOutput {
+        format,
+        speed_of_light,
+        json,
+        out,
+        against,
+        compare_thesis,
+    } = output;
+    let format = bench::Format::parse(&format)?;
     let against = against.map(|t| Technique::parse(&t)).transpose()?;
-    let thesis_table = match (compare_thesis, Technique::parse(&frame.technique)?) {
-        (false, _) => None,
-        (true, Technique::Control) => Some(lucent::seeds::THESIS_TABLE_2_CONTROL),
-        // The thesis times only LBB (Table 1); LCB runs the same pipeline with the control's blur.
-        (true, Technique::Lbb | Technique::Lcb) => Some(lucent::seeds::THESIS_TABLE_1_LBB),
-        (true, other) => {
-            return Err(LucentError::InvalidInput(format!(
-                "--compare-thesis needs --technique control, lcb or lbb (the thesis's Tables 1 \
-                 and 2); '{}' has no table in the thesis",
-                other.name()
-            )))
+    let technique = Technique::parse(&frame.technique)?;
+    let thesis_table = lucent::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
+    let gdc = compare_thesis && technique == Technique::Translucency;
+    if compare_thesis && thesis_table.is_none() && !gdc {
+        return Err(LucentError::InvalidInput(format!(
+            "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
+             Table 1) or translucency (GDC 2011's cost); '{}' has no published table (Li et \
+             al.'s Table 1 is in `lucent report`)",
+            technique.name()
+        )));
+    }
+    if format != bench::Format::Markdown && (compare_thesis || against.is_some()) {
+        return Err(LucentError::InvalidInput(
+            "--compare-thesis and --against print Markdown tables; use them with --format markdown"
+                .into(),
+        ));
+    }
+    // With CSV or JSON on stdout, messages go to stderr so stdout stays parseable.
+    let note = |text: String| {
+        if format == bench::Format::Markdown {
+            println!("{text}");
+        } else {
+            eprintln!("{text}");
         }
     };
     with_renderer(frame, gpu_args, false, |session, renderer| {
         let gpu = &session.gpu;
-        let report = bench::run(gpu, renderer, &frame.scene, &options)?;
-        println!("{}", report.markdown());
+        let report = if speed_of_light {
+            let mut copies = lucent::speed_of_light::CopyFrame::for_plan(
+                gpu,
+                &session.shaders,
+                &session.pipeline_cache,
+                &renderer.executable.plan,
+            )?;
+            let report =
+                bench::run_with_floor(gpu, renderer, Some(&mut copies), &frame.scene, &options);
+            let idle = gpu.wait_idle();
+            copies.destroy(gpu);
+            idle?;
+            report?
+        } else {
+            bench::run(gpu, renderer, &frame.scene, &options)?
+        };
+        print!("{}", report.format(format));
+        if format != bench::Format::Csv {
+            println!();
+        }
         if let Some(table) = &thesis_table {
             println!("{}", lucent::seeds::beside(&report, table));
+        }
+        if gdc {
+            let cost = lucent::suite::gdc_cost(
+                gpu,
+                &session.shaders,
+                &session.pipeline_cache,
+                &scene::load_scene(&frame.scene)?,
+                &format!("`{}`", frame.scene),
+                (renderer.settings.width, renderer.settings.height),
+                (options.frames, options.warmup),
+            )?;
+            println!("{}", lucent::seeds::gdc_beside(&cost));
         }
         if let Some(technique) = against {
             let scene = scene::load_scene(&frame.scene)?;
@@ -492,12 +557,12 @@ fn bench_command(
         }
         if let Some(json) = &json {
             output::write_file_atomic(json, report.json().as_bytes())?;
-            println!("wrote {}", json.display());
+            note(format!("wrote {}", json.display()));
         }
         if let Some(out) = &out {
             let (width, height) = (renderer.settings.width, renderer.settings.height);
             output::write_png_rgba8(out, width, height, &renderer.read_display(gpu)?)?;
-            println!("wrote {}", out.display());
+            note(format!("wrote {}", out.display()));
         }
         if report.trusted {
             Ok(())
@@ -507,6 +572,16 @@ fn bench_command(
             ))
         }
     })
+}
+
+/// What `bench` prints and writes besides the measurement itself.
+struct BenchOutput {
+    format: String,
+    speed_of_light: bool,
+    json: Option<PathBuf>,
+    out: Option<PathBuf>,
+    against: Option<String>,
+    compare_thesis: bool,
 }
 
 fn bake_thickness(
@@ -600,35 +675,73 @@ fn sweep_command(
     Ok(())
 }
 
-fn report_command(
-    technique: &str,
-    out: &std::path::Path,
-    options: lucent::report::ReportOptions,
-    gpu_args: &GpuArgs,
-) -> Result<()> {
-    let write = match technique {
-        "translucency" => lucent::report::write_translucency_report,
-        "sss" => lucent::sss_report::write_sss_report,
-        _ => {
-            return Err(LucentError::InvalidInput(format!(
-                "report: unknown technique '{technique}'; available: translucency, sss"
-            )))
-        }
-    };
-    if options.rounds == 0 {
+/// `report` as given on the command line.
+struct ReportArgs {
+    technique: Option<String>,
+    out: PathBuf,
+    quick: bool,
+    size: Option<(u32, u32)>,
+    rounds: Option<usize>,
+    warmup: Option<usize>,
+}
+
+fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
+    if args.rounds == Some(0) {
         return Err(LucentError::InvalidInput(
             "report: --rounds must be at least 1".into(),
         ));
     }
-    let (text, files) = with_session(gpu_args, |session| {
-        write(
-            &session.gpu,
-            &session.shaders,
-            &session.pipeline_cache,
-            out,
-            &options,
-        )
-    })?;
+    let (text, files) = match &args.technique {
+        Some(technique) => {
+            let write = match technique.as_str() {
+                "translucency" => lucent::report::write_translucency_report,
+                "sss" => lucent::sss_report::write_sss_report,
+                _ => {
+                    return Err(LucentError::InvalidInput(format!(
+                        "report: unknown section '{technique}'; available: translucency, sss (or \
+                         no section: the whole suite)"
+                    )))
+                }
+            };
+            let (width, height) = args.size.unwrap_or((1024, 768));
+            let options = lucent::report::ReportOptions {
+                width,
+                height,
+                rounds: args.rounds.unwrap_or(15),
+                warmup: args.warmup.unwrap_or(3),
+            };
+            with_session(gpu_args, |session| {
+                write(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &args.out,
+                    &options,
+                )
+            })?
+        }
+        None => {
+            let mut options = if args.quick {
+                lucent::suite::SuiteOptions::quick()
+            } else {
+                lucent::suite::SuiteOptions::full()
+            };
+            if let Some((w, h)) = args.size {
+                (options.width, options.height) = (w, h);
+            }
+            options.frames = args.rounds.unwrap_or(options.frames);
+            options.warmup = args.warmup.unwrap_or(options.warmup);
+            with_session(gpu_args, |session| {
+                lucent::suite::run(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &args.out,
+                    options,
+                )
+            })?
+        }
+    };
     println!("{text}");
     for f in files {
         println!("wrote {}", f.display());
@@ -656,6 +769,8 @@ fn run(cli: Cli) -> Result<()> {
             frames,
             warmup,
             isolate,
+            format,
+            speed_of_light,
             json,
             out,
             against,
@@ -668,10 +783,14 @@ fn run(cli: Cli) -> Result<()> {
                 warmup,
                 isolate,
             },
-            json,
-            out,
-            against,
-            compare_thesis,
+            BenchOutput {
+                format,
+                speed_of_light,
+                json,
+                out,
+                against,
+                compare_thesis,
+            },
         ),
         Command::Sweep {
             technique,
@@ -682,16 +801,17 @@ fn run(cli: Cli) -> Result<()> {
         Command::Report {
             technique,
             out,
+            quick,
             size,
             rounds,
             warmup,
             gpu,
         } => report_command(
-            &technique,
-            &out,
-            lucent::report::ReportOptions {
-                width: size.0,
-                height: size.1,
+            ReportArgs {
+                technique,
+                out,
+                quick,
+                size,
                 rounds,
                 warmup,
             },

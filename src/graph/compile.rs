@@ -61,6 +61,8 @@ pub struct PlannedPass {
     pub reads: Vec<Use>,
     /// Writes as declared.
     pub writes: Vec<Use>,
+    /// Texture taps per pixel, when declared ([`super::declare::PassBuilder::taps`]).
+    pub taps: Option<u32>,
 }
 
 /// One synchronisation2 barrier.
@@ -449,6 +451,7 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
             declared_index: i,
             reads: decls[i].reads.clone(),
             writes: decls[i].writes.clone(),
+            taps: decls[i].taps,
         })
         .collect();
 

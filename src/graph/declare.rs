@@ -140,6 +140,9 @@ pub struct PassDecl {
     pub writes: Vec<Use>,
     /// Never culled (it has effects the graph cannot see, e.g. writes a host buffer).
     pub side_effects: bool,
+    /// Texture taps per shaded pixel, when the pass declares them ([`PassBuilder::taps`]);
+    /// the benchmark's speed-of-light table counts one per image read otherwise.
+    pub taps: Option<u32>,
     /// The code that records the pass; `None` in graph-only tests.
     pub exec: Option<Box<dyn PassExec>>,
 }
@@ -199,6 +202,7 @@ impl RenderGraph {
                 reads: Vec::new(),
                 writes: Vec::new(),
                 side_effects: false,
+                taps: None,
                 exec: None,
             },
         }
@@ -334,6 +338,14 @@ impl PassBuilder<'_> {
     /// The pass has effects the graph cannot see; never cull it.
     pub fn side_effects(&mut self) -> &mut Self {
         self.decl.side_effects = true;
+        self
+    }
+
+    /// Declares how many texture taps the pass's shader makes per pixel (a blur: its kernel's
+    /// taps, times the images it reads at each). The benchmark divides the pass's time by it;
+    /// without it, each image the pass reads counts as one tap.
+    pub fn taps(&mut self, per_pixel: u32) -> &mut Self {
+        self.decl.taps = Some(per_pixel);
         self
     }
 

@@ -318,6 +318,15 @@ pub fn sss_passes(
     let first: Vec<ResourceId> = std::iter::once(inputs.diffuse.id())
         .chain(lean.map(|l| l.id()))
         .collect();
+    // Texture fetches per pixel, for the benchmark's cost per tap: the centre texels, depth and
+    // strength, then each kernel tap's texels and depth (the control: Jimenez's six bilinear
+    // taps around its centre; the bilateral blur: its point taps, centre included).
+    let texels = targets as u32;
+    let taps = if blur.bilateral() {
+        texels + 2 + knobs.taps * (texels + 1)
+    } else {
+        texels + 2 + 6 * (texels + 1)
+    };
     let steps = blur_steps(profile);
     let mut completed_variance = 0.0f32;
     for (i, step) in steps.iter().enumerate() {
@@ -353,7 +362,7 @@ pub fn sss_passes(
                 pass.sample(c);
             }
         }
-        pass.sample(inputs.depth).sample(inputs.strength);
+        pass.sample(inputs.depth).sample(inputs.strength).taps(taps);
         for t in &mut temp {
             pass.color(t, LoadOp::DontCare);
         }
@@ -383,7 +392,7 @@ pub fn sss_passes(
         for t in &temp {
             pass.sample(t);
         }
-        pass.sample(inputs.depth).sample(inputs.strength);
+        pass.sample(inputs.depth).sample(inputs.strength).taps(taps);
         for c in &mut current {
             pass.color(c, LoadOp::DontCare);
         }

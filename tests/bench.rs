@@ -1,0 +1,190 @@
+//! `lucent bench` output formats and the speed-of-light table, through the command line (with
+//! the validation layer on: any validation error fails the command and so the test).
+
+mod common;
+
+use common::{run_bench, TestGpu};
+use lucent::renderer::{FrameSettings, Renderer, Technique};
+use lucent::speed_of_light::{floors, CopyFrame};
+
+fn bench_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "bench",
+        "--validation",
+        "--scene",
+        "cubes",
+        "--technique",
+        "translucency",
+        "--size",
+        "128x96",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+    ];
+    args.extend_from_slice(extra);
+    args
+}
+
+#[test]
+fn csv_has_a_row_per_pass_with_its_speed_of_light_ratio() {
+    let csv = run_bench(&bench_args(&["--speed-of-light", "--format", "csv"]));
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header line").split(',').collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (pass, ratio, taps, median) = (
+        column("pass"),
+        column("pass_per_copy"),
+        column("taps"),
+        column("median_ms"),
+    );
+    // The device name holds a comma and is quoted: split on commas outside quotes.
+    let split = |line: &str| -> Vec<String> {
+        let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+        for c in line.chars() {
+            match c {
+                '"' => quoted = !quoted,
+                ',' if !quoted => fields.push(std::mem::take(&mut field)),
+                _ => field.push(c),
+            }
+        }
+        fields.push(field);
+        fields
+    };
+    let rows: Vec<Vec<String>> = lines.map(split).collect();
+    let names: Vec<&str> = rows.iter().map(|r| r[pass].as_str()).collect();
+    assert_eq!(names, ["gbuffer + lighting", "tonemap", "frame"], "{csv}");
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        assert!(r[median].parse::<f64>().is_ok_and(|v| v > 0.0), "{r:?}");
+        if r[pass] != "frame" {
+            let x: f64 = r[ratio].parse().unwrap_or_else(|_| panic!("ratio: {r:?}"));
+            assert!(x.is_finite() && x > 0.0, "{r:?}");
+            assert!(r[taps].parse::<u32>().is_ok_and(|t| t >= 1), "{r:?}");
+        }
+    }
+}
+
+#[test]
+fn json_on_stdout_carries_the_speed_of_light_rows() {
+    let json = run_bench(&bench_args(&["--speed-of-light", "--format", "json"]));
+    let v: serde_json::Value =
+        serde_json::from_str(&json).unwrap_or_else(|e| panic!("{e}: {json}"));
+    let passes = v["passes"].as_array().unwrap();
+    let floors = v["speed_of_light"].as_array().unwrap();
+    assert_eq!(passes.len(), floors.len(), "{v}");
+    for (p, f) in passes.iter().zip(floors) {
+        assert_eq!(p["name"], f["pass"]);
+        assert!(f["copy_ms"].as_f64().is_some_and(|c| c > 0.0), "{f}");
+        let ratio = f["ratio"].as_f64().unwrap();
+        assert!(
+            (ratio - p["median_ms"].as_f64().unwrap() / f["copy_ms"].as_f64().unwrap()).abs()
+                < 1e-9,
+            "{f}"
+        );
+        assert!(f["io"].as_str().unwrap().contains("->"), "{f}");
+    }
+    // The deferred group writes the G-buffer with GB2 (translucency) and depth.
+    assert!(
+        floors[0]["io"].as_str().unwrap().contains("D32"),
+        "{}",
+        floors[0]
+    );
+}
+
+#[test]
+fn markdown_names_the_passes_far_above_their_floor_and_the_seeds_alias_works() {
+    let text = run_bench(&[
+        "bench",
+        "--validation",
+        "--scene",
+        "skin",
+        "--technique",
+        "control",
+        "--size",
+        "96x64",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--speed-of-light",
+        "--compare-seeds",
+    ]);
+    assert!(text.contains("### Speed of light"), "{text}");
+    assert!(
+        text.contains("Far above their floor") || text.contains("No pass is more than"),
+        "{text}"
+    );
+    assert!(text.contains("Table 2 (control)"), "{text}");
+}
+
+#[test]
+fn bad_formats_and_format_conflicts_are_one_line_errors() {
+    for args in [
+        vec!["bench", "--format", "xml"],
+        vec![
+            "bench",
+            "--format",
+            "csv",
+            "--technique",
+            "control",
+            "--compare-thesis",
+        ],
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        let lines: Vec<&str> = stderr
+            .lines()
+            .filter(|l| l.starts_with("lucent: error:"))
+            .collect();
+        assert_eq!(lines.len(), 1, "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
+
+#[test]
+fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    for &(name, technique) in Technique::ALL {
+        let scene_name = lucent::suite::scene_for(technique).unwrap();
+        let scene = lucent::scene::load_scene(&scene_name).unwrap();
+        let settings = FrameSettings {
+            technique,
+            ..FrameSettings::new(96, 64)
+        };
+        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
+        let plan = &renderer.executable.plan;
+        assert_eq!(floors(plan).len(), plan.physical.len());
+        let mut copies = CopyFrame::for_plan(gpu, &test.shaders, &test.cache, plan).unwrap();
+        copies.measure(gpu, false).unwrap();
+        copies.measure(gpu, true).unwrap();
+        let medians = copies.medians();
+        gpu.wait_idle().unwrap();
+        copies.destroy(gpu);
+        renderer.destroy(gpu);
+        assert_eq!(medians.len(), plan_len(&scene, settings), "{name}");
+        for (i, m) in medians.iter().enumerate() {
+            let m = m.unwrap_or_else(|| panic!("{name} on {scene_name}: floor {i} has no copy"));
+            assert!(m.median > 0.0, "{name}: floor {i} took {m:?}");
+        }
+    }
+    test.finish();
+}
+
+fn plan_len(scene: &lucent::scene::Scene, settings: FrameSettings) -> usize {
+    let features = lucent::renderer::FrameFeatures::new(scene, &settings).unwrap();
+    lucent::renderer::plan_frame(&settings, &features)
+        .unwrap()
+        .physical
+        .len()
+}

@@ -708,6 +708,23 @@ pub fn decode_texels(bytes: &[u8], format: vk::Format) -> Result<Vec<[f32; 4]>> 
         .collect())
 }
 
+/// Waits for the device, then destroys `renderers` and `runners` (the round-robin measurements'
+/// teardown): everything is destroyed even when the wait fails, whose error is returned.
+pub fn destroy_after_idle(
+    gpu: &GpuContext,
+    renderers: Vec<Renderer>,
+    runners: Vec<FrameRunner>,
+) -> Result<()> {
+    let idle = gpu.wait_idle();
+    for runner in runners {
+        runner.destroy(gpu);
+    }
+    for renderer in renderers {
+        renderer.destroy(gpu);
+    }
+    idle
+}
+
 /// Times of one frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameTiming {

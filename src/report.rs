@@ -299,14 +299,7 @@ pub fn run(
         }
         Ok(results)
     })();
-    let idle = gpu.wait_idle();
-    for runner in runners {
-        runner.destroy(gpu);
-    }
-    for renderer in renderers {
-        renderer.destroy(gpu);
-    }
-    idle?;
+    crate::renderer::destroy_after_idle(gpu, renderers, runners)?;
     result
 }
 

@@ -140,14 +140,7 @@ pub fn measure(
             })
             .collect())
     })();
-    let idle = gpu.wait_idle();
-    for runner in runners {
-        runner.destroy(gpu);
-    }
-    for renderer in renderers {
-        renderer.destroy(gpu);
-    }
-    idle?;
+    crate::renderer::destroy_after_idle(gpu, renderers, runners)?;
     result
 }
 

@@ -4,7 +4,8 @@
 // plane (a normal n has slope n.xy / n.z in view space). Moments, unlike normals, stay exact
 // under blurring: a blend of slope distributions has the blend of their moments, so the
 // covariance `m - b b^T` after a blur is the spread of everything the blur mixed.
-// The f64 twin is src/reference/sss.rs (`view_plane_lean`, `lean_specular`): change both.
+// The f64 twins are src/reference/sss.rs (`view_plane_lean`, `lean_specular`) and
+// src/scene/lean.rs (`covariance_of`): change both.
 #ifndef LUCENT_LEAN_GLSL
 #define LUCENT_LEAN_GLSL
 

@@ -15,6 +15,7 @@ use glam::{DMat3, DVec2};
 use super::lighting::{light_incidence, radiance, shade_direct_split, shininess};
 use super::{gbuffer_pixels, DVec3};
 use crate::renderer::GBufferReadback;
+use crate::scene::lean::covariance_of;
 use crate::scene::material::SssProfile;
 use crate::scene::Scene;
 
@@ -69,14 +70,6 @@ pub fn view_slope(n_view: DVec3) -> DVec2 {
     DVec2::new(n_view.x, n_view.y) / z
 }
 
-/// Covariance (xx, yy, xy) of moments `m` about mean `b`, clamped as the shader clamps it.
-pub fn lean_covariance(b: DVec2, m: DVec3) -> DVec3 {
-    let xx = (m.x - b.x * b.x).max(0.0);
-    let yy = (m.y - b.y * b.y).max(0.0);
-    let limit = (xx * yy).sqrt();
-    DVec3::new(xx, yy, (m.z - b.x * b.y).clamp(-limit, limit))
-}
-
 /// The LEAN specular lobe (glsl `lean_lobe`): the slope-space Gaussian of mean `b`, covariance
 /// `c` at the unit view-space half vector `h`, as a half-vector density, times Schlick's
 /// Fresnel from `f0` (none at all for `f0 = 0`), times Cook-Torrance's shadowing-masking term,
@@ -119,7 +112,7 @@ pub fn lean_specular(
     m: DVec3,
     ks: f64,
 ) -> DVec3 {
-    let c = lean_covariance(b, m);
+    let c = covariance_of(b, m);
     let to_eye = view * (scene.camera.eye.as_dvec3() - position).normalize();
     let n = DVec3::new(b.x, b.y, 1.0).normalize();
     let n_dot_v = n.dot(to_eye);
@@ -151,7 +144,7 @@ pub fn view_plane_lean(
     base: f64,
 ) -> (DVec3, DVec2, DVec3) {
     let [t, bt, n] = frame;
-    let c_t = lean_covariance(b_t, m_t) + DVec3::new(base, base, 0.0);
+    let c_t = covariance_of(b_t, m_t) + DVec3::new(base, base, 0.0);
     let (t_v, bt_v, n_v) = (view * t, view * bt, view * n);
     let u = t_v * b_t.x + bt_v * b_t.y + n_v;
     let n_world = (t * b_t.x + bt * b_t.y + n).normalize();

@@ -56,11 +56,18 @@ pub fn slope_and_moments(n: Vec3) -> ([f32; 2], [f32; 3]) {
 pub fn covariance(lean1: [f32; 4], lean2: [f32; 4]) -> (DVec2, f64) {
     let b = DVec2::new(lean1[0].into(), lean1[1].into());
     let m = DVec3::new(lean1[2].into(), lean1[3].into(), lean2[0].into());
+    let c = covariance_of(b, m);
+    (DVec2::new(c.x, c.y), c.z)
+}
+
+/// The covariance (xx, yy, xy) of slope moments `m` about their mean `b`, clamped as the
+/// shaders clamp it (glsl/common/lean.glsl `lean_covariance`): diagonal at 0, off-diagonal
+/// shrunk so the determinant stays >= 0.
+pub fn covariance_of(b: DVec2, m: DVec3) -> DVec3 {
     let xx = (m.x - b.x * b.x).max(0.0);
     let yy = (m.y - b.y * b.y).max(0.0);
     let limit = (xx * yy).sqrt();
-    let xy = (m.z - b.x * b.y).clamp(-limit, limit);
-    (DVec2::new(xx, yy), xy)
+    DVec3::new(xx, yy, (m.z - b.x * b.y).clamp(-limit, limit))
 }
 
 #[cfg(test)]

@@ -708,6 +708,23 @@ pub fn decode_texels(bytes: &[u8], format: vk::Format) -> Result<Vec<[f32; 4]>> 
         .collect())
 }
 
+/// Builds the frame of `scene`, renders it once, reads back what it exports and tears it down
+/// (whatever the frame returned).
+pub fn render_frame(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    scene: &Scene,
+    settings: FrameSettings,
+) -> Result<FrameImages> {
+    let renderer = Renderer::new(gpu, shaders, pipeline_cache, scene, settings)?;
+    let images = renderer.render_once(gpu);
+    let idle = gpu.wait_idle();
+    renderer.destroy(gpu);
+    idle?;
+    images
+}
+
 /// Waits for the device, then destroys `renderers` and `runners` (the round-robin measurements'
 /// teardown): everything is destroyed even when the wait fails, whose error is returned.
 pub fn destroy_after_idle(

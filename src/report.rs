@@ -26,7 +26,9 @@ use crate::passes::deferred::GBufferPrecision;
 use crate::plot::{write_scatter_png, PlotPoint, PlotSeries};
 use crate::reference::tonemap::display_rgba8;
 use crate::reference::translucency::{shade_gbuffer, LightingInputs};
-use crate::renderer::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::renderer::{
+    render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
+};
 use crate::scene::material::PowMode;
 use crate::scene::{Light, Scene};
 use crate::{LucentError, Result};
@@ -321,12 +323,7 @@ fn image_error(
         ..settings(opts, Technique::Translucency)
     };
     let features = FrameFeatures::new(&exact, &settings)?;
-    let renderer = Renderer::new(gpu, shaders, pipeline_cache, &exact, settings)?;
-    let images = renderer.render_once(gpu);
-    let idle = gpu.wait_idle();
-    renderer.destroy(gpu);
-    idle?;
-    let gbuffer = images?
+    let gbuffer = render_frame(gpu, shaders, pipeline_cache, &exact, settings)?
         .gbuffer
         .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
     let reference = shade_gbuffer(

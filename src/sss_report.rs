@@ -26,7 +26,7 @@ use crate::passes::sss::{fit_profile, SssPrecision};
 use crate::plot::{write_scatter_png, PlotPoint, PlotSeries};
 use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
 use crate::renderer::{
-    FrameFeatures, FrameImages, FrameRunner, FrameSettings, Renderer, Technique,
+    render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
 };
 use crate::report::ReportOptions;
 use crate::scene::{self, Scene};
@@ -147,21 +147,6 @@ fn error_scene(scene: &Scene, factor: f32, no_specular: bool) -> Scene {
     s
 }
 
-fn render_once(
-    gpu: &GpuContext,
-    shaders: &ShaderCompiler,
-    cache: &PipelineCache,
-    scene: &Scene,
-    settings: FrameSettings,
-) -> Result<FrameImages> {
-    let renderer = Renderer::new(gpu, shaders, cache, scene, settings)?;
-    let images = renderer.render_once(gpu);
-    let idle = gpu.wait_idle();
-    renderer.destroy(gpu);
-    idle?;
-    images
-}
-
 /// Whether a physical pass belongs to the SSS technique (blurs, combine, final lighting).
 fn is_sss_pass(name: &str) -> bool {
     name.contains("blur #") || name == "combine" || name == "final lighting"
@@ -190,7 +175,7 @@ pub fn run(
         export_gbuffer: true,
         ..FrameSettings::new(ew, eh)
     };
-    let frame = render_once(gpu, shaders, cache, &edges, reference_frame)?;
+    let frame = render_frame(gpu, shaders, cache, &edges, reference_frame)?;
     let gbuffer = frame
         .gbuffer
         .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
@@ -200,7 +185,7 @@ pub fn run(
     // Specular is off on the SSS objects: both specular models add nothing there.
     let reference = reference_image(&edges, &gbuffer, &profile, ReferenceSpecular::Lean);
     let strength = gbuffer.sss.clone().unwrap_or_default();
-    let plain = render_once(
+    let plain = render_frame(
         gpu,
         shaders,
         cache,
@@ -218,7 +203,7 @@ pub fn run(
             export_hdr: true,
             ..sized(&v.settings, ew, eh)
         };
-        let hdr = render_once(gpu, shaders, cache, &edges, settings)?
+        let hdr = render_frame(gpu, shaders, cache, &edges, settings)?
             .hdr
             .unwrap_or_default();
         let m = edge_metrics(ew as usize, &strength, &plain, &hdr, &reference, 2);

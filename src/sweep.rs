@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::renderer::{FrameSettings, Renderer, Technique};
+use crate::renderer::{render_frame, FrameSettings, Technique};
 use crate::scene::generators::{self, Generator};
 use crate::scene::material::{PowMode, ThicknessSource, Translucency};
 use crate::scene::{Camera, Light, Material, Mesh, Object, Scene};
@@ -296,12 +296,8 @@ pub fn run_translucency(
     let mut rows = Vec::with_capacity(cases.len());
     for case in cases {
         let scene = case_scene(case)?;
-        let renderer = Renderer::new(gpu, shaders, pipeline_cache, &scene, settings)?;
-        let images = renderer.render_once(gpu);
-        let idle = gpu.wait_idle();
-        renderer.destroy(gpu);
-        idle?;
-        let hdr = images?.hdr.unwrap_or_default();
+        let images = render_frame(gpu, shaders, pipeline_cache, &scene, settings)?;
+        let hdr = images.hdr.unwrap_or_default();
         rows.push(measure(*case, &hdr));
     }
     Ok(rows)

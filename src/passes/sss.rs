@@ -315,17 +315,13 @@ pub fn sss_passes(
     let mut sum: Vec<Handle<Image>> = (0..targets)
         .map(|t| graph.create_image(&format!("sss.sum{}", names[t]), sum_info))
         .collect();
-    let first: Vec<ResourceId> = std::iter::once(inputs.diffuse.id())
-        .chain(lean.map(|l| l.id()))
-        .collect();
-    // Texture fetches per pixel, for the benchmark's cost per tap: the centre texels, depth and
-    // strength, then each kernel tap's texels and depth (the control: Jimenez's six bilinear
-    // taps around its centre; the bilateral blur: its point taps, centre included).
-    let texels = targets as u32;
-    let taps = if blur.bilateral() {
-        texels + 2 + knobs.taps * (texels + 1)
-    } else {
-        texels + 2 + 6 * (texels + 1)
+    // Texture fetches per pixel of a pass reading `texels` colour images, for the benchmark's
+    // cost per tap: the centre texels, depth and strength, then each kernel tap's texels and
+    // depth (the control: Jimenez's six bilinear taps around its centre; the bilateral blur:
+    // its point taps, centre included).
+    let fetches = |texels: u32| {
+        let kernel = if blur.bilateral() { knobs.taps } else { 6 };
+        texels + 2 + kernel * (texels + 1)
     };
     let steps = blur_steps(profile);
     let mut completed_variance = 0.0f32;
@@ -346,23 +342,19 @@ pub fn sss_passes(
             weight: [step.weight[0], step.weight[1], step.weight[2], mean_weight],
         };
         // Horizontal: the previous result (the lit diffuse the first time) into the temporary.
-        let sources: Vec<ResourceId> = if i == 0 {
-            first.clone()
+        let source_handles: Vec<&Handle<Image>> = if i == 0 {
+            std::iter::once(inputs.diffuse).chain(lean).collect()
         } else {
-            current.iter().map(|h| h.id()).collect()
+            current.iter().collect()
         };
         let mut pass = graph.add_pass(&format!("horizontal blur #{n}"), PassKind::Raster);
-        if i == 0 {
-            pass.sample(inputs.diffuse);
-            if let Some(l) = lean {
-                pass.sample(l);
-            }
-        } else {
-            for c in &current {
-                pass.sample(c);
-            }
+        for h in &source_handles {
+            pass.sample(h);
         }
-        pass.sample(inputs.depth).sample(inputs.strength).taps(taps);
+        pass.sample(inputs.depth)
+            .sample(inputs.strength)
+            .taps(fetches(source_handles.len() as u32));
+        let sources: Vec<ResourceId> = source_handles.iter().map(|h| h.id()).collect();
         for t in &mut temp {
             pass.color(t, LoadOp::DontCare);
         }
@@ -392,7 +384,9 @@ pub fn sss_passes(
         for t in &temp {
             pass.sample(t);
         }
-        pass.sample(inputs.depth).sample(inputs.strength).taps(taps);
+        pass.sample(inputs.depth)
+            .sample(inputs.strength)
+            .taps(fetches(temp.len() as u32));
         for c in &mut current {
             pass.color(c, LoadOp::DontCare);
         }

@@ -30,6 +30,14 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     Light lights[MAX_LIGHTS];
 } frame;
 
+// World position of the surface at window position `frag_coord` (gl_FragCoord.xy) with device
+// depth `device_depth`.
+vec3 world_position(vec2 frag_coord, float device_depth) {
+    vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
+    vec4 world = frame.inv_view_proj * vec4(ndc, device_depth, 1.0);
+    return world.xyz / world.w;
+}
+
 // View-space distance along the view axis from a device depth in [0, 1] (glam's right-handed
 // perspective, depth 0 at the near plane). Clamped away from the far plane's singularity.
 float linear_depth(float device_depth) {

@@ -72,9 +72,7 @@ void main() {
         Surface s = unpack_gbuffer(t, texelFetch(gb1_tex, p, 0));
         vec4 material = translucency_materials.rows[id];
         vec3 thickness = unpack_thickness(g2);
-        vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
-        vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
-        vec3 pos = world.xyz / world.w;
+        vec3 pos = world_position(gl_FragCoord.xy, d);
         vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
         float v_dot_n = dot(to_eye, s.normal);
         int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);

@@ -46,9 +46,7 @@ void main() {
         return;
     }
     Surface s = unpack_gbuffer(subpassLoad(gb0), subpassLoad(gb1));
-    vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
-    vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
-    vec3 pos = world.xyz / world.w;
+    vec3 pos = world_position(gl_FragCoord.xy, d);
     vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
     vec3 color = frame.ambient.rgb * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);

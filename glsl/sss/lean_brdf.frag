@@ -34,9 +34,7 @@ void main() {
         vec3 c = lean_covariance(b, s1.yzw);
         float ks = texelFetch(albedo_tex, px, 0).a;
         float d = texelFetch(depth_tex, px, 0).r;
-        vec2 ndc = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
-        vec4 world = frame.inv_view_proj * vec4(ndc, d, 1.0);
-        vec3 pos = world.xyz / world.w;
+        vec3 pos = world_position(gl_FragCoord.xy, d);
         mat3 view = mat3(frame.view);
         vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
         vec3 n = normalize(vec3(b, 1.0));

@@ -212,6 +212,11 @@ impl FrameFeatures {
         })
     }
 
+    /// The SSS blur the frame runs, if any.
+    pub fn sss_blur(&self) -> Option<sss::SssBlur> {
+        self.sss.as_ref().map(|(_, blur)| *blur)
+    }
+
     /// The G-buffer layout these features and `settings` call for.
     pub fn gbuffer_layout(&self, settings: &FrameSettings) -> GBufferLayout {
         GBufferLayout {
@@ -225,11 +230,10 @@ impl FrameFeatures {
                     single_material: table.rows.len() == 1,
                 }),
             sss: self.sss.is_some(),
-            lean: self.sss.as_ref().is_some_and(|(_, blur)| blur.lean()),
+            lean: self.sss_blur().is_some_and(sss::SssBlur::lean),
             lean_clear: self
-                .sss
-                .as_ref()
-                .is_some_and(|(_, blur)| blur.lean() && !blur.bilateral()),
+                .sss_blur()
+                .is_some_and(|blur| blur.lean() && !blur.bilateral()),
             normal_maps: self.normal_maps,
             fault_injection: settings.fault.is_some(),
         }
@@ -475,7 +479,7 @@ impl Renderer {
             scene,
             uniforms.buffer,
             translucency,
-            features.sss.as_ref().is_some_and(|(_, blur)| blur.lean()),
+            features.sss_blur().is_some_and(sss::SssBlur::lean),
         ) {
             Ok(s) => s,
             Err(e) => {

@@ -654,6 +654,22 @@ impl PipelineCache {
         Self::load_checked(device, path, None)
     }
 
+    /// The device's cache in the default cache directory
+    /// ([`ShaderCompiler::default_cache_dir`]`/pipelines.bin`), checked against the device as
+    /// [`PipelineCache::load_for_device`] does: what every command and the demo use.
+    pub fn load_default(gpu: &crate::backend::GpuContext) -> Result<Self> {
+        // SAFETY: the physical device handle belongs to this instance.
+        let properties = unsafe {
+            gpu.instance
+                .get_physical_device_properties(gpu.physical_device)
+        };
+        Self::load_for_device(
+            &gpu.device,
+            Some(ShaderCompiler::default_cache_dir().join("pipelines.bin")),
+            &properties,
+        )
+    }
+
     /// Like [`PipelineCache::load`], and also ignores (with a warning) a file whose header names
     /// another vendor, device or pipeline cache UUID than `properties`.
     pub fn load_for_device(

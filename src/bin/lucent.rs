@@ -343,19 +343,11 @@ impl Session {
     fn new(args: &GpuArgs) -> Result<Self> {
         let gpu = GpuContext::new(&ContextDesc::from_env(args.validation, args.device.clone()))?;
         log::info!("device: {} ({})", gpu.info.describe(), gpu.info.driver());
-        let cache_dir = ShaderCompiler::default_cache_dir();
-        let shaders =
-            ShaderCompiler::new(ShaderCompiler::default_glsl_root(), Some(cache_dir.clone()))?;
-        // SAFETY: the physical device handle belongs to this instance.
-        let properties = unsafe {
-            gpu.instance
-                .get_physical_device_properties(gpu.physical_device)
-        };
-        let pipeline_cache = PipelineCache::load_for_device(
-            &gpu.device,
-            Some(cache_dir.join("pipelines.bin")),
-            &properties,
+        let shaders = ShaderCompiler::new(
+            ShaderCompiler::default_glsl_root(),
+            Some(ShaderCompiler::default_cache_dir()),
         )?;
+        let pipeline_cache = PipelineCache::load_default(&gpu)?;
         Ok(Self {
             gpu,
             shaders,

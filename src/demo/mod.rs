@@ -114,19 +114,11 @@ pub fn run(options: DemoOptions) -> Result<()> {
         swapchain: true,
         ..ContextDesc::from_env(options.validation, options.device.clone())
     })?;
-    let cache_dir = ShaderCompiler::default_cache_dir();
-    let shaders =
-        ShaderCompiler::new(ShaderCompiler::default_glsl_root(), Some(cache_dir.clone()))?;
-    // SAFETY: the physical device handle belongs to this instance.
-    let properties = unsafe {
-        gpu.instance
-            .get_physical_device_properties(gpu.physical_device)
-    };
-    let pipeline_cache = PipelineCache::load_for_device(
-        &gpu.device,
-        Some(cache_dir.join("pipelines.bin")),
-        &properties,
+    let shaders = ShaderCompiler::new(
+        ShaderCompiler::default_glsl_root(),
+        Some(ShaderCompiler::default_cache_dir()),
     )?;
+    let pipeline_cache = PipelineCache::load_default(&gpu)?;
     // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
     // the timing columns line up.
     let font = crate::plot::font_file().map(|p| {

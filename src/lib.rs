@@ -1,39 +1,39 @@
 //! lucent: real-time translucency and subsurface scattering on Vulkan, measured honestly.
 //!
 //! Layers (dependencies point one way, down this list):
-//! - [`passes`]: the techniques, each a struct that adds its passes to a graph.
+//! - [`frame`]: the frame a scene's materials ask for ([`frame::FrameDesc`]), declared as one
+//!   render graph, the [`frame::Renderer`] that records it (frames in flight, into its own
+//!   image or one the caller gives), read-back and the frame runner.
+//! - [`features`]: one module per technique or feature (G-buffer and lighting, GDC 2011
+//!   translucency, screen-space SSS, tonemap, debug views), each adding its passes to a graph:
+//!   handles in, handles out.
+//! - [`gpu_scene`]: what a scene becomes on the GPU (meshes, textures, draws) and the
+//!   per-frame parameter buffer the passes read (camera, lights, material and profile tables).
 //! - [`graph`]: the render graph: declare passes and resources, compile to a plan, execute
 //!   into any command buffer. Knows nothing about techniques.
 //! - [`backend`]: a thin layer over `ash`: context (own or wrapped), memory, images, the one
-//!   access table, debug labels, GPU timer, shader compilation.
+//!   access table, the one format table, debug labels, GPU timer, shader compilation.
 //!
-//! Beside them: [`scene`] (what is drawn), [`reference`](mod@reference) (CPU f64 versions of every shading
-//! equation, for tests and reports), [`output`] (PNG/EXR), [`compare`] (perceptual image
-//! comparison), [`bench`](mod@bench) (the benchmark and its honest timing modes), [`speed_of_light`] (each pass's
-//! copy floor), [`scaling`] (time against triangles, resolution, lights), [`suite`] (`lucent
-//! report`: everything above written as one report with plots), and, with the `window`
-//! feature, `demo` (the interactive window; it sits above the renderer and passes).
+//! Beside them: [`scene`] (the CPU model of what is drawn; no GPU), [`bake`] (the thickness
+//! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
+//! versions of every shading equation, used by tests and reports, never by features),
+//! [`images`] (PNG/EXR files and FLIP comparison). Above the frame: [`measure`] (benchmark,
+//! speed of light, scaling, sweeps), [`report`] (`lucent report`: the suite, its sections,
+//! the seeds' tables, plots) and, with the `window` feature, `demo` (the interactive window).
 
 pub mod backend;
 pub mod bake;
-pub mod bench;
-pub mod compare;
 #[cfg(feature = "window")]
 pub mod demo;
 pub mod error;
+pub mod features;
+pub mod frame;
+pub mod gpu_scene;
 pub mod graph;
-pub mod output;
-pub mod passes;
-pub mod plot;
+pub mod images;
+pub mod measure;
 pub mod reference;
-pub mod renderer;
 pub mod report;
-pub mod scaling;
 pub mod scene;
-pub mod seeds;
-pub mod speed_of_light;
-pub mod sss_report;
-pub mod suite;
-pub mod sweep;
 
 pub use error::{LucentError, Result};

@@ -297,7 +297,7 @@ fn texture_bake_fills_charts_and_a_dilated_ring_and_writes_a_png() {
     let dir = temp_dir("png");
     let path = dir.join("thickness.png");
     map.write_png(&path).unwrap();
-    let (w, h, rgba) = lucent::output::read_png_rgba8(&path).unwrap();
+    let (w, h, rgba) = lucent::images::output::read_png_rgba8(&path).unwrap();
     assert_eq!((w, h), (64, 64));
     let grey: Vec<u8> = rgba.chunks_exact(4).map(|p| p[0]).collect();
     assert_eq!(grey, map.to_luma8());

@@ -4,8 +4,8 @@
 mod common;
 
 use common::{run_bench, TestGpu};
-use lucent::renderer::{FrameSettings, Renderer, Technique};
-use lucent::speed_of_light::{floors, CopyFrame};
+use lucent::frame::{FrameSettings, Renderer, Technique};
+use lucent::measure::speed_of_light::{floors, CopyFrame};
 
 fn bench_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
@@ -156,8 +156,8 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
     let test = TestGpu::new();
     let gpu = &test.gpu;
     for &(name, technique) in Technique::ALL {
-        let scene_name = lucent::suite::scene_for(technique).unwrap();
-        let scene = lucent::scene::load_scene(&scene_name).unwrap();
+        let scene_name = lucent::report::scene_for(technique).unwrap();
+        let scene = lucent::bake::scene::load_scene_baked(&scene_name).unwrap();
         let settings = FrameSettings {
             technique,
             ..FrameSettings::new(96, 64)
@@ -182,8 +182,8 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
 }
 
 fn plan_len(scene: &lucent::scene::Scene, settings: FrameSettings) -> usize {
-    let features = lucent::renderer::FrameFeatures::new(scene, &settings).unwrap();
-    lucent::renderer::plan_frame(&settings, &features)
+    let features = lucent::frame::FrameFeatures::new(scene, &settings).unwrap();
+    lucent::frame::plan_frame(&settings, &features)
         .unwrap()
         .physical
         .len()

@@ -3,7 +3,8 @@
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use lucent::backend::{format_texel_size, ContextDesc, GpuContext, GpuImage, ImageDesc};
+use lucent::backend::format::texel_bytes;
+use lucent::backend::{ContextDesc, GpuContext, GpuImage, ImageDesc};
 use lucent::LucentError;
 
 /// Environment variable that makes `environment_child` run, naming what its environment lacks.
@@ -198,10 +199,10 @@ fn create_and_destroy_image_and_buffer() {
     ctx.destroy_image(depth);
     ctx.destroy_buffer(buffer);
     ctx.destroy_buffer(device_local);
-    assert_eq!(format_texel_size(vk::Format::R8G8B8A8_UNORM), Some(4));
-    assert_eq!(format_texel_size(vk::Format::R16G16B16A16_SFLOAT), Some(8));
-    assert_eq!(format_texel_size(vk::Format::R32G32B32A32_SFLOAT), Some(16));
-    assert_eq!(format_texel_size(vk::Format::BC1_RGB_UNORM_BLOCK), None);
+    assert_eq!(texel_bytes(vk::Format::R8G8B8A8_UNORM), Some(4));
+    assert_eq!(texel_bytes(vk::Format::R16G16B16A16_SFLOAT), Some(8));
+    assert_eq!(texel_bytes(vk::Format::R32G32B32A32_SFLOAT), Some(16));
+    assert_eq!(texel_bytes(vk::Format::BC1_RGB_UNORM_BLOCK), None);
     assert_clean(&ctx);
 }
 

@@ -4,9 +4,9 @@
 mod common;
 
 use common::TestGpu;
-use lucent::passes::debug_view::DebugView;
-use lucent::passes::translucency::ThicknessPacking;
-use lucent::renderer::{FrameRunner, FrameSettings, GBufferReadback, Renderer, Technique};
+use lucent::features::debug_view::DebugView;
+use lucent::features::translucency::ThicknessPacking;
+use lucent::frame::{FrameRunner, FrameSettings, GBufferReadback, Renderer, Technique};
 use lucent::scene;
 
 /// The display image of one frame, and its G-buffer.
@@ -54,7 +54,7 @@ fn worst(display: &[u8], expected: impl Iterator<Item = [f32; 3]>) -> u8 {
 #[test]
 fn gbuffer_views_show_what_the_gbuffer_holds() {
     let test = TestGpu::new();
-    let cubes = scene::load_scene("cubes").unwrap();
+    let cubes = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     let base = FrameSettings {
         technique: Technique::Translucency,
         ..FrameSettings::new(160, 120)
@@ -130,7 +130,7 @@ fn gbuffer_views_show_what_the_gbuffer_holds() {
 fn pre_blur_view_is_the_unblurred_lighting_and_the_blur_changes_it() {
     let test = TestGpu::new();
     // `edges`: a skin profile four times as wide, so the blur reaches over several pixels.
-    let edges = scene::load_scene("edges").unwrap();
+    let edges = lucent::bake::scene::load_scene_baked("edges").unwrap();
     let base = FrameSettings {
         technique: Technique::Control,
         ..FrameSettings::new(320, 240)
@@ -187,7 +187,7 @@ fn translucency_term_view_is_the_difference_translucency_makes() {
     // The lighting pass adds the talk's term to diffuse + specular: the term view must be the
     // translucency frame's HDR minus the plain frame's, tonemapped alike.
     let test = TestGpu::new();
-    let cubes = scene::load_scene("cubes").unwrap();
+    let cubes = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     let hdr = |technique| {
         let gpu = &test.gpu;
         let settings = FrameSettings {

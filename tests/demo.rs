@@ -12,8 +12,8 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use lucent::compare::{flip_rgba8, FlipThresholds};
-use lucent::output::read_png_rgba8;
+use lucent::images::compare::{flip_rgba8, FlipThresholds};
+use lucent::images::output::read_png_rgba8;
 
 /// A running Xvfb, killed on drop.
 struct Xvfb {

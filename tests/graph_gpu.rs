@@ -6,11 +6,11 @@ use ash::vk;
 use lucent::backend::access::Access;
 use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
+use lucent::frame::FrameRunner;
 use lucent::graph::{
     CompileOptions, Executable, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext,
     RecordContext, RenderGraph,
 };
-use lucent::renderer::FrameRunner;
 
 /// Fills its colour attachment with one value (`vkCmdClearAttachments`: no pipeline needed).
 struct Fill([f32; 4]);

@@ -7,10 +7,10 @@ use std::process::Command;
 mod common;
 
 use common::TestGpu;
-use lucent::compare::{compare_with_golden, flip_rgba8, FlipThresholds};
+use lucent::frame::{FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::graph::CompileOptions;
+use lucent::images::compare::{compare_with_golden, flip_rgba8, FlipThresholds};
 use lucent::reference::raytrace;
-use lucent::renderer::{FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::scene;
 
 fn output_dir() -> PathBuf {
@@ -48,7 +48,7 @@ fn every_builtin_scene_renders_finite_and_validation_clean() {
     // Loaded as the command loads them (thickness baked through the cache), nothing read from
     // outside the repository.
     for &(name, _) in scene::BUILTIN_SCENES {
-        let scene = scene::load_scene(name).unwrap();
+        let scene = lucent::bake::scene::load_scene_baked(name).unwrap();
         let settings = FrameSettings {
             export_hdr: true,
             ..FrameSettings::new(96, 72)
@@ -107,7 +107,10 @@ fn sss_scenes_match_their_goldens_under_every_sss_technique() {
 /// tests/golden/NAME.png.
 fn check_golden(name: &str, scene_name: &str, settings: FrameSettings) {
     let (w, h) = (settings.width, settings.height);
-    let (display, _) = render_scene(&scene::load_scene(scene_name).unwrap(), settings);
+    let (display, _) = render_scene(
+        &lucent::bake::scene::load_scene_baked(scene_name).unwrap(),
+        settings,
+    );
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
     let outcome = compare_with_golden(
         name,
@@ -202,11 +205,21 @@ fn smoke_matches_the_raytraced_f64_reference() {
     );
     if !flip.within(&FlipThresholds::default()) {
         let dir = output_dir();
-        lucent::output::write_png_rgba8(&dir.join("smoke-reference.expected.png"), w, h, &expected)
-            .unwrap();
-        lucent::output::write_png_rgba8(&dir.join("smoke-reference.actual.png"), w, h, &display)
-            .unwrap();
-        lucent::output::write_png_rgba8(
+        lucent::images::output::write_png_rgba8(
+            &dir.join("smoke-reference.expected.png"),
+            w,
+            h,
+            &expected,
+        )
+        .unwrap();
+        lucent::images::output::write_png_rgba8(
+            &dir.join("smoke-reference.actual.png"),
+            w,
+            h,
+            &display,
+        )
+        .unwrap();
+        lucent::images::output::write_png_rgba8(
             &dir.join("smoke-reference.diff.png"),
             w,
             h,
@@ -394,7 +407,7 @@ fn render_writes_png_and_linear_exr() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let (w, h, _) = lucent::output::read_png_rgba8(&png).unwrap();
+    let (w, h, _) = lucent::images::output::read_png_rgba8(&png).unwrap();
     assert_eq!((w, h), (96, 64));
     let hdr = image::open(&exr).unwrap().into_rgba32f();
     assert_eq!(hdr.dimensions(), (96, 64));
@@ -446,7 +459,7 @@ fn bench_against_another_technique_prints_both_sides_and_the_ratio() {
 
 #[test]
 fn normal_maps_bend_the_shading_and_stay_validation_clean() {
-    let mapped = scene::load_scene("teapot").unwrap();
+    let mapped = lucent::bake::scene::load_scene_baked("teapot").unwrap();
     let mut flat = mapped.clone();
     for o in &mut flat.objects {
         o.material.normal_texture = None;

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use lucent::renderer::Technique;
+use lucent::frame::Technique;
 
 /// One bench table of the report: its title, its pass names, and the (pass, pass / copy) rows
 /// of the speed-of-light table after it.

@@ -7,9 +7,9 @@
 mod common;
 
 use common::TestGpu;
+use lucent::frame::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
 use lucent::reference::sss::ReferenceSpecular;
-use lucent::renderer::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
-use lucent::scene::{self, Scene};
+use lucent::scene::Scene;
 
 fn settings(technique: Technique) -> FrameSettings {
     FrameSettings {
@@ -42,7 +42,7 @@ fn scaled_profiles(scene: &Scene, factor: f32) -> Scene {
     scene
 }
 
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::renderer::FrameImages {
+fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::frame::FrameImages {
     let gpu = &test.gpu;
     let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
     let images = renderer.render_once(gpu).unwrap();
@@ -53,7 +53,7 @@ fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::ren
 
 #[test]
 fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
-    let skin = scene::load_scene("skin").unwrap();
+    let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let s = settings(Technique::Control);
     let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
@@ -65,7 +65,7 @@ fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
     expected.extend(["combine".to_string(), "tonemap".to_string()]);
     assert_eq!(names, expected);
     // No SSS material: no blur passes, no SSS targets.
-    let smoke = scene::load_scene("smoke").unwrap();
+    let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
     let plan = plan_frame(&s, &FrameFeatures::new(&smoke, &s).unwrap()).unwrap();
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["gbuffer + lighting", "tonemap"]);
@@ -83,7 +83,7 @@ fn sss_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
         // Widened fivefold so every technique's blur spans pixels at 160x120 (the control-style
         // blurs leave Gaussians under a pixel alone).
         let scene = scaled_profiles(
-            &scene::load_scene(name.split(' ').next().unwrap()).unwrap(),
+            &lucent::bake::scene::load_scene_baked(name.split(' ').next().unwrap()).unwrap(),
             5.0,
         );
         // Unblurred, same shading: plain lighting for the control; LCB and LBB (whose LEAN
@@ -136,7 +136,7 @@ fn sss_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
 #[test]
 fn extreme_profiles_stay_finite_and_bounded() {
     let test = TestGpu::new();
-    let base = scene::load_scene("skin").unwrap();
+    let base = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let plain = render(&test, &base, settings(Technique::None)).hdr.unwrap();
     let plain_peak = plain.iter().fold(0.0f32, |m, v| m.max(*v));
     for technique in SSS_TECHNIQUES {
@@ -218,7 +218,7 @@ fn blurring_only_the_profiles_rectangles_gives_the_whole_screen_result() {
         .into_iter()
         .flat_map(|n| SSS_TECHNIQUES.map(|t| (n, t)))
     {
-        let scene = scene::load_scene(name).unwrap();
+        let scene = lucent::bake::scene::load_scene_baked(name).unwrap();
         let tiled = render(&test, &scene, settings(technique));
         let whole = render(
             &test,
@@ -275,7 +275,8 @@ fn every_technique_is_closer_to_the_brute_force_reference_than_no_blur() {
         // adds its bilinear taps' filtering (measured: at 1x and 5x the control is further
         // from the reference than no blur at all). Widened twentyfold it spans many pixels,
         // where the blur must win.
-        let mut scene = scaled_profiles(&scene::load_scene(name).unwrap(), 20.0);
+        let mut scene =
+            scaled_profiles(&lucent::bake::scene::load_scene_baked(name).unwrap(), 20.0);
         if technique != Technique::Control {
             // LCB and LBB blur the LEAN moments too, so their highlights spread with the light
             // (the thesis's intent; a physical reference keeps specular at the surface). This
@@ -340,9 +341,9 @@ fn lean_final_pass_matches_the_f64_lean_brdf_where_nothing_blurs() {
     // computes in f64 from the same read-back G-buffer.
     let test = TestGpu::new();
     for name in ["skin", "teapot"] {
-        let scene = scaled_profiles(&scene::load_scene(name).unwrap(), 1e-6);
+        let scene = scaled_profiles(&lucent::bake::scene::load_scene_baked(name).unwrap(), 1e-6);
         let s = FrameSettings {
-            gbuffer: lucent::passes::deferred::GBufferPrecision::Full,
+            gbuffer: lucent::features::deferred::GBufferPrecision::Full,
             ..settings(Technique::Lbb)
         };
         let frame = render(&test, &scene, s);
@@ -397,9 +398,9 @@ fn lean_projection_matches_its_f64_twin() {
     use glam::{DMat3, DVec2, DVec3};
     use lucent::reference::sss::{roughness_variance, view_plane_lean};
     let test = TestGpu::new();
-    let scene = scene::load_scene("skin").unwrap();
+    let scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let s = FrameSettings {
-        gbuffer: lucent::passes::deferred::GBufferPrecision::Full,
+        gbuffer: lucent::features::deferred::GBufferPrecision::Full,
         ..settings(Technique::Lbb)
     };
     let frame = render(&test, &scene, s);
@@ -440,7 +441,7 @@ fn lean_projection_matches_its_f64_twin() {
 
 #[test]
 fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
-    let skin = scene::load_scene("skin").unwrap();
+    let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
     for (technique, gaussians) in [
         (Technique::Lbb, None),
         (Technique::Lcb, None),
@@ -465,7 +466,7 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
     let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
     assert!(plan.resources.iter().all(|r| !r.name.contains("lean")));
     // No SSS material: nothing of any SSS technique.
-    let smoke = scene::load_scene("smoke").unwrap();
+    let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
     for technique in SSS_TECHNIQUES {
         let s = settings(technique);
         let plan = plan_frame(&s, &FrameFeatures::new(&smoke, &s).unwrap()).unwrap();
@@ -485,9 +486,9 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
 
 #[test]
 fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
-    use lucent::renderer::Fault;
+    use lucent::frame::Fault;
     let test = TestGpu::new();
-    let scene = scene::load_scene("skin").unwrap();
+    let scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
     for technique in SSS_TECHNIQUES {
         let clean = render(&test, &scene, settings(technique));
         let clean_hdr = clean.hdr.unwrap();
@@ -543,7 +544,7 @@ fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
 #[test]
 fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
     let test = TestGpu::new();
-    let scene = scene::load_scene("edges").unwrap();
+    let scene = lucent::bake::scene::load_scene_baked("edges").unwrap();
     // The same scene with the SSS objects' specular off: LCB and LBB blur their highlights
     // (the thesis's intent) and the control does not, so bleed is compared on diffusion alone.
     let mut diffuse_only = scene.clone();
@@ -650,7 +651,7 @@ fn sss_report_writes_its_table_and_plot() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     let md = std::fs::read_to_string(dir.join("sss.md")).unwrap();
-    for variant in lucent::sss_report::sss_variants() {
+    for variant in lucent::report::sss::sss_variants() {
         let row = md
             .lines()
             .find(|l| l.contains(&format!("| {} |", variant.name)))

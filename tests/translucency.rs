@@ -3,10 +3,10 @@
 //! only translucent pixels, leaving it out of scenes that do not use it, the stability sweep,
 //! and the error-against-time report.
 
-use lucent::passes::deferred::GBufferPrecision;
+use lucent::features::deferred::GBufferPrecision;
+use lucent::frame::{FrameFeatures, FrameImages, FrameSettings, Renderer, Technique};
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
-use lucent::renderer::{FrameFeatures, FrameImages, FrameSettings, Renderer, Technique};
-use lucent::scene::{self, Scene};
+use lucent::scene::Scene;
 
 mod common;
 
@@ -68,7 +68,7 @@ fn compare_with_reference(
 #[test]
 fn cubes_match_the_f64_reference_evaluated_from_the_gbuffer() {
     let gpu = TestGpu::new();
-    let scene = scene::load_scene("cubes").unwrap();
+    let scene = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     for precision in [GBufferPrecision::Compact, GBufferPrecision::Full] {
         let settings = FrameSettings {
             gbuffer: precision,
@@ -96,7 +96,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     let gpu = TestGpu::new();
     let size = (160, 120);
     // Half the grid translucent: translucent pixels brighten, opaque ones are untouched.
-    let half = scene::load_scene("grid125:50").unwrap();
+    let half = lucent::bake::scene::load_scene_baked("grid125:50").unwrap();
     let plain = FrameSettings {
         export_hdr: true,
         export_gbuffer: true,
@@ -129,7 +129,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     );
 
     // A scene with nothing translucent gets no GB2 and the same frame as technique `none`.
-    let smoke = scene::load_scene("smoke").unwrap();
+    let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
     let settings = translucency_settings(size.0, size.1);
     assert!(FrameFeatures::new(&smoke, &settings)
         .unwrap()
@@ -153,9 +153,16 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
 #[test]
 fn stability_sweep_has_no_nan_or_inf_in_any_case() {
     let gpu = TestGpu::new();
-    let cases = lucent::sweep::translucency_cases();
-    let rows = lucent::sweep::run_translucency(&gpu.gpu, &gpu.shaders, &gpu.cache, 32, 24, &cases)
-        .unwrap();
+    let cases = lucent::measure::sweep::translucency_cases();
+    let rows = lucent::measure::sweep::run_translucency(
+        &gpu.gpu,
+        &gpu.shaders,
+        &gpu.cache,
+        32,
+        24,
+        &cases,
+    )
+    .unwrap();
     assert_eq!(rows.len(), cases.len());
     let bad: Vec<String> = rows
         .iter()
@@ -175,13 +182,13 @@ fn report_measures_every_knob_and_writes_table_and_plot() {
     let gpu = TestGpu::new();
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-translucency");
     let _ = std::fs::remove_dir_all(&dir);
-    let options = lucent::report::ReportOptions {
+    let options = lucent::report::section::ReportOptions {
         width: 96,
         height: 72,
         rounds: 2,
         warmup: 1,
     };
-    let (text, files) = lucent::report::write_translucency_report(
+    let (text, files) = lucent::report::translucency::write_translucency_report(
         &gpu.gpu,
         &gpu.shaders,
         &gpu.cache,

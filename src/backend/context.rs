@@ -20,10 +20,10 @@
 //! ([`GpuContext::begin_label`]) are no-ops when `VK_EXT_debug_utils` is absent; when it is present
 //! they show up in validation messages and in RenderDoc captures.
 
-use std::ffi::{c_void, CStr, CString};
+use std::ffi::{CStr, CString};
 use std::fmt;
 use std::mem::ManuallyDrop;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard};
 
 use ash::vk;
@@ -32,12 +32,17 @@ use gpu_allocator::AllocatorDebugSettings;
 
 use crate::error::{LucentError, Result, VkResultExt};
 
+use super::device::{
+    create_device, device_type_name, pick_device, probe_device, queue_family_usable,
+};
+use super::instance::{create_instance, messenger_create_info, CreatedInstance, MessengerState};
+
 /// Name of the Khronos validation layer.
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+pub(super) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 /// How many validation error messages are kept for [`GpuContext::take_validation_messages`].
-const MAX_STORED_MESSAGES: usize = 50;
+pub(super) const MAX_STORED_MESSAGES: usize = 50;
 /// `log` target of messages coming from the Vulkan debug messenger.
-const LOG_TARGET: &str = "lucent::vulkan";
+pub(super) const LOG_TARGET: &str = "lucent::vulkan";
 
 /// How to create a [`GpuContext`] with [`GpuContext::new`].
 #[derive(Clone, Debug)]
@@ -135,14 +140,6 @@ impl DeviceInfo {
     pub fn api_version_string(&self) -> String {
         version_string(self.api_version)
     }
-}
-
-/// Heap state the debug messenger callback writes into. It lives in a `Box` owned by the context
-/// and is dropped only after the messenger (and, for owned contexts, the instance) is destroyed.
-#[derive(Default)]
-struct MessengerState {
-    errors: AtomicU32,
-    messages: Mutex<Vec<String>>,
 }
 
 /// The command pool, command buffer and fence behind [`GpuContext::submit_and_wait`].
@@ -573,492 +570,24 @@ impl Drop for GpuContext {
 
 /// Locks a mutex, recovering from poisoning (a panic in another thread does not make the
 /// protected Vulkan state invalid).
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+pub(super) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 /// A C string from `s`, dropping interior NULs instead of failing.
-fn c_string(s: &str) -> CString {
+pub(super) fn c_string(s: &str) -> CString {
     CString::new(s.replace('\0', "")).unwrap_or_default()
 }
 
-fn version_string(v: u32) -> String {
+pub(super) fn version_string(v: u32) -> String {
     format!(
         "{}.{}.{}",
         vk::api_version_major(v),
         vk::api_version_minor(v),
         vk::api_version_patch(v)
     )
-}
-
-fn device_type_name(t: vk::PhysicalDeviceType) -> &'static str {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
-        vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
-        vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
-        vk::PhysicalDeviceType::CPU => "CPU",
-        _ => "other",
-    }
-}
-
-/// Preference order when no filter is given: discrete > integrated > virtual > CPU > other.
-fn device_type_score(t: vk::PhysicalDeviceType) -> u32 {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 4,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 3,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 1,
-        _ => 0,
-    }
-}
-
-fn messenger_create_info(state: &MessengerState) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
-    vk::DebugUtilsMessengerCreateInfoEXT::default()
-        // VERBOSE is left out: it is loader chatter.
-        .message_severity(
-            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
-                | vk::DebugUtilsMessageSeverityFlagsEXT::INFO,
-        )
-        .message_type(
-            vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-        )
-        .pfn_user_callback(Some(debug_callback))
-        .user_data(state as *const MessengerState as *mut c_void)
-}
-
-/// Routes debug-utils messages to `log` and counts errors in the [`MessengerState`] that
-/// `user_data` points to.
-unsafe extern "system" fn debug_callback(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    _types: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user_data: *mut c_void,
-) -> vk::Bool32 {
-    // A panic must not unwind into the Vulkan implementation.
-    let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        if data.is_null() {
-            return;
-        }
-        // SAFETY: the implementation passes a valid callback-data struct for this call's duration.
-        let data = unsafe { &*data };
-        // SAFETY: the strings are null or valid NUL-terminated strings (Vulkan spec).
-        let (id_name, message) = unsafe {
-            (
-                data.message_id_name_as_c_str()
-                    .map(|s| s.to_string_lossy())
-                    .unwrap_or_default(),
-                data.message_as_c_str()
-                    .map(|s| s.to_string_lossy())
-                    .unwrap_or_default(),
-            )
-        };
-        if severity == vk::DebugUtilsMessageSeverityFlagsEXT::INFO && id_name == "Loader Message" {
-            // The loader reports every layer and driver it looks at: harmless spam.
-            return;
-        }
-        let level = if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            log::Level::Error
-        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-            log::Level::Warn
-        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::INFO) {
-            log::Level::Info
-        } else {
-            log::Level::Debug
-        };
-        log::log!(target: LOG_TARGET, level, "{message}");
-        if level == log::Level::Error && !user_data.is_null() {
-            // SAFETY: user_data is the address of the context's boxed MessengerState, which
-            // outlives the messenger (see MessengerState).
-            let state = unsafe { &*(user_data as *const MessengerState) };
-            state.errors.fetch_add(1, Ordering::Relaxed);
-            let mut messages = lock(&state.messages);
-            if messages.len() < MAX_STORED_MESSAGES {
-                messages.push(if message.contains(id_name.as_ref()) {
-                    message.into_owned()
-                } else {
-                    format!("[{id_name}] {message}")
-                });
-            }
-        }
-    }));
-    vk::FALSE
-}
-
-struct CreatedInstance {
-    instance: ash::Instance,
-    debug_instance: Option<ash::ext::debug_utils::Instance>,
-    messenger: vk::DebugUtilsMessengerEXT,
-}
-
-fn create_instance(
-    entry: &ash::Entry,
-    desc: &ContextDesc,
-    state: &MessengerState,
-) -> Result<CreatedInstance> {
-    // SAFETY: plain queries of the loaded loader.
-    let loader_version = unsafe { entry.try_enumerate_instance_version() }
-        .vk("vkEnumerateInstanceVersion")?
-        .unwrap_or(vk::API_VERSION_1_0);
-    if loader_version < vk::API_VERSION_1_3 {
-        return Err(LucentError::NoVulkanDriver(format!(
-            " for Vulkan 1.3 (the loader supports {})",
-            version_string(loader_version)
-        )));
-    }
-    // SAFETY: plain queries of the loaded loader.
-    let extensions = unsafe { entry.enumerate_instance_extension_properties(None) }
-        .vk("vkEnumerateInstanceExtensionProperties")?;
-    let has_extension = |list: &[vk::ExtensionProperties], name: &CStr| {
-        list.iter()
-            .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name))
-    };
-
-    let mut layer_extensions = Vec::new();
-    if desc.validation {
-        // SAFETY: plain queries of the loaded loader.
-        let layers = unsafe { entry.enumerate_instance_layer_properties() }
-            .vk("vkEnumerateInstanceLayerProperties")?;
-        if !layers
-            .iter()
-            .any(|l| l.layer_name_as_c_str().is_ok_and(|n| n == VALIDATION_LAYER))
-        {
-            return Err(LucentError::NoValidationLayer);
-        }
-        // SAFETY: the layer name is a valid NUL-terminated string of an installed layer.
-        layer_extensions =
-            unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
-                .vk("vkEnumerateInstanceExtensionProperties")?;
-    }
-
-    let debug_utils = ash::ext::debug_utils::NAME;
-    let has_debug_utils =
-        has_extension(&extensions, debug_utils) || has_extension(&layer_extensions, debug_utils);
-    if desc.validation && !has_debug_utils {
-        // Without the messenger validation errors could not be seen or counted.
-        return Err(LucentError::Vulkan {
-            call: "vkCreateInstance (VK_EXT_debug_utils)",
-            result: vk::Result::ERROR_EXTENSION_NOT_PRESENT,
-        });
-    }
-    let validation_features = ash::ext::validation_features::NAME;
-    let has_validation_features = desc.validation
-        && (has_extension(&layer_extensions, validation_features)
-            || has_extension(&extensions, validation_features));
-
-    let mut extension_names = Vec::new();
-    for wanted in &desc.instance_extensions {
-        if !has_extension(&extensions, wanted) {
-            return Err(LucentError::MissingFeature {
-                device: "the Vulkan loader".to_string(),
-                feature: format!(
-                    "instance extension {} (asked for by the window system)",
-                    wanted.to_string_lossy()
-                ),
-            });
-        }
-        extension_names.push(wanted.as_ptr());
-    }
-    if has_debug_utils {
-        extension_names.push(debug_utils.as_ptr());
-    }
-    if has_validation_features {
-        extension_names.push(validation_features.as_ptr());
-    }
-    let layer_names = if desc.validation {
-        vec![VALIDATION_LAYER.as_ptr()]
-    } else {
-        Vec::new()
-    };
-
-    let app_name = c_string(&desc.app_name);
-    let app_info = vk::ApplicationInfo::default()
-        .application_name(&app_name)
-        .application_version(0)
-        .engine_name(c"lucent")
-        .engine_version(vk::make_api_version(0, 0, 1, 0))
-        .api_version(vk::API_VERSION_1_3);
-    let enabled_validation = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-    let mut features =
-        vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_validation);
-    let mut messenger_info = messenger_create_info(state);
-    let mut create_info = vk::InstanceCreateInfo::default()
-        .application_info(&app_info)
-        .enabled_layer_names(&layer_names)
-        .enabled_extension_names(&extension_names);
-    if has_debug_utils {
-        // Also captures messages from vkCreateInstance / vkDestroyInstance themselves.
-        create_info = create_info.push_next(&mut messenger_info);
-    }
-    if has_validation_features {
-        create_info = create_info.push_next(&mut features);
-    } else if desc.validation {
-        log::warn!("VK_EXT_validation_features missing: synchronization validation is off");
-    }
-
-    // SAFETY: every pointer in `create_info` refers to locals that outlive the call; the
-    // messenger user data points to `state`, which the caller keeps alive past the instance.
-    let instance = match unsafe { entry.create_instance(&create_info, None) } {
-        Ok(instance) => instance,
-        Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
-            return Err(LucentError::NoVulkanDriver(
-                " (vkCreateInstance: ERROR_INCOMPATIBLE_DRIVER)".to_string(),
-            ))
-        }
-        Err(vk::Result::ERROR_LAYER_NOT_PRESENT) => return Err(LucentError::NoValidationLayer),
-        Err(result) => {
-            return Err(LucentError::Vulkan {
-                call: "vkCreateInstance",
-                result,
-            })
-        }
-    };
-
-    let debug_instance =
-        has_debug_utils.then(|| ash::ext::debug_utils::Instance::new(entry, &instance));
-    let messenger = match &debug_instance {
-        Some(debug) => {
-            let info = messenger_create_info(state);
-            // SAFETY: the instance enables VK_EXT_debug_utils; user data outlives the messenger.
-            match unsafe { debug.create_debug_utils_messenger(&info, None) } {
-                Ok(m) => m,
-                Err(result) => {
-                    // SAFETY: the instance was created above and has no children.
-                    unsafe { instance.destroy_instance(None) };
-                    return Err(LucentError::Vulkan {
-                        call: "vkCreateDebugUtilsMessengerEXT",
-                        result,
-                    });
-                }
-            }
-        }
-        None => vk::DebugUtilsMessengerEXT::null(),
-    };
-    Ok(CreatedInstance {
-        instance,
-        debug_instance,
-        messenger,
-    })
-}
-
-/// The result of checking a physical device against lucent's requirements.
-struct Probe {
-    info: DeviceInfo,
-    queue_family: u32,
-}
-
-fn queue_family_usable(family: &vk::QueueFamilyProperties) -> bool {
-    family
-        .queue_flags
-        .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-        && family.timestamp_valid_bits > 0
-        && family.queue_count > 0
-}
-
-/// Checks that `pd` supports what lucent needs (and `VK_KHR_swapchain` when `swapchain`) and
-/// collects its [`DeviceInfo`]; the optional feature flags say what is supported (and will be
-/// enabled by [`create_device`]).
-fn probe_device(
-    instance: &ash::Instance,
-    pd: vk::PhysicalDevice,
-    swapchain: bool,
-) -> Result<Probe> {
-    // SAFETY: `pd` was enumerated from `instance` (or supplied by a host under wrap's contract).
-    let props = unsafe { instance.get_physical_device_properties(pd) };
-    let name = props
-        .device_name_as_c_str()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|_| "unnamed device".to_string());
-    let missing = |feature: String| LucentError::MissingFeature {
-        device: name.clone(),
-        feature,
-    };
-    if props.api_version < vk::API_VERSION_1_3 {
-        return Err(missing(format!(
-            "Vulkan 1.3 (device supports {})",
-            version_string(props.api_version)
-        )));
-    }
-
-    // SAFETY: as above; the device supports Vulkan 1.3, so the 1.2 driver-properties and the
-    // 1.2/1.3 feature structs are valid in these chains.
-    let (driver, core, v12, v13, families) = unsafe {
-        let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-        instance.get_physical_device_properties2(pd, &mut props2);
-
-        let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
-        let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default()
-            .push_next(&mut v12)
-            .push_next(&mut v13);
-        instance.get_physical_device_features2(pd, &mut features2);
-        let core = features2.features;
-        let families = instance.get_physical_device_queue_family_properties(pd);
-        (driver, core, v12, v13, families)
-    };
-    if v13.synchronization2 == vk::FALSE {
-        return Err(missing("synchronization2 (Vulkan 1.3)".to_string()));
-    }
-    if v13.maintenance4 == vk::FALSE {
-        return Err(missing(
-            "maintenance4 (Vulkan 1.3; SPIR-V for Vulkan 1.3 needs it)".to_string(),
-        ));
-    }
-    let (queue_family, family) = families
-        .iter()
-        .enumerate()
-        .find(|(_, f)| queue_family_usable(f))
-        .ok_or_else(|| {
-            missing(
-                "a queue family with graphics + compute and timestamps (timestampValidBits > 0)"
-                    .to_string(),
-            )
-        })?;
-
-    if swapchain {
-        // SAFETY: plain query of a physical device of `instance`.
-        let extensions = unsafe { instance.enumerate_device_extension_properties(pd) }
-            .vk("vkEnumerateDeviceExtensionProperties")?;
-        if !extensions.iter().any(|e| {
-            e.extension_name_as_c_str()
-                .is_ok_and(|n| n == ash::khr::swapchain::NAME)
-        }) {
-            return Err(missing(
-                "VK_KHR_swapchain (presenting to a window)".to_string(),
-            ));
-        }
-    }
-
-    let text = |s: std::result::Result<&CStr, _>| {
-        s.map(|s: &CStr| s.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    };
-    let info = DeviceInfo {
-        name,
-        driver_name: text(driver.driver_name_as_c_str()),
-        driver_info: text(driver.driver_info_as_c_str()),
-        device_type: props.device_type,
-        api_version: props.api_version,
-        timestamp_period_ns: props.limits.timestamp_period,
-        timestamp_valid_bits: family.timestamp_valid_bits,
-        host_query_reset: v12.host_query_reset == vk::TRUE,
-        independent_blend: core.independent_blend == vk::TRUE,
-        storage_image_write_without_format: core.shader_storage_image_write_without_format
-            == vk::TRUE,
-        swapchain,
-    };
-    Ok(Probe {
-        info,
-        queue_family: queue_family as u32,
-    })
-}
-
-/// Picks the physical device: the best-scored (or filter-matching) device that passes
-/// [`probe_device`]; when none passes, the best candidate's error is returned.
-fn pick_device(
-    instance: &ash::Instance,
-    desc: &ContextDesc,
-) -> Result<(vk::PhysicalDevice, Probe)> {
-    // SAFETY: plain query of a valid instance.
-    let devices = match unsafe { instance.enumerate_physical_devices() } {
-        Ok(devices) => devices,
-        Err(vk::Result::ERROR_INITIALIZATION_FAILED) => {
-            return Err(LucentError::NoVulkanDriver(
-                " (vkEnumeratePhysicalDevices: ERROR_INITIALIZATION_FAILED)".to_string(),
-            ))
-        }
-        Err(result) => {
-            return Err(LucentError::Vulkan {
-                call: "vkEnumeratePhysicalDevices",
-                result,
-            })
-        }
-    };
-    if devices.is_empty() {
-        return Err(LucentError::NoVulkanDriver(
-            " (no physical devices)".to_string(),
-        ));
-    }
-    let mut candidates: Vec<(vk::PhysicalDevice, String, u32)> = devices
-        .iter()
-        .map(|&pd| {
-            // SAFETY: `pd` was just enumerated from `instance`.
-            let props = unsafe { instance.get_physical_device_properties(pd) };
-            let name = props
-                .device_name_as_c_str()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            (pd, name, device_type_score(props.device_type))
-        })
-        .collect();
-    if let Some(filter) = &desc.device_filter {
-        let wanted = filter.to_lowercase();
-        let available = candidates
-            .iter()
-            .map(|(_, name, _)| name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ");
-        candidates.retain(|(_, name, _)| name.to_lowercase().contains(&wanted));
-        if candidates.is_empty() {
-            return Err(LucentError::NoMatchingDevice {
-                wanted: filter.clone(),
-                available,
-            });
-        }
-    }
-    // Stable sort: equal scores keep the driver's enumeration order.
-    candidates.sort_by_key(|(_, _, score)| std::cmp::Reverse(*score));
-    let mut first_error = None;
-    for (pd, name, _) in &candidates {
-        match probe_device(instance, *pd, desc.swapchain) {
-            Ok(probe) => return Ok((*pd, probe)),
-            Err(e) => {
-                log::info!("skipping Vulkan device '{name}': {e}");
-                first_error.get_or_insert(e);
-            }
-        }
-    }
-    Err(first_error.unwrap_or_else(|| LucentError::NoVulkanDriver(String::new())))
-}
-
-fn create_device(
-    instance: &ash::Instance,
-    pd: vk::PhysicalDevice,
-    probe: &Probe,
-) -> Result<ash::Device> {
-    let priorities = [1.0f32];
-    let queue_infos = [vk::DeviceQueueCreateInfo::default()
-        .queue_family_index(probe.queue_family)
-        .queue_priorities(&priorities)];
-    let core = vk::PhysicalDeviceFeatures::default()
-        .independent_blend(probe.info.independent_blend)
-        .shader_storage_image_write_without_format(probe.info.storage_image_write_without_format);
-    let mut v12 =
-        vk::PhysicalDeviceVulkan12Features::default().host_query_reset(probe.info.host_query_reset);
-    let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
-        .synchronization2(true)
-        .maintenance4(true);
-    let mut features2 = vk::PhysicalDeviceFeatures2::default()
-        .features(core)
-        .push_next(&mut v12)
-        .push_next(&mut v13);
-    let extensions = if probe.info.swapchain {
-        vec![ash::khr::swapchain::NAME.as_ptr()]
-    } else {
-        Vec::new()
-    };
-    let create_info = vk::DeviceCreateInfo::default()
-        .queue_create_infos(&queue_infos)
-        .enabled_extension_names(&extensions)
-        .push_next(&mut features2);
-    // SAFETY: `pd` belongs to `instance`; every enabled feature was reported as supported by
-    // probe_device, and all pointers refer to locals that outlive the call.
-    unsafe { instance.create_device(pd, &create_info, None) }.vk("vkCreateDevice")
 }
 
 /// What lucent creates on any device, owned or wrapped.

@@ -196,61 +196,6 @@ impl MemoryBlock {
     }
 }
 
-/// Bytes per texel of the formats lucent reads back or sizes, or `None` for others.
-pub fn format_texel_size(format: vk::Format) -> Option<u32> {
-    use vk::Format as F;
-    Some(match format {
-        F::R8_UNORM | F::R8_SNORM | F::R8_UINT | F::R8_SINT | F::R8_SRGB | F::S8_UINT => 1,
-        F::R8G8_UNORM
-        | F::R8G8_SNORM
-        | F::R8G8_UINT
-        | F::R8G8_SINT
-        | F::R16_UNORM
-        | F::R16_SNORM
-        | F::R16_UINT
-        | F::R16_SINT
-        | F::R16_SFLOAT
-        | F::D16_UNORM => 2,
-        F::R8G8B8A8_UNORM
-        | F::R8G8B8A8_SNORM
-        | F::R8G8B8A8_UINT
-        | F::R8G8B8A8_SINT
-        | F::R8G8B8A8_SRGB
-        | F::B8G8R8A8_UNORM
-        | F::B8G8R8A8_SNORM
-        | F::B8G8R8A8_UINT
-        | F::B8G8R8A8_SINT
-        | F::B8G8R8A8_SRGB
-        | F::A8B8G8R8_UNORM_PACK32
-        | F::A8B8G8R8_SRGB_PACK32
-        | F::A2B10G10R10_UNORM_PACK32
-        | F::A2R10G10B10_UNORM_PACK32
-        | F::B10G11R11_UFLOAT_PACK32
-        | F::E5B9G9R9_UFLOAT_PACK32
-        | F::R16G16_UNORM
-        | F::R16G16_SNORM
-        | F::R16G16_UINT
-        | F::R16G16_SINT
-        | F::R16G16_SFLOAT
-        | F::R32_UINT
-        | F::R32_SINT
-        | F::R32_SFLOAT
-        | F::D32_SFLOAT
-        | F::X8_D24_UNORM_PACK32 => 4,
-        F::R16G16B16A16_UNORM
-        | F::R16G16B16A16_SNORM
-        | F::R16G16B16A16_UINT
-        | F::R16G16B16A16_SINT
-        | F::R16G16B16A16_SFLOAT
-        | F::R32G32_UINT
-        | F::R32G32_SINT
-        | F::R32G32_SFLOAT => 8,
-        F::R32G32B32_SFLOAT => 12,
-        F::R32G32B32A32_UINT | F::R32G32B32A32_SINT | F::R32G32B32A32_SFLOAT => 16,
-        _ => return None,
-    })
-}
-
 impl GpuContext {
     /// Creates an image with its own device-local memory and a view of it (no view when the
     /// usage is transfer-only).
@@ -648,7 +593,7 @@ impl GpuContext {
     ///
     /// `layout` is the image's current layout; the image is returned to it. All earlier GPU
     /// writes to the image are waited for. The image needs `TRANSFER_SRC` usage and a format
-    /// known to [`format_texel_size`].
+    /// known to the format table ([`crate::backend::format`]).
     pub fn read_image(&self, image: &GpuImage, layout: vk::ImageLayout) -> Result<Vec<u8>> {
         let desc = &image.desc;
         if matches!(
@@ -683,7 +628,7 @@ impl GpuContext {
         let texel = if crate::backend::access::has_stencil(desc.format) {
             Some(4)
         } else {
-            format_texel_size(desc.format)
+            crate::backend::format::texel_bytes(desc.format)
         };
         let texel = texel.ok_or_else(|| {
             LucentError::InvalidInput(format!(

@@ -41,7 +41,7 @@ use ash::vk;
 use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use crate::error::{LucentError, Result, VkResultExt};
-use crate::output::write_file_atomic;
+use crate::images::output::write_file_atomic;
 
 /// Everything besides the inputs that changes the SPIR-V; part of every cache key. Change it when a
 /// compile option below changes, so old cache entries stop matching. (A newer system shaderc does

@@ -56,6 +56,7 @@
 
 pub mod bvh;
 mod cache;
+pub mod scene;
 mod texture;
 
 use std::time::Instant;

@@ -9,14 +9,14 @@ use clap::{Args, Parser, Subcommand};
 
 use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
-use lucent::bench::{self, BenchOptions};
+use lucent::bake::scene as bake;
+use lucent::features::deferred::GBufferPrecision;
+use lucent::features::sss::{SssKnobs, SssPrecision};
+use lucent::frame::{plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::graph::CompileOptions;
-use lucent::passes::deferred::GBufferPrecision;
-use lucent::passes::sss::{SssKnobs, SssPrecision};
-use lucent::renderer::{
-    plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
-};
-use lucent::{output, scene, LucentError, Result};
+use lucent::images::output;
+use lucent::measure::bench::{self, BenchOptions};
+use lucent::{scene, LucentError, Result};
 
 #[derive(Parser)]
 #[command(
@@ -227,7 +227,7 @@ struct FrameArgs {
     sss_precision: SssPrecision,
     /// Bilateral blur (LBB): sensitivity to depth differences, relative to each profile
     /// Gaussian's width (1: weights follow the taps' 3D distance).
-    #[arg(long, default_value_t = lucent::passes::sss::DEFAULT_SENSITIVITY)]
+    #[arg(long, default_value_t = lucent::features::sss::DEFAULT_SENSITIVITY)]
     sensitivity: f32,
     /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
     /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
@@ -380,7 +380,7 @@ fn with_renderer(
     export_hdr: bool,
     work: impl FnOnce(&Session, &Renderer) -> Result<()>,
 ) -> Result<()> {
-    let scene = scene::load_scene(&frame.scene)?;
+    let scene = bake::load_scene_baked(&frame.scene)?;
     let settings = frame.settings(export_hdr)?;
     with_session(gpu_args, |session| {
         let renderer = Renderer::new(
@@ -454,7 +454,8 @@ fn bench_command(
     let format = bench::Format::parse(&format)?;
     let against = against.map(|t| Technique::parse(&t)).transpose()?;
     let technique = Technique::parse(&frame.technique)?;
-    let thesis_table = lucent::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
+    let thesis_table =
+        lucent::report::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
     let gdc = compare_thesis && technique == Technique::Translucency;
     if compare_thesis && thesis_table.is_none() && !gdc {
         return Err(LucentError::InvalidInput(format!(
@@ -481,7 +482,7 @@ fn bench_command(
     with_renderer(frame, gpu_args, false, |session, renderer| {
         let gpu = &session.gpu;
         let report = if speed_of_light {
-            let mut copies = lucent::speed_of_light::CopyFrame::for_plan(
+            let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
                 gpu,
                 &session.shaders,
                 &session.pipeline_cache,
@@ -501,22 +502,22 @@ fn bench_command(
             println!();
         }
         if let Some(table) = &thesis_table {
-            println!("{}", lucent::seeds::beside(&report, table));
+            println!("{}", lucent::report::seeds::beside(&report, table));
         }
         if gdc {
-            let cost = lucent::suite::gdc_cost(
+            let cost = lucent::report::gdc_cost(
                 gpu,
                 &session.shaders,
                 &session.pipeline_cache,
-                &scene::load_scene(&frame.scene)?,
+                &bake::load_scene_baked(&frame.scene)?,
                 &format!("`{}`", frame.scene),
                 (renderer.settings.width, renderer.settings.height),
                 (options.frames, options.warmup),
             )?;
-            println!("{}", lucent::seeds::gdc_beside(&cost));
+            println!("{}", lucent::report::seeds::gdc_beside(&cost));
         }
         if let Some(technique) = against {
-            let scene = scene::load_scene(&frame.scene)?;
+            let scene = bake::load_scene_baked(&frame.scene)?;
             let other = Renderer::new(
                 gpu,
                 &session.shaders,
@@ -542,7 +543,7 @@ fn bench_command(
             let compared = compared?;
             println!("{}", compared.markdown(&gpu.info.describe()));
             if thesis_table.is_some() {
-                if let Some(line) = lucent::seeds::thesis_ratio_line(&compared) {
+                if let Some(line) = lucent::report::seeds::thesis_ratio_line(&compared) {
                     println!("{line}");
                 }
             }
@@ -640,9 +641,9 @@ fn sweep_command(
             "sweep: unknown technique '{technique}'; available: translucency"
         )));
     }
-    let cases = lucent::sweep::translucency_cases();
+    let cases = lucent::measure::sweep::translucency_cases();
     let (rows, device) = with_session(gpu_args, |session| {
-        let rows = lucent::sweep::run_translucency(
+        let rows = lucent::measure::sweep::run_translucency(
             &session.gpu,
             &session.shaders,
             &session.pipeline_cache,
@@ -652,7 +653,7 @@ fn sweep_command(
         )?;
         Ok((rows, session.gpu.info.describe()))
     })?;
-    let table = lucent::sweep::markdown(&rows, width, height, &device);
+    let table = lucent::measure::sweep::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
         output::write_file_atomic(out, table.as_bytes())?;
@@ -686,8 +687,8 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
     let (text, files) = match &args.technique {
         Some(technique) => {
             let write = match technique.as_str() {
-                "translucency" => lucent::report::write_translucency_report,
-                "sss" => lucent::sss_report::write_sss_report,
+                "translucency" => lucent::report::translucency::write_translucency_report,
+                "sss" => lucent::report::sss::write_sss_report,
                 _ => {
                     return Err(LucentError::InvalidInput(format!(
                         "report: unknown section '{technique}'; available: translucency, sss (or \
@@ -696,7 +697,7 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
                 }
             };
             let (width, height) = args.size.unwrap_or((1024, 768));
-            let options = lucent::report::ReportOptions {
+            let options = lucent::report::section::ReportOptions {
                 width,
                 height,
                 rounds: args.rounds.unwrap_or(15),
@@ -714,9 +715,9 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
         }
         None => {
             let mut options = if args.quick {
-                lucent::suite::SuiteOptions::quick()
+                lucent::report::SuiteOptions::quick()
             } else {
-                lucent::suite::SuiteOptions::full()
+                lucent::report::SuiteOptions::full()
             };
             if let Some((w, h)) = args.size {
                 (options.width, options.height) = (w, h);
@@ -724,7 +725,7 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
             options.frames = args.rounds.unwrap_or(options.frames);
             options.warmup = args.warmup.unwrap_or(options.warmup);
             with_session(gpu_args, |session| {
-                lucent::suite::run(
+                lucent::report::run(
                     &session.gpu,
                     &session.shaders,
                     &session.pipeline_cache,
@@ -845,7 +846,7 @@ fn run(cli: Cli) -> Result<()> {
             base: FrameSettings::new(size.0, size.1),
         }),
         Command::Plan { frame } => {
-            let scene = scene::load_scene(&frame.scene)?;
+            let scene = bake::load_scene_baked(&frame.scene)?;
             let settings = frame.settings(false)?;
             let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings)?)?;
             print!("{}", plan.dump());

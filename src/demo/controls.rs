@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use crate::renderer::FrameSettings;
+use crate::frame::FrameSettings;
 use crate::scene::material::PowMode;
 use crate::scene::{Camera, Scene};
 
@@ -452,7 +452,7 @@ mod tests {
     use super::*;
 
     fn cubes() -> Scene {
-        crate::scene::load_scene("cubes").unwrap()
+        crate::bake::scene::load_scene_baked("cubes").unwrap()
     }
 
     #[test]
@@ -518,7 +518,7 @@ mod tests {
             assert!(cycle_pow_mode(&mut scene).is_some());
         }
         assert_eq!(pow_mode(&scene), Some(first));
-        let mut smoke = crate::scene::load_scene("smoke").unwrap();
+        let mut smoke = crate::bake::scene::load_scene_baked("smoke").unwrap();
         if pow_mode(&smoke).is_none() {
             assert_eq!(cycle_pow_mode(&mut smoke), None);
         }

@@ -34,10 +34,11 @@ use winit::window::{Window, WindowId};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{ContextDesc, GpuContext};
-use crate::passes::debug_view::DebugView;
-use crate::renderer::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::features::debug_view::DebugView;
+use crate::frame::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::images::output;
 use crate::scene::Scene;
-use crate::{output, LucentError, Result};
+use crate::{LucentError, Result};
 
 use controls::{Action, OrbitCamera, KNOBS};
 use overlay::{Panel, TextRenderer, Tone};
@@ -92,7 +93,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
         ));
     }
     let script = options.script.as_deref().map(Script::load).transpose()?;
-    let mut scene = crate::scene::load_scene(&options.scene)?;
+    let mut scene = crate::bake::scene::load_scene_baked(&options.scene)?;
     let event_loop = EventLoop::new().map_err(|e| {
         LucentError::InvalidInput(format!(
             "cannot open a window ({e}); is a display available (DISPLAY or WAYLAND_DISPLAY)? \
@@ -121,7 +122,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
     let pipeline_cache = PipelineCache::load_default(&gpu)?;
     // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
     // the timing columns line up.
-    let font = crate::plot::font_file().map(|p| {
+    let font = crate::report::plot::font_file().map(|p| {
         let mono = p.with_file_name("DejaVuSansMono.ttf");
         if mono.is_file() {
             mono

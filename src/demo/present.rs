@@ -24,7 +24,7 @@ use gpu_allocator::MemoryLocation;
 use crate::backend::timer::{GpuTimer, ScopeTime};
 use crate::backend::{GpuBuffer, GpuContext};
 use crate::error::VkResultExt;
-use crate::renderer::Renderer;
+use crate::frame::Renderer;
 use crate::{LucentError, Result};
 
 use super::overlay::Panel;

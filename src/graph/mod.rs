@@ -42,6 +42,7 @@ pub mod compile;
 pub mod declare;
 pub mod dump;
 pub mod execute;
+pub mod plan;
 
 pub use compile::{CompileOptions, Plan};
 pub use declare::{

@@ -4,6 +4,8 @@
 
 use std::f64::consts::PI;
 
+use crate::scene::profile::fit_sum_of_gaussians;
+
 /// Diffuse Fresnel reflectance of a boundary with relative index `eta` (Jensen's fit).
 pub fn fresnel_diffuse_reflectance(eta: f64) -> f64 {
     -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
@@ -23,62 +25,6 @@ pub fn dipole_rd(r: f64, sigma_s_prime: f64, sigma_a: f64, eta: f64) -> f64 {
     let dv = (r * r + zv * zv).sqrt();
     let term = |z: f64, d: f64| z * (sigma_tr * d + 1.0) * (-sigma_tr * d).exp() / (d * d * d);
     albedo / (4.0 * PI) * (term(zr, dr) + term(zv, dv))
-}
-
-/// The normalised 2D Gaussian of variance `v` at radius `r`: exp(-r²/2v) / (2πv).
-pub fn gaussian(v: f64, r: f64) -> f64 {
-    (-r * r / (2.0 * v)).exp() / (2.0 * PI * v)
-}
-
-/// Non-negative weights w minimising ∫ (profile(r) - Σ w_i G(v_i, r))² 2πr dr over [0, r_max]
-/// (area-weighted, as the profile is applied over the plane). Returns the weights and the
-/// relative L2 error of the fit.
-pub fn fit_sum_of_gaussians(
-    variances: &[f64],
-    profile: impl Fn(f64) -> f64,
-    r_max: f64,
-) -> (Vec<f64>, f64) {
-    let n = variances.len();
-    let samples = 4000;
-    let dr = r_max / samples as f64;
-    // Normal equations H w = b by midpoint quadrature.
-    let mut h = vec![vec![0.0; n]; n];
-    let mut b = vec![0.0; n];
-    let mut norm = 0.0;
-    for s in 0..samples {
-        let r = (s as f64 + 0.5) * dr;
-        let area = 2.0 * PI * r * dr;
-        let p = profile(r);
-        let g: Vec<f64> = variances.iter().map(|&v| gaussian(v, r)).collect();
-        for i in 0..n {
-            b[i] += g[i] * p * area;
-            for j in 0..n {
-                h[i][j] += g[i] * g[j] * area;
-            }
-        }
-        norm += p * p * area;
-    }
-    // Projected coordinate descent: the problem is a convex quadratic with w >= 0.
-    let mut w = vec![0.0; n];
-    for _ in 0..20_000 {
-        for i in 0..n {
-            let grad: f64 = (0..n).map(|j| h[i][j] * w[j]).sum::<f64>() - b[i];
-            if h[i][i] > 0.0 {
-                w[i] = (w[i] - grad / h[i][i]).max(0.0);
-            }
-        }
-    }
-    let residual: f64 = {
-        let mut e = norm;
-        for i in 0..n {
-            e -= 2.0 * w[i] * b[i];
-            for j in 0..n {
-                e += w[i] * w[j] * h[i][j];
-            }
-        }
-        e.max(0.0)
-    };
-    (w, (residual / norm.max(1e-300)).sqrt())
 }
 
 /// Jensen et al.'s measured marble: reduced scattering and absorption per channel (1/mm), η.
@@ -111,6 +57,7 @@ pub fn fit_marble(variances: &[f64]) -> (Vec<[f64; 3]>, [f64; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::profile::gaussian;
 
     #[test]
     fn dipole_is_positive_decreasing_and_finite() {

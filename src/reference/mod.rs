@@ -30,7 +30,7 @@ pub struct GBufferPixel {
 
 /// Every pixel of `gbuffer` seen through `camera`: `None` where no surface was drawn (sky).
 pub fn gbuffer_pixels(
-    gbuffer: &crate::renderer::GBufferReadback,
+    gbuffer: &crate::frame::GBufferReadback,
     camera: &crate::scene::Camera,
 ) -> Vec<Option<GBufferPixel>> {
     let (w, h) = (gbuffer.width as usize, gbuffer.height as usize);

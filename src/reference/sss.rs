@@ -14,44 +14,11 @@ use glam::{DMat3, DVec2};
 
 use super::lighting::{light_incidence, radiance, shade_direct_split, shininess};
 use super::{gbuffer_pixels, DVec3};
-use crate::renderer::GBufferReadback;
+use crate::frame::GBufferReadback;
 use crate::scene::lean::covariance_of;
 use crate::scene::material::SssProfile;
+use crate::scene::profile::normalized_weights;
 use crate::scene::Scene;
-
-/// Each Gaussian's weight, normalised per channel so the weights sum to 1 (as the blurs
-/// normalise them); a channel whose weights are all 0 keeps its light where it is, which the
-/// first Gaussian then takes whole.
-pub fn normalized_weights(profile: &SssProfile) -> Vec<DVec3> {
-    let total = profile
-        .gaussians
-        .iter()
-        .fold(DVec3::ZERO, |acc, g| acc + g.weight.as_dvec3());
-    profile
-        .gaussians
-        .iter()
-        .enumerate()
-        .map(|(i, g)| {
-            DVec3::select(
-                total.cmpgt(DVec3::ZERO),
-                g.weight.as_dvec3() / total.max(DVec3::splat(1e-300)),
-                DVec3::splat(if i == 0 { 1.0 } else { 0.0 }),
-            )
-        })
-        .collect()
-}
-
-/// `R(r)` of a profile at `r_mm` millimetres, per channel, with [`normalized_weights`].
-pub fn profile_value(profile: &SssProfile, r_mm: f64) -> DVec3 {
-    profile
-        .gaussians
-        .iter()
-        .zip(normalized_weights(profile))
-        .fold(DVec3::ZERO, |sum, (g, w)| {
-            let v = f64::from(g.variance).max(1e-12);
-            sum + w * ((-r_mm * r_mm / (2.0 * v)).exp() / (2.0 * std::f64::consts::PI * v))
-        })
-}
 
 /// One pixel of the read-back frame, in world space.
 struct SurfacePixel {
@@ -346,6 +313,7 @@ pub fn edge_metrics(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::profile::profile_value;
 
     #[test]
     fn profile_integrates_to_one_per_channel() {

@@ -4,8 +4,8 @@
 
 use super::lighting::{light_incidence, radiance, shade_direct};
 use super::{gbuffer_pixels, DVec3};
-use crate::passes::translucency::{MaterialRow, ThicknessPacking};
-use crate::renderer::GBufferReadback;
+use crate::features::translucency::{MaterialRow, ThicknessPacking};
+use crate::frame::GBufferReadback;
 use crate::scene::{Light, Scene};
 
 /// `x^n` for `x` in [0, 1]: exact `pow` (mode 0) or the spherical-Gaussian `exp2(n x - n)`

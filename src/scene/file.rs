@@ -815,17 +815,15 @@ fn build_material(
 }
 
 /// Loads a scene by built-in name, or from a `.toml` file when `name_or_path` ends in `.toml`
-/// or names an existing file, and bakes the thickness its materials ask for.
+/// or names an existing file. Only parses and checks: thickness the materials ask to bake or
+/// sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
 pub fn load_scene(name_or_path: &str) -> Result<Scene> {
     let path = Path::new(name_or_path);
-    let mut scene = if name_or_path.ends_with(".toml") || path.is_file() {
-        load_scene_file(path)?
+    if name_or_path.ends_with(".toml") || path.is_file() {
+        load_scene_file(path)
     } else {
-        super::builtin(name_or_path)?
-    };
-    let cache = crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness");
-    super::prepare_thickness(&mut scene, &cache)?;
-    Ok(scene)
+        super::builtin(name_or_path)
+    }
 }
 
 #[cfg(test)]

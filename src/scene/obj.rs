@@ -233,7 +233,7 @@ pub fn write_obj_with_colors(path: &Path, mesh: &Mesh, colors: &[Vec3]) -> Resul
         }
         s.push('\n');
     }
-    crate::output::write_file_atomic(path, s.as_bytes())
+    crate::images::output::write_file_atomic(path, s.as_bytes())
 }
 
 // ---------------------------------------------------------------------------------------------

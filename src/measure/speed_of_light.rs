@@ -11,7 +11,7 @@
 //! any pass a technique adds.
 //!
 //! The copies are timed submitted one by one with the device idle (the isolated mode of
-//! [`crate::bench`]), alternating with the frames of the same run, so machine noise hits both.
+//! [`crate::measure::bench`]), alternating with the frames of the same run, so machine noise hits both.
 //!
 //! Taps: a pass that declares its texture taps per pixel ([`crate::graph::declare::PassBuilder::taps`])
 //! is divided by that; otherwise each image a pass reads (an input attachment, a sampled image,
@@ -28,16 +28,17 @@ use std::collections::HashSet;
 use ash::vk;
 use serde::Serialize;
 
+use crate::backend::format::format_name;
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
+use crate::features::util::{
+    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+};
+use crate::frame::FrameRunner;
 use crate::graph::{
     CompileOptions, Executable, ImageInfo, LoadOp, PassExec, PassKind, Plan, PrepareContext,
     RecordContext, RenderGraph, ResourceId,
 };
-use crate::passes::util::{
-    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
-};
-use crate::renderer::FrameRunner;
 use crate::{LucentError, Result};
 
 /// Passes at more than this many times their copy's time are named as far above their floor.
@@ -315,10 +316,10 @@ impl CopyFrame {
     }
 
     /// Median copy time of each floor (`None`: no copy for it, or not measured yet).
-    pub fn medians(&self) -> Vec<Option<crate::bench::Stats>> {
+    pub fn medians(&self) -> Vec<Option<crate::measure::stats::Stats>> {
         self.samples
             .iter()
-            .map(|s| (!s.is_empty()).then(|| crate::bench::Stats::of(s)))
+            .map(|s| (!s.is_empty()).then(|| crate::measure::stats::Stats::of(s)))
             .collect()
     }
 
@@ -355,21 +356,6 @@ pub struct FloorRow {
     pub note: Option<String>,
 }
 
-fn format_name(format: vk::Format) -> String {
-    match format {
-        vk::Format::R8_UNORM => "R8".into(),
-        vk::Format::R8G8_UNORM => "RG8".into(),
-        vk::Format::R8G8B8A8_UNORM => "RGBA8".into(),
-        vk::Format::R16G16_SFLOAT => "RG16F".into(),
-        vk::Format::R16G16B16A16_SFLOAT => "RGBA16F".into(),
-        vk::Format::R32G32_SFLOAT => "RG32F".into(),
-        vk::Format::R32G32B32A32_SFLOAT => "RGBA32F".into(),
-        vk::Format::D32_SFLOAT => "D32".into(),
-        vk::Format::D32_SFLOAT_S8_UINT => "D32S8".into(),
-        other => format!("{other:?}"),
-    }
-}
-
 /// The copy's inputs and outputs as text.
 pub fn describe_io(floor: &PassFloor) -> String {
     let reads: Vec<String> = floor.reads.iter().map(|i| format_name(i.format)).collect();
@@ -392,7 +378,7 @@ pub fn describe_io(floor: &PassFloor) -> String {
 /// pass's reported median up by name).
 pub fn rows(
     floors: &[PassFloor],
-    copies: &[Option<crate::bench::Stats>],
+    copies: &[Option<crate::measure::stats::Stats>],
     pass_ms: impl Fn(&str) -> Option<f64>,
 ) -> Vec<FloorRow> {
     floors
@@ -559,10 +545,10 @@ impl PassExec for CopyPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::{plan_frame, FrameFeatures, FrameSettings, Technique};
+    use crate::frame::{plan_frame, FrameFeatures, FrameSettings, Technique};
 
     fn plan(scene: &str, technique: Technique) -> Plan {
-        let scene = crate::scene::load_scene(scene).unwrap();
+        let scene = crate::bake::scene::load_scene_baked(scene).unwrap();
         let settings = FrameSettings {
             technique,
             ..FrameSettings::new(64, 48)
@@ -624,7 +610,7 @@ mod tests {
             taps: 7,
             taps_declared: true,
         };
-        let stat = |m| crate::bench::Stats {
+        let stat = |m| crate::measure::stats::Stats {
             median: m,
             min: m,
             max: m,

@@ -15,9 +15,9 @@ use serde::Serialize;
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::bench::Stats;
+use crate::frame::{FrameRunner, FrameSettings, Renderer, Technique};
 use crate::graph::CompileOptions;
-use crate::renderer::{FrameRunner, FrameSettings, Renderer, Technique};
+use crate::measure::stats::Stats;
 use crate::scene::Scene;
 use crate::Result;
 
@@ -140,7 +140,7 @@ pub fn measure(
             })
             .collect())
     })();
-    crate::renderer::destroy_after_idle(gpu, renderers, runners)?;
+    crate::frame::destroy_after_idle(gpu, renderers, runners)?;
     result
 }
 

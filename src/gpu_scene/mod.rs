@@ -1,20 +1,6 @@
-//! The techniques, each a struct that adds its passes to a [`RenderGraph`](crate::graph::RenderGraph):
-//! handles in, handles out.
-//!
-//! - [`deferred`]: the MRT G-buffer and per-light deferred lighting (merged as subpasses).
-//! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
-//!   packing (its shading runs inside the deferred lighting pass).
-//! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
-//! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
-//! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
-//! - [`util`]: pipeline and descriptor helpers the passes share.
-
-pub mod debug_view;
-pub mod deferred;
-pub mod sss;
-pub mod tonemap;
-pub mod translucency;
-pub mod util;
+//! What a scene becomes on the GPU: meshes with their vertex streams, the draws, normal and
+//! albedo maps, and the translucency material table. Made once per scene and frame layout
+//! ([`SceneGpu::new`]); the passes of [`crate::features`] share it read-only.
 
 use std::sync::Arc;
 
@@ -27,7 +13,7 @@ use crate::scene::texture::{load_texture, procedural_texture, Texture, TextureUs
 use crate::scene::Scene;
 use crate::Result;
 
-use translucency::{thickness_factor, MaterialTable, ThicknessPacking};
+use crate::features::translucency::{thickness_factor, MaterialTable, ThicknessPacking};
 
 /// One draw: which mesh, with which per-object constants.
 #[derive(Clone, Copy, Debug)]
@@ -71,13 +57,13 @@ pub struct GpuMesh {
 
 /// What the translucency technique keeps on the GPU (absent from frames without it).
 pub struct TranslucencyGpu {
-    /// The material table uniform buffer ([`translucency::MaterialTableGpu`]).
+    /// The material table uniform buffer ([`crate::features::translucency::MaterialTableGpu`]).
     pub materials: GpuBuffer,
     /// How GB2 packs thickness.
     pub packing: ThicknessPacking,
     /// The lighting pass's rectangles for this frame ([`translucency::tile_rects`]), written
     /// by the renderer before each frame is recorded.
-    pub tiles: std::sync::Mutex<Vec<translucency::TileRect>>,
+    pub tiles: std::sync::Mutex<Vec<crate::features::translucency::TileRect>>,
 }
 
 /// Normal maps of a normal-mapped frame: image 0 is a flat 1x1 map for objects without one.
@@ -110,7 +96,7 @@ pub struct SceneGpu {
     /// The screen's rectangles for the SSS passes this frame, marked (`translucent`) where
     /// objects with a profile (widened by the profile's reach) may be: the blurs run only in
     /// those. Written by the renderer before each frame; `None`: everything is blurred.
-    pub sss_tiles: std::sync::Mutex<Option<Vec<translucency::TileRect>>>,
+    pub sss_tiles: std::sync::Mutex<Option<Vec<crate::features::translucency::TileRect>>>,
 }
 
 /// Linear RGBA f32 texels as tightly packed RGBA16F bytes (values clamped to fp16's range).
@@ -328,7 +314,7 @@ impl SceneGpu {
     }
 
     /// Sets the lighting pass's rectangles for the next frames (frames with translucency).
-    pub fn set_tiles(&self, rects: Vec<translucency::TileRect>) {
+    pub fn set_tiles(&self, rects: Vec<crate::features::translucency::TileRect>) {
         if let Some(t) = &self.translucency {
             // A poisoned lock only means a recording thread panicked; the data is plain.
             *t.tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
@@ -336,7 +322,7 @@ impl SceneGpu {
     }
 
     /// Sets the SSS blurs' rectangles for the next frames (`None`: whole screen).
-    pub fn set_sss_tiles(&self, rects: Option<Vec<translucency::TileRect>>) {
+    pub fn set_sss_tiles(&self, rects: Option<Vec<crate::features::translucency::TileRect>>) {
         // A poisoned lock only means a recording thread panicked; the data is plain.
         *self.sss_tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
     }

@@ -12,7 +12,7 @@
 
 use std::fmt::Write as _;
 
-use crate::bench::BenchReport;
+use crate::measure::bench::BenchReport;
 
 /// One row of a published per-pass table.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,7 +98,7 @@ pub fn thesis_table(technique: &str) -> Option<SeedTable> {
 
 /// The thesis's LBB / control cost ratio beside ours, when `compared` measured a LEAN technique
 /// (`lbb` or `lcb`) against `control` in one run (alternating frames).
-pub fn thesis_ratio_line(compared: &crate::bench::Comparison) -> Option<String> {
+pub fn thesis_ratio_line(compared: &crate::measure::bench::Comparison) -> Option<String> {
     let [a, b] = &compared.names;
     let (lean, control) = match (a.as_str(), b.as_str()) {
         ("control", "lbb" | "lcb") => (1, 0),
@@ -117,7 +117,10 @@ pub fn thesis_ratio_line(compared: &crate::bench::Comparison) -> Option<String> 
 }
 
 /// lucent's pass for a thesis row: blurs by name (case-insensitive), the lighting rows by role.
-fn matching_pass<'a>(report: &'a BenchReport, seed_row: &str) -> Option<&'a crate::bench::PassRow> {
+fn matching_pass<'a>(
+    report: &'a BenchReport,
+    seed_row: &str,
+) -> Option<&'a crate::measure::bench::PassRow> {
     let wanted = seed_row.to_ascii_lowercase();
     report.passes.iter().find(|p| {
         let name = p.name.to_ascii_lowercase();

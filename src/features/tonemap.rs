@@ -15,7 +15,7 @@ use crate::graph::{
 use crate::Result;
 
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
-use super::SceneGpu;
+use crate::gpu_scene::SceneGpu;
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;

@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{LucentError, Result};
-use crate::output::{read_png_rgba8, write_png_rgba8};
+use crate::images::output::{read_png_rgba8, write_png_rgba8};
 
 /// Limits a test image must stay within to count as equal to its reference.
 ///

@@ -3,13 +3,13 @@
 //!
 //! In order:
 //! 1. **Per technique** (every entry of [`Technique::ALL`], on the scene made for it, see
-//!    [`scene_for`]): the verified benchmark ([`crate::bench`], with `--isolate`) and every
-//!    pass beside its speed-of-light copy ([`crate::speed_of_light`]), measured in the same run;
+//!    [`scene_for`]): the verified benchmark ([`crate::measure::bench`], with `--isolate`) and every
+//!    pass beside its speed-of-light copy ([`crate::measure::speed_of_light`]), measured in the same run;
 //!    a bar plot of pass against copy; beside the thesis's table where the thesis has one.
 //! 2. **The seeds' tables**: GDC 2011's full-screen translucency cost beside ours as a share of
 //!    the lighting pass, and Li et al.'s Table 1 beside our frame times at its triangle counts
-//!    and resolutions ([`crate::seeds`]).
-//! 3. **Scaling** ([`crate::scaling`]): frame and per-pass time against triangles, resolution
+//!    and resolutions ([`crate::report::seeds`]).
+//! 3. **Scaling** ([`crate::measure::scaling`]): frame and per-pass time against triangles, resolution
 //!    and light count, with curves and which passes grow with what.
 //! 4. **Error against time**: one section per technique with approximation knobs
 //!    ([`ERROR_SECTIONS`]; a section is one [`SectionFn`], so a technique plugs its own in).
@@ -23,129 +23,51 @@ use std::time::Instant;
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::bench::{BenchOptions, BenchReport};
-use crate::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, PlotSeries};
-use crate::renderer::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
-use crate::scaling::{Config, Measured};
-use crate::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
-use crate::speed_of_light::CopyFrame;
+use crate::frame::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
+use crate::measure::bench::{BenchOptions, BenchReport};
+use crate::measure::scaling::{Config, Measured};
+use crate::measure::speed_of_light::CopyFrame;
+use crate::report::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, PlotSeries};
+use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
 
-/// How much the suite measures.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SuiteOptions {
-    /// The small preset (`--quick`: under 2 minutes on lavapipe).
-    pub quick: bool,
-    /// Benchmark size of the per-technique tables.
-    pub width: u32,
-    /// Benchmark size of the per-technique tables.
-    pub height: u32,
-    /// Measured frames (rounds, for round-robin sections).
-    pub frames: usize,
-    /// Discarded frames first.
-    pub warmup: usize,
-}
+pub mod plot;
+pub mod section;
+pub mod seeds;
+pub mod sss;
+pub mod translucency;
 
-impl SuiteOptions {
-    /// The default run: 1024x768 tables, the full axes (under 15 minutes on lavapipe).
-    pub fn full() -> Self {
-        Self {
-            quick: false,
-            width: 1024,
-            height: 768,
-            frames: 25,
-            warmup: 3,
-        }
-    }
-
-    /// `--quick`: small frames, few rounds, short axes.
-    pub fn quick() -> Self {
-        Self {
-            quick: true,
-            width: 256,
-            height: 192,
-            frames: 3,
-            warmup: 1,
-        }
-    }
-}
-
-/// What a section needs.
-pub struct SuiteContext<'a> {
-    /// The device.
-    pub gpu: &'a GpuContext,
-    /// Shader compiler.
-    pub shaders: &'a ShaderCompiler,
-    /// Pipeline cache.
-    pub pipeline_cache: &'a PipelineCache,
-    /// Output directory (exists).
-    pub dir: &'a Path,
-    /// The run's options.
-    pub options: SuiteOptions,
-}
-
-/// What a section produced.
-#[derive(Clone, Debug, Default)]
-pub struct SectionOutput {
-    /// Markdown for `report.md` (headings at level 2 and below).
-    pub markdown: String,
-    /// Files it wrote (plots, its own Markdown).
-    pub files: Vec<PathBuf>,
-    /// Problems to list in the summary (e.g. untrusted timing).
-    pub warnings: Vec<String>,
-    /// Findings to list in the summary at the top.
-    pub summary: Vec<String>,
-}
-
-/// One section of the suite.
-pub type SectionFn = fn(&SuiteContext<'_>) -> Result<SectionOutput>;
+pub use section::{embed, SectionFn, SectionOutput, SuiteContext, SuiteOptions};
 
 /// The error-against-time sections, one per technique with approximation knobs, in report order.
 pub const ERROR_SECTIONS: &[(&str, SectionFn)] = &[
     (
         "translucency",
-        crate::report::translucency_section as SectionFn,
+        crate::report::translucency::translucency_section as SectionFn,
     ),
     ("sss", sss_section as SectionFn),
 ];
 
-/// A section's own Markdown file embedded in `report.md`: every heading one level down.
-pub fn embed(text: &str) -> String {
-    let mut out: String = text
-        .lines()
-        .map(|l| {
-            if l.starts_with('#') {
-                format!("#{l}")
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n");
-    out.push('\n');
-    out
-}
-
-/// The SSS error-against-time report ([`crate::sss_report`]) as a section, written beside
+/// The SSS error-against-time report ([`crate::report::sss`]) as a section, written beside
 /// `report.md`. Full run: the suite's size, 5 rounds after 1 warm-up (as `docs/report/sss.md`
 /// was first measured); quick: 128x96, 1 round, no warm-up.
 pub fn sss_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     let opts = if ctx.options.quick {
-        crate::report::ReportOptions {
+        crate::report::section::ReportOptions {
             width: 128,
             height: 96,
             rounds: 1,
             warmup: 0,
         }
     } else {
-        crate::report::ReportOptions {
+        crate::report::section::ReportOptions {
             width: ctx.options.width,
             height: ctx.options.height,
             rounds: 5,
             warmup: 1,
         }
     };
-    let (text, files) = crate::sss_report::write_sss_report(
+    let (text, files) = crate::report::sss::write_sss_report(
         ctx.gpu,
         ctx.shaders,
         ctx.pipeline_cache,
@@ -181,7 +103,7 @@ pub fn scene_for(technique: Technique) -> Result<String> {
         .collect();
     let mut scenes = Vec::new();
     for name in &candidates {
-        let scene = crate::scene::load_scene(name)?;
+        let scene = crate::bake::scene::load_scene_baked(name)?;
         let made_for = match (&scene.technique, technique) {
             (None, Technique::None) => true,
             (Some(t), _) => t == technique.name(),
@@ -292,7 +214,7 @@ pub fn run(
     }
     text.push_str(&body);
     let md = dir.join("report.md");
-    crate::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
     files.insert(0, md);
     Ok((text, files))
 }
@@ -308,7 +230,7 @@ pub fn bench_technique(
     technique: Technique,
     scene_name: &str,
 ) -> Result<BenchReport> {
-    let scene = crate::scene::load_scene(scene_name)?;
+    let scene = crate::bake::scene::load_scene_baked(scene_name)?;
     let settings = FrameSettings {
         technique,
         ..FrameSettings::new(ctx.options.width, ctx.options.height)
@@ -321,7 +243,7 @@ pub fn bench_technique(
         &renderer.executable.plan,
     );
     let result = copies.and_then(|mut copies| {
-        let report = crate::bench::run_with_floor(
+        let report = crate::measure::bench::run_with_floor(
             ctx.gpu,
             &renderer,
             Some(&mut copies),
@@ -376,7 +298,7 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                 if far.is_empty() {
                     format!(
                         "no pass above {}x its copy",
-                        crate::speed_of_light::FAR_ABOVE_FLOOR
+                        crate::measure::speed_of_light::FAR_ABOVE_FLOOR
                     )
                 } else {
                     format!("far above their copy: {}", far.join(", "))
@@ -416,9 +338,10 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         )?;
         let _ = writeln!(out.markdown, "\n![passes of {name}]({})\n", file_name(&png));
         out.files.push(png);
-        if let Some(table) = crate::seeds::thesis_table(name) {
-            out.markdown
-                .push_str(&crate::seeds::beside(&report, &table).replacen("## ", "#### ", 1));
+        if let Some(table) = crate::report::seeds::thesis_table(name) {
+            out.markdown.push_str(
+                &crate::report::seeds::beside(&report, &table).replacen("## ", "#### ", 1),
+            );
             out.markdown.push('\n');
         }
     }
@@ -438,13 +361,13 @@ fn measure_with_progress(
 ) -> Result<Vec<Measured>> {
     let rounds = ctx.options.frames;
     let warmup = ctx.options.warmup;
-    let bar = crate::bench::progress_bar(
+    let bar = crate::measure::bench::progress_bar(
         (rounds + warmup) as u64,
         // Unknown until measured: a run of many configurations is assumed long.
         configs.len() as f64,
         what,
     );
-    let result = crate::scaling::measure(
+    let result = crate::measure::scaling::measure(
         ctx.gpu,
         ctx.shaders,
         ctx.pipeline_cache,
@@ -477,13 +400,13 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         ctx.gpu,
         ctx.shaders,
         ctx.pipeline_cache,
-        &crate::scene::load_scene("grid125")?,
+        &crate::bake::scene::load_scene_baked("grid125")?,
         "`grid125` (all 125 cubes translucent, 3 point lights)",
         (w, h),
         (ctx.options.frames, ctx.options.warmup),
     )?;
     out.markdown
-        .push_str(&crate::seeds::gdc_beside(&cost).replacen("## ", "### ", 1));
+        .push_str(&crate::report::seeds::gdc_beside(&cost).replacen("## ", "### ", 1));
     out.markdown.push('\n');
     // Li et al.: scaling:N at their counts, 512x512 and 1024x1024.
     let li = li_points(ctx)?;
@@ -496,7 +419,8 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         })
         .collect();
     out.markdown.push_str(
-        &crate::seeds::li_beside(&device, Technique::None.name(), &ours).replacen("## ", "### ", 1),
+        &crate::report::seeds::li_beside(&device, Technique::None.name(), &ours)
+            .replacen("## ", "### ", 1),
     );
     let png = ctx.dir.join("li-table-1.png");
     let mut series = Vec::new();
@@ -560,10 +484,10 @@ pub fn gdc_cost(
             label: t.name().into(),
             x: 1.0,
             scene: scene.clone(),
-            settings: crate::scaling::settings(t, width, height),
+            settings: crate::measure::scaling::settings(t, width, height),
         })
         .collect();
-    let m = crate::scaling::measure(
+    let m = crate::measure::scaling::measure(
         gpu,
         shaders,
         pipeline_cache,
@@ -590,7 +514,9 @@ fn li_points(ctx: &SuiteContext<'_>) -> Result<[Vec<Measured>; 2]> {
     let counts = li_counts(ctx.options.quick);
     let mut scenes = Vec::new();
     for &n in &counts {
-        scenes.push(crate::scene::load_scene(&format!("scaling:{n}"))?);
+        scenes.push(crate::bake::scene::load_scene_baked(&format!(
+            "scaling:{n}"
+        ))?);
     }
     let mut out: [Vec<Measured>; 2] = [Vec::new(), Vec::new()];
     for (i, size) in [512u32, 1024].iter().enumerate() {
@@ -599,9 +525,9 @@ fn li_points(ctx: &SuiteContext<'_>) -> Result<[Vec<Measured>; 2]> {
             .zip(&scenes)
             .map(|(&n, scene)| Config {
                 label: format!("{n}"),
-                x: crate::scaling::triangles(scene) as f64,
+                x: crate::measure::scaling::triangles(scene) as f64,
                 scene: scene.clone(),
-                settings: crate::scaling::settings(Technique::None, *size, *size),
+                settings: crate::measure::scaling::settings(Technique::None, *size, *size),
             })
             .collect();
         out[i] = measure_with_progress(ctx, &format!("Li et al. {size}x{size}"), &configs)?;
@@ -658,12 +584,12 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     };
     let mut tri = Vec::new();
     for n in counts {
-        let scene = crate::scene::load_scene(&format!("scaling:{n}"))?;
+        let scene = crate::bake::scene::load_scene_baked(&format!("scaling:{n}"))?;
         tri.push(Config {
             label: format!("{n}"),
-            x: crate::scaling::triangles(&scene) as f64,
+            x: crate::measure::scaling::triangles(&scene) as f64,
             scene,
-            settings: crate::scaling::settings(Technique::None, w, h),
+            settings: crate::measure::scaling::settings(Technique::None, w, h),
         });
     }
     axes.push((
@@ -678,7 +604,7 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     } else {
         &[256, 512, 1024, 2048]
     };
-    let skin = crate::scene::load_scene("skin")?;
+    let skin = crate::bake::scene::load_scene_baked("skin")?;
     axes.push((
         "resolution",
         "pixels",
@@ -689,7 +615,7 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                 label: format!("{s}x{s}"),
                 x: f64::from(s) * f64::from(s),
                 scene: skin.clone(),
-                settings: crate::scaling::settings(Technique::Control, s, s),
+                settings: crate::measure::scaling::settings(Technique::Control, s, s),
             })
             .collect(),
     ));
@@ -699,7 +625,7 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     } else {
         &[1, 2, 4, 8, 16, 32, 64]
     };
-    let grid = crate::scene::load_scene("grid125")?;
+    let grid = crate::bake::scene::load_scene_baked("grid125")?;
     axes.push((
         "lights",
         "lights",
@@ -709,15 +635,15 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
             .map(|&n| Config {
                 label: format!("{n}"),
                 x: n as f64,
-                scene: crate::report::with_lights(&grid, n),
-                settings: crate::scaling::settings(Technique::Translucency, w, h),
+                scene: crate::report::section::with_lights(&grid, n),
+                settings: crate::measure::scaling::settings(Technique::Translucency, w, h),
             })
             .collect(),
     ));
     for (axis, unit, setup, configs) in axes {
         eprintln!("report:   scaling with {axis}");
         let points = measure_with_progress(ctx, &format!("scaling: {axis}"), &configs)?;
-        let grows: Vec<String> = crate::scaling::growth(&points)
+        let grows: Vec<String> = crate::measure::scaling::growth(&points)
             .iter()
             .filter(|g| g.pass != "frame" && g.exponent >= 0.35)
             .map(|g| format!("`{}` (s = {:.2})", g.pass, g.exponent))
@@ -734,7 +660,7 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         ));
         let _ = writeln!(out.markdown, "### Against {axis}: {setup}\n");
         out.markdown
-            .push_str(&crate::scaling::markdown(axis, unit, &points));
+            .push_str(&crate::measure::scaling::markdown(axis, unit, &points));
         let png = ctx.dir.join(format!("scaling-{axis}.png"));
         write_curves_png(
             &png,

@@ -24,8 +24,9 @@ use std::io::IsTerminal as _;
 use serde::Serialize;
 
 use crate::backend::GpuContext;
-use crate::renderer::{FrameRunner, FrameTiming, Renderer};
-use crate::speed_of_light::{CopyFrame, FloorRow};
+use crate::frame::{FrameRunner, FrameTiming, Renderer};
+use crate::measure::speed_of_light::{CopyFrame, FloorRow};
+use crate::measure::stats::Stats;
 use crate::{LucentError, Result};
 
 /// Estimated run time (from the warm-up) above which a progress bar is drawn.
@@ -47,44 +48,6 @@ pub struct BenchOptions {
     pub warmup: usize,
     /// Also time every pass alone and compare.
     pub isolate: bool,
-}
-
-/// Median, minimum and maximum of a sample.
-#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
-pub struct Stats {
-    /// Median.
-    pub median: f64,
-    /// Minimum.
-    pub min: f64,
-    /// Maximum.
-    pub max: f64,
-}
-
-impl Stats {
-    /// Statistics of a non-empty sample (NaNs sort last and never reach the median of a sane
-    /// sample; an empty sample gives zeros).
-    pub fn of(samples: &[f64]) -> Stats {
-        if samples.is_empty() {
-            return Stats {
-                median: 0.0,
-                min: 0.0,
-                max: 0.0,
-            };
-        }
-        let mut sorted = samples.to_vec();
-        sorted.sort_by(|a, b| a.total_cmp(b));
-        let n = sorted.len();
-        let median = if n % 2 == 1 {
-            sorted[n / 2]
-        } else {
-            0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
-        };
-        Stats {
-            median,
-            min: sorted[0],
-            max: sorted[n - 1],
-        }
-    }
 }
 
 /// One row of the table.
@@ -324,7 +287,7 @@ fn measure(
         verdict = judge(names, &samples, options.isolate);
     }
     let speed_of_light = copies.map(|c| {
-        crate::speed_of_light::rows(&c.floors, &c.medians(), |name| {
+        crate::measure::speed_of_light::rows(&c.floors, &c.medians(), |name| {
             verdict
                 .passes
                 .iter()
@@ -570,7 +533,7 @@ impl BenchReport {
         }
         if let Some(rows) = &self.speed_of_light {
             out.push_str("\n### Speed of light: each pass against a copy of the same formats\n\n");
-            out.push_str(&crate::speed_of_light::markdown(rows));
+            out.push_str(&crate::measure::speed_of_light::markdown(rows));
         }
         out
     }

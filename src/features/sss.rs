@@ -29,7 +29,7 @@ use crate::Result;
 
 use super::deferred::HDR_FORMAT;
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
-use super::SceneGpu;
+use crate::gpu_scene::SceneGpu;
 
 /// Depth correction of the control blur: a tap whose linear depth differs from the centre's by
 /// `1 / DEPTH_CORRECTION` world units or more is fully replaced by the centre colour.
@@ -189,68 +189,6 @@ impl Default for SssKnobs {
             taps: 5,
         }
     }
-}
-
-/// `profile` refitted with `n` Gaussians (1 to 8): variances spaced geometrically between the
-/// profile's narrowest and widest, weights per channel by non-negative least squares against
-/// the profile's radial shape (area-weighted, out to 4 sigma of the widest), normalised per
-/// channel. Returns it with the fit's relative L2 error per channel. `n` at or above the
-/// profile's own count returns the profile unchanged (error 0).
-pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 3])> {
-    if !(1..=8).contains(&n) {
-        return Err(crate::LucentError::InvalidInput(format!(
-            "--sss-gaussians {n}: 1 to 8 Gaussians are supported"
-        )));
-    }
-    if n >= profile.gaussians.len() {
-        return Ok((profile.clone(), [0.0; 3]));
-    }
-    let variances: Vec<f64> = profile
-        .gaussians
-        .iter()
-        .map(|g| f64::from(g.variance).max(1e-9))
-        .collect();
-    let (lo, hi) = variances
-        .iter()
-        .fold((f64::MAX, 0.0f64), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let fitted: Vec<f64> = (0..n)
-        .map(|k| {
-            if n == 1 {
-                (lo * hi).sqrt()
-            } else {
-                (lo.ln() + (hi.ln() - lo.ln()) * k as f64 / (n - 1) as f64).exp()
-            }
-        })
-        .collect();
-    let r_max = 4.0 * hi.sqrt();
-    let mut weights = vec![glam::Vec3::ZERO; n];
-    let mut errors = [0.0; 3];
-    for c in 0..3 {
-        let target = |r: f64| crate::reference::sss::profile_value(profile, r)[c];
-        let (w, err) = crate::reference::dipole::fit_sum_of_gaussians(&fitted, target, r_max);
-        let total: f64 = w.iter().sum();
-        for (i, wi) in w.iter().enumerate() {
-            weights[i][c] = if total > 0.0 {
-                (wi / total) as f32
-            } else {
-                0.0
-            };
-        }
-        errors[c] = err;
-    }
-    let refit = SssProfile {
-        name: format!("{} ({n} Gaussians)", profile.name),
-        gaussians: fitted
-            .iter()
-            .zip(weights)
-            .map(|(&v, weight)| crate::scene::material::Gaussian {
-                variance: v as f32,
-                weight,
-            })
-            .collect(),
-        units_per_mm: profile.units_per_mm,
-    };
-    Ok((refit, errors))
 }
 
 /// The images the SSS passes read.
@@ -613,7 +551,7 @@ struct FinalPass {
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
     /// LCB, LBB: the pass-through variant for rectangles nothing scatters in.
-    passthrough: Option<crate::passes::util::GraphicsPipeline>,
+    passthrough: Option<crate::features::util::GraphicsPipeline>,
 }
 
 impl FinalPass {
@@ -654,7 +592,7 @@ impl PassExec for FinalPass {
         let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
         if self.fragment == LEAN_FINAL_SHADER {
             let layouts = [pipeline.set.layout];
-            let passthrough = crate::passes::util::GraphicsPipeline::new(
+            let passthrough = crate::features::util::GraphicsPipeline::new(
                 ctx,
                 &GraphicsPipelineDesc {
                     defines: &[("LUCENT_SSS_PASSTHROUGH", "1")],
@@ -733,31 +671,6 @@ mod tests {
             let total: f32 = steps.iter().map(|s| s.weight[c]).sum();
             assert!((total - 1.0).abs() < 1e-5, "channel {c}: {total}");
         }
-    }
-
-    #[test]
-    fn fitting_fewer_gaussians_reports_a_growing_error() {
-        let skin = SssProfile::preset("skin").unwrap();
-        let (same, e) = fit_profile(&skin, 6).unwrap();
-        assert_eq!(same, skin);
-        assert_eq!(e, [0.0; 3]);
-        let mut previous = 0.0;
-        for n in [4, 3, 2, 1] {
-            let (fit, e) = fit_profile(&skin, n).unwrap();
-            assert_eq!(fit.gaussians.len(), n);
-            fit.validate().unwrap();
-            let worst = e.iter().fold(0.0f64, |a, &b| a.max(b));
-            assert!(worst.is_finite() && worst >= previous - 1e-9, "{n}: {e:?}");
-            previous = worst;
-            for c in 0..3 {
-                let total: f32 = fit.gaussians.iter().map(|g| g.weight[c]).sum();
-                assert!((total - 1.0).abs() < 1e-4, "{n} channel {c}: {total}");
-            }
-        }
-        // Four Gaussians (the thesis's count) fit d'Eon's six within a few percent.
-        let (_, e4) = fit_profile(&skin, 4).unwrap();
-        assert!(e4.iter().all(|&e| e < 0.05), "{e4:?}");
-        assert!(fit_profile(&skin, 0).is_err() && fit_profile(&skin, 9).is_err());
     }
 
     #[test]

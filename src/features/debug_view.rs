@@ -19,7 +19,7 @@ use super::deferred::{GBuffer, Lit};
 use super::tonemap::LDR_FORMAT;
 use super::translucency::ThicknessPacking;
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
-use super::SceneGpu;
+use crate::gpu_scene::SceneGpu;
 
 /// What a debug view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

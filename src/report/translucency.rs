@@ -10,27 +10,24 @@
 //!
 //! The report writes `translucency.md` (tables) and `translucency-error-vs-time.png` (max abs
 //! error against lighting ms, one colour per knob). [`translucency_section`] is the same as one
-//! section of the full suite ([`crate::suite`]).
+//! section of the full suite ([`crate::report`]).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
-
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::bench::Stats;
-use crate::compare::flip_rgba8;
+use crate::features::deferred::GBufferPrecision;
+use crate::frame::{render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::graph::CompileOptions;
-use crate::passes::deferred::GBufferPrecision;
-use crate::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::images::compare::flip_rgba8;
+use crate::measure::stats::Stats;
 use crate::reference::tonemap::display_rgba8;
 use crate::reference::translucency::{shade_gbuffer, LightingInputs};
-use crate::renderer::{
-    render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
-};
+use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::report::section::{with_lights, ReportOptions};
 use crate::scene::material::PowMode;
-use crate::scene::{Light, Scene};
+use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 /// One configuration to measure.
@@ -78,19 +75,6 @@ pub struct ImageError {
     pub flip_mean: f32,
 }
 
-/// Options of a report run.
-#[derive(Clone, Copy, Debug)]
-pub struct ReportOptions {
-    /// Frame size of every variant.
-    pub width: u32,
-    /// Frame size of every variant.
-    pub height: u32,
-    /// Measured rounds (one frame of each variant per round).
-    pub rounds: usize,
-    /// Discarded rounds first.
-    pub warmup: usize,
-}
-
 fn settings(opts: &ReportOptions, technique: Technique) -> FrameSettings {
     FrameSettings {
         technique,
@@ -114,38 +98,11 @@ fn with_pow(scene: &Scene, mode: PowMode) -> Scene {
     s
 }
 
-/// `scene` with `n` point lights on a ring around its centre (deterministic colours).
-pub fn with_lights(scene: &Scene, n: usize) -> Scene {
-    let mut s = scene.clone();
-    s.lights = (0..n)
-        .map(|i| {
-            let a = i as f32 / n as f32 * std::f32::consts::TAU;
-            let color = Vec3::new(
-                0.6 + 0.4 * (a).cos().abs(),
-                0.6 + 0.4 * (a * 1.7).sin().abs(),
-                0.6 + 0.4 * (a * 2.3).cos().abs(),
-            );
-            // Total intensity held constant so images stay comparable across counts.
-            Light::point(
-                Vec3::new(
-                    3.5 * a.cos(),
-                    1.0 + 0.8 * (a * 3.0).sin(),
-                    3.5 * a.sin() - 0.5,
-                ),
-                color,
-                30.0 / n as f32,
-                12.0,
-            )
-        })
-        .collect();
-    s
-}
-
 /// The translucency report's variants on `cubes` (and its light-count series), and the
 /// grid125 coverage series (technique none against translucency at 0%, 50%, 100%, and 100%
 /// with exact pow instead of the grid's exp2).
 pub fn translucency_variants(opts: &ReportOptions) -> Result<Vec<Variant>> {
-    let cubes = crate::scene::load_scene("cubes")?;
+    let cubes = crate::bake::scene::load_scene_baked("cubes")?;
     let t = settings(opts, Technique::Translucency);
     let exact = with_pow(&cubes, PowMode::Exact);
     let mut variants = vec![
@@ -215,7 +172,7 @@ pub fn translucency_variants(opts: &ReportOptions) -> Result<Vec<Variant>> {
             reference: Some(lit),
         });
     }
-    let grid = |name: &str| crate::scene::load_scene(name);
+    let grid = |name: &str| crate::bake::scene::load_scene_baked(name);
     let coverage = [
         ("0% translucent", grid("grid125:0")?),
         ("50% translucent", grid("grid125:50")?),
@@ -301,7 +258,7 @@ pub fn run(
         }
         Ok(results)
     })();
-    crate::renderer::destroy_after_idle(gpu, renderers, runners)?;
+    crate::frame::destroy_after_idle(gpu, renderers, runners)?;
     result
 }
 
@@ -475,7 +432,7 @@ pub fn write_translucency_report(
         png.file_name()
             .map_or(String::new(), |n| n.to_string_lossy().into_owned())
     );
-    crate::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
     Ok((text, vec![md, png]))
 }
 
@@ -483,8 +440,8 @@ pub fn write_translucency_report(
 /// tables embedded one heading level down. Full run: 1024x768 (the size of the technique
 /// tables), the suite's rounds; quick: 128x96, 2 rounds.
 pub fn translucency_section(
-    ctx: &crate::suite::SuiteContext<'_>,
-) -> Result<crate::suite::SectionOutput> {
+    ctx: &crate::report::SuiteContext<'_>,
+) -> Result<crate::report::SectionOutput> {
     let opts = if ctx.options.quick {
         ReportOptions {
             width: 128,
@@ -502,8 +459,8 @@ pub fn translucency_section(
     };
     let (text, files) =
         write_translucency_report(ctx.gpu, ctx.shaders, ctx.pipeline_cache, ctx.dir, &opts)?;
-    Ok(crate::suite::SectionOutput {
-        markdown: crate::suite::embed(&text),
+    Ok(crate::report::SectionOutput {
+        markdown: crate::report::embed(&text),
         files,
         ..Default::default()
     })

@@ -21,15 +21,14 @@ use std::path::{Path, PathBuf};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::bench::Stats;
-use crate::passes::sss::{fit_profile, SssPrecision};
-use crate::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::features::sss::SssPrecision;
+use crate::frame::{render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::measure::stats::Stats;
 use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
-use crate::renderer::{
-    render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique,
-};
-use crate::report::ReportOptions;
-use crate::scene::{self, Scene};
+use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::report::section::ReportOptions;
+use crate::scene::profile::fit_profile;
+use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 /// One configuration to measure.
@@ -167,7 +166,7 @@ pub fn run(
     }
     // Errors first (small frames); the widened profile keeps the blur's pixel footprint.
     let (ew, eh) = ((opts.width / 4).max(64), (opts.height / 4).max(48));
-    let edges = scene::load_scene("edges")?;
+    let edges = crate::bake::scene::load_scene_baked("edges")?;
     let edges = error_scene(&edges, 4.0, true);
     let reference_frame = FrameSettings {
         technique: Technique::Lbb,
@@ -219,7 +218,7 @@ pub fn run(
         errors.push((m, mean, fit));
     }
     // Times: every variant's frames round-robin.
-    let teapot = scene::load_scene("teapot")?;
+    let teapot = crate::bake::scene::load_scene_baked("teapot")?;
     let mut renderers = Vec::with_capacity(variants.len());
     let mut runners = Vec::with_capacity(variants.len());
     let timed = (|| -> Result<Vec<(Stats, Stats, usize)>> {
@@ -265,7 +264,7 @@ pub fn run(
             })
             .collect())
     })();
-    crate::renderer::destroy_after_idle(gpu, renderers, runners)?;
+    crate::frame::destroy_after_idle(gpu, renderers, runners)?;
     Ok(variants
         .iter()
         .zip(timed?)
@@ -359,7 +358,7 @@ pub fn write_sss_report(
     std::fs::create_dir_all(out)
         .map_err(|e| LucentError::InvalidInput(format!("{}: {e}", out.display())))?;
     let md = out.join("sss.md");
-    crate::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
     let mut series: Vec<PlotSeries> = Vec::new();
     for r in &results {
         let point = PlotPoint {

@@ -14,7 +14,7 @@ use glam::{Mat4, Vec3};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::renderer::{render_frame, FrameSettings, Technique};
+use crate::frame::{render_frame, FrameSettings, Technique};
 use crate::scene::generators::{self, Generator};
 use crate::scene::material::{PowMode, ThicknessSource, Translucency};
 use crate::scene::{Camera, Light, Material, Mesh, Object, Scene};

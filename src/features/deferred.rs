@@ -25,7 +25,7 @@ use super::translucency::ThicknessPacking;
 use super::util::{
     Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
 };
-use super::SceneGpu;
+use crate::gpu_scene::SceneGpu;
 
 /// Depth.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -355,7 +355,8 @@ impl PassExec for GBufferPass {
                 cull_back: true,
                 additive_attachments: 0,
                 set_layouts: &[],
-                push_constant_bytes: std::mem::size_of::<super::ObjectConstants>() as u32,
+                push_constant_bytes: std::mem::size_of::<crate::gpu_scene::ObjectConstants>()
+                    as u32,
                 name: "gbuffer",
             },
         )?);

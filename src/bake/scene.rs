@@ -1,0 +1,167 @@
+//! A scene's thickness, made ready for the GPU: what whoever loads a scene calls before
+//! rendering it (`scene::load_scene` only parses; it never bakes behind the caller's back).
+//!
+//! [`prepare_thickness`] puts every translucent mesh's local thickness into its vertex colours:
+//! `thickness = "bake"` through the on-disk cache, thickness textures sampled at the vertices.
+//! [`load_scene_baked`] is the two steps together, with the default cache directory.
+
+use glam::Vec3;
+
+use crate::scene::{self, material, texture, Scene};
+
+/// Loads a scene by built-in name or `.toml` path ([`scene::load_scene`]) and prepares its
+/// thickness ([`prepare_thickness`]) with the bake cache under the default cache directory.
+pub fn load_scene_baked(name_or_path: &str) -> crate::Result<Scene> {
+    let mut scene = scene::load_scene(name_or_path)?;
+    let cache = crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness");
+    prepare_thickness(&mut scene, &cache)?;
+    Ok(scene)
+}
+
+/// Puts every mesh's local thickness (GDC 2011) into its vertex colours, where the G-buffer
+/// pass reads it: meshes drawn with `thickness = "bake"` are baked through the on-disk cache
+/// keyed by mesh content (only the first load pays), meshes drawn with a thickness texture
+/// sample it at their vertices' UVs (the talk's vertex-colour path: per-vertex, so detail
+/// finer than the tessellation is lost; the texture is read as linear data).
+pub fn prepare_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crate::Result<()> {
+    sample_thickness_textures(scene)?;
+    let mut wanted: Vec<usize> = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            o.material
+                .translucency
+                .as_ref()
+                .is_some_and(|t| t.thickness == material::ThicknessSource::Bake)
+        })
+        .map(|o| o.mesh)
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let options = crate::bake::BakeOptions {
+        rays: 256,
+        max_distance: None,
+        seed: 1,
+        texture_size: 512,
+        progress: false,
+    };
+    for m in wanted {
+        if !scene.meshes[m].colors.is_empty() {
+            continue; // the mesh brought its own (e.g. an OBJ written by bake-thickness)
+        }
+        let values = crate::bake::cached_per_vertex(&scene.meshes[m], &options, cache_dir)?;
+        scene.meshes[m].colors = values.into_iter().map(Vec3::splat).collect();
+    }
+    Ok(())
+}
+
+/// Samples each thickness texture into the vertex colours of the meshes drawn with it.
+fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
+    let mut done: Vec<(usize, std::path::PathBuf)> = Vec::new();
+    for object in &scene.objects {
+        let Some(material::ThicknessSource::Texture(source)) =
+            object.material.translucency.as_ref().map(|t| &t.thickness)
+        else {
+            continue;
+        };
+        let material::TextureSource::File(path) = source else {
+            return Err(crate::LucentError::InvalidInput(format!(
+                "material '{}': a procedural texture cannot be a thickness map",
+                object.material.name
+            )));
+        };
+        if done.iter().any(|(m, p)| *m == object.mesh && p == path) {
+            continue;
+        }
+        let mesh = &scene.meshes[object.mesh];
+        if let Some((m, other)) = done.iter().find(|(m, _)| *m == object.mesh) {
+            return Err(crate::LucentError::InvalidInput(format!(
+                "mesh {m} is drawn with two thickness textures ({} and {}); give each its own mesh",
+                other.display(),
+                path.display()
+            )));
+        }
+        if mesh.uvs.len() != mesh.positions.len() {
+            return Err(crate::LucentError::file(
+                path,
+                format!(
+                    "thickness texture of material '{}': its mesh has no texture coordinates",
+                    object.material.name
+                ),
+            ));
+        }
+        let texture = texture::load_texture(path, texture::TextureUsage::Data)?;
+        let colors = mesh
+            .uvs
+            .iter()
+            .map(|&uv| {
+                let [r, g, b, _] = texture.sample_bilinear(uv);
+                // Thickness is a fraction of light let through: [0, 1], whatever the file held.
+                Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE)
+            })
+            .collect();
+        scene.meshes[object.mesh].colors = colors;
+        done.push((object.mesh, path.clone()));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::material::{ThicknessSource, Translucency};
+    use crate::scene::{builtin, Material, Mesh, Object, Shape};
+    use glam::Mat4;
+
+    fn plane_scene(thickness: ThicknessSource) -> Scene {
+        let mut scene = builtin("smoke").unwrap();
+        scene.meshes = vec![Mesh::generate(Shape::Plane { half_size: 1.0 }, 4, 1)];
+        let mut material = Material::opaque("t", Vec3::splat(0.8), 0.1, 0.5);
+        material.translucency = Some(Translucency::new(thickness));
+        scene.objects = vec![Object {
+            mesh: 0,
+            transform: Mat4::IDENTITY,
+            material,
+        }];
+        scene
+    }
+
+    #[test]
+    fn thickness_textures_are_sampled_into_vertex_colours() {
+        let dir = std::env::temp_dir().join(format!("lucent-thickness-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("ramp.png");
+        // A horizontal ramp: red rises with u, green is constant, blue falls.
+        let image = image::RgbImage::from_fn(64, 8, |x, _| {
+            let t = (x as f32 + 0.5) / 64.0;
+            image::Rgb([(t * 255.0) as u8, 128, ((1.0 - t) * 255.0) as u8])
+        });
+        image.save(&path).unwrap();
+        let mut scene = plane_scene(ThicknessSource::Texture(material::TextureSource::File(
+            path.clone(),
+        )));
+        prepare_thickness(&mut scene, &dir).unwrap();
+        let mesh = &scene.meshes[0];
+        assert_eq!(mesh.colors.len(), mesh.positions.len());
+        for (uv, c) in mesh.uvs.iter().zip(&mesh.colors) {
+            // Inside the texture (away from the wrapped edge), bilinear follows the ramp.
+            if (0.05..0.95).contains(&uv.x) {
+                assert!((c.x - uv.x).abs() < 0.03, "uv {uv} -> {c}");
+                assert!((c.z - (1.0 - uv.x)).abs() < 0.03, "uv {uv} -> {c}");
+            }
+            assert!((c.y - 128.0 / 255.0).abs() < 1e-3);
+        }
+        // A mesh without UVs cannot take a texture: an error naming the file.
+        let mut no_uvs = scene.clone();
+        no_uvs.meshes[0].uvs.clear();
+        no_uvs.meshes[0].colors.clear();
+        let err = prepare_thickness(&mut no_uvs, &dir)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("ramp.png") && err.contains("texture coordinates"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

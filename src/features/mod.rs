@@ -1,0 +1,19 @@
+//! The techniques and features, each adding its passes to a
+//! [`RenderGraph`](crate::graph::RenderGraph): handles in, handles out. The frame
+//! ([`crate::frame`]) decides which are in a frame; a feature never reads the scene's CPU model
+//! or the f64 reference, only what [`crate::gpu_scene`] put on the GPU.
+//!
+//! - [`deferred`]: the MRT G-buffer and per-light deferred lighting (merged as subpasses).
+//! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
+//!   packing (its shading runs inside the deferred lighting pass).
+//! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
+//! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
+//! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
+//! - [`util`]: pipeline and descriptor helpers the passes share.
+
+pub mod debug_view;
+pub mod deferred;
+pub mod sss;
+pub mod tonemap;
+pub mod translucency;
+pub mod util;

@@ -1,0 +1,26 @@
+//! The frame: what a scene's materials ask for, declared as one render graph, and the renderer
+//! that records it.
+//!
+//! - [`settings`]: how a frame is built ([`FrameSettings`]) and the A/B technique override
+//!   ([`Technique`]; `auto`, the default, lets the materials decide).
+//! - [`desc`]: the frame description derived from the scene's materials ([`FrameFeatures`]).
+//! - [`declare`]: [`declare_frame`], the one place that decides which passes a frame has;
+//!   `lucent plan` calls it without a GPU, [`Renderer`] with one.
+//! - [`renderer`]: a scene compiled into an executable frame on a device.
+//! - [`readback`]: images and G-buffers read back and decoded.
+//! - [`runner`]: [`FrameRunner`] submits frames either as one command buffer (in-frame
+//!   timestamps) or one submission per physical pass (isolated timing).
+
+pub mod declare;
+pub mod desc;
+pub mod readback;
+pub mod renderer;
+pub mod runner;
+pub mod settings;
+
+pub use declare::{declare_frame, plan_frame, FrameOutputs, GBufferOutputs};
+pub use desc::FrameFeatures;
+pub use readback::{decode_texels, FrameImages, GBufferReadback};
+pub use renderer::{render_frame, FrameUniforms, Renderer};
+pub use runner::{destroy_after_idle, FrameRunner, FrameTiming};
+pub use settings::{Fault, FrameSettings, Technique};

@@ -17,7 +17,8 @@
 //! Beside them: [`scene`] (the CPU model of what is drawn; no GPU), [`bake`] (the thickness
 //! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
 //! versions of every shading equation, used by tests and reports, never by features),
-//! [`images`] (PNG/EXR files and FLIP comparison). Above the frame: [`measure`] (benchmark,
+//! [`images`] (PNG/EXR files and FLIP comparison), [`files`] (every file read is a regular file
+//! read with a cap; a command's outputs are checked against its inputs). Above the frame: [`measure`] (benchmark,
 //! speed of light, scaling, sweeps), [`report`] (`lucent report`: the suite, its sections,
 //! the seeds' tables, plots) and, with the `window` feature, `demo` (the interactive window).
 
@@ -27,6 +28,7 @@ pub mod bake;
 pub mod demo;
 pub mod error;
 pub mod features;
+pub mod files;
 pub mod frame;
 pub mod gpu_scene;
 pub mod graph;

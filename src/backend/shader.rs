@@ -41,6 +41,7 @@ use ash::vk;
 use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use crate::error::{LucentError, Result, VkResultExt};
+use crate::files::{read_capped, read_optional};
 use crate::images::output::write_file_atomic;
 
 /// Everything besides the inputs that changes the SPIR-V; part of every cache key. Change it when a
@@ -54,6 +55,13 @@ const CACHE_MAGIC: &[u8; 8] = b"LUCSPV\0\x01";
 
 /// File name extension of SPIR-V cache entries.
 const CACHE_EXTENSION: &str = "spvcache";
+
+/// Largest GLSL source or include read.
+const MAX_SOURCE_BYTES: u64 = 4 << 20;
+/// Largest SPIR-V cache entry read.
+const MAX_CACHE_ENTRY_BYTES: u64 = 64 << 20;
+/// Largest pipeline cache file read.
+const MAX_PIPELINE_CACHE_BYTES: u64 = 1 << 30;
 
 /// Deepest `#include` nesting accepted; deeper is taken to be an include cycle.
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -223,7 +231,9 @@ impl ShaderCompiler {
         let name = path_to_name(&name);
         let defines = sorted_defines(path, defines)?;
         let file = self.glsl_root.join(&name);
-        let source = std::fs::read_to_string(&file).map_err(|e| LucentError::file(&file, e))?;
+        let source = read_capped(&file, MAX_SOURCE_BYTES, "GLSL source")
+            .and_then(|b| String::from_utf8(b).map_err(|_| "not UTF-8 text".to_string()))
+            .map_err(|e| LucentError::file(&file, e))?;
         if source.contains('\0') {
             return Err(LucentError::file(&file, "GLSL source contains a NUL byte"));
         }
@@ -335,9 +345,9 @@ impl ShaderCompiler {
     /// A cache hit: an entry for `key` exists, parses, and every dependency still has its hash.
     fn cache_lookup(&self, key: u128) -> Option<(Vec<u32>, Vec<Dependency>)> {
         let path = self.cache_entry_path(key)?;
-        let bytes = match std::fs::read(&path) {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return None,
+        let bytes = match read_optional(&path, MAX_CACHE_ENTRY_BYTES, "SPIR-V cache entry") {
+            Ok(Some(bytes)) => bytes,
+            Ok(None) => return None,
             Err(e) => {
                 log::warn!(
                     "SPIR-V cache entry {} unreadable ({e}); recompiling",
@@ -355,7 +365,7 @@ impl ShaderCompiler {
         };
         for dep in &deps {
             let file = self.glsl_root.join(&dep.name);
-            match std::fs::read(&file) {
+            match read_capped(&file, MAX_SOURCE_BYTES, "GLSL source") {
                 Ok(content) if xxh3_64(&content) == dep.hash => {}
                 _ => {
                     log::debug!(
@@ -462,8 +472,9 @@ fn resolve_include(
     }
     for name in &candidates {
         let file = root.join(name);
-        if file.is_file() {
-            let content = std::fs::read_to_string(&file)
+        if file.exists() {
+            let content = read_capped(&file, MAX_SOURCE_BYTES, "GLSL source")
+                .and_then(|b| String::from_utf8(b).map_err(|_| "not UTF-8 text".to_string()))
                 .map_err(|e| format!("cannot read include {}: {e}", file.display()))?;
             if content.contains('\0') {
                 return Err(format!("include {} contains a NUL byte", file.display()));
@@ -687,8 +698,9 @@ impl PipelineCache {
     ) -> Result<Self> {
         let data = match &path {
             None => Vec::new(),
-            Some(path) => match std::fs::read(path) {
-                Ok(data) => match check_pipeline_cache_header(&data, properties) {
+            Some(path) => match read_optional(path, MAX_PIPELINE_CACHE_BYTES, "pipeline cache") {
+                Ok(None) => Vec::new(),
+                Ok(Some(data)) => match check_pipeline_cache_header(&data, properties) {
                     Ok(()) => data,
                     Err(why) => {
                         log::warn!(
@@ -698,7 +710,6 @@ impl PipelineCache {
                         Vec::new()
                     }
                 },
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
                 Err(e) => {
                     log::warn!(
                         "pipeline cache {} unreadable ({e}); starting empty",

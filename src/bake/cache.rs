@@ -26,6 +26,9 @@ use crate::Result;
 pub const CACHE_FORMAT_VERSION: u32 = 1;
 
 const MAGIC: &[u8; 8] = b"LUCTHICK";
+
+/// Largest cache entry read: the header and 4 bytes for each vertex 32-bit indices can address.
+const MAX_CACHE_FILE_BYTES: u64 = HEADER as u64 + 4 * u32::MAX as u64;
 /// Magic, version, reserved, key, count.
 const HEADER: usize = 8 + 4 + 4 + 16 + 8;
 
@@ -82,15 +85,17 @@ pub fn cached_per_vertex_with_status(
     mesh.validate("mesh to bake")?;
     let key = cache_key(mesh, options);
     let path = cache_dir.join(format!("thickness-{key:032x}.bin"));
-    match std::fs::read(&path) {
-        Ok(bytes) => match decode(&bytes, key, mesh.vertex_count()) {
+    // A regular file read with a cap: a cache entry replaced by a FIFO or device is a miss
+    // with a warning, never a hang.
+    match crate::files::read_optional(&path, MAX_CACHE_FILE_BYTES, "thickness cache entry") {
+        Ok(Some(bytes)) => match decode(&bytes, key, mesh.vertex_count()) {
             Ok(values) => {
                 log::debug!("thickness cache hit: {}", path.display());
                 return Ok((values, true));
             }
             Err(why) => log::warn!("thickness cache {}: {why}; baking again", path.display()),
         },
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+        Ok(None) => {
             log::debug!("thickness cache miss: {}", path.display());
         }
         Err(e) => log::warn!(

@@ -50,19 +50,11 @@ pub struct Script {
 impl Script {
     /// Reads and parses a script file.
     pub fn load(path: &Path) -> Result<Self> {
-        let metadata = std::fs::metadata(path)
+        // A regular file read with a cap (a FIFO or device is refused, never read forever).
+        let bytes = crate::files::read_capped(path, MAX_SCRIPT_BYTES, "demo script")
             .map_err(|e| LucentError::file(path, format!("cannot read script: {e}")))?;
-        if metadata.len() > MAX_SCRIPT_BYTES {
-            return Err(LucentError::file(
-                path,
-                format!(
-                    "script is {} bytes; at most {MAX_SCRIPT_BYTES}",
-                    metadata.len()
-                ),
-            ));
-        }
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| LucentError::file(path, format!("cannot read script: {e}")))?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| LucentError::file(path, "cannot read script: not UTF-8 text"))?;
         Self::parse(&text).map_err(|e| LucentError::file(path, e))
     }
 
@@ -148,6 +140,8 @@ fn parse_command(name: &str, args: &[&str]) -> std::result::Result<Command, Stri
         }
         "technique" => {
             count(1)?;
+            // Checked here, so a typo fails before the window opens, with its line.
+            crate::frame::Technique::parse(args[0]).map_err(|e| e.to_string())?;
             Ok(Command::Technique(args[0].to_string()))
         }
         "orbit" => {
@@ -177,6 +171,17 @@ fn parse_command(name: &str, args: &[&str]) -> std::result::Result<Command, Stri
         "reset" => count(0).map(|()| Command::Reset),
         "key" => {
             count(1)?;
+            if super::controls::action_named(args[0]).is_none() {
+                return Err(format!(
+                    "unknown key '{}'; known: {}",
+                    args[0],
+                    super::controls::KEYS
+                        .iter()
+                        .map(|k| k.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
             Ok(Command::Key(args[0].to_string()))
         }
         "screenshot" => {
@@ -230,6 +235,11 @@ mod tests {
             ("\n5 dance", "line 2: unknown command 'dance'"),
             ("9 reset\n3 reset", "ticks must not decrease"),
             ("7", "a command must follow"),
+            (
+                "1 reset\n2 key Nope",
+                "line 2: unknown key 'Nope'; known: F1",
+            ),
+            ("3 technique lbbb", "line 1: unknown technique 'lbbb'"),
         ] {
             let err = Script::parse(text).unwrap_err();
             assert!(err.contains(wanted), "{text:?}: {err}");

@@ -204,7 +204,8 @@ pub fn font_file() -> Result<PathBuf> {
 
 /// Reads `path` and registers it as "sans-serif". The bytes are leaked only after they were read.
 fn register(path: &Path) -> std::result::Result<(), String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read font: {e}"))?;
+    let bytes = crate::files::read_capped(path, 64 << 20, "font")
+        .map_err(|e| format!("cannot read font: {e}"))?;
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
     plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
         .map_err(|_| String::from("not a TrueType/OpenType font plotters can parse"))

@@ -227,19 +227,10 @@ impl Locator<'_> {
 /// Loads a scene file. Relative paths inside it (OBJ files, textures) are resolved against the
 /// file's directory.
 pub fn load_scene_file(path: &Path) -> Result<Scene> {
-    let metadata = std::fs::metadata(path)
-        .map_err(|e| LucentError::file(path, format!("cannot read scene file: {e}")))?;
-    if metadata.len() > MAX_SCENE_FILE_BYTES {
-        return Err(LucentError::file(
-            path,
-            format!(
-                "{} bytes is too large for a scene file (at most {MAX_SCENE_FILE_BYTES})",
-                metadata.len()
-            ),
-        ));
-    }
-    let bytes = std::fs::read(path)
-        .map_err(|e| LucentError::file(path, format!("cannot read scene file: {e}")))?;
+    // A regular file, read with the cap counted as it is read (not the size the filesystem
+    // reports): a device or FIFO named as a scene is an error, never an endless read.
+    let bytes = crate::files::read_capped(path, MAX_SCENE_FILE_BYTES, "scene file")
+        .map_err(|e| LucentError::file(path, e))?;
     let source = String::from_utf8(bytes).map_err(|e| {
         LucentError::file(
             path,
@@ -819,7 +810,9 @@ fn build_material(
 /// sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
 pub fn load_scene(name_or_path: &str) -> Result<Scene> {
     let path = Path::new(name_or_path);
-    if name_or_path.ends_with(".toml") || path.is_file() {
+    // Anything at that path but a directory is the user's file (a FIFO or device named as a
+    // scene gets the loader's "not a regular file" error, not "unknown scene").
+    if name_or_path.ends_with(".toml") || (path.exists() && !path.is_dir()) {
         load_scene_file(path)
     } else {
         super::builtin(name_or_path)

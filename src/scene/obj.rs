@@ -241,21 +241,9 @@ pub fn write_obj_with_colors(path: &Path, mesh: &Mesh, colors: &[Vec3]) -> Resul
 
 /// Reads a whole OBJ/MTL file as UTF-8 text; the error says what is wrong (no path).
 fn read_text(path: &Path) -> std::result::Result<String, String> {
-    let meta = match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err("file not found".into()),
-        Err(e) => return Err(format!("cannot read: {e}")),
-        Ok(m) => m,
-    };
-    if meta.is_dir() {
-        return Err("is a directory, not a file".into());
-    }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "file is {} bytes, larger than the 2 GiB limit",
-            meta.len()
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
+    // A regular file (a device would be read forever, a FIFO blocks), read with the cap
+    // counted as the bytes arrive.
+    let bytes = crate::files::read_capped(path, MAX_FILE_BYTES, "mesh or material file")?;
     decode_text(bytes)
 }
 
@@ -276,8 +264,9 @@ fn decode_text(bytes: Vec<u8>) -> std::result::Result<String, String> {
                 "text looks UTF-16 encoded (every other byte is NUL); save it as UTF-8".into(),
             );
         }
+        let like = binary_kind(&bytes).map_or(String::new(), |k| format!(", it starts like {k}"));
         return Err(format!(
-            "line {}: binary data (NUL byte at offset {offset}); not a text file",
+            "line {}: binary data (NUL byte at offset {offset}{like}); not a text file",
             line_of(&bytes, offset)
         ));
     }
@@ -298,22 +287,41 @@ fn decode_text(bytes: Vec<u8>) -> std::result::Result<String, String> {
     Ok(text)
 }
 
-/// True when most bytes at even (or odd) offsets of the start are NUL: UTF-16 without a BOM.
+/// True when the start reads as UTF-16 text without a BOM: in nine pairs of bytes out of ten,
+/// one byte (the same one in every pair) is NUL and the other printable ASCII or whitespace.
+/// Binary files have NULs too (an executable's header is mostly zeros), but not in that
+/// pattern.
 fn looks_like_utf16(bytes: &[u8]) -> bool {
     let head = &bytes[..bytes.len().min(512)];
     let pairs = head.len() / 2;
     if pairs < 2 {
         return false;
     }
-    let zeros = |parity: usize| {
-        head.iter()
-            .skip(parity)
-            .step_by(2)
-            .take(pairs)
-            .filter(|&&b| b == 0)
-            .count()
-    };
-    zeros(0) * 4 >= pairs * 3 || zeros(1) * 4 >= pairs * 3
+    let text = |b: u8| matches!(b, b'\t' | b'\n' | b'\r' | 0x20..=0x7e);
+    [0, 1].into_iter().any(|nul| {
+        let texty = head
+            .chunks_exact(2)
+            .filter(|pair| pair[nul] == 0 && text(pair[1 - nul]))
+            .count();
+        texty * 10 >= pairs * 9
+    })
+}
+
+/// What a binary file looks like from its first bytes, for the error message.
+fn binary_kind(bytes: &[u8]) -> Option<&'static str> {
+    const MAGIC: &[(&[u8], &str)] = &[
+        (b"\x7fELF", "an ELF executable or library"),
+        (b"MZ", "a Windows executable"),
+        (b"\x89PNG", "a PNG image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"\x1f\x8b", "a gzip archive"),
+        (b"glTF", "a binary glTF file"),
+    ];
+    MAGIC
+        .iter()
+        .find(|(magic, _)| bytes.starts_with(magic))
+        .map(|&(_, kind)| kind)
 }
 
 /// 1-based line number of byte `offset`.

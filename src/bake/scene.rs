@@ -90,7 +90,8 @@ fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
                 ),
             ));
         }
-        let texture = texture::load_texture(path, texture::TextureUsage::Data)?;
+        // Level 0 only: the vertices sample it bilinearly, no mip is ever read.
+        let texture = texture::load_texture_level0(path, texture::TextureUsage::Data)?;
         let colors = mesh
             .uvs
             .iter()

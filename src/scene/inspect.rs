@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | `.obj` | [`load_obj`] | vertices, triangles, attributes, bounds, materials, repairs |
 //! | `.mtl` | [`load_mtl`] | materials with their colours and textures |
-//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`load_texture`] (as data, no sRGB decode) | size, mips, value range |
+//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`load_texture_level0`](super::texture::load_texture_level0) (as data, no sRGB decode) | size, mips, value range |
 //! | `.toml` | [`load_scene_file`] | meshes, objects, lights, camera |
 
 use std::fmt::Write as _;
@@ -18,7 +18,7 @@ use glam::Vec3;
 
 use super::file::load_scene_file;
 use super::obj::{load_mtl, load_obj, ObjMaterial};
-use super::texture::{load_texture, TextureUsage};
+use super::texture::{host_bytes, load_texture_level0, mip_levels, TextureUsage};
 use crate::{LucentError, Result};
 
 /// Extensions [`inspect_file`] understands.
@@ -71,7 +71,8 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             write_materials(&mut s, &materials);
         }
         "png" | "jpg" | "jpeg" | "tga" | "exr" | "hdr" => {
-            let t = load_texture(path, TextureUsage::Data)?;
+            // Level 0 is what is summarised; the mips a render would make are only counted.
+            let t = load_texture_level0(path, TextureUsage::Data)?;
             let (mut lo, mut hi) = ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]);
             for texel in t.mips.first().into_iter().flatten() {
                 for c in 0..4 {
@@ -81,7 +82,12 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             }
             let _ = writeln!(s, "{}: {} image", path.display(), ext.to_uppercase());
             let _ = writeln!(s, "  size: {}x{}", t.width, t.height);
-            let _ = writeln!(s, "  mip levels: {}", t.level_count());
+            let _ = writeln!(s, "  mip levels: {}", mip_levels(t.width, t.height));
+            let _ = writeln!(
+                s,
+                "  host memory when loaded (RGBA f32 with mips): {}",
+                crate::files::format_bytes(host_bytes(t.width, t.height).unwrap_or(u64::MAX))
+            );
             let _ = writeln!(s, "  value range (RGBA, as stored): {lo:?} .. {hi:?}");
         }
         "toml" => {

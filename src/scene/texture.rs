@@ -12,14 +12,20 @@
 //! Float texels that are NaN or infinite are replaced by 0 and counted in a warning. Mip levels
 //! go down to 1x1 with a 2x2 box filter; an odd size is filtered by area (a texel of the smaller
 //! level covers 2.5 texels of a 5-wide level, with weights 1, 1, 0.5), so every level keeps the
-//! image's mean exactly. Errors name the file: "not found", "corrupt or unsupported", or larger
-//! than [`MAX_TEXTURE_SIZE`] per side.
+//! image's mean exactly. Errors name the file: "not found", not a regular file (a device or FIFO
+//! is never read), "corrupt or unsupported", larger than [`MAX_TEXTURE_SIZE`] per side or than
+//! [`MAX_TEXTURE_TEXELS`] in all (refused from the header, before anything is decoded).
+//!
+//! Memory: a loaded texture costs its linear `f32` texels and mips ([`host_bytes`], about 21
+//! bytes per texel); while loading, the decoded file is held beside its `f32` level 0 and
+//! nothing else of the image's size. [`load_texture_level0`] skips the mips for CPU sampling.
 
 use std::path::Path;
 
 use image::{DynamicImage, ImageReader, Limits};
 use rayon::prelude::*;
 
+use crate::files::Capped;
 use crate::{LucentError, Result};
 
 /// Largest width or height accepted (the minimum `maxImageDimension2D` Vulkan devices commonly
@@ -173,52 +179,153 @@ pub fn procedural_texture(
     )
 }
 
+/// Largest texture file read (2 GiB): an uncompressed 8192x8192 RGBA f32 EXR is 1 GiB.
+pub const MAX_TEXTURE_FILE_BYTES: u64 = 2 << 30;
+
+/// Most texels one texture may have: 8192 x 8192 (or, say, 16384 x 4096). A loaded texture
+/// is linear RGBA `f32` with its mip chain, about 21.3 bytes per texel on the host (1.3 GiB at
+/// this limit, 5.3 GiB for a 16384x16384 image), and a normal map drawn with LEAN mapping
+/// makes two more of the same size; so the limit is on the texel count, checked from the
+/// file's header before anything is decoded.
+pub const MAX_TEXTURE_TEXELS: u64 = 8192 * 8192;
+
+/// Mip levels of a `width x height` texture down to 1x1 (`floor(log2(max side)) + 1`).
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+/// Host bytes of a loaded `width x height` texture: linear RGBA `f32` texels of every mip
+/// level. Checked arithmetic: `None` only beyond `u64`, which no accepted size reaches.
+pub fn host_bytes(width: u32, height: u32) -> Option<u64> {
+    (0..mip_levels(width, height)).try_fold(0u64, |sum, level| {
+        let (w, h) = ((width >> level).max(1), (height >> level).max(1));
+        u64::from(w)
+            .checked_mul(u64::from(h))?
+            .checked_mul(16)?
+            .checked_add(sum)
+    })
+}
+
+/// Opens an image file after checking it is a regular file (symlinks followed), reads at most
+/// [`MAX_TEXTURE_FILE_BYTES`] of it, and guesses its format from its first bytes.
+fn open_image(path: &Path) -> Result<ImageReader<std::io::BufReader<Capped<std::fs::File>>>> {
+    let err = |message: String| LucentError::file(path, message);
+    let (file, len) =
+        crate::files::open_regular(path, MAX_TEXTURE_FILE_BYTES, "texture").map_err(|e| {
+            if e == "file not found" {
+                err("texture not found".into())
+            } else {
+                err(e)
+            }
+        })?;
+    if len == 0 {
+        return Err(err("image file is empty (0 bytes)".into()));
+    }
+    let mut reader = ImageReader::new(std::io::BufReader::new(Capped::new(
+        file,
+        MAX_TEXTURE_FILE_BYTES,
+    )));
+    // The extension first (TGA has no signature), the content where it is recognised.
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    let reader = reader
+        .with_guessed_format()
+        .map_err(|e| err(format!("cannot read texture: {e}")))?;
+    if reader.format().is_none() {
+        return Err(err(
+            "corrupt or unsupported image: format not recognised (supported: PNG, JPEG, TGA, \
+             EXR, HDR)"
+                .into(),
+        ));
+    }
+    Ok(reader)
+}
+
+fn corrupt(path: &Path, e: image::ImageError) -> LucentError {
+    LucentError::file(path, format!("corrupt or unsupported image: {e}"))
+}
+
+/// The size an image file declares in its header, read without decoding anything, after the
+/// checks [`load_texture`] makes first (a regular file, not empty, a known format).
+pub fn texture_dimensions(path: &Path) -> Result<(u32, u32)> {
+    open_image(path)?
+        .into_dimensions()
+        .map_err(|e| corrupt(path, e))
+}
+
+/// Refuses a `width x height` image lucent would not load: more than [`MAX_TEXTURE_SIZE`] per
+/// side or more than [`MAX_TEXTURE_TEXELS`] texels. The message names the size, the limit and
+/// what the image would cost.
+pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
+    if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+        return Err(LucentError::file(
+            path,
+            format!("image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"),
+        ));
+    }
+    let texels = u64::from(width) * u64::from(height);
+    if texels > MAX_TEXTURE_TEXELS {
+        let cost = host_bytes(width, height).unwrap_or(u64::MAX);
+        return Err(LucentError::file(
+            path,
+            format!(
+                "image is {width}x{height} ({texels} texels), more than the {MAX_TEXTURE_TEXELS} \
+                 texels (8192x8192) a texture may have: decoded to linear RGBA f32 with mips it \
+                 would take {} of host memory (and a normal map twice that again for its LEAN \
+                 maps); scale it down to at most 8192x8192",
+                crate::files::format_bytes(cost)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Loads an image file as a linear-float texture with mips; see the module docs for how
 /// `usage` decides sRGB decoding.
 ///
-/// Errors name the file and say whether it was not found, is empty, is corrupt or unsupported,
-/// or is larger than [`MAX_TEXTURE_SIZE`] per side.
+/// Errors name the file and say whether it was not found, is not a regular file, is empty, is
+/// corrupt or unsupported, or is too large ([`check_texture_size`], decided from the header
+/// before anything is decoded). Memory: the decoded file and the `f32` texels at once, then the
+/// texture ([`host_bytes`]); nothing else of the image's size.
 pub fn load_texture(path: &Path, usage: TextureUsage) -> Result<Texture> {
-    let err = |message: String| LucentError::file(path, message);
-    match std::fs::metadata(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(err("texture not found".into()))
-        }
-        Err(e) => return Err(err(format!("cannot read texture: {e}"))),
-        Ok(m) if m.is_dir() => return Err(err("is a directory, not an image".into())),
-        Ok(m) if m.len() == 0 => return Err(err("image file is empty (0 bytes)".into())),
-        Ok(_) => {}
-    }
-    let open = || -> Result<ImageReader<std::io::BufReader<std::fs::File>>> {
-        let reader = ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| err(format!("cannot read texture: {e}")))?;
-        if reader.format().is_none() {
-            return Err(err(
-                "corrupt or unsupported image: format not recognised (supported: PNG, JPEG, TGA, \
-                 EXR, HDR)"
-                    .into(),
-            ));
-        }
-        Ok(reader)
-    };
-    let corrupt = |e: image::ImageError| err(format!("corrupt or unsupported image: {e}"));
+    let (width, height, texels) = decode(path, usage)?;
+    Texture::from_texels(&path.display().to_string(), width, height, usage, texels)
+}
 
-    // Read the header alone first, so an absurd size is refused before anything is allocated.
-    let (width, height) = open()?.into_dimensions().map_err(corrupt)?;
-    if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
-        return Err(err(format!(
-            "image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"
-        )));
+/// [`load_texture`] without the mip chain: level 0 only ([`Texture::level_count`] is 1), for
+/// what samples a texture on the CPU (thickness maps sampled at vertices, `lucent inspect`).
+pub fn load_texture_level0(path: &Path, usage: TextureUsage) -> Result<Texture> {
+    let (width, height, mut texels) = decode(path, usage)?;
+    let replaced = sanitize(&mut texels);
+    if replaced > 0 {
+        log::warn!(
+            "{}: replaced {replaced} NaN or infinite texel values with 0",
+            path.display()
+        );
     }
-    let mut reader = open()?;
+    Ok(Texture {
+        width,
+        height,
+        usage,
+        mips: vec![texels],
+    })
+}
+
+/// Decodes an image file to linear RGBA `f32` texels (level 0).
+fn decode(path: &Path, usage: TextureUsage) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+    // Read the header alone first, so an absurd size is refused before anything is allocated.
+    let (width, height) = texture_dimensions(path)?;
+    check_texture_size(path, width, height)?;
+    let mut reader = open_image(path)?;
     let mut limits = Limits::default();
     limits.max_image_width = Some(MAX_TEXTURE_SIZE);
     limits.max_image_height = Some(MAX_TEXTURE_SIZE);
-    // The decoded image of the largest accepted size in the widest format (RGBA f32).
-    limits.max_alloc = Some(u64::from(MAX_TEXTURE_SIZE).pow(2) * 16);
+    // The decoded image of the largest accepted size in the widest format (RGBA f32): the
+    // decoder may not allocate more, whatever the header said.
+    limits.max_alloc = Some(MAX_TEXTURE_TEXELS * 16);
     reader.limits(limits);
-    let image = reader.decode().map_err(corrupt)?;
+    let image = reader.decode().map_err(|e| corrupt(path, e))?;
 
     // Float formats (EXR, HDR) store linear values; 8/16-bit ones store sRGB for colours.
     let stored_linear = matches!(
@@ -227,24 +334,103 @@ pub fn load_texture(path: &Path, usage: TextureUsage) -> Result<Texture> {
     );
     let decode_srgb = usage == TextureUsage::Color && !stored_linear;
     let (width, height) = (image.width(), image.height());
-    let rgba = image.into_rgba32f();
-    let texels: Vec<[f32; 4]> = rgba
-        .as_raw()
-        .chunks_exact(4)
-        .map(|c| {
-            if decode_srgb {
+    // Straight from the decoded samples to linear texels: no intermediate RGBA f32 copy.
+    Ok((width, height, linear_texels(image, decode_srgb)))
+}
+
+/// The decoded image as linear RGBA `f32` texels: grey replicated to RGB, missing alpha 1,
+/// 8/16-bit values mapped to [0, 1] and, with `srgb`, RGB decoded from sRGB (alpha never).
+fn linear_texels(image: DynamicImage, srgb: bool) -> Vec<[f32; 4]> {
+    let curve = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+    let lut: [f32; 256] = std::array::from_fn(|i| curve(i as f32 / 255.0));
+    let wide = |v: u16| curve(f32::from(v) / 65535.0);
+    let alpha8 = |v: u8| f32::from(v) / 255.0;
+    let alpha16 = |v: u16| f32::from(v) / 65535.0;
+    match image {
+        DynamicImage::ImageLuma8(i) => i
+            .as_raw()
+            .par_iter()
+            .map(|&l| {
+                let c = lut[usize::from(l)];
+                [c, c, c, 1.0]
+            })
+            .collect(),
+        DynamicImage::ImageLumaA8(i) => i
+            .as_raw()
+            .par_chunks_exact(2)
+            .map(|p| {
+                let c = lut[usize::from(p[0])];
+                [c, c, c, alpha8(p[1])]
+            })
+            .collect(),
+        DynamicImage::ImageRgb8(i) => i
+            .as_raw()
+            .par_chunks_exact(3)
+            .map(|p| {
                 [
-                    srgb_to_linear(c[0]),
-                    srgb_to_linear(c[1]),
-                    srgb_to_linear(c[2]),
-                    c[3],
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    1.0,
                 ]
-            } else {
-                [c[0], c[1], c[2], c[3]]
-            }
-        })
-        .collect();
-    Texture::from_texels(&path.display().to_string(), width, height, usage, texels)
+            })
+            .collect(),
+        DynamicImage::ImageRgba8(i) => i
+            .as_raw()
+            .par_chunks_exact(4)
+            .map(|p| {
+                [
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    alpha8(p[3]),
+                ]
+            })
+            .collect(),
+        DynamicImage::ImageLuma16(i) => i
+            .as_raw()
+            .par_iter()
+            .map(|&l| {
+                let c = wide(l);
+                [c, c, c, 1.0]
+            })
+            .collect(),
+        DynamicImage::ImageLumaA16(i) => i
+            .as_raw()
+            .par_chunks_exact(2)
+            .map(|p| {
+                let c = wide(p[0]);
+                [c, c, c, alpha16(p[1])]
+            })
+            .collect(),
+        DynamicImage::ImageRgb16(i) => i
+            .as_raw()
+            .par_chunks_exact(3)
+            .map(|p| [wide(p[0]), wide(p[1]), wide(p[2]), 1.0])
+            .collect(),
+        DynamicImage::ImageRgba16(i) => i
+            .as_raw()
+            .par_chunks_exact(4)
+            .map(|p| [wide(p[0]), wide(p[1]), wide(p[2]), alpha16(p[3])])
+            .collect(),
+        DynamicImage::ImageRgb32F(i) => i
+            .as_raw()
+            .par_chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2], 1.0])
+            .collect(),
+        DynamicImage::ImageRgba32F(i) => i
+            .as_raw()
+            .par_chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect(),
+        // A layout added to `image` later: through its own RGBA f32 conversion.
+        other => other
+            .into_rgba32f()
+            .as_raw()
+            .chunks_exact(4)
+            .map(|p| [curve(p[0]), curve(p[1]), curve(p[2]), p[3]])
+            .collect(),
+    }
 }
 
 /// The sRGB electro-optical transfer function (IEC 61966-2-1), encoded [0, 1] to linear.

@@ -52,11 +52,11 @@ enum Command {
         frame: FrameArgs,
         #[command(flatten)]
         gpu: GpuArgs,
-        /// Frames measured.
-        #[arg(long, default_value_t = 30)]
+        /// Frames measured (1 to 100000; short runs are noisy).
+        #[arg(long, default_value_t = 30, value_parser = parse_frames)]
         frames: usize,
-        /// Frames run and discarded first (lazy shader compilation).
-        #[arg(long, default_value_t = 5)]
+        /// Frames run and discarded first (lazy shader compilation; 0 to 10000).
+        #[arg(long, default_value_t = 5, value_parser = parse_warmup)]
         warmup: usize,
         /// Also time each pass submitted alone and compare.
         #[arg(long)]
@@ -144,18 +144,18 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// The small preset (under 2 minutes on lavapipe).
+        /// The small preset (QUICK_REPORT_TIME on the project's 2-core lavapipe machine).
         #[arg(long)]
         quick: bool,
         /// Resolution as WIDTHxHEIGHT (suite: of the per-technique tables; default 1024x768,
         /// --quick 256x192).
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
-        /// Measured rounds or frames (section default 15; suite 25, --quick 3).
-        #[arg(long)]
+        /// Measured rounds or frames (1 to 100000; section default 15; suite 25, --quick 3).
+        #[arg(long, value_parser = parse_frames)]
         rounds: Option<usize>,
-        /// Discarded rounds first (section default 3; suite 3, --quick 1).
-        #[arg(long)]
+        /// Discarded rounds first (0 to 10000; section default 3; suite 3, --quick 1).
+        #[arg(long, value_parser = parse_warmup)]
         warmup: Option<usize>,
         #[command(flatten)]
         gpu: GpuArgs,
@@ -175,14 +175,14 @@ enum Command {
         /// Write the mesh back as OBJ with the thickness as vertex colours (`v x y z r g b`).
         #[arg(long)]
         per_vertex: Option<PathBuf>,
-        /// Rays per sample.
-        #[arg(long, default_value_t = 256)]
+        /// Rays per sample (1 to 1048576).
+        #[arg(long, default_value_t = 256, value_parser = parse_rays)]
         rays: u32,
-        /// Texture size in texels (square).
-        #[arg(long, default_value_t = 512)]
+        /// Texture size in texels (square, 1 to 8192).
+        #[arg(long, default_value_t = 512, value_parser = parse_bake_size)]
         size: u32,
         /// Occlusion distance (default: the mesh's bounding-box diagonal).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = parse_max_distance)]
         max_distance: Option<f32>,
         /// Random seed (the bake is deterministic for a seed).
         #[arg(long, default_value_t = 1)]
@@ -218,24 +218,73 @@ struct FrameArgs {
     /// a profile (A/B comparison).
     #[arg(long)]
     no_sss_tiles: bool,
-    /// Refit the SSS profile with this many Gaussians (1-8): fewer blur pairs, at the fit
-    /// error `lucent plan` and the report print.
-    #[arg(long)]
+    /// SSS (control, lcb, lbb): refit the profile with this many Gaussians (1-8): fewer blur
+    /// pairs, at the fit error `lucent plan` and the report print.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_gaussians)]
     sss_gaussians: Option<usize>,
-    /// Precision of the SSS sum-of-Gaussians targets: half (RGBA16F) or full (RGBA32F).
-    #[arg(long, default_value = "full", value_parser = parse_sss_precision)]
-    sss_precision: SssPrecision,
-    /// Bilateral blur (LBB): sensitivity to depth differences, relative to each profile
-    /// Gaussian's width (1: weights follow the taps' 3D distance).
-    #[arg(long, default_value_t = lucent::features::sss::DEFAULT_SENSITIVITY)]
-    sensitivity: f32,
+    /// SSS (control, lcb, lbb): precision of the sum-of-Gaussians targets: half (RGBA16F) or
+    /// full (RGBA32F, the default).
+    #[arg(long, value_parser = parse_sss_precision)]
+    sss_precision: Option<SssPrecision>,
+    /// LBB: the bilateral blur's sensitivity to depth differences, relative to each profile
+    /// Gaussian's width (a finite number >= 0; 1: weights follow the taps' 3D distance;
+    /// default 1).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_sensitivity)]
+    sensitivity: Option<f32>,
     /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
     /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
     #[arg(long)]
     sss_packed: bool,
-    /// LBB: bilateral taps per direction (3, 5 or 7; the thesis's shader has 7).
-    #[arg(long, default_value_t = 5, value_parser = parse_taps)]
-    sss_taps: u32,
+    /// LBB: bilateral taps per direction (3, 5 or 7; default 5; the thesis's shader has 7).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_taps)]
+    sss_taps: Option<u32>,
+}
+
+/// A whole number in `range`, for the count flags: the bound is checked here, at parse time,
+/// so nothing is ever sized from an absurd count.
+fn count_in(text: &str, range: std::ops::RangeInclusive<u64>) -> std::result::Result<u64, String> {
+    let (lo, hi) = (range.start(), range.end());
+    text.trim()
+        .parse::<u64>()
+        .ok()
+        .filter(|v| range.contains(v))
+        .ok_or_else(|| format!("'{text}' is not a whole number from {lo} to {hi}"))
+}
+
+fn parse_frames(text: &str) -> std::result::Result<usize, String> {
+    count_in(text, 1..=bench::MAX_FRAMES as u64).map(|v| v as usize)
+}
+
+fn parse_warmup(text: &str) -> std::result::Result<usize, String> {
+    count_in(text, 0..=bench::MAX_WARMUP as u64).map(|v| v as usize)
+}
+
+fn parse_rays(text: &str) -> std::result::Result<u32, String> {
+    count_in(text, 1..=u64::from(lucent::bake::MAX_RAYS)).map(|v| v as u32)
+}
+
+fn parse_bake_size(text: &str) -> std::result::Result<u32, String> {
+    count_in(text, 1..=u64::from(lucent::bake::MAX_TEXTURE_SIZE)).map(|v| v as u32)
+}
+
+fn parse_gaussians(text: &str) -> std::result::Result<usize, String> {
+    count_in(text, 1..=8).map(|v| v as usize)
+}
+
+fn parse_sensitivity(text: &str) -> std::result::Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("'{text}' is not a finite number >= 0"))
+}
+
+fn parse_max_distance(text: &str) -> std::result::Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| format!("'{text}' is not a finite number > 0"))
 }
 
 fn parse_taps(text: &str) -> std::result::Result<u32, String> {
@@ -313,22 +362,85 @@ impl FrameArgs {
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,
             fault: None,
-            sss: SssKnobs {
-                gaussians: self.sss_gaussians,
-                precision: self.sss_precision,
-                packed: self.sss_packed,
-                taps: self.sss_taps,
-                sensitivity: if self.sensitivity.is_finite() && self.sensitivity >= 0.0 {
-                    self.sensitivity
-                } else {
-                    return Err(LucentError::InvalidInput(format!(
-                        "--sensitivity {}: must be finite and >= 0",
-                        self.sensitivity
-                    )));
-                },
+            sss: {
+                let defaults = SssKnobs::default();
+                SssKnobs {
+                    gaussians: self.sss_gaussians,
+                    precision: self.sss_precision.unwrap_or(defaults.precision),
+                    packed: self.sss_packed,
+                    taps: self.sss_taps.unwrap_or(defaults.taps),
+                    // Range-checked by the parser (finite, >= 0).
+                    sensitivity: self.sensitivity.unwrap_or(defaults.sensitivity),
+                }
             },
             debug_view: None,
         })
+    }
+
+    /// The knobs given on the command line that do nothing under `technique`, each as a
+    /// warning naming the technique it needs.
+    fn inapplicable_knobs(&self, technique: Technique) -> Vec<String> {
+        let blur = technique.sss_blur();
+        let sss = "--technique control, lcb or lbb (screen-space SSS)";
+        let lbb = "--technique lbb (the bilateral blur)";
+        let knobs = [
+            (
+                self.sss_taps.is_some(),
+                "--sss-taps",
+                lbb,
+                blur.is_some_and(|b| b.bilateral()),
+            ),
+            (
+                self.sss_packed,
+                "--sss-packed",
+                lbb,
+                blur.is_some_and(|b| b.bilateral()),
+            ),
+            (
+                self.sensitivity.is_some(),
+                "--sensitivity",
+                lbb,
+                blur.is_some_and(|b| b.bilateral()),
+            ),
+            (
+                self.sss_gaussians.is_some(),
+                "--sss-gaussians",
+                sss,
+                blur.is_some(),
+            ),
+            (
+                self.sss_precision.is_some(),
+                "--sss-precision",
+                sss,
+                blur.is_some(),
+            ),
+            (self.no_sss_tiles, "--no-sss-tiles", sss, blur.is_some()),
+            (
+                self.grayscale,
+                "--grayscale",
+                "--technique translucency",
+                technique == Technique::Translucency,
+            ),
+        ];
+        knobs
+            .iter()
+            .filter(|(given, _, _, applies)| *given && !applies)
+            .map(|(_, flag, needs, _)| {
+                format!(
+                    "{flag} has no effect with --technique {}: it applies to {needs}",
+                    technique.name()
+                )
+            })
+            .collect()
+    }
+
+    /// [`FrameArgs::settings`], warning (on stderr) about every knob that does not apply.
+    fn settings_warned(&self, export_hdr: bool) -> Result<FrameSettings> {
+        let settings = self.settings(export_hdr)?;
+        for warning in self.inapplicable_knobs(settings.technique) {
+            eprintln!("lucent: warning: {warning}");
+        }
+        Ok(settings)
     }
 }
 
@@ -380,8 +492,8 @@ fn with_renderer(
     export_hdr: bool,
     work: impl FnOnce(&Session, &Renderer) -> Result<()>,
 ) -> Result<()> {
+    let settings = frame.settings_warned(export_hdr)?;
     let scene = bake::load_scene_baked(&frame.scene)?;
-    let settings = frame.settings(export_hdr)?;
     with_session(gpu_args, |session| {
         let renderer = Renderer::new(
             &session.gpu,
@@ -414,6 +526,10 @@ fn render(
     out: Option<PathBuf>,
     exr: Option<PathBuf>,
 ) -> Result<()> {
+    let out = out.unwrap_or_else(|| PathBuf::from(format!("{}.png", frame.scene)));
+    let mut outputs = vec![("--out", out.as_path())];
+    outputs.extend(exr.as_deref().map(|e| ("--exr", e)));
+    check_scene_outputs(&frame.scene, &outputs)?;
     with_renderer(frame, gpu_args, exr.is_some(), |session, renderer| {
         let gpu = &session.gpu;
         let (width, height) = (renderer.settings.width, renderer.settings.height);
@@ -421,7 +537,6 @@ fn render(
         let timing = runner.run_frame(gpu, &renderer.executable);
         runner.destroy(gpu);
         let timing = timing?;
-        let out = out.unwrap_or_else(|| PathBuf::from(format!("{}.png", frame.scene)));
         output::write_png_rgba8(&out, width, height, &renderer.read_display(gpu)?)?;
         println!(
             "wrote {} ({width}x{height}, frame {:.2} ms on {})",
@@ -471,6 +586,11 @@ fn bench_command(
                 .into(),
         ));
     }
+    let outputs: Vec<(&str, &std::path::Path)> = [("--json", &json), ("--out", &out)]
+        .into_iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+        .collect();
+    check_scene_outputs(&frame.scene, &outputs)?;
     // With CSV or JSON on stdout, messages go to stderr so stdout stays parseable.
     let note = |text: String| {
         if format == bench::Format::Markdown {
@@ -560,11 +680,33 @@ fn bench_command(
         if report.trusted {
             Ok(())
         } else {
-            Err(LucentError::Timing(
-                "the per-pass times could not be verified (see the checks above)".into(),
-            ))
+            // Tiny runs fail the checks by chance on a shared machine: say so.
+            let short = if options.frames < bench::SHORT_RUN_FRAMES {
+                format!(
+                    "; {} measured frames is a short run, and short runs are noisy: try \
+                     --frames {} or more",
+                    options.frames,
+                    bench::SHORT_RUN_FRAMES * 3
+                )
+            } else {
+                String::new()
+            };
+            Err(LucentError::Timing(format!(
+                "the per-pass times could not be verified (see the checks above){short}"
+            )))
         }
     })
+}
+
+/// Refuses, before any work, outputs that are the scene file or a file it names, or that are
+/// the same file twice.
+fn check_scene_outputs(scene: &str, outputs: &[(&str, &std::path::Path)]) -> Result<()> {
+    let inputs = scene::inputs::scene_inputs(scene);
+    let inputs: Vec<(&str, &std::path::Path)> = inputs
+        .iter()
+        .map(|(what, path)| (what.as_str(), path.as_path()))
+        .collect();
+    lucent::files::check_outputs(&inputs, outputs)
 }
 
 /// What `bench` prints and writes besides the measurement itself.
@@ -591,21 +733,12 @@ fn bake_thickness(
             "bake-thickness needs --out FILE.png and/or --per-vertex OUT.obj".into(),
         ));
     }
-    if !(1..=1 << 20).contains(&rays) {
-        return Err(LucentError::InvalidInput(format!(
-            "--rays {rays} must be 1..=1048576"
-        )));
-    }
-    if !(1..=16384).contains(&size) {
-        return Err(LucentError::InvalidInput(format!(
-            "--size {size} must be 1..=16384"
-        )));
-    }
-    if max_distance.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
-        return Err(LucentError::InvalidInput(
-            "--max-distance must be finite and > 0".into(),
-        ));
-    }
+    // --rays, --size and --max-distance were range-checked by their parsers.
+    let outputs: Vec<(&str, &std::path::Path)> = [("--out", &out), ("--per-vertex", &per_vertex)]
+        .into_iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+        .collect();
+    lucent::files::check_outputs(&[("the input mesh", mesh_path)], &outputs)?;
     let loaded = scene::obj::load_obj(mesh_path)?;
     let options = lucent::bake::BakeOptions {
         rays,
@@ -640,6 +773,9 @@ fn sweep_command(
         return Err(LucentError::InvalidInput(format!(
             "sweep: unknown technique '{technique}'; available: translucency"
         )));
+    }
+    if let Some(out) = &out {
+        lucent::files::check_outputs(&[], &[("--out", out)])?;
     }
     let cases = lucent::measure::sweep::translucency_cases();
     let (rows, device) = with_session(gpu_args, |session| {
@@ -846,8 +982,8 @@ fn run(cli: Cli) -> Result<()> {
             base: FrameSettings::new(size.0, size.1),
         }),
         Command::Plan { frame } => {
+            let settings = frame.settings_warned(false)?;
             let scene = bake::load_scene_baked(&frame.scene)?;
-            let settings = frame.settings(false)?;
             let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings)?)?;
             print!("{}", plan.dump());
             Ok(())
@@ -855,9 +991,54 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// A command-line error as the one line `lucent: error:` carries: clap's message, its tips,
+/// and where the usage is (clap's own text spreads over several lines with a usage block).
+fn usage_error(error: &clap::Error) -> String {
+    use clap::error::ErrorKind;
+    if error.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        let commands: Vec<String> = <Cli as clap::CommandFactory>::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        return format!(
+            "no command given; commands: {} (see `lucent --help`)",
+            commands.join(", ")
+        );
+    }
+    let text = error.render().to_string();
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    let first = lines.next().unwrap_or("invalid command line");
+    let mut parts = vec![first.trim_start_matches("error: ").to_string()];
+    parts.extend(
+        lines
+            .filter_map(|l| l.strip_prefix("tip: "))
+            .map(str::to_string),
+    );
+    // The command the help is for: the first argument that names one.
+    let cli = <Cli as clap::CommandFactory>::command();
+    let command = std::env::args()
+        .skip(1)
+        .find(|a| cli.find_subcommand(a).is_some())
+        .map_or("lucent".to_string(), |c| format!("lucent {c}"));
+    format!("{} (see `{command} --help`)", parts.join("; "))
+}
+
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                // --help and --version: clap's text on stdout, success.
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // A usage error: one line, exit code 2 (clap's convention).
+            eprintln!("lucent: error: {}", usage_error(&e));
+            return ExitCode::from(2);
+        }
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

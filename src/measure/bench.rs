@@ -39,6 +39,30 @@ pub const ISOLATION_TOLERANCE: f64 = 0.20;
 /// Passes shorter than this are too close to timer noise to compare with their isolated time.
 pub const ISOLATION_MIN_MS: f64 = 0.5;
 
+/// Most frames (or rounds) one measurement takes: the bound `--frames` and `--rounds` are
+/// checked against at parse time, and every per-frame buffer is sized within it.
+pub const MAX_FRAMES: usize = 100_000;
+/// Most warm-up frames (or rounds).
+pub const MAX_WARMUP: usize = 10_000;
+/// Runs shorter than this many measured frames fail the timing checks by chance on a shared
+/// machine; the error says so.
+pub const SHORT_RUN_FRAMES: usize = 10;
+
+/// Refuses frame and warm-up counts outside `1..=MAX_FRAMES` and `0..=MAX_WARMUP`.
+fn check_counts(frames: usize, warmup: usize) -> Result<()> {
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(LucentError::InvalidInput(format!(
+            "--frames {frames}: must be 1 to {MAX_FRAMES}"
+        )));
+    }
+    if warmup > MAX_WARMUP {
+        return Err(LucentError::InvalidInput(format!(
+            "--warmup {warmup}: must be 0 to {MAX_WARMUP}"
+        )));
+    }
+    Ok(())
+}
+
 /// What to measure.
 #[derive(Clone, Copy, Debug)]
 pub struct BenchOptions {
@@ -169,11 +193,7 @@ pub fn run_with_floor(
     scene_name: &str,
     options: &BenchOptions,
 ) -> Result<BenchReport> {
-    if options.frames == 0 {
-        return Err(LucentError::InvalidInput(
-            "--frames must be at least 1".into(),
-        ));
-    }
+    check_counts(options.frames, options.warmup)?;
     let exe = &renderer.executable;
     let names: Vec<String> = exe.plan.physical.iter().map(|p| p.name.clone()).collect();
     let mut runner = FrameRunner::new(gpu, names.len())?;
@@ -764,11 +784,7 @@ pub fn compare(
     frames: usize,
     warmup: usize,
 ) -> Result<Comparison> {
-    if frames == 0 {
-        return Err(LucentError::InvalidInput(
-            "--frames must be at least 1".into(),
-        ));
-    }
+    check_counts(frames, warmup)?;
     let names: [Vec<String>; 2] = sides.map(|(_, r)| {
         r.executable
             .plan

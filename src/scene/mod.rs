@@ -7,6 +7,7 @@
 pub mod builtin;
 pub mod file;
 pub mod generators;
+pub mod inputs;
 pub mod inspect;
 pub mod lean;
 pub mod material;

@@ -124,6 +124,31 @@ fn markdown_names_the_passes_far_above_their_floor_and_the_seeds_alias_works() {
 }
 
 #[test]
+fn packed_lbb_bench_with_its_copies_is_validation_clean() {
+    // The issue-12 case: the packed RGBA32UI target's copy read it as float (88 errors).
+    let text = run_bench(&[
+        "bench",
+        "--validation",
+        "--scene",
+        "skin",
+        "--technique",
+        "lbb",
+        "--sss-packed",
+        "--speed-of-light",
+        "--size",
+        "64x48",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+    ]);
+    assert!(
+        text.is_empty() || text.contains("RGBA32UI"),
+        "the packed target is not in the table:\n{text}"
+    );
+}
+
+#[test]
 fn bad_formats_and_format_conflicts_are_one_line_errors() {
     for args in [
         vec!["bench", "--format", "xml"],
@@ -155,13 +180,20 @@ fn bad_formats_and_format_conflicts_are_one_line_errors() {
 fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
     let test = TestGpu::new();
     let gpu = &test.gpu;
-    for &(name, technique) in Technique::ALL {
+    // Every technique, and LBB once more with its packed RGBA32UI ping-pong target (whose copy
+    // must read and write integers: a float read of it is a validation error).
+    let cases = Technique::ALL
+        .iter()
+        .map(|&(name, technique)| (name, technique, false))
+        .chain([("lbb --sss-packed", Technique::Lbb, true)]);
+    for (name, technique, packed) in cases {
         let scene_name = lucent::report::scene_for(technique).unwrap();
         let scene = lucent::bake::scene::load_scene_baked(&scene_name).unwrap();
-        let settings = FrameSettings {
+        let mut settings = FrameSettings {
             technique,
             ..FrameSettings::new(96, 64)
         };
+        settings.sss.packed = packed;
         let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
         let plan = &renderer.executable.plan;
         assert_eq!(floors(plan).len(), plan.physical.len());

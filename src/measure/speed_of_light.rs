@@ -8,7 +8,10 @@
 //! each read format and writes every written format, nothing else. That is the cheapest pass
 //! that moves the same bytes, so `pass / copy` says how much of a pass is its own work (ALU,
 //! extra taps, geometry) rather than bandwidth. Because it is derived from the plan, it covers
-//! any pass a technique adds.
+//! any pass a technique adds. Integer formats (LBB's packed RGBA32UI ping-pong target) are read
+//! with integer samplers and written as integer vectors, as the format table
+//! ([`crate::backend::format`]) says: reading them as floats would be undefined behaviour and
+//! the copy's time meaningless.
 //!
 //! The copies are timed submitted one by one with the device idle (the isolated mode of
 //! [`crate::measure::bench`]), alternating with the frames of the same run, so machine noise hits both.
@@ -28,7 +31,7 @@ use std::collections::HashSet;
 use ash::vk;
 use serde::Serialize;
 
-use crate::backend::format::format_name;
+use crate::backend::format::{format_info, format_name, FormatKind};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::util::{
@@ -245,7 +248,12 @@ impl CopyFrame {
             pass.taps(inputs.len() as u32).side_effects();
             pass.execute(CopyPass {
                 inputs: inputs.iter().map(|h| h.id()).collect(),
-                outputs: outputs.len(),
+                input_kinds: floor.reads.iter().map(|r| shader_kind(r.format)).collect(),
+                output_kinds: floor
+                    .colour_writes
+                    .iter()
+                    .map(|&f| shader_kind(f))
+                    .collect(),
                 depth: depth.is_some(),
                 sampler: vk::Sampler::null(),
                 pipeline: None,
@@ -464,10 +472,23 @@ impl PassExec for FillPass {
     fn destroy(&mut self, _gpu: &GpuContext) {}
 }
 
+/// How `glsl/bench/copy.frag` reads or writes an image of `format` (its `LUCENT_COPY_*_KIND`):
+/// 0 as floats, 1 as unsigned integers, 2 as signed integers. The one format table decides.
+fn shader_kind(format: vk::Format) -> u8 {
+    match format_info(format).map(|f| f.kind) {
+        Some(FormatKind::Uint) => 1,
+        Some(FormatKind::Sint) => 2,
+        _ => 0,
+    }
+}
+
 /// `glsl/bench/copy.frag` over the whole render area.
 struct CopyPass {
     inputs: Vec<ResourceId>,
-    outputs: usize,
+    /// [`shader_kind`] of each input.
+    input_kinds: Vec<u8>,
+    /// [`shader_kind`] of each colour output.
+    output_kinds: Vec<u8>,
     depth: bool,
     sampler: vk::Sampler,
     /// With inputs: pipeline and descriptor set.
@@ -479,11 +500,24 @@ struct CopyPass {
 impl PassExec for CopyPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         let inputs = self.inputs.len().to_string();
-        let outputs = self.outputs.to_string();
+        let outputs = self.output_kinds.len().to_string();
+        // Integer images are read with integer samplers and written as integer vectors.
+        let kinds: Vec<(String, String)> = (self.input_kinds.iter().enumerate())
+            .map(|(k, kind)| (format!("LUCENT_COPY_IN{k}_KIND"), kind))
+            .chain(
+                self.output_kinds
+                    .iter()
+                    .enumerate()
+                    .map(|(k, kind)| (format!("LUCENT_COPY_OUT{k}_KIND"), kind)),
+            )
+            .filter(|(_, &kind)| kind != 0)
+            .map(|(name, kind)| (name, kind.to_string()))
+            .collect();
         let mut defines = vec![
             ("LUCENT_COPY_INPUTS", inputs.as_str()),
             ("LUCENT_COPY_OUTPUTS", outputs.as_str()),
         ];
+        defines.extend(kinds.iter().map(|(n, v)| (n.as_str(), v.as_str())));
         if self.depth {
             defines.push(("LUCENT_COPY_DEPTH", "1"));
         }
@@ -593,6 +627,32 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn packed_lbb_floors_read_and_write_their_rgba32ui_target_as_integers() {
+        let scene = crate::bake::scene::load_scene_baked("skin").unwrap();
+        let mut settings = FrameSettings {
+            technique: Technique::Lbb,
+            ..FrameSettings::new(64, 48)
+        };
+        settings.sss.packed = true;
+        let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings).unwrap()).unwrap();
+        let floors = floors(&plan);
+        let packed = vk::Format::R32G32B32A32_UINT;
+        let reads_packed = floors
+            .iter()
+            .filter(|f| f.reads.iter().any(|r| r.format == packed))
+            .count();
+        let writes_packed = floors
+            .iter()
+            .filter(|f| f.colour_writes.contains(&packed))
+            .count();
+        assert!(reads_packed > 0 && writes_packed > 0, "{floors:?}");
+        assert_eq!(shader_kind(packed), 1);
+        assert_eq!(shader_kind(vk::Format::R32G32B32A32_SINT), 2);
+        assert_eq!(shader_kind(vk::Format::R16G16B16A16_SFLOAT), 0);
+        assert_eq!(shader_kind(vk::Format::D32_SFLOAT), 0);
     }
 
     #[test]

@@ -14,6 +14,7 @@ pub mod material;
 pub mod mesh;
 pub mod normals;
 pub mod obj;
+pub mod polygon;
 pub mod profile;
 pub mod texture;
 

@@ -2,7 +2,7 @@
 //!
 //! [`load_obj`] is the only way a user's OBJ file becomes a [`Mesh`]. It never panics, and every
 //! error names the file, the line (when there is one) and the problem. The parsing itself is
-//! `tobj`'s (triangulated, single index), but tobj 4.0.5 panics on some malformed files and
+//! `tobj`'s (triangulated, single index; concave polygons are ear-clipped before it sees them), but tobj 4.0.5 panics on some malformed files and
 //! passes others through silently (see DESIGN.md, "Facts measured"), so the text is checked
 //! line by line *before* tobj sees it, and tobj's output is checked again after:
 //!
@@ -18,6 +18,7 @@
 //! | degenerate triangles (zero area or a repeated vertex) | **repair**: dropped, counted in [`LoadedObj::repairs`]; error if all are |
 //! | normals on some corners but not others, zero-length normals | **repair**: generated instead, recorded |
 //! | polylines (`l`) | **repair**: ignored (they are not surfaces), recorded |
+//! | concave polygons (a U, a ring bridged round its hole) | **repair**: ear-clipped ([`super::polygon`]) instead of tobj's fan, which covers area outside them; recorded with their lines |
 //! | `#` comments after the data on a line | accepted (stripped before tobj, which rejects them) |
 //!
 //! Whatever tobj might still panic on is caught with `catch_unwind` and becomes an error.
@@ -95,8 +96,25 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
             scan.polylines
         ));
     }
+    if !scan.clipped.is_empty() {
+        repairs.push(format!(
+            "triangulated {} concave polygon(s) by ear clipping ({}): a fan from the first \
+             corner would cover area outside them",
+            scan.clipped.len(),
+            lines_list(scan.clipped.iter().map(|(ln, _)| *ln))
+        ));
+    }
+    if !scan.unclean.is_empty() {
+        repairs.push(format!(
+            "{} polygon(s) cross themselves or have more than {} corners ({}): fanned where no \
+             ear was left; check them",
+            scan.unclean.len(),
+            super::polygon::MAX_EAR_CLIP_CORNERS,
+            lines_list(scan.unclean.iter().copied())
+        ));
+    }
     let buffer = if scan.needs_rewrite {
-        Cow::Owned(rewrite_for_tobj(&text))
+        Cow::Owned(rewrite_for_tobj(&text, &scan.clipped))
     } else {
         Cow::Borrowed(text.as_str())
     };
@@ -324,6 +342,23 @@ fn binary_kind(bytes: &[u8]) -> Option<&'static str> {
         .map(|&(_, kind)| kind)
 }
 
+/// "line 4" / "lines 4, 9, 12 and 3 more", for repair notes.
+fn lines_list(lines: impl Iterator<Item = usize>) -> String {
+    let lines: Vec<usize> = lines.collect();
+    let shown: Vec<String> = lines.iter().take(5).map(usize::to_string).collect();
+    let more = lines.len().saturating_sub(shown.len());
+    format!(
+        "line{} {}{}",
+        if lines.len() == 1 { "" } else { "s" },
+        shown.join(", "),
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        }
+    )
+}
+
 /// 1-based line number of byte `offset`.
 fn line_of(bytes: &[u8], offset: usize) -> usize {
     bytes[..offset.min(bytes.len())]
@@ -353,8 +388,16 @@ struct ObjScan {
     polylines: usize,
     /// `mtllib` lines: (line number, file name as tobj extracts it).
     mtllibs: Vec<(usize, String)>,
-    /// Comments after data, or polylines: the text tobj gets must be rewritten.
+    /// Comments after data, polylines or concave polygons: the text tobj gets must be
+    /// rewritten.
     needs_rewrite: bool,
+    /// Every vertex position so far (after dividing by `w`), for triangulating polygons.
+    positions: Vec<DVec3>,
+    /// Concave polygons, ear-clipped: (line number, triangles as corner numbers of the face).
+    /// tobj would fan them; the rewrite writes these triangles instead.
+    clipped: Vec<(usize, Vec<[usize; 3]>)>,
+    /// Lines of polygons that cross themselves (or are too large to ear-clip): partly fanned.
+    unclean: Vec<usize>,
 }
 
 /// The tokens of a data line after its keyword, up to a `#` comment.
@@ -472,8 +515,9 @@ fn scan_obj(text: &str) -> std::result::Result<ObjScan, String> {
                 for (k, t) in nums[..3].iter().enumerate() {
                     p[k] = finite(t, ln, "vertex position")?;
                 }
+                let mut w = 1.0;
                 if n == 4 {
-                    let w = finite(nums[3], ln, "vertex weight w")?;
+                    w = finite(nums[3], ln, "vertex weight w")?;
                     if w == 0.0 {
                         return Err(format!("line {ln}: vertex weight w is 0"));
                     }
@@ -484,6 +528,8 @@ fn scan_obj(text: &str) -> std::result::Result<ObjScan, String> {
                         ));
                     }
                 }
+                scan.positions
+                    .push(DVec3::new(p[0].into(), p[1].into(), p[2].into()) / f64::from(w));
                 if n == 6 {
                     for t in &nums[3..] {
                         finite(t, ln, "vertex colour")?;
@@ -596,6 +642,30 @@ fn scan_obj(text: &str) -> std::result::Result<ObjScan, String> {
                         ));
                     }
                 }
+                if n > 3 {
+                    // Checked above: every index is a valid integer in range.
+                    let corners: Vec<DVec3> = corners
+                        .iter()
+                        .map(|c| {
+                            let i = c.split('/').next().and_then(|t| isize::from_str(t).ok());
+                            let i = i.unwrap_or(1);
+                            let at = if i > 0 {
+                                i.unsigned_abs() - 1
+                            } else {
+                                scan.positions.len() - i.unsigned_abs()
+                            };
+                            scan.positions[at]
+                        })
+                        .collect();
+                    let t = super::polygon::triangulate(&corners);
+                    if !t.clean {
+                        scan.unclean.push(ln);
+                    }
+                    if !t.convex {
+                        scan.clipped.push((ln, t.triangles));
+                        scan.needs_rewrite = true;
+                    }
+                }
                 scan.faces += 1;
                 triangles = triangles.saturating_add(n - 2);
                 if triangles > MAX_TRIANGLES {
@@ -629,11 +699,15 @@ fn scan_obj(text: &str) -> std::result::Result<ObjScan, String> {
     Ok(scan)
 }
 
-/// The text tobj parses: polylines blanked (tobj would read `l 1 2 3` as a triangle) and
-/// trailing `#` comments cut from data lines (tobj rejects them). Line numbers are unchanged.
-fn rewrite_for_tobj(text: &str) -> String {
+/// The text tobj parses: polylines blanked (tobj would read `l 1 2 3` as a triangle),
+/// trailing `#` comments cut from data lines (tobj rejects them), and each concave polygon of
+/// `clipped` (line number, triangles as corner numbers) written as its triangles, one `f` line
+/// each with the face's own corner tokens (no `v` line moves, so relative indices still hold).
+/// tobj reports no line numbers; ours come from the original text.
+fn rewrite_for_tobj(text: &str, clipped: &[(usize, Vec<[usize; 3]>)]) -> String {
     let mut out = String::with_capacity(text.len());
-    for line in text.lines() {
+    let mut clipped = clipped.iter().peekable();
+    for (i, line) in text.lines().enumerate() {
         let key = line.split_whitespace().next().unwrap_or("");
         match key {
             "l" => {}
@@ -643,7 +717,22 @@ fn rewrite_for_tobj(text: &str) -> String {
                     .map(|(i, _)| i)
                     .find(|&i| line[..i].ends_with(char::is_whitespace))
                     .unwrap_or(line.len());
-                out.push_str(&line[..cut]);
+                let data = &line[..cut];
+                match clipped.peek() {
+                    Some((ln, triangles)) if *ln == i + 1 => {
+                        let corners: Vec<&str> = data.split_whitespace().skip(1).collect();
+                        for t in triangles {
+                            let _ = writeln!(
+                                out,
+                                "f {} {} {}",
+                                corners[t[0]], corners[t[1]], corners[t[2]]
+                            );
+                        }
+                        clipped.next();
+                        continue;
+                    }
+                    _ => out.push_str(data),
+                }
             }
             _ => out.push_str(line),
         }
@@ -1050,6 +1139,88 @@ mod tests {
         assert_eq!(o.mesh.triangle_count(), 2);
         assert_eq!(o.repairs.len(), 1, "{:?}", o.repairs);
         assert!(o.repairs[0].contains("polyline"));
+    }
+
+    /// Total area of a loaded mesh's triangles.
+    fn mesh_area(mesh: &Mesh) -> f64 {
+        mesh.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[t[k] as usize].as_dvec3());
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn concave_polygons_are_ear_clipped_to_their_true_area_and_reported() {
+        // A U (area 7 of its 3x3 box) as one face.
+        let u = "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 2 3 0\nv 2 1 0\nv 1 1 0\nv 1 3 0\nv 0 3 0\n\
+                 f 1 2 3 4 5 6 7 8 # the U\n";
+        let o = load_str("u", u).unwrap();
+        assert_eq!(o.mesh.triangle_count(), 6);
+        assert!(
+            (mesh_area(&o.mesh) - 7.0).abs() < 1e-5,
+            "{}",
+            mesh_area(&o.mesh)
+        );
+        assert!(
+            o.repairs.iter().any(|r| r.contains(
+                "triangulated 1 concave polygon(s) by ear \
+                 clipping (line 9)"
+            )),
+            "{:?}",
+            o.repairs
+        );
+        // A ring (radii 2 and 1, 16 segments) as one face bridged from the outside in, with
+        // relative indices, UVs and normals: it keeps its hole.
+        let n = 16;
+        let mut text = String::new();
+        for r in [2.0f64, 1.0] {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                let _ = writeln!(text, "v {} {} 0", r * a.cos(), r * a.sin());
+                let _ = writeln!(text, "vt {} {}", a.cos() * 0.5 + 0.5, a.sin() * 0.5 + 0.5);
+            }
+        }
+        text.push_str("vn 0 0 1\nf");
+        let corner = |v: usize| format!(" {}/{}/1", v as isize - 2 * n as isize, v + 1);
+        let mut face: Vec<usize> = (0..n).collect();
+        face.push(0);
+        face.push(n);
+        face.extend((n + 1..2 * n).rev());
+        face.push(n);
+        for v in face {
+            text.push_str(&corner(v));
+        }
+        text.push('\n');
+        let o = load_str("ring", &text).unwrap();
+        let want = 3.0 * 8.0 * (std::f64::consts::TAU / 16.0).sin();
+        assert!(
+            (mesh_area(&o.mesh) - want).abs() < 1e-4,
+            "{} vs {want}",
+            mesh_area(&o.mesh)
+        );
+        // Every triangle faces +z like the face (winding kept), none covers the centre.
+        for t in o.mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| o.mesh.positions[t[k] as usize]);
+            assert!((b - a).cross(c - a).z > 0.0);
+            let centroid = (a + b + c) / 3.0;
+            assert!(
+                centroid.length() > 0.9,
+                "a triangle inside the hole: {centroid}"
+            );
+        }
+        assert!(
+            o.repairs.iter().any(|r| r.contains("ear clipping")),
+            "{:?}",
+            o.repairs
+        );
+        // A convex quad is not a repair.
+        assert!(load_str("quad2", &format!("{QUAD}f 1 2 3 4\n"))
+            .unwrap()
+            .repairs
+            .is_empty());
     }
 
     #[test]

@@ -2,13 +2,14 @@
 //!
 //! [`load_obj`] is the only way a user's OBJ file becomes a [`Mesh`]. It never panics, and every
 //! error names the file, the line (when there is one) and the problem. The parsing itself is
-//! `tobj`'s (triangulated, single index; concave polygons are ear-clipped before it sees them), but tobj 4.0.5 panics on some malformed files and
-//! passes others through silently (see DESIGN.md, "Facts measured"), so the text is checked
-//! line by line *before* tobj sees it, and tobj's output is checked again after:
+//! `tobj`'s (triangulated, single index; concave polygons are ear-clipped before it sees
+//! them), but tobj 4.0.5 panics on some malformed files and passes others through silently
+//! (see DESIGN.md, "Facts measured"), so the text is checked line by line *before* tobj sees
+//! it, and tobj's output is checked again after:
 //!
 //! | input | result |
 //! |---|---|
-//! | empty, UTF-16, binary (NUL bytes), not UTF-8, over 2 GiB | error |
+//! | not a regular file (device, FIFO, directory), empty, UTF-16, binary (NUL bytes), not UTF-8, over 2 GiB | error |
 //! | `v`/`vt`/`vn` with too few numbers, a non-number, NaN or infinity | error naming the line |
 //! | face with fewer than 3 corners; index 0; index beyond what is defined so far (positive or negative) | error naming the line |
 //! | more than [`MAX_VERTICES`] vertices or [`MAX_TRIANGLES`] triangles | error naming the line |
@@ -18,7 +19,7 @@
 //! | degenerate triangles (zero area or a repeated vertex) | **repair**: dropped, counted in [`LoadedObj::repairs`]; error if all are |
 //! | normals on some corners but not others, zero-length normals | **repair**: generated instead, recorded |
 //! | polylines (`l`) | **repair**: ignored (they are not surfaces), recorded |
-//! | concave polygons (a U, a ring bridged round its hole) | **repair**: ear-clipped ([`super::polygon`]) instead of tobj's fan, which covers area outside them; recorded with their lines |
+//! | concave polygons (a U, a ring bridged round its hole) | **repair**: ear-clipped ([`super::polygon`]), not fanned (a fan covers area outside them); recorded with their lines |
 //! | `#` comments after the data on a line | accepted (stripped before tobj, which rejects them) |
 //!
 //! Whatever tobj might still panic on is caught with `catch_unwind` and becomes an error.

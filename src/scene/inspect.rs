@@ -66,9 +66,12 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             }
         }
         "mtl" => {
-            let materials = load_mtl(path)?;
+            let (materials, notes) = load_mtl(path)?;
             let _ = writeln!(s, "{}: MTL material library", path.display());
             write_materials(&mut s, &materials);
+            for n in &notes {
+                let _ = writeln!(s, "  note: {n}");
+            }
         }
         "png" | "jpg" | "jpeg" | "tga" | "exr" | "hdr" => {
             // Level 0 is what is summarised; the mips a render would make are only counted.

@@ -15,7 +15,8 @@
 //! | more than [`MAX_VERTICES`] vertices or [`MAX_TRIANGLES`] triangles | error naming the line |
 //! | texture coordinates on some face corners but not others | error naming the line |
 //! | `Ka`/`Kd`/`Ks`/`Ke` with fewer than 3 numbers (tobj panics), other bad MTL values | error naming the MTL and its line |
-//! | missing MTL file, missing texture named by an MTL | error naming both files |
+//! | missing MTL file | error naming both files |
+//! | texture named by an MTL that is not there | **note** in [`LoadedObj::repairs`] (MTL textures are not rendered); `\` separators are tried as `/` first |
 //! | degenerate triangles (zero area or a repeated vertex) | **repair**: dropped, counted in [`LoadedObj::repairs`]; error if all are |
 //! | normals on some corners but not others, zero-length normals | **repair**: generated instead, recorded |
 //! | polylines (`l`) | **repair**: ignored (they are not surfaces), recorded |
@@ -58,9 +59,10 @@ pub struct ObjMaterial {
     pub name: String,
     /// `Kd`: diffuse colour (finite; as written, usually in [0, 1]).
     pub diffuse: Option<Vec3>,
-    /// `map_Kd`: diffuse texture, resolved relative to the MTL file's directory (it exists).
+    /// `map_Kd`: diffuse texture, resolved relative to the MTL file's directory (Windows `\`
+    /// separators accepted); `None` also when the file named is not there (a repair note).
     pub diffuse_texture: Option<PathBuf>,
-    /// `map_Bump` / `bump`: normal map, resolved relative to the MTL file's directory (it exists).
+    /// `map_Bump` / `bump`: normal map, resolved like `diffuse_texture`.
     pub normal_texture: Option<PathBuf>,
 }
 
@@ -123,13 +125,15 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
     let obj_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let mtl_error: RefCell<Option<String>> = RefCell::new(None);
     let materials: RefCell<Vec<ObjMaterial>> = RefCell::new(Vec::new());
+    let mtl_notes: RefCell<Vec<String>> = RefCell::new(Vec::new());
     let material_loader = |requested: &Path| -> tobj::MTLLoadResult {
         if mtl_error.borrow().is_some() {
             return Err(tobj::LoadError::GenericFailure);
         }
         match load_material_libraries(&obj_dir, requested, &scan.mtllibs) {
-            Ok((tobj_result, mut ours)) => {
+            Ok((tobj_result, mut ours, mut notes)) => {
                 materials.borrow_mut().append(&mut ours);
+                mtl_notes.borrow_mut().append(&mut notes);
                 tobj_result
             }
             Err(message) => {
@@ -167,6 +171,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
         Ok(Ok((models, _))) => models,
     };
 
+    repairs.append(&mut mtl_notes.into_inner());
     let (mut mesh, partial_normals) = merge_models(&models).map_err(fail)?;
     if partial_normals {
         repairs.push(
@@ -192,10 +197,11 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
 }
 
 /// Loads one MTL file on its own, with the same checks [`load_obj`] applies to the MTL files an
-/// OBJ names (numbers, finiteness, textures that exist).
-pub fn load_mtl(path: &Path) -> Result<Vec<ObjMaterial>> {
+/// OBJ names (numbers, finiteness): its materials and one note per texture it names that is
+/// not there (not an error: lucent does not render MTL textures).
+pub fn load_mtl(path: &Path) -> Result<(Vec<ObjMaterial>, Vec<String>)> {
     load_mtl_file(path)
-        .map(|(_, materials)| materials)
+        .map(|(_, materials, notes)| (materials, notes))
         .map_err(|message| LucentError::file(path, message))
 }
 
@@ -769,9 +775,23 @@ const TEXTURE_KEYS: &[(&str, usize)] = &[
     ("map_d", 5),
 ];
 
-/// Checks every line of an MTL file for what tobj would panic on or pass silently, and that the
-/// textures it names exist (relative to `dir`).
-fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<(), String> {
+/// Where the texture an MTL file names is (relative to the MTL's directory `dir`), if it is
+/// there: as written, or with Windows separators (`.\tex.jpg`, `maps\wood.png`, which a
+/// Unix path takes as one odd file name) turned into `/`.
+fn resolve_texture(dir: &Path, name: &str) -> Option<PathBuf> {
+    let as_written = dir.join(name);
+    if as_written.is_file() {
+        return Some(as_written);
+    }
+    let slashed = dir.join(name.replace('\\', "/"));
+    slashed.is_file().then_some(slashed)
+}
+
+/// Checks every line of an MTL file for what tobj would panic on or pass silently. Textures it
+/// names that are not there are notes, not errors (lucent does not render MTL textures; a
+/// missing one must not fail the mesh's load): one per missing texture, naming its line.
+fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<Vec<String>, String> {
+    let mut notes = Vec::new();
     for (i, raw) in text.lines().enumerate() {
         let ln = i + 1;
         let line = raw.trim();
@@ -818,28 +838,28 @@ fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<(), String> {
                         return Err(format!("line {ln}: {key} names no texture file"));
                     }
                     let name = texture_file_name(value);
-                    let full = dir.join(name);
-                    if !full.is_file() {
-                        return Err(format!(
-                            "line {ln}: texture '{name}' ({key}) not found (looked for {})",
-                            full.display()
+                    if resolve_texture(dir, name).is_none() {
+                        notes.push(format!(
+                            "line {ln}: texture '{name}' ({key}) not found (looked for {}): \
+                             ignored, lucent does not render MTL textures",
+                            dir.join(name).display()
                         ));
                     }
                 }
             }
         }
     }
-    Ok(())
+    Ok(notes)
 }
 
-/// Reads, checks and parses one MTL file: tobj's result (always `Ok`, for `usemtl` lookups)
-/// and ours.
+/// Reads, checks and parses one MTL file: tobj's result (always `Ok`, for `usemtl` lookups),
+/// ours, and the notes of [`scan_mtl`].
 fn load_mtl_file(
     path: &Path,
-) -> std::result::Result<(tobj::MTLLoadResult, Vec<ObjMaterial>), String> {
+) -> std::result::Result<(tobj::MTLLoadResult, Vec<ObjMaterial>, Vec<String>), String> {
     let text = read_text(path)?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    scan_mtl(&text, dir)?;
+    let notes = scan_mtl(&text, dir)?;
     let parsed = catch_unwind(AssertUnwindSafe(|| {
         tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes()))
     }));
@@ -862,24 +882,24 @@ fn load_mtl_file(
             diffuse_texture: m
                 .diffuse_texture
                 .as_deref()
-                .map(|t| dir.join(texture_file_name(t))),
+                .and_then(|t| resolve_texture(dir, texture_file_name(t))),
             normal_texture: m
                 .normal_texture
                 .as_deref()
-                .map(|t| dir.join(texture_file_name(t))),
+                .and_then(|t| resolve_texture(dir, texture_file_name(t))),
         })
         .collect();
-    Ok((Ok(parsed), ours))
+    Ok((Ok(parsed), ours, notes))
 }
 
 /// Loads the material library an OBJ's `mtllib` names (relative to the OBJ's directory). A name
 /// that is not a file but contains spaces is taken as several files (`mtllib a.mtl b.mtl`).
-/// Errors name the MTL path and the OBJ line that references it.
+/// Errors (and notes) name the MTL path and the OBJ line that references it.
 fn load_material_libraries(
     obj_dir: &Path,
     requested: &Path,
     mtllibs: &[(usize, String)],
-) -> std::result::Result<(tobj::MTLLoadResult, Vec<ObjMaterial>), String> {
+) -> std::result::Result<(tobj::MTLLoadResult, Vec<ObjMaterial>, Vec<String>), String> {
     let name = requested.to_string_lossy();
     let line = mtllibs
         .iter()
@@ -893,9 +913,15 @@ fn load_material_libraries(
     };
     let mut merged: tobj::MTLLoadResult = Ok(Default::default());
     let mut ours = Vec::new();
+    let mut notes = Vec::new();
     for file in files {
-        let (parsed, mut converted) = load_mtl_file(&file)
+        let (parsed, mut converted, file_notes) = load_mtl_file(&file)
             .map_err(|m| format!("material library {}{line}: {m}", file.display()))?;
+        notes.extend(
+            file_notes
+                .into_iter()
+                .map(|n| format!("material library {}{line}: {n}", file.display())),
+        );
         if let (Ok((all, all_map)), Ok((mut materials, map))) = (&mut merged, parsed) {
             let offset = all.len();
             all.append(&mut materials);
@@ -903,7 +929,7 @@ fn load_material_libraries(
         }
         ours.append(&mut converted);
     }
-    Ok((merged, ours))
+    Ok((merged, ours, notes))
 }
 
 /// The message of a caught panic.
@@ -1348,11 +1374,31 @@ mod tests {
         );
         let e = obj("missing.mtl").unwrap_err().to_string();
         assert!(e.contains("missing.mtl") && e.contains("not found"), "{e}");
-        let e = obj("tex.mtl").unwrap_err().to_string();
-        assert!(e.contains("tex.mtl") && e.contains("gone.png") && e.contains("not found"));
+        // A texture that is not there is a note, not an error: MTL textures are not rendered.
+        let o = obj("tex.mtl").unwrap();
+        assert_eq!(o.materials[0].diffuse_texture, None);
+        assert!(
+            o.repairs.iter().any(|r| r.contains("tex.mtl")
+                && r.contains("line 2: texture 'gone.png' (map_Kd) not found")
+                && r.contains("ignored")),
+            "{:?}",
+            o.repairs
+        );
         let e = load_mtl(&dir.join("bad.mtl")).unwrap_err().to_string();
         assert!(e.contains("bad.mtl: line 2: Kd needs 3"), "{e}");
-        assert_eq!(load_mtl(&dir.join("good.mtl")).unwrap().len(), 1);
+        assert_eq!(load_mtl(&dir.join("good.mtl")).unwrap().0.len(), 1);
+        // Windows separators: `.\wood.png` and `maps\wood.png` are found.
+        std::fs::create_dir_all(dir.join("maps")).unwrap();
+        std::fs::write(dir.join("maps/wood.png"), b"not checked here").unwrap();
+        std::fs::write(
+            dir.join("win.mtl"),
+            "newmtl wood\nmap_Kd .\\wood.png\nbump maps\\wood.png\n",
+        )
+        .unwrap();
+        let (m, notes) = load_mtl(&dir.join("win.mtl")).unwrap();
+        assert!(notes.is_empty(), "{notes:?}");
+        assert_eq!(m[0].diffuse_texture, Some(dir.join("./wood.png")));
+        assert_eq!(m[0].normal_texture, Some(dir.join("maps/wood.png")));
         std::fs::remove_dir_all(dir).ok();
     }
 

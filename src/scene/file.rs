@@ -120,11 +120,54 @@ struct MaterialToml {
     layers: Option<LayersToml>,
 }
 
-#[derive(Deserialize)]
-#[serde(untagged)]
+/// `scale = 2` or `scale = [x, y, z]`. Deserialized by hand: serde's untagged enum would
+/// report anything else as "data did not match any variant of untagged enum ScaleToml".
 enum ScaleToml {
     Uniform(f32),
     PerAxis([f32; 3]),
+}
+
+impl<'de> Deserialize<'de> for ScaleToml {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        const EXPECTED: &str = "one number (uniform) or [x, y, z] (three numbers)";
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = ScaleToml;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(EXPECTED)
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<ScaleToml, E> {
+                Ok(ScaleToml::Uniform(v as f32))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<ScaleToml, E> {
+                Ok(ScaleToml::Uniform(v as f32))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ScaleToml, E> {
+                Ok(ScaleToml::Uniform(v as f32))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<ScaleToml, A::Error> {
+                let mut values = Vec::new();
+                while let Some(v) = seq.next_element::<f32>()? {
+                    values.push(v);
+                    if values.len() > 3 {
+                        break;
+                    }
+                }
+                match <[f32; 3]>::try_from(values.as_slice()) {
+                    Ok(v) => Ok(ScaleToml::PerAxis(v)),
+                    Err(_) => Err(serde::de::Error::custom(format!(
+                        "`scale` must be {EXPECTED}, not an array of {}{} numbers",
+                        if values.len() > 3 { "more than " } else { "" },
+                        values.len().min(3)
+                    ))),
+                }
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
 }
 
 #[derive(Deserialize)]
@@ -171,36 +214,72 @@ struct Locator<'a> {
 
 impl Locator<'_> {
     /// The 1-based line of `key` inside the `index`-th `[[section]]` (or `[section]`, or the
-    /// top level for an empty section name), if it can be found.
+    /// top level for an empty section name), if it can be found. `key` may be dotted
+    /// (`sss.units_per_mm`): it is then found in a `[section.sss]` sub-table, as a dotted key,
+    /// or inside an inline table `sss = { ... }`. A key not found at its full path is looked
+    /// for by its last part anywhere in the section (sub-tables and inline tables included).
     fn line(&self, section: &str, index: Option<usize>, key: &str) -> Option<usize> {
-        let mut current: Option<(String, usize)> = Some((String::new(), 0));
+        let (parent, leaf) = match key.rsplit_once('.') {
+            Some((parent, leaf)) => (Some(parent), leaf),
+            None => (None, key),
+        };
+        let mut current = (String::new(), 0usize);
         let mut counts: HashMap<String, usize> = HashMap::new();
+        let mut fallback = None;
         for (number, raw) in self.source.lines().enumerate() {
             let line = raw.trim();
             if let Some(header) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
                 let name = header.trim().to_string();
                 let n = counts.entry(name.clone()).or_insert(0);
-                current = Some((name, *n));
+                current = (name, *n);
                 *n += 1;
                 continue;
             }
             if let Some(header) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
-                current = Some((header.trim().to_string(), 0));
+                let name = header.trim().to_string();
+                // `[material.sss]` belongs to the latest `[[material]]`.
+                let owner = counts
+                    .iter()
+                    .filter(|(array, _)| {
+                        name.strip_prefix(array.as_str())
+                            .is_some_and(|rest| rest.starts_with('.'))
+                    })
+                    .map(|(_, n)| n.saturating_sub(1))
+                    .next()
+                    .unwrap_or(0);
+                current = (name, owner);
                 continue;
             }
-            let Some((name, i)) = &current else { continue };
-            let section_matches = name == section
-                || (name.starts_with(section) && name[section.len()..].starts_with('.'));
-            let index_matches = index.is_none_or(|want| *i == want);
-            let key_matches = line
-                .split('=')
-                .next()
-                .is_some_and(|k| k.trim() == key && line.contains('='));
-            if section_matches && index_matches && key_matches {
+            let (name, i) = &current;
+            // Where this table sits inside the section: "" for the section itself.
+            let within = if name == section {
+                Some("")
+            } else if section.is_empty() {
+                None
+            } else {
+                name.strip_prefix(section).and_then(|r| r.strip_prefix('.'))
+            };
+            let Some(within) = within else { continue };
+            if !index.is_none_or(|want| *i == want) {
+                continue;
+            }
+            let Some((k, value)) = line.split_once('=') else {
+                continue;
+            };
+            let k = k.trim();
+            let full = if within.is_empty() {
+                k.to_string()
+            } else {
+                format!("{within}.{k}")
+            };
+            if full == key || (parent.is_some_and(|p| p == full) && inline_has(value, leaf)) {
                 return Some(number + 1);
             }
+            if fallback.is_none() && (k == leaf || inline_has(value, leaf)) {
+                fallback = Some(number + 1);
+            }
         }
-        None
+        fallback
     }
 
     /// An error naming the file, the line (when found) and the key.
@@ -222,6 +301,65 @@ impl Locator<'_> {
         };
         LucentError::file(self.path, format!("{location}: {message}"))
     }
+}
+
+/// Largest `far / near` a scene may have without a warning: the 32-bit float depth buffer
+/// (standard, not reversed, depth) then resolves 0.6% of the distance at the far plane.
+pub const MAX_DEPTH_RATIO: f32 = 1e5;
+
+/// The warning for a depth range the depth buffer cannot resolve, with the numbers, or `None`.
+///
+/// With depth `d = f/(f-n) (1 - n/z)` stored as f32 (spacing `2^-24` just below 1), two
+/// surfaces at distance `z` are told apart when they are `z^2 2^-24 / n` apart, and a surface
+/// beyond `n 2^25` gets the depth the buffer is cleared to (1) and fails the depth test: it
+/// vanishes. `distance` is the camera's distance to its target, where the step is reported.
+pub fn depth_range_warning(near: f32, far: f32, distance: f32) -> Option<String> {
+    let ratio = far / near;
+    if ratio <= MAX_DEPTH_RATIO {
+        return None;
+    }
+    // f64: near 1e-7 squared and divided must not round to 0 or overflow.
+    let (n, f, d) = (
+        f64::from(near),
+        f64::from(far),
+        f64::from(distance).min(f64::from(far)),
+    );
+    let step = d * d * 2f64.powi(-24) / n;
+    let lost = n * 2f64.powi(25);
+    let vanish = if lost < f {
+        format!(
+            "; surfaces farther than {lost:.3} from the camera get the far plane's depth and \
+             vanish"
+        )
+    } else {
+        String::new()
+    };
+    // Tiny and huge numbers in exponent form (`1e-7`, not `0.0000001`).
+    let num = |x: f64| {
+        if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+            format!("{x:.3e}")
+        } else {
+            format!("{x:.3}")
+        }
+    };
+    Some(format!(
+        "near = {near:e} and far = {far} (far/near = {ratio:.1e}) is more than the 32-bit depth \
+         buffer resolves: at the target's distance ({}) its step is {}, so surfaces closer \
+         together than that are not told apart{vanish}; raise `near` or lower `far` to keep \
+         far/near under {MAX_DEPTH_RATIO:.0e}",
+        num(d),
+        num(step)
+    ))
+}
+
+/// Whether the value text of a line is an inline table with `key = ...` in it.
+fn inline_has(value: &str, key: &str) -> bool {
+    value.trim_start().starts_with('{')
+        && value.match_indices(key).any(|(at, _)| {
+            let before = value[..at].trim_end().chars().last();
+            let after = value[at + key.len()..].trim_start();
+            matches!(before, Some('{' | ',')) && after.starts_with('=')
+        })
 }
 
 /// Loads a scene file. Relative paths inside it (OBJ files, textures) are resolved against the
@@ -252,6 +390,34 @@ fn toml_error(path: &Path, source: &str, error: &toml::de::Error) -> LucentError
         .split_whitespace()
         .collect::<Vec<_>>()
         .join(" ");
+    // A missing key is reported at the table it is missing from: the text of that table's
+    // first line is not the key at fault. A missing [camera] is at the top of the file.
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.strip_suffix('`'))
+    {
+        if field == "camera" {
+            return LucentError::file(
+                path,
+                "invalid scene: no [camera] table; every scene needs one, with `eye` and \
+                 `target` (see docs/scene-format.toml)",
+            );
+        }
+        let table = error.span().and_then(|span| {
+            // The span may start at the blank line before the table: skip to its text.
+            let text = source.get(span.clone())?;
+            let start = span.start + (text.len() - text.trim_start().len());
+            let before = source.get(..start)?;
+            Some(format!("line {}: ", before.matches('\n').count() + 1))
+        });
+        return LucentError::file(
+            path,
+            format!(
+                "invalid scene: {}missing key `{field}` in this table",
+                table.unwrap_or_default()
+            ),
+        );
+    }
     let location = error.span().and_then(|span| {
         let before = source.get(..span.start)?;
         let line = before.matches('\n').count() + 1;
@@ -345,6 +511,13 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
     }
     if Vec3::from(cam.eye).distance(Vec3::from(cam.target)) < 1e-6 {
         return Err(at.error("camera", None, "target", "must differ from eye"));
+    }
+    if let Some(warning) = depth_range_warning(
+        near,
+        far,
+        Vec3::from(cam.eye).distance(Vec3::from(cam.target)),
+    ) {
+        log::warn!("{}", at.error("camera", None, "near", warning));
     }
 
     // Meshes.
@@ -523,6 +696,19 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
             Ok(Vec3::from(v))
         };
         let range = l.range.unwrap_or(20.0);
+        // Checked here so the message names `range` itself (the light's own check names the
+        // position and range together).
+        if !(range.is_finite() && range > 0.0) {
+            return Err(at.error(
+                "light",
+                Some(i),
+                "range",
+                format!(
+                    "{range} must be finite and > 0 (the distance at which the light's \
+                     contribution falls to zero)"
+                ),
+            ));
+        }
         let kind = match l.kind.as_str() {
             "directional" => LightKind::Directional {
                 direction: need(l.direction, "direction")?,
@@ -733,6 +919,18 @@ fn build_material(
             }
         };
         if let Some(u) = s.units_per_mm {
+            if !(u.is_finite() && u > 0.0) {
+                return Err(at.error(
+                    "material",
+                    Some(i),
+                    "sss.units_per_mm",
+                    format!(
+                        "{u} must be finite and > 0 (scene units per millimetre of the \
+                         profile: 1 when a scene unit is a millimetre, 0.001 when it is a \
+                         metre)"
+                    ),
+                ));
+            }
             profile.units_per_mm = u;
         }
         profile.validate().map_err(|e| {
@@ -908,6 +1106,64 @@ material = "red"
             parse(&spot).unwrap().lights[0].kind,
             LightKind::Spot { .. }
         ));
+    }
+
+    #[test]
+    fn scene_messages_name_the_key_and_line() {
+        let scale = MINIMAL.replace("material = \"red\"", "material = \"red\"\nscale = [8, 1]");
+        let e = parse(&scale).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&scale, "scale"));
+        assert!(
+            e.contains(&line) && e.contains("[x, y, z]") && e.contains("array of 2"),
+            "{e}"
+        );
+        assert!(!e.contains("untagged"), "{e}");
+        let range = format!(
+            "{MINIMAL}\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 5\nrange = -1\n"
+        );
+        let e = parse(&range).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&range, "range"));
+        assert!(e.contains("light[0].range") && e.contains(&line), "{e}");
+        assert!(!e.contains("position"), "{e}");
+        let upm = MINIMAL.replace(
+            "albedo = [0.8, 0.1, 0.1]",
+            "albedo = [0.8, 0.1, 0.1]\nsss = { preset = \"skin\", units_per_mm = 0 }",
+        );
+        let e = parse(&upm).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&upm, "sss"));
+        assert!(
+            e.contains("material[0].sss.units_per_mm") && e.contains(&line),
+            "{e}"
+        );
+        let no_camera = format!(
+            "name = \"x\"\n{}",
+            MINIMAL.replace("[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n", "")
+        );
+        let e = parse(&no_camera).unwrap_err().to_string();
+        assert!(
+            e.contains("no [camera] table") && !e.contains("`name`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn depth_ranges_beyond_the_depth_buffer_warn_with_the_numbers() {
+        assert_eq!(depth_range_warning(0.1, 100.0, 5.0), None);
+        let w = depth_range_warning(1e-7, 100.0, 5.0).unwrap();
+        assert!(
+            w.contains("near = 1e-7")
+                && w.contains("far/near = 1.0e9")
+                && w.contains("vanish")
+                && w.contains("3.355")
+                && w.contains("step is 14.901"),
+            "{w}"
+        );
+        // Beyond the limit but nothing vanishes: the step is reported, not a vanishing distance.
+        let w = depth_range_warning(1e-3, 200.0, 10.0).unwrap();
+        assert!(w.contains("2.0e5") && !w.contains("vanish"), "{w}");
+        // The scene still loads.
+        let s = MINIMAL.replace("target = [0, 0, 0]", "target = [0, 0, 0]\nnear = 1e-7");
+        assert_eq!(parse(&s).unwrap().camera.near, 1e-7);
     }
 
     #[test]

@@ -32,10 +32,16 @@ pub enum LucentError {
         call: &'static str,
         result: ash::vk::Result,
     },
-    /// GPU memory allocation failed.
-    #[error("GPU memory allocation '{name}' failed: {source}")]
+    /// GPU memory allocation failed: what for, how much, and what to try.
+    #[error(
+        "GPU memory allocation '{name}' of {size} failed: {source}; render at a smaller --size \
+         (the frame's images grow with it) or use smaller textures",
+        size = crate::files::format_bytes(*.bytes)
+    )]
     Allocation {
         name: String,
+        /// Bytes asked for.
+        bytes: u64,
         #[source]
         source: gpu_allocator::AllocationError,
     },

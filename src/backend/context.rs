@@ -119,6 +119,11 @@ pub struct DeviceInfo {
     pub storage_image_write_without_format: bool,
     /// `VK_KHR_swapchain` is enabled (asked for with [`ContextDesc::swapchain`]).
     pub swapchain: bool,
+    /// `limits.maxImageDimension2D`: the widest or tallest 2D image the device creates.
+    pub max_image_dimension_2d: u32,
+    /// Size of the largest device-local memory heap (on a CPU driver such as lavapipe, host
+    /// memory): what a frame's images and a scene's textures must fit in.
+    pub device_local_bytes: u64,
 }
 
 impl DeviceInfo {
@@ -613,9 +618,10 @@ fn create_owned_parts(
         buffer_device_address: false,
         allocation_sizes: Default::default(),
     })
-    .map_err(|source| LucentError::Allocation {
-        name: "lucent allocator".to_string(),
-        source,
+    .map_err(|source| {
+        LucentError::InvalidInput(format!(
+            "the GPU memory allocator could not be created: {source}"
+        ))
     })?;
     let pool_info = vk::CommandPoolCreateInfo::default()
         .flags(vk::CommandPoolCreateFlags::TRANSIENT)

@@ -137,6 +137,18 @@ pub(super) fn probe_device(
         storage_image_write_without_format: core.shader_storage_image_write_without_format
             == vk::TRUE,
         swapchain,
+        max_image_dimension_2d: props.limits.max_image_dimension2_d,
+        device_local_bytes: {
+            // SAFETY: plain query of a physical device of `instance`.
+            let memory = unsafe { instance.get_physical_device_memory_properties(pd) };
+            memory
+                .memory_heaps_as_slice()
+                .iter()
+                .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+                .map(|h| h.size)
+                .max()
+                .unwrap_or(0)
+        },
     };
     Ok(Probe {
         info,

@@ -864,6 +864,7 @@ impl GpuContext {
             })
             .map_err(|source| LucentError::Allocation {
                 name: name.to_string(),
+                bytes: requirements.size,
                 source,
             })
     }

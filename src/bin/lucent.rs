@@ -494,7 +494,10 @@ fn with_renderer(
 ) -> Result<()> {
     let settings = frame.settings_warned(export_hdr)?;
     let scene = bake::load_scene_baked(&frame.scene)?;
+    // Texture headers first: one too large is refused before the device is even opened.
+    scene::texture::scene_texture_sizes(&scene, None)?;
     with_session(gpu_args, |session| {
+        check_device_fits(&session.gpu, &scene, &settings)?;
         let renderer = Renderer::new(
             &session.gpu,
             &session.shaders,
@@ -507,6 +510,57 @@ fn with_renderer(
         renderer.destroy(&session.gpu);
         worked.and(idle)
     })
+}
+
+/// Refuses textures larger than the device's `maxImageDimension2D`, and warns when the
+/// frame's images and the textures will not fit the device's largest memory heap (naming the
+/// largest image and what to try): an out-of-memory error later would be less clear. Only a
+/// warning, because some drivers (lavapipe: 2 GiB reported) allocate beyond the heap they
+/// report.
+fn check_device_fits(
+    gpu: &GpuContext,
+    scene: &scene::Scene,
+    settings: &FrameSettings,
+) -> Result<()> {
+    let info = &gpu.info;
+    let textures = scene::texture::scene_texture_sizes(scene, Some(info.max_image_dimension_2d))?;
+    let plan = plan_frame(settings, &FrameFeatures::new(scene, settings)?)?;
+    let (frame_bytes, largest) = plan.frame_memory();
+    // Normal maps go up as RGBA16F with mips (4/3), LEAN frames as two such maps each.
+    let lean = matches!(settings.technique, Technique::Lcb | Technique::Lbb);
+    let texture_bytes: u64 = textures
+        .iter()
+        .map(|(_, w, h)| u64::from(*w) * u64::from(*h) * 8 * 4 / 3 * if lean { 2 } else { 1 })
+        .sum();
+    let heap = info.device_local_bytes;
+    if heap > 0 && frame_bytes.saturating_add(texture_bytes) > heap {
+        let size = lucent::files::format_bytes;
+        let largest = largest.map_or(String::new(), |r| {
+            format!(
+                "; largest image '{}' {}x{} {}, {}",
+                r.name,
+                r.info.width,
+                r.info.height,
+                lucent::backend::format::format_name(r.info.format),
+                size(r.estimated_bytes())
+            )
+        });
+        eprintln!(
+            "lucent: warning: the frame at {}x{} needs about {} of GPU memory for its images{largest}{}, \
+             more than the device's largest memory heap ({}): it may fail with out of memory; \
+             try a smaller --size",
+            settings.width,
+            settings.height,
+            size(frame_bytes),
+            if texture_bytes > 0 {
+                format!(", and {} for textures", size(texture_bytes))
+            } else {
+                String::new()
+            },
+            size(heap)
+        );
+    }
+    Ok(())
 }
 
 /// Opens a session, runs `work` with it, and closes it whatever `work` returned; `work`'s error

@@ -193,7 +193,20 @@ impl Executable {
                     "memory slot {s}: its images share no memory type; compile with aliasing off"
                 )));
             }
-            let block = gpu.allocate_memory_block(requirements, &format!("graph slot {s}"))?;
+            // Named by what it holds, so an out-of-memory error says which images.
+            let names: Vec<&str> = slot
+                .resources
+                .iter()
+                .map(|&id| self.plan.resources[id].name.as_str())
+                .collect();
+            let shown = names.iter().take(3).copied().collect::<Vec<_>>().join(", ");
+            let more = names.len().saturating_sub(3);
+            let label = if more > 0 {
+                format!("graph slot {s}: {shown} and {more} more")
+            } else {
+                format!("graph slot {s}: {shown}")
+            };
+            let block = gpu.allocate_memory_block(requirements, &label)?;
             for &id in &slot.resources {
                 gpu.bind_image(self.images[id], &block, 0)?;
                 let view = gpu.create_view(

@@ -201,6 +201,24 @@ impl Plan {
         (slotted + unslotted, unaliased)
     }
 
+    /// Estimated bytes of device memory the executable allocates for the frame's images: every
+    /// memory slot, and every image it owns outside a slot (exported ones included; a host's
+    /// imported images are not counted). With the largest of those images.
+    pub fn frame_memory(&self) -> (u64, Option<&PlannedResource>) {
+        let owned = self
+            .resources
+            .iter()
+            .filter(|r| r.lifetime.is_some() && !r.imported && r.slot.is_none());
+        let slotted: u64 = self.slots.iter().map(|s| s.estimated_bytes).sum();
+        let total = slotted + owned.map(PlannedResource::estimated_bytes).sum::<u64>();
+        let largest = self
+            .resources
+            .iter()
+            .filter(|r| r.lifetime.is_some() && !r.imported)
+            .max_by_key(|r| r.estimated_bytes());
+        (total, largest)
+    }
+
     /// The physical pass index of a resource's export barrier etc.: finds a resource by name.
     pub fn resource_by_name(&self, name: &str) -> Option<ResourceId> {
         self.resources.iter().position(|r| r.name == name)

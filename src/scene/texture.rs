@@ -281,6 +281,40 @@ pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
+/// The image files `scene` uploads as textures (its materials' normal maps), each once, with
+/// the size its header declares, checked before anything is decoded: [`check_texture_size`],
+/// and with `max_dimension` (the device's `maxImageDimension2D`) that neither side is larger.
+/// Reads only the headers, so a scene with a texture too large is refused in milliseconds.
+pub fn scene_texture_sizes(
+    scene: &super::Scene,
+    max_dimension: Option<u32>,
+) -> Result<Vec<(std::path::PathBuf, u32, u32)>> {
+    let mut sizes: Vec<(std::path::PathBuf, u32, u32)> = Vec::new();
+    for object in &scene.objects {
+        let Some(super::material::TextureSource::File(path)) = &object.material.normal_texture
+        else {
+            continue;
+        };
+        if sizes.iter().any(|(p, _, _)| p == path) {
+            continue;
+        }
+        let (width, height) = texture_dimensions(path)?;
+        check_texture_size(path, width, height)?;
+        if let Some(limit) = max_dimension.filter(|&l| width > l || height > l) {
+            return Err(LucentError::file(
+                path,
+                format!(
+                    "normal map of material '{}' is {width}x{height}, larger than this device \
+                     supports ({limit} per side, maxImageDimension2D); scale it down",
+                    object.material.name
+                ),
+            ));
+        }
+        sizes.push((path.clone(), width, height));
+    }
+    Ok(sizes)
+}
+
 /// Loads an image file as a linear-float texture with mips; see the module docs for how
 /// `usage` decides sRGB decoding.
 ///

@@ -203,6 +203,39 @@ pub fn bake_report(stats: &BakeStats) -> String {
     )
 }
 
+/// A warning when the baked `values` are all the same (within one 8-bit grey level): a
+/// constant thickness map says nothing, and is usually a sign of a mesh or distance problem,
+/// named here with the likely cause. `None` when the values vary.
+pub fn constant_warning(values: &[f32], stats: &BakeStats) -> Option<String> {
+    let (lo, hi) = values
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if values.is_empty() || hi - lo > 1.0 / 255.0 {
+        return None;
+    }
+    let why = if hi <= 0.5 / 255.0 {
+        format!(
+            "no ray met the mesh within the maximum distance {} (an open mesh, normals \
+             pointing inward, or --max-distance too small)",
+            stats.max_distance
+        )
+    } else if lo >= 1.0 - 0.5 / 255.0 {
+        format!(
+            "every ray met the mesh within the maximum distance {} (try a larger \
+             --max-distance)",
+            stats.max_distance
+        )
+    } else {
+        "the mesh is equally thick everywhere (a sphere is)".to_string()
+    };
+    Some(format!(
+        "every one of the {} baked samples is {lo:.3}: the thickness map is constant; {why}",
+        values.len()
+    ))
+}
+
 /// The mesh's bounding-box diagonal (the default maximum distance).
 pub fn bounding_box_diagonal(mesh: &Mesh) -> f32 {
     let (lo, hi) = mesh.positions.iter().fold(
@@ -455,5 +488,26 @@ mod tests {
             "baked 10 samples x 256 rays in 1.50 s (max distance 2); Monte Carlo error: mean \
              ±0.0200, worst case ±0.0300"
         );
+    }
+
+    #[test]
+    fn constant_maps_are_named_with_their_likely_cause() {
+        let stats = BakeStats {
+            samples: 3,
+            rays: 768,
+            seconds: 0.1,
+            max_distance: 2.0,
+            std_error: 0.03,
+            mean_std_error: 0.02,
+        };
+        let w = constant_warning(&[0.0; 3], &stats).unwrap();
+        assert!(
+            w.contains("0.000") && w.contains("no ray met the mesh"),
+            "{w}"
+        );
+        let w = constant_warning(&[1.0; 3], &stats).unwrap();
+        assert!(w.contains("larger"), "{w}");
+        assert!(constant_warning(&[0.2, 0.5, 0.9], &stats).is_none());
+        assert!(constant_warning(&[], &stats).is_none());
     }
 }

@@ -114,6 +114,10 @@ pub fn bake_texture(mesh: &Mesh, options: &BakeOptions) -> Result<(ThicknessMap,
         ));
     }
     let (texels, points) = rasterize(mesh, size);
+    if texels.is_empty() {
+        // Baking nothing would write an all-black map: "thick everywhere", silently.
+        return Err(LucentError::InvalidInput(no_coverage_message(mesh, size)));
+    }
     let (baked, stats) = baker.run(&points, start);
     let n = (size as usize).pow(2);
     let mut values = vec![0.0f32; n];
@@ -132,6 +136,46 @@ pub fn bake_texture(mesh: &Mesh, options: &BakeOptions) -> Result<(ThicknessMap,
         },
         stats,
     ))
+}
+
+/// Why a mesh's UVs cover no texel centre of a `size` map, with the numbers.
+fn no_coverage_message(mesh: &Mesh, size: u32) -> String {
+    let (lo, hi) = mesh.uvs.iter().filter(|uv| uv.is_finite()).fold(
+        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+        |(lo, hi), uv| (lo.min(*uv), hi.max(*uv)),
+    );
+    let texel = 1.0 / size as f32;
+    let mut with_area = 0usize;
+    let mut largest = 0.0f32;
+    for tri in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| mesh.uvs[tri[k] as usize]);
+        let area = 0.5 * cross2(b - a, c - a).abs();
+        if area.is_finite() && area > 0.0 {
+            with_area += 1;
+            largest = largest.max(area);
+        }
+    }
+    let why = if !(lo.x < 1.0 && lo.y < 1.0 && hi.x > 0.0 && hi.y > 0.0) {
+        "they lie outside [0, 1] (the baker clips, it does not wrap)".to_string()
+    } else if with_area == 0 {
+        "every triangle has zero UV area".to_string()
+    } else {
+        format!(
+            "no triangle's UVs contain a texel centre (the largest covers {:.2} texels)",
+            largest / (texel * texel)
+        )
+    };
+    format!(
+        "thickness texture bake: the mesh's UVs cover no texel of the {size}x{size} map, so \
+         the map would be empty (black: thick everywhere): its {} triangles' UVs span u {:.4} \
+         to {:.4}, v {:.4} to {:.4}, and {why}; bake per vertex (--per-vertex) or give the \
+         mesh a UV layout in [0, 1]",
+        mesh.triangle_count(),
+        lo.x,
+        hi.x,
+        lo.y,
+        hi.y
+    )
 }
 
 /// 2D cross product (twice the signed area of the triangle `o, o + a, o + b`).
@@ -266,6 +310,31 @@ mod tests {
                 assert_eq!(values[i], if ring <= 2 { 0.5 } else { 0.0 });
             }
         }
+    }
+
+    #[test]
+    fn uvs_that_cover_no_texel_are_refused_with_the_numbers() {
+        let mut mesh = Mesh::generate(crate::scene::Shape::Sphere { radius: 1.0 }, 8, 4);
+        // Every UV squeezed into a speck smaller than a texel.
+        for uv in &mut mesh.uvs {
+            *uv = Vec2::splat(0.3) + *uv * 1e-4;
+        }
+        let options = BakeOptions {
+            rays: 4,
+            texture_size: 64,
+            ..BakeOptions::default()
+        };
+        let e = bake_texture(&mesh, &options).unwrap_err().to_string();
+        assert!(
+            e.contains("cover no texel of the 64x64 map") && e.contains("u 0.3000 to 0.3001"),
+            "{e}"
+        );
+        assert!(e.contains("--per-vertex"), "{e}");
+        for uv in &mut mesh.uvs {
+            *uv += Vec2::splat(5.0);
+        }
+        let e = bake_texture(&mesh, &options).unwrap_err().to_string();
+        assert!(e.contains("outside [0, 1]"), "{e}");
     }
 
     #[test]

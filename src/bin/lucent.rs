@@ -803,12 +803,26 @@ fn bake_thickness(
     };
     if let Some(out) = &out {
         let (map, stats) = lucent::bake::bake_texture(&loaded.mesh, &options)?;
+        let covered: Vec<f32> = (map.values.iter().zip(&map.coverage))
+            .filter_map(|(&v, &c)| c.then_some(v))
+            .collect();
+        if let Some(warning) = lucent::bake::constant_warning(&covered, &stats) {
+            eprintln!("lucent: warning: {warning}");
+        }
         map.write_png(out)?;
         println!("{}", lucent::bake::bake_report(&stats));
-        println!("wrote {} ({size}x{size})", out.display());
+        println!(
+            "wrote {} ({size}x{size}; the UVs cover {} texels, {:.1}%)",
+            out.display(),
+            covered.len(),
+            100.0 * covered.len() as f64 / f64::from(size).powi(2)
+        );
     }
     if let Some(per_vertex) = &per_vertex {
         let (values, stats) = lucent::bake::bake_per_vertex(&loaded.mesh, &options)?;
+        if let Some(warning) = lucent::bake::constant_warning(&values, &stats) {
+            eprintln!("lucent: warning: {warning}");
+        }
         let colors: Vec<glam::Vec3> = values.iter().map(|&v| glam::Vec3::splat(v)).collect();
         scene::obj::write_obj_with_colors(per_vertex, &loaded.mesh, &colors)?;
         println!("{}", lucent::bake::bake_report(&stats));

@@ -44,6 +44,25 @@ use crate::error::{LucentError, Result, VkResultExt};
 use crate::files::{read_capped, read_optional};
 use crate::images::output::write_file_atomic;
 
+/// The platform's per-user cache directory (see [`ShaderCompiler::default_cache_dir`]).
+fn user_cache_dir() -> PathBuf {
+    user_cache_dir_from(|name| std::env::var_os(name))
+}
+
+/// [`user_cache_dir`] with the environment given as a lookup (for tests). Relative values are
+/// ignored, as the XDG base directory specification asks.
+fn user_cache_dir_from(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> PathBuf {
+    let var = |name: &str| env(name).map(PathBuf::from).filter(|p| p.is_absolute());
+    let found = if cfg!(windows) {
+        var("LOCALAPPDATA")
+    } else if cfg!(target_os = "macos") {
+        var("HOME").map(|h| h.join("Library/Caches"))
+    } else {
+        var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")))
+    };
+    found.unwrap_or_else(std::env::temp_dir)
+}
+
 /// Everything besides the inputs that changes the SPIR-V; part of every cache key. Change it when a
 /// compile option below changes, so old cache entries stop matching. (A newer system shaderc does
 /// not invalidate entries: their SPIR-V stays valid, only possibly less optimised.)
@@ -161,7 +180,10 @@ impl ShaderCompiler {
         if !glsl_root.is_dir() {
             return Err(LucentError::file(
                 &glsl_root,
-                "GLSL root is not a directory (set LUCENT_GLSL_DIR to the repository's glsl/ folder)",
+                "GLSL root is not a directory; lucent looks in $LUCENT_GLSL_DIR, then beside \
+                 the executable (glsl/, ../share/lucent/glsl, glsl/ in a directory above it), \
+                 then in the source tree it was built from: set LUCENT_GLSL_DIR to lucent's \
+                 glsl/ folder",
             ));
         }
         // Absolute, so dependencies and cache-hit checks do not depend on the working directory.
@@ -179,23 +201,43 @@ impl ShaderCompiler {
         })
     }
 
-    /// The GLSL root used when none is given: `$LUCENT_GLSL_DIR`, else the crate's own `glsl/`.
+    /// The GLSL root used when none is given: `$LUCENT_GLSL_DIR`; else the first shader tree
+    /// found from the running executable: `glsl/` beside it, `../share/lucent/glsl` (an
+    /// installed layout), or `glsl/` in a directory above it (the repository a `target/`
+    /// build runs from: `cargo run`, the tests); else the source tree the library was
+    /// compiled from, when it still exists (a host embedding the library). A tree is
+    /// recognised by its `fullscreen.vert`.
     pub fn default_glsl_root() -> PathBuf {
-        match std::env::var_os("LUCENT_GLSL_DIR") {
-            Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-            _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"),
+        if let Some(dir) = std::env::var_os("LUCENT_GLSL_DIR").filter(|d| !d.is_empty()) {
+            return PathBuf::from(dir);
         }
+        let is_root = |dir: &Path| dir.join("fullscreen.vert").is_file();
+        let compiled_from = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+        let exe_dir = std::env::current_exe()
+            .ok()
+            .and_then(|exe| exe.canonicalize().ok())
+            .and_then(|exe| exe.parent().map(Path::to_path_buf));
+        if let Some(dir) = exe_dir {
+            let beside = [dir.join("glsl"), dir.join("../share/lucent/glsl")];
+            let above = dir.ancestors().skip(1).map(|a| a.join("glsl"));
+            if let Some(found) = beside.into_iter().chain(above).find(|d| is_root(d)) {
+                return found;
+            }
+        }
+        compiled_from
     }
 
-    /// The SPIR-V cache directory used when none is given: `$LUCENT_CACHE_DIR`, else
-    /// `target/lucent-cache` in the crate's directory.
+    /// The SPIR-V cache directory used when none is given (the thickness bake cache and the
+    /// pipeline cache live in it too): `$LUCENT_CACHE_DIR`, else `lucent` in the user's cache
+    /// directory: `$XDG_CACHE_HOME` or `~/.cache` on Linux and other Unixes,
+    /// `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's temporary
+    /// directory when none of those is known. Per user, so another user's run neither warns
+    /// nor writes into someone else's tree.
     pub fn default_cache_dir() -> PathBuf {
-        match std::env::var_os("LUCENT_CACHE_DIR") {
-            Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-            _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("target")
-                .join("lucent-cache"),
+        if let Some(dir) = std::env::var_os("LUCENT_CACHE_DIR").filter(|d| !d.is_empty()) {
+            return PathBuf::from(dir);
         }
+        user_cache_dir().join("lucent")
     }
 
     /// The (absolute) GLSL root directory.
@@ -902,6 +944,42 @@ mod tests {
         assert!(!compiler.compile("a.comp", &[]).unwrap().from_cache);
         assert!(!compiler.compile("a.comp", &[]).unwrap().from_cache);
         std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn default_paths_are_per_user_and_found_from_the_executable() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |name: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, v)| std::ffi::OsString::from(v))
+            }
+        };
+        if cfg!(all(unix, not(target_os = "macos"))) {
+            assert_eq!(
+                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "/c"), ("HOME", "/h")])),
+                Path::new("/c")
+            );
+            assert_eq!(
+                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "rel"), ("HOME", "/h")])),
+                Path::new("/h/.cache")
+            );
+        }
+        assert_eq!(user_cache_dir_from(env(&[])), std::env::temp_dir());
+        // Not under the source tree, unless the user's cache is there.
+        if std::env::var_os("LUCENT_CACHE_DIR").is_none() {
+            assert!(ShaderCompiler::default_cache_dir().ends_with("lucent"));
+        }
+        // This test runs from target/<profile>/deps: the repository's tree is found above it.
+        if std::env::var_os("LUCENT_GLSL_DIR").is_none() {
+            let found = ShaderCompiler::default_glsl_root().canonicalize().unwrap();
+            let repo = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("glsl")
+                .canonicalize()
+                .unwrap();
+            assert_eq!(found, repo);
+        }
     }
 
     #[test]

@@ -144,7 +144,7 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// The small preset (QUICK_REPORT_TIME on the project's 2-core lavapipe machine).
+        /// The small preset (about 15 s on the project's 2-core lavapipe machine).
         #[arg(long)]
         quick: bool,
         /// Resolution as WIDTHxHEIGHT (suite: of the per-technique tables; default 1024x768,

@@ -105,3 +105,25 @@ impl LucentError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn out_of_memory_names_the_resource_its_size_and_what_to_try() {
+        let e = LucentError::Allocation {
+            name: "graph slot 9: sss.temp, hdr".into(),
+            bytes: 4 << 30,
+            source: gpu_allocator::AllocationError::OutOfMemory,
+        }
+        .to_string();
+        assert!(
+            e.contains("'graph slot 9: sss.temp, hdr'")
+                && e.contains("4 GiB")
+                && e.contains("smaller --size"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}

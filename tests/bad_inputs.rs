@@ -8,11 +8,20 @@
 //!   on stderr that names the file and contains the substrings, and nothing panicked;
 //! - in-process: `lucent::scene::inspect::inspect_file` returns the same error (and does not
 //!   panic), so a failure points at the loader rather than the command line.
+//!
+//! The README's second table lists files that load with a repair or a warning: `inspect` must
+//! succeed and print the note. Cases that cannot be committed as files are made at run time:
+//! FIFOs, devices and directories where files are expected (each must fail at once, never
+//! block or read forever), a 16384x16384 normal map (refused from its header in under a
+//! second), command lines with absurd counts or misplaced knobs (one `lucent: error:` line, or a
+//! warning naming the technique they need), a bake whose UVs cover no texel, a demo script with
+//! a bad key.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
-/// One row of the README's table.
+/// One row of the README's tables.
 struct Case {
     file: String,
     expected: Vec<String>,
@@ -31,16 +40,32 @@ fn backticked(cell: &str) -> Vec<String> {
         .collect()
 }
 
-/// The table rows and the helper files listed in the README.
+/// The README's rows: files that must fail, files that must load with a note, helpers.
+struct Readme {
+    failing: Vec<Case>,
+    loaded: Vec<Case>,
+    helpers: Vec<String>,
+}
+
+/// The table rows and the helper files listed in the README (the failing table's rows for the
+/// first two tests; see [`read_corpus`] for all of them).
 fn read_readme() -> (Vec<Case>, Vec<String>) {
+    let r = read_corpus();
+    let mut helpers = r.helpers;
+    helpers.extend(r.loaded.into_iter().map(|c| c.file));
+    (r.failing, helpers)
+}
+
+fn read_corpus() -> Readme {
     let readme = std::fs::read_to_string(corpus_dir().join("README.md"))
         .expect("tests/data/bad/README.md is readable");
-    let (mut cases, mut helpers) = (Vec::new(), Vec::new());
-    let mut in_helpers = false;
+    let (mut cases, mut loaded, mut helpers) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut in_helpers, mut in_loaded) = (false, false);
     for line in readme.lines() {
         let line = line.trim();
         if line.starts_with("## ") {
             in_helpers = line.eq_ignore_ascii_case("## helpers");
+            in_loaded = line.starts_with("## Loaded");
         } else if line.starts_with("| `") {
             let cells: Vec<&str> = line.trim_matches('|').split('|').collect();
             let file = backticked(cells[0]);
@@ -50,21 +75,31 @@ fn read_readme() -> (Vec<Case>, Vec<String>) {
                 !expected.is_empty(),
                 "README row without a substring: {line}"
             );
-            cases.push(Case {
+            let case = Case {
                 file: file[0].clone(),
                 expected,
-            });
+            };
+            if in_loaded {
+                loaded.push(case);
+            } else {
+                cases.push(case);
+            }
         } else if in_helpers && line.starts_with("- `") {
             helpers.push(backticked(line)[0].clone());
         }
     }
-    (cases, helpers)
+    Readme {
+        failing: cases,
+        loaded,
+        helpers,
+    }
 }
 
 #[test]
 fn readme_lists_every_corpus_file() {
     let (cases, helpers) = read_readme();
-    assert!(cases.len() >= 28, "only {} cases", cases.len());
+    assert!(cases.len() >= 33, "only {} cases", cases.len());
+    assert!(read_corpus().loaded.len() >= 5);
     let listed: Vec<&str> = cases
         .iter()
         .map(|c| c.file.as_str())
@@ -154,4 +189,545 @@ fn cli_reports_each_problem() {
         }
     }
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+#[test]
+fn repaired_files_load_and_say_what_was_repaired() {
+    let mut failures = Vec::new();
+    for case in &read_corpus().loaded {
+        let path = corpus_dir().join(&case.file);
+        if let Err(e) = lucent::scene::inspect::inspect_file(&path) {
+            failures.push(format!("{}: inspect_file failed: {e}", case.file));
+        }
+        let out = lucent(&["inspect", &path.to_string_lossy()]);
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        if !out.status.success() {
+            failures.push(format!(
+                "{}: exit status {}:\n{text}",
+                case.file, out.status
+            ));
+            continue;
+        }
+        let missing: Vec<&String> = case
+            .expected
+            .iter()
+            .filter(|s| !text.contains(s.as_str()))
+            .collect();
+        if !missing.is_empty() {
+            failures.push(format!("{}: {missing:?} not in:\n{text}", case.file));
+        }
+    }
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+/// `lucent ARGS` with a time limit (a test that hangs is a failure, not a stuck CI job).
+fn lucent_in(dir: Option<&Path>, args: &[&str]) -> Output {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lucent"));
+    command
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    if let Some(dir) = dir {
+        command.current_dir(dir);
+    }
+    let mut child = command.spawn().expect("the lucent binary runs");
+    let start = Instant::now();
+    while child.try_wait().expect("waitable").is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("lucent {args:?} still running after 60 s (hung)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}
+
+fn lucent(args: &[&str]) -> Output {
+    lucent_in(None, args)
+}
+
+/// The single `lucent: error:` line of a failed run (panics if there is not exactly one, the
+/// run succeeded or anything panicked).
+fn one_error_line(args: &[&str], out: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked:\n{stderr}");
+    let errors: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("lucent: error:"))
+        .collect();
+    assert_eq!(errors.len(), 1, "{args:?}: not one error line:\n{stderr}");
+    let lines = stderr.lines().filter(|l| !l.trim().is_empty()).count();
+    assert_eq!(
+        lines, 1,
+        "{args:?}: a command-line error is one line, not:\n{stderr}"
+    );
+    errors[0].to_string()
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("bad-inputs-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+const SCENE: &str = "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\n[[mesh]]\nname = \"m\"\n\
+                     MESH\n\n[[material]]\nname = \"a\"\nMATERIAL\n\n[[object]]\nmesh = \"m\"\n\
+                     material = \"a\"\n";
+
+fn scene_with(mesh: &str, material: &str) -> String {
+    SCENE.replace("MESH", mesh).replace("MATERIAL", material)
+}
+
+#[cfg(unix)]
+#[test]
+fn devices_fifos_and_directories_are_refused_at_once() {
+    let dir = temp_dir("special");
+    let fifo = |name: &str| {
+        let path = dir.join(name);
+        let made = Command::new("mkfifo")
+            .arg(&path)
+            .status()
+            .expect("mkfifo runs");
+        assert!(made.success(), "mkfifo {name}");
+        path
+    };
+    fifo("fifo.obj");
+    fifo("fifo.toml");
+    fifo("fifo.png");
+    fifo("fifo.mtl");
+    for (name, target) in [("zero.obj", "/dev/zero"), ("zero.png", "/dev/zero")] {
+        std::os::unix::fs::symlink(target, dir.join(name)).unwrap();
+    }
+    std::os::unix::fs::symlink(dir.join("fifo.toml"), dir.join("link.toml")).unwrap();
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    std::fs::write(
+        dir.join("fifo_mesh.toml"),
+        scene_with("obj = \"fifo.obj\"", "albedo = [1, 1, 1]"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("fifo_normal_map.toml"),
+        scene_with("generator = \"sphere\"", "normal_texture = \"zero.png\""),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("uses_fifo.obj"),
+        "mtllib fifo.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let d = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let fifo_says = "is a FIFO (named pipe), not a regular file";
+    let zero_says = "is a symlink to /dev/zero, which is a character device, not a regular file";
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            vec!["inspect".into(), d("fifo.obj")],
+            vec!["fifo.obj", fifo_says],
+        ),
+        (
+            vec!["inspect".into(), d("fifo.toml")],
+            vec!["fifo.toml", fifo_says],
+        ),
+        (
+            vec!["inspect".into(), d("fifo.png")],
+            vec!["fifo.png", fifo_says],
+        ),
+        (
+            vec!["inspect".into(), d("fifo.mtl")],
+            vec!["fifo.mtl", fifo_says],
+        ),
+        (
+            vec!["inspect".into(), d("zero.obj")],
+            vec!["zero.obj", zero_says],
+        ),
+        (
+            vec!["inspect".into(), d("zero.png")],
+            vec!["zero.png", zero_says],
+        ),
+        (
+            vec!["inspect".into(), d("link.toml")],
+            vec!["link.toml", "is a symlink to", "a FIFO (named pipe)"],
+        ),
+        (
+            vec!["inspect".into(), d("folder.obj")],
+            vec!["folder.obj", "is a directory, not a regular file"],
+        ),
+        (
+            vec!["inspect".into(), d("uses_fifo.obj")],
+            vec!["fifo.mtl", "mtllib on line 1", fifo_says],
+        ),
+        (
+            vec!["inspect".into(), d("fifo_mesh.toml")],
+            vec!["fifo.obj", fifo_says],
+        ),
+        (
+            vec!["render".into(), "--scene".into(), d("fifo.toml")],
+            vec!["fifo.toml", fifo_says],
+        ),
+        (
+            vec!["render".into(), "--scene".into(), d("fifo_normal_map.toml")],
+            vec!["zero.png", zero_says],
+        ),
+        (
+            vec![
+                "bake-thickness".into(),
+                d("zero.obj"),
+                "--per-vertex".into(),
+                d("o.obj"),
+            ],
+            vec!["zero.obj", zero_says],
+        ),
+    ];
+    for (args, wanted) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let start = Instant::now();
+        let out = lucent(&args);
+        let line = one_error_line(&args, &out);
+        for w in wanted {
+            assert!(line.contains(w), "{args:?}: '{w}' not in: {line}");
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "{args:?} took {:?}",
+            start.elapsed()
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Command lines with absurd counts, values out of range, misplaced arguments: each is one
+/// `lucent: error:` line (exit code 2 for what the parser refuses) with the substrings, before
+/// any GPU work.
+#[test]
+fn command_line_errors_are_one_line_with_the_fix() {
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &["bench", "--frames", "18446744073709551615"],
+            &["--frames", "from 1 to 100000", "lucent bench --help"],
+        ),
+        (&["bench", "--frames", "4294967295"], &["from 1 to 100000"]),
+        (&["bench", "--frames", "0"], &["from 1 to 100000"]),
+        (
+            &["bench", "--warmup", "99999999"],
+            &["--warmup", "from 0 to 10000"],
+        ),
+        (
+            &["report", "--rounds", "4294967296"],
+            &["--rounds", "from 1 to 100000"],
+        ),
+        (
+            &["bench", "--sensitivity", "-1"],
+            &["--sensitivity", "'-1' is not a finite number >= 0"],
+        ),
+        (&["render", "--sensitivity", "nan"], &["finite number"]),
+        (
+            &[
+                "bake-thickness",
+                "x.obj",
+                "--size",
+                "16384",
+                "--out",
+                "t.png",
+            ],
+            &["--size", "from 1 to 8192"],
+        ),
+        (
+            &["bake-thickness", "x.obj", "--rays", "0"],
+            &["--rays", "from 1 to 1048576"],
+        ),
+        (
+            &["bake-thickness", "x.obj", "--max-distance", "-2"],
+            &["--max-distance", "finite number > 0"],
+        ),
+        (
+            &["render", "--sss-gaussians", "9"],
+            &["--sss-gaussians", "from 1 to 8"],
+        ),
+        (&["render", "--size", "0x10"], &["between 1 and 16384"]),
+        (&["render", "--sss-taps", "4"], &["not one of 3, 5, 7"]),
+        (
+            &["render", "--bogus"],
+            &["unexpected argument '--bogus'", "lucent render --help"],
+        ),
+        (&["paint"], &["unrecognized subcommand 'paint'"]),
+        (&[], &["no command given", "render", "bench"]),
+        (&["bench", "--format", "xml"], &["xml"]),
+    ];
+    for &(args, wanted) in cases {
+        let out = lucent(args);
+        let line = one_error_line(args, &out);
+        for w in wanted {
+            assert!(line.contains(w), "{args:?}: '{w}' not in: {line}");
+        }
+    }
+    // Parser errors exit with 2, as clap's convention has it.
+    assert_eq!(lucent(&["bench", "--frames", "0"]).status.code(), Some(2));
+    // Help and version are not errors.
+    let help = lucent(&["report", "--help"]);
+    assert!(help.status.success());
+    let help = String::from_utf8_lossy(&help.stdout).into_owned();
+    assert!(help.contains("--quick"), "{help}");
+}
+
+#[test]
+fn knobs_that_do_not_apply_warn_naming_the_technique_they_need() {
+    let warnings = |args: &[&str]| {
+        let out = lucent(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .filter(|l| l.starts_with("lucent: warning:"))
+            .map(str::to_string)
+            .collect::<Vec<_>>()
+    };
+    let w = warnings(&[
+        "plan",
+        "--technique",
+        "none",
+        "--sss-taps",
+        "3",
+        "--sss-packed",
+    ]);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("--sss-taps has no effect with --technique none")
+            && w[0].contains("--technique lbb"),
+        "{w:?}"
+    );
+    assert!(
+        w[1].contains("--sss-packed") && w[1].contains("--technique lbb"),
+        "{w:?}"
+    );
+    let w = warnings(&[
+        "plan",
+        "--scene",
+        "skin",
+        "--technique",
+        "control",
+        "--sss-packed",
+    ]);
+    assert!(
+        w.len() == 1 && w[0].contains("--technique control") && w[0].contains("lbb"),
+        "{w:?}"
+    );
+    let w = warnings(&[
+        "plan",
+        "--technique",
+        "translucency",
+        "--sss-gaussians",
+        "2",
+    ]);
+    assert!(
+        w.len() == 1 && w[0].contains("control, lcb or lbb"),
+        "{w:?}"
+    );
+    let w = warnings(&["plan", "--technique", "none", "--grayscale"]);
+    assert!(
+        w.len() == 1 && w[0].contains("--technique translucency"),
+        "{w:?}"
+    );
+    // Where they apply, no warning.
+    let w = warnings(&[
+        "plan",
+        "--scene",
+        "skin",
+        "--technique",
+        "lbb",
+        "--sss-taps",
+        "3",
+        "--sss-packed",
+        "--sensitivity",
+        "2",
+    ]);
+    assert!(w.is_empty(), "{w:?}");
+}
+
+/// Writes a `size` x `size` RGB8 PNG of the flat normal (128, 128, 255) row by row, so the test
+/// never holds the image in memory.
+fn write_flat_normal_map(path: &Path, size: u32) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut encoder = png::Encoder::new(file, size, size);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Fastest);
+    let mut writer = encoder
+        .write_header()
+        .unwrap()
+        .into_stream_writer()
+        .unwrap();
+    let row: Vec<u8> = (0..size).flat_map(|_| [128u8, 128, 255]).collect();
+    for _ in 0..size {
+        std::io::Write::write_all(&mut writer, &row).unwrap();
+    }
+    writer.finish().unwrap();
+}
+
+#[test]
+fn a_16384_squared_normal_map_is_refused_from_its_header_in_under_a_second() {
+    let dir = temp_dir("huge-normal-map");
+    let map = dir.join("normal16k.png");
+    write_flat_normal_map(&map, 16384);
+    // A real, decodable PNG of that size (not only a header).
+    let (w, h) = image::ImageReader::open(&map)
+        .unwrap()
+        .into_dimensions()
+        .unwrap();
+    assert_eq!((w, h), (16384, 16384));
+    std::fs::write(
+        dir.join("scene.toml"),
+        scene_with(
+            "generator = \"sphere\"",
+            "normal_texture = \"normal16k.png\"\ntranslucency = { thickness = 0.5 }",
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("thickness.toml"),
+        scene_with(
+            "generator = \"sphere\"",
+            "translucency = { thickness = \"normal16k.png\" }",
+        ),
+    )
+    .unwrap();
+    let scene = dir.join("scene.toml").to_string_lossy().into_owned();
+    let thickness = dir.join("thickness.toml").to_string_lossy().into_owned();
+    let map_arg = map.to_string_lossy().into_owned();
+    let runs: [&[&str]; 4] = [
+        &["inspect", &map_arg],
+        &[
+            "render",
+            "--scene",
+            &scene,
+            "--technique",
+            "lbb",
+            "--size",
+            "64x48",
+            "--out",
+            "x.png",
+        ],
+        &[
+            "render", "--scene", &scene, "--size", "64x48", "--out", "x.png",
+        ],
+        &[
+            "render",
+            "--scene",
+            &thickness,
+            "--technique",
+            "translucency",
+            "--size",
+            "64x48",
+        ],
+    ];
+    for args in runs {
+        let start = Instant::now();
+        let out = lucent_in(Some(&dir), args);
+        let took = start.elapsed();
+        let line = one_error_line(args, &out);
+        assert!(
+            line.contains("normal16k.png")
+                && line.contains("16384x16384")
+                && line.contains("8192x8192")
+                && line.contains("of host memory"),
+            "{args:?}: {line}"
+        );
+        assert!(took < Duration::from_secs(1), "{args:?} took {took:?}");
+        eprintln!("{args:?}: refused in {took:?}: {line}");
+    }
+    assert!(!dir.join("x.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_bake_whose_uvs_cover_no_texel_is_an_error_not_a_black_map() {
+    let dir = temp_dir("bake-no-texel");
+    // A tetrahedron whose UVs all sit in a speck smaller than a texel.
+    let obj = dir.join("speck.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0.3 0.3\nvt 0.30001 0.3\nvt 0.3 0.30001\n\
+         f 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 1/1 4/3 3/2\nf 2/2 3/3 4/1\n",
+    )
+    .unwrap();
+    let out_png = dir.join("t.png");
+    let args = [
+        "bake-thickness",
+        &*obj.to_string_lossy(),
+        "--out",
+        &*out_png.to_string_lossy(),
+        "--rays",
+        "8",
+    ]
+    .map(str::to_string);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = lucent(&args);
+    let line = one_error_line(&args, &out);
+    assert!(
+        line.contains("cover no texel of the 512x512 map") && line.contains("--per-vertex"),
+        "{line}"
+    );
+    assert!(!out_png.exists(), "a map was written");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[cfg(feature = "window")]
+#[test]
+fn a_bad_demo_script_fails_before_any_window_with_its_line() {
+    let dir = temp_dir("demo-script");
+    let script = dir.join("bad.script");
+    std::fs::write(&script, "# keys\n1 key F1\n2 key Hyperspace\n3 quit\n").unwrap();
+    let args = ["demo", "--script", &*script.to_string_lossy()].map(str::to_string);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    // No display: the script is read first, so its error comes before "cannot open a window".
+    let out = lucent(&args);
+    let line = one_error_line(&args, &out);
+    assert!(
+        line.contains("bad.script") && line.contains("line 3: unknown key 'Hyperspace'"),
+        "{line}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn docs_and_help_agree_with_the_binary() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let format = std::fs::read_to_string(root.join("docs/scene-format.toml")).unwrap();
+    let limit = format!("Lights (at most {})", lucent::scene::MAX_LIGHTS);
+    assert!(
+        format.contains(&limit),
+        "docs/scene-format.toml does not say '{limit}'"
+    );
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let help = String::from_utf8_lossy(&lucent(&["report", "--help"]).stdout).into_owned();
+    let quick = "about 15 s";
+    assert!(help.contains(quick), "report --help: {help}");
+    let row = readme
+        .lines()
+        .find(|l| l.starts_with("| `lucent report [--out DIR] [--quick]`"))
+        .unwrap();
+    assert!(row.contains(&format!("`--quick` {quick}")), "{row}");
+    // The light limit is the one the loader applies.
+    let light = "[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 1\n";
+    let scene = |n: usize| {
+        format!(
+            "{}{}",
+            scene_with("generator = \"sphere\"", ""),
+            light.repeat(n)
+        )
+    };
+    let path = Path::new("lights.toml");
+    assert!(lucent::scene::file::parse_scene(path, &scene(lucent::scene::MAX_LIGHTS)).is_ok());
+    let e = lucent::scene::file::parse_scene(path, &scene(lucent::scene::MAX_LIGHTS + 1))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("at most 64"), "{e}");
 }

@@ -260,7 +260,7 @@ impl Locator<'_> {
                 name.strip_prefix(section).and_then(|r| r.strip_prefix('.'))
             };
             let Some(within) = within else { continue };
-            if !index.is_none_or(|want| *i == want) {
+            if index.is_some_and(|want| *i != want) {
                 continue;
             }
             let Some((k, value)) = line.split_once('=') else {

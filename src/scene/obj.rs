@@ -783,7 +783,12 @@ fn resolve_texture(dir: &Path, name: &str) -> Option<PathBuf> {
     if as_written.is_file() {
         return Some(as_written);
     }
-    let slashed = dir.join(name.replace('\\', "/"));
+    // `.` components dropped, so `.\tex.jpg` is shown as `dir/tex.jpg`.
+    let slashed: PathBuf = Path::new(&name.replace('\\', "/"))
+        .components()
+        .filter(|c| *c != std::path::Component::CurDir)
+        .collect();
+    let slashed = dir.join(slashed);
     slashed.is_file().then_some(slashed)
 }
 
@@ -1397,7 +1402,7 @@ mod tests {
         .unwrap();
         let (m, notes) = load_mtl(&dir.join("win.mtl")).unwrap();
         assert!(notes.is_empty(), "{notes:?}");
-        assert_eq!(m[0].diffuse_texture, Some(dir.join("./wood.png")));
+        assert_eq!(m[0].diffuse_texture, Some(dir.join("wood.png")));
         assert_eq!(m[0].normal_texture, Some(dir.join("maps/wood.png")));
         std::fs::remove_dir_all(dir).ok();
     }

@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | `.obj` | [`load_obj`] | vertices, triangles, attributes, bounds, materials, repairs |
 //! | `.mtl` | [`load_mtl`] | materials with their colours and textures |
-//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`load_texture_level0`](super::texture::load_texture_level0) (as data, no sRGB decode) | size, mips, value range |
+//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`load_texture_level0`] (as data, no sRGB decode) | size, mips, value range |
 //! | `.toml` | [`load_scene_file`] | meshes, objects, lights, camera |
 
 use std::fmt::Write as _;

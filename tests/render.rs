@@ -242,6 +242,7 @@ fn merged_and_unmerged_graphs_render_the_same_frame() {
     settings.compile = CompileOptions {
         merge: false,
         alias: false,
+        ..CompileOptions::default()
     };
     let (separate, _) = render("smoke", settings);
     let max_diff = merged

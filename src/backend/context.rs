@@ -111,6 +111,8 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: f32,
     /// Valid bits of timestamps written on lucent's queue family.
     pub timestamp_valid_bits: u32,
+    /// `limits.minUniformBufferOffsetAlignment`: how per-frame uniform slots are aligned.
+    pub uniform_offset_alignment: u64,
     /// `hostQueryReset` (Vulkan 1.2) is enabled: query pools may be reset from the host.
     pub host_query_reset: bool,
     /// `independentBlend` is enabled: colour attachments may use different blend states.

@@ -132,6 +132,7 @@ pub(super) fn probe_device(
         api_version: props.api_version,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamp_valid_bits: family.timestamp_valid_bits,
+        uniform_offset_alignment: props.limits.min_uniform_buffer_offset_alignment.max(1),
         host_query_reset: v12.host_query_reset == vk::TRUE,
         independent_blend: core.independent_blend == vk::TRUE,
         storage_image_write_without_format: core.shader_storage_image_write_without_format

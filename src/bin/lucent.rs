@@ -12,7 +12,7 @@ use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
 use lucent::features::deferred::GBufferPrecision;
 use lucent::features::sss::{SssKnobs, SssPrecision};
-use lucent::frame::{plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use lucent::frame::{plan_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::graph::CompileOptions;
 use lucent::images::output;
 use lucent::measure::bench::{self, BenchOptions};
@@ -198,8 +198,11 @@ struct FrameArgs {
     /// Resolution as WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768", value_parser = parse_size)]
     size: (u32, u32),
-    /// Technique the scene is lit with (`none`: plain deferred lighting).
-    #[arg(long, default_value = "none")]
+    /// What the frame shades: `auto` (default) is what the scene's materials ask for, every
+    /// technique composed in one frame; `none` (plain deferred lighting), `translucency`,
+    /// `control`, `lcb` or `lbb` restrict the frame to one technique (A/B runs, the seeds'
+    /// tables).
+    #[arg(long, default_value = "auto")]
     technique: String,
     /// Do not merge same-pixel passes into subpasses (A/B comparison).
     #[arg(long)]
@@ -306,6 +309,7 @@ impl FrameArgs {
             compile: CompileOptions {
                 merge: !self.no_merge,
                 alias: !self.no_alias,
+                ..CompileOptions::default()
             },
             export_hdr,
             export_gbuffer: false,
@@ -328,6 +332,8 @@ impl FrameArgs {
                 },
             },
             debug_view: None,
+            frames_in_flight: 1,
+            target: None,
         })
     }
 }
@@ -848,7 +854,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Plan { frame } => {
             let scene = bake::load_scene_baked(&frame.scene)?;
             let settings = frame.settings(false)?;
-            let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings)?)?;
+            let plan = plan_frame(&settings, &FrameDesc::new(&scene, &settings)?)?;
             print!("{}", plan.dump());
             Ok(())
         }

@@ -35,7 +35,7 @@ use winit::window::{Window, WindowId};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{ContextDesc, GpuContext};
 use crate::features::debug_view::DebugView;
-use crate::frame::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::images::output;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -137,14 +137,8 @@ pub fn run(options: DemoOptions) -> Result<()> {
             None
         }
     };
-    let technique = match options.technique {
-        Some(t) => t,
-        None => scene
-            .technique
-            .as_deref()
-            .and_then(|t| Technique::parse(t).ok())
-            .unwrap_or(Technique::None),
-    };
+    // Default: what the scene's materials ask for.
+    let technique = options.technique.unwrap_or(Technique::Auto);
     let orbit = OrbitCamera::from_camera(&scene.camera);
     orbit.apply(&mut scene.camera);
     let mut app = Demo {
@@ -825,7 +819,7 @@ impl Demo<'_> {
             technique: self.technique,
             ..self.options.base
         };
-        let Ok(features) = FrameFeatures::new(&self.scene, &settings) else {
+        let Ok(features) = FrameDesc::new(&self.scene, &settings) else {
             return false;
         };
         match view {

@@ -257,6 +257,7 @@ impl CopyFrame {
         let (plan, execs) = graph.compile(CompileOptions {
             merge: false,
             alias: true,
+            ..CompileOptions::default()
         })?;
         let copy_index = names
             .iter()
@@ -545,7 +546,7 @@ impl PassExec for CopyPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::{plan_frame, FrameFeatures, FrameSettings, Technique};
+    use crate::frame::{plan_frame, FrameDesc, FrameSettings, Technique};
 
     fn plan(scene: &str, technique: Technique) -> Plan {
         let scene = crate::bake::scene::load_scene_baked(scene).unwrap();
@@ -553,7 +554,7 @@ mod tests {
             technique,
             ..FrameSettings::new(64, 48)
         };
-        plan_frame(&settings, &FrameFeatures::new(&scene, &settings).unwrap()).unwrap()
+        plan_frame(&settings, &FrameDesc::new(&scene, &settings).unwrap()).unwrap()
     }
 
     #[test]

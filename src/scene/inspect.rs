@@ -88,9 +88,6 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let scene = load_scene_file(path)?;
             let triangles: usize = scene.meshes.iter().map(|m| m.triangle_count()).sum();
             let _ = writeln!(s, "{}: scene '{}'", path.display(), scene.name);
-            if let Some(t) = &scene.technique {
-                let _ = writeln!(s, "  technique: {t}");
-            }
             let _ = writeln!(
                 s,
                 "  meshes: {} ({triangles} triangles)",

@@ -508,10 +508,15 @@ impl Demo<'_> {
                     Some(value) => {
                         let next = knob.stepped(value, action == Action::KnobUp);
                         (knob.set)(&mut self.scene, &mut self.options.base, next);
-                        if knob.rebuild {
+                        // Values only (lights, material and profile tables): the next frame
+                        // writes them into its per-frame slot. A new shape (two materials'
+                        // parameters became equal, or apart) needs a new frame.
+                        let in_place = match self.renderer.as_mut() {
+                            Some(r) => r.retune(&self.options.base) && r.can_update(&self.scene)?,
+                            None => false,
+                        };
+                        if knob.rebuild || !in_place {
                             self.rebuild_pending = true;
-                        } else if let Some(r) = self.renderer.as_mut() {
-                            r.update(&self.scene)?;
                         }
                     }
                     None => self.say(format!("nothing in this scene uses {}", knob.name), false),

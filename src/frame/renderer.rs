@@ -134,6 +134,27 @@ impl Renderer {
             && desc.same_shape(&self.desc, &self.settings))
     }
 
+    /// Takes `settings` if they differ from the frame's only in values the per-frame tables
+    /// carry (the bilateral sensitivity); returns whether it did (otherwise the frame must be
+    /// rebuilt for them).
+    pub fn retune(&mut self, settings: &FrameSettings) -> bool {
+        let values_only = FrameSettings {
+            sss: crate::features::sss::SssKnobs {
+                sensitivity: self.settings.sss.sensitivity,
+                ..settings.sss
+            },
+            width: self.settings.width,
+            height: self.settings.height,
+            technique: self.settings.technique,
+            debug_view: self.settings.debug_view,
+            ..*settings
+        } == self.settings;
+        if values_only {
+            self.settings.sss.sensitivity = settings.sss.sensitivity;
+        }
+        values_only
+    }
+
     /// Writes `scene`'s per-frame values into slot `slot` (whose previous frame has
     /// completed): frame uniforms, the translucency material table, the SSS profile table and
     /// the screen tiles.

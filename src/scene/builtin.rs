@@ -418,7 +418,7 @@ fn edges() -> Result<Scene> {
 fn mixed() -> Result<Scene> {
     let mut s = base_scene(
         "mixed",
-        camera(Vec3::new(0.0, 1.25, 4.6), Vec3::new(0.0, 0.55, 0.0)),
+        camera(Vec3::new(0.0, 1.3, 5.0), Vec3::new(0.0, 0.55, 0.0)),
     );
     s.add_floor();
     let cube = s.add_mesh(generators::generate(Generator::Cube, 6)?);
@@ -443,7 +443,7 @@ fn mixed() -> Result<Scene> {
         Mat4::from_scale_rotation_translation(
             Vec3::splat(0.45),
             glam::Quat::from_rotation_y(0.5),
-            Vec3::new(-2.1, 0.45, -0.2),
+            Vec3::new(-1.85, 0.45, -0.2),
         ),
         cube_material,
     );
@@ -456,7 +456,7 @@ fn mixed() -> Result<Scene> {
         Mat4::from_scale_rotation_translation(
             Vec3::splat(0.55),
             glam::Quat::IDENTITY,
-            Vec3::new(-0.7, 0.55, 0.0),
+            Vec3::new(-0.62, 0.55, 0.0),
         ),
         skin,
     );
@@ -469,7 +469,7 @@ fn mixed() -> Result<Scene> {
         Mat4::from_scale_rotation_translation(
             Vec3::splat(0.55),
             glam::Quat::IDENTITY,
-            Vec3::new(0.7, 0.55, 0.0),
+            Vec3::new(0.62, 0.55, 0.0),
         ),
         marble,
     );
@@ -485,7 +485,7 @@ fn mixed() -> Result<Scene> {
         Mat4::from_scale_rotation_translation(
             Vec3::new(0.5, 0.65, 0.5),
             glam::Quat::from_rotation_y(-0.35),
-            Vec3::new(2.05, 0.7, -0.1),
+            Vec3::new(1.82, 0.7, -0.1),
         ),
         ear,
     );

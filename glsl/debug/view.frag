@@ -1,5 +1,5 @@
 #version 450
-// Debug views of the G-buffer and of the lit image before screen-space SSS (src/passes/debug_view.rs).
+// Debug views of the G-buffer and of the lit image before screen-space SSS (src/features/debug_view.rs).
 // One permutation per view (LUCENT_VIEW_*); the result is written sRGB-encoded like the tonemap's.
 // permutations-only
 // permutation: LUCENT_VIEW_ALBEDO

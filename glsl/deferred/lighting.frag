@@ -11,7 +11,7 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
-// drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
+// drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
 // GDC 2011's per-light term joins diffuse and specular; opaque pixels in those tiles read
 // thickness 0 and get none of it.
 #include "../common/gbuffer.glsl"

@@ -8,17 +8,7 @@ use ash::vk;
 
 use crate::error::{LucentError, Result, VkResultExt};
 
-use super::context::{version_string, ContextDesc, DeviceInfo};
-
-pub(super) fn device_type_name(t: vk::PhysicalDeviceType) -> &'static str {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
-        vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
-        vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
-        vk::PhysicalDeviceType::CPU => "CPU",
-        _ => "other",
-    }
-}
+use super::desc::{version_string, ContextDesc, DeviceInfo};
 
 /// Preference order when no filter is given: discrete > integrated > virtual > CPU > other.
 pub(super) fn device_type_score(t: vk::PhysicalDeviceType) -> u32 {

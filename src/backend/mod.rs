@@ -3,12 +3,13 @@
 //! - [`context`]: the Vulkan context, created by lucent or wrapping a host engine's device.
 //! - [`resources`]: images and buffers with named allocations, readback.
 //! - [`access`]: the one access table every barrier is derived from.
-//! - [`format`]: the one format table (sizes, channels, encodings, names).
+//! - [`format`](mod@format): the one format table (sizes, channels, encodings, names).
 //! - [`shader`]: GLSL compiled at run time with shaderc, SPIR-V cache, pipeline cache.
 //! - [`timer`]: GPU timestamp scopes, read without stalling.
 
 pub mod access;
 pub mod context;
+mod desc;
 mod device;
 pub mod format;
 mod instance;

@@ -286,7 +286,7 @@ pub const DEFAULT_SENSITIVITY: f32 = 1.0;
 /// The screen-space SSS knobs a frame is built with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SssKnobs {
-    /// Refit the profile with this many Gaussians (fewer blur pairs; [`fit_profile`] reports
+    /// Refit the profile with this many Gaussians (fewer blur pairs; [`crate::scene::profile::fit_profile`] reports
     /// the error it costs). `None`: the material's own profile.
     pub gaussians: Option<usize>,
     /// Precision of the sum targets.

@@ -4,14 +4,15 @@
 //! The technique adds no pass of its own. It adds one G-buffer target (`GB2`: local thickness
 //! and material ID, layout in `glsl/common/gbuffer.glsl`), a thickness stream per mesh, and a
 //! material table the lighting pass indexes by material ID; the per-light scale travels with the
-//! light. A frame whose scene has no translucent object (or whose technique is not
-//! `translucency`) declares none of it: no target, no vertex stream, no table, no shader code.
+//! light. A frame whose scene has no translucent object (or whose technique leaves
+//! translucency out) declares none of it: no target, no vertex stream, no table, no shader code.
 //!
 //! This module is the CPU side: which materials get which ID ([`MaterialTable`]), the table's
-//! GPU layout ([`MaterialTableGpu`]), how thickness is packed ([`ThicknessPacking`]), and which
-//! screen tiles the lighting pass shades with the translucency variant ([`translucent_tiles`],
-//! [`tile_rects`]): the projected bounds of translucent objects, recomputed every frame, so
-//! pixels no translucent object can cover never run its code.
+//! GPU layout ([`MaterialTableGpu`], a region of the per-frame buffer, so a changed power or
+//! distortion needs no new frame) and how thickness is packed ([`ThicknessPacking`]). Which
+//! screen tiles the lighting pass shades with the translucency variant is
+//! [`crate::gpu_scene::tiles`]: the projected bounds of translucent objects, recomputed every
+//! frame, so pixels no translucent object can cover never run its code.
 
 use glam::Vec3;
 

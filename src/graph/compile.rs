@@ -27,37 +27,13 @@ use super::declare::{LoadOp, PassKind, RenderGraph, ResourceId, Use};
 use super::PassExec;
 
 pub use super::plan::{
-    AttachmentPlan, Barrier, MemorySlot, PhysicalPass, Plan, PlannedPass, PlannedResource,
-    RenderPassPlan, SubpassDependencyPlan, SubpassPlan,
+    AttachmentPlan, Barrier, CompileOptions, MemorySlot, PhysicalPass, Plan, PlannedPass,
+    PlannedResource, RenderPassPlan, SubpassDependencyPlan, SubpassPlan,
 };
 
 /// The executors of a plan's passes, in [`Plan::passes`] order (`None` for passes declared
 /// without code).
 pub type PassExecs = Vec<Option<Box<dyn PassExec>>>;
-
-/// Switches for A/B comparisons of the compiler's optimisations.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CompileOptions {
-    /// Merge same-pixel raster chains into subpasses of one render pass.
-    pub merge: bool,
-    /// Let transient images with disjoint lifetimes share memory.
-    pub alias: bool,
-    /// Frames are submitted back to back without the host waiting for each (frames in
-    /// flight): each frame's first access to a transient image also waits for the previous
-    /// frame's last access to it (and to its memory slot). Off, the caller waits for a frame
-    /// before submitting the next, and frames start from nothing.
-    pub chained_frames: bool,
-}
-
-impl Default for CompileOptions {
-    fn default() -> Self {
-        Self {
-            merge: true,
-            alias: true,
-            chained_frames: false,
-        }
-    }
-}
 
 /// Where a resource stands between accesses while barriers are derived.
 #[derive(Clone, Copy, Debug)]

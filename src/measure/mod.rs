@@ -1,7 +1,7 @@
 //! Measurement: everything that times frames or checks their numbers, above the frame layer.
 //!
 //! - [`stats`]: medians, minima and maxima of samples, the one summary every table uses.
-//! - [`bench`]: the benchmark (`lucent bench`): per-pass GPU times proven to add up, and its
+//! - [`bench`](mod@bench): the benchmark (`lucent bench`): per-pass GPU times proven to add up, and its
 //!   timing modes, formats and alternating comparisons.
 //! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.

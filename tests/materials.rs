@@ -353,6 +353,53 @@ fn each_sss_material_is_diffused_with_its_own_profile_without_bleeding() {
 }
 
 #[test]
+fn two_blur_chains_compose_in_one_frame() {
+    let test = TestGpu::new();
+    let (w, h) = (256, 160);
+    let two = mixed_two_chains();
+    let s = exported(Technique::Auto, w, h);
+    let both = render(&test, &two, s);
+    // The same frame without the LBB chain: the control chain alone.
+    let control_only = render(&test, &only_scattering(&two, &["skin", "ear"]), s);
+    let hdr = both.hdr.as_ref().unwrap();
+    assert!(hdr.iter().all(|v| v.is_finite()), "non-finite output");
+    let ids = both.gbuffer.as_ref().unwrap().sss.as_ref().unwrap();
+    let desc = FrameDesc::new(&two, &s).unwrap();
+    let profiles = desc.sss.as_ref().unwrap();
+    assert_eq!(
+        profiles.chains(),
+        [SssBlur::Control, SssBlur::LeanBilateral]
+    );
+    let skin = {
+        let i = two
+            .objects
+            .iter()
+            .position(|o| o.material.name == "skin")
+            .unwrap();
+        f32::from(profiles.object_ids[i])
+    };
+    // The LBB chain's final pass keeps the control chain's result on the control chain's
+    // pixels (the LEAN G-buffer pass shades their normals alike, up to rounding).
+    let other = control_only.hdr.as_ref().unwrap();
+    let (mut diff, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (i, &id) in ids.iter().enumerate() {
+        if id == skin {
+            for c in 0..3 {
+                diff += f64::from((hdr[i * 4 + c] - other[i * 4 + c]).abs());
+                sum += f64::from(other[i * 4 + c].abs());
+            }
+            n += 1;
+        }
+    }
+    eprintln!(
+        "control chain's pixels in a two-chain frame: {n}, mean relative change {:.2e}",
+        diff / sum
+    );
+    assert!(n > 500 && diff <= 1e-2 * sum, "{diff} of {sum}");
+    test.finish();
+}
+
+#[test]
 fn mixed_translucent_pixels_match_the_f64_reference() {
     let test = TestGpu::new();
     let mixed = load_scene_baked("mixed").unwrap();

@@ -214,7 +214,7 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
 }
 
 fn plan_len(scene: &lucent::scene::Scene, settings: FrameSettings) -> usize {
-    let features = lucent::frame::FrameFeatures::new(scene, &settings).unwrap();
+    let features = lucent::frame::FrameDesc::new(scene, &settings).unwrap();
     lucent::frame::plan_frame(&settings, &features)
         .unwrap()
         .physical

@@ -185,6 +185,7 @@ fn merging_can_be_switched_off() {
         .plan(CompileOptions {
             merge: false,
             alias: true,
+            ..CompileOptions::default()
         })
         .unwrap();
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
@@ -353,6 +354,7 @@ fn aliasing_never_overlaps_lifetimes() {
         g.plan(CompileOptions {
             merge: true,
             alias: false,
+            ..CompileOptions::default()
         })
         .unwrap()
     };

@@ -114,6 +114,7 @@ fn aliased_chain_executes_validation_clean_and_ends_in_the_last_value() {
     let (unaliased, shared) = run_chain(CompileOptions {
         merge: true,
         alias: false,
+        ..CompileOptions::default()
     });
     assert_eq!(shared, 0);
     assert_eq!(unaliased, pixels);

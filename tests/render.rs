@@ -86,6 +86,12 @@ fn translucent_cubes_and_grid125_match_their_goldens() {
 }
 
 #[test]
+fn mixed_matches_its_golden_under_auto() {
+    // Same settings as tests/golden/LIST's `mixed` line: no technique, the materials decide.
+    check_golden("mixed", "mixed", FrameSettings::new(320, 240));
+}
+
+#[test]
 fn sss_scenes_match_their_goldens_under_every_sss_technique() {
     // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
     for scene_name in ["skin", "teapot"] {
@@ -242,6 +248,7 @@ fn merged_and_unmerged_graphs_render_the_same_frame() {
     settings.compile = CompileOptions {
         merge: false,
         alias: false,
+        ..CompileOptions::default()
     };
     let (separate, _) = render("smoke", settings);
     let max_diff = merged

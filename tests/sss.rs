@@ -7,7 +7,7 @@
 mod common;
 
 use common::TestGpu;
-use lucent::frame::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
+use lucent::frame::{plan_frame, FrameDesc, FrameSettings, Renderer, Technique};
 use lucent::reference::sss::ReferenceSpecular;
 use lucent::scene::Scene;
 
@@ -55,7 +55,7 @@ fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::fra
 fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
     let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let s = settings(Technique::Control);
-    let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
+    let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
     let mut expected = vec!["gbuffer + lighting".to_string()];
     for i in 1..=6 {
@@ -66,7 +66,7 @@ fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
     assert_eq!(names, expected);
     // No SSS material: no blur passes, no SSS targets.
     let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
-    let plan = plan_frame(&s, &FrameFeatures::new(&smoke, &s).unwrap()).unwrap();
+    let plan = plan_frame(&s, &FrameDesc::new(&smoke, &s).unwrap()).unwrap();
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["gbuffer + lighting", "tonemap"]);
     assert!(plan.resources.iter().all(|r| !r.name.starts_with("sss.")));
@@ -309,7 +309,12 @@ fn every_technique_is_closer_to_the_brute_force_reference_than_no_blur() {
             _ => render(&test, &scaled_profiles(&scene, 1e-6), s),
         };
         let gbuffer = blurred.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+        let (profile, _) = FrameDesc::new(&scene, &s)
+            .unwrap()
+            .sss
+            .unwrap()
+            .profiles
+            .remove(0);
         let reference = lucent::reference::sss::reference_image(
             &scene,
             gbuffer,
@@ -348,7 +353,12 @@ fn lean_final_pass_matches_the_f64_lean_brdf_where_nothing_blurs() {
         };
         let frame = render(&test, &scene, s);
         let gbuffer = frame.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+        let (profile, _) = FrameDesc::new(&scene, &s)
+            .unwrap()
+            .sss
+            .unwrap()
+            .profiles
+            .remove(0);
         let reference = lucent::reference::sss::reference_image(
             &scene,
             gbuffer,
@@ -450,7 +460,7 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
     ] {
         let mut s = settings(technique);
         s.sss.gaussians = gaussians;
-        let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
+        let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
         let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
         let mut expected = vec!["projection + lighting".to_string()];
         for i in 1..=gaussians.unwrap_or(6) {
@@ -463,13 +473,13 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
     }
     // The control needs no LEAN target.
     let s = settings(Technique::Control);
-    let plan = plan_frame(&s, &FrameFeatures::new(&skin, &s).unwrap()).unwrap();
+    let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
     assert!(plan.resources.iter().all(|r| !r.name.contains("lean")));
     // No SSS material: nothing of any SSS technique.
     let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
     for technique in SSS_TECHNIQUES {
         let s = settings(technique);
-        let plan = plan_frame(&s, &FrameFeatures::new(&smoke, &s).unwrap()).unwrap();
+        let plan = plan_frame(&s, &FrameDesc::new(&smoke, &s).unwrap()).unwrap();
         let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(
             names,
@@ -580,7 +590,12 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
         let frame = render(&test, &scene, s);
         let diffusion_only = render(&test, &diffuse_only, s);
         let gbuffer = frame.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameFeatures::new(&scene, &s).unwrap().sss.unwrap();
+        let (profile, _) = FrameDesc::new(&scene, &s)
+            .unwrap()
+            .sss
+            .unwrap()
+            .profiles
+            .remove(0);
         let reference = lucent::reference::sss::reference_image(
             &scene,
             gbuffer,

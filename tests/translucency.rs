@@ -4,7 +4,7 @@
 //! and the error-against-time report.
 
 use lucent::features::deferred::GBufferPrecision;
-use lucent::frame::{FrameFeatures, FrameImages, FrameSettings, Renderer, Technique};
+use lucent::frame::{FrameDesc, FrameImages, FrameSettings, Renderer, Technique};
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
 use lucent::scene::Scene;
 
@@ -39,14 +39,14 @@ fn compare_with_reference(
     settings: &FrameSettings,
     images: &FrameImages,
 ) -> (f64, f64) {
-    let features = FrameFeatures::new(scene, settings).unwrap();
-    let (table, packing) = features.translucency.as_ref().expect("translucent scene");
+    let features = FrameDesc::new(scene, settings).unwrap();
+    let t = features.translucency.as_ref().expect("translucent scene");
     let gbuffer = images.gbuffer.as_ref().unwrap();
     let reference = shade_gbuffer(
         gbuffer,
         &LightingInputs {
             scene,
-            translucency: Some((&table.rows, *packing)),
+            translucency: Some((&t.table.rows, t.packing)),
         },
     );
     let hdr = images.hdr.as_ref().unwrap();
@@ -98,6 +98,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     // Half the grid translucent: translucent pixels brighten, opaque ones are untouched.
     let half = lucent::bake::scene::load_scene_baked("grid125:50").unwrap();
     let plain = FrameSettings {
+        technique: Technique::None,
         export_hdr: true,
         export_gbuffer: true,
         ..FrameSettings::new(size.0, size.1)
@@ -131,7 +132,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     // A scene with nothing translucent gets no GB2 and the same frame as technique `none`.
     let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
     let settings = translucency_settings(size.0, size.1);
-    assert!(FrameFeatures::new(&smoke, &settings)
+    assert!(FrameDesc::new(&smoke, &settings)
         .unwrap()
         .translucency
         .is_none());

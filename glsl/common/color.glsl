@@ -18,4 +18,11 @@ vec3 linear_to_srgb(vec3 c) {
     return mix(hi, lo, lessThanEqual(c, vec3(0.0031308)));
 }
 
+// Its inverse, for targets that store linear values.
+vec3 srgb_to_linear(vec3 c) {
+    vec3 lo = c / 12.92;
+    vec3 hi = pow(max((c + 0.055) / 1.055, vec3(0.0)), vec3(2.4));
+    return mix(hi, lo, lessThanEqual(c, vec3(0.04045)));
+}
+
 #endif

@@ -1,5 +1,5 @@
 // Frame uniforms shared by every pass: camera, lights, ambient, sky.
-// Layout must match `FrameUniforms` in src/renderer.rs (std140).
+// Layout must match `FrameUniforms` in src/gpu_scene/per_frame.rs (std140); a region of the per-frame buffer, bound at each frame-in-flight slot.
 #ifndef LUCENT_SCENE_GLSL
 #define LUCENT_SCENE_GLSL
 

@@ -58,4 +58,15 @@ vec3 shade_incident_translucent(Surface s, vec3 to_eye, float v_dot_n, vec3 to_l
     return (diffuse + vec3(s.specular * spec * n_dot_l)) * light.radiance_range.rgb * attenuation;
 }
 
+// The talk's term alone (what shade_incident_translucent adds to diffuse + specular): the
+// light let through to the eye, albedo * lightColour * attenuation * (lobe + ambient) *
+// thickness. Frames with screen-space SSS add it to the diffuse light, so the blur also
+// diffuses the light coming through thin parts (transmission plus diffusion on one skin).
+vec3 translucency_transmitted(Surface s, vec3 to_eye, float v_dot_n, vec3 to_light,
+                              float attenuation, Light light, vec4 material, vec3 thickness) {
+    float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
+    float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
+    return s.albedo * (lobe + material.z) * thickness * light.radiance_range.rgb * attenuation;
+}
+
 #endif

@@ -1,8 +1,9 @@
 #version 450
-// Debug views of the G-buffer and of the lit image before screen-space SSS (src/passes/debug_view.rs).
+// Debug views of the G-buffer and of the lit image before screen-space SSS (src/features/debug_view.rs).
 // One permutation per view (LUCENT_VIEW_*); the result is written sRGB-encoded like the tonemap's.
 // permutations-only
 // permutation: LUCENT_VIEW_ALBEDO
+// permutation: LUCENT_VIEW_ALBEDO LUCENT_OUTPUT_LINEAR
 // permutation: LUCENT_VIEW_NORMAL
 // permutation: LUCENT_VIEW_DEPTH
 // permutation: LUCENT_VIEW_THICKNESS
@@ -90,6 +91,10 @@ void main() {
     c = linear_to_srgb(tonemap_aces(hdr * frame.exposure.x));
 #else
 #error "no LUCENT_VIEW_* defined"
+#endif
+#ifdef LUCENT_OUTPUT_LINEAR
+    // sRGB and float targets take linear values: undo the encoding the views above apply.
+    c = srgb_to_linear(c);
 #endif
     out_color = vec4(c, 1.0);
 }

@@ -1,24 +1,51 @@
 #version 450
 // permutation: LUCENT_TRANSLUCENCY
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS
-// permutation: LUCENT_SSS_STRENGTH
+// permutation: LUCENT_SSS_PROFILE
 // permutation: LUCENT_NORMAL_MAP
-// permutation: LUCENT_SSS_STRENGTH LUCENT_NORMAL_MAP
-// permutation: LUCENT_SSS_STRENGTH LUCENT_LEAN
-// permutation: LUCENT_SSS_STRENGTH LUCENT_LEAN LUCENT_NORMAL_MAP
+// permutation: LUCENT_SSS_PROFILE LUCENT_NORMAL_MAP
+// permutation: LUCENT_SSS_PROFILE LUCENT_LEAN
+// permutation: LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP
+// permutation: LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=1
+// permutation: LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=2
+// permutation: LUCENT_TRANSLUCENCY LUCENT_SSS_PROFILE LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3
+// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=3 LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3 LUCENT_LEAN_LOCATION=4
+// The G-buffer pass (src/features/deferred.rs): GB0 and GB1 at locations 0 and 1, then the
+// targets the frame's materials need at the locations the defines give (GB2 with
+// translucency, the SSS profile ID with SSS, the LEAN target with LCB or LBB blurs). Set 0:
+// binding 0 the frame uniforms, then the material textures the frame has (normal or LEAN map
+// 1, LEAN map 2, albedo map at LUCENT_ALBEDO_BINDING).
+#ifndef LUCENT_GB2_LOCATION
+#define LUCENT_GB2_LOCATION 2
+#endif
+#ifndef LUCENT_SSS_LOCATION
+#define LUCENT_SSS_LOCATION 2
+#endif
+#ifndef LUCENT_LEAN_LOCATION
+#define LUCENT_LEAN_LOCATION 3
+#endif
+#ifndef LUCENT_ALBEDO_BINDING
+#define LUCENT_ALBEDO_BINDING 1
+#endif
 #include "../common/gbuffer.glsl"
 #include "object.glsl"
 #ifdef LUCENT_LEAN
 #include "../common/lean.glsl"
 // LCB and LBB: the view-plane LEAN slope y and moments xx, yy, xy (slope x travels in the
 // lighting pass's diffuse alpha: the blurs read both targets as two RGBA texels).
-layout(location = 3) out vec4 out_lean;
+layout(location = LUCENT_LEAN_LOCATION) out vec4 out_lean;
 #endif
 
 layout(location = 0) in vec3 in_normal;
-#ifdef LUCENT_NORMAL_MAP
+#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP)
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec4 in_tangent;
+#endif
+#ifdef LUCENT_ALBEDO_MAP
+// Albedo texture (decoded from sRGB to linear at load), multiplied with the material's albedo.
+layout(set = 0, binding = LUCENT_ALBEDO_BINDING) uniform sampler2D albedo_map;
+#endif
+#ifdef LUCENT_NORMAL_MAP
 // Tangent-space normal map, stored as n * 0.5 + 0.5 (binding 0 is the frame uniforms).
 layout(set = 0, binding = 1) uniform sampler2D normal_map;
 
@@ -44,11 +71,11 @@ layout(set = 0, binding = 2) uniform sampler2D lean2_map;
 #endif
 #ifdef LUCENT_TRANSLUCENCY
 layout(location = 1) in vec3 in_thickness;
-layout(location = 2) out vec4 out_gb2;
+layout(location = LUCENT_GB2_LOCATION) out vec4 out_gb2;
 #endif
-#ifdef LUCENT_SSS_STRENGTH
-// Screen-space SSS strength (0: the pixel does not scatter), for the blur passes.
-layout(location = 2) out vec4 out_sss;
+#ifdef LUCENT_SSS_PROFILE
+// Screen-space SSS profile ID / 255 (0: the pixel does not scatter), for the blur passes.
+layout(location = LUCENT_SSS_LOCATION) out vec4 out_sss;
 #endif
 
 layout(location = 0) out vec4 out_gb0;
@@ -57,6 +84,9 @@ layout(location = 1) out vec4 out_gb1;
 void main() {
     Surface s;
     s.albedo = object.albedo_specular.rgb;
+#ifdef LUCENT_ALBEDO_MAP
+    s.albedo *= texture(albedo_map, in_uv).rgb;
+#endif
     s.specular = object.albedo_specular.a;
 #if defined(LUCENT_LEAN)
     vec3 n = sanitize_normal(in_normal);
@@ -99,7 +129,7 @@ void main() {
 #ifdef LUCENT_TRANSLUCENCY
     out_gb2 = pack_gb2(in_thickness, int(object.thickness.w + 0.5));
 #endif
-#ifdef LUCENT_SSS_STRENGTH
-    out_sss = vec4(clamp(object.roughness.y, 0.0, 1.0));
+#ifdef LUCENT_SSS_PROFILE
+    out_sss = vec4(clamp(object.roughness.y, 0.0, 255.0) / 255.0);
 #endif
 }

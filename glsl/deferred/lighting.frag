@@ -7,9 +7,11 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_FAULT_INJECTION
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_FAULT_INJECTION
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
-// drawn over the screen tiles translucent objects may cover (src/passes/translucency.rs):
+// drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
 // GDC 2011's per-light term joins diffuse and specular; opaque pixels in those tiles read
 // thickness 0 and get none of it.
 #include "../common/gbuffer.glsl"
@@ -61,6 +63,8 @@ void main() {
 #endif
     vec3 thickness = unpack_thickness(t);
     float v_dot_n = dot(to_eye, s.normal);
+#endif
+#if defined(LUCENT_TRANSLUCENCY) && !defined(LUCENT_SPLIT_SPECULAR)
     for (int i = 0; i < count; ++i) {
         Light light = frame.lights[i];
         vec3 to_light;
@@ -80,6 +84,11 @@ void main() {
         vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation);
         color += s.albedo / PI * incident;
         specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
+#ifdef LUCENT_TRANSLUCENCY
+        // Transmitted light joins the diffuse: the SSS blur diffuses it too.
+        color += translucency_transmitted(s, to_eye, v_dot_n, to_light, attenuation, light,
+                                          material, thickness);
+#endif
     }
     out_specular = vec4(min(specular, vec3(65504.0)), 1.0);
 #ifdef LUCENT_LEAN

@@ -1,5 +1,7 @@
 #version 450
-// HDR -> display: exposure, ACES fit, sRGB encoding into an UNORM target.
+// permutation: LUCENT_OUTPUT_LINEAR
+// HDR -> display: exposure, ACES fit, sRGB encoding into an UNORM target; with
+// LUCENT_OUTPUT_LINEAR (sRGB and float targets) the tonemapped values are written linear.
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 
@@ -10,5 +12,9 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     vec3 c = texelFetch(hdr, ivec2(gl_FragCoord.xy), 0).rgb * frame.exposure.x;
+#ifdef LUCENT_OUTPUT_LINEAR
+    out_color = vec4(tonemap_aces(c), 1.0);
+#else
     out_color = vec4(linear_to_srgb(tonemap_aces(c)), 1.0);
+#endif
 }

@@ -10,9 +10,15 @@
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_OUT
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT LUCENT_SSS_ACCUMULATE
-// One direction of a separable screen-space SSS blur (src/passes/sss.rs), for one Gaussian of
-// the profile. The Gaussian's world-space sigma is projected to the screen at the pixel's depth
-// (wider up close) and scaled by the pixel's SSS strength; non-SSS pixels come out unchanged.
+// permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE
+// One direction of a separable screen-space SSS blur (src/features/sss.rs), for one step (one
+// Gaussian) of each pixel's own profile: the pixel's profile ID picks its sigma and weight from
+// the profile table. The Gaussian's world-space sigma is projected to the screen at the pixel's
+// depth (wider up close); pixels whose profile this chain does not blur come out unchanged.
+// - LUCENT_SSS_PROFILE_EDGES (frames with several profiles): a tap on a pixel of another
+//   profile counts as a depth discontinuity (control: back to the centre colour; bilateral:
+//   no weight), so one profile's light never bleeds into another profile's object.
 //
 // - Control (Jimenez et al. 2009 as the LEAN-mapping thesis gives it, section 3.2.2): a 7-tap
 //   kernel at fractional offsets (bilinear taps); a tap across a large depth difference is
@@ -31,22 +37,21 @@
 // into the sum-of-Gaussians targets (additive blending): RGB weights for the diffuse light, their
 // mean (which sums to 1 over the profile too) for the LEAN moments.
 #include "../common/scene.glsl"
+#include "../common/sss.glsl"
 
 #ifdef LUCENT_SSS_PACKED_IN
-layout(set = 0, binding = 1) uniform usampler2D packed_tex;  // both texels, packed (nearest)
+layout(set = 0, binding = 2) uniform usampler2D packed_tex;  // both texels, packed (nearest)
 #else
-layout(set = 0, binding = 1) uniform sampler2D color_tex;    // linear filtering, clamp to edge
+layout(set = 0, binding = 2) uniform sampler2D color_tex;    // linear filtering, clamp to edge
 #endif
-layout(set = 0, binding = 2) uniform sampler2D depth_tex;    // device depth, read with texelFetch
-layout(set = 0, binding = 3) uniform sampler2D strength_tex; // SSS strength, 0 = not SSS
+layout(set = 0, binding = 3) uniform sampler2D depth_tex;    // device depth, read with texelFetch
+layout(set = 0, binding = 4) uniform sampler2D profile_tex;  // SSS profile ID, 0 = not SSS
 #if defined(LUCENT_SSS_LEAN) && !defined(LUCENT_SSS_PACKED_IN)
-layout(set = 0, binding = 4) uniform sampler2D lean_tex;     // slope y, moments (same filter)
+layout(set = 0, binding = 5) uniform sampler2D lean_tex;     // slope y, moments (same filter)
 #endif
 
 layout(push_constant) uniform Blur {
-    vec4 step;    // xy: direction (1,0) or (0,1); z: this step's sigma, world units;
-                  // w: control: depth correction; bilateral: depth sensitivity (per world unit)
-    vec4 weight;  // rgb: the Gaussian's weight in the sum (vertical pass); a: their mean
+    vec4 step;    // xy: direction (1,0) or (0,1); z: the step (Gaussian) index; w: the chain
 } blur;
 
 layout(location = 0) in vec2 in_uv;
@@ -101,11 +106,14 @@ void main() {
     vec4 center = finite_or(texelFetch(color_tex, px, 0), vec4(0.0));
 #endif
     float device_depth = texelFetch(depth_tex, px, 0).r;
-    float strength = clamp(texelFetch(strength_tex, px, 0).r, 0.0, 1.0);
-    // Sky pixels have no surface to scatter in.
-    strength = device_depth < 1.0 ? strength : 0.0;
+    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    SssStep profile_step = sss_step(id, int(blur.step.z + 0.5));
+    // Pixels of other chains' profiles (and of none) are left as they are; sky pixels have no
+    // surface to scatter in.
+    float strength = sss_in_chain(id, int(blur.step.w + 0.5)) && device_depth < 1.0 ? 1.0 : 0.0;
+    float depth_term = profile_step.blur.y;
     float depth_m = linear_depth(device_depth);
-    float sigma_px = blur.step.z * frame.camera.z / max(depth_m, 1e-4) * strength;
+    float sigma_px = profile_step.blur.x * frame.camera.z / max(depth_m, 1e-4) * strength;
     // Clamp the reach (3 sigma) to a quarter of the screen: an extreme strength or a surface at
     // the near plane must not sample across the whole image.
     sigma_px = min(sigma_px, 0.25 / 3.0 * float(max(size.x, size.y)));
@@ -126,9 +134,13 @@ void main() {
     for (int k = -LUCENT_SSS_HALF_TAPS; k <= LUCENT_SSS_HALF_TAPS; ++k) {
         float offset = round(float(k) * spacing);
         ivec2 tap = clamp(px + ivec2(blur.step.xy * offset), ivec2(0), size - 1);
-        float dz = (linear_depth(texelFetch(depth_tex, tap, 0).r) - depth_m) * blur.step.w;
+        float dz = (linear_depth(texelFetch(depth_tex, tap, 0).r) - depth_m) * depth_term;
         float r = sigma > 0.0 ? offset / sigma : 0.0;
         float w = exp(-0.5 * (r * r + dz * dz));
+#ifdef LUCENT_SSS_PROFILE_EDGES
+        int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
+        w = tap_id != id && tap_id != 0 ? 0.0 : w;
+#endif
         // A NaN depth would poison the sum: such a tap gets no weight.
         w = w >= 0.0 ? w : 0.0;
 #ifdef LUCENT_SSS_LEAN
@@ -165,7 +177,11 @@ void main() {
         ivec2 tap = clamp(ivec2(offset * frame.viewport.xy), ivec2(0), size - 1);
         float depth = linear_depth(texelFetch(depth_tex, tap, 0).r);
         // A huge depth difference (another object, the background): back to the centre colour.
-        float s = min(blur.step.w * abs(depth_m - depth), 1.0);
+        float s = min(depth_term * abs(depth_m - depth), 1.0);
+#ifdef LUCENT_SSS_PROFILE_EDGES
+        int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
+        s = tap_id != id && tap_id != 0 ? 1.0 : s;
+#endif
         blurred += w[i] * mix(finite_or(textureLod(color_tex, offset, 0.0), center), center, s);
 #ifdef LUCENT_SSS_LEAN
         blurred_lean +=
@@ -189,10 +205,14 @@ void main() {
 #endif
 #ifdef LUCENT_SSS_ACCUMULATE
 #ifdef LUCENT_SSS_LEAN
-    out_sum = vec4(blurred.rgb * blur.weight.rgb, blurred.a * blur.weight.a);
-    out_lean_sum = blurred_lean * blur.weight.a;
+    // Pixels this chain does not blur add nothing (their profile's weights are not this
+    // chain's); a profile with fewer steps than the chain has zero weights past its last.
+    vec4 weight = strength > 0.0 ? profile_step.weight : vec4(0.0);
+    out_sum = vec4(blurred.rgb * weight.rgb, blurred.a * weight.a);
+    out_lean_sum = blurred_lean * weight.a;
 #else
-    out_sum = vec4(blurred.rgb * blur.weight.rgb, 0.0);
+    vec4 weight = strength > 0.0 ? profile_step.weight : vec4(0.0);
+    out_sum = vec4(blurred.rgb * weight.rgb, 0.0);
 #endif
 #endif
 }

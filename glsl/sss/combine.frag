@@ -1,20 +1,38 @@
 #version 450
-// Screen-space SSS, final composite: the sum of Gaussians where the pixel scatters, the lit
-// diffuse elsewhere, plus the specular the blur kept out.
+// permutation: LUCENT_SSS_BASE
+// Screen-space SSS, the control chain's final composite: on the pixels of this chain's
+// profiles the sum of Gaussians plus the specular the blur kept out; elsewhere the previous
+// chain's result (LUCENT_SSS_BASE, frames with several chains) or the lit diffuse + specular.
 #include "../common/scene.glsl"
+#include "../common/sss.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D sum_tex;
-layout(set = 0, binding = 2) uniform sampler2D diffuse_tex;
-layout(set = 0, binding = 3) uniform sampler2D specular_tex;
-layout(set = 0, binding = 4) uniform sampler2D strength_tex;
+layout(set = 0, binding = 2) uniform sampler2D sum_tex;
+layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;
+layout(set = 0, binding = 4) uniform sampler2D specular_tex;
+layout(set = 0, binding = 5) uniform sampler2D profile_tex;
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = 6) uniform sampler2D base_tex;
+#endif
+
+layout(push_constant) uniform Chain {
+    vec4 step;  // w: this chain's index
+} chain;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    float strength = texelFetch(strength_tex, px, 0).r;
-    vec3 diffuse = strength > 0.0 ? texelFetch(sum_tex, px, 0).rgb : texelFetch(diffuse_tex, px, 0).rgb;
-    vec3 color = diffuse + texelFetch(specular_tex, px, 0).rgb;
+    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    vec3 color;
+    if (sss_in_chain(id, int(chain.step.w + 0.5))) {
+        color = texelFetch(sum_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb;
+    } else {
+#ifdef LUCENT_SSS_BASE
+        color = texelFetch(base_tex, px, 0).rgb;
+#else
+        color = texelFetch(diffuse_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb;
+#endif
+    }
     out_color = vec4(min(color, vec3(65504.0)), 1.0);
 }

@@ -1,19 +1,30 @@
 #version 450
 // permutation: LUCENT_SSS_PASSTHROUGH
-// LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): where the
-// pixel scatters, the blurred diffuse light plus LEAN specular with Fresnel evaluated on the
-// blurred view-plane slopes and moments, for every light; elsewhere the lighting pass's
-// diffuse + specular. Half vectors come from the depth (no position or half-vector targets:
+// permutation: LUCENT_SSS_BASE
+// permutation: LUCENT_SSS_BASE LUCENT_SSS_PASSTHROUGH
+// LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): on the pixels
+// of this chain's profiles, the blurred diffuse light plus LEAN specular with Fresnel evaluated
+// on the blurred view-plane slopes and moments, for every light; elsewhere the previous chain's
+// result (LUCENT_SSS_BASE, frames with several chains) or the lighting pass's diffuse +
+// specular. Half vectors come from the depth (no position or half-vector targets:
 // the thesis stored both; the depth buffer already holds what they encode).
 #include "../common/lean.glsl"
+#include "../common/sss.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D sum_tex;       // blurred diffuse rgb + slope x
-layout(set = 0, binding = 2) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
-layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
-layout(set = 0, binding = 4) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
-layout(set = 0, binding = 5) uniform sampler2D strength_tex;
-layout(set = 0, binding = 6) uniform sampler2D depth_tex;
-layout(set = 0, binding = 7) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
+layout(set = 0, binding = 2) uniform sampler2D sum_tex;       // blurred diffuse rgb + slope x
+layout(set = 0, binding = 3) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
+layout(set = 0, binding = 4) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
+layout(set = 0, binding = 5) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
+layout(set = 0, binding = 6) uniform sampler2D profile_tex;   // SSS profile ID
+layout(set = 0, binding = 7) uniform sampler2D depth_tex;
+layout(set = 0, binding = 8) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = 9) uniform sampler2D base_tex;      // the previous chain's result
+#endif
+
+layout(push_constant) uniform Chain {
+    vec4 step;  // w: this chain's index
+} chain;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
@@ -21,13 +32,14 @@ layout(location = 0) out vec4 out_color;
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
 #ifdef LUCENT_SSS_PASSTHROUGH
-    // Drawn on the screen rectangles no scattering object can touch.
-    float strength = 0.0;
+    // Drawn on the screen rectangles no object of this chain can touch.
+    bool scatters = false;
 #else
-    float strength = texelFetch(strength_tex, px, 0).r;
+    bool scatters = sss_in_chain(sss_profile_id(texelFetch(profile_tex, px, 0).r),
+                                 int(chain.step.w + 0.5));
 #endif
     vec3 color;
-    if (strength > 0.0) {
+    if (scatters) {
         vec4 s0 = texelFetch(sum_tex, px, 0);
         vec4 s1 = texelFetch(lean_sum_tex, px, 0);
         vec2 b = vec2(s0.a, s1.x);
@@ -60,7 +72,11 @@ void main() {
         }
         color = s0.rgb + specular;
     } else {
+#ifdef LUCENT_SSS_BASE
+        color = texelFetch(base_tex, px, 0).rgb;
+#else
         color = texelFetch(diffuse_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb;
+#endif
     }
     // Into fp16's range; a NaN (which clamp need not catch) becomes black.
     color = any(isnan(color)) ? vec3(0.0) : clamp(color, vec3(0.0), vec3(65504.0));

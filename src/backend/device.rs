@@ -8,17 +8,7 @@ use ash::vk;
 
 use crate::error::{LucentError, Result, VkResultExt};
 
-use super::context::{version_string, ContextDesc, DeviceInfo};
-
-pub(super) fn device_type_name(t: vk::PhysicalDeviceType) -> &'static str {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
-        vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
-        vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
-        vk::PhysicalDeviceType::CPU => "CPU",
-        _ => "other",
-    }
-}
+use super::desc::{version_string, ContextDesc, DeviceInfo};
 
 /// Preference order when no filter is given: discrete > integrated > virtual > CPU > other.
 pub(super) fn device_type_score(t: vk::PhysicalDeviceType) -> u32 {
@@ -132,6 +122,7 @@ pub(super) fn probe_device(
         api_version: props.api_version,
         timestamp_period_ns: props.limits.timestamp_period,
         timestamp_valid_bits: family.timestamp_valid_bits,
+        uniform_offset_alignment: props.limits.min_uniform_buffer_offset_alignment.max(1),
         host_query_reset: v12.host_query_reset == vk::TRUE,
         independent_blend: core.independent_blend == vk::TRUE,
         storage_image_write_without_format: core.shader_storage_image_write_without_format

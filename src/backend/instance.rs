@@ -10,7 +10,7 @@ use ash::vk;
 
 use crate::error::{LucentError, Result, VkResultExt};
 
-use super::context::{
+use super::desc::{
     c_string, lock, version_string, ContextDesc, LOG_TARGET, MAX_STORED_MESSAGES, VALIDATION_LAYER,
 };
 

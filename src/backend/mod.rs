@@ -9,6 +9,7 @@
 
 pub mod access;
 pub mod context;
+mod desc;
 mod device;
 pub mod format;
 mod instance;

@@ -12,7 +12,7 @@ use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
 use lucent::features::deferred::GBufferPrecision;
 use lucent::features::sss::{SssKnobs, SssPrecision};
-use lucent::frame::{plan_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use lucent::frame::{plan_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::graph::CompileOptions;
 use lucent::images::output;
 use lucent::measure::bench::{self, BenchOptions};
@@ -198,8 +198,11 @@ struct FrameArgs {
     /// Resolution as WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768", value_parser = parse_size)]
     size: (u32, u32),
-    /// Technique the scene is lit with (`none`: plain deferred lighting).
-    #[arg(long, default_value = "none")]
+    /// What the frame shades: `auto` (default) is what the scene's materials ask for, every
+    /// technique composed in one frame; `none` (plain deferred lighting), `translucency`,
+    /// `control`, `lcb` or `lbb` restrict the frame to one technique (A/B runs, the seeds'
+    /// tables).
+    #[arg(long, default_value = "auto")]
     technique: String,
     /// Do not merge same-pixel passes into subpasses (A/B comparison).
     #[arg(long)]
@@ -355,6 +358,7 @@ impl FrameArgs {
             compile: CompileOptions {
                 merge: !self.no_merge,
                 alias: !self.no_alias,
+                ..CompileOptions::default()
             },
             export_hdr,
             export_gbuffer: false,
@@ -374,73 +378,57 @@ impl FrameArgs {
                 }
             },
             debug_view: None,
+            frames_in_flight: 1,
+            target: None,
         })
     }
 
-    /// The knobs given on the command line that do nothing under `technique`, each as a
-    /// warning naming the technique it needs.
-    fn inapplicable_knobs(&self, technique: Technique) -> Vec<String> {
-        let blur = technique.sss_blur();
-        let sss = "--technique control, lcb or lbb (screen-space SSS)";
-        let lbb = "--technique lbb (the bilateral blur)";
+    /// The knobs given on the command line that do nothing in this frame (`desc`, of `scene`
+    /// under `settings`), each as a warning naming the technique they need.
+    fn inapplicable_knobs(
+        &self,
+        scene: &scene::Scene,
+        settings: &FrameSettings,
+        desc: &FrameDesc,
+    ) -> Vec<String> {
+        let chains = desc.sss.as_ref().map(|s| s.chains()).unwrap_or_default();
+        let bilateral = chains.iter().any(|b| b.bilateral());
+        let sss = !chains.is_empty();
+        let translucent = desc.translucency.is_some();
+        let lbb = "the bilateral blur: --technique lbb (or SSS materials with blur = \"lbb\")";
+        let blur = "screen-space SSS: --technique control, lcb or lbb (or auto) on a scene \
+                    with SSS materials";
+        let gdc = "GDC 2011 translucency: --technique translucency (or auto) on a scene with \
+                   translucent materials";
         let knobs = [
-            (
-                self.sss_taps.is_some(),
-                "--sss-taps",
-                lbb,
-                blur.is_some_and(|b| b.bilateral()),
-            ),
-            (
-                self.sss_packed,
-                "--sss-packed",
-                lbb,
-                blur.is_some_and(|b| b.bilateral()),
-            ),
-            (
-                self.sensitivity.is_some(),
-                "--sensitivity",
-                lbb,
-                blur.is_some_and(|b| b.bilateral()),
-            ),
-            (
-                self.sss_gaussians.is_some(),
-                "--sss-gaussians",
-                sss,
-                blur.is_some(),
-            ),
-            (
-                self.sss_precision.is_some(),
-                "--sss-precision",
-                sss,
-                blur.is_some(),
-            ),
-            (self.no_sss_tiles, "--no-sss-tiles", sss, blur.is_some()),
-            (
-                self.grayscale,
-                "--grayscale",
-                "--technique translucency",
-                technique == Technique::Translucency,
-            ),
+            (self.sss_taps.is_some(), "--sss-taps", lbb, bilateral),
+            (self.sss_packed, "--sss-packed", lbb, bilateral),
+            (self.sensitivity.is_some(), "--sensitivity", lbb, bilateral),
+            (self.sss_gaussians.is_some(), "--sss-gaussians", blur, sss),
+            (self.sss_precision.is_some(), "--sss-precision", blur, sss),
+            (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
+            (self.grayscale, "--grayscale", gdc, translucent),
         ];
+        let technique = settings.technique;
         knobs
             .iter()
             .filter(|(given, _, _, applies)| *given && !applies)
             .map(|(_, flag, needs, _)| {
                 format!(
-                    "{flag} has no effect with --technique {}: it applies to {needs}",
-                    technique.name()
+                    "{flag} has no effect with --technique {} on scene '{}': it applies to \
+                     {needs}",
+                    technique.name(),
+                    scene.name
                 )
             })
             .collect()
     }
 
-    /// [`FrameArgs::settings`], warning (on stderr) about every knob that does not apply.
-    fn settings_warned(&self, export_hdr: bool) -> Result<FrameSettings> {
-        let settings = self.settings(export_hdr)?;
-        for warning in self.inapplicable_knobs(settings.technique) {
+    /// Prints a warning (on stderr) for every knob that does nothing in this frame.
+    fn warn_inapplicable(&self, scene: &scene::Scene, settings: &FrameSettings, desc: &FrameDesc) {
+        for warning in self.inapplicable_knobs(scene, settings, desc) {
             eprintln!("lucent: warning: {warning}");
         }
-        Ok(settings)
     }
 }
 
@@ -492,8 +480,9 @@ fn with_renderer(
     export_hdr: bool,
     work: impl FnOnce(&Session, &Renderer) -> Result<()>,
 ) -> Result<()> {
-    let settings = frame.settings_warned(export_hdr)?;
+    let settings = frame.settings(export_hdr)?;
     let scene = bake::load_scene_baked(&frame.scene)?;
+    frame.warn_inapplicable(&scene, &settings, &FrameDesc::new(&scene, &settings)?);
     // Texture headers first: one too large is refused before the device is even opened.
     scene::texture::scene_texture_sizes(&scene, None)?;
     with_session(gpu_args, |session| {
@@ -524,13 +513,16 @@ fn check_device_fits(
 ) -> Result<()> {
     let info = &gpu.info;
     let textures = scene::texture::scene_texture_sizes(scene, Some(info.max_image_dimension_2d))?;
-    let plan = plan_frame(settings, &FrameFeatures::new(scene, settings)?)?;
+    let plan = plan_frame(settings, &FrameDesc::new(scene, settings)?)?;
     let (frame_bytes, largest) = plan.frame_memory();
-    // Normal maps go up as RGBA16F with mips (4/3), LEAN frames as two such maps each.
-    let lean = matches!(settings.technique, Technique::Lcb | Technique::Lbb);
+    // Maps go up as RGBA16F with mips (4/3); in LEAN frames a normal map as two such maps.
+    let lean = FrameDesc::new(scene, settings)?.lean();
     let texture_bytes: u64 = textures
         .iter()
-        .map(|(_, w, h)| u64::from(*w) * u64::from(*h) * 8 * 4 / 3 * if lean { 2 } else { 1 })
+        .map(|(_, w, h, normal)| {
+            let copies = if *normal && lean { 2 } else { 1 };
+            u64::from(*w) * u64::from(*h) * 8 * 4 / 3 * copies
+        })
         .sum();
     let heap = info.device_local_bytes;
     if heap > 0 && frame_bytes.saturating_add(texture_bytes) > heap {
@@ -1050,9 +1042,11 @@ fn run(cli: Cli) -> Result<()> {
             base: FrameSettings::new(size.0, size.1),
         }),
         Command::Plan { frame } => {
-            let settings = frame.settings_warned(false)?;
+            let settings = frame.settings(false)?;
             let scene = bake::load_scene_baked(&frame.scene)?;
-            let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings)?)?;
+            let desc = FrameDesc::new(&scene, &settings)?;
+            frame.warn_inapplicable(&scene, &settings, &desc);
+            let plan = plan_frame(&settings, &desc)?;
             print!("{}", plan.dump());
             Ok(())
         }

@@ -125,8 +125,10 @@ pub struct Knob {
     pub get: fn(&Scene, &FrameSettings) -> Option<f32>,
     /// Writes the value everywhere it applies.
     pub set: fn(&mut Scene, &mut FrameSettings, f32),
-    /// Whether a change needs the renderer rebuilt (the value is baked into GPU tables); the
-    /// others only need the frame uniforms updated.
+    /// Whether a change needs the renderer rebuilt (it changes passes or shader
+    /// permutations); the others only change values of the per-frame parameters (uniforms,
+    /// the material and profile tables), which the next frame writes without re-uploading
+    /// the scene.
     pub rebuild: bool,
 }
 
@@ -183,7 +185,7 @@ pub const KNOBS: &[Knob] = &[
         range: (0.1, 1e4),
         get: |s, _| translucency_param(s, |t| t.power),
         set: |s, _, v| set_translucency_param(s, v, |t, v| t.power = v),
-        rebuild: true,
+        rebuild: false,
     },
     Knob {
         name: "translucency distortion",
@@ -192,7 +194,7 @@ pub const KNOBS: &[Knob] = &[
         range: (0.0, 10.0),
         get: |s, _| translucency_param(s, |t| t.distortion),
         set: |s, _, v| set_translucency_param(s, v, |t, v| t.distortion = v),
-        rebuild: true,
+        rebuild: false,
     },
     Knob {
         name: "translucency ambient",
@@ -201,7 +203,7 @@ pub const KNOBS: &[Knob] = &[
         range: (0.0, 1.0),
         get: |s, _| translucency_param(s, |t| t.ambient),
         set: |s, _, v| set_translucency_param(s, v, |t, v| t.ambient = v),
-        rebuild: true,
+        rebuild: false,
     },
     Knob {
         name: "SSS width (world units per mm)",
@@ -220,7 +222,7 @@ pub const KNOBS: &[Knob] = &[
                 }
             }
         },
-        rebuild: true,
+        rebuild: false,
     },
     Knob {
         name: "bilateral sensitivity (LBB)",
@@ -234,7 +236,7 @@ pub const KNOBS: &[Knob] = &[
                 .then_some(f.sss.sensitivity)
         },
         set: |_, f, v| f.sss.sensitivity = v,
-        rebuild: true,
+        rebuild: false,
     },
 ];
 

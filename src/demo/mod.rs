@@ -4,16 +4,21 @@
 //! - [`present`]: surface, swapchain, per-frame submit and present (resize, minimize,
 //!   `OUT_OF_DATE`/`SUBOPTIMAL`, bounded waits).
 //! - [`controls`]: the orbit/fly camera, the knobs, the key list (no window needed).
+//! - `input`: window events, keys and the mouse, and script commands, turned into actions.
 //! - [`overlay`]: on-screen text rasterized on the CPU.
 //! - [`script`]: `--script FILE`, scripted input for tests.
 //! - [`watch`]: shader hot reload's file polling.
 //!
-//! The frame itself is the ordinary [`Renderer`]: it is rebuilt on resize, on a technique or
-//! knob change and when a file under the GLSL root changes; a rebuild that fails (a shader
-//! typo) keeps the previous renderer running and shows the error. Layering: the binary calls
+//! The frame itself is the ordinary [`Renderer`]: it is rebuilt on resize, on a technique
+//! change, on a knob change that changes the frame's shape (a pow form) and when a file under
+//! the GLSL root changes; knobs that change only values (lights, translucency parameters, SSS
+//! width and sensitivity) are written into the next frame's per-frame parameters without
+//! re-uploading the scene. A rebuild that fails (a shader typo) keeps the previous renderer
+//! running and shows the error. Layering: the binary calls
 //! this module, which uses the renderer and passes; nothing below knows about windows.
 
 pub mod controls;
+mod input;
 pub mod overlay;
 pub mod present;
 pub mod script;
@@ -27,23 +32,23 @@ use std::time::{Duration, Instant};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::keyboard::KeyCode;
 use winit::window::{Window, WindowId};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{ContextDesc, GpuContext};
 use crate::features::debug_view::DebugView;
-use crate::frame::{FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::images::output;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-use controls::{Action, OrbitCamera, KNOBS};
+use controls::{OrbitCamera, KNOBS};
 use overlay::{Panel, TextRenderer, Tone};
 use present::{Drawn, Presenter};
-use script::{Command, Script};
+use script::Script;
 use watch::ShaderWatcher;
 
 /// How often the on-screen timings are refreshed.
@@ -137,14 +142,8 @@ pub fn run(options: DemoOptions) -> Result<()> {
             None
         }
     };
-    let technique = match options.technique {
-        Some(t) => t,
-        None => scene
-            .technique
-            .as_deref()
-            .and_then(|t| Technique::parse(t).ok())
-            .unwrap_or(Technique::None),
-    };
+    // Default: what the scene's materials ask for.
+    let technique = options.technique.unwrap_or(Technique::Auto);
     let orbit = OrbitCamera::from_camera(&scene.camera);
     orbit.apply(&mut scene.camera);
     let mut app = Demo {
@@ -412,208 +411,6 @@ impl Demo<'_> {
         Ok(())
     }
 
-    fn on_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) -> Result<()> {
-        match event {
-            WindowEvent::CloseRequested => {
-                self.done = true;
-                event_loop.exit();
-            }
-            WindowEvent::Resized(size) => {
-                self.window_zero = size.width == 0 || size.height == 0;
-                self.resize_pending = true;
-            }
-            WindowEvent::ScaleFactorChanged { .. } => {
-                // The new physical size follows as a Resized event; the swapchain follows it.
-                self.resize_pending = true;
-            }
-            WindowEvent::ModifiersChanged(m) => self.input.shift = m.state().shift_key(),
-            WindowEvent::KeyboardInput { event, .. } => {
-                let PhysicalKey::Code(code) = event.physical_key else {
-                    return Ok(());
-                };
-                if event.state == ElementState::Released {
-                    self.input.held.remove(&code);
-                    return Ok(());
-                }
-                self.input.held.insert(code);
-                if event.repeat && !matches!(code, KeyCode::Equal | KeyCode::Minus) {
-                    return Ok(());
-                }
-                if let Some(action) = key_action(code, self.input.shift) {
-                    self.act(event_loop, action)?;
-                }
-            }
-            WindowEvent::MouseInput { state, button, .. } => {
-                let down = state == ElementState::Pressed;
-                match button {
-                    MouseButton::Left => self.input.orbiting = down,
-                    MouseButton::Right | MouseButton::Middle => self.input.panning = down,
-                    _ => {}
-                }
-            }
-            WindowEvent::CursorMoved { position, .. } => {
-                let (x, y) = (position.x, position.y);
-                if let Some((px, py)) = self.input.cursor {
-                    let (dx, dy) = ((x - px) as f32, (y - py) as f32);
-                    if self.input.orbiting {
-                        self.orbit
-                            .orbit(-dx * ORBIT_PER_PIXEL, dy * ORBIT_PER_PIXEL);
-                    } else if self.input.panning {
-                        let height = self.window.as_ref().map_or(1, |w| w.inner_size().height);
-                        // Guarded: a zero-height window reports motion too.
-                        let h = height.max(1) as f32;
-                        self.orbit.pan(-dx / h, dy / h);
-                    }
-                }
-                self.input.cursor = Some((x, y));
-            }
-            WindowEvent::MouseWheel { delta, .. } => {
-                let lines = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => y,
-                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 50.0,
-                };
-                self.orbit.zoom(0.9f32.powf(lines));
-            }
-            _ => {}
-        }
-        Ok(())
-    }
-
-    /// Carries out one action (a key, or a script's `key`).
-    fn act(&mut self, event_loop: &ActiveEventLoop, action: Action) -> Result<()> {
-        match action {
-            Action::NextTechnique | Action::PreviousTechnique => {
-                let all = Technique::ALL;
-                let i = all
-                    .iter()
-                    .position(|(_, t)| *t == self.technique)
-                    .unwrap_or(0);
-                let next = if action == Action::NextTechnique {
-                    (i + 1) % all.len()
-                } else {
-                    (i + all.len() - 1) % all.len()
-                };
-                self.technique = all[next].1;
-                self.rebuild_pending = true;
-            }
-            Action::CyclePow => match controls::cycle_pow_mode(&mut self.scene) {
-                Some(name) => {
-                    self.say(format!("pow form: {name}"), false);
-                    self.rebuild_pending = true;
-                }
-                None => self.say("no translucent material in this scene".into(), false),
-            },
-            Action::CycleDebugView => {
-                self.debug_view = self.next_debug_view();
-                self.rebuild_pending = true;
-            }
-            Action::SelectKnob(i) => self.view.knob = i.min(KNOBS.len() - 1),
-            Action::KnobUp | Action::KnobDown => {
-                let knob = &KNOBS[self.view.knob];
-                match (knob.get)(&self.scene, &self.options.base) {
-                    Some(value) => {
-                        let next = knob.stepped(value, action == Action::KnobUp);
-                        (knob.set)(&mut self.scene, &mut self.options.base, next);
-                        if knob.rebuild {
-                            self.rebuild_pending = true;
-                        } else if let Some(r) = self.renderer.as_mut() {
-                            r.update(&self.scene)?;
-                        }
-                    }
-                    None => self.say(format!("nothing in this scene uses {}", knob.name), false),
-                }
-            }
-            Action::ResetCamera => self.orbit.reset(),
-            Action::ToggleHelp => self.view.help = !self.view.help,
-            Action::ToggleOverlay => self.view.hidden = !self.view.hidden,
-            Action::Screenshot => {
-                self.screenshots_taken += 1;
-                self.screenshot_pending.push(PathBuf::from(format!(
-                    "lucent-screenshot-{}.png",
-                    self.screenshots_taken
-                )));
-            }
-            Action::ReloadShaders => self.rebuild_pending = true,
-            Action::ToggleTiming => {
-                self.isolated = !self.isolated;
-                self.stats.clear();
-            }
-            Action::Quit => {
-                self.done = true;
-                event_loop.exit();
-            }
-        }
-        Ok(())
-    }
-
-    fn say(&mut self, message: String, error: bool) {
-        if error {
-            log::error!("{message}");
-        } else {
-            log::info!("{message}");
-        }
-        self.view.message = Some((message, error));
-    }
-
-    fn run_script(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
-        let Some(script) = self.script.as_mut() else {
-            return Ok(());
-        };
-        for command in script.due(self.tick) {
-            log::info!("script tick {}: {command:?}", self.tick);
-            match command {
-                Command::Resize(w, h) => {
-                    let window = self.window.as_ref();
-                    if w == 0 || h == 0 {
-                        // A window system may refuse a zero size (X11 does): the demo enters
-                        // the zero-size state itself and asks the window system to minimize.
-                        self.minimized_by_script = true;
-                        if let Some(window) = window {
-                            window.set_minimized(true);
-                        }
-                    } else {
-                        self.minimized_by_script = false;
-                        if let Some(window) = window {
-                            window.set_minimized(false);
-                            // Applied now (Some) or later through a Resized event (None).
-                            let _ = window.request_inner_size(PhysicalSize::new(w, h));
-                        }
-                    }
-                    self.resize_pending = true;
-                }
-                Command::Technique(name) => {
-                    self.technique = Technique::parse(&name)
-                        .map_err(|e| LucentError::InvalidInput(format!("script: {e}")))?;
-                    self.rebuild_pending = true;
-                }
-                Command::Orbit(dx, dy) => self.orbit.orbit(dx, dy),
-                Command::Zoom(f) => self.orbit.zoom(f),
-                Command::Pan(dx, dy) => self.orbit.pan(dx, dy),
-                Command::Fly(f, r, u) => self.orbit.fly(f, r, u),
-                Command::Reset => self.orbit.reset(),
-                Command::Key(name) => {
-                    let action = controls::action_named(&name).ok_or_else(|| {
-                        LucentError::InvalidInput(format!(
-                            "script: unknown key '{name}'; known: {}",
-                            controls::KEYS
-                                .iter()
-                                .map(|k| k.name)
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ))
-                    })?;
-                    self.act(event_loop, action)?;
-                }
-                Command::Screenshot(path) => self.screenshot_pending.push(path),
-                Command::Quit => {
-                    self.done = true;
-                    event_loop.exit();
-                }
-            }
-        }
-        Ok(())
-    }
-
     fn minimized(&self) -> bool {
         self.minimized_by_script
             || self.window_zero
@@ -749,18 +546,6 @@ impl Demo<'_> {
             .map_or((0, 0), |w| (w.inner_size().width, w.inner_size().height))
     }
 
-    fn fly(&mut self, dt: f32) {
-        let held = |k| self.input.held.contains(&k);
-        let axis = |plus, minus| f32::from(u8::from(held(plus))) - f32::from(u8::from(held(minus)));
-        let forward = axis(KeyCode::KeyW, KeyCode::KeyS);
-        let right = axis(KeyCode::KeyD, KeyCode::KeyA);
-        let up = axis(KeyCode::KeyE, KeyCode::KeyQ);
-        if forward != 0.0 || right != 0.0 || up != 0.0 {
-            let step = FLY_SPEED * self.orbit.distance * dt;
-            self.orbit.fly(forward * step, right * step, up * step);
-        }
-    }
-
     /// Builds the renderer for the current size, technique and scene. A failure keeps the
     /// previous renderer (if any) and shows the error; without a previous one it is fatal.
     fn rebuild(&mut self) -> Result<()> {
@@ -825,7 +610,7 @@ impl Demo<'_> {
             technique: self.technique,
             ..self.options.base
         };
-        let Ok(features) = FrameFeatures::new(&self.scene, &settings) else {
+        let Ok(features) = FrameDesc::new(&self.scene, &settings) else {
             return false;
         };
         match view {
@@ -1029,30 +814,4 @@ impl Demo<'_> {
         self.window = None;
         result.and(idle)
     }
-}
-
-/// The action of a key press (camera keys are held, not actions).
-fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
-    let name = match code {
-        KeyCode::F1 => "F1",
-        KeyCode::KeyT if shift => "Shift+T",
-        KeyCode::KeyT => "T",
-        KeyCode::KeyP => "P",
-        KeyCode::KeyV => "V",
-        KeyCode::Digit1 | KeyCode::Numpad1 => "1",
-        KeyCode::Digit2 | KeyCode::Numpad2 => "2",
-        KeyCode::Digit3 | KeyCode::Numpad3 => "3",
-        KeyCode::Digit4 | KeyCode::Numpad4 => "4",
-        KeyCode::Digit5 | KeyCode::Numpad5 => "5",
-        KeyCode::Equal | KeyCode::NumpadAdd | KeyCode::PageUp => "+",
-        KeyCode::Minus | KeyCode::NumpadSubtract | KeyCode::PageDown => "-",
-        KeyCode::KeyR => "R",
-        KeyCode::KeyH => "H",
-        KeyCode::KeyI => "I",
-        KeyCode::F5 => "F5",
-        KeyCode::F12 => "F12",
-        KeyCode::Escape => "Esc",
-        _ => return None,
-    };
-    controls::action_named(name)
 }

@@ -486,9 +486,9 @@ impl Presenter {
             let timer = self.timer.as_mut().map(|(t, _)| t);
             if let Some(t) = timer {
                 t.reset(gpu, cmd);
-                renderer.executable.record_frame(gpu, cmd, Some(t));
+                renderer.executable.record_frame(gpu, cmd, 0, Some(t));
             } else {
-                renderer.executable.record_frame(gpu, cmd, None);
+                renderer.executable.record_frame(gpu, cmd, 0, None);
             }
         }
         gpu.begin_label(cmd, "present");

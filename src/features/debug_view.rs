@@ -10,13 +10,12 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
+    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
+    ResourceId,
 };
 use crate::Result;
 
 use super::deferred::{GBuffer, Lit};
-use super::tonemap::LDR_FORMAT;
 use super::translucency::ThicknessPacking;
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
 use crate::gpu_scene::SceneGpu;
@@ -83,6 +82,7 @@ pub fn debug_view_pass(
     view: DebugView,
     gb: &GBuffer,
     lit: &Lit,
+    display: impl FnOnce(&mut RenderGraph) -> Handle<Image>,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Option<Handle<Image>> {
     let (source, second) = match view {
@@ -104,14 +104,8 @@ pub fn debug_view_pass(
         (DebugView::TranslucencyTerm, Some(gb2)) => Some((gb2, &gb.depth)),
         _ => None,
     };
-    let info = graph.resources()[gb.gb0.id()].info;
-    let mut ldr = graph.create_image(
-        "display",
-        ImageInfo {
-            format: LDR_FORMAT,
-            ..info
-        },
-    );
+    let mut ldr = display(graph);
+    let linear = super::tonemap::writes_linear(graph.resources()[ldr.id()].info.format);
     let mut pass = graph.add_pass("debug view", PassKind::Raster);
     pass.sample(source);
     if let Some(s) = second {
@@ -130,6 +124,7 @@ pub fn debug_view_pass(
             scene: scene.clone(),
             view,
             colored,
+            linear,
             inputs: (source.id(), second.map(|s| s.id())),
             term: term_inputs.map(|(g, d)| (g.id(), d.id())),
             sampler: vk::Sampler::null(),
@@ -144,6 +139,8 @@ struct DebugViewPass {
     scene: Arc<SceneGpu>,
     view: DebugView,
     colored: bool,
+    /// Write linear values (sRGB or float targets).
+    linear: bool,
     inputs: (ResourceId, Option<ResourceId>),
     /// The translucency term's GB2 and depth.
     term: Option<(ResourceId, ResourceId)>,
@@ -155,17 +152,29 @@ impl PassExec for DebugViewPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let mut bindings = vec![
-            Binding::Uniform(self.scene.frame_uniforms),
+            Binding::PerFrame(
+                self.scene
+                    .per_frame
+                    .binding(crate::gpu_scene::Region::Frame),
+            ),
             Binding::Sampled(ctx.views[self.inputs.0], self.sampler),
         ];
         let mut defines = vec![(self.view.define(), "1")];
-        match (self.inputs.1, self.term, &self.scene.translucency) {
-            (Some(gb1), Some((gb2, depth)), Some(t)) => {
+        let has_table = self
+            .scene
+            .per_frame
+            .has(crate::gpu_scene::Region::Translucency);
+        match (self.inputs.1, self.term, has_table) {
+            (Some(gb1), Some((gb2, depth)), true) => {
                 for id in [gb1, gb2] {
                     bindings.push(Binding::Sampled(ctx.views[id], self.sampler));
                 }
                 bindings.push(Binding::Sampled(ctx.descriptor_views[depth], self.sampler));
-                bindings.push(Binding::Uniform(t.materials.buffer));
+                bindings.push(Binding::PerFrame(
+                    self.scene
+                        .per_frame
+                        .binding(crate::gpu_scene::Region::Translucency),
+                ));
                 defines.push(("LUCENT_POW_MODES", "3"));
             }
             (Some(second), _, _) => {
@@ -176,6 +185,9 @@ impl PassExec for DebugViewPass {
         }
         if self.colored {
             defines.push(("LUCENT_COLORED_THICKNESS", "1"));
+        }
+        if self.linear {
+            defines.push(("LUCENT_OUTPUT_LINEAR", "1"));
         }
         self.pipeline = Some(PassPipeline::new(
             ctx,

@@ -25,14 +25,14 @@ use super::translucency::ThicknessPacking;
 use super::util::{
     Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
 };
-use crate::gpu_scene::SceneGpu;
+use crate::gpu_scene::{Region, SceneGpu};
 
 /// Depth.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Lit HDR colour.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
-/// Screen-space SSS strength per pixel.
-pub const SSS_STRENGTH_FORMAT: vk::Format = vk::Format::R8_UNORM;
+/// Screen-space SSS profile ID per pixel (ID / 255; 0: the pixel does not scatter).
+pub const SSS_PROFILE_FORMAT: vk::Format = vk::Format::R8_UNORM;
 /// LCB and LBB: view-plane LEAN slope y and moments (blurred, so at least fp16).
 pub const LEAN_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
@@ -74,8 +74,9 @@ pub struct GBufferLayout {
     pub precision: GBufferPrecision,
     /// `None`: the frame has no translucency and no GB2.
     pub translucency: Option<TranslucencyLayout>,
-    /// Screen-space SSS: the G-buffer stores each pixel's SSS strength (R8) and the lighting
-    /// pass writes diffuse and specular to separate targets, so the blur sees diffuse only.
+    /// Screen-space SSS: the G-buffer stores each pixel's SSS profile ID (R8) and the
+    /// lighting pass writes diffuse and specular to separate targets, so the blur sees diffuse
+    /// only.
     pub sss: bool,
     /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
     /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
@@ -84,6 +85,9 @@ pub struct GBufferLayout {
     pub lean_clear: bool,
     /// Some object has a normal map: the G-buffer pass reads UVs and tangents and samples it.
     pub normal_maps: bool,
+    /// Some object has an albedo texture: the G-buffer pass reads UVs and multiplies the
+    /// albedo by it.
+    pub albedo_maps: bool,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
     pub fault_injection: bool,
 }
@@ -100,7 +104,54 @@ pub struct TranslucencyLayout {
     pub single_material: bool,
 }
 
+/// A G-buffer target beyond GB0 and GB1, each present only in frames whose materials need it;
+/// they take the colour locations after GB1 in this order (glsl/deferred/gbuffer.frag reads
+/// each location from its define).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExtraTarget {
+    /// GB2: thickness + translucency material ID.
+    Translucency,
+    /// The SSS profile ID.
+    SssProfile,
+    /// The view-plane LEAN slope y + moments.
+    Lean,
+}
+
+impl ExtraTarget {
+    /// The define that carries the target's location.
+    fn location_define(self) -> &'static str {
+        match self {
+            ExtraTarget::Translucency => "LUCENT_GB2_LOCATION",
+            ExtraTarget::SssProfile => "LUCENT_SSS_LOCATION",
+            ExtraTarget::Lean => "LUCENT_LEAN_LOCATION",
+        }
+    }
+}
+
+/// Location values as shader define strings (at most 2 + three extra targets).
+const LOCATIONS: [&str; 5] = ["0", "1", "2", "3", "4"];
+
 impl GBufferLayout {
+    /// The targets after GB0 and GB1, in location order (2, 3, ...).
+    pub fn extra_targets(&self) -> Vec<ExtraTarget> {
+        let mut targets = Vec::new();
+        if self.translucency.is_some() {
+            targets.push(ExtraTarget::Translucency);
+        }
+        if self.sss {
+            targets.push(ExtraTarget::SssProfile);
+        }
+        if self.lean {
+            targets.push(ExtraTarget::Lean);
+        }
+        targets
+    }
+
+    /// The G-buffer pass reads the UV + tangent stream.
+    pub fn surface_stream(&self) -> bool {
+        self.normal_maps || self.albedo_maps
+    }
+
     /// GB0: albedo rgb + specular.
     pub fn gb0_format(&self) -> vk::Format {
         match self.precision {
@@ -131,17 +182,27 @@ impl GBufferLayout {
         })
     }
 
-    /// G-buffer pass defines.
+    /// G-buffer pass defines: the features, each extra target's location, and the binding of
+    /// each material texture (set 0: 0 the frame uniforms, then normal or LEAN map 1, LEAN
+    /// map 2, albedo map, those the frame has).
     fn gbuffer_defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut defines = self.defines();
         if self.sss {
-            defines.push(("LUCENT_SSS_STRENGTH", "1"));
+            defines.push(("LUCENT_SSS_PROFILE", "1"));
         }
         if self.normal_maps {
             defines.push(("LUCENT_NORMAL_MAP", "1"));
         }
         if self.lean {
             defines.push(("LUCENT_LEAN", "1"));
+        }
+        if self.albedo_maps {
+            defines.push(("LUCENT_ALBEDO_MAP", "1"));
+            let binding = 1 + usize::from(self.normal_maps) * (1 + usize::from(self.lean));
+            defines.push(("LUCENT_ALBEDO_BINDING", LOCATIONS[binding]));
+        }
+        for (i, target) in self.extra_targets().into_iter().enumerate() {
+            defines.push((target.location_define(), LOCATIONS[2 + i]));
         }
         defines
     }
@@ -179,7 +240,7 @@ pub struct GBuffer {
     pub gb1: Handle<Image>,
     /// Local thickness + material ID, in frames with translucency.
     pub gb2: Option<Handle<Image>>,
-    /// Screen-space SSS strength per pixel, in frames with SSS.
+    /// Screen-space SSS profile ID per pixel, in frames with SSS.
     pub sss: Option<Handle<Image>>,
     /// View-plane LEAN slope y + moments, in LCB and LBB frames.
     pub lean: Option<Handle<Image>>,
@@ -210,7 +271,7 @@ pub fn gbuffer_pass(
             .map(|f| graph.create_image("gbuffer.translucency", image(f))),
         sss: layout
             .sss
-            .then(|| graph.create_image("gbuffer.sss", image(SSS_STRENGTH_FORMAT))),
+            .then(|| graph.create_image("gbuffer.sss", image(SSS_PROFILE_FORMAT))),
         lean: layout
             .lean
             .then(|| graph.create_image("gbuffer.lean", image(LEAN_FORMAT))),
@@ -231,7 +292,7 @@ pub fn gbuffer_pass(
         pass.color(sss, LoadOp::Clear([0.0; 4]));
     }
     if let Some(lean) = &mut gb.lean {
-        // Location 3 of glsl/deferred/gbuffer.frag. LCB clears it: the control-style blur's
+        // LUCENT_LEAN_LOCATION of glsl/deferred/gbuffer.frag. LCB clears it: the control-style blur's
         // bilinear taps straddle silhouettes and would filter undefined sky texels into the
         // moments. LBB's point taps give sky texels zero weight (depth) and replace non-finite
         // ones, so it skips the clear.
@@ -318,20 +379,30 @@ struct GBufferPass {
     scene: Arc<SceneGpu>,
     layout: GBufferLayout,
     pipeline: Option<PassPipeline>,
-    /// Normal-mapped frames: one set per normal map after the first (which is the pipeline's
-    /// own), each `frame uniforms + that map`, bound per draw.
+    /// Frames with maps: one set per material-texture pair after the first (which is the
+    /// pipeline's own), each `frame uniforms + those maps`, bound per draw.
     map_sets: Vec<DescriptorSet>,
 }
 
 impl GBufferPass {
-    /// Set 0's bindings with normal map `index` (glsl/deferred/gbuffer.frag).
+    /// Set 0's bindings with material-texture pair `index` of the scene's maps
+    /// (glsl/deferred/gbuffer.frag): the frame uniforms, then the normal (or LEAN 1) map, LEAN
+    /// map 2 and the albedo map, those the frame has.
     fn bindings(&self, index: usize) -> Vec<Binding> {
-        let mut bindings = vec![Binding::Uniform(self.scene.frame_uniforms)];
-        if let Some(maps) = &self.scene.normal_maps {
-            bindings.push(Binding::Sampled(maps.images[index].view, maps.sampler));
-            // LEAN frames: binding 2 is the second LEAN map.
-            if let Some(lean2) = maps.lean2.get(index) {
-                bindings.push(Binding::Sampled(lean2.view, maps.sampler));
+        let mut bindings = vec![Binding::PerFrame(
+            self.scene.per_frame.binding(Region::Frame),
+        )];
+        if let Some(maps) = &self.scene.maps {
+            let (normal, albedo) = maps.sets.get(index).copied().unwrap_or((0, 0));
+            if let Some(map) = maps.normal.get(normal) {
+                bindings.push(Binding::Sampled(map.view, maps.sampler));
+                // LEAN frames: the second LEAN map follows.
+                if let Some(lean2) = maps.lean2.get(normal) {
+                    bindings.push(Binding::Sampled(lean2.view, maps.sampler));
+                }
+            }
+            if let Some(map) = maps.albedo.get(albedo) {
+                bindings.push(Binding::Sampled(map.view, maps.sampler));
             }
         }
         bindings
@@ -349,7 +420,7 @@ impl PassExec for GBufferPass {
                 defines: &self.layout.gbuffer_defines(),
                 vertex_input: VertexInput::Mesh {
                     thickness: self.layout.translucency.is_some(),
-                    surface: self.layout.normal_maps,
+                    surface: self.layout.surface_stream(),
                 },
                 depth_test: true,
                 cull_back: true,
@@ -360,18 +431,14 @@ impl PassExec for GBufferPass {
                 name: "gbuffer",
             },
         )?);
-        let maps = self
-            .scene
-            .normal_maps
-            .as_ref()
-            .map_or(0, |m| m.images.len());
-        for index in 1..maps {
+        let sets = self.scene.maps.as_ref().map_or(0, |m| m.sets.len());
+        for index in 1..sets {
             // Identically defined layouts are compatible: these sets bind to the pipeline's.
             let set = DescriptorSet::new(
                 ctx,
                 &self.bindings(index),
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                "gbuffer normal map",
+                "gbuffer material maps",
             )?;
             self.map_sets.push(set);
         }
@@ -384,26 +451,19 @@ impl PassExec for GBufferPass {
         };
         pipeline.bind(ctx);
         let device = &ctx.gpu.device;
-        let mut bound_map = 0usize;
-        // SAFETY: the pipeline is bound inside this pass's subpass; buffers and sets are alive.
-        unsafe {
-            for draw in &self.scene.draws {
-                let mesh = &self.scene.meshes[draw.mesh];
-                if draw.normal_map != bound_map {
-                    let set = match draw.normal_map {
-                        0 => pipeline.set.set,
-                        i => self.map_sets[i - 1].set,
-                    };
-                    device.cmd_bind_descriptor_sets(
-                        ctx.cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        pipeline.pipeline.layout,
-                        0,
-                        &[set],
-                        &[],
-                    );
-                    bound_map = draw.normal_map;
-                }
+        let mut bound_maps = 0usize;
+        for draw in &self.scene.draws {
+            let mesh = &self.scene.meshes[draw.mesh];
+            if draw.maps != bound_maps {
+                let set = match draw.maps {
+                    0 => &pipeline.set,
+                    i => &self.map_sets[i - 1],
+                };
+                set.bind(ctx, pipeline.pipeline.layout, 0);
+                bound_maps = draw.maps;
+            }
+            // SAFETY: the pipeline is bound inside this pass's subpass; buffers are alive.
+            unsafe {
                 device.cmd_push_constants(
                     ctx.cmd,
                     pipeline.pipeline.layout,
@@ -415,7 +475,7 @@ impl PassExec for GBufferPass {
                 if let (Some(thickness), Some(_)) = (&mesh.thickness, self.layout.translucency) {
                     device.cmd_bind_vertex_buffers(ctx.cmd, 1, &[thickness.buffer], &[0]);
                 }
-                if let (Some(surface), true) = (&mesh.surface, self.layout.normal_maps) {
+                if let (Some(surface), true) = (&mesh.surface, self.layout.surface_stream()) {
                     device.cmd_bind_vertex_buffers(ctx.cmd, 2, &[surface.buffer], &[0]);
                 }
                 device.cmd_bind_index_buffer(
@@ -467,14 +527,16 @@ impl PassExec for LightingPass {
         // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency
         // (glsl/deferred/lighting.frag).
         let mut bindings = vec![
-            Binding::Uniform(self.scene.frame_uniforms),
+            Binding::PerFrame(self.scene.per_frame.binding(Region::Frame)),
             Binding::InputAttachment(views[inputs.gb0], color_layout),
             Binding::InputAttachment(views[inputs.gb1], color_layout),
             Binding::InputAttachment(views[inputs.depth], depth_layout),
         ];
-        if let (Some(gb2), Some(t)) = (inputs.gb2, &self.scene.translucency) {
+        if let Some(gb2) = inputs.gb2 {
             bindings.push(Binding::InputAttachment(views[gb2], color_layout));
-            bindings.push(Binding::Uniform(t.materials.buffer));
+            bindings.push(Binding::PerFrame(
+                self.scene.per_frame.binding(Region::Translucency),
+            ));
         }
         let mut plain_defines: Vec<(&str, &str)> = Vec::new();
         if self.layout.sss {
@@ -500,7 +562,9 @@ impl PassExec for LightingPass {
         };
         let mut pipeline = PassPipeline::new(ctx, &bindings, &plain)?;
         if self.layout.translucency.is_some() {
-            let defines = self.layout.defines();
+            // The plain variant's defines (split specular, LEAN slope) plus the translucency's.
+            let mut defines = plain_defines.clone();
+            defines.extend(self.layout.defines());
             let layouts = [pipeline.set.layout];
             let translucent = GraphicsPipeline::new(
                 ctx,
@@ -527,11 +591,11 @@ impl PassExec for LightingPass {
         let Some(pipeline) = &self.pipeline else {
             return;
         };
-        let (Some(translucent), Some(t)) = (&self.translucent, &self.scene.translucency) else {
+        let Some(translucent) = &self.translucent else {
             pipeline.draw_fullscreen(ctx);
             return;
         };
-        let rects = t.tiles.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        let rects = self.scene.per_frame.tiles(ctx.frame).lighting.clone();
         pipeline.bind(ctx);
         PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
         // SAFETY: made for this subpass with the bound set's layout.

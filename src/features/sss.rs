@@ -1,4 +1,5 @@
-//! Screen-space subsurface scattering as separable blurs of the lit diffuse light.
+//! Screen-space subsurface scattering as separable blurs of the lit diffuse light, each pixel
+//! with its own material's diffusion profile.
 //!
 //! The control technique (Jimenez et al. 2009, as the LEAN-mapping thesis describes it): for
 //! each Gaussian of the material's diffusion profile (a sum of Gaussians, narrowest first), a
@@ -11,25 +12,180 @@
 //! specular the lighting pass kept apart. Pass names follow the thesis's Table 2
 //! (`horizontal blur #1`, `vertical blur #1`, ...).
 //!
-//! A frame blurs with one profile: the first SSS material's (the scenes use one profile each);
-//! the per-pixel strength (0 = not SSS, from the G-buffer) scales the kernel width. With tiles
-//! on (the default), the blurs draw only over the screen rectangles of objects with a profile,
-//! widened by the profile's reach ([`profile_reach`]).
+//! **Profiles per pixel.** Every SSS material of the frame gets a profile ID (1 to
+//! [`MAX_SSS_PROFILES`]` - 1`), which the G-buffer pass writes per pixel; a profile table on
+//! the GPU ([`ProfileTableGpu`], a region of the per-frame buffer) holds each profile's blur
+//! steps. Step `i` of the blur reads the pixel's own profile's sigma and weight, so skin and
+//! marble in one frame are each diffused with their own profile in the same passes; a
+//! profile with fewer Gaussians than the frame's longest simply adds nothing at the extra
+//! steps. With more than one profile in the frame, a tap that lands on another profile's
+//! pixel counts as a depth discontinuity (no light bleeds from one profile's object into
+//! another's).
+//!
+//! **Chains.** Materials choose their blur ([`SssBlur`]: control, LCB, LBB). The frame runs one
+//! chain of blur passes per blur in use, each touching only the pixels of its profiles, and
+//! each chain's final pass keeps the previous chain's result elsewhere; a frame with one
+//! blur (every frame under a named technique) has exactly the passes the thesis's tables
+//! list. With tiles on (the default), each chain draws only over the screen rectangles of its
+//! objects, widened by their profiles' reach ([`profile_reach`]).
 
 use std::sync::Arc;
 
 use ash::vk;
 
+use crate::gpu_scene::{Region, SceneGpu};
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
     RenderGraph, ResourceId,
 };
 use crate::scene::material::SssProfile;
-use crate::Result;
+use crate::scene::Scene;
+use crate::{LucentError, Result};
+
+pub use crate::scene::material::SssBlur;
 
 use super::deferred::HDR_FORMAT;
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
-use crate::gpu_scene::SceneGpu;
+
+/// Profile IDs are stored in 8 bits and index a uniform table: 0 means "does not scatter", so
+/// a frame holds up to `MAX_SSS_PROFILES - 1` distinct profiles (glsl/common/sss.glsl).
+pub const MAX_SSS_PROFILES: usize = 32;
+/// Most blur steps (Gaussians) of one profile ([`SssProfile::validate`] allows 8).
+pub const MAX_SSS_STEPS: usize = 8;
+
+/// The SSS profiles of a frame: every distinct (profile, blur) of the scene's SSS materials,
+/// each with its ID, and each object's ID.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SssProfiles {
+    /// The profiles in ID order (ID = index + 1), refitted when `--sss-gaussians` asks, with
+    /// the blur each is diffused with.
+    pub profiles: Vec<(SssProfile, SssBlur)>,
+    /// Per scene object: its profile ID (0: the object does not scatter).
+    pub object_ids: Vec<u8>,
+}
+
+impl SssProfiles {
+    /// The profiles `scene`'s SSS materials ask for: each with its own blur, or `forced` on
+    /// all (a named technique); refitted to `gaussians` Gaussians when set. `None` when no
+    /// object scatters.
+    pub fn new(
+        scene: &Scene,
+        forced: Option<SssBlur>,
+        gaussians: Option<usize>,
+    ) -> Result<Option<Self>> {
+        let mut profiles: Vec<(SssProfile, SssBlur)> = Vec::new();
+        let mut object_ids = Vec::with_capacity(scene.objects.len());
+        for object in &scene.objects {
+            let Some(p) = &object.material.sss else {
+                object_ids.push(0);
+                continue;
+            };
+            let blur = forced.unwrap_or_else(|| p.blur_or_default());
+            let profile = match gaussians {
+                Some(n) => crate::scene::profile::fit_profile(p, n)?.0,
+                None => p.clone(),
+            };
+            let entry = (profile, blur);
+            let index = match profiles.iter().position(|e| *e == entry) {
+                Some(i) => i,
+                None => {
+                    if profiles.len() + 1 == MAX_SSS_PROFILES {
+                        return Err(LucentError::InvalidInput(format!(
+                            "scene '{}' has more than {} distinct SSS profiles (profile IDs \
+                             index a table of {MAX_SSS_PROFILES})",
+                            scene.name,
+                            MAX_SSS_PROFILES - 1
+                        )));
+                    }
+                    profiles.push(entry);
+                    profiles.len() - 1
+                }
+            };
+            object_ids.push(index as u8 + 1);
+        }
+        Ok((!profiles.is_empty()).then_some(Self {
+            profiles,
+            object_ids,
+        }))
+    }
+
+    /// The blurs in use, one chain each, in [`SssBlur`] order.
+    pub fn chains(&self) -> Vec<SssBlur> {
+        let mut chains: Vec<SssBlur> = self.profiles.iter().map(|(_, b)| *b).collect();
+        chains.sort();
+        chains.dedup();
+        chains
+    }
+
+    /// Blur steps of `chain`: its longest profile's Gaussian count.
+    pub fn steps(&self, chain: SssBlur) -> usize {
+        self.profiles
+            .iter()
+            .filter(|(_, b)| *b == chain)
+            .map(|(p, _)| p.gaussians.len())
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Whether some chain blurs the LEAN G-buffer.
+    pub fn lean(&self) -> bool {
+        self.profiles.iter().any(|(_, b)| b.lean())
+    }
+
+    /// The profile of `object`, if it scatters.
+    pub fn of_object(&self, object: usize) -> Option<&(SssProfile, SssBlur)> {
+        let id = *self.object_ids.get(object)?;
+        (id > 0).then(|| &self.profiles[usize::from(id) - 1])
+    }
+
+    /// The GPU profile table with `knobs` (the bilateral sensitivity).
+    pub fn table(&self, knobs: &SssKnobs) -> ProfileTableGpu {
+        let chains = self.chains();
+        let mut table = ProfileTableGpu {
+            info: [[0.0; 4]; MAX_SSS_PROFILES],
+            steps: [[[0.0; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+        };
+        for (i, (profile, blur)) in self.profiles.iter().enumerate() {
+            let id = i + 1;
+            let chain = chains.iter().position(|c| c == blur).unwrap_or(0);
+            let steps = blur_steps(profile);
+            table.info[id] = [chain as f32, steps.len() as f32, 0.0, 0.0];
+            let mut completed_variance = 0.0f32;
+            for (s, step) in steps.iter().take(MAX_SSS_STEPS).enumerate() {
+                completed_variance += step.sigma * step.sigma;
+                // Bilateral: per world unit of depth difference, the sensitivity over the width
+                // of the Gaussian this step completes (guarded: a zero-width profile rejects
+                // every neighbour, which leaves the pixel as it is).
+                let depth_term = if blur.bilateral() {
+                    knobs.sensitivity.max(0.0) / completed_variance.sqrt().max(1e-9)
+                } else {
+                    DEPTH_CORRECTION
+                };
+                let mean_weight = step.weight.iter().sum::<f32>() / 3.0;
+                table.steps[id * MAX_SSS_STEPS + s] = [
+                    [step.sigma, depth_term, 0.0, 0.0],
+                    [step.weight[0], step.weight[1], step.weight[2], mean_weight],
+                ];
+            }
+        }
+        table
+    }
+}
+
+/// The profile table uniform block (std140, glsl/common/sss.glsl `SssProfiles`), indexed by
+/// profile ID; ID 0 is unused ("does not scatter").
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ProfileTableGpu {
+    /// Per ID: x the chain (index into [`SssProfiles::chains`]), y its step count.
+    pub info: [[f32; 4]; MAX_SSS_PROFILES],
+    /// Per ID and step (`id * MAX_SSS_STEPS + step`): `[sigma in world units, depth term, 0,
+    /// 0]` and `[weight r, g, b, their mean]`.
+    pub steps: [[[f32; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+}
+
+/// Bytes of [`ProfileTableGpu`] (the per-frame buffer's profile region).
+pub const PROFILE_TABLE_BYTES: u64 = std::mem::size_of::<ProfileTableGpu>() as u64;
 
 /// Depth correction of the control blur: a tap whose linear depth differs from the centre's by
 /// `1 / DEPTH_CORRECTION` world units or more is fully replaced by the centre colour.
@@ -87,35 +243,6 @@ pub fn profile_reach(profile: &SssProfile) -> f32 {
     3.0 * widest.max(0.0).sqrt() * profile.units_per_mm
 }
 
-/// LBB's packed ping-pong texel: eight fp16 halves (glsl/sss/blur.frag `pack_texels`).
-pub const PACKED_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
-
-/// LCB's and LBB's final lighting pass.
-const LEAN_FINAL_SHADER: &str = "sss/lean_brdf.frag";
-
-/// Which screen-space blur a frame runs (the technique decides: control, LCB, LBB).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SssBlur {
-    /// Jimenez's blur of the lit diffuse light (the thesis's control, C).
-    Control,
-    /// The LEAN pipeline with Jimenez's blur (LCB).
-    LeanControl,
-    /// The LEAN pipeline with the bilateral blur (LBB).
-    LeanBilateral,
-}
-
-impl SssBlur {
-    /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
-    pub fn lean(self) -> bool {
-        self != SssBlur::Control
-    }
-
-    /// Whether taps are weighted by a depth-difference Gaussian (else lerped back by depth).
-    pub fn bilateral(self) -> bool {
-        self == SssBlur::LeanBilateral
-    }
-}
-
 /// Precision of the sum-of-Gaussians targets.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SssPrecision {
@@ -159,7 +286,7 @@ pub const DEFAULT_SENSITIVITY: f32 = 1.0;
 /// The screen-space SSS knobs a frame is built with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SssKnobs {
-    /// Refit the profile with this many Gaussians (fewer blur pairs; [`fit_profile`] reports
+    /// Refit the profile with this many Gaussians (fewer blur pairs; [`crate::scene::profile::fit_profile`] reports
     /// the error it costs). `None`: the material's own profile.
     pub gaussians: Option<usize>,
     /// Precision of the sum targets.
@@ -191,33 +318,102 @@ impl Default for SssKnobs {
     }
 }
 
+/// LBB's packed ping-pong texel: eight fp16 halves (glsl/sss/blur.frag `pack_texels`).
+pub const PACKED_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+
+/// LCB's and LBB's final lighting pass.
+const LEAN_FINAL_SHADER: &str = "sss/lean_brdf.frag";
+
 /// The images the SSS passes read.
 pub struct SssInputs<'a> {
-    /// Lit diffuse (LCB, LBB: alpha holds the view-plane slope x).
+    /// Lit diffuse (LEAN frames: alpha holds the view-plane slope x).
     pub diffuse: &'a Handle<Image>,
     /// Lit specular, added back where the pixel does not scatter (everywhere for the control).
     pub specular: &'a Handle<Image>,
     /// Depth.
     pub depth: &'a Handle<Image>,
-    /// SSS strength per pixel.
-    pub strength: &'a Handle<Image>,
-    /// LCB, LBB: the G-buffer's view-plane LEAN target (slope y, moments).
+    /// SSS profile ID per pixel (R8: ID / 255).
+    pub profile_ids: &'a Handle<Image>,
+    /// LEAN frames: the G-buffer's view-plane LEAN target (slope y, moments).
     pub lean: Option<&'a Handle<Image>>,
     /// G-buffer albedo + specular intensity (LEAN specular).
     pub gb0: &'a Handle<Image>,
 }
 
-/// Declares the SSS passes after the lighting pass: one horizontal + vertical blur pair per
-/// Gaussian of `profile`, then the final pass (`combine` for the control, `final lighting`
-/// with LEAN specular for LCB and LBB). Returns the final HDR image.
+/// Declares every chain's passes after the lighting pass (see the module docs): per chain, one
+/// horizontal + vertical blur pair per step, then its final pass (`combine` for the control,
+/// `final lighting` with LEAN specular for LCB and LBB), which keeps the previous chain's
+/// result on the pixels the chain does not own. Returns the final HDR image.
 pub fn sss_passes(
     graph: &mut RenderGraph,
     inputs: &SssInputs<'_>,
-    profile: &SssProfile,
-    blur: SssBlur,
+    profiles: &SssProfiles,
     knobs: &SssKnobs,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
+    let chains = profiles.chains();
+    let edges = profiles.profiles.len() > 1;
+    let mut base: Option<Handle<Image>> = None;
+    for (index, &blur) in chains.iter().enumerate() {
+        // One chain keeps the thesis's names; several are told apart by their blur.
+        let prefix = if chains.len() == 1 {
+            String::new()
+        } else {
+            format!("{} ", blur.name())
+        };
+        let chain = Chain {
+            index,
+            blur,
+            steps: profiles.steps(blur),
+            edges,
+            prefix,
+            last: index + 1 == chains.len(),
+        };
+        base = Some(chain_passes(
+            graph,
+            inputs,
+            &chain,
+            base.as_ref(),
+            knobs,
+            scene,
+        ));
+    }
+    base.expect("SssProfiles is never empty")
+}
+
+/// One chain of a frame.
+struct Chain {
+    /// Its index in the frame's chains (the profile table's chain number).
+    index: usize,
+    blur: SssBlur,
+    steps: usize,
+    /// The frame has more than one profile: taps on another profile's pixels are rejected.
+    edges: bool,
+    /// Pass name prefix (empty in one-chain frames).
+    prefix: String,
+    /// The frame's last chain writes `hdr`.
+    last: bool,
+}
+
+impl Chain {
+    fn image_name(&self, what: &str) -> String {
+        if self.prefix.is_empty() {
+            format!("sss.{what}")
+        } else {
+            format!("sss.{}.{what}", self.blur.name())
+        }
+    }
+}
+
+fn chain_passes(
+    graph: &mut RenderGraph,
+    inputs: &SssInputs<'_>,
+    chain: &Chain,
+    base: Option<&Handle<Image>>,
+    knobs: &SssKnobs,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let blur = chain.blur;
     let info = ImageInfo {
         format: HDR_FORMAT,
         ..graph.resources()[inputs.diffuse.id()].info
@@ -245,85 +441,91 @@ pub fn sss_passes(
         (targets, info)
     };
     let mut temp: Vec<Handle<Image>> = (0..pingpong)
-        .map(|t| graph.create_image(&format!("sss.temp{}", names[t]), pingpong_info))
+        .map(|t| {
+            graph.create_image(
+                &chain.image_name(&format!("temp{}", names[t])),
+                pingpong_info,
+            )
+        })
         .collect();
     let mut current: Vec<Handle<Image>> = (0..pingpong)
-        .map(|t| graph.create_image(&format!("sss.current{}", names[t]), pingpong_info))
+        .map(|t| {
+            graph.create_image(
+                &chain.image_name(&format!("current{}", names[t])),
+                pingpong_info,
+            )
+        })
         .collect();
     let mut sum: Vec<Handle<Image>> = (0..targets)
-        .map(|t| graph.create_image(&format!("sss.sum{}", names[t]), sum_info))
+        .map(|t| graph.create_image(&chain.image_name(&format!("sum{}", names[t])), sum_info))
         .collect();
     // Texture fetches per pixel of a pass reading `texels` colour images, for the benchmark's
-    // cost per tap: the centre texels, depth and strength, then each kernel tap's texels and
+    // cost per tap: the centre texels, depth and profile ID, then each kernel tap's texels and
     // depth (the control: Jimenez's six bilinear taps around its centre; the bilateral blur:
-    // its point taps, centre included).
+    // its point taps, centre included), and with several profiles each tap's profile ID.
     let fetches = |texels: u32| {
         let kernel = if blur.bilateral() { knobs.taps } else { 6 };
-        texels + 2 + kernel * (texels + 1)
+        let per_tap = texels + 1 + u32::from(chain.edges);
+        texels + 2 + kernel * per_tap
     };
-    let steps = blur_steps(profile);
-    let mut completed_variance = 0.0f32;
-    for (i, step) in steps.iter().enumerate() {
-        let n = i + 1;
-        completed_variance += step.sigma * step.sigma;
-        // Bilateral: per world unit of depth difference, the sensitivity over the width of the
-        // Gaussian this step completes (guarded: a zero-width profile rejects every neighbour,
-        // which leaves the pixel as it is).
-        let depth_term = if blur.bilateral() {
-            knobs.sensitivity.max(0.0) / completed_variance.sqrt().max(1e-9)
-        } else {
-            DEPTH_CORRECTION
-        };
-        let mean_weight = step.weight.iter().sum::<f32>() / 3.0;
-        let constants = |direction: [f32; 2]| BlurConstants {
-            step: [direction[0], direction[1], step.sigma, depth_term],
-            weight: [step.weight[0], step.weight[1], step.weight[2], mean_weight],
-        };
+    for step in 0..chain.steps {
+        let n = step + 1;
         // Horizontal: the previous result (the lit diffuse the first time) into the temporary.
-        let source_handles: Vec<&Handle<Image>> = if i == 0 {
+        let source_handles: Vec<&Handle<Image>> = if step == 0 {
             std::iter::once(inputs.diffuse).chain(lean).collect()
         } else {
             current.iter().collect()
         };
-        let mut pass = graph.add_pass(&format!("horizontal blur #{n}"), PassKind::Raster);
+        let mut pass = graph.add_pass(
+            &format!("{}horizontal blur #{n}", chain.prefix),
+            PassKind::Raster,
+        );
         for h in &source_handles {
             pass.sample(h);
         }
         pass.sample(inputs.depth)
-            .sample(inputs.strength)
+            .sample(inputs.profile_ids)
             .taps(fetches(source_handles.len() as u32));
         let sources: Vec<ResourceId> = source_handles.iter().map(|h| h.id()).collect();
         for t in &mut temp {
             pass.color(t, LoadOp::DontCare);
         }
-        let exec =
-            |constants, accumulate, colors: Vec<ResourceId>, scene: &Arc<SceneGpu>| BlurPass {
-                scene: scene.clone(),
-                // The first pass reads the lighting pass's and the G-buffer's own targets.
-                packed_in: packed && colors.len() == 1,
-                packed_out: packed,
-                sums: if accumulate { targets } else { 0 },
-                taps: knobs.taps,
-                colors,
-                depth: inputs.depth.id(),
-                strength: inputs.strength.id(),
-                constants,
-                blur,
-                sampler: vk::Sampler::null(),
-                nearest: vk::Sampler::null(),
-                pipeline: None,
-            };
+        let exec = |direction: [f32; 2],
+                    accumulate: bool,
+                    colors: Vec<ResourceId>,
+                    scene: &Arc<SceneGpu>| BlurPass {
+            scene: scene.clone(),
+            packed_in: packed && colors.len() == 1,
+            packed_out: packed,
+            sums: if accumulate { targets } else { 0 },
+            taps: knobs.taps,
+            colors,
+            depth: inputs.depth.id(),
+            profile_ids: inputs.profile_ids.id(),
+            constants: BlurConstants {
+                step: [direction[0], direction[1], step as f32, chain.index as f32],
+            },
+            blur,
+            edges: chain.edges,
+            chain: chain.index,
+            sampler: vk::Sampler::null(),
+            nearest: vk::Sampler::null(),
+            pipeline: None,
+        };
         match scene {
-            Some(scene) => pass.execute(exec(constants([1.0, 0.0]), false, sources, scene)),
+            Some(scene) => pass.execute(exec([1.0, 0.0], false, sources, scene)),
             None => pass.finish(),
         }
         // Vertical: back into the current result, and its weighted share into the sum.
-        let mut pass = graph.add_pass(&format!("vertical blur #{n}"), PassKind::Raster);
+        let mut pass = graph.add_pass(
+            &format!("{}vertical blur #{n}", chain.prefix),
+            PassKind::Raster,
+        );
         for t in &temp {
             pass.sample(t);
         }
         pass.sample(inputs.depth)
-            .sample(inputs.strength)
+            .sample(inputs.profile_ids)
             .taps(fetches(temp.len() as u32));
         for c in &mut current {
             pass.color(c, LoadOp::DontCare);
@@ -331,7 +533,7 @@ pub fn sss_passes(
         for s in &mut sum {
             pass.color(
                 s,
-                if i == 0 {
+                if step == 0 {
                     LoadOp::Clear([0.0; 4])
                 } else {
                     LoadOp::Load
@@ -340,64 +542,80 @@ pub fn sss_passes(
         }
         let temps = temp.iter().map(|h| h.id()).collect();
         match scene {
-            Some(scene) => pass.execute(exec(constants([0.0, 1.0]), true, temps, scene)),
+            Some(scene) => pass.execute(exec([0.0, 1.0], true, temps, scene)),
             None => pass.finish(),
         }
     }
-    let mut hdr = graph.create_image("hdr", info);
-    match lean {
-        None => {
-            let mut pass = graph.add_pass("combine", PassKind::Raster);
-            pass.sample(&sum[0])
-                .sample(inputs.diffuse)
-                .sample(inputs.specular)
-                .sample(inputs.strength)
-                .color(&mut hdr, LoadOp::DontCare);
-            let ids = vec![
-                sum[0].id(),
-                inputs.diffuse.id(),
-                inputs.specular.id(),
-                inputs.strength.id(),
-            ];
-            match scene {
-                Some(scene) => pass.execute(FinalPass::new(scene, ids, "sss/combine.frag")),
-                None => pass.finish(),
-            }
-        }
-        Some(_) => {
-            let mut pass = graph.add_pass("final lighting", PassKind::Raster);
-            pass.sample(&sum[0])
-                .sample(&sum[1])
-                .sample(inputs.diffuse)
-                .sample(inputs.specular)
-                .sample(inputs.strength)
-                .sample(inputs.depth)
-                .sample(inputs.gb0)
-                .color(&mut hdr, LoadOp::DontCare);
-            let ids = vec![
-                sum[0].id(),
-                sum[1].id(),
-                inputs.diffuse.id(),
-                inputs.specular.id(),
-                inputs.strength.id(),
-                inputs.depth.id(),
-                inputs.gb0.id(),
-            ];
-            match scene {
-                Some(scene) => pass.execute(FinalPass::new(scene, ids, LEAN_FINAL_SHADER)),
-                None => pass.finish(),
-            }
-        }
+    let mut hdr = graph.create_image(
+        &if chain.last {
+            "hdr".to_string()
+        } else {
+            chain.image_name("result")
+        },
+        info,
+    );
+    let (name, fragment) = match lean {
+        None => ("combine", "sss/combine.frag"),
+        Some(_) => ("final lighting", LEAN_FINAL_SHADER),
+    };
+    let mut pass = graph.add_pass(&format!("{}{name}", chain.prefix), PassKind::Raster);
+    // Inputs in the shader's binding order (after the frame uniforms and the profile table).
+    let mut reads: Vec<&Handle<Image>> = sum.iter().collect();
+    reads.extend([inputs.diffuse, inputs.specular, inputs.profile_ids]);
+    if lean.is_some() {
+        reads.extend([inputs.depth, inputs.gb0]);
+    }
+    reads.extend(base);
+    for h in &reads {
+        pass.sample(h);
+    }
+    pass.color(&mut hdr, LoadOp::DontCare);
+    let ids = reads.iter().map(|h| h.id()).collect();
+    match scene {
+        Some(scene) => pass.execute(FinalPass {
+            scene: scene.clone(),
+            inputs: ids,
+            fragment,
+            chain: chain.index,
+            base: base.is_some(),
+            sampler: vk::Sampler::null(),
+            pipeline: None,
+            passthrough: None,
+        }),
+        None => pass.finish(),
     }
     hdr
 }
 
-/// Push constants of glsl/sss/blur.frag.
+/// Push constants of glsl/sss/blur.frag and the final passes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct BlurConstants {
+    /// xy: direction; z: step index; w: chain index.
     step: [f32; 4],
-    weight: [f32; 4],
+}
+
+/// The profile table and frame uniforms every SSS pass binds first (0: frame, 1: profiles).
+fn per_frame_bindings(scene: &SceneGpu) -> Vec<Binding> {
+    vec![
+        Binding::PerFrame(scene.per_frame.binding(Region::Frame)),
+        Binding::PerFrame(scene.per_frame.binding(Region::Profiles)),
+    ]
+}
+
+/// The tile rectangles of `chain` in the recorded frame (`None`: the whole screen).
+fn chain_tiles(
+    scene: &SceneGpu,
+    ctx: &RecordContext<'_>,
+    chain: usize,
+) -> Option<Vec<crate::gpu_scene::TileRect>> {
+    scene
+        .per_frame
+        .tiles(ctx.frame)
+        .sss
+        .get(chain)
+        .cloned()
+        .flatten()
 }
 
 struct BlurPass {
@@ -405,9 +623,12 @@ struct BlurPass {
     /// The texels to blur: the light (LCB, LBB: and the LEAN target).
     colors: Vec<ResourceId>,
     depth: ResourceId,
-    strength: ResourceId,
+    profile_ids: ResourceId,
     constants: BlurConstants,
     blur: SssBlur,
+    /// Reject taps on other profiles' pixels.
+    edges: bool,
+    chain: usize,
     /// LBB packed: the input is one RGBA32UI texel (after the first pass).
     packed_in: bool,
     /// LBB packed: the result is written as one RGBA32UI texel.
@@ -418,7 +639,7 @@ struct BlurPass {
     taps: u32,
     /// Linear filtering for the control's taps between texels (its offsets are fractional).
     sampler: vk::Sampler,
-    /// Nearest, for depth and strength and the bilateral blur's whole-texel taps (read with
+    /// Nearest, for depth and profile IDs and the bilateral blur's whole-texel taps (read with
     /// texelFetch; depth formats need not support linear filtering).
     nearest: vk::Sampler,
     pipeline: Option<PassPipeline>,
@@ -426,7 +647,6 @@ struct BlurPass {
 
 impl PassExec for BlurPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let scene = &self.scene;
         self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
         self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
@@ -435,13 +655,13 @@ impl PassExec for BlurPass {
         } else {
             self.sampler
         };
-        // Bindings as glsl/sss/blur.frag declares them: 4 is the LEAN texel.
-        let mut bindings = vec![
-            Binding::Uniform(scene.frame_uniforms),
+        // Bindings as glsl/sss/blur.frag declares them: 5 is the LEAN texel.
+        let mut bindings = per_frame_bindings(&self.scene);
+        bindings.extend([
             Binding::Sampled(views[self.colors[0]], color_sampler),
             Binding::Sampled(views[self.depth], self.nearest),
-            Binding::Sampled(views[self.strength], self.nearest),
-        ];
+            Binding::Sampled(views[self.profile_ids], self.nearest),
+        ]);
         if let Some(&lean) = self.colors.get(1) {
             bindings.push(Binding::Sampled(views[lean], color_sampler));
         }
@@ -461,6 +681,9 @@ impl PassExec for BlurPass {
         }
         if self.blur.bilateral() {
             defines.push(("LUCENT_SSS_BILATERAL", "1"));
+        }
+        if self.edges {
+            defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
         }
         if self.packed_in {
             defines.push(("LUCENT_SSS_PACKED_IN", "1"));
@@ -501,29 +724,17 @@ impl PassExec for BlurPass {
             return;
         };
         pipeline.bind(ctx);
-        // SAFETY: the pipeline's layout has this push-constant range; bound above.
-        unsafe {
-            ctx.gpu.device.cmd_push_constants(
-                ctx.cmd,
-                pipeline.pipeline.layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&self.constants),
-            );
-        }
-        let tiles = self
-            .scene
-            .sss_tiles
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
-        match tiles {
-            // Only where objects with a profile (and their blur's reach) can be: every pixel a
+        push_constants(ctx, pipeline, &self.constants);
+        match chain_tiles(&self.scene, ctx, self.chain) {
+            // Only where objects of this chain (and their blur's reach) can be: every pixel a
             // tap of a scattering pixel reads is written; the rest is never read.
             Some(rects) => {
                 PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
             }
-            None => pipeline.draw_fullscreen(ctx),
+            None => {
+                // SAFETY: bound above, inside the pass's subpass.
+                unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
+            }
         }
     }
 
@@ -539,63 +750,75 @@ impl PassExec for BlurPass {
     }
 }
 
-/// The pass after the blurs: `combine` (control) or `final lighting` (LCB, LBB, with LEAN
-/// specular): every input sampled at its own pixel, in the shader's binding order. With SSS
-/// tiles, `final lighting` evaluates LEAN only on the rectangles that may scatter and draws the
-/// pass-through variant (diffuse + specular) on the others: lavapipe shades both sides of the
-/// shader's per-pixel branch, rasterisation it does skip.
+fn push_constants(ctx: &RecordContext<'_>, pipeline: &PassPipeline, constants: &BlurConstants) {
+    // SAFETY: the pipeline's layout has this push-constant range; it is bound.
+    unsafe {
+        ctx.gpu.device.cmd_push_constants(
+            ctx.cmd,
+            pipeline.pipeline.layout,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            0,
+            bytemuck::bytes_of(constants),
+        );
+    }
+}
+
+/// A chain's pass after its blurs: `combine` (control) or `final lighting` (LCB, LBB, with
+/// LEAN specular): every input sampled at its own pixel, in the shader's binding order. On
+/// the pixels of its chain's profiles it writes the blurred light; elsewhere the previous
+/// chain's result (`base`), or the lighting pass's diffuse + specular. With SSS tiles,
+/// `final lighting` evaluates LEAN only on the rectangles its chain may cover and draws the
+/// pass-through variant on the others: lavapipe shades both sides of the shader's per-pixel
+/// branch, rasterisation it does skip.
 struct FinalPass {
     scene: Arc<SceneGpu>,
     inputs: Vec<ResourceId>,
     fragment: &'static str,
+    chain: usize,
+    /// The last input is the previous chain's result.
+    base: bool,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
-    /// LCB, LBB: the pass-through variant for rectangles nothing scatters in.
-    passthrough: Option<crate::features::util::GraphicsPipeline>,
-}
-
-impl FinalPass {
-    fn new(scene: &Arc<SceneGpu>, inputs: Vec<ResourceId>, fragment: &'static str) -> Self {
-        Self {
-            scene: scene.clone(),
-            inputs,
-            fragment,
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-            passthrough: None,
-        }
-    }
+    /// LCB, LBB: the pass-through variant for rectangles nothing of the chain scatters in.
+    passthrough: Option<super::util::GraphicsPipeline>,
 }
 
 impl PassExec for FinalPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
         let views = ctx.descriptor_views;
-        let mut bindings = vec![Binding::Uniform(self.scene.frame_uniforms)];
+        let mut bindings = per_frame_bindings(&self.scene);
         bindings.extend(
             self.inputs
                 .iter()
                 .map(|&id| Binding::Sampled(views[id], self.sampler)),
         );
+        let defines: &[(&str, &str)] = if self.base {
+            &[("LUCENT_SSS_BASE", "1")]
+        } else {
+            &[]
+        };
         let desc = GraphicsPipelineDesc {
             vertex: "fullscreen.vert",
             fragment: self.fragment,
-            defines: &[],
+            defines,
             vertex_input: VertexInput::None,
             depth_test: false,
             cull_back: false,
             additive_attachments: 0,
             set_layouts: &[],
-            push_constant_bytes: 0,
+            push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
             name: self.fragment,
         };
         let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
         if self.fragment == LEAN_FINAL_SHADER {
             let layouts = [pipeline.set.layout];
-            let passthrough = crate::features::util::GraphicsPipeline::new(
+            let mut passthrough_defines = defines.to_vec();
+            passthrough_defines.push(("LUCENT_SSS_PASSTHROUGH", "1"));
+            let passthrough = super::util::GraphicsPipeline::new(
                 ctx,
                 &GraphicsPipelineDesc {
-                    defines: &[("LUCENT_SSS_PASSTHROUGH", "1")],
+                    defines: &passthrough_defines,
                     set_layouts: &layouts,
                     name: "final lighting (pass-through)",
                     ..desc
@@ -618,19 +841,19 @@ impl PassExec for FinalPass {
         let Some(pipeline) = &self.pipeline else {
             return;
         };
-        let tiles = self
-            .scene
-            .sss_tiles
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
-        let (Some(passthrough), Some(rects)) = (&self.passthrough, tiles) else {
-            pipeline.draw_fullscreen(ctx);
-            return;
+        let constants = BlurConstants {
+            step: [0.0, 0.0, 0.0, self.chain as f32],
         };
         pipeline.bind(ctx);
+        push_constants(ctx, pipeline, &constants);
+        let tiles = chain_tiles(&self.scene, ctx, self.chain);
+        let (Some(passthrough), Some(rects)) = (&self.passthrough, tiles) else {
+            // SAFETY: bound above, inside the pass's subpass.
+            unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
+            return;
+        };
         PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
-        // SAFETY: made for this subpass with the bound set's layout.
+        // SAFETY: made for this subpass with the bound set's layout (same push constants).
         unsafe {
             ctx.gpu.device.cmd_bind_pipeline(
                 ctx.cmd,

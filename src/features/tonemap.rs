@@ -1,4 +1,6 @@
-//! HDR to display: exposure, ACES fit, sRGB encoding into an RGBA8 UNORM target.
+//! HDR to display: exposure, ACES fit, and the encoding the display image's format needs:
+//! the sRGB transfer function into UNORM targets (lucent's own RGBA8 display, a host's UNORM
+//! swapchain), linear values into `_SRGB` targets (the hardware encodes) and float targets.
 //!
 //! The tonemap samples its input rather than reading it as an input attachment: it is where the
 //! post chain (SSS blurs, which read neighbourhoods) ends, so it is its own physical pass with
@@ -9,8 +11,8 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
+    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
+    ResourceId,
 };
 use crate::Result;
 
@@ -20,37 +22,45 @@ use crate::gpu_scene::SceneGpu;
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 
-/// Declares the tonemap pass: samples `hdr`, writes a new display image.
+/// Whether a display image of `format` is written linear (the hardware or the host encodes)
+/// rather than sRGB-encoded by the shader.
+pub fn writes_linear(format: vk::Format) -> bool {
+    crate::backend::format::format_info(format).is_some_and(|f| {
+        matches!(
+            f.kind,
+            crate::backend::format::FormatKind::Srgb | crate::backend::format::FormatKind::Float
+        )
+    })
+}
+
+/// Declares the tonemap pass: samples `hdr`, writes `display` (encoded for its format).
 pub fn tonemap_pass(
     graph: &mut RenderGraph,
     hdr: &Handle<Image>,
+    mut display: Handle<Image>,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
-    let info = graph.resources()[hdr.id()].info;
-    let mut ldr = graph.create_image(
-        "display",
-        ImageInfo {
-            format: LDR_FORMAT,
-            ..info
-        },
-    );
+    let linear = writes_linear(graph.resources()[display.id()].info.format);
     let mut pass = graph.add_pass("tonemap", PassKind::Raster);
-    pass.sample(hdr).color(&mut ldr, LoadOp::DontCare);
+    pass.sample(hdr).color(&mut display, LoadOp::DontCare);
     match scene {
         Some(scene) => pass.execute(TonemapPass {
             scene: scene.clone(),
             input: hdr.id(),
+            linear,
             sampler: vk::Sampler::null(),
             pipeline: None,
         }),
         None => pass.finish(),
     }
-    ldr
+    display
 }
 
 struct TonemapPass {
     scene: Arc<SceneGpu>,
     input: ResourceId,
+    /// Write linear values (sRGB or float targets).
+    linear: bool,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
 }
@@ -61,13 +71,21 @@ impl PassExec for TonemapPass {
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &[
-                Binding::Uniform(self.scene.frame_uniforms),
+                Binding::PerFrame(
+                    self.scene
+                        .per_frame
+                        .binding(crate::gpu_scene::Region::Frame),
+                ),
                 Binding::Sampled(ctx.views[self.input], self.sampler),
             ],
             &GraphicsPipelineDesc {
                 vertex: "fullscreen.vert",
                 fragment: "post/tonemap.frag",
-                defines: &[],
+                defines: if self.linear {
+                    &[("LUCENT_OUTPUT_LINEAR", "1")]
+                } else {
+                    &[]
+                },
                 vertex_input: VertexInput::None,
                 depth_test: false,
                 cull_back: false,

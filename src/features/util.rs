@@ -24,6 +24,9 @@ pub fn clamp_sampler(ctx: &PrepareContext<'_>, filter: vk::Filter) -> Result<vk:
 pub enum Binding {
     /// A uniform buffer (whole range).
     Uniform(vk::Buffer),
+    /// A region of the per-frame buffer: a dynamic uniform buffer bound at the recorded
+    /// frame's slot ([`crate::gpu_scene::PerFrame`]).
+    PerFrame(crate::gpu_scene::PerFrameBinding),
     /// An input attachment (same-pixel read) in the given layout.
     InputAttachment(vk::ImageView, vk::ImageLayout),
     /// A combined image sampler in SHADER_READ_ONLY_OPTIMAL.
@@ -37,6 +40,10 @@ pub struct DescriptorSet {
     /// The set, to bind.
     pub set: vk::DescriptorSet,
     pool: vk::DescriptorPool,
+    /// Per-frame bindings (dynamic uniform buffers) and their slot stride: each is bound at
+    /// `slot * stride`.
+    dynamic: u32,
+    stride: u64,
 }
 
 impl DescriptorSet {
@@ -50,6 +57,7 @@ impl DescriptorSet {
         let device = &ctx.gpu.device;
         let kind = |b: &Binding| match b {
             Binding::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::PerFrame(_) => vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
             Binding::InputAttachment(..) => vk::DescriptorType::INPUT_ATTACHMENT,
             Binding::Sampled(..) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
         };
@@ -121,6 +129,11 @@ impl DescriptorSet {
                     offset: 0,
                     range: vk::WHOLE_SIZE,
                 }],
+                Binding::PerFrame(p) => [vk::DescriptorBufferInfo {
+                    buffer: p.buffer,
+                    offset: p.offset,
+                    range: p.range,
+                }],
                 _ => [vk::DescriptorBufferInfo::default()],
             })
             .collect();
@@ -137,7 +150,7 @@ impl DescriptorSet {
                     image_view: *view,
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 }],
-                Binding::Uniform(_) => [vk::DescriptorImageInfo::default()],
+                Binding::Uniform(_) | Binding::PerFrame(_) => [vk::DescriptorImageInfo::default()],
             })
             .collect();
         let writes: Vec<vk::WriteDescriptorSet> = bindings
@@ -149,14 +162,52 @@ impl DescriptorSet {
                     .dst_binding(i as u32)
                     .descriptor_type(kind(b));
                 match b {
-                    Binding::Uniform(_) => w.buffer_info(&buffer_infos[i]),
+                    Binding::Uniform(_) | Binding::PerFrame(_) => w.buffer_info(&buffer_infos[i]),
                     _ => w.image_info(&image_infos[i]),
                 }
             })
             .collect();
         // SAFETY: every write names a live set, buffer, view and sampler.
         unsafe { device.update_descriptor_sets(&writes, &[]) };
-        Ok(Self { layout, set, pool })
+        let per_frame: Vec<u64> = bindings
+            .iter()
+            .filter_map(|b| match b {
+                Binding::PerFrame(p) => Some(p.stride),
+                _ => None,
+            })
+            .collect();
+        Ok(Self {
+            layout,
+            set,
+            pool,
+            dynamic: per_frame.len() as u32,
+            // Every per-frame region lives in the same buffer: one stride.
+            stride: per_frame.first().copied().unwrap_or(0),
+        })
+    }
+
+    /// Binds the set as set `index` of `layout`, its per-frame bindings at the recorded
+    /// frame's slot.
+    pub fn bind(
+        &self,
+        ctx: &crate::graph::RecordContext<'_>,
+        layout: vk::PipelineLayout,
+        index: u32,
+    ) {
+        // At most MAX_FRAMES_IN_FLIGHT slots of a few tens of kilobytes: fits u32.
+        let offset = (self.stride * ctx.frame as u64) as u32;
+        let offsets = vec![offset; self.dynamic as usize];
+        // SAFETY: the set and layout are alive; the executor began this pass's subpass.
+        unsafe {
+            ctx.gpu.device.cmd_bind_descriptor_sets(
+                ctx.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                layout,
+                index,
+                &[self.set],
+                &offsets,
+            );
+        }
     }
 
     /// Destroys the pool (and with it the set) and the layout.
@@ -168,6 +219,7 @@ impl DescriptorSet {
         }
         self.pool = vk::DescriptorPool::null();
         self.layout = vk::DescriptorSetLayout::null();
+        self.dynamic = 0;
     }
 }
 
@@ -445,25 +497,17 @@ impl PassPipeline {
         }
     }
 
-    /// Binds the pipeline and its set.
+    /// Binds the pipeline and its set (per-frame bindings at the recorded frame's slot).
     pub fn bind(&self, ctx: &crate::graph::RecordContext<'_>) {
-        let device = &ctx.gpu.device;
-        // SAFETY: pipeline and set are alive; the executor began this pass's subpass.
+        // SAFETY: the pipeline is alive; the executor began this pass's subpass.
         unsafe {
-            device.cmd_bind_pipeline(
+            ctx.gpu.device.cmd_bind_pipeline(
                 ctx.cmd,
                 vk::PipelineBindPoint::GRAPHICS,
                 self.pipeline.pipeline,
             );
-            device.cmd_bind_descriptor_sets(
-                ctx.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline.layout,
-                0,
-                &[self.set.set],
-                &[],
-            );
         }
+        self.set.bind(ctx, self.pipeline.layout, 0);
     }
 
     /// Binds and draws the fullscreen triangle (glsl/fullscreen.vert).
@@ -477,7 +521,7 @@ impl PassPipeline {
     /// pipeline must be bound), then restores the scissor to the render area.
     pub fn draw_fullscreen_in<'r>(
         ctx: &crate::graph::RecordContext<'_>,
-        rects: impl IntoIterator<Item = &'r super::translucency::TileRect>,
+        rects: impl IntoIterator<Item = &'r crate::gpu_scene::TileRect>,
     ) {
         let device = &ctx.gpu.device;
         // SAFETY: scissor is dynamic state of every lucent pipeline; called inside a subpass

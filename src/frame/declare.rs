@@ -1,12 +1,18 @@
+//! [`declare_frame`]: the one place that decides which passes a frame has, from its
+//! [`FrameDesc`]; `lucent plan` calls it without a GPU ([`plan_frame`]), the
+//! [`super::Renderer`] with one.
+
 use std::sync::Arc;
 
-use super::{FrameFeatures, FrameSettings};
+use ash::vk;
+
+use super::{FrameDesc, FrameSettings};
 use crate::backend::access::Access;
-use crate::features::debug_view::{self};
+use crate::features::debug_view;
 use crate::features::deferred::GBufferLayout;
 use crate::features::{deferred, sss, tonemap};
 use crate::gpu_scene::SceneGpu;
-use crate::graph::{Plan, RenderGraph, ResourceId};
+use crate::graph::{CompileOptions, ImageInfo, ImportedImage, Plan, RenderGraph, ResourceId};
 use crate::Result;
 
 /// The G-buffer images a frame hands out when asked to (`export_gbuffer`).
@@ -18,7 +24,7 @@ pub struct GBufferOutputs {
     pub gb1: ResourceId,
     /// Thickness + material ID (frames with translucency).
     pub gb2: Option<ResourceId>,
-    /// Screen-space SSS strength (frames with SSS).
+    /// Screen-space SSS profile ID (frames with SSS).
     pub sss: Option<ResourceId>,
     /// View-plane LEAN slope y and second moments (LCB and LBB frames).
     pub lean: Option<ResourceId>,
@@ -31,8 +37,11 @@ pub struct GBufferOutputs {
 /// The images a frame hands out.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameOutputs {
-    /// Display image (RGBA8, sRGB-encoded), left in TRANSFER_SRC layout.
+    /// Display image: lucent's own (RGBA8, sRGB-encoded, left in TRANSFER_SRC layout), or the
+    /// caller's target (imported, left in its `final_access` state).
     pub display: ResourceId,
+    /// Whether `display` is the caller's target.
+    pub target: bool,
     /// Linear HDR image (RGBA16F), when exported.
     pub hdr: Option<ResourceId>,
     /// The G-buffer, when exported.
@@ -43,35 +52,67 @@ pub struct FrameOutputs {
 pub fn declare_frame(
     graph: &mut RenderGraph,
     settings: &FrameSettings,
-    features: &FrameFeatures,
+    desc: &FrameDesc,
     scene_gpu: Option<&Arc<SceneGpu>>,
 ) -> FrameOutputs {
-    let layout = features.gbuffer_layout(settings);
+    let layout = desc.gbuffer_layout(settings);
     let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
     let lit = deferred::lighting_pass(graph, &gb, scene_gpu);
-    let debug_display = settings
-        .debug_view
-        .and_then(|view| debug_view::debug_view_pass(graph, view, &gb, &lit, scene_gpu));
-    let hdr = match (&features.sss, &lit.specular, &gb.sss) {
-        (Some((profile, blur)), Some(specular), Some(strength)) => sss::sss_passes(
+    let display_info = ImageInfo {
+        width: settings.width,
+        height: settings.height,
+        format: settings
+            .target
+            .map_or(tonemap::LDR_FORMAT, |target| target.format),
+    };
+    // The image the frame ends in, declared by the pass that writes it (so resources keep the
+    // order they had before targets existed). The caller's target enters with the state the
+    // caller promises; its image is bound per frame (`Renderer::bind_target`).
+    let new_display = |graph: &mut RenderGraph| match settings.target {
+        Some(target) => graph.import_image(
+            "target",
+            display_info,
+            ImportedImage {
+                image: vk::Image::null(),
+                view: vk::ImageView::null(),
+                initial: target.initial,
+            },
+        ),
+        None => graph.create_image("display", display_info),
+    };
+    let debug_display = settings.debug_view.and_then(|view| {
+        debug_view::debug_view_pass(graph, view, &gb, &lit, new_display, scene_gpu)
+    });
+    let hdr = match (&desc.sss, &lit.specular, &gb.sss) {
+        (Some(profiles), Some(specular), Some(profile_ids)) => sss::sss_passes(
             graph,
             &sss::SssInputs {
                 diffuse: &lit.color,
                 specular,
                 depth: &gb.depth,
-                strength,
+                profile_ids,
                 lean: gb.lean.as_ref(),
                 gb0: &gb.gb0,
             },
-            profile,
-            *blur,
+            profiles,
             &settings.sss,
             scene_gpu,
         ),
         _ => lit.color,
     };
-    let display = debug_display.unwrap_or_else(|| tonemap::tonemap_pass(graph, &hdr, scene_gpu));
-    graph.export_image(&display, Access::TransferRead);
+    let display = match debug_display {
+        Some(display) => display,
+        None => {
+            let display = new_display(graph);
+            tonemap::tonemap_pass(graph, &hdr, display, scene_gpu)
+        }
+    };
+    graph.export_image(
+        &display,
+        settings
+            .target
+            .map_or(Access::TransferRead, |target| target.final_access),
+    );
     let hdr_id = settings.export_hdr.then(|| {
         graph.export_image(&hdr, Access::TransferRead);
         hdr.id()
@@ -97,14 +138,24 @@ pub fn declare_frame(
     });
     FrameOutputs {
         display: display.id(),
+        target: settings.target.is_some(),
         hdr: hdr_id,
         gbuffer,
     }
 }
 
+/// The compiler options of a frame: `settings.compile`, with frames chained when several are
+/// in flight.
+pub fn compile_options(settings: &FrameSettings) -> CompileOptions {
+    CompileOptions {
+        chained_frames: settings.compile.chained_frames || settings.frames_in_flight > 1,
+        ..settings.compile
+    }
+}
+
 /// Compiles the plan of a frame without a GPU (for `lucent plan` and tests).
-pub fn plan_frame(settings: &FrameSettings, features: &FrameFeatures) -> Result<Plan> {
+pub fn plan_frame(settings: &FrameSettings, desc: &FrameDesc) -> Result<Plan> {
     let mut graph = RenderGraph::new();
-    declare_frame(&mut graph, settings, features, None);
-    graph.plan(settings.compile)
+    declare_frame(&mut graph, settings, desc, None);
+    graph.plan(compile_options(settings))
 }

@@ -1,91 +1,179 @@
-use super::{FrameSettings, Technique};
+//! The frame description: what a frame of a scene shades, derived from the scene's materials.
+//!
+//! A feature is in the frame exactly when some object's material asks for it (and the
+//! [`super::Technique`] override does not leave it out): GB2 and the GDC 2011 term when some material
+//! is translucent, one SSS chain per blur the SSS materials use with every profile in the
+//! profile table, the LEAN targets when some chain is LCB or LBB, normal and albedo maps when
+//! some material has one. Everything else costs nothing: [`super::declare_frame`] declares
+//! no pass, image or shader permutation for it, and [`crate::gpu_scene`] uploads no stream,
+//! texture or table.
+
+use super::FrameSettings;
 use crate::features::deferred::{GBufferLayout, TranslucencyLayout};
-use crate::features::sss;
-use crate::features::translucency::{MaterialTable, ThicknessPacking};
-use crate::scene::material::SssProfile;
+use crate::features::sss::SssProfiles;
+use crate::features::translucency::{MaterialTable, MaterialTableGpu, ThicknessPacking};
+use crate::gpu_scene::SceneUpload;
 use crate::scene::Scene;
 use crate::Result;
 
-/// What a frame of a scene needs beyond the plain deferred path: derived once from the scene
-/// and the settings, so the graph declares only what the scene uses.
+/// The translucency part of a frame.
 #[derive(Clone, Debug, PartialEq)]
-pub struct FrameFeatures {
-    /// The translucent materials and GB2's packing, when the technique is `translucency` and
-    /// some object is translucent.
-    pub translucency: Option<(MaterialTable, ThicknessPacking)>,
-    /// The diffusion profile the SSS blurs use, when the technique is an SSS one and some
-    /// object has a profile (the first such object's; refitted to `SssKnobs::gaussians` when
-    /// that is set), and the blur.
-    pub sss: Option<(SssProfile, sss::SssBlur)>,
-    /// Some object has a normal map.
-    pub normal_maps: bool,
+pub struct TranslucencyDesc {
+    /// The translucent materials with their IDs.
+    pub table: MaterialTable,
+    /// How GB2 packs thickness.
+    pub packing: ThicknessPacking,
 }
 
-impl FrameFeatures {
-    /// The features `scene` needs under `settings`.
+/// What a frame of a scene shades beyond plain deferred lighting (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameDesc {
+    /// GDC 2011 translucency, when some object is translucent (and the technique keeps it).
+    pub translucency: Option<TranslucencyDesc>,
+    /// Screen-space SSS: every profile of the SSS materials with its blur, when some object
+    /// scatters (and the technique keeps it).
+    pub sss: Option<SssProfiles>,
+    /// Some object has a normal map.
+    pub normal_maps: bool,
+    /// Some object has an albedo texture.
+    pub albedo_maps: bool,
+}
+
+impl FrameDesc {
+    /// What `scene` asks for under `settings` (its technique and knobs).
     pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
-        let sss = match settings.technique.sss_blur() {
-            Some(blur) => scene
-                .objects
-                .iter()
-                .find_map(|o| o.material.sss.clone())
-                .map(|p| -> Result<_> {
-                    let profile = match settings.sss.gaussians {
-                        Some(n) => crate::scene::profile::fit_profile(&p, n)?.0,
-                        None => p,
-                    };
-                    Ok((profile, blur))
-                })
-                .transpose()?,
-            None => None,
+        let technique = settings.technique;
+        let sss = if technique.sss() {
+            SssProfiles::new(scene, technique.sss_blur(), settings.sss.gaussians)?
+        } else {
+            None
         };
-        let translucency = match settings.technique {
-            Technique::None | Technique::Control | Technique::Lcb | Technique::Lbb => None,
-            Technique::Translucency => {
-                let table = MaterialTable::new(scene)?;
-                let packing = if settings.force_grayscale {
-                    ThicknessPacking::Grayscale
-                } else {
-                    table.packing()
-                };
-                (!table.is_empty()).then_some((table, packing))
-            }
+        let translucency = if technique.translucency() {
+            let table = MaterialTable::new(scene)?;
+            let packing = if settings.force_grayscale {
+                ThicknessPacking::Grayscale
+            } else {
+                table.packing()
+            };
+            (!table.is_empty()).then_some(TranslucencyDesc { table, packing })
+        } else {
+            None
         };
-        let normal_maps = scene
-            .objects
-            .iter()
-            .any(|o| o.material.normal_texture.is_some());
+        let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
+            scene.objects.iter().any(|o| f(&o.material))
+        };
         Ok(Self {
             translucency,
             sss,
-            normal_maps,
+            normal_maps: any(&|m| m.normal_texture.is_some()),
+            albedo_maps: any(&|m| m.albedo_texture.is_some()),
         })
     }
 
-    /// The SSS blur the frame runs, if any.
-    pub fn sss_blur(&self) -> Option<sss::SssBlur> {
-        self.sss.as_ref().map(|(_, blur)| *blur)
+    /// Whether the frame blurs the LEAN G-buffer (some SSS chain is LCB or LBB).
+    pub fn lean(&self) -> bool {
+        self.sss.as_ref().is_some_and(SssProfiles::lean)
     }
 
-    /// The G-buffer layout these features and `settings` call for.
+    /// The G-buffer layout this description and `settings` call for.
     pub fn gbuffer_layout(&self, settings: &FrameSettings) -> GBufferLayout {
+        let chains = self
+            .sss
+            .as_ref()
+            .map(SssProfiles::chains)
+            .unwrap_or_default();
         GBufferLayout {
             precision: settings.gbuffer,
-            translucency: self
-                .translucency
-                .as_ref()
-                .map(|(table, packing)| TranslucencyLayout {
-                    packing: *packing,
-                    pow_modes: table.pow_modes(),
-                    single_material: table.rows.len() == 1,
-                }),
+            translucency: self.translucency.as_ref().map(|t| TranslucencyLayout {
+                packing: t.packing,
+                pow_modes: t.table.pow_modes(),
+                single_material: t.table.rows.len() == 1,
+            }),
             sss: self.sss.is_some(),
-            lean: self.sss_blur().is_some_and(sss::SssBlur::lean),
-            lean_clear: self
-                .sss_blur()
-                .is_some_and(|blur| blur.lean() && !blur.bilateral()),
+            lean: self.lean(),
+            // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
+            lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),
             normal_maps: self.normal_maps,
+            albedo_maps: self.albedo_maps,
             fault_injection: settings.fault.is_some(),
         }
+    }
+
+    /// What the scene's GPU data must hold for this frame.
+    pub fn upload(&self, frames_in_flight: usize) -> SceneUpload<'_> {
+        SceneUpload {
+            translucency_ids: self.translucency.as_ref().map(|t| &t.table.object_ids[..]),
+            profile_ids: self.sss.as_ref().map(|s| &s.object_ids[..]),
+            normal_maps: self.normal_maps,
+            lean: self.lean(),
+            albedo_maps: self.albedo_maps,
+            frames_in_flight,
+            translucency_table_bytes: if self.translucency.is_some() {
+                std::mem::size_of::<MaterialTableGpu>() as u64
+            } else {
+                0
+            },
+            profile_table_bytes: if self.sss.is_some() {
+                crate::features::sss::PROFILE_TABLE_BYTES
+            } else {
+                0
+            },
+        }
+    }
+
+    /// Whether a frame built for `self` can show `other` by rewriting only its per-frame
+    /// tables: the same passes, images, permutations and per-object IDs (a knob changed a
+    /// value, not which features or profiles exist).
+    pub fn same_shape(&self, other: &FrameDesc, settings: &FrameSettings) -> bool {
+        let ids = |d: &FrameDesc| {
+            (
+                d.translucency.as_ref().map(|t| t.table.object_ids.clone()),
+                d.sss.as_ref().map(|s| s.object_ids.clone()),
+            )
+        };
+        let steps = |d: &FrameDesc| {
+            d.sss.as_ref().map(|s| {
+                s.chains()
+                    .into_iter()
+                    .map(|c| (c, s.steps(c)))
+                    .collect::<Vec<_>>()
+            })
+        };
+        self.gbuffer_layout(settings) == other.gbuffer_layout(settings)
+            && ids(self) == ids(other)
+            && steps(self) == steps(other)
+            && self.sss.as_ref().map(|s| s.profiles.len())
+                == other.sss.as_ref().map(|s| s.profiles.len())
+    }
+
+    /// The features in the frame, for messages and the plan dump's header.
+    pub fn names(&self) -> Vec<String> {
+        let mut names = Vec::new();
+        if let Some(t) = &self.translucency {
+            names.push(format!(
+                "translucency ({} material{}, {})",
+                t.table.rows.len(),
+                if t.table.rows.len() == 1 { "" } else { "s" },
+                t.packing.name()
+            ));
+        }
+        if let Some(s) = &self.sss {
+            for chain in s.chains() {
+                let profiles: Vec<&str> = s
+                    .profiles
+                    .iter()
+                    .filter(|(_, b)| *b == chain)
+                    .map(|(p, _)| p.name.as_str())
+                    .collect();
+                names.push(format!("sss {} ({})", chain.name(), profiles.join(", ")));
+            }
+        }
+        if self.normal_maps {
+            names.push("normal maps".into());
+        }
+        if self.albedo_maps {
+            names.push("albedo maps".into());
+        }
+        names
     }
 }

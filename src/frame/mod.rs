@@ -3,7 +3,7 @@
 //!
 //! - [`settings`]: how a frame is built ([`FrameSettings`]) and the A/B technique override
 //!   ([`Technique`]; `auto`, the default, lets the materials decide).
-//! - [`desc`]: the frame description derived from the scene's materials ([`FrameFeatures`]).
+//! - [`desc`]: the frame description derived from the scene's materials ([`FrameDesc`]).
 //! - [`declare`]: [`declare_frame`], the one place that decides which passes a frame has;
 //!   `lucent plan` calls it without a GPU, [`Renderer`] with one.
 //! - [`renderer`]: a scene compiled into an executable frame on a device.
@@ -18,9 +18,9 @@ pub mod renderer;
 pub mod runner;
 pub mod settings;
 
-pub use declare::{declare_frame, plan_frame, FrameOutputs, GBufferOutputs};
-pub use desc::FrameFeatures;
+pub use declare::{compile_options, declare_frame, plan_frame, FrameOutputs, GBufferOutputs};
+pub use desc::{FrameDesc, TranslucencyDesc};
 pub use readback::{decode_texels, FrameImages, GBufferReadback};
-pub use renderer::{render_frame, FrameUniforms, Renderer};
+pub use renderer::{render_frame, Renderer};
 pub use runner::{destroy_after_idle, FrameRunner, FrameTiming};
-pub use settings::{Fault, FrameSettings, Technique};
+pub use settings::{Fault, FrameSettings, TargetDesc, Technique};

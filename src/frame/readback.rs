@@ -1,3 +1,6 @@
+//! Frames read back: [`FrameImages`] (display, HDR, G-buffer, times) and the G-buffer decoded
+//! to f32 ([`GBufferReadback`], the f64 reference's input).
+
 use ash::vk;
 
 use super::FrameTiming;
@@ -31,7 +34,8 @@ pub struct GBufferReadback {
     pub gb1: Vec<[f32; 4]>,
     /// Thickness + material ID as stored (see glsl/common/gbuffer.glsl).
     pub gb2: Option<Vec<[f32; 4]>>,
-    /// Screen-space SSS strength per pixel (frames with SSS).
+    /// Screen-space SSS profile ID per pixel (frames with SSS; 0: the pixel does not
+    /// scatter).
     pub sss: Option<Vec<f32>>,
     /// View-plane LEAN slope y and second moments xx, yy, xy (LCB and LBB frames).
     pub lean: Option<Vec<[f32; 4]>>,

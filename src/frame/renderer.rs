@@ -1,106 +1,33 @@
+//! [`Renderer`]: a scene compiled into an executable frame on a device, recorded into any
+//! command buffer, with frames in flight and into the caller's target image.
+
 use std::sync::Arc;
 
 use ash::vk;
 
+use super::declare::compile_options;
 use super::{
-    declare_frame, decode_texels, FrameFeatures, FrameImages, FrameOutputs, FrameRunner,
-    FrameSettings, GBufferReadback,
+    declare_frame, decode_texels, FrameDesc, FrameImages, FrameOutputs, FrameRunner, FrameSettings,
+    GBufferReadback,
 };
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
-use crate::backend::{GpuBuffer, GpuContext};
+use crate::backend::GpuContext;
 use crate::features::sss;
-use crate::features::translucency::{mesh_bounds, object_tiles, tile_rects, translucent_tiles};
-use crate::gpu_scene::SceneGpu;
+use crate::gpu_scene::tiles::{mesh_bounds, object_tiles, tile_rects, translucent_tiles};
+use crate::gpu_scene::{FrameUniforms, Region, SceneGpu, SlotTiles};
 use crate::graph::{Executable, RenderGraph, ResourceId};
-use crate::scene::{LightKind, Scene, MAX_LIGHTS};
+use crate::scene::{Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
 use glam::Vec3;
 
-/// Frame uniforms, std140 (glsl/common/scene.glsl `Frame`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FrameUniforms {
-    view_proj: [[f32; 4]; 4],
-    inv_view_proj: [[f32; 4]; 4],
-    view: [[f32; 4]; 4],
-    camera_pos: [f32; 4],
-    ambient: [f32; 4],
-    sky: [f32; 4],
-    viewport: [f32; 4],
-    exposure: [f32; 4],
-    light_count: [i32; 4],
-    camera: [f32; 4],
-    fault: [i32; 4],
-    lights: [[[f32; 4]; 4]; MAX_LIGHTS],
-}
-
-impl FrameUniforms {
-    /// Fills the uniforms from a scene at a size.
-    pub fn new(scene: &Scene, width: u32, height: u32) -> Self {
-        let aspect = width as f32 / height.max(1) as f32;
-        let view_proj = scene.camera.projection(aspect) * scene.camera.view();
-        let mut lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
-        for (slot, light) in lights.iter_mut().zip(&scene.lights) {
-            let radiance = light.radiance();
-            let scale = light.translucency_scale;
-            *slot = match light.kind {
-                LightKind::Directional { direction } => [
-                    direction.extend(0.0).to_array(),
-                    radiance.extend(0.0).to_array(),
-                    [0.0; 4],
-                    [1.0, scale, 0.0, 0.0],
-                ],
-                LightKind::Point { position, range } => [
-                    position.extend(1.0).to_array(),
-                    radiance.extend(range).to_array(),
-                    [0.0; 4],
-                    [1.0, scale, 0.0, 0.0],
-                ],
-                LightKind::Spot {
-                    position,
-                    direction,
-                    range,
-                    inner_degrees,
-                    outer_degrees,
-                } => [
-                    position.extend(2.0).to_array(),
-                    radiance.extend(range).to_array(),
-                    direction
-                        .normalize_or(Vec3::NEG_Y)
-                        .extend(outer_degrees.to_radians().cos())
-                        .to_array(),
-                    [inner_degrees.to_radians().cos(), scale, 0.0, 0.0],
-                ],
-            };
-        }
-        Self {
-            view_proj: view_proj.to_cols_array_2d(),
-            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-            view: scene.camera.view().to_cols_array_2d(),
-            camera_pos: scene.camera.eye.extend(1.0).to_array(),
-            ambient: scene.ambient.extend(0.0).to_array(),
-            sky: scene.sky.extend(0.0).to_array(),
-            viewport: [
-                width as f32,
-                height as f32,
-                1.0 / width as f32,
-                1.0 / height as f32,
-            ],
-            exposure: [scene.exposure, 0.0, 0.0, 0.0],
-            light_count: [scene.lights.len().min(MAX_LIGHTS) as i32, 0, 0, 0],
-            camera: [
-                scene.camera.near,
-                scene.camera.far,
-                scene.camera.focal_px(height),
-                0.0,
-            ],
-            fault: [0; 4],
-            lights,
-        }
-    }
-}
-
 /// A scene compiled into an executable frame on a device.
+///
+/// One frame at a time: [`Renderer::update`] then record ([`FrameRunner`] does both halves of
+/// a frame and waits). Frames in flight ([`FrameSettings::frames_in_flight`] N): per frame,
+/// [`Renderer::update_slot`] for slot `k` (whose previous frame has completed),
+/// [`Renderer::bind_target`] when rendering into the caller's images, then
+/// [`Renderer::record`] into the caller's command buffer with slot `k`; the N slots' frames
+/// may run on the GPU together.
 pub struct Renderer {
     /// The executable frame.
     pub executable: Executable,
@@ -108,12 +35,11 @@ pub struct Renderer {
     pub outputs: FrameOutputs,
     /// The settings it was built with.
     pub settings: FrameSettings,
+    /// What the frame shades (derived from the scene's materials).
+    pub desc: FrameDesc,
     scene_gpu: Option<Arc<SceneGpu>>,
-    uniforms: Option<GpuBuffer>,
     /// Object-space bounds per mesh, for the screen tiles (frames with translucency or SSS).
     mesh_bounds: Vec<(Vec3, Vec3)>,
-    /// Whether the frame blurs SSS.
-    sss: bool,
 }
 
 impl Renderer {
@@ -142,43 +68,32 @@ impl Renderer {
                 scene.lights.len()
             )));
         }
-        let features = FrameFeatures::new(scene, &settings)?;
-        let uniforms = gpu.create_buffer(
-            std::mem::size_of::<FrameUniforms>() as u64,
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-            gpu_allocator::MemoryLocation::CpuToGpu,
-            "frame uniforms",
-        )?;
-        let translucency = features.translucency.as_ref().map(|(t, p)| (t, *p));
-        let scene_gpu = match SceneGpu::new(
+        if let Some(target) = settings.target {
+            check_target_format(target.format)?;
+        }
+        let desc = FrameDesc::new(scene, &settings)?;
+        let scene_gpu = Arc::new(SceneGpu::new(
             gpu,
             scene,
-            uniforms.buffer,
-            translucency,
-            features.sss_blur().is_some_and(sss::SssBlur::lean),
-        ) {
-            Ok(s) => s,
-            Err(e) => {
-                gpu.destroy_buffer(uniforms);
-                return Err(e);
-            }
-        };
+            &desc.upload(settings.frames_in_flight),
+        )?);
         let mut graph = RenderGraph::new();
-        let outputs = declare_frame(&mut graph, &settings, &features, Some(&scene_gpu));
-        let compiled = graph.compile(settings.compile).and_then(|(plan, execs)| {
-            Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)
-        });
+        let outputs = declare_frame(&mut graph, &settings, &desc, Some(&scene_gpu));
+        let compiled = graph
+            .compile(compile_options(&settings))
+            .and_then(|(plan, execs)| {
+                Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)
+            });
         let executable = match compiled {
             Ok(e) => e,
             Err(e) => {
                 if let Ok(s) = Arc::try_unwrap(scene_gpu) {
                     s.destroy(gpu);
                 }
-                gpu.destroy_buffer(uniforms);
                 return Err(e);
             }
         };
-        let mesh_bounds = if features.translucency.is_some() || features.sss.is_some() {
+        let mesh_bounds = if desc.translucency.is_some() || desc.sss.is_some() {
             mesh_bounds(scene)
         } else {
             Vec::new()
@@ -187,53 +102,167 @@ impl Renderer {
             executable,
             outputs,
             settings,
+            desc,
             scene_gpu: Some(scene_gpu),
-            uniforms: Some(uniforms),
             mesh_bounds,
-            sss: features.sss.is_some(),
         };
-        renderer.update(scene)?;
+        if let Err(e) = renderer.update(scene) {
+            renderer.destroy(gpu);
+            return Err(e);
+        }
         Ok(renderer)
     }
 
-    /// Writes the scene's camera and lights into the frame uniforms. Call between frames: the
-    /// GPU must not be reading them (every frame is waited for before the next update).
+    /// Writes the scene's camera, lights and material values into every slot of the
+    /// per-frame parameters. Call between frames: the GPU must not be reading any slot (with
+    /// frames in flight use [`Self::update_slot`]). Fails when the scene no longer has the
+    /// shape the frame was built for (see [`Self::can_update`]).
     pub fn update(&mut self, scene: &Scene) -> Result<()> {
-        let mut uniforms = FrameUniforms::new(scene, self.settings.width, self.settings.height);
-        if let Some(f) = self.settings.fault {
-            uniforms.fault = [f.x as i32, f.y as i32, if f.nan { 1 } else { 2 }, 0];
-        }
-        let mapped = self
-            .uniforms
-            .as_mut()
-            .and_then(|b| b.mapped_mut())
-            .ok_or_else(|| {
-                LucentError::InvalidInput("frame uniform buffer is not host-visible".into())
-            })?;
-        let bytes = bytemuck::bytes_of(&uniforms);
-        mapped[..bytes.len()].copy_from_slice(bytes);
-        if let Some(scene_gpu) = self.scene_gpu.as_ref().filter(|s| s.translucency.is_some()) {
-            let (width, height) = (self.settings.width, self.settings.height);
-            let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
-            scene_gpu.set_tiles(tile_rects(columns, &marked, width, height));
-        }
-        if let Some(scene_gpu) = &self.scene_gpu {
-            let (width, height) = (self.settings.width, self.settings.height);
-            let tiles = (self.sss && self.settings.sss_tiles).then(|| {
-                let (columns, _, marked) =
-                    object_tiles(scene, &self.mesh_bounds, width, height, |o| {
-                        o.material.sss.as_ref().map(sss::profile_reach)
-                    });
-                // All rectangles: the blurs draw the marked ones, LCB's and LBB's final pass
-                // its LEAN variant there and the pass-through variant elsewhere.
-                tile_rects(columns, &marked, width, height)
-            });
-            scene_gpu.set_sss_tiles(tiles);
+        for slot in 0..self.settings.frames_in_flight {
+            self.update_slot(scene, slot)?;
         }
         Ok(())
     }
 
-    /// Reads the display image of the last frame: RGBA8, sRGB-encoded, tightly packed.
+    /// Whether [`Self::update`] can show `scene` without rebuilding: the same features,
+    /// profiles, permutations and per-object IDs; only values changed (camera, lights, a
+    /// material's translucency power or an SSS width). Changing a knob that only changes
+    /// values must not re-upload the scene.
+    pub fn can_update(&self, scene: &Scene) -> Result<bool> {
+        let desc = FrameDesc::new(scene, &self.settings)?;
+        Ok(scene.objects.len() == self.scene_gpu().draws.len()
+            && desc.same_shape(&self.desc, &self.settings))
+    }
+
+    /// Takes `settings` if they differ from the frame's only in values the per-frame tables
+    /// carry (the bilateral sensitivity); returns whether it did (otherwise the frame must be
+    /// rebuilt for them).
+    pub fn retune(&mut self, settings: &FrameSettings) -> bool {
+        let values_only = FrameSettings {
+            sss: crate::features::sss::SssKnobs {
+                sensitivity: self.settings.sss.sensitivity,
+                ..settings.sss
+            },
+            width: self.settings.width,
+            height: self.settings.height,
+            technique: self.settings.technique,
+            debug_view: self.settings.debug_view,
+            ..*settings
+        } == self.settings;
+        if values_only {
+            self.settings.sss.sensitivity = settings.sss.sensitivity;
+        }
+        values_only
+    }
+
+    /// Writes `scene`'s per-frame values into slot `slot` (whose previous frame has
+    /// completed): frame uniforms, the translucency material table, the SSS profile table and
+    /// the screen tiles.
+    pub fn update_slot(&self, scene: &Scene, slot: usize) -> Result<()> {
+        if slot >= self.settings.frames_in_flight {
+            return Err(LucentError::InvalidInput(format!(
+                "frame slot {slot}: the renderer has {} frame(s) in flight",
+                self.settings.frames_in_flight
+            )));
+        }
+        let desc = FrameDesc::new(scene, &self.settings)?;
+        if scene.objects.len() != self.scene_gpu().draws.len()
+            || !desc.same_shape(&self.desc, &self.settings)
+        {
+            return Err(LucentError::InvalidInput(format!(
+                "scene '{}' no longer has the shape its frame was built for (features, \
+                 profiles or objects changed): build a new renderer",
+                scene.name
+            )));
+        }
+        let per_frame = &self.scene_gpu().per_frame;
+        let (width, height) = (self.settings.width, self.settings.height);
+        let mut uniforms = FrameUniforms::new(scene, width, height);
+        if let Some(f) = self.settings.fault {
+            uniforms.fault = [f.x as i32, f.y as i32, if f.nan { 1 } else { 2 }, 0];
+        }
+        per_frame.write(slot, Region::Frame, bytemuck::bytes_of(&uniforms))?;
+        let mut tiles = SlotTiles::default();
+        if let Some(t) = &desc.translucency {
+            per_frame.write(
+                slot,
+                Region::Translucency,
+                bytemuck::bytes_of(&t.table.gpu()),
+            )?;
+            let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
+            tiles.lighting = tile_rects(columns, &marked, width, height);
+        }
+        if let Some(profiles) = &desc.sss {
+            let table = profiles.table(&self.settings.sss);
+            per_frame.write(slot, Region::Profiles, bytemuck::bytes_of(&table))?;
+            for chain in profiles.chains() {
+                let rects = self.settings.sss_tiles.then(|| {
+                    let (columns, _, marked) =
+                        object_tiles(scene, &self.mesh_bounds, width, height, |i, o| {
+                            let (_, blur) = profiles.of_object(i)?;
+                            let own = o.material.sss.as_ref()?;
+                            (*blur == chain).then(|| sss::profile_reach(own))
+                        });
+                    // All rectangles: the blurs draw the marked ones, LCB's and LBB's final
+                    // pass its LEAN variant there and the pass-through variant elsewhere.
+                    tile_rects(columns, &marked, width, height)
+                });
+                tiles.sss.push(rects);
+            }
+        }
+        *per_frame.tiles(slot) = tiles;
+        Ok(())
+    }
+
+    /// Gives the caller's target its image for the frames recorded from now on (frames built
+    /// with [`FrameSettings::target`]): an image of the target's format and the frame's size,
+    /// usable as a colour attachment, and a view of it.
+    pub fn bind_target(
+        &mut self,
+        gpu: &GpuContext,
+        image: vk::Image,
+        view: vk::ImageView,
+    ) -> Result<()> {
+        if !self.outputs.target {
+            return Err(LucentError::InvalidInput(
+                "bind_target: the frame was built without a target (FrameSettings::target)".into(),
+            ));
+        }
+        self.executable
+            .bind_import(gpu, self.outputs.display, image, view)
+    }
+
+    /// Records one frame for slot `slot` into `cmd` (in the recording state), with a
+    /// timestamp pair per physical pass when `timer` is given. Fails when the frame renders
+    /// into the caller's target and none is bound.
+    pub fn record(
+        &self,
+        gpu: &GpuContext,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        timer: Option<&mut crate::backend::timer::GpuTimer>,
+    ) -> Result<()> {
+        if slot >= self.settings.frames_in_flight {
+            return Err(LucentError::InvalidInput(format!(
+                "frame slot {slot}: the renderer has {} frame(s) in flight",
+                self.settings.frames_in_flight
+            )));
+        }
+        if !self.executable.ready() {
+            return Err(LucentError::InvalidInput(
+                "the frame renders into the caller's target and none is bound (bind_target)".into(),
+            ));
+        }
+        self.executable.record_frame(gpu, cmd, slot, timer);
+        Ok(())
+    }
+
+    fn scene_gpu(&self) -> &SceneGpu {
+        self.scene_gpu.as_ref().expect("alive until destroy")
+    }
+
+    /// Reads lucent's own display image of the last frame: RGBA8, sRGB-encoded, tightly
+    /// packed (a frame with a caller's target has none: the caller reads its image).
     pub fn read_display(&self, gpu: &GpuContext) -> Result<Vec<u8>> {
         self.read_export(gpu, self.outputs.display)
     }
@@ -281,9 +310,10 @@ impl Renderer {
             gb0: read(outputs.gb0)?,
             gb1: read(outputs.gb1)?,
             gb2: outputs.gb2.map(read).transpose()?,
+            // Stored as ID / 255 (UNORM8): rounding recovers the integer.
             sss: outputs
                 .sss
-                .map(|id| read(id).map(|t| t.into_iter().map(|v| v[0]).collect()))
+                .map(|id| read(id).map(|t| t.into_iter().map(|v| (v[0] * 255.0).round()).collect()))
                 .transpose()?,
             lean: outputs.lean.map(read).transpose()?,
             depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
@@ -307,12 +337,10 @@ impl Renderer {
 
     /// Destroys the frame and the scene's GPU data. The GPU must be idle.
     pub fn destroy(mut self, gpu: &GpuContext) {
+        // The passes hold the scene's data: they go first, so the data is ours alone.
         self.executable.destroy(gpu);
         if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
             s.destroy(gpu);
-        }
-        if let Some(u) = self.uniforms.take() {
-            gpu.destroy_buffer(u);
         }
     }
 }
@@ -332,4 +360,26 @@ pub fn render_frame(
     renderer.destroy(gpu);
     idle?;
     images
+}
+
+/// Refuses target formats the tonemap cannot write: colour formats of the format table with
+/// four 8-bit UNORM or SRGB channels, or RGBA fp16 or fp32.
+fn check_target_format(format: vk::Format) -> Result<()> {
+    use crate::backend::format::{format_info, FormatKind};
+    let ok = format_info(format).is_some_and(|f| {
+        f.channels >= 3
+            && match f.kind {
+                FormatKind::Unorm | FormatKind::Srgb => f.bytes == 4,
+                FormatKind::Float => f.bytes == 8 || f.bytes == 16,
+                _ => false,
+            }
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(LucentError::InvalidInput(format!(
+            "target format {format:?}: lucent writes RGBA8/BGRA8 UNORM or SRGB, RGBA16F or \
+             RGBA32F targets"
+        )))
+    }
 }

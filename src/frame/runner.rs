@@ -1,3 +1,7 @@
+//! [`FrameRunner`]: submits frames and measures them, either as one command buffer (in-frame
+//! timestamps) or one submission per physical pass (isolated timing); and the teardown the
+//! round-robin measurements share.
+
 use std::time::Instant;
 
 use ash::vk;
@@ -131,7 +135,7 @@ impl FrameRunner {
     /// One whole frame in one command buffer, timestamps around each physical pass.
     pub fn run_frame(&mut self, gpu: &GpuContext, executable: &Executable) -> Result<FrameTiming> {
         self.submit(gpu, |gpu, cmd, timer| {
-            executable.record_frame(gpu, cmd, Some(timer))
+            executable.record_frame(gpu, cmd, 0, Some(timer))
         })
     }
 
@@ -147,7 +151,7 @@ impl FrameRunner {
         let mut wall_ms = 0.0;
         for index in 0..count {
             let timing = self.submit(gpu, |gpu, cmd, timer| {
-                executable.record_physical(gpu, cmd, index, Some(timer));
+                executable.record_physical(gpu, cmd, index, 0, Some(timer));
                 if index + 1 == count {
                     executable.record_exports(gpu, cmd);
                 }

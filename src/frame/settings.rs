@@ -1,12 +1,22 @@
+//! How a frame is built: [`FrameSettings`], and the [`Technique`] override for A/B runs.
+
+use crate::backend::access::Access;
 use crate::features::debug_view::DebugView;
 use crate::features::deferred::GBufferPrecision;
 use crate::features::sss;
 use crate::graph::CompileOptions;
+use crate::scene::material::SssBlur;
 use crate::{LucentError, Result};
 
-/// Which technique lights the scene.
+/// What the frame shades. `Auto` (the default) is what the scene's materials ask for: every
+/// feature some material has, composed in one frame. The named techniques restrict the frame
+/// to one technique for A/B runs and the seeds' tables: the materials' parts of other
+/// techniques are left out, and an SSS technique blurs every SSS material with its blur.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
+    /// Whatever the materials ask for: GDC 2011 translucency on translucent materials, each
+    /// SSS material's profile with its own blur, normal and albedo maps.
+    Auto,
     /// Plain deferred lighting (no translucency, no SSS).
     None,
     /// Deferred lighting plus GDC 2011 thickness-based translucency for translucent materials.
@@ -26,6 +36,7 @@ pub enum Technique {
 impl Technique {
     /// Every technique with its command-line name.
     pub const ALL: &'static [(&'static str, Technique)] = &[
+        ("auto", Technique::Auto),
         ("none", Technique::None),
         ("translucency", Technique::Translucency),
         ("control", Technique::Control),
@@ -59,14 +70,27 @@ impl Technique {
             .map_or("?", |(n, _)| n)
     }
 
-    /// The screen-space SSS blur this technique runs, if any.
-    pub fn sss_blur(self) -> Option<sss::SssBlur> {
+    /// The screen-space SSS blur this technique forces on every SSS material, if any.
+    pub fn sss_blur(self) -> Option<SssBlur> {
         match self {
-            Technique::None | Technique::Translucency => None,
-            Technique::Control => Some(sss::SssBlur::Control),
-            Technique::Lcb => Some(sss::SssBlur::LeanControl),
-            Technique::Lbb => Some(sss::SssBlur::LeanBilateral),
+            Technique::Auto | Technique::None | Technique::Translucency => None,
+            Technique::Control => Some(SssBlur::Control),
+            Technique::Lcb => Some(SssBlur::LeanControl),
+            Technique::Lbb => Some(SssBlur::LeanBilateral),
         }
+    }
+
+    /// Whether translucent materials get GDC 2011 translucency.
+    pub fn translucency(self) -> bool {
+        matches!(self, Technique::Auto | Technique::Translucency)
+    }
+
+    /// Whether SSS materials get their screen-space blur.
+    pub fn sss(self) -> bool {
+        matches!(
+            self,
+            Technique::Auto | Technique::Control | Technique::Lcb | Technique::Lbb
+        )
     }
 }
 
@@ -101,6 +125,33 @@ pub struct FrameSettings {
     /// Show a G-buffer target (or the lit image before SSS) instead of the frame, when the
     /// frame has it (the demo's debug views).
     pub debug_view: Option<DebugView>,
+    /// Frames recorded and submitted before the first completes (1 to
+    /// [`crate::gpu_scene::per_frame::MAX_FRAMES_IN_FLIGHT`]): the per-frame parameters get
+    /// one slot each, and each frame's first use of a transient image waits for the previous
+    /// frame's last. With 1 the caller waits for each frame before submitting the next.
+    pub frames_in_flight: usize,
+    /// Write the frame into an image the caller gives (a host's swapchain or render target)
+    /// instead of lucent's own `display` image; each frame binds its image
+    /// ([`super::Renderer::bind_target`]).
+    pub target: Option<TargetDesc>,
+}
+
+/// An image the caller renders into: its format, the state it is in when the frame starts
+/// and the state the frame must leave it in. The size is the frame's.
+///
+/// The encoding follows the format: UNORM targets get the sRGB transfer function applied by
+/// the shader (as lucent's own display image), `_SRGB` targets are written linear and the
+/// hardware encodes, float targets are written linear (the tonemapped, display-referred
+/// values, for a host that composites in linear light).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TargetDesc {
+    /// Its format: any colour-renderable 8-bit UNORM or SRGB, fp16 or fp32 RGBA format.
+    pub format: ash::vk::Format,
+    /// How the host last used it (`Access::Undefined` when its contents do not matter).
+    pub initial: Access,
+    /// How the host uses it next (`Access::Present` for a swapchain image, `TransferRead`
+    /// to read it back, `FragmentSampledRead` to sample it).
+    pub final_access: Access,
 }
 
 /// A value injected into one pixel of the lit image.
@@ -115,12 +166,13 @@ pub struct Fault {
 }
 
 impl FrameSettings {
-    /// Defaults for a size: technique none, merging and aliasing on, no HDR export.
+    /// Defaults for a size: technique `auto` (what the materials ask for), merging and
+    /// aliasing on, no HDR export, one frame in flight, lucent's own display image.
     pub fn new(width: u32, height: u32) -> Self {
         Self {
             width,
             height,
-            technique: Technique::None,
+            technique: Technique::Auto,
             compile: CompileOptions::default(),
             export_hdr: false,
             export_gbuffer: false,
@@ -130,6 +182,8 @@ impl FrameSettings {
             fault: None,
             sss: sss::SssKnobs::default(),
             debug_view: None,
+            frames_in_flight: 1,
+            target: None,
         }
     }
 }

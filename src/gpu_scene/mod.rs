@@ -1,8 +1,17 @@
-//! What a scene becomes on the GPU: meshes with their vertex streams, the draws, normal and
-//! albedo maps, and the translucency material table. Made once per scene and frame layout
+//! What a scene becomes on the GPU: meshes with the vertex streams the frame needs, the draws
+//! with their per-object constants, the material textures (normal or LEAN maps, albedo maps),
+//! and the per-frame parameter buffer ([`per_frame`]). Made once per scene and frame layout
 //! ([`SceneGpu::new`]); the passes of [`crate::features`] share it read-only.
+//!
+//! A stream or texture exists only in frames that read it: thickness streams with
+//! translucency, UV + tangent streams and the samplers with normal or albedo maps.
+//!
+//! - [`per_frame`]: frame uniforms and material/profile tables, one slot per frame in flight.
+//! - [`tiles`]: the screen rectangles objects of a kind may cover, for the passes to draw their
+//!   expensive variants in.
 
-use std::sync::Arc;
+pub mod per_frame;
+pub mod tiles;
 
 use ash::vk;
 
@@ -11,22 +20,23 @@ use crate::error::VkResultExt;
 use crate::scene::material::TextureSource;
 use crate::scene::texture::{load_texture, procedural_texture, Texture, TextureUsage};
 use crate::scene::Scene;
-use crate::Result;
+use crate::{LucentError, Result};
 
-use crate::features::translucency::{thickness_factor, MaterialTable, ThicknessPacking};
+pub use per_frame::{FrameUniforms, PerFrame, PerFrameBinding, Region, SlotTiles};
+pub use tiles::TileRect;
 
-/// One draw: which mesh, with which per-object constants.
+/// One draw: which mesh, with which material textures and per-object constants.
 #[derive(Clone, Copy, Debug)]
 pub struct Draw {
     /// Index into [`SceneGpu::meshes`].
     pub mesh: usize,
-    /// Index into [`NormalMaps::images`] (0: the flat map).
-    pub normal_map: usize,
+    /// Index into [`MaterialMaps::sets`] (0 in frames without maps).
+    pub maps: usize,
     /// Push constants of the G-buffer pass.
     pub constants: ObjectConstants,
 }
 
-/// Per-object push constants (glsl/deferred/gbuffer.vert `Object`).
+/// Per-object push constants (glsl/deferred/object.glsl `Object`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ObjectConstants {
@@ -34,7 +44,8 @@ pub struct ObjectConstants {
     pub model: [[f32; 4]; 4],
     /// Albedo rgb, specular a.
     pub albedo_specular: [f32; 4],
-    /// Roughness in x.
+    /// Roughness in x; y: the SSS profile ID (0: the object does not scatter), in frames
+    /// with SSS.
     pub roughness: [f32; 4],
     /// Translucency: thickness factor rgb (tint x constant thickness), material ID in w
     /// (0: not translucent). Zero when the frame has no translucency.
@@ -51,52 +62,64 @@ pub struct GpuMesh {
     pub index_count: u32,
     /// Per-vertex RGB thickness (vertex colours, or white), only in frames with translucency.
     pub thickness: Option<GpuBuffer>,
-    /// Per-vertex UV + tangent (`[u, v, tx, ty, tz, tw]`), only in normal-mapped frames.
+    /// Per-vertex UV + tangent (`[u, v, tx, ty, tz, tw]`), only in frames with normal or
+    /// albedo maps.
     pub surface: Option<GpuBuffer>,
 }
 
-/// What the translucency technique keeps on the GPU (absent from frames without it).
-pub struct TranslucencyGpu {
-    /// The material table uniform buffer ([`crate::features::translucency::MaterialTableGpu`]).
-    pub materials: GpuBuffer,
-    /// How GB2 packs thickness.
-    pub packing: ThicknessPacking,
-    /// The lighting pass's rectangles for this frame ([`translucency::tile_rects`]), written
-    /// by the renderer before each frame is recorded.
-    pub tiles: std::sync::Mutex<Vec<crate::features::translucency::TileRect>>,
-}
-
-/// Normal maps of a normal-mapped frame: image 0 is a flat 1x1 map for objects without one.
-/// In LEAN frames (LCB, LBB) each normal map is uploaded as its two LEAN maps instead
-/// ([`crate::scene::lean`]): `images` holds LEAN map 1, `lean2` LEAN map 2.
-pub struct NormalMaps {
-    /// Sampled images (RGBA16F, mipmapped), in `SHADER_READ_ONLY_OPTIMAL`.
-    pub images: Vec<GpuImage>,
-    /// LEAN frames: the second LEAN map of each entry of `images` (empty otherwise).
+/// The material textures of a frame with normal or albedo maps. Entry 0 of each list is the
+/// neutral texture objects without a map of that kind read (a flat normal, white albedo).
+/// In LEAN frames each normal map is uploaded as its two LEAN maps instead
+/// ([`crate::scene::lean`]): `normal` holds LEAN map 1, `lean2` LEAN map 2.
+pub struct MaterialMaps {
+    /// Normal (or LEAN 1) maps, RGBA16F mipmapped; empty without normal maps.
+    pub normal: Vec<GpuImage>,
+    /// LEAN frames: the second LEAN map of each entry of `normal` (empty otherwise).
     pub lean2: Vec<GpuImage>,
+    /// Albedo maps (decoded from sRGB to linear), RGBA16F mipmapped; empty without albedo
+    /// maps.
+    pub albedo: Vec<GpuImage>,
     /// Trilinear, repeating sampler.
     pub sampler: vk::Sampler,
+    /// The distinct (normal index, albedo index) pairs the draws use: one descriptor set each.
+    pub sets: Vec<(usize, usize)>,
+}
+
+/// What the frame needs of the scene on the GPU (the frame description decides it).
+#[derive(Clone, Copy, Debug)]
+pub struct SceneUpload<'a> {
+    /// Frames with translucency: each object's translucency material ID (0: opaque); the
+    /// meshes get their thickness streams.
+    pub translucency_ids: Option<&'a [u8]>,
+    /// Frames with SSS: each object's SSS profile ID (0: does not scatter).
+    pub profile_ids: Option<&'a [u8]>,
+    /// Some object has a normal map.
+    pub normal_maps: bool,
+    /// Normal maps are uploaded as LEAN maps (LCB and LBB blurs).
+    pub lean: bool,
+    /// Some object has an albedo texture.
+    pub albedo_maps: bool,
+    /// Frames in flight (slots of the per-frame buffer).
+    pub frames_in_flight: usize,
+    /// Bytes of the translucency material table (0 without translucency).
+    pub translucency_table_bytes: u64,
+    /// Bytes of the SSS profile table (0 without SSS).
+    pub profile_table_bytes: u64,
 }
 
 /// Side of the procedural textures lucent makes, in texels.
 pub const PROCEDURAL_TEXTURE_SIZE: u32 = 512;
 
-/// The scene's GPU data the passes share: meshes, draws, and the frame uniform buffer.
+/// The scene's GPU data the passes share (see the module docs).
 pub struct SceneGpu {
     /// Meshes.
     pub meshes: Vec<GpuMesh>,
     /// Draws in submission order.
     pub draws: Vec<Draw>,
-    /// Frame uniform buffer (camera, lights), owned and written by the renderer.
-    pub frame_uniforms: vk::Buffer,
-    /// Translucency data, when the frame shades translucency.
-    pub translucency: Option<TranslucencyGpu>,
-    /// Normal maps, when some object has one.
-    pub normal_maps: Option<NormalMaps>,
-    /// The screen's rectangles for the SSS passes this frame, marked (`translucent`) where
-    /// objects with a profile (widened by the profile's reach) may be: the blurs run only in
-    /// those. Written by the renderer before each frame; `None`: everything is blurred.
-    pub sss_tiles: std::sync::Mutex<Option<Vec<crate::features::translucency::TileRect>>>,
+    /// Material textures, when some object has a normal or albedo map.
+    pub maps: Option<MaterialMaps>,
+    /// The per-frame parameters (uniforms, tables, tiles), one slot per frame in flight.
+    pub per_frame: PerFrame,
 }
 
 /// Linear RGBA f32 texels as tightly packed RGBA16F bytes (values clamped to fp16's range).
@@ -123,29 +146,48 @@ pub fn upload_texture(gpu: &GpuContext, texture: &Texture, name: &str) -> Result
     gpu.upload_image(&desc, &levels, name)
 }
 
+/// The distinct sources of one kind of map, in order of first use.
+fn distinct_sources<'s>(
+    scene: &'s Scene,
+    pick: impl Fn(&'s crate::scene::Object) -> Option<&'s TextureSource>,
+) -> Vec<&'s TextureSource> {
+    let mut sources: Vec<&TextureSource> = Vec::new();
+    for o in &scene.objects {
+        if let Some(t) = pick(o) {
+            if !sources.contains(&t) {
+                sources.push(t);
+            }
+        }
+    }
+    sources
+}
+
+fn load_source(source: &TextureSource, usage: TextureUsage) -> Result<Texture> {
+    match source {
+        TextureSource::File(path) => load_texture(path, usage),
+        TextureSource::Procedural(p) => procedural_texture(p, PROCEDURAL_TEXTURE_SIZE),
+    }
+}
+
 impl SceneGpu {
-    /// Uploads `scene`'s meshes; `frame_uniforms` is the renderer's uniform buffer. With
-    /// `translucency` (the frame's material table and packing), also each mesh's thickness
-    /// stream and the material table; when some object has a normal map, each mesh's UV +
-    /// tangent stream and the normal maps (with `lean`, their LEAN maps).
-    pub fn new(
-        gpu: &GpuContext,
-        scene: &Scene,
-        frame_uniforms: vk::Buffer,
-        translucency: Option<(&MaterialTable, ThicknessPacking)>,
-        lean: bool,
-    ) -> Result<Arc<Self>> {
+    /// Uploads what `upload` asks for of `scene` and creates the per-frame buffer.
+    pub fn new(gpu: &GpuContext, scene: &Scene, upload: &SceneUpload<'_>) -> Result<Self> {
+        let per_frame = PerFrame::new(
+            gpu,
+            upload.frames_in_flight,
+            upload.translucency_table_bytes,
+            upload.profile_table_bytes,
+            &scene.name,
+        )?;
         let mut out = Self {
             meshes: Vec::with_capacity(scene.meshes.len()),
             draws: Vec::with_capacity(scene.objects.len()),
-            frame_uniforms,
-            translucency: None,
-            normal_maps: None,
-            sss_tiles: std::sync::Mutex::new(None),
+            maps: None,
+            per_frame,
         };
         // Everything created so far is freed by `destroy` if a later step fails.
-        match out.upload(gpu, scene, translucency, lean) {
-            Ok(()) => Ok(Arc::new(out)),
+        match out.upload(gpu, scene, upload) {
+            Ok(()) => Ok(out),
             Err(e) => {
                 out.destroy(gpu);
                 Err(e)
@@ -153,69 +195,13 @@ impl SceneGpu {
         }
     }
 
-    fn upload(
-        &mut self,
-        gpu: &GpuContext,
-        scene: &Scene,
-        translucency: Option<(&MaterialTable, ThicknessPacking)>,
-        lean: bool,
-    ) -> Result<()> {
-        if let Some((table, packing)) = translucency {
-            let materials = gpu.upload_buffer(
-                std::slice::from_ref(&table.gpu()),
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                &format!("{} translucency materials", scene.name),
-            )?;
-            self.translucency = Some(TranslucencyGpu {
-                materials,
-                packing,
-                tiles: std::sync::Mutex::new(Vec::new()),
-            });
-        }
-        // Normal maps: one per distinct source, after the flat default.
-        let mut sources: Vec<&TextureSource> = Vec::new();
-        for o in &scene.objects {
-            if let Some(t) = &o.material.normal_texture {
-                if !sources.contains(&t) {
-                    sources.push(t);
-                }
-            }
-        }
-        let normal_mapped = !sources.is_empty();
-        if normal_mapped {
-            self.normal_maps = Some(NormalMaps {
-                images: Vec::with_capacity(sources.len() + 1),
-                lean2: Vec::new(),
-                sampler: create_repeat_sampler(gpu)?,
-            });
-            let flat = Texture::from_texels(
-                "flat normal map",
-                1,
-                1,
-                TextureUsage::Data,
-                vec![[0.5, 0.5, 1.0, 1.0]],
-            )?;
-            let maps = self.normal_maps.as_mut().expect("just set");
-            let push = |maps: &mut NormalMaps, texture: &Texture, name: &str| -> Result<()> {
-                if lean {
-                    let (lean1, lean2) = crate::scene::lean::lean_maps(texture)?;
-                    maps.images
-                        .push(upload_texture(gpu, &lean1, &format!("{name} LEAN 1"))?);
-                    maps.lean2
-                        .push(upload_texture(gpu, &lean2, &format!("{name} LEAN 2"))?);
-                } else {
-                    maps.images.push(upload_texture(gpu, texture, name)?);
-                }
-                Ok(())
-            };
-            push(maps, &flat, "flat normal map")?;
-            for (i, source) in sources.iter().enumerate() {
-                let texture = match source {
-                    TextureSource::File(path) => load_texture(path, TextureUsage::Data)?,
-                    TextureSource::Procedural(p) => procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?,
-                };
-                push(maps, &texture, &format!("{} normal map {i}", scene.name))?;
-            }
+    fn upload(&mut self, gpu: &GpuContext, scene: &Scene, upload: &SceneUpload<'_>) -> Result<()> {
+        let normal_sources = distinct_sources(scene, |o| o.material.normal_texture.as_ref());
+        let albedo_sources = distinct_sources(scene, |o| o.material.albedo_texture.as_ref());
+        let normal_maps = upload.normal_maps && !normal_sources.is_empty();
+        let albedo_maps = upload.albedo_maps && !albedo_sources.is_empty();
+        if normal_maps || albedo_maps {
+            self.upload_maps(gpu, scene, upload.lean, normal_maps, albedo_maps)?;
         }
         for (i, mesh) in scene.meshes.iter().enumerate() {
             // A deforming scene is drawn as it stands at t = 0 (per-frame updates come with
@@ -249,7 +235,7 @@ impl SceneGpu {
                 surface: None,
             });
             let gpu_mesh = self.meshes.last_mut().expect("just pushed");
-            if translucency.is_some() {
+            if upload.translucency_ids.is_some() {
                 // Meshes without vertex colours are uniformly "thin": the material's
                 // constant thickness then carries the value.
                 let colors: Vec<[f32; 3]> = if mesh.colors.is_empty() {
@@ -263,7 +249,7 @@ impl SceneGpu {
                     &format!("{name} thickness"),
                 )?);
             }
-            if normal_mapped {
+            if self.maps.is_some() {
                 gpu_mesh.surface = Some(gpu.upload_buffer(
                     &surface_stream(mesh),
                     vk::BufferUsageFlags::VERTEX_BUFFER,
@@ -272,40 +258,70 @@ impl SceneGpu {
             }
         }
         for (index, o) in scene.objects.iter().enumerate() {
-            if o.material.normal_texture.is_some() {
-                let m = &scene.meshes[o.mesh];
-                if m.uvs.len() != m.positions.len() || m.tangents.len() != m.positions.len() {
-                    return Err(crate::LucentError::InvalidInput(format!(
-                        "material '{}' has a normal map but mesh {} has no UVs and tangents",
-                        o.material.name, o.mesh
-                    )));
-                }
+            let m = &scene.meshes[o.mesh];
+            if o.material.normal_texture.is_some()
+                && normal_maps
+                && (m.uvs.len() != m.positions.len() || m.tangents.len() != m.positions.len())
+            {
+                return Err(LucentError::InvalidInput(format!(
+                    "material '{}' has a normal map but mesh {} has no UVs and tangents",
+                    o.material.name, o.mesh
+                )));
             }
-            let thickness = match (translucency, &o.material.translucency) {
-                (Some((table, _)), Some(t)) => thickness_factor(t)
-                    .extend(f32::from(table.object_ids[index]))
-                    .to_array(),
+            if o.material.albedo_texture.is_some()
+                && albedo_maps
+                && m.uvs.len() != m.positions.len()
+            {
+                return Err(LucentError::InvalidInput(format!(
+                    "material '{}' has an albedo texture but mesh {} has no texture coordinates",
+                    o.material.name, o.mesh
+                )));
+            }
+            let translucency_id = upload
+                .translucency_ids
+                .and_then(|ids| ids.get(index).copied())
+                .unwrap_or(0);
+            let thickness = match (&o.material.translucency, translucency_id) {
+                (Some(t), id) if id > 0 => t.thickness_factor().extend(f32::from(id)).to_array(),
                 _ => [0.0; 4],
             };
-            let normal_map = o
-                .material
-                .normal_texture
-                .as_ref()
-                .and_then(|t| sources.iter().position(|s| *s == t))
-                .map_or(0, |i| i + 1);
+            let profile_id = upload
+                .profile_ids
+                .and_then(|ids| ids.get(index).copied())
+                .unwrap_or(0);
+            let position_in = |sources: &[&TextureSource], t: Option<&TextureSource>| {
+                t.and_then(|t| sources.iter().position(|s| *s == t))
+                    .map_or(0, |i| i + 1)
+            };
+            let pair = (
+                if normal_maps {
+                    position_in(&normal_sources, o.material.normal_texture.as_ref())
+                } else {
+                    0
+                },
+                if albedo_maps {
+                    position_in(&albedo_sources, o.material.albedo_texture.as_ref())
+                } else {
+                    0
+                },
+            );
+            let maps = match &mut self.maps {
+                Some(maps) => match maps.sets.iter().position(|&p| p == pair) {
+                    Some(i) => i,
+                    None => {
+                        maps.sets.push(pair);
+                        maps.sets.len() - 1
+                    }
+                },
+                None => 0,
+            };
             self.draws.push(Draw {
                 mesh: o.mesh,
-                normal_map,
+                maps,
                 constants: ObjectConstants {
                     model: o.transform.to_cols_array_2d(),
                     albedo_specular: o.material.albedo.extend(o.material.specular).to_array(),
-                    // y: screen-space SSS strength (read only by SSS frames).
-                    roughness: [
-                        o.material.roughness,
-                        if o.material.sss.is_some() { 1.0 } else { 0.0 },
-                        0.0,
-                        0.0,
-                    ],
+                    roughness: [o.material.roughness, f32::from(profile_id), 0.0, 0.0],
                     thickness,
                 },
             });
@@ -313,18 +329,63 @@ impl SceneGpu {
         Ok(())
     }
 
-    /// Sets the lighting pass's rectangles for the next frames (frames with translucency).
-    pub fn set_tiles(&self, rects: Vec<crate::features::translucency::TileRect>) {
-        if let Some(t) = &self.translucency {
-            // A poisoned lock only means a recording thread panicked; the data is plain.
-            *t.tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
+    /// Loads and uploads the normal (or LEAN) and albedo maps, each list after its neutral
+    /// texture.
+    fn upload_maps(
+        &mut self,
+        gpu: &GpuContext,
+        scene: &Scene,
+        lean: bool,
+        normal_maps: bool,
+        albedo_maps: bool,
+    ) -> Result<()> {
+        self.maps = Some(MaterialMaps {
+            normal: Vec::new(),
+            lean2: Vec::new(),
+            albedo: Vec::new(),
+            sampler: create_repeat_sampler(gpu)?,
+            sets: Vec::new(),
+        });
+        let maps = self.maps.as_mut().expect("just set");
+        if normal_maps {
+            let flat = Texture::from_texels(
+                "flat normal map",
+                1,
+                1,
+                TextureUsage::Data,
+                vec![[0.5, 0.5, 1.0, 1.0]],
+            )?;
+            let push = |maps: &mut MaterialMaps, texture: &Texture, name: &str| -> Result<()> {
+                if lean {
+                    let (lean1, lean2) = crate::scene::lean::lean_maps(texture)?;
+                    maps.normal
+                        .push(upload_texture(gpu, &lean1, &format!("{name} LEAN 1"))?);
+                    maps.lean2
+                        .push(upload_texture(gpu, &lean2, &format!("{name} LEAN 2"))?);
+                } else {
+                    maps.normal.push(upload_texture(gpu, texture, name)?);
+                }
+                Ok(())
+            };
+            push(maps, &flat, "flat normal map")?;
+            let sources = distinct_sources(scene, |o| o.material.normal_texture.as_ref());
+            for (i, source) in sources.iter().enumerate() {
+                let texture = load_source(source, TextureUsage::Data)?;
+                push(maps, &texture, &format!("{} normal map {i}", scene.name))?;
+            }
         }
-    }
-
-    /// Sets the SSS blurs' rectangles for the next frames (`None`: whole screen).
-    pub fn set_sss_tiles(&self, rects: Option<Vec<crate::features::translucency::TileRect>>) {
-        // A poisoned lock only means a recording thread panicked; the data is plain.
-        *self.sss_tiles.lock().unwrap_or_else(|e| e.into_inner()) = rects;
+        if albedo_maps {
+            let white = Texture::from_texels("white", 1, 1, TextureUsage::Color, vec![[1.0; 4]])?;
+            maps.albedo
+                .push(upload_texture(gpu, &white, "white albedo map")?);
+            let sources = distinct_sources(scene, |o| o.material.albedo_texture.as_ref());
+            for (i, source) in sources.iter().enumerate() {
+                let texture = load_source(source, TextureUsage::Color)?;
+                let name = format!("{} albedo map {i}", scene.name);
+                maps.albedo.push(upload_texture(gpu, &texture, &name)?);
+            }
+        }
+        Ok(())
     }
 
     /// Frees the GPU memory. The GPU must be done with it.
@@ -336,21 +397,19 @@ impl SceneGpu {
                 gpu.destroy_buffer(b);
             }
         }
-        if let Some(t) = self.translucency {
-            gpu.destroy_buffer(t.materials);
-        }
-        if let Some(maps) = self.normal_maps {
-            for image in maps.images.into_iter().chain(maps.lean2) {
+        if let Some(maps) = self.maps {
+            for image in maps.normal.into_iter().chain(maps.lean2).chain(maps.albedo) {
                 gpu.destroy_image(image);
             }
             // SAFETY: created by `create_repeat_sampler`; the GPU is done with it.
             unsafe { gpu.device.destroy_sampler(maps.sampler, None) };
         }
+        self.per_frame.destroy(gpu);
     }
 }
 
-/// UV + tangent per vertex; meshes without them (drawn without a normal map in a normal-mapped
-/// frame) get zeros and a +X tangent, which the flat map ignores.
+/// UV + tangent per vertex; meshes without them (drawn without a map in a frame with maps)
+/// get zeros and a +X tangent, which the neutral maps ignore.
 fn surface_stream(mesh: &crate::scene::Mesh) -> Vec<[f32; 6]> {
     (0..mesh.positions.len())
         .map(|i| {

@@ -27,31 +27,13 @@ use super::declare::{LoadOp, PassKind, RenderGraph, ResourceId, Use};
 use super::PassExec;
 
 pub use super::plan::{
-    AttachmentPlan, Barrier, MemorySlot, PhysicalPass, Plan, PlannedPass, PlannedResource,
-    RenderPassPlan, SubpassDependencyPlan, SubpassPlan,
+    AttachmentPlan, Barrier, CompileOptions, MemorySlot, PhysicalPass, Plan, PlannedPass,
+    PlannedResource, RenderPassPlan, SubpassDependencyPlan, SubpassPlan,
 };
 
 /// The executors of a plan's passes, in [`Plan::passes`] order (`None` for passes declared
 /// without code).
 pub type PassExecs = Vec<Option<Box<dyn PassExec>>>;
-
-/// Switches for A/B comparisons of the compiler's optimisations.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct CompileOptions {
-    /// Merge same-pixel raster chains into subpasses of one render pass.
-    pub merge: bool,
-    /// Let transient images with disjoint lifetimes share memory.
-    pub alias: bool,
-}
-
-impl Default for CompileOptions {
-    fn default() -> Self {
-        Self {
-            merge: true,
-            alias: true,
-        }
-    }
-}
 
 /// Where a resource stands between accesses while barriers are derived.
 #[derive(Clone, Copy, Debug)]
@@ -296,13 +278,54 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
         Vec::new()
     };
 
-    // Rule 6: barriers, render passes, subpass dependencies.
-    let mut state: Vec<SyncState> = res
+    // Rule 6: barriers, render passes, subpass dependencies. Frames submitted back to back
+    // without the host waiting (`chained_frames`) first run the rule once to learn the state
+    // the frame leaves every transient image and memory slot in: the next frame's first
+    // access must wait for the previous frame's last, as it would for an earlier pass.
+    let initial: Vec<SyncState> = res
         .iter()
         .map(|r| SyncState::from_access(r.import.map_or(Access::Undefined, |i| i.initial)))
         .collect();
-    // Which slot member last used each slot, to detect an image taking over aliased memory.
-    let mut slot_owner: Vec<Option<ResourceId>> = vec![None; slots.len()];
+    let mut start = (initial.clone(), vec![None; slots.len()]);
+    if options.chained_frames {
+        let mut state = start.clone();
+        derive_sync(res, &passes, &groups, &planned, &mut state.0, &mut state.1);
+        for (id, r) in res.iter().enumerate() {
+            // Imports enter every frame in the state the host promises; transients in the
+            // state the previous frame left them.
+            if r.import.is_none() {
+                start.0[id] = state.0[id];
+            }
+        }
+        start.1 = state.1;
+    }
+    let (mut state, mut slot_owner) = start;
+    let (physical, export_barriers) =
+        derive_sync(res, &passes, &groups, &planned, &mut state, &mut slot_owner);
+
+    Ok(Plan {
+        options,
+        resources: planned,
+        passes,
+        physical,
+        export_barriers,
+        slots,
+        culled,
+    })
+}
+
+/// Rule 6 over the whole frame from `state` (each resource's state as the frame starts) and
+/// `slot_owner` (which member last used each memory slot, to detect an image taking over
+/// aliased memory): the physical passes with their barriers and render passes, and the export
+/// barriers. Leaves `state` and `slot_owner` as the frame ends.
+fn derive_sync(
+    res: &[super::declare::ResourceDecl],
+    passes: &[PlannedPass],
+    groups: &[Vec<usize>],
+    planned: &[PlannedResource],
+    state: &mut [SyncState],
+    slot_owner: &mut [Option<ResourceId>],
+) -> (Vec<PhysicalPass>, Vec<Barrier>) {
     let mut physical = Vec::with_capacity(groups.len());
     for (g, group) in groups.iter().enumerate() {
         let mut barriers = Vec::new();
@@ -333,7 +356,7 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
         }
         let first_kind = passes[group[0]].kind;
         let render_pass = (first_kind == PassKind::Raster)
-            .then(|| plan_render_pass(group, &passes, &planned, &mut state, g));
+            .then(|| plan_render_pass(group, passes, planned, state, g));
         let extent = render_pass
             .as_ref()
             .and_then(|rp| rp.attachments.first())
@@ -376,15 +399,7 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
         }
     }
 
-    Ok(Plan {
-        options,
-        resources: planned,
-        passes,
-        physical,
-        export_barriers,
-        slots,
-        culled,
-    })
+    (physical, export_barriers)
 }
 
 /// Checks one pass's accesses fit its kind, and that it does not read and write one image.

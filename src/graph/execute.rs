@@ -54,6 +54,9 @@ pub struct RecordContext<'a> {
     pub images: &'a [vk::Image],
     /// Views by [`ResourceId`].
     pub views: &'a [vk::ImageView],
+    /// The frame-in-flight slot being recorded: passes read their per-frame data (uniforms,
+    /// tiles) from this slot, so frames of other slots may still be running on the GPU.
+    pub frame: usize,
 }
 
 /// How a physical image came to be.
@@ -85,7 +88,13 @@ pub struct Executable {
     descriptor_views: Vec<vk::ImageView>,
     blocks: Vec<MemoryBlock>,
     render_passes: Vec<vk::RenderPass>,
+    /// The framebuffer each physical pass records with now (null: an imported attachment
+    /// has no image yet, see [`Executable::bind_import`]).
     framebuffers: Vec<vk::Framebuffer>,
+    /// Every framebuffer made, by physical pass and attachment views: an import bound again
+    /// (a host's swapchain images in turn) reuses its framebuffer, and frames still in flight
+    /// keep theirs alive until [`Executable::destroy`].
+    framebuffer_cache: Vec<((usize, Vec<vk::ImageView>), vk::Framebuffer)>,
 }
 
 impl Executable {
@@ -116,6 +125,7 @@ impl Executable {
             blocks: Vec::new(),
             render_passes: Vec::new(),
             framebuffers: Vec::new(),
+            framebuffer_cache: Vec::new(),
             execs: Vec::new(),
             plan,
         };
@@ -243,22 +253,130 @@ impl Executable {
             .zip(&self.depth_views)
             .map(|(&v, &d)| if d == vk::ImageView::null() { v } else { d })
             .collect();
-        for phys in &self.plan.physical {
-            let framebuffer = match &phys.render_pass {
+        for g in 0..self.plan.physical.len() {
+            let phys = &self.plan.physical[g];
+            match &phys.render_pass {
                 Some(plan) => {
                     let rp = create_render_pass(gpu, plan, &phys.name)?;
-                    // Kept before the framebuffer is made, so `destroy` frees it on error.
                     self.render_passes.push(rp);
-                    create_framebuffer(gpu, plan, rp, &self.views, phys.extent, &phys.name)?
                 }
-                None => {
-                    self.render_passes.push(vk::RenderPass::null());
-                    vk::Framebuffer::null()
-                }
-            };
-            self.framebuffers.push(framebuffer);
+                None => self.render_passes.push(vk::RenderPass::null()),
+            }
+            self.framebuffers.push(vk::Framebuffer::null());
+            self.update_framebuffer(gpu, g)?;
         }
         Ok(())
+    }
+
+    /// Points physical pass `g` at the framebuffer of the current attachment views, making it
+    /// (once per distinct set of views) unless an imported attachment has no view yet.
+    fn update_framebuffer(&mut self, gpu: &GpuContext, g: usize) -> Result<()> {
+        let phys = &self.plan.physical[g];
+        let Some(plan) = &phys.render_pass else {
+            return Ok(());
+        };
+        let views: Vec<vk::ImageView> = plan
+            .attachments
+            .iter()
+            .map(|a| self.views[a.resource])
+            .collect();
+        if views.contains(&vk::ImageView::null()) {
+            self.framebuffers[g] = vk::Framebuffer::null();
+            return Ok(());
+        }
+        let key = (g, views);
+        let framebuffer = match self.framebuffer_cache.iter().find(|(k, _)| *k == key) {
+            Some(&(_, fb)) => fb,
+            None => {
+                let fb = create_framebuffer(
+                    gpu,
+                    plan,
+                    self.render_passes[g],
+                    &self.views,
+                    phys.extent,
+                    &phys.name,
+                )?;
+                self.framebuffer_cache.push((key, fb));
+                fb
+            }
+        };
+        self.framebuffers[g] = framebuffer;
+        Ok(())
+    }
+
+    /// Gives an imported image its image and view for the frames recorded from now on (a
+    /// host's swapchain image, or the next of several targets while earlier frames are still
+    /// in flight). Only images the frame uses as attachments or transfer targets can change
+    /// between frames: a descriptor that samples an import is written once, at `new`.
+    pub fn bind_import(
+        &mut self,
+        gpu: &GpuContext,
+        id: ResourceId,
+        image: vk::Image,
+        view: vk::ImageView,
+    ) -> Result<()> {
+        let resource = self.plan.resources.get(id).ok_or_else(|| {
+            LucentError::Graph(format!("bind_import: no resource {id} in this plan"))
+        })?;
+        if !resource.imported {
+            return Err(LucentError::Graph(format!(
+                "bind_import: '{}' is not an imported image",
+                resource.name
+            )));
+        }
+        let through_descriptors = self.plan.passes.iter().any(|p| {
+            p.reads.iter().chain(&p.writes).any(|u| {
+                u.resource == id
+                    && !matches!(
+                        u.access,
+                        Access::ColorAttachmentWrite
+                            | Access::DepthAttachmentWrite
+                            | Access::DepthAttachmentRead
+                            | Access::TransferRead
+                            | Access::TransferWrite
+                    )
+            })
+        });
+        if through_descriptors {
+            return Err(LucentError::Graph(format!(
+                "bind_import: '{}' is read through descriptors, so it cannot change between frames",
+                resource.name
+            )));
+        }
+        if image == vk::Image::null() || view == vk::ImageView::null() {
+            return Err(LucentError::Graph(format!(
+                "bind_import: '{}' needs an image and a view",
+                resource.name
+            )));
+        }
+        self.images[id] = image;
+        self.views[id] = view;
+        self.descriptor_views[id] = view;
+        for g in 0..self.plan.physical.len() {
+            let uses = self.plan.physical[g]
+                .render_pass
+                .as_ref()
+                .is_some_and(|rp| rp.attachments.iter().any(|a| a.resource == id));
+            if uses {
+                self.update_framebuffer(gpu, g)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether every physical pass can be recorded (every imported attachment has an image).
+    pub fn ready(&self) -> bool {
+        self.plan
+            .physical
+            .iter()
+            .zip(&self.framebuffers)
+            .all(|(p, fb)| p.render_pass.is_none() || *fb != vk::Framebuffer::null())
+            && self
+                .plan
+                .resources
+                .iter()
+                .zip(&self.images)
+                .all(|(r, i)| r.lifetime.is_none() || *i != vk::Image::null())
     }
 
     fn prepare_passes(
@@ -297,14 +415,16 @@ impl Executable {
 
     /// Records the whole frame: every physical pass (each under its debug label and, with a
     /// timer, its timestamp pair) and the final transitions to export states.
+    /// `frame` is the frame-in-flight slot whose per-frame data the passes read.
     pub fn record_frame(
         &self,
         gpu: &GpuContext,
         cmd: vk::CommandBuffer,
+        frame: usize,
         mut timer: Option<&mut GpuTimer>,
     ) {
         for index in 0..self.plan.physical.len() {
-            self.record_physical(gpu, cmd, index, timer.as_deref_mut());
+            self.record_physical(gpu, cmd, index, frame, timer.as_deref_mut());
         }
         self.record_exports(gpu, cmd);
     }
@@ -316,6 +436,7 @@ impl Executable {
         gpu: &GpuContext,
         cmd: vk::CommandBuffer,
         index: usize,
+        frame: usize,
         timer: Option<&mut GpuTimer>,
     ) {
         let phys = &self.plan.physical[index];
@@ -332,6 +453,7 @@ impl Executable {
             extent: area,
             images: &self.images,
             views: &self.views,
+            frame,
         };
         match &phys.render_pass {
             Some(rp) => {
@@ -467,10 +589,9 @@ impl Executable {
         self.execs.clear();
         // SAFETY: created by this executable on this device; the caller guarantees idle.
         unsafe {
-            for fb in self.framebuffers.drain(..) {
-                if fb != vk::Framebuffer::null() {
-                    gpu.device.destroy_framebuffer(fb, None);
-                }
+            self.framebuffers.clear();
+            for (_, fb) in self.framebuffer_cache.drain(..) {
+                gpu.device.destroy_framebuffer(fb, None);
             }
             for rp in self.render_passes.drain(..) {
                 if rp != vk::RenderPass::null() {

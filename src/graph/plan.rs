@@ -7,7 +7,6 @@ use ash::vk;
 
 use crate::backend::access::Access;
 
-use super::compile::CompileOptions;
 use super::declare::{ImageInfo, PassKind, ResourceId, Use};
 
 /// A pass that survived culling, in execution order.
@@ -222,5 +221,29 @@ impl Plan {
     /// The physical pass index of a resource's export barrier etc.: finds a resource by name.
     pub fn resource_by_name(&self, name: &str) -> Option<ResourceId> {
         self.resources.iter().position(|r| r.name == name)
+    }
+}
+
+/// Switches for A/B comparisons of the compiler's optimisations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CompileOptions {
+    /// Merge same-pixel raster chains into subpasses of one render pass.
+    pub merge: bool,
+    /// Let transient images with disjoint lifetimes share memory.
+    pub alias: bool,
+    /// Frames are submitted back to back without the host waiting for each (frames in
+    /// flight): each frame's first access to a transient image also waits for the previous
+    /// frame's last access to it (and to its memory slot). Off, the caller waits for a frame
+    /// before submitting the next, and frames start from nothing.
+    pub chained_frames: bool,
+}
+
+impl Default for CompileOptions {
+    fn default() -> Self {
+        Self {
+            merge: true,
+            alias: true,
+            chained_frames: false,
+        }
     }
 }

@@ -77,6 +77,7 @@ pub fn settings(technique: Technique, width: u32, height: u32) -> FrameSettings 
         compile: CompileOptions {
             merge: false,
             alias: true,
+            ..CompileOptions::default()
         },
         ..FrameSettings::new(width, height)
     }

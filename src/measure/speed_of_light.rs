@@ -265,6 +265,7 @@ impl CopyFrame {
         let (plan, execs) = graph.compile(CompileOptions {
             merge: false,
             alias: true,
+            ..CompileOptions::default()
         })?;
         let copy_index = names
             .iter()
@@ -579,7 +580,7 @@ impl PassExec for CopyPass {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::{plan_frame, FrameFeatures, FrameSettings, Technique};
+    use crate::frame::{plan_frame, FrameDesc, FrameSettings, Technique};
 
     fn plan(scene: &str, technique: Technique) -> Plan {
         let scene = crate::bake::scene::load_scene_baked(scene).unwrap();
@@ -587,7 +588,7 @@ mod tests {
             technique,
             ..FrameSettings::new(64, 48)
         };
-        plan_frame(&settings, &FrameFeatures::new(&scene, &settings).unwrap()).unwrap()
+        plan_frame(&settings, &FrameDesc::new(&scene, &settings).unwrap()).unwrap()
     }
 
     #[test]
@@ -637,7 +638,7 @@ mod tests {
             ..FrameSettings::new(64, 48)
         };
         settings.sss.packed = true;
-        let plan = plan_frame(&settings, &FrameFeatures::new(&scene, &settings).unwrap()).unwrap();
+        let plan = plan_frame(&settings, &FrameDesc::new(&scene, &settings).unwrap()).unwrap();
         let floors = floors(&plan);
         let packed = vk::Format::R32G32B32A32_UINT;
         let reads_packed = floors

@@ -218,7 +218,6 @@ pub fn case_scene(case: &SweepCase) -> Result<Scene> {
     light.translucency_scale = p.scale;
     Ok(Scene {
         name: "sweep".into(),
-        technique: Some("translucency".into()),
         meshes: vec![mesh],
         objects: vec![Object {
             mesh: 0,

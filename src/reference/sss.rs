@@ -2,7 +2,7 @@
 //! the visible surface, from a read-back G-buffer. It is the reference every screen-space
 //! blur (the control, LCB, LBB) is measured against.
 //!
-//! For each scattering pixel `p` (SSS strength > 0), the outgoing diffuse light is
+//! For each scattering pixel `p` (SSS profile ID > 0), the outgoing diffuse light is
 //! `sum_q R(|x_p - x_q|) A_q E_q / sum_q R(|x_p - x_q|) A_q` over the scattering pixels `q`,
 //! where `x` is the world position rebuilt from depth, `A_q` the world area the pixel covers,
 //! `E_q` its lit diffuse (ambient + Lambert, as the lighting pass computes it) and
@@ -147,7 +147,7 @@ pub enum ReferenceSpecular {
 }
 
 /// The reference HDR image (RGB per pixel, rows top first) of the SSS frame whose G-buffer is
-/// `gbuffer` (it must carry the SSS strength), blurring with `profile`; scattering pixels get
+/// `gbuffer` (it must carry the SSS profile IDs), blurring with `profile`; scattering pixels get
 /// `specular`'s model, unblurred (specular reflection happens at the surface).
 pub fn reference_image(
     scene: &Scene,
@@ -251,7 +251,7 @@ pub struct EdgeMetrics {
     pub interior_error: f64,
 }
 
-/// Measures halo and bleed: `strength` is the frame's SSS strength per pixel, `plain` and `sss`
+/// Measures halo and bleed: `strength` is the frame's SSS profile ID per pixel, `plain` and `sss`
 /// its HDR (RGBA) without and with SSS, `reference` the f64 reference; the edge band is `band`
 /// pixels wide.
 pub fn edge_metrics(

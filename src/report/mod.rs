@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::frame::{plan_frame, FrameFeatures, FrameSettings, Renderer, Technique};
+use crate::frame::{FrameSettings, Renderer, Technique};
 use crate::measure::bench::{BenchOptions, BenchReport};
 use crate::measure::scaling::{Config, Measured};
 use crate::measure::speed_of_light::CopyFrame;
@@ -92,41 +92,17 @@ pub fn sss_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     })
 }
 
-/// The built-in scene a technique is measured on: the first made for it (its `technique`), else
-/// the first whose frame under the technique differs from plain deferred lighting (the
-/// technique has something to do there), else `smoke`.
+/// The built-in scene a technique is measured on: the scene made to show it (`auto`: `mixed`,
+/// where every technique meets in one frame).
 pub fn scene_for(technique: Technique) -> Result<String> {
-    let candidates: Vec<&str> = crate::scene::BUILTIN_SCENES
-        .iter()
-        .map(|(n, _)| *n)
-        .filter(|n| *n != "scaling")
-        .collect();
-    let mut scenes = Vec::new();
-    for name in &candidates {
-        let scene = crate::bake::scene::load_scene_baked(name)?;
-        let made_for = match (&scene.technique, technique) {
-            (None, Technique::None) => true,
-            (Some(t), _) => t == technique.name(),
-            _ => false,
-        };
-        if made_for {
-            return Ok(name.to_string());
-        }
-        scenes.push((name, scene));
+    Ok(match technique {
+        Technique::Auto => "mixed",
+        Technique::None => "smoke",
+        Technique::Translucency => "cubes",
+        Technique::Control => "skin",
+        Technique::Lcb | Technique::Lbb => "teapot",
     }
-    let dump = |scene: &crate::scene::Scene, technique| -> Result<String> {
-        let settings = FrameSettings {
-            technique,
-            ..FrameSettings::new(64, 48)
-        };
-        Ok(plan_frame(&settings, &FrameFeatures::new(scene, &settings)?)?.dump())
-    };
-    for (name, scene) in &scenes {
-        if dump(scene, technique)? != dump(scene, Technique::None)? {
-            return Ok(name.to_string());
-        }
-    }
-    Ok("smoke".into())
+    .to_string())
 }
 
 /// Runs the suite and writes `report.md` (and the plots) under `dir`. Prints one progress line

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::sss::SssPrecision;
-use crate::frame::{render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{render_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::measure::stats::Stats;
 use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
 use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
@@ -178,8 +178,10 @@ pub fn run(
     let gbuffer = frame
         .gbuffer
         .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
-    let (profile, _) = FrameFeatures::new(&edges, &reference_frame)?
+    // The edges scene has one profile (its skin): the reference convolves with it.
+    let (profile, _) = FrameDesc::new(&edges, &reference_frame)?
         .sss
+        .and_then(|s| s.profiles.into_iter().next())
         .ok_or_else(|| LucentError::InvalidInput("the edges scene has no SSS profile".into()))?;
     // Specular is off on the SSS objects: both specular models add nothing there.
     let reference = reference_image(&edges, &gbuffer, &profile, ReferenceSpecular::Lean);

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::deferred::GBufferPrecision;
-use crate::frame::{render_frame, FrameFeatures, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{render_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::graph::CompileOptions;
 use crate::images::compare::flip_rgba8;
 use crate::measure::stats::Stats;
@@ -83,6 +83,7 @@ fn settings(opts: &ReportOptions, technique: Technique) -> FrameSettings {
         compile: CompileOptions {
             merge: false,
             alias: true,
+            ..CompileOptions::default()
         },
         ..FrameSettings::new(opts.width, opts.height)
     }
@@ -279,7 +280,7 @@ fn image_error(
         gbuffer: GBufferPrecision::Full,
         ..settings(opts, Technique::Translucency)
     };
-    let features = FrameFeatures::new(&exact, &settings)?;
+    let features = FrameDesc::new(&exact, &settings)?;
     let gbuffer = render_frame(gpu, shaders, pipeline_cache, &exact, settings)?
         .gbuffer
         .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
@@ -290,7 +291,7 @@ fn image_error(
             translucency: features
                 .translucency
                 .as_ref()
-                .map(|(t, p)| (t.rows.as_slice(), *p)),
+                .map(|t| (t.table.rows.as_slice(), t.packing)),
         },
     );
     let (mut max_abs, mut sum, mut peak) = (0.0f64, 0.0f64, 0.0f64);

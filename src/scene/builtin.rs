@@ -1,5 +1,6 @@
 //! The built-in scenes, by name. Each renders with no file from outside the repository: meshes
-//! are generated, textures are procedural, thickness is baked at load (and cached).
+//! are generated and textures procedural; thickness asked to be baked is baked by whoever loads
+//! the scene ([`crate::bake::scene::prepare_thickness`], cached).
 
 use glam::{Mat4, Vec3};
 
@@ -27,6 +28,10 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     ("teapot", "the Utah teapot in normal-mapped marble (SSS profile)"),
     ("skin", "spheres with d'Eon's six-Gaussian skin profile"),
+    (
+        "mixed",
+        "every technique in one frame: a translucent cube, a skin sphere, a marble sphere, a thin skin disc with both translucency and SSS, a floor",
+    ),
     (
         "edges",
         "SSS edge quality: a skin sphere before a bright wall, a thin skin slab before a dark pillar",
@@ -69,6 +74,7 @@ pub fn builtin(name: &str) -> Result<Scene> {
         }
         "teapot" => teapot(),
         "skin" => skin(),
+        "mixed" => mixed(),
         "edges" => edges(),
         "layered" => layered(),
         "dynamic" => dynamic(),
@@ -101,10 +107,9 @@ fn floor() -> (Mesh, Material) {
     )
 }
 
-fn base_scene(name: &str, technique: Option<&str>, camera: Camera) -> Scene {
+fn base_scene(name: &str, camera: Camera) -> Scene {
     Scene {
         name: name.to_string(),
-        technique: technique.map(str::to_string),
         meshes: Vec::new(),
         objects: Vec::new(),
         lights: Vec::new(),
@@ -154,7 +159,6 @@ impl Scene {
 fn smoke() -> Scene {
     let mut s = base_scene(
         "smoke",
-        None,
         camera(Vec3::new(0.0, 2.2, 5.0), Vec3::new(0.0, 0.8, 0.0)),
     );
     let sphere = s.add_mesh(Mesh::generate(Shape::Sphere { radius: 1.0 }, 96, 48));
@@ -198,7 +202,6 @@ fn translucent(name: &str, albedo: Vec3, thickness: ThicknessSource, color: Vec3
 fn cubes() -> Result<Scene> {
     let mut s = base_scene(
         "cubes",
-        Some("translucency"),
         camera(Vec3::new(0.0, 2.5, 7.5), Vec3::new(0.0, 0.9, 0.0)),
     );
     s.add_floor();
@@ -261,11 +264,7 @@ fn cubes() -> Result<Scene> {
 /// its translucency G-buffer target and material-ID test while no pixel is translucent, which is
 /// what the "0% of the screen" measurement needs.
 fn grid125(percent: u32) -> Result<Scene> {
-    let mut s = base_scene(
-        "grid125",
-        Some("translucency"),
-        camera(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO),
-    );
+    let mut s = base_scene("grid125", camera(Vec3::new(0.0, 0.0, 9.0), Vec3::ZERO));
     s.sky = Vec3::new(0.02, 0.02, 0.03);
     let cube = s.add_mesh(generators::generate(Generator::Cube, 1)?);
     let mut material = translucent(
@@ -329,7 +328,6 @@ fn marble_normal() -> TextureSource {
 fn teapot() -> Result<Scene> {
     let mut s = base_scene(
         "teapot",
-        Some("lbb"),
         camera(Vec3::new(0.0, 1.6, 3.6), Vec3::new(0.0, 0.6, 0.0)),
     );
     s.add_floor();
@@ -353,7 +351,6 @@ fn teapot() -> Result<Scene> {
 fn edges() -> Result<Scene> {
     let mut s = base_scene(
         "edges",
-        Some("control"),
         camera(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 0.9, 0.0)),
     );
     s.sky = Vec3::new(0.05, 0.05, 0.06);
@@ -411,10 +408,111 @@ fn edges() -> Result<Scene> {
     Ok(s)
 }
 
+/// Every technique in one frame, each object asking for its own: a translucent cube (GDC
+/// 2011, baked thickness), a skin sphere (d'Eon's profile), a marble sphere (the marble
+/// profile; both with the default blur, each pixel with its own profile), a thin disc of skin
+/// that is both translucent and scattering (the light behind it shines through, and the
+/// diffusion blurs it), and a floor that is neither. The profiles are at 5x physical scale
+/// (0.05 units per mm on spheres 0.5 units across), so each blur spans many pixels and the
+/// two profiles' colours are told apart; a key light from the side, a warm back light.
+fn mixed() -> Result<Scene> {
+    let mut s = base_scene(
+        "mixed",
+        camera(Vec3::new(0.0, 1.3, 5.0), Vec3::new(0.0, 0.55, 0.0)),
+    );
+    s.add_floor();
+    let cube = s.add_mesh(generators::generate(Generator::Cube, 6)?);
+    let sphere = s.add_mesh(generators::generate(Generator::Icosphere, 4)?);
+    // A disc: the unit sphere flattened to a fifth along z in its own mesh, so the baked
+    // thickness sees the thin shape.
+    let mut disc = generators::generate(Generator::Icosphere, 4)?;
+    for p in &mut disc.positions {
+        p.z *= 0.2;
+    }
+    disc.normals = super::normals::angle_weighted_normals(&disc.positions, &disc.indices);
+    disc.shape = None;
+    let disc = s.add_mesh(disc);
+    let cube_material = translucent(
+        "translucent-jade",
+        Vec3::new(0.55, 0.8, 0.6),
+        ThicknessSource::Bake,
+        Vec3::new(0.6, 1.0, 0.7),
+    );
+    s.add(
+        cube,
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.45),
+            glam::Quat::from_rotation_y(0.5),
+            Vec3::new(-1.85, 0.45, -0.2),
+        ),
+        cube_material,
+    );
+    let mut skin = Material::opaque("skin", Vec3::new(0.85, 0.62, 0.52), 0.3, 0.5);
+    let mut skin_profile = SssProfile::preset("skin")?;
+    skin_profile.units_per_mm = 0.05;
+    skin.sss = Some(skin_profile.clone());
+    s.add(
+        sphere,
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.55),
+            glam::Quat::IDENTITY,
+            Vec3::new(-0.62, 0.55, 0.0),
+        ),
+        skin,
+    );
+    let mut marble = Material::opaque("marble", Vec3::new(0.86, 0.83, 0.78), 0.4, 0.3);
+    let mut marble_profile = SssProfile::preset("marble")?;
+    marble_profile.units_per_mm = 0.05;
+    marble.sss = Some(marble_profile);
+    s.add(
+        sphere,
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(0.55),
+            glam::Quat::IDENTITY,
+            Vec3::new(0.62, 0.55, 0.0),
+        ),
+        marble,
+    );
+    let mut ear = translucent(
+        "ear",
+        Vec3::new(0.85, 0.6, 0.5),
+        ThicknessSource::Bake,
+        Vec3::new(1.0, 0.35, 0.25),
+    );
+    ear.sss = Some(skin_profile);
+    s.add(
+        disc,
+        Mat4::from_scale_rotation_translation(
+            Vec3::new(0.5, 0.65, 0.5),
+            glam::Quat::from_rotation_y(-0.35),
+            Vec3::new(1.82, 0.7, -0.1),
+        ),
+        ear,
+    );
+    s.lights = vec![
+        // Key light from the side: the terminators where the profiles show their colour.
+        Light::point(
+            Vec3::new(-3.5, 2.2, 1.8),
+            Vec3::new(1.0, 0.96, 0.9),
+            30.0,
+            15.0,
+        ),
+        // Warm back light behind the cube and the disc: light through the thin parts.
+        Light::point(
+            Vec3::new(1.2, 1.4, -2.6),
+            Vec3::new(1.0, 0.75, 0.5),
+            16.0,
+            10.0,
+        ),
+        // A cool fill from the front.
+        Light::directional(Vec3::new(0.2, -0.5, -1.0), Vec3::new(0.55, 0.65, 0.8), 0.35),
+    ];
+    Ok(s)
+}
+
 fn skin() -> Result<Scene> {
     let mut s = base_scene(
         "skin",
-        Some("control"),
         camera(Vec3::new(0.0, 1.2, 5.0), Vec3::new(0.0, 0.8, 0.0)),
     );
     s.add_floor();
@@ -460,7 +558,6 @@ fn skin() -> Result<Scene> {
 fn layered() -> Result<Scene> {
     let mut s = base_scene(
         "layered",
-        Some("layered"),
         camera(Vec3::new(0.0, 1.5, 6.5), Vec3::new(0.0, 0.6, 0.0)),
     );
     s.add_floor();
@@ -503,7 +600,6 @@ fn layered() -> Result<Scene> {
 fn dynamic() -> Result<Scene> {
     let mut s = base_scene(
         "dynamic",
-        Some("layered"),
         camera(Vec3::new(0.0, 2.0, 4.5), Vec3::new(0.0, 0.8, 0.0)),
     );
     s.add_floor();
@@ -540,7 +636,6 @@ fn dynamic() -> Result<Scene> {
 fn scaling(triangles: u64) -> Result<Scene> {
     let mut s = base_scene(
         "scaling",
-        Some("layered"),
         camera(Vec3::new(0.0, 1.6, 3.6), Vec3::new(0.0, 0.6, 0.0)),
     );
     let (mesh, _) = generators::generate_with_triangles(Generator::Teapot, triangles)?;

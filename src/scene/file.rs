@@ -26,7 +26,8 @@ const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
 #[serde(deny_unknown_fields)]
 struct SceneToml {
     name: Option<String>,
-    technique: Option<String>,
+    /// Gone: the materials decide the frame. Kept only to explain that.
+    technique: Option<toml::Value>,
     ambient: Option<[f32; 3]>,
     sky: Option<[f32; 3]>,
     exposure: Option<f32>,
@@ -87,6 +88,7 @@ struct SssToml {
     /// Rows of `[variance_mm2, r, g, b]`.
     gaussians: Option<Vec<[f32; 4]>>,
     units_per_mm: Option<f32>,
+    blur: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -441,6 +443,16 @@ fn toml_error(path: &Path, source: &str, error: &toml::de::Error) -> LucentError
 pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
     let raw: SceneToml = toml::from_str(source).map_err(|e| toml_error(path, source, &e))?;
     let at = Locator { path, source };
+    if raw.technique.is_some() {
+        return Err(at.error(
+            "",
+            None,
+            "technique",
+            "the scene-level `technique` key is gone: each material's parts decide what the \
+             frame shades (translucency, [material.sss] with its `blur`); remove the key, and \
+             use `--technique` on the command line for A/B comparisons",
+        ));
+    }
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolve = |p: &Path| {
         if p.is_absolute() {
@@ -520,8 +532,10 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
         log::warn!("{}", at.error("camera", None, "near", warning));
     }
 
-    // Meshes.
+    // Meshes. An OBJ whose faces use MTL materials with a colour or texture becomes one part
+    // per material (each drawn with its `Kd` and `map_Kd`); every other mesh is one part.
     let mut meshes = Vec::new();
+    let mut mesh_parts: Vec<Vec<(usize, Option<super::obj::ObjMaterial>)>> = Vec::new();
     let mut mesh_index: HashMap<&str, usize> = HashMap::new();
     for (i, m) in raw.mesh.iter().enumerate() {
         if mesh_index.insert(m.name.as_str(), i).is_some() {
@@ -543,7 +557,14 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
                         format!("mesh file {} not found", obj_path.display()),
                     ));
                 }
-                super::obj::load_obj(&obj_path)?.mesh
+                let loaded = super::obj::load_obj(&obj_path)?;
+                let mut parts = Vec::new();
+                for (part, material) in loaded.parts() {
+                    meshes.push(part);
+                    parts.push((meshes.len() - 1, material.cloned()));
+                }
+                mesh_parts.push(parts);
+                continue;
             }
             (None, Some(name)) => {
                 let generator = Generator::parse(name)
@@ -579,6 +600,7 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
             }
         };
         meshes.push(mesh);
+        mesh_parts.push(vec![(meshes.len() - 1, None)]);
     }
 
     // Materials.
@@ -598,7 +620,7 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
     // Objects.
     let mut objects = Vec::new();
     for (i, o) in raw.object.iter().enumerate() {
-        let mesh = *mesh_index.get(o.mesh.as_str()).ok_or_else(|| {
+        let mesh_entry = *mesh_index.get(o.mesh.as_str()).ok_or_else(|| {
             at.error(
                 "object",
                 Some(i),
@@ -656,11 +678,22 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
             rotation,
             Vec3::from(o.translate.unwrap_or_default()),
         );
-        objects.push(Object {
-            mesh,
-            transform,
-            material,
-        });
+        let explicit_albedo = raw
+            .material
+            .iter()
+            .find(|m| m.name == o.material)
+            .is_some_and(|m| m.albedo.is_some());
+        for (mesh, obj_material) in &mesh_parts[mesh_entry] {
+            let material = match obj_material {
+                Some(m) => with_mtl(&material, m, explicit_albedo),
+                None => material.clone(),
+            };
+            objects.push(Object {
+                mesh: *mesh,
+                transform,
+                material,
+            });
+        }
     }
     if objects.is_empty() {
         return Err(LucentError::file(
@@ -809,7 +842,6 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
     });
     Ok(Scene {
         name,
-        technique: raw.technique.clone(),
         meshes,
         objects,
         lights,
@@ -825,6 +857,31 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
         exposure,
         deformation,
     })
+}
+
+/// `material` on the faces of an OBJ part whose MTL material is `mtl`: the MTL's `map_Kd`
+/// becomes the albedo texture unless the scene's material has one, and its `Kd` the albedo
+/// unless the scene's material sets `albedo` (clamped to [0, 1], which is all a reflectance
+/// can be).
+fn with_mtl(material: &Material, mtl: &super::obj::ObjMaterial, explicit_albedo: bool) -> Material {
+    let mut m = material.clone();
+    m.name = format!("{} ({})", material.name, mtl.name);
+    if m.albedo_texture.is_none() {
+        if let Some(t) = &mtl.diffuse_texture {
+            m.albedo_texture = Some(TextureSource::File(t.clone()));
+        }
+    }
+    if let (false, Some(kd)) = (explicit_albedo, mtl.diffuse) {
+        let clamped = kd.clamp(Vec3::ZERO, Vec3::ONE);
+        if clamped != kd {
+            log::warn!(
+                "MTL material '{}': Kd {kd} clamped to {clamped} (a reflectance is in [0, 1])",
+                mtl.name
+            );
+        }
+        m.albedo = clamped;
+    }
+    m
 }
 
 fn build_material(
@@ -908,6 +965,7 @@ fn build_material(
                     })
                     .collect(),
                 units_per_mm: 0.01,
+                blur: None,
             },
             _ => {
                 return Err(at.error(
@@ -932,6 +990,12 @@ fn build_material(
                 ));
             }
             profile.units_per_mm = u;
+        }
+        if let Some(b) = &s.blur {
+            profile.blur = Some(
+                crate::scene::material::SssBlur::parse(b)
+                    .map_err(|e| at.error("material", Some(i), "blur", e))?,
+            );
         }
         profile.validate().map_err(|e| {
             at.error(

@@ -97,15 +97,13 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let scene = load_scene_file(path)?;
             let triangles: usize = scene.meshes.iter().map(|m| m.triangle_count()).sum();
             let _ = writeln!(s, "{}: scene '{}'", path.display(), scene.name);
-            if let Some(t) = &scene.technique {
-                let _ = writeln!(s, "  technique: {t}");
-            }
             let _ = writeln!(
                 s,
                 "  meshes: {} ({triangles} triangles)",
                 scene.meshes.len()
             );
             let _ = writeln!(s, "  objects: {}", scene.objects.len());
+            write_scene_materials(&mut s, &scene);
             let _ = writeln!(s, "  lights: {}", scene.lights.len());
             let _ = writeln!(
                 s,
@@ -129,6 +127,58 @@ pub fn inspect_file(path: &Path) -> Result<String> {
         }
     }
     Ok(s)
+}
+
+/// Appends one line per material the scene's objects use, with the parts that decide what a
+/// frame of the scene shades under `--technique auto`.
+fn write_scene_materials(s: &mut String, scene: &super::Scene) {
+    let mut seen: Vec<&str> = Vec::new();
+    for o in &scene.objects {
+        let m = &o.material;
+        if seen.contains(&m.name.as_str()) {
+            continue;
+        }
+        seen.push(&m.name);
+        let mut parts: Vec<String> = Vec::new();
+        if let Some(t) = &m.albedo_texture {
+            parts.push(format!("albedo texture {}", texture_name(t)));
+        }
+        if let Some(t) = &m.normal_texture {
+            parts.push(format!("normal map {}", texture_name(t)));
+        }
+        if m.translucency.is_some() {
+            parts.push("translucency".into());
+        }
+        if let Some(p) = &m.sss {
+            parts.push(format!(
+                "SSS profile {} ({} Gaussians, {} units/mm, blur {})",
+                p.name,
+                p.gaussians.len(),
+                p.units_per_mm,
+                p.blur_or_default().name()
+            ));
+        }
+        if let Some(l) = &m.layers {
+            parts.push(format!(
+                "layered {} ({} layers; not rendered yet)",
+                l.name,
+                l.layers.len()
+            ));
+        }
+        let parts = if parts.is_empty() {
+            "opaque".to_string()
+        } else {
+            parts.join(", ")
+        };
+        let _ = writeln!(s, "  material {}: {parts}", m.name);
+    }
+}
+
+fn texture_name(t: &super::material::TextureSource) -> String {
+    match t {
+        super::material::TextureSource::File(p) => p.display().to_string(),
+        super::material::TextureSource::Procedural(p) => format!("{p:?}"),
+    }
 }
 
 /// Appends one line per material.

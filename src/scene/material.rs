@@ -95,6 +95,17 @@ impl Translucency {
         }
     }
 
+    /// The constant part of the thickness, multiplied in the G-buffer pass with the mesh's
+    /// thickness stream (its vertex colours, or white): the tint times the constant thickness
+    /// (1 for per-vertex, baked or texture thickness, which live in the stream).
+    pub fn thickness_factor(&self) -> Vec3 {
+        let constant = match self.thickness {
+            ThicknessSource::Constant(c) => c,
+            _ => 1.0,
+        };
+        self.color * constant
+    }
+
     /// Whether the thickness is coloured (not the same in every channel).
     pub fn is_colored(&self) -> bool {
         self.color.x != self.color.y || self.color.y != self.color.z
@@ -119,6 +130,71 @@ pub struct SssProfile {
     pub gaussians: Vec<Gaussian>,
     /// World units per millimetre of the profile (scene scale).
     pub units_per_mm: f32,
+    /// The screen-space blur the material asks for (`[material.sss] blur`); `None`: the
+    /// project's default, [`SssBlur::DEFAULT`].
+    pub blur: Option<SssBlur>,
+}
+
+/// The screen-space blurs a material's profile can be diffused with. Each pixel is blurred by
+/// its own material's blur and profile; a frame runs one chain of passes per blur its
+/// materials use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SssBlur {
+    /// Jimenez's separable sum-of-Gaussians blur of the lit diffuse light (the LEAN-mapping
+    /// thesis's control, C).
+    Control,
+    /// The thesis's LEAN pipeline with Jimenez's blur (LCB).
+    LeanControl,
+    /// The thesis's LEAN pipeline with the separable bilateral blur (LBB).
+    LeanBilateral,
+}
+
+impl SssBlur {
+    /// Every blur with its name (scene files, `--technique`), in chain order.
+    pub const ALL: &'static [(&'static str, SssBlur)] = &[
+        ("control", SssBlur::Control),
+        ("lcb", SssBlur::LeanControl),
+        ("lbb", SssBlur::LeanBilateral),
+    ];
+
+    /// The blur of materials that name none: the one measured best for its error at its cost,
+    /// artefacts included. docs/sss.md: LBB's mean error against the brute-force reference is
+    /// lower (7.2e-3 against the control's 1.08e-2) for 1.06-1.11x the control's time, but its
+    /// LEAN specular draws fireflies at silhouettes (HDR maximum 156.8 on `edges` against
+    /// 5.97 without SSS) and dot grids and streaks on smooth shapes, which the control never
+    /// does; the control is also the cheapest. Until the LEAN lobe is bounded, the control.
+    pub const DEFAULT: SssBlur = SssBlur::Control;
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, b)| *b == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    /// Parses a name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, b)| b)
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "unknown SSS blur '{name}'; use control, lcb or lbb"
+                ))
+            })
+    }
+
+    /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
+    pub fn lean(self) -> bool {
+        self != SssBlur::Control
+    }
+
+    /// Whether taps are weighted by a depth-difference Gaussian (else lerped back by depth).
+    pub fn bilateral(self) -> bool {
+        self == SssBlur::LeanBilateral
+    }
 }
 
 /// d'Eon's six-Gaussian fit of human skin (the thesis, Figure 17): (variance mm², R, G, B).
@@ -167,7 +243,13 @@ impl SssProfile {
                 })
                 .collect(),
             units_per_mm: 0.01,
+            blur: None,
         })
+    }
+
+    /// The blur this profile is diffused with: its own, or the default.
+    pub fn blur_or_default(&self) -> SssBlur {
+        self.blur.unwrap_or(SssBlur::DEFAULT)
     }
 
     /// Checks the profile can be blurred safely: 1 to 8 Gaussians, finite positive variances,

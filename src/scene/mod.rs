@@ -78,8 +78,6 @@ pub struct Object {
 pub struct Scene {
     /// Name (built-in scene name or file stem).
     pub name: String,
-    /// The technique the scene is made to show (`None`: plain deferred lighting).
-    pub technique: Option<String>,
     /// Meshes, shared by objects.
     pub meshes: Vec<Mesh>,
     /// Instances.

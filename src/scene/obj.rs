@@ -16,7 +16,7 @@
 //! | texture coordinates on some face corners but not others | error naming the line |
 //! | `Ka`/`Kd`/`Ks`/`Ke` with fewer than 3 numbers (tobj panics), other bad MTL values | error naming the MTL and its line |
 //! | missing MTL file | error naming both files |
-//! | texture named by an MTL that is not there | **note** in [`LoadedObj::repairs`] (MTL textures are not rendered); `\` separators are tried as `/` first |
+//! | texture named by an MTL that is not there | **note** in [`LoadedObj::repairs`]: the material is drawn without it, the mesh still loads; `\` separators are tried as `/` first |
 //! | degenerate triangles (zero area or a repeated vertex) | **repair**: dropped, counted in [`LoadedObj::repairs`]; error if all are |
 //! | normals on some corners but not others, zero-length normals | **repair**: generated instead, recorded |
 //! | polylines (`l`) | **repair**: ignored (they are not surfaces), recorded |
@@ -74,6 +74,9 @@ pub struct LoadedObj {
     pub mesh: Mesh,
     /// Materials of every MTL file the OBJ names, in file order.
     pub materials: Vec<ObjMaterial>,
+    /// Per triangle of `mesh`: the index into `materials` of the material its face was given
+    /// with `usemtl`, or `None`.
+    pub triangle_materials: Vec<Option<usize>>,
     /// One human-readable line per repair applied (e.g. "dropped 3 degenerate triangles ...").
     pub repairs: Vec<String>,
 }
@@ -172,7 +175,8 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
     };
 
     repairs.append(&mut mtl_notes.into_inner());
-    let (mut mesh, partial_normals) = merge_models(&models).map_err(fail)?;
+    let (mut mesh, mut triangle_materials, partial_normals) =
+        merge_models(&models).map_err(fail)?;
     if partial_normals {
         repairs.push(
             "normals were on some face corners but not others: ignored them and generated all"
@@ -180,7 +184,7 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
         );
         mesh.normals.clear();
     }
-    drop_degenerate_triangles(&mut mesh, &mut repairs).map_err(fail)?;
+    drop_degenerate_triangles(&mut mesh, &mut triangle_materials, &mut repairs).map_err(fail)?;
     finish_normals(&mut mesh, &mut repairs);
     if !mesh.uvs.is_empty() {
         mesh.tangents = generate_tangents(&mesh.positions, &mesh.normals, &mesh.uvs, &mesh.indices);
@@ -189,16 +193,23 @@ pub fn load_obj(path: &Path) -> Result<LoadedObj> {
     for r in &repairs {
         log::warn!("{}: {r}", path.display());
     }
+    let materials = materials.into_inner();
+    // A material index past the libraries read names nothing (tobj keeps usemtl names it
+    // could not resolve as no material).
+    for m in &mut triangle_materials {
+        *m = m.filter(|&i| i < materials.len());
+    }
     Ok(LoadedObj {
         mesh,
-        materials: materials.into_inner(),
+        materials,
+        triangle_materials,
         repairs,
     })
 }
 
 /// Loads one MTL file on its own, with the same checks [`load_obj`] applies to the MTL files an
 /// OBJ names (numbers, finiteness): its materials and one note per texture it names that is
-/// not there (not an error: lucent does not render MTL textures).
+/// not there (not an error: the material is drawn without it).
 pub fn load_mtl(path: &Path) -> Result<(Vec<ObjMaterial>, Vec<String>)> {
     load_mtl_file(path)
         .map(|(_, materials, notes)| (materials, notes))
@@ -793,8 +804,8 @@ fn resolve_texture(dir: &Path, name: &str) -> Option<PathBuf> {
 }
 
 /// Checks every line of an MTL file for what tobj would panic on or pass silently. Textures it
-/// names that are not there are notes, not errors (lucent does not render MTL textures; a
-/// missing one must not fail the mesh's load): one per missing texture, naming its line.
+/// names that are not there are notes, not errors (a missing texture must not fail the mesh's
+/// load; its material is drawn without it): one per missing texture, naming its line.
 fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<Vec<String>, String> {
     let mut notes = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -846,7 +857,7 @@ fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<Vec<String>, String> 
                     if resolve_texture(dir, name).is_none() {
                         notes.push(format!(
                             "line {ln}: texture '{name}' ({key}) not found (looked for {}): \
-                             ignored, lucent does not render MTL textures",
+                             ignored, the material is drawn without it",
                             dir.join(name).display()
                         ));
                     }
@@ -954,8 +965,14 @@ fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
 /// Concatenates tobj's models into one mesh (UVs flipped to image space), checking that every
 /// attribute array has the length tobj promises. The flag is true when the file has normals on
 /// some face corners but not all (the mesh's normals are then incomplete).
-fn merge_models(models: &[tobj::Model]) -> std::result::Result<(Mesh, bool), String> {
+/// Merges the parser's models into one mesh; returns it with each triangle's material index and
+/// whether normals were only on some face corners.
+#[allow(clippy::type_complexity)]
+fn merge_models(
+    models: &[tobj::Model],
+) -> std::result::Result<(Mesh, Vec<Option<usize>>, bool), String> {
     let mut mesh = Mesh::default();
+    let mut triangle_materials = Vec::new();
     let (mut uv_models, mut plain_models) = (0, 0);
     let (mut any_normals, mut normals_complete) = (false, true);
     for model in models {
@@ -1034,6 +1051,7 @@ fn merge_models(models: &[tobj::Model]) -> std::result::Result<(Mesh, bool), Str
             }
             mesh.indices.push((base + i as usize) as u32);
         }
+        triangle_materials.extend(std::iter::repeat_n(m.material_id, m.indices.len() / 3));
     }
     if uv_models > 0 && plain_models > 0 {
         return Err(
@@ -1048,18 +1066,20 @@ fn merge_models(models: &[tobj::Model]) -> std::result::Result<(Mesh, bool), Str
     if !normals_complete {
         mesh.normals.clear();
     }
-    Ok((mesh, any_normals && !normals_complete))
+    Ok((mesh, triangle_materials, any_normals && !normals_complete))
 }
 
 /// Drops triangles with a repeated vertex or zero area; errors when none is left.
 fn drop_degenerate_triangles(
     mesh: &mut Mesh,
+    triangle_materials: &mut Vec<Option<usize>>,
     repairs: &mut Vec<String>,
 ) -> std::result::Result<(), String> {
     let total = mesh.triangle_count();
     let positions = &mesh.positions;
     let mut kept = Vec::with_capacity(mesh.indices.len());
-    for t in mesh.indices.chunks_exact(3) {
+    let mut kept_materials = Vec::with_capacity(triangle_materials.len());
+    for (i, t) in mesh.indices.chunks_exact(3).enumerate() {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
             continue;
         }
@@ -1069,7 +1089,9 @@ fn drop_degenerate_triangles(
             continue;
         }
         kept.extend_from_slice(t);
+        kept_materials.push(triangle_materials.get(i).copied().flatten());
     }
+    *triangle_materials = kept_materials;
     let dropped = total - kept.len() / 3;
     if kept.is_empty() {
         return Err(format!(
@@ -1109,6 +1131,71 @@ fn finish_normals(mesh: &mut Mesh, repairs: &mut Vec<String>) {
             "replaced {replaced} zero-length normals with generated ones"
         ));
     }
+}
+
+impl LoadedObj {
+    /// The mesh split by the materials its faces use, for rendering each with its MTL
+    /// material's colour and texture: one part per distinct material among the faces that name
+    /// one with a `Kd` or `map_Kd`, each a compact mesh of its triangles, plus one part (with
+    /// no material) for the rest. A file whose faces name no such material is one part.
+    pub fn parts(&self) -> Vec<(Mesh, Option<&ObjMaterial>)> {
+        let shading = |m: &Option<usize>| {
+            m.and_then(|i| self.materials.get(i))
+                .filter(|m| m.diffuse.is_some() || m.diffuse_texture.is_some())
+        };
+        let mut keys: Vec<Option<usize>> = Vec::new();
+        for m in &self.triangle_materials {
+            let key = shading(m).and(*m);
+            if !keys.contains(&key) {
+                keys.push(key);
+            }
+        }
+        if keys.len() <= 1 && keys.first().is_none_or(|k| k.is_none()) {
+            return vec![(self.mesh.clone(), None)];
+        }
+        keys.iter()
+            .map(|&key| {
+                let triangles: Vec<usize> = (0..self.mesh.triangle_count())
+                    .filter(|&t| {
+                        shading(self.triangle_materials.get(t).unwrap_or(&None))
+                            .and(self.triangle_materials[t])
+                            == key
+                    })
+                    .collect();
+                (
+                    sub_mesh(&self.mesh, &triangles),
+                    key.and_then(|i| self.materials.get(i)),
+                )
+            })
+            .collect()
+    }
+}
+
+/// The triangles `triangles` of `mesh` as a mesh of their own (vertices renumbered, every
+/// per-vertex stream kept).
+fn sub_mesh(mesh: &Mesh, triangles: &[usize]) -> Mesh {
+    let mut remap = vec![u32::MAX; mesh.positions.len()];
+    let mut out = Mesh::default();
+    fn copy<T: Copy>(src: &[T], dst: &mut Vec<T>, v: usize) {
+        if let Some(x) = src.get(v) {
+            dst.push(*x);
+        }
+    }
+    for &t in triangles {
+        for k in 0..3 {
+            let v = mesh.indices[t * 3 + k] as usize;
+            if remap[v] == u32::MAX {
+                remap[v] = out.positions.len() as u32;
+                out.positions.push(mesh.positions[v]);
+                copy(&mesh.normals, &mut out.normals, v);
+                copy(&mesh.uvs, &mut out.uvs, v);
+                copy(&mesh.tangents, &mut out.tangents, v);
+                copy(&mesh.colors, &mut out.colors, v);
+            }
+            out.indices.push(remap[v]);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -1379,7 +1466,7 @@ mod tests {
         );
         let e = obj("missing.mtl").unwrap_err().to_string();
         assert!(e.contains("missing.mtl") && e.contains("not found"), "{e}");
-        // A texture that is not there is a note, not an error: MTL textures are not rendered.
+        // A texture that is not there is a note, not an error: drawn without it.
         let o = obj("tex.mtl").unwrap();
         assert_eq!(o.materials[0].diffuse_texture, None);
         assert!(

@@ -159,6 +159,7 @@ pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 
             })
             .collect(),
         units_per_mm: profile.units_per_mm,
+        blur: profile.blur,
     };
     Ok((refit, errors))
 }

@@ -281,36 +281,45 @@ pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-/// The image files `scene` uploads as textures (its materials' normal maps), each once, with
-/// the size its header declares, checked before anything is decoded: [`check_texture_size`],
-/// and with `max_dimension` (the device's `maxImageDimension2D`) that neither side is larger.
-/// Reads only the headers, so a scene with a texture too large is refused in milliseconds.
+/// The image files `scene` uploads as textures (its materials' normal and albedo maps), each
+/// once, with the size its header declares and whether it is a normal map, checked before
+/// anything is decoded: [`check_texture_size`], and with `max_dimension` (the device's
+/// `maxImageDimension2D`) that neither side is larger. Reads only the headers, so a scene with
+/// a texture too large is refused in milliseconds.
 pub fn scene_texture_sizes(
     scene: &super::Scene,
     max_dimension: Option<u32>,
-) -> Result<Vec<(std::path::PathBuf, u32, u32)>> {
-    let mut sizes: Vec<(std::path::PathBuf, u32, u32)> = Vec::new();
+) -> Result<Vec<(std::path::PathBuf, u32, u32, bool)>> {
+    let mut sizes: Vec<(std::path::PathBuf, u32, u32, bool)> = Vec::new();
     for object in &scene.objects {
-        let Some(super::material::TextureSource::File(path)) = &object.material.normal_texture
-        else {
-            continue;
-        };
-        if sizes.iter().any(|(p, _, _)| p == path) {
-            continue;
+        let m = &object.material;
+        let maps = [(&m.normal_texture, true), (&m.albedo_texture, false)];
+        for (source, normal) in maps {
+            let Some(super::material::TextureSource::File(path)) = source else {
+                continue;
+            };
+            if sizes.iter().any(|(p, _, _, n)| p == path && *n == normal) {
+                continue;
+            }
+            let (width, height) = texture_dimensions(path)?;
+            check_texture_size(path, width, height)?;
+            if let Some(limit) = max_dimension.filter(|&l| width > l || height > l) {
+                return Err(LucentError::file(
+                    path,
+                    format!(
+                        "{} of material '{}' is {width}x{height}, larger than this device \
+                         supports ({limit} per side, maxImageDimension2D); scale it down",
+                        if normal {
+                            "normal map"
+                        } else {
+                            "albedo texture"
+                        },
+                        m.name
+                    ),
+                ));
+            }
+            sizes.push((path.clone(), width, height, normal));
         }
-        let (width, height) = texture_dimensions(path)?;
-        check_texture_size(path, width, height)?;
-        if let Some(limit) = max_dimension.filter(|&l| width > l || height > l) {
-            return Err(LucentError::file(
-                path,
-                format!(
-                    "normal map of material '{}' is {width}x{height}, larger than this device \
-                     supports ({limit} per side, maxImageDimension2D); scale it down",
-                    object.material.name
-                ),
-            ));
-        }
-        sizes.push((path.clone(), width, height));
     }
     Ok(sizes)
 }

@@ -1,0 +1,36 @@
+// Screen-space SSS: the profile table (src/features/sss.rs `ProfileTableGpu`, std140) and the
+// per-pixel profile ID the G-buffer pass writes (R8: ID / 255, 0 = does not scatter).
+// Binding 1 of every SSS pass (binding 0 is the frame uniforms); a region of the per-frame
+// buffer, so a frame in flight reads its own copy.
+#ifndef LUCENT_SSS_GLSL
+#define LUCENT_SSS_GLSL
+
+#define MAX_SSS_PROFILES 32
+#define MAX_SSS_STEPS 8
+
+struct SssStep {
+    vec4 blur;    // x: sigma this step adds, world units; y: depth term (control: depth
+                  // correction; bilateral: sensitivity per world unit of depth difference)
+    vec4 weight;  // rgb: the completed Gaussian's weight in the sum; a: their mean
+};
+
+layout(std140, set = 0, binding = 1) uniform SssProfiles {
+    vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count
+    SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
+} sss_profiles;
+
+// The profile ID stored at a texel (exact for UNORM8: rounding recovers the integer).
+int sss_profile_id(float stored) {
+    return clamp(int(stored * 255.0 + 0.5), 0, MAX_SSS_PROFILES - 1);
+}
+
+// Whether profile `id` is blurred by chain `chain` (0 never is).
+bool sss_in_chain(int id, int chain) {
+    return id > 0 && int(sss_profiles.info[id].x + 0.5) == chain;
+}
+
+SssStep sss_step(int id, int step) {
+    return sss_profiles.steps[id * MAX_SSS_STEPS + clamp(step, 0, MAX_SSS_STEPS - 1)];
+}
+
+#endif

@@ -536,6 +536,13 @@ fn knobs_that_do_not_apply_warn_naming_the_technique_they_need() {
         w.len() == 1 && w[0].contains("--technique translucency"),
         "{w:?}"
     );
+    // Under auto the frame decides: skin's profile is blurred with the control, so the
+    // bilateral knobs still do nothing.
+    let w = warnings(&["plan", "--scene", "skin", "--sss-packed"]);
+    assert!(
+        w.len() == 1 && w[0].contains("--technique auto on scene 'skin'") && w[0].contains("lbb"),
+        "{w:?}"
+    );
     // Where they apply, no warning.
     let w = warnings(&[
         "plan",

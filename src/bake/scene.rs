@@ -90,8 +90,9 @@ fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
                 ),
             ));
         }
-        // Level 0 only: the vertices sample it bilinearly, no mip is ever read.
-        let texture = texture::load_texture_level0(path, texture::TextureUsage::Data)?;
+        // As stored (its decoded size in memory): the vertices sample it bilinearly, no mip or
+        // f32 copy is ever needed.
+        let texture = texture::decode_texture(path, texture::TextureUsage::Data)?;
         let colors = mesh
             .uvs
             .iter()

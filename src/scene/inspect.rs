@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | `.obj` | [`load_obj`] | vertices, triangles, attributes, bounds, materials, repairs |
 //! | `.mtl` | [`load_mtl`] | materials with their colours and textures |
-//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`load_texture_level0`] (as data, no sRGB decode) | size, mips, value range |
+//! | `.png` `.jpg` `.jpeg` `.tga` `.exr` `.hdr` | [`decode_texture`] (as data, no sRGB decode) | size, mips, value range |
 //! | `.toml` | [`load_scene_file`] | meshes, objects, lights, camera |
 
 use std::fmt::Write as _;
@@ -18,8 +18,9 @@ use glam::Vec3;
 
 use super::file::load_scene_file;
 use super::obj::{load_mtl, load_obj, ObjMaterial};
-use super::texture::{host_bytes, load_texture_level0, mip_levels, TextureUsage};
+use super::texture::{decode_texture, host_bytes, mip_levels, TextureUsage};
 use crate::{LucentError, Result};
+use rayon::prelude::*;
 
 /// Extensions [`inspect_file`] understands.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -74,15 +75,25 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             }
         }
         "png" | "jpg" | "jpeg" | "tga" | "exr" | "hdr" => {
-            // Level 0 is what is summarised; the mips a render would make are only counted.
-            let t = load_texture_level0(path, TextureUsage::Data)?;
-            let (mut lo, mut hi) = ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]);
-            for texel in t.mips.first().into_iter().flatten() {
-                for c in 0..4 {
-                    lo[c] = lo[c].min(texel[c]);
-                    hi[c] = hi[c].max(texel[c]);
-                }
-            }
+            // Summarised as stored (its decoded size in memory); the mips a render would make
+            // are only counted.
+            let t = decode_texture(path, TextureUsage::Data)?;
+            let w = t.width as usize;
+            let (lo, hi) = (0..w * t.height as usize)
+                .into_par_iter()
+                .map(|i| {
+                    let texel = t.texel(i % w, i / w);
+                    (texel, texel)
+                })
+                .reduce(
+                    || ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]),
+                    |(lo, hi), (l, h)| {
+                        (
+                            std::array::from_fn(|c| lo[c].min(l[c])),
+                            std::array::from_fn(|c| hi[c].max(h[c])),
+                        )
+                    },
+                );
             let _ = writeln!(s, "{}: {} image", path.display(), ext.to_uppercase());
             let _ = writeln!(s, "  size: {}x{}", t.width, t.height);
             let _ = writeln!(s, "  mip levels: {}", mip_levels(t.width, t.height));

@@ -18,7 +18,8 @@
 //!
 //! Memory: a loaded texture costs its linear `f32` texels and mips ([`host_bytes`], about 21
 //! bytes per texel); while loading, the decoded file is held beside its `f32` level 0 and
-//! nothing else of the image's size. [`load_texture_level0`] skips the mips for CPU sampling.
+//! nothing else of the image's size. [`decode_texture`] keeps the image as stored (its decoded
+//! size, no `f32` copy) for what samples it on the CPU: thickness maps, `lucent inspect`.
 
 use std::path::Path;
 
@@ -115,25 +116,39 @@ impl Texture {
     /// Bilinear sample of level 0 at `uv` (0..1, v = 0 the top row), wrapping like a `REPEAT`
     /// sampler. A non-finite `uv` samples texel (0, 0) rather than propagating NaN.
     pub fn sample_bilinear(&self, uv: glam::Vec2) -> [f32; 4] {
-        let uv = if uv.is_finite() { uv } else { glam::Vec2::ZERO };
-        let (w, h) = (self.width as f32, self.height as f32);
-        let x = uv.x * w - 0.5;
-        let y = uv.y * h - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let texel = |tx: f32, ty: f32| {
-            let tx = (tx as i64).rem_euclid(i64::from(self.width)) as usize;
-            let ty = (ty as i64).rem_euclid(i64::from(self.height)) as usize;
-            self.mips[0][ty * self.width as usize + tx]
-        };
-        let (a, b) = (texel(x0, y0), texel(x0 + 1.0, y0));
-        let (c, d) = (texel(x0, y0 + 1.0), texel(x0 + 1.0, y0 + 1.0));
-        std::array::from_fn(|i| {
-            let top = a[i] + (b[i] - a[i]) * fx;
-            let bottom = c[i] + (d[i] - c[i]) * fx;
-            top + (bottom - top) * fy
+        let width = self.width as usize;
+        bilinear(self.width, self.height, uv, |x, y| {
+            self.mips[0][y * width + x]
         })
     }
+}
+
+/// Bilinear sample at `uv` (0..1, v = 0 the top row) of a `width x height` image whose texels
+/// `texel(x, y)` gives, wrapping like a `REPEAT` sampler. A non-finite `uv` samples texel
+/// (0, 0) rather than propagating NaN.
+fn bilinear(
+    width: u32,
+    height: u32,
+    uv: glam::Vec2,
+    texel: impl Fn(usize, usize) -> [f32; 4],
+) -> [f32; 4] {
+    let uv = if uv.is_finite() { uv } else { glam::Vec2::ZERO };
+    let x = uv.x * width as f32 - 0.5;
+    let y = uv.y * height as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let at = |tx: f32, ty: f32| {
+        let tx = (tx as i64).rem_euclid(i64::from(width)) as usize;
+        let ty = (ty as i64).rem_euclid(i64::from(height)) as usize;
+        texel(tx, ty)
+    };
+    let (a, b) = (at(x0, y0), at(x0 + 1.0, y0));
+    let (c, d) = (at(x0, y0 + 1.0), at(x0 + 1.0, y0 + 1.0));
+    std::array::from_fn(|i| {
+        let top = a[i] + (b[i] - a[i]) * fx;
+        let bottom = c[i] + (d[i] - c[i]) * fx;
+        top + (bottom - top) * fy
+    })
 }
 
 /// Makes a procedural texture at `size` x `size` (linear data, with mips).
@@ -336,27 +351,135 @@ pub fn load_texture(path: &Path, usage: TextureUsage) -> Result<Texture> {
     Texture::from_texels(&path.display().to_string(), width, height, usage, texels)
 }
 
-/// [`load_texture`] without the mip chain: level 0 only ([`Texture::level_count`] is 1), for
-/// what samples a texture on the CPU (thickness maps sampled at vertices, `lucent inspect`).
-pub fn load_texture_level0(path: &Path, usage: TextureUsage) -> Result<Texture> {
-    let (width, height, mut texels) = decode(path, usage)?;
-    let replaced = sanitize(&mut texels);
-    if replaced > 0 {
-        log::warn!(
-            "{}: replaced {replaced} NaN or infinite texel values with 0",
-            path.display()
-        );
-    }
-    Ok(Texture {
-        width,
-        height,
-        usage,
-        mips: vec![texels],
-    })
+/// An image file decoded but kept in the layout it was stored in (8- or 16-bit integers, or
+/// floats): about the image's decoded size in memory, a quarter of [`load_texture`]'s level 0
+/// for an 8-bit RGBA file. Texels become linear RGBA `f32` as they are read
+/// ([`DecodedImage::texel`]), with the same rules as [`load_texture`] (sRGB decoded for colour
+/// usage of 8/16-bit files, grey replicated, missing alpha 1, non-finite values 0). What samples a
+/// texture on the CPU uses this (thickness maps at vertices, `lucent inspect`).
+pub struct DecodedImage {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    image: DynamicImage,
+    /// sRGB-decoded 8-bit values (or the plain `v / 255` for linear data).
+    lut: [f32; 256],
+    srgb: bool,
 }
 
-/// Decodes an image file to linear RGBA `f32` texels (level 0).
-fn decode(path: &Path, usage: TextureUsage) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+impl DecodedImage {
+    /// Texel (`x`, `y`) (`y = 0` the top row) as linear RGBA, every value finite.
+    pub fn texel(&self, x: usize, y: usize) -> [f32; 4] {
+        let i = y * self.width as usize + x;
+        let lut = &self.lut;
+        let wide = |v: u16| {
+            let v = f32::from(v) / 65535.0;
+            if self.srgb {
+                srgb_to_linear(v)
+            } else {
+                v
+            }
+        };
+        let a8 = |v: u8| f32::from(v) / 255.0;
+        let a16 = |v: u16| f32::from(v) / 65535.0;
+        let t = match &self.image {
+            DynamicImage::ImageLuma8(im) => {
+                let c = lut[usize::from(im.as_raw()[i])];
+                [c, c, c, 1.0]
+            }
+            DynamicImage::ImageLumaA8(im) => {
+                let p = &im.as_raw()[i * 2..i * 2 + 2];
+                let c = lut[usize::from(p[0])];
+                [c, c, c, a8(p[1])]
+            }
+            DynamicImage::ImageRgb8(im) => {
+                let p = &im.as_raw()[i * 3..i * 3 + 3];
+                [
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    1.0,
+                ]
+            }
+            DynamicImage::ImageRgba8(im) => {
+                let p = &im.as_raw()[i * 4..i * 4 + 4];
+                [
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    a8(p[3]),
+                ]
+            }
+            DynamicImage::ImageLuma16(im) => {
+                let c = wide(im.as_raw()[i]);
+                [c, c, c, 1.0]
+            }
+            DynamicImage::ImageLumaA16(im) => {
+                let p = &im.as_raw()[i * 2..i * 2 + 2];
+                let c = wide(p[0]);
+                [c, c, c, a16(p[1])]
+            }
+            DynamicImage::ImageRgb16(im) => {
+                let p = &im.as_raw()[i * 3..i * 3 + 3];
+                [wide(p[0]), wide(p[1]), wide(p[2]), 1.0]
+            }
+            DynamicImage::ImageRgba16(im) => {
+                let p = &im.as_raw()[i * 4..i * 4 + 4];
+                [wide(p[0]), wide(p[1]), wide(p[2]), a16(p[3])]
+            }
+            DynamicImage::ImageRgb32F(im) => {
+                let p = &im.as_raw()[i * 3..i * 3 + 3];
+                [p[0], p[1], p[2], 1.0]
+            }
+            DynamicImage::ImageRgba32F(im) => {
+                let p = &im.as_raw()[i * 4..i * 4 + 4];
+                [p[0], p[1], p[2], p[3]]
+            }
+            // A layout added to `image` later: converted one texel at a time.
+            other => {
+                let p = image::GenericImageView::get_pixel(other, x as u32, y as u32).0;
+                [
+                    lut[p[0] as usize],
+                    lut[p[1] as usize],
+                    lut[p[2] as usize],
+                    a8(p[3]),
+                ]
+            }
+        };
+        // Guarded where it is born: one NaN poisons every filter tap that touches it.
+        t.map(|v| if v.is_finite() { v } else { 0.0 })
+    }
+
+    /// Bilinear sample at `uv`, as [`Texture::sample_bilinear`] samples level 0.
+    pub fn sample_bilinear(&self, uv: glam::Vec2) -> [f32; 4] {
+        bilinear(self.width, self.height, uv, |x, y| self.texel(x, y))
+    }
+
+    /// Every texel in row order as linear RGBA `f32` (level 0 of a [`Texture`]), converted in
+    /// parallel; non-finite values counted.
+    fn texels(&self) -> (Vec<[f32; 4]>, usize) {
+        let w = self.width as usize;
+        let texels: Vec<[f32; 4]> = (0..w * self.height as usize)
+            .into_par_iter()
+            .map(|i| self.texel(i % w, i / w))
+            .collect();
+        (texels, self.non_finite())
+    }
+
+    /// How many stored float values are NaN or infinite (read back as 0).
+    pub fn non_finite(&self) -> usize {
+        let bad = |v: &[f32]| v.par_iter().filter(|x| !x.is_finite()).count();
+        match &self.image {
+            DynamicImage::ImageRgb32F(im) => bad(im.as_raw()),
+            DynamicImage::ImageRgba32F(im) => bad(im.as_raw()),
+            _ => 0,
+        }
+    }
+}
+
+/// Decodes an image file ([`load_texture`]'s checks and limits) into a [`DecodedImage`].
+pub fn decode_texture(path: &Path, usage: TextureUsage) -> Result<DecodedImage> {
     // Read the header alone first, so an absurd size is refused before anything is allocated.
     let (width, height) = texture_dimensions(path)?;
     check_texture_size(path, width, height)?;
@@ -369,111 +492,41 @@ fn decode(path: &Path, usage: TextureUsage) -> Result<(u32, u32, Vec<[f32; 4]>)>
     limits.max_alloc = Some(MAX_TEXTURE_TEXELS * 16);
     reader.limits(limits);
     let image = reader.decode().map_err(|e| corrupt(path, e))?;
-
     // Float formats (EXR, HDR) store linear values; 8/16-bit ones store sRGB for colours.
     let stored_linear = matches!(
         image,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
-    let decode_srgb = usage == TextureUsage::Color && !stored_linear;
-    let (width, height) = (image.width(), image.height());
-    // Straight from the decoded samples to linear texels: no intermediate RGBA f32 copy.
-    Ok((width, height, linear_texels(image, decode_srgb)))
+    let srgb = usage == TextureUsage::Color && !stored_linear;
+    let lut = std::array::from_fn(|i| {
+        let v = i as f32 / 255.0;
+        if srgb {
+            srgb_to_linear(v)
+        } else {
+            v
+        }
+    });
+    Ok(DecodedImage {
+        width: image.width(),
+        height: image.height(),
+        image,
+        lut,
+        srgb,
+    })
 }
 
-/// The decoded image as linear RGBA `f32` texels: grey replicated to RGB, missing alpha 1,
-/// 8/16-bit values mapped to [0, 1] and, with `srgb`, RGB decoded from sRGB (alpha never).
-fn linear_texels(image: DynamicImage, srgb: bool) -> Vec<[f32; 4]> {
-    let curve = |v: f32| if srgb { srgb_to_linear(v) } else { v };
-    let lut: [f32; 256] = std::array::from_fn(|i| curve(i as f32 / 255.0));
-    let wide = |v: u16| curve(f32::from(v) / 65535.0);
-    let alpha8 = |v: u8| f32::from(v) / 255.0;
-    let alpha16 = |v: u16| f32::from(v) / 65535.0;
-    match image {
-        DynamicImage::ImageLuma8(i) => i
-            .as_raw()
-            .par_iter()
-            .map(|&l| {
-                let c = lut[usize::from(l)];
-                [c, c, c, 1.0]
-            })
-            .collect(),
-        DynamicImage::ImageLumaA8(i) => i
-            .as_raw()
-            .par_chunks_exact(2)
-            .map(|p| {
-                let c = lut[usize::from(p[0])];
-                [c, c, c, alpha8(p[1])]
-            })
-            .collect(),
-        DynamicImage::ImageRgb8(i) => i
-            .as_raw()
-            .par_chunks_exact(3)
-            .map(|p| {
-                [
-                    lut[p[0] as usize],
-                    lut[p[1] as usize],
-                    lut[p[2] as usize],
-                    1.0,
-                ]
-            })
-            .collect(),
-        DynamicImage::ImageRgba8(i) => i
-            .as_raw()
-            .par_chunks_exact(4)
-            .map(|p| {
-                [
-                    lut[p[0] as usize],
-                    lut[p[1] as usize],
-                    lut[p[2] as usize],
-                    alpha8(p[3]),
-                ]
-            })
-            .collect(),
-        DynamicImage::ImageLuma16(i) => i
-            .as_raw()
-            .par_iter()
-            .map(|&l| {
-                let c = wide(l);
-                [c, c, c, 1.0]
-            })
-            .collect(),
-        DynamicImage::ImageLumaA16(i) => i
-            .as_raw()
-            .par_chunks_exact(2)
-            .map(|p| {
-                let c = wide(p[0]);
-                [c, c, c, alpha16(p[1])]
-            })
-            .collect(),
-        DynamicImage::ImageRgb16(i) => i
-            .as_raw()
-            .par_chunks_exact(3)
-            .map(|p| [wide(p[0]), wide(p[1]), wide(p[2]), 1.0])
-            .collect(),
-        DynamicImage::ImageRgba16(i) => i
-            .as_raw()
-            .par_chunks_exact(4)
-            .map(|p| [wide(p[0]), wide(p[1]), wide(p[2]), alpha16(p[3])])
-            .collect(),
-        DynamicImage::ImageRgb32F(i) => i
-            .as_raw()
-            .par_chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2], 1.0])
-            .collect(),
-        DynamicImage::ImageRgba32F(i) => i
-            .as_raw()
-            .par_chunks_exact(4)
-            .map(|p| [p[0], p[1], p[2], p[3]])
-            .collect(),
-        // A layout added to `image` later: through its own RGBA f32 conversion.
-        other => other
-            .into_rgba32f()
-            .as_raw()
-            .chunks_exact(4)
-            .map(|p| [curve(p[0]), curve(p[1]), curve(p[2]), p[3]])
-            .collect(),
+/// Decodes an image file to linear RGBA `f32` texels (level 0). The decoded image is dropped
+/// as soon as its texels are made.
+fn decode(path: &Path, usage: TextureUsage) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+    let decoded = decode_texture(path, usage)?;
+    let (texels, replaced) = decoded.texels();
+    if replaced > 0 {
+        log::warn!(
+            "{}: replaced {replaced} NaN or infinite texel values with 0",
+            path.display()
+        );
     }
+    Ok((decoded.width, decoded.height, texels))
 }
 
 /// The sRGB electro-optical transfer function (IEC 61966-2-1), encoded [0, 1] to linear.
@@ -695,6 +748,49 @@ mod tests {
         )
         .unwrap();
         assert_eq!(t.mips[1], vec![[2.0; 4]]);
+    }
+
+    #[test]
+    fn decoded_images_read_like_the_textures_they_would_load() {
+        let dir = temp_dir("decoded");
+        let rgba = dir.join("rgba.png");
+        let img = image::RgbaImage::from_fn(5, 3, |x, y| {
+            image::Rgba([(x * 50) as u8, (y * 80) as u8, 200, (x * 40 + 10) as u8])
+        });
+        img.save(&rgba).unwrap();
+        let grey16 = dir.join("grey16.png");
+        image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_fn(4, 4, |x, y| {
+            image::Luma([(x * 9000 + y * 1000) as u16])
+        })
+        .save(&grey16)
+        .unwrap();
+        let exr = dir.join("nan.exr");
+        let mut f = Rgba32FImage::from_pixel(2, 2, image::Rgba([2.5, 0.25, 0.5, 1.0]));
+        f.put_pixel(1, 1, image::Rgba([f32::NAN, 1.0, f32::INFINITY, 1.0]));
+        DynamicImage::ImageRgba32F(f)
+            .save_with_format(&exr, ImageFormat::OpenExr)
+            .unwrap();
+        for path in [&rgba, &grey16, &exr] {
+            for usage in [TextureUsage::Color, TextureUsage::Data] {
+                let t = load_texture(path, usage).unwrap();
+                let d = decode_texture(path, usage).unwrap();
+                assert_eq!((d.width, d.height), (t.width, t.height));
+                for y in 0..t.height as usize {
+                    for x in 0..t.width as usize {
+                        assert_eq!(d.texel(x, y), t.mips[0][y * t.width as usize + x]);
+                    }
+                }
+                let uv = glam::Vec2::new(0.37, 0.61);
+                assert_eq!(d.sample_bilinear(uv), t.sample_bilinear(uv));
+            }
+        }
+        assert_eq!(
+            decode_texture(&exr, TextureUsage::Data)
+                .unwrap()
+                .non_finite(),
+            2
+        );
+        std::fs::remove_dir_all(dir).ok();
     }
 
     #[test]

@@ -167,8 +167,8 @@ fn no_coverage_message(mesh: &Mesh, size: u32) -> String {
     };
     format!(
         "thickness texture bake: the mesh's UVs cover no texel of the {size}x{size} map, so \
-         the map would be empty (black: thick everywhere): its {} triangles' UVs span u {:.4} \
-         to {:.4}, v {:.4} to {:.4}, and {why}; bake per vertex (--per-vertex) or give the \
+         the map would be empty (black: thick everywhere): its {} triangles' UVs span u {:.5} \
+         to {:.5}, v {:.5} to {:.5}, and {why}; bake per vertex (--per-vertex) or give the \
          mesh a UV layout in [0, 1]",
         mesh.triangle_count(),
         lo.x,
@@ -326,7 +326,7 @@ mod tests {
         };
         let e = bake_texture(&mesh, &options).unwrap_err().to_string();
         assert!(
-            e.contains("cover no texel of the 64x64 map") && e.contains("u 0.3000 to 0.3001"),
+            e.contains("cover no texel of the 64x64 map") && e.contains("u 0.30000 to 0.30010"),
             "{e}"
         );
         assert!(e.contains("--per-vertex"), "{e}");

@@ -247,7 +247,14 @@ fn identity(path: &Path) -> Option<(Identity, bool)> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let parent = std::fs::canonicalize(parent).unwrap_or_else(|_| parent.to_path_buf());
+    // A directory that does not exist yet (the writer creates it) cannot be canonicalised:
+    // compared without its `.` components then.
+    let parent = std::fs::canonicalize(parent).unwrap_or_else(|_| {
+        parent
+            .components()
+            .filter(|c| *c != std::path::Component::CurDir)
+            .collect()
+    });
     Some((Identity::New(parent.join(name)), true))
 }
 
@@ -376,6 +383,9 @@ mod tests {
             &[("--out", &a), ("--exr", &dir.join("b"))],
         )
         .unwrap();
+        // In a directory that does not exist yet.
+        let (x, y) = (dir.join("new/x.png"), dir.join("new/./x.png"));
+        assert!(check_outputs(&[], &[("--out", &x), ("--exr", &y)]).is_err());
         #[cfg(unix)]
         check_outputs(
             &[],

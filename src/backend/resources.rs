@@ -419,33 +419,68 @@ impl GpuContext {
         levels: &[Vec<u8>],
         name: &str,
     ) -> Result<GpuImage> {
-        if levels.len() != desc.mip_levels.max(1) as usize {
+        let sizes: Vec<u64> = levels.iter().map(|l| l.len() as u64).collect();
+        self.upload_image_with(desc, &sizes, name, |level, out| {
+            out.copy_from_slice(&levels[level]);
+            Ok(())
+        })
+    }
+
+    /// [`Self::upload_image`] without the levels in memory first: `fill(level, bytes)` writes
+    /// level `level` (of `level_bytes[level]` bytes) straight into the staging buffer, so a
+    /// large texture costs its staging copy and nothing more.
+    pub fn upload_image_with(
+        &self,
+        desc: &ImageDesc,
+        level_bytes: &[u64],
+        name: &str,
+        mut fill: impl FnMut(usize, &mut [u8]) -> Result<()>,
+    ) -> Result<GpuImage> {
+        if level_bytes.len() != desc.mip_levels.max(1) as usize {
             return Err(LucentError::InvalidInput(format!(
                 "upload '{name}': {} levels of data for {} mip levels",
-                levels.len(),
+                level_bytes.len(),
                 desc.mip_levels
             )));
         }
-        let bytes: Vec<u8> = levels.concat();
-        if bytes.is_empty() {
+        let total = level_bytes
+            .iter()
+            .try_fold(0u64, |sum, &b| sum.checked_add(b))
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!("upload '{name}': size overflows 64 bits"))
+            })?;
+        if total == 0 {
             return Err(LucentError::InvalidInput(format!(
                 "upload '{name}' has no data"
             )));
         }
         let mut staging = self.create_buffer(
-            bytes.len() as u64,
+            total,
             vk::BufferUsageFlags::TRANSFER_SRC,
             MemoryLocation::CpuToGpu,
             &format!("{name} (staging)"),
         )?;
-        match staging.mapped_mut() {
-            Some(mapped) => mapped.copy_from_slice(&bytes),
-            None => {
-                self.destroy_buffer(staging);
-                return Err(LucentError::InvalidInput(format!(
-                    "staging memory for '{name}' is not host-visible"
-                )));
+        let filled = match staging.mapped_mut() {
+            Some(mapped) => {
+                let mut start = 0usize;
+                let mut result = Ok(());
+                for (level, &bytes) in level_bytes.iter().enumerate() {
+                    let end = start + bytes as usize;
+                    result = fill(level, &mut mapped[start..end]);
+                    if result.is_err() {
+                        break;
+                    }
+                    start = end;
+                }
+                result
             }
+            None => Err(LucentError::InvalidInput(format!(
+                "staging memory for '{name}' is not host-visible"
+            ))),
+        };
+        if let Err(e) = filled {
+            self.destroy_buffer(staging);
+            return Err(e);
         }
         let desc = ImageDesc {
             usage: desc.usage | vk::ImageUsageFlags::TRANSFER_DST,
@@ -458,9 +493,9 @@ impl GpuContext {
                 return Err(e);
             }
         };
-        let mut regions = Vec::with_capacity(levels.len());
+        let mut regions = Vec::with_capacity(level_bytes.len());
         let mut offset = 0u64;
-        for (level, data) in levels.iter().enumerate() {
+        for (level, &bytes) in level_bytes.iter().enumerate() {
             let shift = level as u32;
             regions.push(vk::BufferImageCopy {
                 buffer_offset: offset,
@@ -479,7 +514,7 @@ impl GpuContext {
                     depth: 1,
                 },
             });
-            offset += data.len() as u64;
+            offset += bytes;
         }
         let range = desc.subresource_range();
         let copied = self.submit_and_wait(|cmd| {

@@ -122,16 +122,9 @@ pub struct SceneGpu {
     pub per_frame: PerFrame,
 }
 
-/// Linear RGBA f32 texels as tightly packed RGBA16F bytes (values clamped to fp16's range).
-fn rgba16f_bytes(texels: &[[f32; 4]]) -> Vec<u8> {
-    texels
-        .iter()
-        .flat_map(|t| t.map(|v| half::f16::from_f32(v.clamp(-65504.0, 65504.0))))
-        .flat_map(|h| h.to_le_bytes())
-        .collect()
-}
-
-/// Uploads a texture with its whole mip chain as RGBA16F.
+/// Uploads a texture with its whole mip chain as RGBA16F, converting each level straight into
+/// the staging buffer (values clamped to fp16's range): the upload costs the staging copy, no
+/// second copy of the texels.
 pub fn upload_texture(gpu: &GpuContext, texture: &Texture, name: &str) -> Result<GpuImage> {
     let desc = crate::backend::ImageDesc {
         mip_levels: texture.level_count() as u32,
@@ -142,8 +135,16 @@ pub fn upload_texture(gpu: &GpuContext, texture: &Texture, name: &str) -> Result
             vk::ImageUsageFlags::SAMPLED,
         )
     };
-    let levels: Vec<Vec<u8>> = texture.mips.iter().map(|m| rgba16f_bytes(m)).collect();
-    gpu.upload_image(&desc, &levels, name)
+    let sizes: Vec<u64> = texture.mips.iter().map(|m| m.len() as u64 * 8).collect();
+    gpu.upload_image_with(&desc, &sizes, name, |level, out| {
+        for (texel, bytes) in texture.mips[level].iter().zip(out.chunks_exact_mut(8)) {
+            for (c, &v) in texel.iter().enumerate() {
+                let h = half::f16::from_f32(v.clamp(-65504.0, 65504.0));
+                bytes[c * 2..c * 2 + 2].copy_from_slice(&h.to_le_bytes());
+            }
+        }
+        Ok(())
+    })
 }
 
 /// The distinct sources of one kind of map, in order of first use.
@@ -357,9 +358,13 @@ impl SceneGpu {
             )?;
             let push = |maps: &mut MaterialMaps, texture: &Texture, name: &str| -> Result<()> {
                 if lean {
-                    let (lean1, lean2) = crate::scene::lean::lean_maps(texture)?;
+                    // One LEAN map at a time: each is made, uploaded and dropped before the
+                    // next, so a large map's two LEAN maps are never in memory together.
+                    let lean1 = crate::scene::lean::lean_map(texture, 1)?;
                     maps.normal
                         .push(upload_texture(gpu, &lean1, &format!("{name} LEAN 1"))?);
+                    drop(lean1);
+                    let lean2 = crate::scene::lean::lean_map(texture, 2)?;
                     maps.lean2
                         .push(upload_texture(gpu, &lean2, &format!("{name} LEAN 2"))?);
                 } else {

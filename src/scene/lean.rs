@@ -26,17 +26,30 @@ pub const MIN_NZ: f32 = 0.05;
 
 /// The two LEAN maps of a normal map stored as `n * 0.5 + 0.5`.
 pub fn lean_maps(normal_map: &Texture) -> Result<(Texture, Texture)> {
-    let (mut lean1, mut lean2) = (Vec::new(), Vec::new());
-    for t in &normal_map.mips[0] {
-        let (b, m) = slope_and_moments(Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE);
-        lean1.push([b[0], b[1], m[0], m[1]]);
-        lean2.push([m[2], 0.0, 0.0, 1.0]);
-    }
+    Ok((lean_map(normal_map, 1)?, lean_map(normal_map, 2)?))
+}
+
+/// One of the two LEAN maps of [`lean_maps`] (`which` 1 or 2), so a large normal map's two
+/// maps need not be in memory at once.
+pub fn lean_map(normal_map: &Texture, which: u8) -> Result<Texture> {
+    let texels: Vec<[f32; 4]> = normal_map.mips[0]
+        .iter()
+        .map(|t| {
+            let (b, m) = slope_and_moments(Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE);
+            if which == 1 {
+                [b[0], b[1], m[0], m[1]]
+            } else {
+                [m[2], 0.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    let name = if which == 1 {
+        "LEAN map 1"
+    } else {
+        "LEAN map 2"
+    };
     let (w, h) = (normal_map.width, normal_map.height);
-    Ok((
-        Texture::from_texels("LEAN map 1", w, h, TextureUsage::Data, lean1)?,
-        Texture::from_texels("LEAN map 2", w, h, TextureUsage::Data, lean2)?,
-    ))
+    Texture::from_texels(name, w, h, TextureUsage::Data, texels)
 }
 
 /// Slope `B` and second moments `(B.x^2, B.y^2, B.x B.y)` of a tangent-space normal.

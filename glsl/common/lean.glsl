@@ -31,36 +31,104 @@ vec3 lean_covariance(vec2 b, vec3 m) {
     return vec3(xx, yy, clamp(m.z - b.x * b.y, -limit, limit));
 }
 
-// The LEAN specular lobe for half vector `h_view` (unit, view space): the slope-space Gaussian
-// of mean `b` and covariance `c`, turned into a half-vector density (1 / h.z^4), times Schlick's
-// Fresnel for `v_dot_h` from normal-incidence reflectance `f0`, times Cook-Torrance's
-// shadowing-masking term (without it, grazing views light every silhouette as a rim), over
-// 4 n.v (n.v >= 0.1 so silhouettes cannot blow up); the n.l of the microfacet BRDF cancels
-// against the irradiance's. The thesis uses F0 = 0.028 (skin); lucent takes the material's
-// specular intensity, which the lighting pass's Blinn-Phong lobe scales the same way, and a
-// material without specular (f0 = 0) reflects nothing, as in the lighting pass (Schlick's
-// grazing term would otherwise add a reflection to a material that declares none). A tiny
-// variance floor keeps the determinant > 0 for a perfectly flat, perfectly smooth surface.
-float lean_lobe(vec2 b, vec3 c, vec3 h_view, float v_dot_h, float n_dot_v, float n_dot_l,
-                float n_dot_h, float f0) {
-    c.xy += vec2(1e-5);
-    float det = max(c.x * c.y - c.z * c.z, 1e-10);
-    float hz = max(h_view.z, LEAN_MIN_NZ);
-    vec2 x = h_view.xy / hz - b;
-    float e = (x.x * x.x * c.y + x.y * x.y * c.x - 2.0 * x.x * x.y * c.z) / det;
-    float density = exp(-0.5 * e) / (2.0 * PI * sqrt(det));
+// A covariance held to at least `c_base` (the material's own roughness): a blur mixes slope
+// distributions, which only widens them, but fp16 moments at large slopes lose the difference
+// m - b b^T to rounding (400 +- 0.25 against a variance of 0.01), and a covariance rounded
+// towards 0 is a lobe of unbounded height. Where the determinant falls below the base's, part
+// of the base is added back (k = 1 - det / det_base), which keeps the lobe's peak within 1.16x
+// of the base lobe's (det(A + B) >= det(A) + det(B) for 2x2 PSD matrices) and leaves every
+// covariance above the base unchanged.
+vec3 lean_bounded_covariance(vec3 c, vec3 c_base) {
+    float det = max(c.x * c.y - c.z * c.z, 0.0);
+    float det_base = max(c_base.x * c_base.y - c_base.z * c_base.z, 1e-20);
+    float k = clamp(1.0 - det / det_base, 0.0, 1.0);
+    return c + k * c_base;
+}
+
+// The LEAN specular lobe for half vector `h` (unit, view space), from the view-plane slope
+// mean `b` and covariance `c` and the material's base roughness variance `base`.
+// The view plane is where LEAN is blurred, but it is the wrong frame to turn slopes into a
+// half-vector density: a view-plane slope is measured from the view axis, so at silhouettes
+// (mean normal nearly perpendicular to the view) the slope-space Gaussian's conversion 1 /
+// h.z^4 divides by the fourth power of a small number and a light behind the object draws a
+// rim of fireflies (100x the unblurred frame's brightest pixel on `edges`). So the lobe is
+// evaluated in the frame of the mean normal n = normalize(b, 1): the covariance is carried back
+// through the inverse of the slope mapping's Jacobian at the mean (the same Jacobian
+// view_plane_lean uses to go forward, so for an unblurred pixel this recovers its own
+// tangent-space covariance), held to at least the base roughness (lean_bounded_covariance: a
+// blur only widens a distribution, rounding can narrow it), and the density is the usual
+// microfacet D = p(slope) / (n.h)^4, at most 1.16 / (2 pi base): the unblurred BRDF's own
+// peak. Times Schlick's Fresnel for `v_dot_h` from normal-incidence reflectance `f0`, times
+// Cook-Torrance's shadowing-masking term, over 4 n.v (n.v >= 0.1); the n.l of the microfacet
+// BRDF cancels against the irradiance's. A material without specular (f0 = 0) reflects
+// nothing, as in the lighting pass.
+float lean_lobe(vec2 b, vec3 c, float base, vec3 h, float v_dot_h, float n_dot_v,
+                float n_dot_l, float f0) {
+    vec3 n = normalize(vec3(b, 1.0));
+    float n_dot_h = dot(n, h);
+    if (!(n_dot_h > 0.0)) {
+        return 0.0;
+    }
+    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 t = normalize(cross(helper, n));
+    vec3 bt = cross(n, t);
+    // Jacobian of the view-plane slope with respect to the normal-frame slope, at the mean.
+    float z = max(n.z, LEAN_MIN_NZ);
+    vec2 j0 = (t.xy * z - n.xy * t.z) / (z * z);
+    vec2 j1 = (bt.xy * z - n.xy * bt.z) / (z * z);
+    float j_det = j0.x * j1.y - j1.x * j0.y;
+    // |det J| >= 1 for unit n (it grows towards silhouettes); guarded all the same.
+    mat2 j_inv = mat2(j1.y, -j0.y, -j1.x, j0.x) / (abs(j_det) > 1e-12 ? j_det : 1e-12);
+    mat2 c_n = j_inv * mat2(c.x, c.z, c.z, c.y) * transpose(j_inv);
+    vec3 cn = lean_bounded_covariance(vec3(c_n[0][0], c_n[1][1], c_n[1][0]),
+                                      vec3(base, base, 0.0));
+    float det = max(cn.x * cn.y - cn.z * cn.z, 0.75 * base * base);
+    vec2 x = vec2(dot(h, t), dot(h, bt)) / n_dot_h;
+    float e = (x.x * x.x * cn.y + x.y * x.y * cn.x - 2.0 * x.x * x.y * cn.z) / det;
+    float nh2 = n_dot_h * n_dot_h;
+    float density = exp(-0.5 * e) / (2.0 * PI * sqrt(det) * nh2 * nh2);
     float f = 1.0 - clamp(v_dot_h, 0.0, 1.0);
     float f2 = f * f;
     float fresnel = f0 > 0.0 ? f0 + (1.0 - f0) * (f2 * f2 * f) : 0.0;
     float vh = max(v_dot_h, 1e-4);
-    float g = min(1.0, 2.0 * max(n_dot_h, 0.0) * min(max(n_dot_v, 0.0), max(n_dot_l, 0.0)) / vh);
-    return fresnel * g * density / (4.0 * hz * hz * hz * hz * max(n_dot_v, 0.1));
+    float g = min(1.0, 2.0 * n_dot_h * min(max(n_dot_v, 0.0), max(n_dot_l, 0.0)) / vh);
+    return fresnel * g * density / (4.0 * max(n_dot_v, 0.1));
 }
 
 // The base variance of the material's own roughness (the thesis adds 1 / (s + 2) for
 // specular power s): the Blinn-Phong lobe of the lighting pass, as a slope variance.
 float roughness_variance(float roughness) {
     return 1.0 / (shininess(roughness) + 2.0);
+}
+
+// Slopes further apart than this (normals about 45 degrees apart and more) are a crease (a face
+// seen edge-on beside one seen face-on: the `edges` slab's side, slope -3.2, beside its front,
+// 0.3), not a distribution to blend: the blurs keep such taps out of the LEAN moments, as depth
+// edges are kept out of the light. A normal map's bumps vary the slope by a few tenths.
+const float LEAN_CREASE = 1.0;
+
+// How much of a tap's LEAN texel (slope mean `b`, moments `m`) to replace by the centre's: 0
+// within a smooth surface, 1 across a crease, where the slope means are LEAN_CREASE to twice it
+// apart. `filtered`: the tap is bilinear (LCB), and one that straddles the crease mixes both
+// faces' slopes into a mean that looks smooth, but not into a narrow spread (30% of the slab's
+// side in a tap is a slope variance of 2.6): a tap whose spread exceeds the centre's by as much
+// counts as a crease too. Point taps (LBB) mix nothing, and a one-sided spread test would only
+// bias their covariance low.
+float lean_crease(vec2 b_tap, vec3 m_tap, vec2 b_center, vec3 m_center, bool filtered) {
+    // View-plane slopes stretch as 1 / n.z^2 towards silhouettes: so does the threshold, or a
+    // normal map's bumps near a silhouette would count as creases.
+    float z = 1.0 / sqrt(1.0 + dot(b_center, b_center));
+    float crease = LEAN_CREASE / max(z * z, 0.05);
+    float apart = smoothstep(crease, 2.0 * crease, length(b_tap - b_center));
+    if (!filtered) {
+        return apart;
+    }
+    float spread_tap = m_tap.x - b_tap.x * b_tap.x + m_tap.y - b_tap.y * b_tap.y;
+    float spread_center = m_center.x - b_center.x * b_center.x + m_center.y -
+                          b_center.y * b_center.y;
+    float spread = smoothstep(0.25 * crease * crease, crease * crease,
+                              spread_tap - spread_center);
+    return max(apart, spread);
 }
 
 // A pixel's LEAN data projected to the view plane. `n` is the unit world-space geometric

@@ -38,6 +38,9 @@
 // mean (which sums to 1 over the profile too) for the LEAN moments.
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
+#ifdef LUCENT_SSS_LEAN
+#include "../common/lean.glsl"
+#endif
 
 #ifdef LUCENT_SSS_PACKED_IN
 layout(set = 0, binding = 2) uniform usampler2D packed_tex;  // both texels, packed (nearest)
@@ -128,7 +131,12 @@ void main() {
     float spacing = sigma * (3.0 / float(LUCENT_SSS_HALF_TAPS));
     vec4 sum = vec4(0.0);
 #ifdef LUCENT_SSS_LEAN
+    // The LEAN texels (slope x in the light's alpha, slope y and moments) have weights of
+    // their own: a tap across a crease adds light but no slopes (lean_crease).
     vec4 sum_lean = vec4(0.0);
+    float sum_slope_x = 0.0;
+    float total_lean = 0.0;
+    vec2 b_center = vec2(center.a, center_lean.x);
 #endif
     float total = 0.0;
     for (int k = -LUCENT_SSS_HALF_TAPS; k <= LUCENT_SSS_HALF_TAPS; ++k) {
@@ -146,8 +154,15 @@ void main() {
 #ifdef LUCENT_SSS_LEAN
         vec4 color, lean;
         fetch_texels(tap, color, lean);
-        sum += w * finite_or(color, center);
-        sum_lean += w * finite_or(lean, center_lean);
+        color = finite_or(color, center);
+        lean = finite_or(lean, center_lean);
+        float w_lean =
+            w * (1.0 - lean_crease(vec2(color.a, lean.x), lean.yzw, b_center, center_lean.yzw,
+                                   false));
+        sum += w * color;
+        sum_slope_x += w_lean * color.a;
+        sum_lean += w_lean * lean;
+        total_lean += w_lean;
 #else
         sum += w * finite_or(texelFetch(color_tex, tap, 0), center);
 #endif
@@ -156,7 +171,9 @@ void main() {
     // The centre tap has weight 1 (offset 0, no depth difference): total >= 1.
     vec4 blurred = sum / max(total, 1e-6);
 #ifdef LUCENT_SSS_LEAN
-    vec4 blurred_lean = sum_lean / max(total, 1e-6);
+    // The centre's LEAN weight is 1 too: total_lean >= 1.
+    blurred.a = sum_slope_x / max(total_lean, 1e-6);
+    vec4 blurred_lean = sum_lean / max(total_lean, 1e-6);
 #endif
 #else
     // Jimenez's kernel: centre 0.382, six taps at +-1/3, +-2/3, +-1 of the reach (sums to 1).
@@ -182,10 +199,18 @@ void main() {
         int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
         s = tap_id != id && tap_id != 0 ? 1.0 : s;
 #endif
-        blurred += w[i] * mix(finite_or(textureLod(color_tex, offset, 0.0), center), center, s);
 #ifdef LUCENT_SSS_LEAN
-        blurred_lean +=
-            w[i] * mix(finite_or(textureLod(lean_tex, offset, 0.0), center_lean), center_lean, s);
+        vec4 color = finite_or(textureLod(color_tex, offset, 0.0), center);
+        vec4 lean = finite_or(textureLod(lean_tex, offset, 0.0), center_lean);
+        // Across a crease the tap adds light but no slopes (lean_crease).
+        float s_lean = max(s, lean_crease(vec2(color.a, lean.x), lean.yzw,
+                                          vec2(center.a, center_lean.x), center_lean.yzw, true));
+        vec4 tap_color = mix(color, center, s);
+        tap_color.a = mix(color.a, center.a, s_lean);
+        blurred += w[i] * tap_color;
+        blurred_lean += w[i] * mix(lean, center_lean, s_lean);
+#else
+        blurred += w[i] * mix(finite_or(textureLod(color_tex, offset, 0.0), center), center, s);
 #endif
     }
 #endif

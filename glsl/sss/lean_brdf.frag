@@ -18,8 +18,9 @@ layout(set = 0, binding = 5) uniform sampler2D specular_tex;  // lighting pass s
 layout(set = 0, binding = 6) uniform sampler2D profile_tex;   // SSS profile ID
 layout(set = 0, binding = 7) uniform sampler2D depth_tex;
 layout(set = 0, binding = 8) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
+layout(set = 0, binding = 9) uniform sampler2D normal_tex;    // GB1: a = roughness
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 9) uniform sampler2D base_tex;      // the previous chain's result
+layout(set = 0, binding = 10) uniform sampler2D base_tex;     // the previous chain's result
 #endif
 
 layout(push_constant) uniform Chain {
@@ -44,7 +45,15 @@ void main() {
         vec4 s1 = texelFetch(lean_sum_tex, px, 0);
         vec2 b = vec2(s0.a, s1.x);
         vec3 c = lean_covariance(b, s1.yzw);
+        // The lobe is never sharper than the material's own roughness allows (lean_lobe), and
+        // never brighter than the unblurred BRDF's own maximum: the lighting pass's normalised
+        // Blinn-Phong peak ks (s + 8) / (8 pi), which it reaches with n.h = n.l = 1. The
+        // microfacet lobe's Fresnel and 1 / n.v would otherwise light silhouettes facing away
+        // from a back light as a rim the frame without SSS never has.
+        float roughness = texelFetch(normal_tex, px, 0).a;
+        float base = roughness_variance(roughness);
         float ks = texelFetch(albedo_tex, px, 0).a;
+        float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
         float d = texelFetch(depth_tex, px, 0).r;
         vec3 pos = world_position(gl_FragCoord.xy, d);
         mat3 view = mat3(frame.view);
@@ -67,7 +76,7 @@ void main() {
                 continue;
             }
             h *= inversesqrt(h_len2);
-            float lobe = lean_lobe(b, c, h, dot(to_eye, h), n_dot_v, n_dot_l, dot(n, h), ks);
+            float lobe = min(lean_lobe(b, c, base, h, dot(to_eye, h), n_dot_v, n_dot_l, ks), peak);
             specular += lobe * light.radiance_range.rgb * attenuation;
         }
         color = s0.rgb + specular;

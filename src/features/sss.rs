@@ -338,6 +338,8 @@ pub struct SssInputs<'a> {
     pub lean: Option<&'a Handle<Image>>,
     /// G-buffer albedo + specular intensity (LEAN specular).
     pub gb0: &'a Handle<Image>,
+    /// G-buffer normal + roughness (LEAN specular's roughness bound).
+    pub gb1: &'a Handle<Image>,
 }
 
 /// Declares every chain's passes after the lighting pass (see the module docs): per chain, one
@@ -563,7 +565,7 @@ fn chain_passes(
     let mut reads: Vec<&Handle<Image>> = sum.iter().collect();
     reads.extend([inputs.diffuse, inputs.specular, inputs.profile_ids]);
     if lean.is_some() {
-        reads.extend([inputs.depth, inputs.gb0]);
+        reads.extend([inputs.depth, inputs.gb0, inputs.gb1]);
     }
     reads.extend(base);
     for h in &reads {

@@ -93,6 +93,7 @@ pub fn declare_frame(
                 profile_ids,
                 lean: gb.lean.as_ref(),
                 gb0: &gb.gb0,
+                gb1: &gb.gb1,
             },
             profiles,
             &settings.sss,

@@ -37,40 +37,69 @@ pub fn view_slope(n_view: DVec3) -> DVec2 {
     DVec2::new(n_view.x, n_view.y) / z
 }
 
-/// The LEAN specular lobe (glsl `lean_lobe`): the slope-space Gaussian of mean `b`, covariance
-/// `c` at the unit view-space half vector `h`, as a half-vector density, times Schlick's
-/// Fresnel from `f0` (none at all for `f0 = 0`), times Cook-Torrance's shadowing-masking term,
-/// over 4 n.v (n.v >= 0.1).
+/// The LEAN lobe (glsl/common/lean.glsl `lean_lobe`): the view-plane covariance carried back
+/// to the mean normal's frame through the inverse slope Jacobian, held to at least the base
+/// roughness variance `base` (`lean_bounded_covariance`), the microfacet density p / (n.h)^4,
+/// Schlick's Fresnel, Cook-Torrance's G, over 4 max(n.v, 0.1).
 #[allow(clippy::too_many_arguments)]
 pub fn lean_lobe(
     b: DVec2,
     c: DVec3,
+    base: f64,
     h: DVec3,
     v_dot_h: f64,
     n_dot_v: f64,
     n_dot_l: f64,
-    n_dot_h: f64,
     f0: f64,
 ) -> f64 {
-    let (cx, cy) = (c.x + 1e-5, c.y + 1e-5);
-    let det = (cx * cy - c.z * c.z).max(1e-10);
-    let hz = h.z.max(LEAN_MIN_NZ);
-    let x = DVec2::new(h.x, h.y) / hz - b;
-    let e = (x.x * x.x * cy + x.y * x.y * cx - 2.0 * x.x * x.y * c.z) / det;
-    let density = (-0.5 * e).exp() / (2.0 * std::f64::consts::PI * det.sqrt());
+    let n = DVec3::new(b.x, b.y, 1.0).normalize();
+    let n_dot_h = n.dot(h);
+    if n_dot_h.is_nan() || n_dot_h <= 0.0 {
+        return 0.0;
+    }
+    let helper = if n.y.abs() < 0.9 { DVec3::Y } else { DVec3::X };
+    let t = helper.cross(n).normalize();
+    let bt = n.cross(t);
+    let z = n.z.max(LEAN_MIN_NZ);
+    let column = |v: DVec3| (DVec2::new(v.x, v.y) * z - DVec2::new(n.x, n.y) * v.z) / (z * z);
+    let j = glam::DMat2::from_cols(column(t), column(bt));
+    let j_det = j.determinant();
+    let j_inv = glam::DMat2::from_cols(
+        DVec2::new(j.y_axis.y, -j.x_axis.y),
+        DVec2::new(-j.y_axis.x, j.x_axis.x),
+    ) / if j_det.abs() > 1e-12 { j_det } else { 1e-12 };
+    let c_n = j_inv
+        * glam::DMat2::from_cols(DVec2::new(c.x, c.z), DVec2::new(c.z, c.y))
+        * j_inv.transpose();
+    let cn = bounded_covariance(
+        DVec3::new(c_n.x_axis.x, c_n.y_axis.y, c_n.x_axis.y),
+        DVec3::new(base, base, 0.0),
+    );
+    let det = (cn.x * cn.y - cn.z * cn.z).max(0.75 * base * base);
+    let x = DVec2::new(h.dot(t), h.dot(bt)) / n_dot_h;
+    let e = (x.x * x.x * cn.y + x.y * x.y * cn.x - 2.0 * x.x * x.y * cn.z) / det;
+    let density = (-0.5 * e).exp() / (2.0 * std::f64::consts::PI * det.sqrt() * n_dot_h.powi(4));
     let f = 1.0 - v_dot_h.clamp(0.0, 1.0);
     let fresnel = if f0 > 0.0 {
         f0 + (1.0 - f0) * f.powi(5)
     } else {
         0.0
     };
-    let g = (2.0 * n_dot_h.max(0.0) * n_dot_v.max(0.0).min(n_dot_l.max(0.0)) / v_dot_h.max(1e-4))
-        .min(1.0);
-    fresnel * g * density / (4.0 * hz.powi(4) * n_dot_v.max(0.1))
+    let g = (2.0 * n_dot_h * n_dot_v.max(0.0).min(n_dot_l.max(0.0)) / v_dot_h.max(1e-4)).min(1.0);
+    fresnel * g * density / (4.0 * n_dot_v.max(0.1))
+}
+
+/// `c` held to at least `c_base` (glsl `lean_bounded_covariance`).
+pub fn bounded_covariance(c: DVec3, c_base: DVec3) -> DVec3 {
+    let det = (c.x * c.y - c.z * c.z).max(0.0);
+    let det_base = (c_base.x * c_base.y - c_base.z * c_base.z).max(1e-20);
+    let k = (1.0 - det / det_base).clamp(0.0, 1.0);
+    c + k * c_base
 }
 
 /// LEAN specular at a surface point from every light (glsl/sss/lean_brdf.frag): view-plane
-/// slope mean `b` and moments `m`, specular intensity `ks`, `view` the world-to-view rotation.
+/// slope mean `b` and moments `m`, specular intensity `ks`, the material's `roughness`, `view`
+/// the world-to-view rotation.
 pub fn lean_specular(
     scene: &Scene,
     view: DMat3,
@@ -78,7 +107,11 @@ pub fn lean_specular(
     b: DVec2,
     m: DVec3,
     ks: f64,
+    roughness: f64,
 ) -> DVec3 {
+    let base = roughness_variance(roughness);
+    // Bounded by the unblurred Blinn-Phong's peak (glsl/sss/lean_brdf.frag).
+    let peak = ks * (shininess(roughness) + 8.0) / (8.0 * std::f64::consts::PI);
     let c = covariance_of(b, m);
     let to_eye = view * (scene.camera.eye.as_dvec3() - position).normalize();
     let n = DVec3::new(b.x, b.y, 1.0).normalize();
@@ -93,7 +126,7 @@ pub fn lean_specular(
             continue;
         }
         let h = h.normalize();
-        let lobe = lean_lobe(b, c, h, to_eye.dot(h), n_dot_v, n_dot_l, n.dot(h), ks);
+        let lobe = lean_lobe(b, c, base, h, to_eye.dot(h), n_dot_v, n_dot_l, ks).min(peak);
         out += lobe * radiance(light) * attenuation;
     }
     out
@@ -182,7 +215,16 @@ pub fn reference_image(
                 let [by, mxx, myy, mxy] = lean[i].map(f64::from);
                 let b = DVec2::new(view_slope(view * p.normal).x, by);
                 let ks = f64::from(p.material.specular);
-                lean_specular(scene, view, p.position, b, DVec3::new(mxx, myy, mxy), ks)
+                let roughness = f64::from(p.material.roughness);
+                lean_specular(
+                    scene,
+                    view,
+                    p.position,
+                    b,
+                    DVec3::new(mxx, myy, mxy),
+                    ks,
+                    roughness,
+                )
             }
             _ => blinn_phong,
         };

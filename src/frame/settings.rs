@@ -31,6 +31,10 @@ pub enum Technique {
     /// The thesis's technique: the LEAN pipeline with a separable bilateral (depth-weighted)
     /// blur of the projected G-buffer in ping-pong targets.
     Lbb,
+    /// Jimenez's separable SSS: two passes, a kernel pre-integrated from each profile.
+    Separable,
+    /// The thesis's bilateral LEAN blur in two passes, tap weights from the whole profile.
+    Bilateral,
 }
 
 impl Technique {
@@ -42,6 +46,8 @@ impl Technique {
         ("control", Technique::Control),
         ("lcb", Technique::Lcb),
         ("lbb", Technique::Lbb),
+        ("separable", Technique::Separable),
+        ("bilateral", Technique::Bilateral),
     ];
 
     /// Parses a command-line name.
@@ -77,6 +83,8 @@ impl Technique {
             Technique::Control => Some(SssBlur::Control),
             Technique::Lcb => Some(SssBlur::LeanControl),
             Technique::Lbb => Some(SssBlur::LeanBilateral),
+            Technique::Separable => Some(SssBlur::Separable),
+            Technique::Bilateral => Some(SssBlur::Bilateral),
         }
     }
 
@@ -87,10 +95,7 @@ impl Technique {
 
     /// Whether SSS materials get their screen-space blur.
     pub fn sss(self) -> bool {
-        matches!(
-            self,
-            Technique::Auto | Technique::Control | Technique::Lcb | Technique::Lbb
-        )
+        !matches!(self, Technique::None | Technique::Translucency)
     }
 }
 

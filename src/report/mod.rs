@@ -100,7 +100,7 @@ pub fn scene_for(technique: Technique) -> Result<String> {
         Technique::None => "smoke",
         Technique::Translucency => "cubes",
         Technique::Control => "skin",
-        Technique::Lcb | Technique::Lbb => "teapot",
+        Technique::Lcb | Technique::Lbb | Technique::Separable | Technique::Bilateral => "teapot",
     }
     .to_string())
 }

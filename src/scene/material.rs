@@ -141,12 +141,19 @@ pub struct SssProfile {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum SssBlur {
     /// Jimenez's separable sum-of-Gaussians blur of the lit diffuse light (the LEAN-mapping
-    /// thesis's control, C).
+    /// thesis's control, C): a horizontal and a vertical pass per Gaussian.
     Control,
     /// The thesis's LEAN pipeline with Jimenez's blur (LCB).
     LeanControl,
-    /// The thesis's LEAN pipeline with the separable bilateral blur (LBB).
+    /// The thesis's LEAN pipeline with the separable bilateral blur (LBB), per Gaussian.
     LeanBilateral,
+    /// Jimenez's separable SSS (2012/2015): one horizontal and one vertical pass with a kernel
+    /// pre-integrated from the whole profile, following the surface's depth.
+    Separable,
+    /// The thesis's idea in two passes: the lit diffuse and the LEAN G-buffer blurred by a
+    /// bilateral kernel whose tap weights are the whole profile at each tap's 3D distance, then
+    /// LEAN specular.
+    Bilateral,
 }
 
 impl SssBlur {
@@ -155,14 +162,12 @@ impl SssBlur {
         ("control", SssBlur::Control),
         ("lcb", SssBlur::LeanControl),
         ("lbb", SssBlur::LeanBilateral),
+        ("separable", SssBlur::Separable),
+        ("bilateral", SssBlur::Bilateral),
     ];
 
     /// The blur of materials that name none: the one measured best for its error at its cost,
-    /// artefacts included. docs/sss.md: LBB's mean error against the brute-force reference is
-    /// lower (7.2e-3 against the control's 1.08e-2) for 1.06-1.11x the control's time, but its
-    /// LEAN specular draws fireflies at silhouettes (HDR maximum 156.8 on `edges` against
-    /// 5.97 without SSS) and dot grids and streaks on smooth shapes, which the control never
-    /// does; the control is also the cheapest. Until the LEAN lobe is bounded, the control.
+    /// artefacts included (docs/sss.md, "Two passes").
     pub const DEFAULT: SssBlur = SssBlur::Control;
 
     /// Its name.
@@ -181,19 +186,35 @@ impl SssBlur {
             .map(|&(_, b)| b)
             .ok_or_else(|| {
                 LucentError::InvalidInput(format!(
-                    "unknown SSS blur '{name}'; use control, lcb or lbb"
+                    "unknown SSS blur '{name}'; use {}",
+                    Self::ALL
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ))
             })
     }
 
     /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
     pub fn lean(self) -> bool {
-        self != SssBlur::Control
+        !matches!(self, SssBlur::Control | SssBlur::Separable)
     }
 
-    /// Whether taps are weighted by a depth-difference Gaussian (else lerped back by depth).
+    /// Whether it blurs one horizontal + vertical pair per Gaussian of the profile (the
+    /// thesis's iterative scheme); else one pair for the whole profile.
+    pub fn iterative(self) -> bool {
+        matches!(
+            self,
+            SssBlur::Control | SssBlur::LeanControl | SssBlur::LeanBilateral
+        )
+    }
+
+    /// Whether taps are point taps weighted by depth (LBB's per-Gaussian depth Gaussian, the
+    /// two-pass bilateral's profile at the 3D distance); else bilinear taps lerped back to the
+    /// centre across depth edges.
     pub fn bilateral(self) -> bool {
-        self == SssBlur::LeanBilateral
+        matches!(self, SssBlur::LeanBilateral | SssBlur::Bilateral)
     }
 }
 

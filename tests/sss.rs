@@ -21,12 +21,18 @@ fn settings(technique: Technique) -> FrameSettings {
 }
 
 /// Every screen-space SSS technique.
-const SSS_TECHNIQUES: [Technique; 3] = [Technique::Control, Technique::Lcb, Technique::Lbb];
+const SSS_TECHNIQUES: [Technique; 5] = [
+    Technique::Control,
+    Technique::Lcb,
+    Technique::Lbb,
+    Technique::Separable,
+    Technique::Bilateral,
+];
 
 /// The specular model of a technique's reference.
 fn reference_specular(technique: Technique) -> ReferenceSpecular {
     match technique {
-        Technique::Control => ReferenceSpecular::BlinnPhong,
+        Technique::Control | Technique::Separable => ReferenceSpecular::BlinnPhong,
         _ => ReferenceSpecular::Lean,
     }
 }

@@ -156,4 +156,43 @@ void view_plane_lean(vec3 n, vec3 t, vec3 bt, vec2 b_t, vec3 m_t, float base,
     m_v = clamp(m_v, vec3(0.0, 0.0, -60000.0), vec3(60000.0));
 }
 
+// The final lighting's LEAN specular at window position `frag_coord` (device depth `d`), for
+// every light, from the (blurred) view-plane slope mean `b` and moments `m`, the material's
+// `roughness` and specular intensity `ks`. The lobe is never sharper than the roughness allows
+// (lean_lobe), and never brighter than the unblurred BRDF's own maximum: the lighting pass's
+// normalised Blinn-Phong peak ks (s + 8) / (8 pi), which it reaches with n.h = n.l = 1. The
+// microfacet lobe's Fresnel and 1 / n.v would otherwise light silhouettes facing away from a
+// back light as a rim the frame without SSS never has. The f64 twin is
+// src/reference/sss.rs `lean_specular`.
+vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughness, float ks) {
+    vec3 c = lean_covariance(b, m);
+    float base = roughness_variance(roughness);
+    float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
+    vec3 pos = world_position(frag_coord, d);
+    mat3 view = mat3(frame.view);
+    vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
+    vec3 n = normalize(vec3(b, 1.0));
+    float n_dot_v = dot(n, to_eye);
+    vec3 specular = vec3(0.0);
+    int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
+    for (int i = 0; i < count; ++i) {
+        Light light = frame.lights[i];
+        vec3 to_light;
+        float attenuation;
+        light_incidence(light, pos, to_light, attenuation);
+        vec3 l = view * to_light;
+        vec3 h = l + to_eye;
+        float h_len2 = dot(h, h);
+        // Light exactly behind the surface point as seen from the eye: no half vector.
+        float n_dot_l = dot(n, l);
+        if (!(h_len2 > 1e-12) || n_dot_l <= 0.0) {
+            continue;
+        }
+        h *= inversesqrt(h_len2);
+        float lobe = min(lean_lobe(b, c, base, h, dot(to_eye, h), n_dot_v, n_dot_l, ks), peak);
+        specular += lobe * light.radiance_range.rgb * attenuation;
+    }
+    return specular;
+}
+
 #endif

@@ -15,8 +15,10 @@ struct SssStep {
 };
 
 layout(std140, set = 0, binding = 1) uniform SssProfiles {
-    vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count
+    vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count; z: Gaussian count
     SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
+    // The whole profile's 1-D form in world units: rgb = weight / sqrt(2 pi v), a = 1 / (2 v).
+    vec4 gaussians[MAX_SSS_PROFILES * MAX_SSS_STEPS];
 } sss_profiles;
 
 // The profile ID stored at a texel (exact for UNORM8: rounding recovers the integer).
@@ -32,5 +34,27 @@ bool sss_in_chain(int id, int chain) {
 SssStep sss_step(int id, int step) {
     return sss_profiles.steps[id * MAX_SSS_STEPS + clamp(step, 0, MAX_SSS_STEPS - 1)];
 }
+
+// The profile of `id` in its 1-D form (the sum of its Gaussians' marginals) per channel at
+// squared world distance `d2`: the two-pass bilateral blur's tap weight.
+vec3 sss_profile_at(int id, float d2) {
+    vec3 r = vec3(0.0);
+    int count = clamp(int(sss_profiles.info[id].z + 0.5), 0, MAX_SSS_STEPS);
+    for (int i = 0; i < count; ++i) {
+        vec4 g = sss_profiles.gaussians[id * MAX_SSS_STEPS + i];
+        r += g.rgb * exp(-d2 * g.a);
+    }
+    return r;
+}
+
+#ifdef LUCENT_SSS_KERNELS
+#define MAX_KERNEL_SAMPLES 25
+// The separable blur's kernels (src/features/sss/kernel.rs `KernelTableGpu`), binding 2 of its
+// passes: per profile x the sample count, y one over the reach (world units), z the reach.
+layout(std140, set = 0, binding = 2) uniform SssKernels {
+    vec4 info[MAX_SSS_PROFILES];
+    vec4 taps[MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES];  // rgb weight, a offset (world units)
+} sss_kernels;
+#endif
 
 #endif

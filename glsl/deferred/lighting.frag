@@ -8,6 +8,8 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_FAULT_INJECTION
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
@@ -41,7 +43,12 @@ layout(location = 1) out vec4 out_specular;
 void main() {
     float d = subpassLoad(depth).r;
     if (d >= 1.0) {
+#ifdef LUCENT_DEPTH_IN_ALPHA
+        // The separable SSS blur reads linear depth from alpha: the sky is at the far plane.
+        out_color = vec4(frame.sky.rgb, frame.camera.y);
+#else
         out_color = vec4(frame.sky.rgb, 1.0);
+#endif
 #ifdef LUCENT_SPLIT_SPECULAR
         out_specular = vec4(0.0);
 #endif
@@ -104,6 +111,9 @@ void main() {
     // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).
 #ifdef LUCENT_LEAN
     out_color = vec4(min(color, vec3(65504.0)), slope_x);
+#elif defined(LUCENT_DEPTH_IN_ALPHA)
+    // The separable SSS blur's taps read the light and its depth in one fetch.
+    out_color = vec4(min(color, vec3(65504.0)), linear_depth(d));
 #else
     out_color = vec4(min(color, vec3(65504.0)), 1.0);
 #endif

@@ -43,42 +43,11 @@ void main() {
     if (scatters) {
         vec4 s0 = texelFetch(sum_tex, px, 0);
         vec4 s1 = texelFetch(lean_sum_tex, px, 0);
-        vec2 b = vec2(s0.a, s1.x);
-        vec3 c = lean_covariance(b, s1.yzw);
-        // The lobe is never sharper than the material's own roughness allows (lean_lobe), and
-        // never brighter than the unblurred BRDF's own maximum: the lighting pass's normalised
-        // Blinn-Phong peak ks (s + 8) / (8 pi), which it reaches with n.h = n.l = 1. The
-        // microfacet lobe's Fresnel and 1 / n.v would otherwise light silhouettes facing away
-        // from a back light as a rim the frame without SSS never has.
-        float roughness = texelFetch(normal_tex, px, 0).a;
-        float base = roughness_variance(roughness);
-        float ks = texelFetch(albedo_tex, px, 0).a;
-        float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
+        vec4 gb0 = texelFetch(albedo_tex, px, 0);
+        vec4 gb1 = texelFetch(normal_tex, px, 0);
         float d = texelFetch(depth_tex, px, 0).r;
-        vec3 pos = world_position(gl_FragCoord.xy, d);
-        mat3 view = mat3(frame.view);
-        vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
-        vec3 n = normalize(vec3(b, 1.0));
-        float n_dot_v = dot(n, to_eye);
-        vec3 specular = vec3(0.0);
-        int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
-        for (int i = 0; i < count; ++i) {
-            Light light = frame.lights[i];
-            vec3 to_light;
-            float attenuation;
-            light_incidence(light, pos, to_light, attenuation);
-            vec3 l = view * to_light;
-            vec3 h = l + to_eye;
-            float h_len2 = dot(h, h);
-            // Light exactly behind the surface point as seen from the eye: no half vector.
-            float n_dot_l = dot(n, l);
-            if (!(h_len2 > 1e-12) || n_dot_l <= 0.0) {
-                continue;
-            }
-            h *= inversesqrt(h_len2);
-            float lobe = min(lean_lobe(b, c, base, h, dot(to_eye, h), n_dot_v, n_dot_l, ks), peak);
-            specular += lobe * light.radiance_range.rgb * attenuation;
-        }
+        vec3 specular =
+            lean_final_specular(gl_FragCoord.xy, d, vec2(s0.a, s1.x), s1.yzw, gb1.a, gb0.a);
         color = s0.rgb + specular;
     } else {
 #ifdef LUCENT_SSS_BASE

@@ -11,7 +11,8 @@ use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
 use lucent::features::deferred::GBufferPrecision;
-use lucent::features::sss::{SssKnobs, SssPrecision};
+use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
+use lucent::features::sss::{SssBlur, SssKnobs, SssPrecision};
 use lucent::frame::{plan_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use lucent::graph::CompileOptions;
 use lucent::images::output;
@@ -241,6 +242,33 @@ struct FrameArgs {
     /// LBB: bilateral taps per direction (3, 5 or 7; default 5; the thesis's shader has 7).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_taps)]
     sss_taps: Option<u32>,
+    /// The two-pass blurs (separable, bilateral): samples per direction (11, 17 or 25;
+    /// default 17).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_samples)]
+    sss_samples: Option<u32>,
+    /// The separable blur's 1-D kernel: marginal (each Gaussian's 1-D marginal, the default)
+    /// or line (the profile along a line, Jimenez 2015).
+    #[arg(long, value_parser = parse_kernel_shape)]
+    sss_kernel: Option<KernelShape>,
+    /// The separable blur at half resolution per side, upsampled depth-aware.
+    #[arg(long)]
+    sss_half_res: bool,
+}
+
+fn parse_samples(text: &str) -> std::result::Result<u32, String> {
+    SAMPLE_COUNTS
+        .iter()
+        .copied()
+        .find(|n| n.to_string() == text.trim())
+        .ok_or_else(|| format!("'{text}' is not one of 11, 17, 25"))
+}
+
+fn parse_kernel_shape(text: &str) -> std::result::Result<KernelShape, String> {
+    match text {
+        "marginal" => Ok(KernelShape::Marginal),
+        "line" => Ok(KernelShape::Line),
+        _ => Err(format!("'{text}' is not one of marginal, line")),
+    }
 }
 
 /// A whole number in `range`, for the count flags: the bound is checked here, at parse time,
@@ -375,6 +403,9 @@ impl FrameArgs {
                     taps: self.sss_taps.unwrap_or(defaults.taps),
                     // Range-checked by the parser (finite, >= 0).
                     sensitivity: self.sensitivity.unwrap_or(defaults.sensitivity),
+                    samples: self.sss_samples.unwrap_or(defaults.samples),
+                    shape: self.sss_kernel.unwrap_or(defaults.shape),
+                    half_res: self.sss_half_res,
                 }
             },
             debug_view: None,
@@ -392,20 +423,37 @@ impl FrameArgs {
         desc: &FrameDesc,
     ) -> Vec<String> {
         let chains = desc.sss.as_ref().map(|s| s.chains()).unwrap_or_default();
-        let bilateral = chains.iter().any(|b| b.bilateral());
+        let lbb_chain = chains.contains(&SssBlur::LeanBilateral);
+        let separable = chains.contains(&SssBlur::Separable);
+        let two_pass = chains.iter().any(|b| !b.iterative());
+        let iterative = chains.iter().any(|b| b.iterative());
         let sss = !chains.is_empty();
         let translucent = desc.translucency.is_some();
         let lbb = "the bilateral blur: --technique lbb (or SSS materials with blur = \"lbb\")";
-        let blur = "screen-space SSS: --technique control, lcb or lbb (or auto) on a scene \
-                    with SSS materials";
+        let blur = "screen-space SSS: --technique control, lcb, lbb, separable or bilateral \
+                    (or auto) on a scene with SSS materials";
+        let per_gaussian = "the per-Gaussian blurs: --technique control, lcb or lbb (or SSS \
+                            materials with one of those blurs)";
+        let two = "the two-pass blurs: --technique separable or bilateral (or SSS materials \
+                   with one of those blurs)";
+        let sep = "the separable blur: --technique separable (or SSS materials with blur = \
+                   \"separable\")";
         let gdc = "GDC 2011 translucency: --technique translucency (or auto) on a scene with \
                    translucent materials";
         let knobs = [
-            (self.sss_taps.is_some(), "--sss-taps", lbb, bilateral),
-            (self.sss_packed, "--sss-packed", lbb, bilateral),
-            (self.sensitivity.is_some(), "--sensitivity", lbb, bilateral),
+            (self.sss_taps.is_some(), "--sss-taps", lbb, lbb_chain),
+            (self.sss_packed, "--sss-packed", lbb, lbb_chain),
+            (self.sensitivity.is_some(), "--sensitivity", lbb, lbb_chain),
             (self.sss_gaussians.is_some(), "--sss-gaussians", blur, sss),
-            (self.sss_precision.is_some(), "--sss-precision", blur, sss),
+            (
+                self.sss_precision.is_some(),
+                "--sss-precision",
+                per_gaussian,
+                iterative,
+            ),
+            (self.sss_samples.is_some(), "--sss-samples", two, two_pass),
+            (self.sss_kernel.is_some(), "--sss-kernel", sep, separable),
+            (self.sss_half_res, "--sss-half-res", sep, separable),
             (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
             (self.grayscale, "--grayscale", gdc, translucent),
         ];

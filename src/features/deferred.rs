@@ -88,6 +88,9 @@ pub struct GBufferLayout {
     /// Some object has an albedo texture: the G-buffer pass reads UVs and multiplies the
     /// albedo by it.
     pub albedo_maps: bool,
+    /// The separable SSS blur reads linear depth from the lit diffuse's alpha (frames with a
+    /// separable chain and no LEAN chain).
+    pub depth_in_alpha: bool,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
     pub fault_injection: bool,
 }
@@ -544,6 +547,9 @@ impl PassExec for LightingPass {
         }
         if self.layout.lean {
             plain_defines.push(("LUCENT_LEAN", "1"));
+        }
+        if self.layout.depth_in_alpha {
+            plain_defines.push(("LUCENT_DEPTH_IN_ALPHA", "1"));
         }
         if self.layout.fault_injection {
             plain_defines.push(("LUCENT_FAULT_INJECTION", "1"));

@@ -70,9 +70,17 @@ impl FrameDesc {
         })
     }
 
-    /// Whether the frame blurs the LEAN G-buffer (some SSS chain is LCB or LBB).
+    /// Whether the frame blurs the LEAN G-buffer (some SSS chain is LCB, LBB or bilateral).
     pub fn lean(&self) -> bool {
         self.sss.as_ref().is_some_and(SssProfiles::lean)
+    }
+
+    /// Whether some SSS chain is the separable blur (the frame needs its kernel table).
+    pub fn separable(&self) -> bool {
+        self.sss.as_ref().is_some_and(|s| {
+            s.chains()
+                .contains(&crate::features::sss::SssBlur::Separable)
+        })
     }
 
     /// The G-buffer layout this description and `settings` call for.
@@ -95,6 +103,7 @@ impl FrameDesc {
             lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),
             normal_maps: self.normal_maps,
             albedo_maps: self.albedo_maps,
+            depth_in_alpha: self.sss.as_ref().is_some_and(SssProfiles::depth_in_alpha),
             fault_injection: settings.fault.is_some(),
         }
     }
@@ -115,6 +124,11 @@ impl FrameDesc {
             },
             profile_table_bytes: if self.sss.is_some() {
                 crate::features::sss::PROFILE_TABLE_BYTES
+            } else {
+                0
+            },
+            kernel_table_bytes: if self.separable() {
+                crate::features::sss::kernel::KERNEL_TABLE_BYTES
             } else {
                 0
             },

@@ -105,6 +105,8 @@ pub struct SceneUpload<'a> {
     pub translucency_table_bytes: u64,
     /// Bytes of the SSS profile table (0 without SSS).
     pub profile_table_bytes: u64,
+    /// Bytes of the separable kernel table (0 without a separable chain).
+    pub kernel_table_bytes: u64,
 }
 
 /// Side of the procedural textures lucent makes, in texels.
@@ -178,6 +180,7 @@ impl SceneGpu {
             upload.frames_in_flight,
             upload.translucency_table_bytes,
             upload.profile_table_bytes,
+            upload.kernel_table_bytes,
             &scene.name,
         )?;
         let mut out = Self {

@@ -113,9 +113,11 @@ pub enum Region {
     Translucency,
     /// The SSS profile table (frames with SSS).
     Profiles,
+    /// The separable SSS kernel table (frames with a separable chain).
+    Kernels,
 }
 
-const REGIONS: usize = 3;
+const REGIONS: usize = 4;
 
 impl Region {
     fn index(self) -> usize {
@@ -123,6 +125,7 @@ impl Region {
             Region::Frame => 0,
             Region::Translucency => 1,
             Region::Profiles => 2,
+            Region::Kernels => 3,
         }
     }
 }
@@ -166,13 +169,14 @@ pub struct PerFrame {
 
 impl PerFrame {
     /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with a
-    /// translucency region of `translucency_bytes` and a profile region of `profile_bytes`
-    /// (0: the frame has none).
+    /// translucency region of `translucency_bytes`, a profile region of `profile_bytes` and a
+    /// kernel region of `kernel_bytes` (0: the frame has none).
     pub fn new(
         gpu: &GpuContext,
         slots: usize,
         translucency_bytes: u64,
         profile_bytes: u64,
+        kernel_bytes: u64,
         name: &str,
     ) -> Result<Self> {
         if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&slots) {
@@ -186,6 +190,7 @@ impl PerFrame {
             std::mem::size_of::<FrameUniforms>() as u64,
             translucency_bytes,
             profile_bytes,
+            kernel_bytes,
         ];
         let mut offsets = [0u64; REGIONS];
         let mut end = 0u64;

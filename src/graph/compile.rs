@@ -273,7 +273,7 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
         }
     }
     let slots = if options.alias {
-        assign_slots(&mut planned)
+        assign_slots(&mut planned, options.chained_frames)
     } else {
         Vec::new()
     };
@@ -715,7 +715,7 @@ fn add_dependency(
 
 /// Greedy interval colouring: each transient image goes into the slot that freed up last before
 /// it starts (best fit by size); imported and exported images never share memory.
-fn assign_slots(planned: &mut [PlannedResource]) -> Vec<MemorySlot> {
+fn assign_slots(planned: &mut [PlannedResource], chained_frames: bool) -> Vec<MemorySlot> {
     let mut candidates: Vec<ResourceId> = (0..planned.len())
         .filter(|&r| {
             planned[r].lifetime.is_some() && !planned[r].imported && planned[r].export.is_none()
@@ -724,11 +724,23 @@ fn assign_slots(planned: &mut [PlannedResource]) -> Vec<MemorySlot> {
     candidates.sort_by_key(|&r| (planned[r].lifetime.map(|l| l.0), r));
     let mut slots: Vec<MemorySlot> = Vec::new();
     let mut slot_end: Vec<usize> = Vec::new();
+    // A barrier on an image covers that image's memory only: an image larger than the slot's
+    // last owner would inherit, beyond the last owner's extent, writes of an earlier owner that
+    // no barrier made available (a write-after-write hazard). So an image takes over a slot only
+    // if it is no larger than the last owner, or no earlier owner reached past the last one
+    // (the memory beyond is untouched this frame). Chained frames (frames in flight) touched
+    // the whole slot in the previous frame: there, never larger.
+    let mut slot_last_bytes: Vec<u64> = Vec::new();
+    let mut slot_earlier_bytes: Vec<u64> = Vec::new();
     for r in candidates {
         let (first, last) = planned[r].lifetime.expect("filtered above");
         let bytes = planned[r].estimated_bytes();
+        let fits = |s: usize| {
+            bytes <= slot_last_bytes[s]
+                || (!chained_frames && slot_earlier_bytes[s] <= slot_last_bytes[s])
+        };
         let free = (0..slots.len())
-            .filter(|&s| slot_end[s] < first)
+            .filter(|&s| slot_end[s] < first && fits(s))
             .min_by_key(|&s| slots[s].estimated_bytes.abs_diff(bytes));
         let s = match free {
             Some(s) => s,
@@ -738,12 +750,18 @@ fn assign_slots(planned: &mut [PlannedResource]) -> Vec<MemorySlot> {
                     estimated_bytes: 0,
                 });
                 slot_end.push(0);
+                slot_last_bytes.push(u64::MAX);
+                slot_earlier_bytes.push(0);
                 slots.len() - 1
             }
         };
+        if slot_last_bytes[s] != u64::MAX {
+            slot_earlier_bytes[s] = slot_earlier_bytes[s].max(slot_last_bytes[s]);
+        }
         slots[s].resources.push(r);
         slots[s].estimated_bytes = slots[s].estimated_bytes.max(bytes);
         slot_end[s] = last;
+        slot_last_bytes[s] = bytes;
         planned[r].slot = Some(s);
     }
     slots

@@ -42,6 +42,8 @@ use crate::{LucentError, Result};
 pub use crate::scene::material::SssBlur;
 
 mod iterative;
+pub mod kernel;
+mod two_pass;
 
 use super::util::{Binding, PassPipeline};
 
@@ -115,7 +117,8 @@ impl SssProfiles {
         chains
     }
 
-    /// Blur steps of `chain`: its longest profile's Gaussian count.
+    /// Blur steps of `chain`: its longest profile's Gaussian count (the iterative chains'
+    /// blur pairs; a two-pass chain has one pair whatever it is).
     pub fn steps(&self, chain: SssBlur) -> usize {
         self.profiles
             .iter()
@@ -130,6 +133,12 @@ impl SssProfiles {
         self.profiles.iter().any(|(_, b)| b.lean())
     }
 
+    /// Whether the lighting pass writes linear depth into the lit diffuse's alpha for the
+    /// separable blur's taps (a separable chain, and no LEAN chain whose slope x lives there).
+    pub fn depth_in_alpha(&self) -> bool {
+        !self.lean() && self.chains().contains(&SssBlur::Separable)
+    }
+
     /// The profile of `object`, if it scatters.
     pub fn of_object(&self, object: usize) -> Option<&(SssProfile, SssBlur)> {
         let id = *self.object_ids.get(object)?;
@@ -142,12 +151,35 @@ impl SssProfiles {
         let mut table = ProfileTableGpu {
             info: [[0.0; 4]; MAX_SSS_PROFILES],
             steps: [[[0.0; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+            gaussians: [[0.0; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
         };
         for (i, (profile, blur)) in self.profiles.iter().enumerate() {
             let id = i + 1;
             let chain = chains.iter().position(|c| c == blur).unwrap_or(0);
             let steps = blur_steps(profile);
-            table.info[id] = [chain as f32, steps.len() as f32, 0.0, 0.0];
+            table.info[id] = [
+                chain as f32,
+                steps.len() as f32,
+                profile.gaussians.len().min(MAX_SSS_STEPS) as f32,
+                0.0,
+            ];
+            // The whole profile in world units, for the two-pass bilateral blur's weights: its
+            // 1-D form at the tap's distance d, sum_i w_i exp(-d^2 / 2 v_i) / sqrt(2 pi v_i)
+            // (each pass blurs along one axis; the Gaussians' marginals are what a separable
+            // pair of passes composes back into the 2-D profile best, kernel.rs measures it),
+            // weights normalised per channel.
+            let units = profile.units_per_mm;
+            let total = profile
+                .gaussians
+                .iter()
+                .fold(glam::Vec3::ZERO, |acc, g| acc + g.weight);
+            for (k, g) in profile.gaussians.iter().take(MAX_SSS_STEPS).enumerate() {
+                // Guarded: a variance under 1e-12 world units^2 is a delta at any scale.
+                let v = (g.variance * units * units).max(1e-12);
+                let w = g.weight / total.max(glam::Vec3::splat(1e-30));
+                let norm = w / (2.0 * std::f32::consts::PI * v).sqrt();
+                table.gaussians[id * MAX_SSS_STEPS + k] = [norm.x, norm.y, norm.z, 0.5 / v];
+            }
             let mut completed_variance = 0.0f32;
             for (s, step) in steps.iter().take(MAX_SSS_STEPS).enumerate() {
                 completed_variance += step.sigma * step.sigma;
@@ -180,6 +212,11 @@ pub struct ProfileTableGpu {
     /// Per ID and step (`id * MAX_SSS_STEPS + step`): `[sigma in world units, depth term, 0,
     /// 0]` and `[weight r, g, b, their mean]`.
     pub steps: [[[f32; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+    /// Per ID and Gaussian (`id * MAX_SSS_STEPS + i`, `info[id].z` of them): RGB weight
+    /// normalised per channel over sqrt(2 pi v), and 1 / 2v, with v in world units squared
+    /// (the two-pass bilateral blur evaluates the whole profile's 1-D form at each tap's 3D
+    /// distance).
+    pub gaussians: [[f32; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
 }
 
 /// Bytes of [`ProfileTableGpu`] (the per-frame buffer's profile region).
@@ -302,6 +339,14 @@ pub struct SssKnobs {
     /// and closer to the brute-force reference than 7 on the edges scene. The control's kernel
     /// is Jimenez's 7 taps.
     pub taps: u32,
+    /// The two-pass blurs (separable, bilateral): samples per direction, 11, 17 or 25
+    /// ([`kernel::SAMPLE_COUNTS`]).
+    pub samples: u32,
+    /// The separable blur's 1-D kernel function ([`kernel::KernelShape`]).
+    pub shape: kernel::KernelShape,
+    /// The separable blur at half resolution per side (a quarter of the pixels), upsampled
+    /// depth-aware in a combine pass.
+    pub half_res: bool,
 }
 
 impl Default for SssKnobs {
@@ -312,6 +357,9 @@ impl Default for SssKnobs {
             sensitivity: DEFAULT_SENSITIVITY,
             packed: false,
             taps: 5,
+            samples: kernel::DEFAULT_SAMPLES,
+            shape: kernel::KernelShape::Marginal,
+            half_res: false,
         }
     }
 }
@@ -369,14 +417,19 @@ pub fn sss_passes(
             prefix,
             last: index + 1 == chains.len(),
         };
-        base = Some(iterative::chain_passes(
-            graph,
-            inputs,
-            &chain,
-            base.as_ref(),
-            knobs,
-            scene,
-        ));
+        base = Some(if blur.iterative() {
+            iterative::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene)
+        } else {
+            two_pass::chain_passes(
+                graph,
+                inputs,
+                &chain,
+                base.as_ref(),
+                knobs,
+                profiles.depth_in_alpha(),
+                scene,
+            )
+        });
     }
     base.expect("SssProfiles is never empty")
 }

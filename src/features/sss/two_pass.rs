@@ -1,0 +1,413 @@
+//! The two-pass chains (separable, bilateral): one horizontal and one vertical pass blur every
+//! profile of the chain with a kernel made from the whole profile (glsl/sss/separable.frag),
+//! the vertical pass writing the chain's result itself. The separable blur can run at half
+//! resolution per side, then a full-resolution `upsample` pass composes it depth-aware
+//! (glsl/sss/upsample.frag).
+//!
+//! Pass names: `horizontal blur`, `vertical blur` (and `upsample`), prefixed by the blur in
+//! frames with several chains.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{
+    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur, SssInputs,
+    SssKnobs,
+};
+use crate::features::deferred::HDR_FORMAT;
+use crate::features::util::{
+    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+};
+use crate::gpu_scene::{Region, SceneGpu, TileRect};
+use crate::graph::{
+    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
+    RenderGraph, ResourceId,
+};
+use crate::Result;
+
+/// Declares a two-pass chain (see the module docs); `depth_in_alpha`: the lit diffuse's alpha
+/// holds linear depth (frames without a LEAN chain). Returns the chain's result.
+pub(super) fn chain_passes(
+    graph: &mut RenderGraph,
+    inputs: &SssInputs<'_>,
+    chain: &Chain,
+    base: Option<&Handle<Image>>,
+    knobs: &SssKnobs,
+    depth_in_alpha: bool,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let blur = chain.blur;
+    let full = ImageInfo {
+        format: HDR_FORMAT,
+        ..graph.resources()[inputs.diffuse.id()].info
+    };
+    let half_res = knobs.half_res && blur == SssBlur::Separable;
+    let blur_info = if half_res {
+        ImageInfo {
+            width: full.width.div_ceil(2),
+            height: full.height.div_ceil(2),
+            ..full
+        }
+    } else {
+        full
+    };
+    let lean = match (blur.lean(), inputs.lean) {
+        (true, Some(l)) => Some(l),
+        _ => None,
+    };
+    let samples = knobs.samples;
+    // Fetches per pixel of a blur pass, for the benchmark's cost per tap: the centre texels,
+    // depth and profile ID, then each sample's texels (and its depth where it does not travel
+    // in alpha, and its profile ID with several profiles).
+    let fetches = |texels: u32, depth_fetch: bool| {
+        let per_sample = texels + u32::from(depth_fetch) + u32::from(chain.edges);
+        texels + 2 + samples * per_sample
+    };
+    let mut temp = graph.create_image(&chain.image_name("temp"), blur_info);
+    let mut temp_lean = lean.map(|_| graph.create_image(&chain.image_name("temp.lean"), blur_info));
+    let constants = |direction: [f32; 2]| BlurConstants {
+        step: [direction[0], direction[1], 0.0, chain.index as f32],
+    };
+    let spec = |vertical: bool, compose: bool, inputs: Vec<ResourceId>| PassSpec {
+        blur,
+        vertical,
+        compose,
+        half_res,
+        base: compose && base.is_some(),
+        edges: chain.edges,
+        depth_in_alpha: depth_in_alpha || vertical,
+        samples,
+        chain: chain.index,
+        constants: constants(if vertical { [0.0, 1.0] } else { [1.0, 0.0] }),
+        inputs,
+    };
+
+    // Horizontal: the lit diffuse (and the LEAN target) into the temporaries.
+    let mut pass = graph.add_pass(
+        &format!("{}horizontal blur", chain.prefix),
+        PassKind::Raster,
+    );
+    let mut reads: Vec<&Handle<Image>> = vec![inputs.diffuse, inputs.depth, inputs.profile_ids];
+    reads.extend(lean);
+    for h in &reads {
+        pass.sample(h);
+    }
+    let texels = 1 + u32::from(lean.is_some());
+    pass.taps(fetches(
+        texels,
+        !depth_in_alpha || blur == SssBlur::Bilateral,
+    ));
+    pass.color(&mut temp, LoadOp::DontCare);
+    if let Some(t) = &mut temp_lean {
+        pass.color(t, LoadOp::DontCare);
+    }
+    let ids = reads.iter().map(|h| h.id()).collect();
+    match scene {
+        Some(scene) => pass.execute(TwoPassBlur::new(scene, spec(false, false, ids))),
+        None => pass.finish(),
+    }
+
+    // Vertical: at full resolution it writes the chain's result; at half resolution a
+    // half-resolution blurred image the upsample composes.
+    let result_name = |chain: &Chain| {
+        if chain.last {
+            "hdr".to_string()
+        } else {
+            chain.image_name("result")
+        }
+    };
+    let mut vertical_out = if half_res {
+        graph.create_image(&chain.image_name("blurred"), blur_info)
+    } else {
+        graph.create_image(&result_name(chain), full)
+    };
+    let mut pass = graph.add_pass(&format!("{}vertical blur", chain.prefix), PassKind::Raster);
+    let mut reads: Vec<&Handle<Image>> = vec![&temp, inputs.depth, inputs.profile_ids];
+    reads.extend(temp_lean.as_ref());
+    if !half_res {
+        reads.extend([inputs.diffuse, inputs.specular]);
+        if lean.is_some() {
+            reads.extend([inputs.gb0, inputs.gb1]);
+        }
+        reads.extend(base);
+    }
+    for h in &reads {
+        pass.sample(h);
+    }
+    pass.taps(fetches(texels, blur == SssBlur::Bilateral));
+    pass.color(&mut vertical_out, LoadOp::DontCare);
+    let ids = reads.iter().map(|h| h.id()).collect();
+    match scene {
+        Some(scene) => pass.execute(TwoPassBlur::new(scene, spec(true, !half_res, ids))),
+        None => pass.finish(),
+    }
+    if !half_res {
+        return vertical_out;
+    }
+
+    // Upsample: the half-resolution blur composed at full resolution.
+    let mut hdr = graph.create_image(&result_name(chain), full);
+    let mut pass = graph.add_pass(&format!("{}upsample", chain.prefix), PassKind::Raster);
+    let mut reads: Vec<&Handle<Image>> = vec![
+        &vertical_out,
+        inputs.depth,
+        inputs.profile_ids,
+        inputs.diffuse,
+        inputs.specular,
+    ];
+    reads.extend(base);
+    for h in &reads {
+        pass.sample(h);
+    }
+    pass.color(&mut hdr, LoadOp::DontCare);
+    let ids = reads.iter().map(|h| h.id()).collect();
+    match scene {
+        Some(scene) => pass.execute(TwoPassBlur::new(
+            scene,
+            PassSpec {
+                constants: constants([0.0, 0.0]),
+                ..spec(true, true, ids)
+            },
+        )),
+        None => pass.finish(),
+    }
+    hdr
+}
+
+/// What one pass of a two-pass chain is.
+#[derive(Clone, Debug)]
+struct PassSpec {
+    blur: SssBlur,
+    /// The vertical pass (its taps read the temporaries).
+    vertical: bool,
+    /// It writes the chain's result (full-resolution vertical pass, or the upsample).
+    compose: bool,
+    half_res: bool,
+    /// The last input is the previous chain's result.
+    base: bool,
+    edges: bool,
+    /// The taps' depth travels in the light's alpha.
+    depth_in_alpha: bool,
+    samples: u32,
+    chain: usize,
+    constants: BlurConstants,
+    /// The images it samples, in the shader's binding order (after the per-frame bindings).
+    inputs: Vec<ResourceId>,
+}
+
+impl PassSpec {
+    /// The upsample pass of a half-resolution chain.
+    fn upsample(&self) -> bool {
+        self.half_res && self.compose
+    }
+
+    fn fragment(&self) -> &'static str {
+        if self.upsample() {
+            "sss/upsample.frag"
+        } else {
+            "sss/separable.frag"
+        }
+    }
+
+    fn defines(&self) -> Vec<(&'static str, &'static str)> {
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.upsample() {
+            if self.base {
+                defines.push(("LUCENT_SSS_BASE", "1"));
+            }
+            return defines;
+        }
+        match self.blur {
+            SssBlur::Bilateral => {
+                defines.push(("LUCENT_SSS_BILATERAL2", "1"));
+                defines.push((
+                    "LUCENT_SSS_SAMPLES",
+                    match self.samples {
+                        11 => "11",
+                        25 => "25",
+                        _ => "17",
+                    },
+                ));
+            }
+            _ => defines.push(("LUCENT_SSS_SEPARABLE", "1")),
+        }
+        if self.vertical {
+            defines.push(("LUCENT_SSS_VERTICAL", "1"));
+        }
+        if self.half_res {
+            defines.push(("LUCENT_SSS_HALF_RES", "1"));
+        }
+        if self.depth_in_alpha && !self.vertical {
+            defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
+        }
+        if self.edges {
+            defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
+        }
+        if self.base {
+            defines.push(("LUCENT_SSS_BASE", "1"));
+        }
+        defines
+    }
+
+    /// Whether the pass reads the kernel table (binding 2).
+    fn kernels(&self) -> bool {
+        self.blur == SssBlur::Separable
+    }
+}
+
+struct TwoPassBlur {
+    scene: Arc<SceneGpu>,
+    spec: PassSpec,
+    /// Linear filtering for the separable blur's taps between texels.
+    linear: vk::Sampler,
+    /// Nearest, for depth and profile IDs and point taps.
+    nearest: vk::Sampler,
+    pipeline: Option<PassPipeline>,
+    /// Composing passes: the variant for rectangles no object of the chain covers.
+    passthrough: Option<GraphicsPipeline>,
+}
+
+impl TwoPassBlur {
+    fn new(scene: &Arc<SceneGpu>, spec: PassSpec) -> Self {
+        Self {
+            scene: scene.clone(),
+            spec,
+            linear: vk::Sampler::null(),
+            nearest: vk::Sampler::null(),
+            pipeline: None,
+            passthrough: None,
+        }
+    }
+}
+
+/// A tile rectangle at half resolution (every half-resolution pixel the full-resolution one
+/// touches).
+fn halved(r: &TileRect) -> TileRect {
+    TileRect {
+        x: r.x / 2,
+        y: r.y / 2,
+        width: (r.x + r.width).div_ceil(2) - r.x / 2,
+        height: (r.y + r.height).div_ceil(2) - r.y / 2,
+        translucent: r.translucent,
+    }
+}
+
+impl PassExec for TwoPassBlur {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        self.linear = clamp_sampler(ctx, vk::Filter::LINEAR)?;
+        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
+        let views = ctx.descriptor_views;
+        let mut bindings = per_frame_bindings(&self.scene);
+        if self.spec.kernels() {
+            bindings.push(Binding::PerFrame(
+                self.scene.per_frame.binding(Region::Kernels),
+            ));
+        }
+        for (i, &id) in self.spec.inputs.iter().enumerate() {
+            // The light the separable blur taps between texels: linear; the rest nearest.
+            let sampler = if i == 0 && self.spec.blur == SssBlur::Separable {
+                self.linear
+            } else {
+                self.nearest
+            };
+            bindings.push(Binding::Sampled(views[id], sampler));
+        }
+        let defines = self.spec.defines();
+        let desc = GraphicsPipelineDesc {
+            vertex: "fullscreen.vert",
+            fragment: self.spec.fragment(),
+            defines: &defines,
+            vertex_input: VertexInput::None,
+            depth_test: false,
+            cull_back: false,
+            additive_attachments: 0,
+            set_layouts: &[],
+            push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
+            name: "sss two-pass blur",
+        };
+        let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        if self.spec.compose {
+            let layouts = [pipeline.set.layout];
+            let mut passthrough_defines = defines.clone();
+            passthrough_defines.push(("LUCENT_SSS_PASSTHROUGH", "1"));
+            let passthrough = GraphicsPipeline::new(
+                ctx,
+                &GraphicsPipelineDesc {
+                    defines: &passthrough_defines,
+                    set_layouts: &layouts,
+                    name: "sss two-pass blur (pass-through)",
+                    ..desc
+                },
+            );
+            match passthrough {
+                Ok(p) => self.passthrough = Some(p),
+                Err(e) => {
+                    let mut pipeline = pipeline;
+                    pipeline.destroy(&ctx.gpu.device);
+                    return Err(e);
+                }
+            }
+        }
+        self.pipeline = Some(pipeline);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        pipeline.bind(ctx);
+        push_constants(ctx, pipeline, &self.spec.constants);
+        let tiles = chain_tiles(&self.scene, ctx, self.spec.chain);
+        // Half-resolution passes (all but the upsample) draw halved rectangles.
+        let scaled = |rects: Vec<TileRect>| {
+            if self.spec.half_res && !self.spec.upsample() {
+                rects.iter().map(halved).collect()
+            } else {
+                rects
+            }
+        };
+        let draw_all = || {
+            // SAFETY: bound above, inside the pass's subpass.
+            unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
+        };
+        match (tiles, &self.passthrough) {
+            (None, _) => draw_all(),
+            // Blurring only: where objects of this chain (and their blur's reach) can be.
+            (Some(rects), None) => {
+                let rects = scaled(rects);
+                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
+            }
+            // Composing: the blur where the chain's objects may be, pass-through elsewhere.
+            (Some(rects), Some(passthrough)) => {
+                let rects = scaled(rects);
+                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
+                // SAFETY: made for this subpass with the bound set's layout (same push
+                // constants).
+                unsafe {
+                    ctx.gpu.device.cmd_bind_pipeline(
+                        ctx.cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        passthrough.pipeline,
+                    );
+                }
+                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
+            }
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.passthrough.take() {
+            p.destroy(&gpu.device);
+        }
+        // SAFETY: created by `prepare` (or null); the GPU is done with them.
+        unsafe {
+            gpu.device.destroy_sampler(self.linear, None);
+            gpu.device.destroy_sampler(self.nearest, None);
+        }
+    }
+}

@@ -49,12 +49,27 @@ vec3 sss_profile_at(int id, float d2) {
 
 #ifdef LUCENT_SSS_KERNELS
 #define MAX_KERNEL_SAMPLES 25
-// The separable blur's kernels (src/features/sss/kernel.rs `KernelTableGpu`), binding 2 of its
-// passes: per profile x the sample count, y one over the reach (world units), z the reach.
+#define FALLOFF_ENTRIES 25
+// The two-pass blurs' kernels (src/features/sss/kernel.rs `KernelTableGpu`), binding 2 of
+// their passes: per profile x the sample count, y one over the kernel's reach (world units),
+// z that reach, w one over the falloff table's reach.
 layout(std140, set = 0, binding = 2) uniform SssKernels {
     vec4 info[MAX_SSS_PROFILES];
     vec4 taps[MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES];  // rgb weight, a offset (world units)
+    vec4 falloff[MAX_SSS_PROFILES * FALLOFF_ENTRIES];  // rgb 1-D profile, a its distance
+    vec4 inverse_falloff[MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES];  // rgb 1 / falloff at offset
 } sss_kernels;
+
+// A bilateral profile's 1-D form per channel at world distance `d`: its falloff table
+// (entries at reach * u^2), interpolated; 0 past the table.
+vec3 sss_falloff(int id, vec4 info, float d) {
+    float x = d * info.w;
+    float u = sqrt(clamp(x, 0.0, 1.0)) * float(FALLOFF_ENTRIES - 1);
+    int i = min(int(u), FALLOFF_ENTRIES - 2);
+    vec3 a = sss_kernels.falloff[id * FALLOFF_ENTRIES + i].rgb;
+    vec3 b = sss_kernels.falloff[id * FALLOFF_ENTRIES + i + 1].rgb;
+    return x >= 1.0 ? vec3(0.0) : mix(a, b, u - float(i));
+}
 #endif
 
 #endif

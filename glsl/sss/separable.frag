@@ -6,6 +6,8 @@
 // permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_VERTICAL LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_VERTICAL LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES
 // permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_HALF_RES
+// permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_POINT_TAPS LUCENT_SSS_DEPTH_IN_ALPHA
+// permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_POINT_TAPS LUCENT_SSS_VERTICAL
 // permutation: LUCENT_SSS_SEPARABLE LUCENT_SSS_HALF_RES LUCENT_SSS_VERTICAL
 // permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=17
 // permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=11 LUCENT_SSS_VERTICAL
@@ -34,20 +36,14 @@
 // - LUCENT_SSS_PROFILE_EDGES (several profiles in the frame): a tap on another profile's pixel
 //   counts as an edge. LUCENT_SSS_PASSTHROUGH: the vertical pass's variant for rectangles no
 //   object of the chain covers (compose only).
-#ifdef LUCENT_SSS_SEPARABLE
 #define LUCENT_SSS_KERNELS
-#endif
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 #ifdef LUCENT_SSS_BILATERAL2
 #include "../common/lean.glsl"
 #endif
 
-#ifdef LUCENT_SSS_SEPARABLE
 #define IMAGE0 3
-#else
-#define IMAGE0 2
-#endif
 layout(set = 0, binding = IMAGE0) uniform sampler2D color_tex;        // light (+ alpha)
 layout(set = 0, binding = IMAGE0 + 1) uniform sampler2D depth_tex;    // device depth, full res
 layout(set = 0, binding = IMAGE0 + 2) uniform sampler2D profile_tex;  // profile IDs, full res
@@ -103,19 +99,33 @@ void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(color_tex, 0);
     ivec2 full_px = full_res_pixel(px);
+#if defined(LUCENT_SSS_SEPARABLE) && defined(LUCENT_SSS_VERTICAL) && !defined(LUCENT_SSS_HALF_RES) && !defined(LUCENT_SSS_PROFILE_EDGES)
+    // One profile in the frame (ID 1), and the horizontal pass marked the pixels that scatter
+    // by the sign of the depth it passes on: no profile fetch.
+#define SCATTER_FROM_ALPHA
+    int id = 1;
+#else
     int id = sss_profile_id(texelFetch(profile_tex, full_px, 0).r);
+#endif
+#if defined(LUCENT_SSS_SEPARABLE) && !(defined(LUCENT_SSS_HALF_RES) && !defined(LUCENT_SSS_VERTICAL)) && (defined(LUCENT_SSS_DEPTH_IN_ALPHA) || defined(LUCENT_SSS_VERTICAL))
+    // The pixel's linear depth travels with its light (sky: the far plane; its profile ID is
+    // 0, so it never scatters): one fetch fewer per pixel.
+#define DEPTH_FROM_ALPHA
+#endif
+#ifdef DEPTH_FROM_ALPHA
+    float device_depth = 0.0;
+#else
     float device_depth = texelFetch(depth_tex, full_px, 0).r;
+#endif
 #ifdef LUCENT_SSS_PASSTHROUGH
     bool scatters = false;
+#elif defined(SCATTER_FROM_ALPHA)
+    bool scatters = texelFetch(color_tex, px, 0).a > 0.0;
+#elif defined(DEPTH_FROM_ALPHA)
+    bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
 #else
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5)) && device_depth < 1.0;
 #endif
-    float depth_m = linear_depth(device_depth);
-    // Pixels per world unit at the pixel's depth (at half resolution, half as many).
-    float px_per_unit = frame.camera.z / max(depth_m, 1e-4) * float(size.y) / frame.viewport.y;
-    // The taps' reach is clamped to a quarter of the screen: an extreme profile or a surface at
-    // the near plane must not sample across the whole image.
-    float max_px = 0.25 * float(max(size.x, size.y));
 #if defined(LUCENT_SSS_HALF_RES) && !defined(LUCENT_SSS_VERTICAL)
     // The light at the block's centre: bilinear between its four pixels.
     vec2 centre_uv = (vec2(full_px) + 1.0) * frame.viewport.zw;
@@ -126,6 +136,16 @@ void main() {
     vec4 center = finite_or(texelFetch(color_tex, px, 0), vec4(0.0));
     vec2 texel = 1.0 / vec2(size);
 #endif
+#ifdef DEPTH_FROM_ALPHA
+    float depth_m = abs(center.a);
+#else
+    float depth_m = linear_depth(device_depth);
+#endif
+    // Pixels per world unit at the pixel's depth (at half resolution, half as many).
+    float px_per_unit = frame.camera.z / max(depth_m, 1e-4) * float(size.y) / frame.viewport.y;
+    // The taps' reach is clamped to a quarter of the screen: an extreme profile or a surface at
+    // the near plane must not sample across the whole image.
+    float max_px = 0.25 * float(max(size.x, size.y));
     vec3 blurred = center.rgb;
 #ifdef LUCENT_SSS_BILATERAL2
     vec4 center_lean = finite_or(texelFetch(lean_tex, px, 0), vec4(0.0));
@@ -141,9 +161,16 @@ void main() {
         for (int k = 0; k < samples; ++k) {
             vec4 tap = sss_kernels.taps[id * MAX_KERNEL_SAMPLES + k];
             vec2 uv = centre_uv + blur.step.xy * (tap.a * scale) * texel;
-            vec4 color = finite_or(textureLod(color_tex, uv, 0.0), center);
+#ifdef LUCENT_SSS_POINT_TAPS
+            // The nearest texel: one fetch where a bilinear tap costs four on a CPU driver.
+            vec4 color =
+                texelFetch(color_tex, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0);
+#else
+            vec4 color = textureLod(color_tex, uv, 0.0);
+#endif
 #if defined(LUCENT_SSS_DEPTH_IN_ALPHA) || defined(LUCENT_SSS_VERTICAL)
-            float depth = color.a;
+            // (The horizontal pass passes depth on signed: negative where nothing scatters.)
+            float depth = abs(color.a);
 #else
             float depth = linear_depth(texelFetch(depth_tex, ivec2(uv * frame.viewport.xy), 0).r);
 #endif
@@ -156,32 +183,35 @@ void main() {
 #endif
             sum += tap.rgb * mix(color.rgb, center.rgb, s);
         }
-        blurred = sum;
+        // A NaN or Inf tap would poison the pixel: checked once on the sum (a poisoned sum
+        // keeps the pixel's own light), so one bad pixel never spreads.
+        blurred = any(isnan(sum)) || any(isinf(sum)) ? center.rgb : sum;
 #else
-        // The whole profile's reach (three standard deviations of its widest Gaussian), in
-        // whole texels, spread evenly over the taps.
-        const int half_taps = LUCENT_SSS_SAMPLES / 2;
-        float widest = 0.0;
-        int count = clamp(int(sss_profiles.info[id].z + 0.5), 0, MAX_SSS_STEPS);
-        for (int i = 0; i < count; ++i) {
-            widest = max(widest, 0.5 / max(sss_profiles.gaussians[id * MAX_SSS_STEPS + i].a,
-                                           1e-30));
-        }
-        float reach_px = min(3.0 * sqrt(widest) * px_per_unit, max_px);
-        float spacing = reach_px / float(half_taps);
-        // Below half a texel every tap rounds onto the centre: the pixel stays as it is.
-        if (reach_px >= 0.5) {
+        // The profile's kernel (as the separable blur's: pre-integrated weights at offsets in
+        // world units), as nearest texels; each tap's weight then falls off with the depth
+        // difference as the profile does: its 1-D form at the tap's 3D distance over that at
+        // its screen offset (exact for every Gaussian of the sum:
+        // G(sqrt(x^2 + dz^2)) = G(x) exp(-dz^2 / 2v)).
+        vec4 info = sss_kernels.info[id];
+        int samples = min(LUCENT_SSS_SAMPLES, clamp(int(info.x + 0.5), 1, MAX_KERNEL_SAMPLES));
+        float scale = min(px_per_unit, max_px / max(info.z, 1e-9));
+        {
             vec3 sum = vec3(0.0), total = vec3(0.0);
             vec4 sum_lean = vec4(0.0);
             float sum_slope_x = 0.0, total_lean = 0.0;
             vec2 b_center = vec2(center.a, center_lean.x);
-            for (int k = -half_taps; k <= half_taps; ++k) {
-                float offset = round(float(k) * spacing);
+            for (int k = 0; k < samples; ++k) {
+                vec4 kernel_tap = sss_kernels.taps[id * MAX_KERNEL_SAMPLES + k];
+                float offset = round(kernel_tap.a * scale);
                 ivec2 tap = clamp(px + ivec2(blur.step.xy * offset), ivec2(0), size - 1);
                 float dz = linear_depth(texelFetch(depth_tex, tap, 0).r) - depth_m;
-                float dx = offset / px_per_unit;
-                // The profile at the 3D distance, times the interval the tap stands for.
-                vec3 w = sss_profile_at(id, dx * dx + dz * dz) * max(spacing, 1.0);
+                // The profile at the tap's 3D distance (its offset in world units and the depth
+                // difference) over the profile at its offset: <= 1, as the profile falls off
+                // with distance (clamped against the table's interpolation); 0 past the table.
+                float dx = kernel_tap.a;
+                vec3 falloff = sss_falloff(id, info, sqrt(dx * dx + dz * dz)) *
+                    sss_kernels.inverse_falloff[id * MAX_KERNEL_SAMPLES + k].rgb;
+                vec3 w = kernel_tap.rgb * clamp(falloff, vec3(0.0), vec3(1.0));
 #ifdef LUCENT_SSS_PROFILE_EDGES
                 int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
                 w = tap_id != id && tap_id != 0 ? vec3(0.0) : w;
@@ -199,8 +229,9 @@ void main() {
                 sum_lean += w_lean * lean;
                 total_lean += w_lean;
             }
-            // The centre tap carries the profile's peak: the totals are > 0 for any profile
-            // with weight in a channel; a channel without keeps its light.
+            // The centre tap (offset 0, depth difference 0) keeps its whole weight: the totals
+            // are > 0 for any profile with weight in a channel; a channel without keeps its
+            // light.
             blurred = mix(center.rgb, sum / max(total, vec3(1e-30)), greaterThan(total, vec3(0.0)));
             if (total_lean > 0.0) {
                 blurred_slope_x = sum_slope_x / total_lean;
@@ -237,7 +268,9 @@ void main() {
     out_color = vec4(blurred, clamp(blurred_slope_x, -65504.0, 65504.0));
     out_lean = clamp(blurred_lean, vec4(-65504.0), vec4(65504.0));
 #else
-    // The pixel's linear depth travels in alpha: the next pass's taps read it with the light.
-    out_color = vec4(blurred, depth_m);
+    // The pixel's linear depth travels in alpha, so the next pass's taps read it with the
+    // light; negative where the pixel does not scatter (the vertical pass then needs no
+    // profile ID in one-profile frames).
+    out_color = vec4(blurred, scatters ? depth_m : -depth_m);
 #endif
 }

@@ -57,7 +57,8 @@ void main() {
                     continue;
                 }
                 float bilinear = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
-                float dz = abs(texel.a - depth);
+                // The half-resolution pass passes depth on signed (negative: not scattering).
+                float dz = abs(abs(texel.a) - depth);
                 float w = bilinear * (1.0 - clamp(dz * edge, 0.0, 1.0));
                 sum += w * texel.rgb;
                 total += w;

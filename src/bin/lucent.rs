@@ -253,6 +253,18 @@ struct FrameArgs {
     /// The separable blur at half resolution per side, upsampled depth-aware.
     #[arg(long)]
     sss_half_res: bool,
+    /// The separable blur's taps: bilinear (between texels, Jimenez's) or point (the nearest
+    /// texel: one fetch instead of four on a CPU driver).
+    #[arg(long, value_parser = parse_filter)]
+    sss_filter: Option<bool>,
+}
+
+fn parse_filter(text: &str) -> std::result::Result<bool, String> {
+    match text {
+        "point" => Ok(true),
+        "bilinear" => Ok(false),
+        _ => Err(format!("'{text}' is not one of point, bilinear")),
+    }
 }
 
 fn parse_samples(text: &str) -> std::result::Result<u32, String> {
@@ -406,6 +418,7 @@ impl FrameArgs {
                     samples: self.sss_samples.unwrap_or(defaults.samples),
                     shape: self.sss_kernel.unwrap_or(defaults.shape),
                     half_res: self.sss_half_res,
+                    point_taps: self.sss_filter.unwrap_or(defaults.point_taps),
                 }
             },
             debug_view: None,
@@ -454,6 +467,7 @@ impl FrameArgs {
             (self.sss_samples.is_some(), "--sss-samples", two, two_pass),
             (self.sss_kernel.is_some(), "--sss-kernel", sep, separable),
             (self.sss_half_res, "--sss-half-res", sep, separable),
+            (self.sss_filter.is_some(), "--sss-filter", sep, separable),
             (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
             (self.grayscale, "--grayscale", gdc, translucent),
         ];

@@ -75,11 +75,14 @@ impl FrameDesc {
         self.sss.as_ref().is_some_and(SssProfiles::lean)
     }
 
-    /// Whether some SSS chain is the separable blur (the frame needs its kernel table).
-    pub fn separable(&self) -> bool {
+    /// Whether some SSS chain is a two-pass blur (separable or bilateral): the frame needs
+    /// the kernel table those passes read their weights from.
+    pub fn two_pass(&self) -> bool {
+        use crate::features::sss::SssBlur;
         self.sss.as_ref().is_some_and(|s| {
             s.chains()
-                .contains(&crate::features::sss::SssBlur::Separable)
+                .iter()
+                .any(|b| matches!(b, SssBlur::Separable | SssBlur::Bilateral))
         })
     }
 
@@ -127,7 +130,7 @@ impl FrameDesc {
             } else {
                 0
             },
-            kernel_table_bytes: if self.separable() {
+            kernel_table_bytes: if self.two_pass() {
                 crate::features::sss::kernel::KERNEL_TABLE_BYTES
             } else {
                 0

@@ -195,7 +195,7 @@ impl Renderer {
         if let Some(profiles) = &desc.sss {
             let table = profiles.table(&self.settings.sss);
             per_frame.write(slot, Region::Profiles, bytemuck::bytes_of(&table))?;
-            if desc.separable() {
+            if desc.two_pass() {
                 let knobs = &self.settings.sss;
                 let kernels = sss::kernel::kernel_table(profiles, knobs.samples, knobs.shape);
                 per_frame.write(slot, Region::Kernels, bytemuck::bytes_of(&kernels))?;

@@ -61,14 +61,22 @@ pub struct SssResult {
     pub fit_error: Option<f64>,
 }
 
-/// Every variant: the three techniques at their defaults, then one LBB knob at a time.
+/// Every variant: the five techniques at their defaults, then one knob at a time (the
+/// per-Gaussian blurs' Gaussian counts and LBB's knobs, the two-pass blurs' samples, taps,
+/// kernel and resolution).
 pub fn sss_variants() -> Vec<SssVariant> {
     let base = |technique| FrameSettings {
         technique,
         ..FrameSettings::new(1, 1)
     };
     let mut v = Vec::new();
-    for t in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+    for t in [
+        Technique::Control,
+        Technique::Lcb,
+        Technique::Lbb,
+        Technique::Separable,
+        Technique::Bilateral,
+    ] {
         v.push(SssVariant {
             knob: "technique",
             name: t.name().into(),
@@ -120,6 +128,53 @@ pub fn sss_variants() -> Vec<SssVariant> {
         name: "lbb whole screen".into(),
         settings: whole,
     });
+    let defaults = crate::features::sss::SssKnobs::default();
+    for t in [Technique::Separable, Technique::Bilateral] {
+        for samples in crate::features::sss::kernel::SAMPLE_COUNTS {
+            if samples == defaults.samples {
+                continue;
+            }
+            let mut s = base(t);
+            s.sss.samples = samples;
+            v.push(SssVariant {
+                knob: if t == Technique::Separable {
+                    "separable samples"
+                } else {
+                    "bilateral samples"
+                },
+                name: format!("{} {samples} samples", t.name()),
+                settings: s,
+            });
+        }
+    }
+    let mut filter = base(Technique::Separable);
+    filter.sss.point_taps = !defaults.point_taps;
+    v.push(SssVariant {
+        knob: "separable taps",
+        name: format!(
+            "separable {} taps",
+            if filter.sss.point_taps {
+                "point"
+            } else {
+                "bilinear"
+            }
+        ),
+        settings: filter,
+    });
+    let mut line = base(Technique::Separable);
+    line.sss.shape = crate::features::sss::kernel::KernelShape::Line;
+    v.push(SssVariant {
+        knob: "separable kernel",
+        name: "separable line kernel".into(),
+        settings: line,
+    });
+    let mut half_res = base(Technique::Separable);
+    half_res.sss.half_res = true;
+    v.push(SssVariant {
+        knob: "separable resolution",
+        name: "separable half resolution".into(),
+        settings: half_res,
+    });
     v
 }
 
@@ -146,9 +201,10 @@ fn error_scene(scene: &Scene, factor: f32, no_specular: bool) -> Scene {
     s
 }
 
-/// Whether a physical pass belongs to the SSS technique (blurs, combine, final lighting).
+/// Whether a physical pass belongs to the SSS technique (blurs, combine, final lighting,
+/// upsample).
 fn is_sss_pass(name: &str) -> bool {
-    name.contains("blur #") || name == "combine" || name == "final lighting"
+    name.contains("blur") || name == "combine" || name == "final lighting" || name == "upsample"
 }
 
 /// Measures every variant: times on `teapot` at the options' size, errors on `edges`.
@@ -260,7 +316,7 @@ pub fn run(
                     .plan
                     .physical
                     .iter()
-                    .filter(|p| p.name.starts_with("vertical blur #"))
+                    .filter(|p| p.name.starts_with("vertical blur"))
                     .count();
                 (Stats::of(frame), Stats::of(sss), pairs)
             })

@@ -12,9 +12,12 @@
 //! 1-D functions are offered and measured ([`KernelShape`], [`separability_error`]): the profile
 //! along a line (Jimenez's choice) and the sum of the Gaussians' 1-D marginals.
 //!
-//! **Bilateral** (the two-pass LEAN blur) evaluates the whole profile at each tap's 3D distance
-//! in the shader, from the profile's Gaussians ([`super::ProfileTableGpu::gaussians`]); its taps
-//! are evenly spaced whole texels, so it needs no table here.
+//! **Bilateral** (the two-pass LEAN blur) weighs each tap by the whole profile at the tap's 3D
+//! distance: its entries in the same table are the profile's 1-D form tabulated at
+//! `MAX_KERNEL_SAMPLES` distances `reach * u^2` (denser near the centre, where the narrow
+//! Gaussians are), which the shader interpolates: six exponentials per tap cost more than every
+//! fetch of the pass on a CPU driver (measured: the horizontal pass 112 ms with them, 47 ms
+//! with one).
 
 use glam::DVec3;
 
@@ -185,39 +188,67 @@ pub fn separability_error(profile: &SssProfile, shape: KernelShape) -> [f64; 3] 
     std::array::from_fn(|c| diff[c])
 }
 
-/// The separable kernel table uniform block (std140, glsl/common/sss.glsl `SssKernels`),
-/// indexed by profile ID like [`super::ProfileTableGpu`].
+/// The two-pass blurs' kernel table uniform block (std140, glsl/common/sss.glsl
+/// `SssKernels`), indexed by profile ID like [`super::ProfileTableGpu`]: a separable profile's
+/// kernel, or a bilateral profile's tabulated weights.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct KernelTableGpu {
-    /// Per ID: x the sample count, y one over the kernel's reach in world units (the follow-
-    /// surface depth term: a depth step as deep as the kernel is wide is a full edge), z the
+    /// Per ID: x the sample count, y one over the kernel's reach in world units (separable:
+    /// the follow-surface depth term, a depth step as deep as the kernel is wide is a full
+    /// edge), z the kernel's reach in world units, w (bilateral) one over the falloff table's
     /// reach in world units.
     pub info: [[f32; 4]; MAX_SSS_PROFILES],
-    /// Per ID and sample (`id * MAX_KERNEL_SAMPLES + k`): RGB weight, offset in world units.
+    /// Per ID and sample (`id * MAX_KERNEL_SAMPLES + k`): RGB weight and offset in world units.
     pub taps: [[f32; 4]; MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES],
+    /// Per bilateral ID and entry (`id * FALLOFF_ENTRIES + k`): the profile's 1-D form per
+    /// channel (per world unit) at distance `reach * (k / (FALLOFF_ENTRIES - 1))^2`, and that
+    /// distance.
+    pub falloff: [[f32; 4]; MAX_SSS_PROFILES * FALLOFF_ENTRIES],
+    /// Per bilateral ID and sample: one over the falloff table's value at the sample's offset
+    /// (RGB; 0 where the table holds 0), so a tap needs one table lookup, at its 3D distance.
+    pub inverse_falloff: [[f32; 4]; MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES],
 }
+
+/// Entries of a bilateral profile's falloff table (glsl/common/sss.glsl `FALLOFF_ENTRIES`).
+pub const FALLOFF_ENTRIES: usize = 25;
 
 /// Bytes of [`KernelTableGpu`] (the per-frame buffer's kernel region).
 pub const KERNEL_TABLE_BYTES: u64 = std::mem::size_of::<KernelTableGpu>() as u64;
 
-/// The kernel table of `profiles` with `samples` samples of `shape`.
+/// How far a bilateral profile's table reaches, mm: the kernel's reach (three standard
+/// deviations of its widest Gaussian) times 1.5, since a tap's 3D distance adds the depth
+/// difference to its offset.
+pub fn bilateral_reach_mm(profile: &SssProfile) -> f64 {
+    1.5 * range_mm(profile)
+}
+
+/// The kernel table of `profiles`: for two-pass profiles their `samples`-sample kernels of
+/// `shape`, and for bilateral profiles also their tabulated falloff (the weight a tap gets at
+/// its 3D distance, relative to the weight at its screen offset).
 pub fn kernel_table(profiles: &SssProfiles, samples: u32, shape: KernelShape) -> KernelTableGpu {
     let mut table = KernelTableGpu {
         info: [[0.0; 4]; MAX_SSS_PROFILES],
         taps: [[0.0; 4]; MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES],
+        falloff: [[0.0; 4]; MAX_SSS_PROFILES * FALLOFF_ENTRIES],
+        inverse_falloff: [[0.0; 4]; MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES],
     };
-    for (i, (profile, _)) in profiles.profiles.iter().enumerate() {
+    for (i, (profile, blur)) in profiles.profiles.iter().enumerate() {
+        if !matches!(blur, super::SssBlur::Separable | super::SssBlur::Bilateral) {
+            continue;
+        }
         let id = i + 1;
-        let kernel = separable_kernel(profile, samples as usize, shape);
         let units = f64::from(profile.units_per_mm);
+        let kernel = separable_kernel(profile, samples as usize, shape);
         let reach = (range_mm(profile) * units) as f32;
+        let falloff_reach_mm = bilateral_reach_mm(profile);
+        let falloff_reach = (falloff_reach_mm * units) as f32;
         table.info[id] = [
             kernel.len() as f32,
             // Guarded: a zero-width profile never blurs, any depth step is an edge.
             1.0 / reach.max(1e-9),
             reach,
-            0.0,
+            1.0 / falloff_reach.max(1e-9),
         ];
         for (k, tap) in kernel.iter().enumerate() {
             table.taps[id * MAX_KERNEL_SAMPLES + k] = [
@@ -227,8 +258,44 @@ pub fn kernel_table(profiles: &SssProfiles, samples: u32, shape: KernelShape) ->
                 (tap.offset_mm * units) as f32,
             ];
         }
+        if *blur == super::SssBlur::Bilateral {
+            let last = (FALLOFF_ENTRIES - 1) as f64;
+            for k in 0..FALLOFF_ENTRIES {
+                let u = k as f64 / last;
+                let d_mm = falloff_reach_mm * u * u;
+                // Per world unit of distance: the mm density over units per mm.
+                let w = kernel_function(profile, KernelShape::Marginal, d_mm) / units;
+                table.falloff[id * FALLOFF_ENTRIES + k] =
+                    [w.x as f32, w.y as f32, w.z as f32, (d_mm * units) as f32];
+            }
+            for (k, tap) in kernel.iter().enumerate() {
+                let at_offset = falloff_at(
+                    &table.falloff[id * FALLOFF_ENTRIES..][..FALLOFF_ENTRIES],
+                    (tap.offset_mm * units).abs() as f32 * table.info[id][3],
+                );
+                // Guarded: where the table holds (next to) nothing the tap gets no weight
+                // rather than an Inf.
+                let inverse = at_offset.map(|v| if v > 1e-30 { 1.0 / v } else { 0.0 });
+                table.inverse_falloff[id * MAX_KERNEL_SAMPLES + k] =
+                    [inverse[0], inverse[1], inverse[2], 0.0];
+            }
+        }
     }
     table
+}
+
+/// A falloff table's value at `x` (distance over the table's reach), as the shader
+/// interpolates it (glsl/common/sss.glsl `sss_falloff`): entries at `x = u^2`, 0 past the end.
+fn falloff_at(entries: &[[f32; 4]], x: f32) -> [f32; 3] {
+    if !(0.0..1.0).contains(&x) {
+        return [0.0; 3];
+    }
+    let last = entries.len() - 1;
+    let u = x.sqrt() * last as f32;
+    let i = (u as usize).min(last - 1);
+    let t = u - i as f32;
+    let (a, b) = (entries[i], entries[i + 1]);
+    [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * t)
 }
 
 #[cfg(test)]

@@ -347,6 +347,10 @@ pub struct SssKnobs {
     /// The separable blur at half resolution per side (a quarter of the pixels), upsampled
     /// depth-aware in a combine pass.
     pub half_res: bool,
+    /// The separable blur's taps: the nearest texel (the default: one fetch instead of four on
+    /// a CPU driver, measured as close to the brute-force reference as bilinear taps,
+    /// docs/sss.md), or bilinear between texels (Jimenez's).
+    pub point_taps: bool,
 }
 
 impl Default for SssKnobs {
@@ -360,6 +364,7 @@ impl Default for SssKnobs {
             samples: kernel::DEFAULT_SAMPLES,
             shape: kernel::KernelShape::Marginal,
             half_res: false,
+            point_taps: true,
         }
     }
 }

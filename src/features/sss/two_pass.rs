@@ -77,6 +77,7 @@ pub(super) fn chain_passes(
         base: compose && base.is_some(),
         edges: chain.edges,
         depth_in_alpha: depth_in_alpha || vertical,
+        point_taps: knobs.point_taps,
         samples,
         chain: chain.index,
         constants: constants(if vertical { [0.0, 1.0] } else { [1.0, 0.0] }),
@@ -189,6 +190,8 @@ struct PassSpec {
     edges: bool,
     /// The taps' depth travels in the light's alpha.
     depth_in_alpha: bool,
+    /// Separable: nearest-texel taps.
+    point_taps: bool,
     samples: u32,
     chain: usize,
     constants: BlurConstants,
@@ -230,7 +233,12 @@ impl PassSpec {
                     },
                 ));
             }
-            _ => defines.push(("LUCENT_SSS_SEPARABLE", "1")),
+            _ => {
+                defines.push(("LUCENT_SSS_SEPARABLE", "1"));
+                if self.point_taps {
+                    defines.push(("LUCENT_SSS_POINT_TAPS", "1"));
+                }
+            }
         }
         if self.vertical {
             defines.push(("LUCENT_SSS_VERTICAL", "1"));
@@ -250,9 +258,9 @@ impl PassSpec {
         defines
     }
 
-    /// Whether the pass reads the kernel table (binding 2).
+    /// Whether the pass reads the kernel table (binding 2): all of them.
     fn kernels(&self) -> bool {
-        self.blur == SssBlur::Separable
+        true
     }
 }
 

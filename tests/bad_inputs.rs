@@ -528,9 +528,43 @@ fn knobs_that_do_not_apply_warn_naming_the_technique_they_need() {
         "2",
     ]);
     assert!(
-        w.len() == 1 && w[0].contains("control, lcb or lbb"),
+        w.len() == 1 && w[0].contains("control, lcb, lbb, separable or bilateral"),
         "{w:?}"
     );
+    // The two-pass knobs name the blurs they apply to.
+    let w = warnings(&[
+        "plan",
+        "--scene",
+        "skin",
+        "--technique",
+        "lbb",
+        "--sss-samples",
+        "25",
+        "--sss-half-res",
+    ]);
+    assert!(
+        w.len() == 2
+            && w[0].contains("--sss-samples")
+            && w[0].contains("--technique separable or bilateral")
+            && w[1].contains("--sss-half-res")
+            && w[1].contains("--technique separable"),
+        "{w:?}"
+    );
+    let w = warnings(&[
+        "plan",
+        "--scene",
+        "skin",
+        "--technique",
+        "separable",
+        "--sss-samples",
+        "25",
+        "--sss-half-res",
+        "--sss-filter",
+        "bilinear",
+        "--sss-kernel",
+        "line",
+    ]);
+    assert!(w.is_empty(), "{w:?}");
     let w = warnings(&["plan", "--technique", "none", "--grayscale"]);
     assert!(
         w.len() == 1 && w[0].contains("--technique translucency"),

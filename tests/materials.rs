@@ -52,11 +52,16 @@ fn has_sss_image(plan: &Plan) -> bool {
 }
 
 /// `mixed` with the marble sphere blurred by LBB: two chains in one frame.
-fn mixed_two_chains() -> Scene {
+/// `mixed` with its marble blurred by LBB and its other SSS materials by `other`.
+fn mixed_two_chains(other: SssBlur) -> Scene {
     let mut scene = load_scene_baked("mixed").unwrap();
     for o in &mut scene.objects {
-        if o.material.name == "marble" {
-            o.material.sss.as_mut().unwrap().blur = Some(SssBlur::LeanBilateral);
+        if let Some(sss) = o.material.sss.as_mut() {
+            sss.blur = Some(if o.material.name == "marble" {
+                SssBlur::LeanBilateral
+            } else {
+                other
+            });
         }
     }
     scene
@@ -77,14 +82,15 @@ fn auto_puts_in_the_frame_exactly_what_the_materials_ask_for() {
     assert!(has_image(&p, "gbuffer.translucency") && !has_sss_image(&p));
     assert_eq!(p.dump(), plan(&cubes, Technique::Translucency).dump());
 
-    // Skin: its blur (the default, the control), no GB2.
+    // Skin: its blur (the default, the separable blur), no GB2.
     let skin = load_scene_baked("skin").unwrap();
     let p = plan(&skin, Technique::Auto);
     assert!(!has_image(&p, "gbuffer.translucency") && has_sss_image(&p));
-    assert_eq!(p.dump(), plan(&skin, Technique::Control).dump());
+    assert_eq!(SssBlur::DEFAULT, SssBlur::Separable);
+    assert_eq!(p.dump(), plan(&skin, Technique::Separable).dump());
 
-    // Mixed: translucency and SSS in one frame, both G-buffer targets, one blur pair per
-    // Gaussian of the longest profile, the control's combine.
+    // Mixed: translucency and SSS in one frame, both G-buffer targets, one blur pair for both
+    // profiles, the vertical pass composing the frame.
     let mixed = load_scene_baked("mixed").unwrap();
     let p = plan(&mixed, Technique::Auto);
     assert!(has_image(&p, "gbuffer.translucency") && has_image(&p, "gbuffer.sss"));
@@ -92,13 +98,15 @@ fn auto_puts_in_the_frame_exactly_what_the_materials_ask_for() {
         !has_image(&p, "gbuffer.lean"),
         "no LEAN chain: no LEAN target"
     );
-    let mut expected = vec!["gbuffer + lighting".to_string()];
-    for i in 1..=6 {
-        expected.push(format!("horizontal blur #{i}"));
-        expected.push(format!("vertical blur #{i}"));
-    }
-    expected.extend(["combine".into(), "tonemap".into()]);
-    assert_eq!(pass_names(&p), expected);
+    assert_eq!(
+        pass_names(&p),
+        [
+            "gbuffer + lighting",
+            "horizontal blur",
+            "vertical blur",
+            "tonemap"
+        ]
+    );
     // Named techniques restrict the frame to theirs.
     let p = plan(&mixed, Technique::Translucency);
     assert!(has_image(&p, "gbuffer.translucency") && !has_sss_image(&p));
@@ -109,7 +117,7 @@ fn auto_puts_in_the_frame_exactly_what_the_materials_ask_for() {
 
     // Two blurs: one chain each, told apart by name, the LEAN target for the LBB chain only
     // once; the LBB chain's final pass keeps the control chain's result elsewhere.
-    let two = mixed_two_chains();
+    let two = mixed_two_chains(SssBlur::Control);
     let p = plan(&two, Technique::Auto);
     let names = pass_names(&p);
     assert_eq!(names[0], "projection + lighting");
@@ -356,46 +364,58 @@ fn each_sss_material_is_diffused_with_its_own_profile_without_bleeding() {
 fn two_blur_chains_compose_in_one_frame() {
     let test = TestGpu::new();
     let (w, h) = (256, 160);
-    let two = mixed_two_chains();
-    let s = exported(Technique::Auto, w, h);
-    let both = render(&test, &two, s);
-    // The same frame without the LBB chain: the control chain alone.
-    let control_only = render(&test, &only_scattering(&two, &["skin", "ear"]), s);
-    let hdr = both.hdr.as_ref().unwrap();
-    assert!(hdr.iter().all(|v| v.is_finite()), "non-finite output");
-    let ids = both.gbuffer.as_ref().unwrap().sss.as_ref().unwrap();
-    let desc = FrameDesc::new(&two, &s).unwrap();
-    let profiles = desc.sss.as_ref().unwrap();
-    assert_eq!(
-        profiles.chains(),
-        [SssBlur::Control, SssBlur::LeanBilateral]
-    );
-    let skin = {
-        let i = two
-            .objects
-            .iter()
-            .position(|o| o.material.name == "skin")
-            .unwrap();
-        f32::from(profiles.object_ids[i])
-    };
-    // The LBB chain's final pass keeps the control chain's result on the control chain's
-    // pixels (the LEAN G-buffer pass shades their normals alike, up to rounding).
-    let other = control_only.hdr.as_ref().unwrap();
-    let (mut diff, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
-    for (i, &id) in ids.iter().enumerate() {
-        if id == skin {
-            for c in 0..3 {
-                diff += f64::from((hdr[i * 4 + c] - other[i * 4 + c]).abs());
-                sum += f64::from(other[i * 4 + c].abs());
+    // The marble's LBB chain beside the thesis's control chain (LBB last), and beside the
+    // default separable chain (LBB first, the separable chain's vertical pass composing).
+    for (other, chains) in [
+        (SssBlur::Control, [SssBlur::Control, SssBlur::LeanBilateral]),
+        (
+            SssBlur::Separable,
+            [SssBlur::LeanBilateral, SssBlur::Separable],
+        ),
+    ] {
+        let two = mixed_two_chains(other);
+        let s = exported(Technique::Auto, w, h);
+        let both = render(&test, &two, s);
+        // The same frame without the LBB chain: the other chain alone.
+        let other_only = render(&test, &only_scattering(&two, &["skin", "ear"]), s);
+        let hdr = both.hdr.as_ref().unwrap();
+        assert!(hdr.iter().all(|v| v.is_finite()), "non-finite output");
+        let ids = both.gbuffer.as_ref().unwrap().sss.as_ref().unwrap();
+        let desc = FrameDesc::new(&two, &s).unwrap();
+        let profiles = desc.sss.as_ref().unwrap();
+        assert_eq!(profiles.chains(), chains);
+        let skin = {
+            let i = two
+                .objects
+                .iter()
+                .position(|o| o.material.name == "skin")
+                .unwrap();
+            f32::from(profiles.object_ids[i])
+        };
+        // The later chain keeps the earlier chain's result on the earlier chain's pixels (the
+        // LEAN G-buffer pass shades their normals alike, up to rounding).
+        let other_hdr = other_only.hdr.as_ref().unwrap();
+        let (mut diff, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+        for (i, &id) in ids.iter().enumerate() {
+            if id == skin {
+                for c in 0..3 {
+                    diff += f64::from((hdr[i * 4 + c] - other_hdr[i * 4 + c]).abs());
+                    sum += f64::from(other_hdr[i * 4 + c].abs());
+                }
+                n += 1;
             }
-            n += 1;
         }
+        eprintln!(
+            "{} chain's pixels in a two-chain frame: {n}, mean relative change {:.2e}",
+            other.name(),
+            diff / sum
+        );
+        assert!(
+            n > 500 && diff <= 1e-2 * sum,
+            "{}: {diff} of {sum}",
+            other.name()
+        );
     }
-    eprintln!(
-        "control chain's pixels in a two-chain frame: {n}, mean relative change {:.2e}",
-        diff / sum
-    );
-    assert!(n > 500 && diff <= 1e-2 * sum, "{diff} of {sum}");
     test.finish();
 }
 

@@ -95,7 +95,13 @@ fn mixed_matches_its_golden_under_auto() {
 fn sss_scenes_match_their_goldens_under_every_sss_technique() {
     // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
     for scene_name in ["skin", "teapot"] {
-        for technique in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+        for technique in [
+            Technique::Control,
+            Technique::Lcb,
+            Technique::Lbb,
+            Technique::Separable,
+            Technique::Bilateral,
+        ] {
             let settings = FrameSettings {
                 technique,
                 ..FrameSettings::new(320, 240)

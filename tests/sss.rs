@@ -501,6 +501,75 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
 }
 
 #[test]
+fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
+    let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
+    let passes = |s: &FrameSettings| {
+        let desc = FrameDesc::new(&skin, s).unwrap();
+        let plan = plan_frame(s, &desc).unwrap();
+        let names: Vec<String> = plan.physical.iter().map(|p| p.name.clone()).collect();
+        let sizes: Vec<(u32, u32)> = plan.physical.iter().map(|p| p.extent).collect();
+        let lean = plan.resources.iter().any(|r| r.name.contains("lean"));
+        let kernel_bytes = desc.upload(1).kernel_table_bytes;
+        (names, sizes, lean, kernel_bytes)
+    };
+    // Separable: two blur passes for six Gaussians, no LEAN target, the kernel table.
+    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Separable));
+    assert_eq!(
+        names,
+        [
+            "gbuffer + lighting",
+            "horizontal blur",
+            "vertical blur",
+            "tonemap"
+        ]
+    );
+    assert!(!lean && kernel_bytes > 0);
+    // Bilateral: the LEAN projection, two blur passes that carry the moments, LEAN specular in
+    // the vertical pass (no final lighting pass).
+    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Bilateral));
+    assert_eq!(
+        names,
+        [
+            "projection + lighting",
+            "horizontal blur",
+            "vertical blur",
+            "tonemap"
+        ]
+    );
+    assert!(lean && kernel_bytes > 0);
+    // Half resolution: both blurs at half size per side (rounded up), then the upsample.
+    let mut half = settings(Technique::Separable);
+    half.sss.half_res = true;
+    let (names, sizes, _, _) = passes(&half);
+    assert_eq!(
+        names,
+        [
+            "gbuffer + lighting",
+            "horizontal blur",
+            "vertical blur",
+            "upsample",
+            "tonemap"
+        ]
+    );
+    assert_eq!(sizes[1], (80, 60));
+    assert_eq!(sizes[2], (80, 60));
+    assert_eq!(sizes[3], (160, 120));
+    // The per-Gaussian chains need no kernel table: the frame's buffer has no such region.
+    for technique in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+        let (_, _, _, kernel_bytes) = passes(&settings(technique));
+        assert_eq!(kernel_bytes, 0, "{}", technique.name());
+    }
+    // Every sample count the knob offers compiles to the same two passes.
+    for samples in [11, 17, 25] {
+        for technique in [Technique::Separable, Technique::Bilateral] {
+            let mut s = settings(technique);
+            s.sss.samples = samples;
+            assert_eq!(passes(&s).0.len(), 4, "{} {samples}", technique.name());
+        }
+    }
+}
+
+#[test]
 fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
     use lucent::frame::Fault;
     let test = TestGpu::new();

@@ -78,7 +78,13 @@ fn lean_specular_stays_bounded_and_draws_no_streaks() {
         let reference = render(&test, &scene, Technique::Control);
         let ids = reference.gbuffer.as_ref().unwrap().sss.clone().unwrap();
         let plain_jump = column_jump(&plain, &ids);
-        for technique in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+        for technique in [
+            Technique::Control,
+            Technique::Lcb,
+            Technique::Lbb,
+            Technique::Separable,
+            Technique::Bilateral,
+        ] {
             let frame = render(&test, &scene, technique);
             let max = hdr_max(&frame);
             let jump = column_jump(&frame, &ids);

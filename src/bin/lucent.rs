@@ -201,7 +201,8 @@ struct FrameArgs {
     size: (u32, u32),
     /// What the frame shades: `auto` (default) is what the scene's materials ask for, every
     /// technique composed in one frame; `none` (plain deferred lighting), `translucency`,
-    /// `control`, `lcb` or `lbb` restrict the frame to one technique (A/B runs, the seeds'
+    /// `control`, `lcb`, `lbb` (the thesis's per-Gaussian SSS chains), `separable` or
+    /// `bilateral` (two-pass SSS) restrict the frame to one technique (A/B runs, the seeds'
     /// tables).
     #[arg(long, default_value = "auto")]
     technique: String,
@@ -246,7 +247,7 @@ struct FrameArgs {
     /// default 17).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_samples)]
     sss_samples: Option<u32>,
-    /// The separable blur's 1-D kernel: marginal (each Gaussian's 1-D marginal, the default)
+    /// The two-pass blurs' 1-D kernel: marginal (each Gaussian's 1-D marginal, the default)
     /// or line (the profile along a line, Jimenez 2015).
     #[arg(long, value_parser = parse_kernel_shape)]
     sss_kernel: Option<KernelShape>,
@@ -465,7 +466,7 @@ impl FrameArgs {
                 iterative,
             ),
             (self.sss_samples.is_some(), "--sss-samples", two, two_pass),
-            (self.sss_kernel.is_some(), "--sss-kernel", sep, separable),
+            (self.sss_kernel.is_some(), "--sss-kernel", two, two_pass),
             (self.sss_half_res, "--sss-half-res", sep, separable),
             (self.sss_filter.is_some(), "--sss-filter", sep, separable),
             (self.no_sss_tiles, "--no-sss-tiles", blur, sss),

@@ -74,7 +74,8 @@ const FONT_CANDIDATES: &[&str] = &[
     "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
 ];
 
-/// Series colours (the "tab10" palette), reused in order when there are more series.
+/// Series colours (the "tab10" palette, then six darker hues so the SSS report's dozen series
+/// each get their own), reused in order when there are more series.
 const COLOURS: &[RGBColor] = &[
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
@@ -86,6 +87,12 @@ const COLOURS: &[RGBColor] = &[
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(0, 70, 140),
+    RGBColor(120, 0, 0),
+    RGBColor(0, 110, 80),
+    RGBColor(110, 90, 0),
+    RGBColor(90, 0, 110),
 ];
 
 /// Writes a scatter plot: x axis `x_label` (e.g. "lighting pass ms"), y axis `y_label` (e.g.

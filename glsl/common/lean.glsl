@@ -11,6 +11,9 @@
 
 #include "gbuffer.glsl"
 #include "lighting.glsl"
+#ifdef LUCENT_SHADOWS
+#include "shadows.glsl"
+#endif
 
 // Smallest view-space n.z (relative to |n|) a slope is taken from: grazing and back-facing
 // normals (normal maps tilt some past the silhouette) are clamped so slopes stay within +-20.
@@ -180,6 +183,11 @@ vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughne
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
+#ifdef LUCENT_SHADOWS
+        // The light-space maps shadow the LEAN specular as the lighting pass's (the view
+        // matrix is a rotation: its transpose takes the mean normal back to world space).
+        attenuation *= shadow_visibility(i, pos, transpose(view) * n, to_light, 0).x;
+#endif
         vec3 l = view * to_light;
         vec3 h = l + to_eye;
         float h_len2 = dot(h, h);

@@ -47,15 +47,18 @@ float translucency_lobe(float x, float n, float mode) {
 // dot(V, N), the same for every light: dot(V, -(L + N d)) = -(dot(V, L) + d dot(V, N)), so the
 // distorted light vector is never built. Equal, up to rounding, to shade_incident plus the
 // talk's term (the reference evaluates them separately).
+// `reflected` is the light's attenuation times its shadow visibility at the surface,
+// `transmitted` the same with the visibility of light through the pixel's own material
+// (glsl/common/shadows.glsl): the object's own front faces do not shadow the talk's term.
 vec3 shade_incident_translucent(Surface s, vec3 to_eye, float v_dot_n, vec3 to_light,
-                                float attenuation, Light light, vec4 material,
-                                vec3 thickness) {
+                                float reflected, float transmitted, Light light,
+                                vec4 material, vec3 thickness) {
     float n_dot_l = max(dot(s.normal, to_light), 0.0);
     float spec = blinn_phong(s, to_eye, to_light);
     float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
     float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
-    vec3 diffuse = s.albedo * (n_dot_l / PI + (lobe + material.z) * thickness);
-    return (diffuse + vec3(s.specular * spec * n_dot_l)) * light.radiance_range.rgb * attenuation;
+    vec3 diffuse = s.albedo * (n_dot_l / PI * reflected + (lobe + material.z) * thickness * transmitted);
+    return (diffuse + vec3(s.specular * spec * n_dot_l * reflected)) * light.radiance_range.rgb;
 }
 
 // The talk's term alone (what shade_incident_translucent adds to diffuse + specular): the

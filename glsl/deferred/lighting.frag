@@ -11,6 +11,10 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
+// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
+// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
@@ -24,6 +28,18 @@
 #ifdef LUCENT_LEAN
 #include "../common/lean.glsl"
 #endif
+#ifdef LUCENT_SHADOWS
+#include "../common/shadows.glsl"
+#endif
+
+// How much of light `i` reaches the pixel: x reflected, y transmitted through `material`.
+vec2 light_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, int material) {
+#ifdef LUCENT_SHADOWS
+    return shadow_visibility(i, pos, normal, to_light, material);
+#else
+    return vec2(1.0);
+#endif
+}
 
 layout(input_attachment_index = 0, set = 0, binding = 1) uniform subpassInput gb0;
 layout(input_attachment_index = 1, set = 0, binding = 2) uniform subpassInput gb1;
@@ -63,10 +79,11 @@ void main() {
     // This variant runs only on tiles translucent objects may cover (the plain variant shades
     // the rest), so it never branches on the material ID to skip work.
     vec4 t = subpassLoad(gb2);
+    int material_id = clamp(unpack_material_id(t), 0, 255);
 #ifdef LUCENT_SINGLE_MATERIAL
     vec4 material = translucency_materials.rows[1];
 #else
-    vec4 material = translucency_materials.rows[clamp(unpack_material_id(t), 0, 255)];
+    vec4 material = translucency_materials.rows[material_id];
 #endif
     vec3 thickness = unpack_thickness(t);
     float v_dot_n = dot(to_eye, s.normal);
@@ -77,8 +94,9 @@ void main() {
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
-        color += shade_incident_translucent(s, to_eye, v_dot_n, to_light, attenuation, light,
-                                            material, thickness);
+        vec2 visible = light_visibility(i, pos, s.normal, to_light, material_id);
+        color += shade_incident_translucent(s, to_eye, v_dot_n, to_light, attenuation * visible.x,
+                                            attenuation * visible.y, light, material, thickness);
     }
 #elif defined(LUCENT_SPLIT_SPECULAR)
     vec3 specular = vec3(0.0);
@@ -87,14 +105,19 @@ void main() {
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
+#ifdef LUCENT_TRANSLUCENCY
+        vec2 visible = light_visibility(i, pos, s.normal, to_light, material_id);
+#else
+        vec2 visible = light_visibility(i, pos, s.normal, to_light, 0);
+#endif
         float n_dot_l = max(dot(s.normal, to_light), 0.0);
-        vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation);
+        vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation * visible.x);
         color += s.albedo / PI * incident;
         specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
 #ifdef LUCENT_TRANSLUCENCY
         // Transmitted light joins the diffuse: the SSS blur diffuses it too.
-        color += translucency_transmitted(s, to_eye, v_dot_n, to_light, attenuation, light,
-                                          material, thickness);
+        color += translucency_transmitted(s, to_eye, v_dot_n, to_light, attenuation * visible.y,
+                                          light, material, thickness);
 #endif
     }
     out_specular = vec4(min(specular, vec3(65504.0)), 1.0);
@@ -105,7 +128,12 @@ void main() {
 #endif
 #else
     for (int i = 0; i < count; ++i) {
-        color += shade_direct(s, pos, to_eye, frame.lights[i]);
+        Light light = frame.lights[i];
+        vec3 to_light;
+        float attenuation;
+        light_incidence(light, pos, to_light, attenuation);
+        float visible = light_visibility(i, pos, s.normal, to_light, 0).x;
+        color += shade_incident(s, to_eye, to_light, attenuation * visible, light);
     }
 #endif
     // fp16 target: clamp to its largest finite value (a real GPU may store +Inf otherwise).

@@ -2,6 +2,7 @@
 // permutation: LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SSS_BASE
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_PASSTHROUGH
+// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
 // LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): on the pixels
 // of this chain's profiles, the blurred diffuse light plus LEAN specular with Fresnel evaluated
 // on the blurred view-plane slopes and moments, for every light; elsewhere the previous chain's

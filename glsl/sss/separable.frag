@@ -13,6 +13,7 @@
 // permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=11 LUCENT_SSS_VERTICAL
 // permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=25 LUCENT_SSS_VERTICAL LUCENT_SSS_PASSTHROUGH LUCENT_SSS_BASE
 // permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SSS_PROFILE_EDGES
+// permutation: LUCENT_SSS_BILATERAL2 LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
 // The two-pass screen-space SSS blurs (src/features/sss/two_pass.rs), one direction per pass:
 // the horizontal pass blurs the lit diffuse into a temporary, the vertical pass blurs that and
 // writes the chain's result (the blurred light plus specular on the chain's pixels, the

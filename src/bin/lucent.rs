@@ -11,6 +11,7 @@ use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
 use lucent::features::deferred::GBufferPrecision;
+use lucent::features::shadows::ShadowSettings;
 use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
 use lucent::features::sss::{SssBlur, SssKnobs, SssPrecision};
 use lucent::frame::{plan_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
@@ -258,6 +259,19 @@ struct FrameArgs {
     /// texel: one fetch instead of four on a CPU driver).
     #[arg(long, value_parser = parse_filter)]
     sss_filter: Option<bool>,
+    /// No light casts shadows (no light-space maps pass; each light's own `shadows = false`
+    /// turns off just that light's).
+    #[arg(long)]
+    no_shadows: bool,
+    /// Edge of each light-space map face in texels (16 to 4096; default 1024; Li et al.'s
+    /// Table 1 uses 512 and 1024). Halved until every face fits an 8192x8192 atlas.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_shadow_size)]
+    shadow_size: Option<u32>,
+}
+
+fn parse_shadow_size(text: &str) -> std::result::Result<u32, String> {
+    let sizes = lucent::features::shadows::SHADOW_SIZES;
+    count_in(text, u64::from(*sizes.start())..=u64::from(*sizes.end())).map(|v| v as u32)
 }
 
 fn parse_filter(text: &str) -> std::result::Result<bool, String> {
@@ -425,6 +439,10 @@ impl FrameArgs {
             debug_view: None,
             frames_in_flight: 1,
             target: None,
+            shadows: ShadowSettings {
+                enabled: !self.no_shadows,
+                size: self.shadow_size.unwrap_or(ShadowSettings::default().size),
+            },
         })
     }
 

@@ -21,9 +21,11 @@ use crate::graph::{
 };
 use crate::Result;
 
+use super::shadows::{self, ShadowMaps};
 use super::translucency::ThicknessPacking;
 use super::util::{
-    Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+    clamp_sampler, Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
+    VertexInput,
 };
 use crate::gpu_scene::{Region, SceneGpu};
 
@@ -327,9 +329,15 @@ pub struct Lit {
     pub specular: Option<Handle<Image>>,
 }
 
-/// Declares the lighting pass: reads the G-buffer at the same pixel, writes lit HDR colour
-/// (with SSS: diffuse and specular apart).
-pub fn lighting_pass(graph: &mut RenderGraph, gb: &GBuffer, scene: Option<&Arc<SceneGpu>>) -> Lit {
+/// Declares the lighting pass: reads the G-buffer at the same pixel (and the light-space maps,
+/// when some light casts shadows), writes lit HDR colour (with SSS: diffuse and specular
+/// apart).
+pub fn lighting_pass(
+    graph: &mut RenderGraph,
+    gb: &GBuffer,
+    shadows: Option<&ShadowMaps>,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Lit {
     let info = graph.resources()[gb.gb0.id()].info;
     let hdr_info = ImageInfo {
         format: HDR_FORMAT,
@@ -352,6 +360,12 @@ pub fn lighting_pass(graph: &mut RenderGraph, gb: &GBuffer, scene: Option<&Arc<S
     if let Some(gb2) = &gb.gb2 {
         pass.input(gb2);
     }
+    if let Some(maps) = shadows {
+        pass.sample(&maps.depth);
+        if let Some(ids) = &maps.ids {
+            pass.sample(ids);
+        }
+    }
     pass.color(&mut hdr, LoadOp::DontCare);
     if let Some(specular) = &mut specular {
         pass.color(specular, LoadOp::DontCare);
@@ -361,6 +375,8 @@ pub fn lighting_pass(graph: &mut RenderGraph, gb: &GBuffer, scene: Option<&Arc<S
         gb1: gb.gb1.id(),
         depth: gb.depth.id(),
         gb2: gb.gb2.as_ref().map(|h| h.id()),
+        shadow_depth: shadows.map(|m| m.depth.id()),
+        shadow_ids: shadows.and_then(|m| m.ids.as_ref().map(|h| h.id())),
     };
     match scene {
         Some(scene) => pass.execute(LightingPass {
@@ -369,6 +385,7 @@ pub fn lighting_pass(graph: &mut RenderGraph, gb: &GBuffer, scene: Option<&Arc<S
             layout: gb.layout,
             pipeline: None,
             translucent: None,
+            sampler: vk::Sampler::null(),
         }),
         None => pass.finish(),
     }
@@ -508,6 +525,9 @@ struct LightingInputs {
     gb1: ResourceId,
     depth: ResourceId,
     gb2: Option<ResourceId>,
+    /// The light-space maps' depth and ID atlases, when some light casts shadows.
+    shadow_depth: Option<ResourceId>,
+    shadow_ids: Option<ResourceId>,
 }
 
 struct LightingPass {
@@ -519,6 +539,8 @@ struct LightingPass {
     pipeline: Option<PassPipeline>,
     /// With translucency: the translucency shader for the other tiles (same set).
     translucent: Option<GraphicsPipeline>,
+    /// Nearest clamp sampler for the light-space maps (null without shadows).
+    sampler: vk::Sampler,
 }
 
 impl PassExec for LightingPass {
@@ -542,6 +564,20 @@ impl PassExec for LightingPass {
             ));
         }
         let mut plain_defines: Vec<(&str, &str)> = Vec::new();
+        let mut shadow_ids = false;
+        if let Some(depth) = inputs.shadow_depth {
+            self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
+            // The shadow table, then the atlases (glsl/common/shadows.glsl).
+            plain_defines.extend(shadows::lighting_defines(bindings.len()));
+            bindings.extend(shadows::lighting_bindings(
+                &self.scene,
+                depth,
+                inputs.shadow_ids,
+                views,
+                self.sampler,
+            ));
+            shadow_ids = inputs.shadow_ids.is_some();
+        }
         if self.layout.sss {
             plain_defines.push(("LUCENT_SPLIT_SPECULAR", "1"));
         }
@@ -571,6 +607,10 @@ impl PassExec for LightingPass {
             // The plain variant's defines (split specular, LEAN slope) plus the translucency's.
             let mut defines = plain_defines.clone();
             defines.extend(self.layout.defines());
+            if shadow_ids {
+                // Only the translucent variant shades transmission: only it reads the IDs.
+                defines.push(("LUCENT_SHADOW_IDS", "1"));
+            }
             let layouts = [pipeline.set.layout];
             let translucent = GraphicsPipeline::new(
                 ctx,
@@ -622,5 +662,8 @@ impl PassExec for LightingPass {
         if let Some(mut p) = self.translucent.take() {
             p.destroy(&gpu.device);
         }
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
+        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
+        self.sampler = vk::Sampler::null();
     }
 }

@@ -13,6 +13,7 @@
 
 pub mod debug_view;
 pub mod deferred;
+pub mod shadows;
 pub mod sss;
 pub mod tonemap;
 pub mod translucency;

@@ -238,6 +238,8 @@ pub enum VertexInput {
         /// UV + tangent stream.
         surface: bool,
     },
+    /// A mesh's positions only (binding 0, location 0: depth-only passes).
+    Positions,
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -364,6 +366,13 @@ impl GraphicsPipeline {
                 vertex_attributes.push(attribute(3, 2, vec2, 0));
                 vertex_attributes.push(attribute(4, 2, vec4, 8));
             }
+        }
+        if let VertexInput::Positions = desc.vertex_input {
+            vertex_bindings.push(binding(
+                0,
+                std::mem::size_of::<crate::scene::mesh::Vertex>() as u32,
+            ));
+            vertex_attributes.push(attribute(0, 0, vk::Format::R32G32B32_SFLOAT, 0));
         }
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)

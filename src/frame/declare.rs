@@ -10,7 +10,7 @@ use super::{FrameDesc, FrameSettings};
 use crate::backend::access::Access;
 use crate::features::debug_view;
 use crate::features::deferred::GBufferLayout;
-use crate::features::{deferred, sss, tonemap};
+use crate::features::{deferred, shadows, sss, tonemap};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{CompileOptions, ImageInfo, ImportedImage, Plan, RenderGraph, ResourceId};
 use crate::Result;
@@ -56,8 +56,13 @@ pub fn declare_frame(
     scene_gpu: Option<&Arc<SceneGpu>>,
 ) -> FrameOutputs {
     let layout = desc.gbuffer_layout(settings);
+    // The light-space maps come first: the G-buffer pass and lighting share one render pass.
+    let shadow_maps = desc
+        .shadows
+        .as_ref()
+        .map(|s| shadows::shadow_pass(graph, s, scene_gpu));
     let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
-    let lit = deferred::lighting_pass(graph, &gb, scene_gpu);
+    let lit = deferred::lighting_pass(graph, &gb, shadow_maps.as_ref(), scene_gpu);
     let display_info = ImageInfo {
         width: settings.width,
         height: settings.height,
@@ -94,6 +99,7 @@ pub fn declare_frame(
                 lean: gb.lean.as_ref(),
                 gb0: &gb.gb0,
                 gb1: &gb.gb1,
+                shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
             },
             profiles,
             &settings.sss,

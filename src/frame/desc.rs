@@ -4,12 +4,14 @@
 //! [`super::Technique`] override does not leave it out): GB2 and the GDC 2011 term when some material
 //! is translucent, one SSS chain per blur the SSS materials use with every profile in the
 //! profile table, the LEAN targets when some chain is LCB or LBB, normal and albedo maps when
-//! some material has one. Everything else costs nothing: [`super::declare_frame`] declares
+//! some material has one, light-space maps when some light casts shadows. Everything else
+//! costs nothing: [`super::declare_frame`] declares
 //! no pass, image or shader permutation for it, and [`crate::gpu_scene`] uploads no stream,
 //! texture or table.
 
 use super::FrameSettings;
 use crate::features::deferred::{GBufferLayout, TranslucencyLayout};
+use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
 use crate::features::translucency::{MaterialTable, MaterialTableGpu, ThicknessPacking};
 use crate::gpu_scene::SceneUpload;
@@ -37,6 +39,8 @@ pub struct FrameDesc {
     pub normal_maps: bool,
     /// Some object has an albedo texture.
     pub albedo_maps: bool,
+    /// Light-space maps, when some light casts shadows.
+    pub shadows: Option<ShadowDesc>,
 }
 
 impl FrameDesc {
@@ -62,7 +66,9 @@ impl FrameDesc {
         let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
             scene.objects.iter().any(|o| f(&o.material))
         };
+        let shadows = ShadowDesc::new(scene, &settings.shadows, translucency.is_some());
         Ok(Self {
+            shadows,
             translucency,
             sss,
             normal_maps: any(&|m| m.normal_texture.is_some()),
@@ -135,6 +141,11 @@ impl FrameDesc {
             } else {
                 0
             },
+            shadow_table_bytes: if self.shadows.is_some() {
+                crate::features::shadows::SHADOW_TABLE_BYTES
+            } else {
+                0
+            },
         }
     }
 
@@ -157,6 +168,7 @@ impl FrameDesc {
             })
         };
         self.gbuffer_layout(settings) == other.gbuffer_layout(settings)
+            && self.shadows == other.shadows
             && ids(self) == ids(other)
             && steps(self) == steps(other)
             && self.sss.as_ref().map(|s| s.profiles.len())
@@ -184,6 +196,9 @@ impl FrameDesc {
                     .collect();
                 names.push(format!("sss {} ({})", chain.name(), profiles.join(", ")));
             }
+        }
+        if let Some(s) = &self.shadows {
+            names.push(s.name());
         }
         if self.normal_maps {
             names.push("normal maps".into());

@@ -182,6 +182,10 @@ impl Renderer {
             uniforms.fault = [f.x as i32, f.y as i32, if f.nan { 1 } else { 2 }, 0];
         }
         per_frame.write(slot, Region::Frame, bytemuck::bytes_of(&uniforms))?;
+        if let Some(shadows) = &desc.shadows {
+            let table = shadows.uniforms(scene, &self.mesh_bounds);
+            per_frame.write(slot, Region::Shadows, bytemuck::bytes_of(&table))?;
+        }
         let mut tiles = SlotTiles::default();
         if let Some(t) = &desc.translucency {
             per_frame.write(

@@ -3,6 +3,7 @@
 use crate::backend::access::Access;
 use crate::features::debug_view::DebugView;
 use crate::features::deferred::GBufferPrecision;
+use crate::features::shadows::ShadowSettings;
 use crate::features::sss;
 use crate::graph::CompileOptions;
 use crate::scene::material::SssBlur;
@@ -139,6 +140,9 @@ pub struct FrameSettings {
     /// instead of lucent's own `display` image; each frame binds its image
     /// ([`super::Renderer::bind_target`]).
     pub target: Option<TargetDesc>,
+    /// Light-space maps: whether lights cast shadows (each light's own switch still applies)
+    /// and the map size.
+    pub shadows: ShadowSettings,
 }
 
 /// An image the caller renders into: its format, the state it is in when the frame starts
@@ -189,6 +193,7 @@ impl FrameSettings {
             debug_view: None,
             frames_in_flight: 1,
             target: None,
+            shadows: ShadowSettings::default(),
         }
     }
 }

@@ -107,6 +107,8 @@ pub struct SceneUpload<'a> {
     pub profile_table_bytes: u64,
     /// Bytes of the separable kernel table (0 without a separable chain).
     pub kernel_table_bytes: u64,
+    /// Bytes of the light-space maps' table (0: no light casts shadows).
+    pub shadow_table_bytes: u64,
 }
 
 /// Side of the procedural textures lucent makes, in texels.
@@ -181,6 +183,7 @@ impl SceneGpu {
             upload.translucency_table_bytes,
             upload.profile_table_bytes,
             upload.kernel_table_bytes,
+            upload.shadow_table_bytes,
             &scene.name,
         )?;
         let mut out = Self {

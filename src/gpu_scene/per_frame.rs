@@ -1,5 +1,6 @@
 //! What changes from frame to frame, once per frame in flight: the frame uniforms (camera,
-//! lights), the translucency material table and the SSS profile table, each a region of one
+//! lights), the translucency material table, the SSS profile and kernel tables and the
+//! light-space maps' table, each a region of one
 //! host-visible uniform buffer with one slot per frame in flight, and the screen tiles the
 //! passes draw their expensive variants in.
 //!
@@ -115,9 +116,11 @@ pub enum Region {
     Profiles,
     /// The separable SSS kernel table (frames with a separable chain).
     Kernels,
+    /// The light-space maps' table (frames where some light casts shadows).
+    Shadows,
 }
 
-const REGIONS: usize = 4;
+const REGIONS: usize = 5;
 
 impl Region {
     fn index(self) -> usize {
@@ -126,6 +129,7 @@ impl Region {
             Region::Translucency => 1,
             Region::Profiles => 2,
             Region::Kernels => 3,
+            Region::Shadows => 4,
         }
     }
 }
@@ -169,14 +173,16 @@ pub struct PerFrame {
 
 impl PerFrame {
     /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with a
-    /// translucency region of `translucency_bytes`, a profile region of `profile_bytes` and a
-    /// kernel region of `kernel_bytes` (0: the frame has none).
+    /// translucency region of `translucency_bytes`, a profile region of `profile_bytes`, a
+    /// kernel region of `kernel_bytes` and a shadow region of `shadow_bytes` (0: the frame
+    /// has none).
     pub fn new(
         gpu: &GpuContext,
         slots: usize,
         translucency_bytes: u64,
         profile_bytes: u64,
         kernel_bytes: u64,
+        shadow_bytes: u64,
         name: &str,
     ) -> Result<Self> {
         if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&slots) {
@@ -191,6 +197,7 @@ impl PerFrame {
             translucency_bytes,
             profile_bytes,
             kernel_bytes,
+            shadow_bytes,
         ];
         let mut offsets = [0u64; REGIONS];
         let mut end = 0u64;

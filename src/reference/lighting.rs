@@ -143,6 +143,7 @@ mod spot_tests {
             color: Vec3::ONE,
             intensity: 1.0,
             translucency_scale: 1.0,
+            shadows: true,
         };
         let l = spot(20.0, 40.0);
         let at = |x: f64| light_incidence(&l, DVec3::new(x, 0.0, 0.0)).1;

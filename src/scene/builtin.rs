@@ -591,6 +591,7 @@ fn layered() -> Result<Scene> {
             color: Vec3::new(1.0, 0.8, 0.6),
             intensity: 30.0,
             translucency_scale: 1.0,
+            shadows: true,
         },
     ];
     Ok(s)

@@ -195,6 +195,7 @@ struct LightToml {
     inner_degrees: Option<f32>,
     outer_degrees: Option<f32>,
     translucency_scale: Option<f32>,
+    shadows: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -772,6 +773,7 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
             color: Vec3::from(l.color.unwrap_or([1.0; 3])),
             intensity: l.intensity,
             translucency_scale: l.translucency_scale.unwrap_or(1.0),
+            shadows: l.shadows.unwrap_or(true),
         };
         // Map the validation failure back to the key it is about.
         light.validate("light").map_err(|e| {

@@ -541,6 +541,9 @@ pub struct Light {
     /// The talk's per-light translucency scale (`fLTScale`): how strongly this light shines
     /// through translucent materials.
     pub translucency_scale: f32,
+    /// Whether the light casts shadows (a light-space map; on by default). A light that does
+    /// not has no map and lights every surface it faces.
+    pub shadows: bool,
 }
 
 impl Light {
@@ -551,6 +554,7 @@ impl Light {
             color,
             intensity,
             translucency_scale: 1.0,
+            shadows: true,
         }
     }
 
@@ -561,6 +565,7 @@ impl Light {
             color,
             intensity,
             translucency_scale: 1.0,
+            shadows: true,
         }
     }
 

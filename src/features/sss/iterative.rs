@@ -186,10 +186,16 @@ pub(super) fn chain_passes(
     for h in &reads {
         pass.sample(h);
     }
+    // LEAN specular is direct light: the light-space maps shadow it.
+    let shadow_depth = inputs.shadow_depth.filter(|_| lean.is_some());
+    if let Some(depth) = shadow_depth {
+        pass.sample(depth);
+    }
     pass.color(&mut hdr, LoadOp::DontCare);
     let ids = reads.iter().map(|h| h.id()).collect();
     match scene {
         Some(scene) => pass.execute(FinalPass {
+            shadow_depth: shadow_depth.map(|h| h.id()),
             scene: scene.clone(),
             inputs: ids,
             fragment,
@@ -354,6 +360,8 @@ struct FinalPass {
     pipeline: Option<PassPipeline>,
     /// LCB, LBB: the pass-through variant for rectangles nothing of the chain scatters in.
     passthrough: Option<crate::features::util::GraphicsPipeline>,
+    /// The light-space maps' depth (LEAN frames where some light casts shadows).
+    shadow_depth: Option<ResourceId>,
 }
 
 impl PassExec for FinalPass {
@@ -366,15 +374,24 @@ impl PassExec for FinalPass {
                 .iter()
                 .map(|&id| Binding::Sampled(views[id], self.sampler)),
         );
-        let defines: &[(&str, &str)] = if self.base {
-            &[("LUCENT_SSS_BASE", "1")]
-        } else {
-            &[]
-        };
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.base {
+            defines.push(("LUCENT_SSS_BASE", "1"));
+        }
+        if let Some(depth) = self.shadow_depth {
+            defines.extend(crate::features::shadows::lighting_defines(bindings.len()));
+            bindings.extend(crate::features::shadows::lighting_bindings(
+                &self.scene,
+                depth,
+                None,
+                views,
+                self.sampler,
+            ));
+        }
         let desc = GraphicsPipelineDesc {
             vertex: "fullscreen.vert",
             fragment: self.fragment,
-            defines,
+            defines: &defines,
             vertex_input: VertexInput::None,
             depth_test: false,
             cull_back: false,

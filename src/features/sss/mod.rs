@@ -391,6 +391,8 @@ pub struct SssInputs<'a> {
     pub gb0: &'a Handle<Image>,
     /// G-buffer normal + roughness (LEAN specular's roughness bound).
     pub gb1: &'a Handle<Image>,
+    /// The light-space maps' depth, when some light casts shadows (LEAN specular is shadowed).
+    pub shadow_depth: Option<&'a Handle<Image>>,
 }
 
 /// Declares every chain's passes after the lighting pass (see the module docs): per chain, one

@@ -82,6 +82,7 @@ pub(super) fn chain_passes(
         chain: chain.index,
         constants: constants(if vertical { [0.0, 1.0] } else { [1.0, 0.0] }),
         inputs,
+        shadow_depth: None,
     };
 
     // Horizontal: the lit diffuse (and the LEAN target) into the temporaries.
@@ -136,11 +137,22 @@ pub(super) fn chain_passes(
     for h in &reads {
         pass.sample(h);
     }
+    // The bilateral chain's LEAN specular is direct light: the light-space maps shadow it.
+    let shadow_depth = inputs.shadow_depth.filter(|_| lean.is_some() && !half_res);
+    if let Some(depth) = shadow_depth {
+        pass.sample(depth);
+    }
     pass.taps(fetches(texels, blur == SssBlur::Bilateral));
     pass.color(&mut vertical_out, LoadOp::DontCare);
     let ids = reads.iter().map(|h| h.id()).collect();
     match scene {
-        Some(scene) => pass.execute(TwoPassBlur::new(scene, spec(true, !half_res, ids))),
+        Some(scene) => pass.execute(TwoPassBlur::new(
+            scene,
+            PassSpec {
+                shadow_depth: shadow_depth.map(|h| h.id()),
+                ..spec(true, !half_res, ids)
+            },
+        )),
         None => pass.finish(),
     }
     if !half_res {
@@ -197,6 +209,9 @@ struct PassSpec {
     constants: BlurConstants,
     /// The images it samples, in the shader's binding order (after the per-frame bindings).
     inputs: Vec<ResourceId>,
+    /// The light-space maps' depth (the bilateral vertical pass's LEAN specular, when some
+    /// light casts shadows).
+    shadow_depth: Option<ResourceId>,
 }
 
 impl PassSpec {
@@ -321,7 +336,17 @@ impl PassExec for TwoPassBlur {
             };
             bindings.push(Binding::Sampled(views[id], sampler));
         }
-        let defines = self.spec.defines();
+        let mut defines = self.spec.defines();
+        if let Some(depth) = self.spec.shadow_depth {
+            defines.extend(crate::features::shadows::lighting_defines(bindings.len()));
+            bindings.extend(crate::features::shadows::lighting_bindings(
+                &self.scene,
+                depth,
+                None,
+                views,
+                self.nearest,
+            ));
+        }
         let desc = GraphicsPipelineDesc {
             vertex: "fullscreen.vert",
             fragment: self.spec.fragment(),

@@ -1,0 +1,134 @@
+// Light-space maps (src/features/shadows.rs): the per-frame shadow table and, in lighting
+// passes, the lookup. The table's layout must match `ShadowUniforms` (std140).
+//
+// The light-space maps pass includes this file with no define: the table is its binding 0 and
+// its push constants name the object and face. Lighting passes define LUCENT_SHADOWS and
+// LUCENT_SHADOW_BINDING (the table's binding; the depth atlas follows, then with
+// LUCENT_SHADOW_IDS the ID atlas) and include scene.glsl first.
+#ifndef LUCENT_SHADOWS_GLSL
+#define LUCENT_SHADOWS_GLSL
+
+#define MAX_SHADOW_LIGHTS 64
+#define MAX_SHADOW_FACES 384
+
+struct ShadowFace {
+    mat4 view_proj;  // world to the face's clip space
+    vec4 rect;       // xy: the tile's top-left texel in the atlas; z: its edge in texels
+    vec4 params;     // a map texel's world size at a point: x * clip.w + y
+};
+
+#ifndef LUCENT_SHADOW_BINDING
+#define LUCENT_SHADOW_BINDING 0
+#endif
+
+layout(std140, set = 0, binding = LUCENT_SHADOW_BINDING) uniform Shadows {
+    vec4 atlas;                          // xy: size in texels; zw: 1 / size
+    ivec4 lights[MAX_SHADOW_LIGHTS];     // x: first face (-1: no map); y: face count (1 or 6)
+    ShadowFace faces[MAX_SHADOW_FACES];
+} shadows;
+
+#ifndef LUCENT_SHADOWS
+// The light-space maps pass: the object and the face it is drawn into.
+layout(push_constant) uniform ShadowObject {
+    mat4 model;
+    ivec4 face_id;  // x: face; y: the object's translucency material ID (0: none)
+} shadow_object;
+#else
+layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2D shadow_depth;
+#ifdef LUCENT_SHADOW_IDS
+layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_ids;
+#endif
+
+// The face of `light`'s map that sees `pos` (-1: the light casts no shadow). A point light's
+// six faces are +X, -X, +Y, -Y, +Z, -Z: the major axis of (pos - light) picks one.
+int shadow_face(int light, vec3 pos) {
+    ivec4 l = shadows.lights[clamp(light, 0, MAX_SHADOW_LIGHTS - 1)];
+    if (l.x < 0 || l.y <= 0) {
+        return -1;
+    }
+    if (l.y == 1) {
+        return l.x;
+    }
+    vec3 d = pos - frame.lights[light].position_type.xyz;
+    vec3 a = abs(d);
+    int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
+    return clamp(l.x + 2 * axis + (d[axis] < 0.0 ? 1 : 0), 0, MAX_SHADOW_FACES - 1);
+}
+
+// Distance from the face's eye along its axis (world units) of a device depth `d`.
+float shadow_distance(vec4 params, float d) {
+    float near = abs(params.z), far = params.w;
+    if (params.z < 0.0) {
+        return near + d * (far - near); // orthographic: linear
+    }
+    // Perspective: depth 1 is the far plane; the max keeps d = 1 from dividing by zero.
+    return near * far / max(far - d * (far - near), 1e-12);
+}
+
+// How much of `light` reaches `pos` (normal `normal`, towards the light `to_light`): x for light
+// reflected at the surface, y for light transmitted through translucency material `material`
+// (GDC 2011: occluders of the pixel's own material do not shadow it; material 0 = not
+// translucent). A 4x4-texel tent (a 3x3 box, bilinearly placed) read with four gathers, the
+// taps compared in world distance from the light: the point is first moved one map texel
+// along its normal, and a tap counts as lit when its occluder lies no nearer than the point's
+// distance minus a bias that grows with the slope (a tap two texels away on a surface at angle
+// theta to the light lies 2 tan(theta) texels nearer; capped at 8 texels, grazing light).
+vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int material) {
+    int index = shadow_face(light, pos);
+    if (index < 0) {
+        return vec2(1.0);
+    }
+    ShadowFace face = shadows.faces[index];
+    vec4 clip = face.view_proj * vec4(pos, 1.0);
+    float texel = face.params.x * abs(clip.w) + face.params.y;
+    clip = face.view_proj * vec4(pos + normal * texel, 1.0);
+    if (!(clip.w > 0.0)) {
+        return vec2(1.0); // behind a perspective face's eye: outside its cone
+    }
+    vec3 ndc = clip.xyz / clip.w;
+    if (any(greaterThan(abs(ndc.xy), vec2(1.0))) || !(ndc.z >= 0.0 && ndc.z <= 1.0)) {
+        return vec2(1.0); // outside the map: nothing there casts
+    }
+    float cos_theta = clamp(abs(dot(normal, to_light)), 0.05, 1.0);
+    float tan_theta = sqrt(1.0 - cos_theta * cos_theta) / cos_theta;
+    float bias = texel * (1.0 + min(2.0 * tan_theta, 8.0));
+    float reference = shadow_distance(face.params, ndc.z) - bias;
+    // Texel-centre coordinates in the atlas; the 4x4 block starts one texel before the
+    // bilinear footprint and is kept inside the tile (a neighbour's tile is another face).
+    vec2 t = face.rect.xy + (ndc.xy * 0.5 + 0.5) * face.rect.z - 0.5;
+    vec2 base = floor(t);
+    vec2 f = t - base;
+    vec2 first = clamp(base - 1.0, face.rect.xy, face.rect.xy + face.rect.z - 4.0);
+    vec4 wx = vec4(1.0 - f.x, 1.0, 1.0, f.x);
+    vec4 wy = vec4(1.0 - f.y, 1.0, 1.0, f.y);
+    vec2 visible = vec2(0.0);
+    for (int by = 0; by < 2; ++by) {
+        for (int bx = 0; bx < 2; ++bx) {
+            // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
+            // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
+            vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadows.atlas.zw;
+            vec4 d = textureGather(shadow_depth, corner, 0);
+            vec4 occluder = vec4(shadow_distance(face.params, d.x),
+                                 shadow_distance(face.params, d.y),
+                                 shadow_distance(face.params, d.z),
+                                 shadow_distance(face.params, d.w));
+            vec4 lit = step(vec4(reference), occluder);
+            float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];
+            float y0 = wy[2 * by], y1 = wy[2 * by + 1];
+            vec4 w = vec4(x0 * y1, x1 * y1, x1 * y0, x0 * y0);
+            visible.x += dot(lit, w);
+#ifdef LUCENT_SHADOW_IDS
+            uvec4 ids = textureGather(shadow_ids, corner, 0);
+            vec4 own = material > 0 ? vec4(equal(ids, uvec4(uint(material)))) : vec4(0.0);
+            visible.y += dot(max(lit, own), w);
+#else
+            visible.y += dot(lit, w);
+#endif
+        }
+    }
+    // The weights sum to 3 x 3.
+    return visible / 9.0;
+}
+#endif
+
+#endif

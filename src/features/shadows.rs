@@ -1,0 +1,602 @@
+//! Light-space maps: one depth atlas holding a map per face of every light that casts shadows
+//! (directional and spot lights one face, point lights six, a cube), drawn in one pass
+//! (`light-space maps`) before the G-buffer, and read by every pass that lights a surface
+//! directly (deferred lighting, the LEAN specular of LCB/LBB/bilateral frames).
+//!
+//! Lookup (glsl/common/shadows.glsl): the shaded point is moved along its normal by 1.5 map
+//! texels (normal-offset shadows: the offset follows the texel's world size at that distance,
+//! so acne is gone at every distance without a depth bias that detaches shadows), projected
+//! with its face's matrix and compared with a 4x4-texel tent of the map (four gathers).
+//!
+//! The GDC 2011 term is light that went *through* the object: its own front faces must not
+//! shadow it. In frames with translucency the atlas also stores which translucency material
+//! each texel's first surface belongs to (`light-space.ids`), and the transmitted term counts a
+//! tap as lit when its occluder is the shaded pixel's own material: only other objects (other
+//! materials) shadow transmission. Frames without translucency have no ID target.
+//!
+//! A frame has the pass and its images exactly when some light casts and the scene has
+//! objects (`--no-shadows` or every light's `shadows = false`: no pass, no image, no shader
+//! permutation).
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Mat4, Vec3, Vec4};
+
+use crate::graph::{
+    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
+    RenderGraph,
+};
+use crate::scene::{LightKind, Scene, MAX_LIGHTS};
+use crate::Result;
+
+use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use crate::gpu_scene::{Region, SceneGpu};
+
+/// Depth of the light-space maps.
+pub const SHADOW_DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+/// The translucency material ID of each map texel's first surface (frames with translucency).
+pub const SHADOW_ID_FORMAT: vk::Format = vk::Format::R8_UINT;
+/// Faces the atlas holds at most: six per light (glsl/common/shadows.glsl).
+pub const MAX_SHADOW_FACES: usize = 6 * MAX_LIGHTS;
+/// Largest atlas edge in texels: when a scene's faces do not fit at the asked size, the tile
+/// edge is halved until they do (8192 x 8192 x 4 bytes = 256 MiB at most).
+pub const MAX_ATLAS_EXTENT: u32 = 8192;
+/// Map sizes the knob takes.
+pub const SHADOW_SIZES: std::ops::RangeInclusive<u32> = 16..=4096;
+
+/// The shadow knobs of a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowSettings {
+    /// Lights cast shadows (each light's own `shadows` switch still applies).
+    pub enabled: bool,
+    /// Edge of one face's map in texels (Li et al.'s Table 1 uses 512 and 1024).
+    pub size: u32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            size: 1024,
+        }
+    }
+}
+
+/// The light-space maps of a frame: which lights cast, and where their faces lie in the atlas.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadowDesc {
+    /// Per scene light: its faces in the atlas (0: the light casts no shadow, 1, or 6).
+    pub light_faces: Vec<u32>,
+    /// Edge of one face's map in texels (the asked size, halved until the atlas fits).
+    pub tile: u32,
+    /// Atlas columns and rows of tiles.
+    pub columns: u32,
+    /// Atlas rows.
+    pub rows: u32,
+    /// The atlas stores each texel's translucency material (frames with translucency).
+    pub transmission_ids: bool,
+}
+
+impl ShadowDesc {
+    /// The maps `scene`'s lights ask for under `settings`; `None` when no light casts (or
+    /// nothing could cast: the scene has no object).
+    pub fn new(scene: &Scene, settings: &ShadowSettings, translucency: bool) -> Option<Self> {
+        if !settings.enabled || scene.objects.is_empty() {
+            return None;
+        }
+        let light_faces: Vec<u32> = scene
+            .lights
+            .iter()
+            .take(MAX_LIGHTS)
+            .map(|l| match (l.shadows, l.kind) {
+                (false, _) => 0,
+                (true, LightKind::Point { .. }) => 6,
+                (true, _) => 1,
+            })
+            .collect();
+        let faces: u32 = light_faces.iter().sum();
+        if faces == 0 {
+            return None;
+        }
+        let columns = (faces as f64).sqrt().ceil() as u32;
+        let rows = faces.div_ceil(columns);
+        let mut tile = settings
+            .size
+            .clamp(*SHADOW_SIZES.start(), *SHADOW_SIZES.end());
+        while tile > *SHADOW_SIZES.start() && columns.max(rows) * tile > MAX_ATLAS_EXTENT {
+            tile /= 2;
+        }
+        Some(Self {
+            light_faces,
+            tile,
+            columns,
+            rows,
+            transmission_ids: translucency,
+        })
+    }
+
+    /// Faces in the atlas.
+    pub fn faces(&self) -> u32 {
+        self.light_faces.iter().sum()
+    }
+
+    /// Atlas size in texels.
+    pub fn extent(&self) -> (u32, u32) {
+        (self.columns * self.tile, self.rows * self.tile)
+    }
+
+    /// Top-left texel of face `face`'s tile.
+    pub fn tile_origin(&self, face: u32) -> (u32, u32) {
+        (
+            (face % self.columns) * self.tile,
+            (face / self.columns) * self.tile,
+        )
+    }
+
+    /// For messages and the plan header.
+    pub fn name(&self) -> String {
+        let lights = self.light_faces.iter().filter(|&&f| f > 0).count();
+        format!(
+            "shadows ({lights} light{}, {} face{} of {}x{})",
+            if lights == 1 { "" } else { "s" },
+            self.faces(),
+            if self.faces() == 1 { "" } else { "s" },
+            self.tile,
+            self.tile
+        )
+    }
+
+    /// The per-frame shadow table of `scene` (whose objects' object-space boxes are
+    /// `mesh_bounds`): each casting light's faces with their matrices.
+    pub fn uniforms(&self, scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> ShadowUniforms {
+        let mut u = ShadowUniforms::zeroed();
+        let (w, h) = self.extent();
+        u.atlas = [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32];
+        let (center, radius) = world_sphere(scene, mesh_bounds);
+        let mut face = 0u32;
+        for (i, (light, &count)) in scene.lights.iter().zip(&self.light_faces).enumerate() {
+            if count == 0 {
+                u.lights[i] = [-1, 0, 0, 0];
+                continue;
+            }
+            u.lights[i] = [face as i32, count as i32, 0, 0];
+            for (view_proj, texel) in light_faces(light.kind, center, radius, self.tile) {
+                let (x, y) = self.tile_origin(face);
+                u.faces[face as usize] = ShadowFaceGpu {
+                    view_proj: view_proj.to_cols_array_2d(),
+                    rect: [x as f32, y as f32, self.tile as f32, 0.0],
+                    params: texel.to_array(),
+                };
+                face += 1;
+            }
+        }
+        u
+    }
+}
+
+/// One face of the atlas, std140 (glsl/common/shadows.glsl `ShadowFace`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadowFaceGpu {
+    /// World to the face's clip space.
+    pub view_proj: [[f32; 4]; 4],
+    /// xy: the tile's top-left texel in the atlas; z: its edge in texels.
+    pub rect: [f32; 4],
+    /// A map texel's world size at a point: x * clip.w + y (perspective faces: x =
+    /// 2 tan(fov / 2) / tile, y = 0; orthographic: x = 0, y = 2 radius / tile); z, w: near
+    /// and far distance (near negated for orthographic faces), to compare distances in world
+    /// units.
+    pub params: [f32; 4],
+}
+
+/// The per-frame shadow table, std140 (glsl/common/shadows.glsl `Shadows`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadowUniforms {
+    /// xy: atlas size in texels; zw: its inverse.
+    pub atlas: [f32; 4],
+    /// Per light: x its first face (-1: no map), y its face count.
+    pub lights: [[i32; 4]; MAX_LIGHTS],
+    /// The faces.
+    pub faces: [ShadowFaceGpu; MAX_SHADOW_FACES],
+}
+
+impl ShadowUniforms {
+    fn zeroed() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
+}
+
+/// Bytes of the per-frame shadow region.
+pub const SHADOW_TABLE_BYTES: u64 = std::mem::size_of::<ShadowUniforms>() as u64;
+
+/// A sphere around every object in world space (the directional lights' maps cover it).
+fn world_sphere(scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> (Vec3, f32) {
+    let mut lo = Vec3::splat(f32::MAX);
+    let mut hi = Vec3::splat(f32::MIN);
+    for object in &scene.objects {
+        let Some(&(a, b)) = mesh_bounds.get(object.mesh) else {
+            continue;
+        };
+        if !(a.is_finite() && b.is_finite()) || a.cmpgt(b).any() {
+            continue; // an empty mesh
+        }
+        for corner in 0..8 {
+            let p = Vec3::new(
+                if corner & 1 == 0 { a.x } else { b.x },
+                if corner & 2 == 0 { a.y } else { b.y },
+                if corner & 4 == 0 { a.z } else { b.z },
+            );
+            let w = object.transform.transform_point3(p);
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    if lo.cmpgt(hi).any() || !(lo.is_finite() && hi.is_finite()) {
+        return (Vec3::ZERO, 1.0);
+    }
+    let center = (lo + hi) * 0.5;
+    // At least a millimetre-scale radius: a degenerate (flat) scene still gets a valid map.
+    (center, ((hi - lo).length() * 0.5).max(1e-3))
+}
+
+/// The view-projection and texel-size parameters of each face of a light.
+fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Mat4, Vec4)> {
+    let tile = tile as f32;
+    // Perspective faces: near at 1/200 of the range keeps fp32 depth resolution at the far end
+    // of a 20-unit range near 1e-4 units (the normal offset covers that).
+    let perspective = |position: Vec3, forward: Vec3, up: Vec3, fov: f32, range: f32| {
+        let far = range.max(1e-3);
+        let near = far / 200.0;
+        let view = Mat4::look_to_rh(position, forward, up);
+        let proj = Mat4::perspective_rh(fov, 1.0, near, far);
+        (
+            proj * view,
+            Vec4::new(2.0 * (fov * 0.5).tan() / tile, 0.0, near, far),
+        )
+    };
+    let up_for = |forward: Vec3| {
+        if forward.y.abs() > 0.99 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        }
+    };
+    match kind {
+        LightKind::Directional { direction } => {
+            let d = direction.normalize_or(Vec3::NEG_Y);
+            let eye = center - d * (2.0 * radius);
+            let view = Mat4::look_to_rh(eye, d, up_for(d));
+            let proj =
+                Mat4::orthographic_rh(-radius, radius, -radius, radius, radius, 3.0 * radius);
+            // Negative near marks the orthographic face (depth is linear in distance).
+            vec![(
+                proj * view,
+                Vec4::new(0.0, 2.0 * radius / tile, -radius, 3.0 * radius),
+            )]
+        }
+        LightKind::Spot {
+            position,
+            direction,
+            range,
+            outer_degrees,
+            ..
+        } => {
+            let d = direction.normalize_or(Vec3::NEG_Y);
+            // The cone's full angle, with a texel of margin; at most 170 degrees (a wider
+            // cone's map would spend its texels at the rim).
+            let fov = (2.0 * outer_degrees).clamp(1.0, 170.0).to_radians() * (1.0 + 2.0 / tile);
+            vec![perspective(position, d, up_for(d), fov, range)]
+        }
+        LightKind::Point { position, range } => {
+            // Faces +X, -X, +Y, -Y, +Z, -Z: glsl/common/shadows.glsl picks the face by the
+            // major axis of (point - light) in this order. A texel of margin on each side
+            // keeps the tent filter inside the face at its edges.
+            let fov = std::f32::consts::FRAC_PI_2 * (1.0 + 4.0 / tile);
+            [
+                Vec3::X,
+                Vec3::NEG_X,
+                Vec3::Y,
+                Vec3::NEG_Y,
+                Vec3::Z,
+                Vec3::NEG_Z,
+            ]
+            .into_iter()
+            .map(|f| perspective(position, f, up_for(f), fov, range))
+            .collect()
+        }
+    }
+}
+
+/// The light-space maps' handles.
+pub struct ShadowMaps {
+    /// Depth atlas.
+    pub depth: Handle<Image>,
+    /// Translucency material of each texel's first surface (frames with translucency).
+    pub ids: Option<Handle<Image>>,
+}
+
+/// Declares the `light-space maps` pass. `scene` is `None` for plan-only graphs.
+pub fn shadow_pass(
+    graph: &mut RenderGraph,
+    desc: &ShadowDesc,
+    scene: Option<&Arc<SceneGpu>>,
+) -> ShadowMaps {
+    let (width, height) = desc.extent();
+    let info = |format| ImageInfo {
+        width,
+        height,
+        format,
+    };
+    let mut maps = ShadowMaps {
+        depth: graph.create_image("light-space.depth", info(SHADOW_DEPTH_FORMAT)),
+        ids: desc
+            .transmission_ids
+            .then(|| graph.create_image("light-space.ids", info(SHADOW_ID_FORMAT))),
+    };
+    let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
+    if let Some(ids) = &mut maps.ids {
+        // 0: no translucent material (texels no object covers are never closer than a point).
+        pass.color(ids, LoadOp::Clear([0.0; 4]));
+    }
+    pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
+    match scene {
+        Some(scene) => pass.execute(ShadowPass {
+            scene: scene.clone(),
+            desc: desc.clone(),
+            pipeline: None,
+        }),
+        None => pass.finish(),
+    }
+    maps
+}
+
+/// Push constants of the shadow pass (glsl/shadow/depth.vert).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadowConstants {
+    model: [[f32; 4]; 4],
+    /// x: face index; y: the object's translucency material ID (0: none).
+    face_id: [i32; 4],
+}
+
+struct ShadowPass {
+    scene: Arc<SceneGpu>,
+    desc: ShadowDesc,
+    pipeline: Option<PassPipeline>,
+}
+
+impl PassExec for ShadowPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        let defines: &[(&str, &str)] = if self.desc.transmission_ids {
+            &[("LUCENT_SHADOW_IDS", "1")]
+        } else {
+            &[]
+        };
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &[Binding::PerFrame(
+                self.scene.per_frame.binding(Region::Shadows),
+            )],
+            &GraphicsPipelineDesc {
+                vertex: "shadow/depth.vert",
+                fragment: "shadow/depth.frag",
+                defines,
+                vertex_input: VertexInput::Positions,
+                depth_test: true,
+                // Open meshes (the floor, a leaf) cast from both sides.
+                cull_back: false,
+                additive_attachments: 0,
+                set_layouts: &[],
+                push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+                name: "light-space maps",
+            },
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        pipeline.bind(ctx);
+        let device = &ctx.gpu.device;
+        for face in 0..self.desc.faces() {
+            let (x, y) = self.desc.tile_origin(face);
+            let tile = self.desc.tile;
+            let viewport = vk::Viewport {
+                x: x as f32,
+                y: y as f32,
+                width: tile as f32,
+                height: tile as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            };
+            let scissor = vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x as i32,
+                    y: y as i32,
+                },
+                extent: vk::Extent2D {
+                    width: tile,
+                    height: tile,
+                },
+            };
+            // SAFETY: recording inside this pass's render pass with its pipeline bound; the
+            // scene's buffers outlive the frame.
+            unsafe {
+                device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
+                device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
+                for draw in &self.scene.draws {
+                    let mesh = &self.scene.meshes[draw.mesh];
+                    let constants = ShadowConstants {
+                        model: draw.constants.model,
+                        face_id: [face as i32, draw.constants.thickness[3] as i32, 0, 0],
+                    };
+                    device.cmd_push_constants(
+                        ctx.cmd,
+                        pipeline.pipeline.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&constants),
+                    );
+                    device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[mesh.vertices.buffer], &[0]);
+                    device.cmd_bind_index_buffer(
+                        ctx.cmd,
+                        mesh.indices.buffer,
+                        0,
+                        vk::IndexType::UINT32,
+                    );
+                    device.cmd_draw_indexed(ctx.cmd, mesh.index_count, 1, 0, 0, 0);
+                }
+            }
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+    }
+}
+
+/// Binding numbers as shader define strings (LUCENT_SHADOW_BINDING).
+const BINDINGS: [&str; 24] = [
+    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12", "13", "14", "15", "16",
+    "17", "18", "19", "20", "21", "22", "23",
+];
+
+/// The defines of a pass whose shadow bindings start at `first` (glsl/common/shadows.glsl).
+pub fn lighting_defines(first: usize) -> [(&'static str, &'static str); 2] {
+    [
+        ("LUCENT_SHADOWS", "1"),
+        (
+            "LUCENT_SHADOW_BINDING",
+            BINDINGS[first.min(BINDINGS.len() - 1)],
+        ),
+    ]
+}
+
+/// The bindings a lighting pass appends for the maps (after its own): the shadow table, the
+/// depth atlas and, with transmission IDs, the ID atlas; `views` are the graph's descriptor
+/// views and `sampler` a nearest clamp sampler.
+pub fn lighting_bindings(
+    scene: &SceneGpu,
+    depth: crate::graph::ResourceId,
+    ids: Option<crate::graph::ResourceId>,
+    views: &[vk::ImageView],
+    sampler: vk::Sampler,
+) -> Vec<Binding> {
+    let mut bindings = vec![
+        Binding::PerFrame(scene.per_frame.binding(Region::Shadows)),
+        Binding::Sampled(views[depth], sampler),
+    ];
+    if let Some(ids) = ids {
+        bindings.push(Binding::Sampled(views[ids], sampler));
+    }
+    bindings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{builtin, Light};
+
+    #[test]
+    fn faces_follow_the_lights_that_cast() {
+        let mut scene = builtin::builtin("layered").unwrap();
+        let settings = ShadowSettings::default();
+        let desc = ShadowDesc::new(&scene, &settings, false).unwrap();
+        // A point light (six faces) and a spot light (one).
+        assert_eq!(desc.light_faces, vec![6, 1]);
+        assert_eq!((desc.columns, desc.rows), (3, 3));
+        assert_eq!(desc.extent(), (3072, 3072));
+        scene.lights[0].shadows = false;
+        assert_eq!(
+            ShadowDesc::new(&scene, &settings, false).unwrap().faces(),
+            1
+        );
+        scene.lights[1].shadows = false;
+        assert!(ShadowDesc::new(&scene, &settings, false).is_none());
+        let off = ShadowSettings {
+            enabled: false,
+            ..settings
+        };
+        assert!(ShadowDesc::new(&builtin::builtin("layered").unwrap(), &off, false).is_none());
+    }
+
+    #[test]
+    fn many_faces_shrink_the_tile_to_fit_the_atlas() {
+        let mut scene = builtin::builtin("layered").unwrap();
+        scene.lights = (0..MAX_LIGHTS)
+            .map(|i| Light::point(Vec3::new(i as f32, 3.0, 0.0), Vec3::ONE, 1.0, 10.0))
+            .collect();
+        let desc = ShadowDesc::new(&scene, &ShadowSettings::default(), false).unwrap();
+        assert_eq!(desc.faces() as usize, MAX_SHADOW_FACES);
+        let (w, h) = desc.extent();
+        assert!(w <= MAX_ATLAS_EXTENT && h <= MAX_ATLAS_EXTENT, "{w}x{h}");
+        assert_eq!(desc.tile, 256);
+    }
+
+    #[test]
+    fn every_face_sees_the_points_it_is_picked_for() {
+        // The shader picks a point light's face by the major axis of (point - light): that
+        // face's frustum must contain the point, its depth in [0, 1].
+        let light = LightKind::Point {
+            position: Vec3::new(0.5, 2.0, -1.0),
+            range: 10.0,
+        };
+        let faces = light_faces(light, Vec3::ZERO, 5.0, 512);
+        let mut seed = 1u32;
+        let mut rand = || {
+            seed = seed.wrapping_mul(1664525).wrapping_add(1013904223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            let d = Vec3::new(rand(), rand(), rand()) * 4.0;
+            if d.length() < 0.2 {
+                continue;
+            }
+            let a = d.abs();
+            let axis = if a.x >= a.y && a.x >= a.z {
+                0
+            } else if a.y >= a.z {
+                1
+            } else {
+                2
+            };
+            let face = axis * 2 + usize::from(d[axis] < 0.0);
+            let clip = faces[face].0 * (Vec3::new(0.5, 2.0, -1.0) + d).extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            assert!(clip.w > 0.0, "{d}");
+            assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{d}: {ndc}");
+            assert!((0.0..=1.0).contains(&ndc.z), "{d}: {ndc}");
+        }
+    }
+
+    #[test]
+    fn a_directional_map_covers_the_whole_scene() {
+        let scene = builtin::builtin("cubes").unwrap();
+        let bounds = crate::gpu_scene::tiles::mesh_bounds(&scene);
+        let (center, radius) = world_sphere(&scene, &bounds);
+        let faces = light_faces(
+            LightKind::Directional {
+                direction: Vec3::new(0.3, -1.0, -0.2),
+            },
+            center,
+            radius,
+            1024,
+        );
+        for object in &scene.objects {
+            let (a, b) = bounds[object.mesh];
+            for p in [a, b] {
+                let w = object.transform.transform_point3(p);
+                let clip = faces[0].0 * w.extend(1.0);
+                let ndc = clip.truncate() / clip.w;
+                assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{ndc}");
+                assert!((0.0..=1.0).contains(&ndc.z), "{ndc}");
+            }
+        }
+    }
+}

@@ -26,6 +26,11 @@ use common::TestGpu;
 fn settings(technique: Technique, w: u32, h: u32) -> FrameSettings {
     FrameSettings {
         technique,
+        // The f64 references shade without shadows (tests/shadows.rs checks those).
+        shadows: lucent::features::shadows::ShadowSettings {
+            enabled: false,
+            ..Default::default()
+        },
         ..FrameSettings::new(w, h)
     }
 }

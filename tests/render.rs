@@ -149,6 +149,9 @@ fn smoke_matches_the_raytraced_f64_reference() {
     let (w, h) = (256, 192);
     let mut settings = FrameSettings::new(w, h);
     settings.export_hdr = true;
+    // The ray tracer's lighting has no shadow rays: its twin is the unshadowed frame
+    // (tests/shadows.rs checks the GPU's visibility against rays).
+    settings.shadows.enabled = false;
     let (display, hdr) = render("smoke", settings);
     let hdr = hdr.unwrap();
     let scene = scene::builtin("smoke").unwrap();
@@ -352,7 +355,7 @@ fn bench_writes_the_documented_json() {
     assert_eq!(v["frames"], 5);
     let passes = v["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["gbuffer + lighting", "tonemap"]);
+    assert_eq!(names, ["light-space maps", "gbuffer + lighting", "tonemap"]);
     for p in passes {
         for key in ["median_ms", "min_ms", "max_ms", "isolated_ms"] {
             assert!(
@@ -376,7 +379,8 @@ fn plan_command_prints_the_merged_group() {
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
-        text.contains("[0] \"gbuffer + lighting\" Raster 1024x768"),
+        text.contains("[0] \"light-space maps\" Raster")
+            && text.contains("[1] \"gbuffer + lighting\" Raster 1024x768"),
         "{text}"
     );
     assert!(text.contains("transient total:"), "{text}");

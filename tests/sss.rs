@@ -16,6 +16,11 @@ fn settings(technique: Technique) -> FrameSettings {
         technique,
         export_hdr: true,
         export_gbuffer: true,
+        // The f64 references shade without shadows (tests/shadows.rs checks those).
+        shadows: lucent::features::shadows::ShadowSettings {
+            enabled: false,
+            ..Default::default()
+        },
         ..FrameSettings::new(160, 120)
     }
 }

@@ -29,6 +29,11 @@ fn translucency_settings(w: u32, h: u32) -> FrameSettings {
         technique: Technique::Translucency,
         export_hdr: true,
         export_gbuffer: true,
+        // The f64 reference shades without shadows (tests/shadows.rs checks those).
+        shadows: lucent::features::shadows::ShadowSettings {
+            enabled: false,
+            ..Default::default()
+        },
         ..FrameSettings::new(w, h)
     }
 }
@@ -101,6 +106,10 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
         technique: Technique::None,
         export_hdr: true,
         export_gbuffer: true,
+        shadows: lucent::features::shadows::ShadowSettings {
+            enabled: false,
+            ..Default::default()
+        },
         ..FrameSettings::new(size.0, size.1)
     };
     let (off, _) = render(&gpu, &half, plain);

@@ -1,6 +1,7 @@
 #version 450
 // permutation: LUCENT_COPY_INPUTS=3 LUCENT_COPY_OUTPUTS=4 LUCENT_COPY_DEPTH=1
 // permutation: LUCENT_COPY_INPUTS=8 LUCENT_COPY_OUTPUTS=8
+// permutation: LUCENT_COPY_INPUTS=10 LUCENT_COPY_OUTPUTS=1 LUCENT_COPY_IN9_KIND=1
 // permutation: LUCENT_COPY_INPUTS=1 LUCENT_COPY_OUTPUTS=1
 // permutation: LUCENT_COPY_INPUTS=2 LUCENT_COPY_OUTPUTS=2 LUCENT_COPY_IN0_KIND=1 LUCENT_COPY_OUT1_KIND=1
 // permutation: LUCENT_COPY_INPUTS=2 LUCENT_COPY_OUTPUTS=2 LUCENT_COPY_IN1_KIND=2 LUCENT_COPY_OUT0_KIND=2 LUCENT_COPY_DEPTH=1
@@ -70,6 +71,12 @@
 #endif
 #ifndef LUCENT_COPY_OUT7_KIND
 #define LUCENT_COPY_OUT7_KIND 0
+#endif
+#ifndef LUCENT_COPY_IN8_KIND
+#define LUCENT_COPY_IN8_KIND 0
+#endif
+#ifndef LUCENT_COPY_IN9_KIND
+#define LUCENT_COPY_IN9_KIND 0
 #endif
 
 #if LUCENT_COPY_INPUTS > 0
@@ -145,6 +152,24 @@ layout(set = 0, binding = 7) uniform sampler2D in7;
 #endif
 #endif
 
+#if LUCENT_COPY_INPUTS > 8
+#if LUCENT_COPY_IN8_KIND == 1
+layout(set = 0, binding = 8) uniform usampler2D in8;
+#elif LUCENT_COPY_IN8_KIND == 2
+layout(set = 0, binding = 8) uniform isampler2D in8;
+#else
+layout(set = 0, binding = 8) uniform sampler2D in8;
+#endif
+#endif
+#if LUCENT_COPY_INPUTS > 9
+#if LUCENT_COPY_IN9_KIND == 1
+layout(set = 0, binding = 9) uniform usampler2D in9;
+#elif LUCENT_COPY_IN9_KIND == 2
+layout(set = 0, binding = 9) uniform isampler2D in9;
+#else
+layout(set = 0, binding = 9) uniform sampler2D in9;
+#endif
+#endif
 #if LUCENT_COPY_OUTPUTS > 0
 #if LUCENT_COPY_OUT0_KIND == 1
 layout(location = 0) out uvec4 out0;
@@ -279,6 +304,20 @@ void main() {
     v += texelFetch(in7, px, 0);
 #else
     bits ^= uvec4(texelFetch(in7, px, 0));
+#endif
+#endif
+#if LUCENT_COPY_INPUTS > 8
+#if LUCENT_COPY_IN8_KIND == 0
+    v += texelFetch(in8, px, 0);
+#else
+    bits ^= uvec4(texelFetch(in8, px, 0));
+#endif
+#endif
+#if LUCENT_COPY_INPUTS > 9
+#if LUCENT_COPY_IN9_KIND == 0
+    v += texelFetch(in9, px, 0);
+#else
+    bits ^= uvec4(texelFetch(in9, px, 0));
 #endif
 #endif
     vec4 f = v + vec4(bits & uvec4(1u));

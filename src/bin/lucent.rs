@@ -489,6 +489,12 @@ impl FrameArgs {
             (self.sss_filter.is_some(), "--sss-filter", sep, separable),
             (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
             (self.grayscale, "--grayscale", gdc, translucent),
+            (
+                self.shadow_size.is_some(),
+                "--shadow-size",
+                "a light that casts shadows (without --no-shadows; lights with shadows = true)",
+                desc.shadows.is_some(),
+            ),
         ];
         let technique = settings.technique;
         knobs

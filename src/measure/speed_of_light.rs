@@ -50,6 +50,8 @@ pub const FAR_ABOVE_FLOOR: f64 = 4.0;
 /// Images one copy pass can read or write (`glsl/bench/copy.frag` declares eight of each, the
 /// colour-attachment count every Vulkan device supports).
 pub const MAX_COPY_IMAGES: usize = 8;
+/// Most images the copy reads (LEAN's final pass reads nine with the light-space maps).
+pub const MAX_COPY_INPUTS: usize = 10;
 
 /// What one physical pass moves, and how many taps it makes.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -76,9 +78,10 @@ pub struct PassFloor {
 impl PassFloor {
     /// Why no copy can stand in for this pass, if none can.
     pub fn unsupported(&self) -> Option<String> {
-        if self.reads.len() > MAX_COPY_IMAGES || self.colour_writes.len() > MAX_COPY_IMAGES {
+        if self.reads.len() > MAX_COPY_INPUTS || self.colour_writes.len() > MAX_COPY_IMAGES {
             return Some(format!(
-                "'{}' reads {} and writes {} images; the copy takes at most {MAX_COPY_IMAGES} of each",
+                "'{}' reads {} and writes {} images; the copy reads at most {MAX_COPY_INPUTS} \
+                 and writes at most {MAX_COPY_IMAGES}",
                 self.pass,
                 self.reads.len(),
                 self.colour_writes.len()
@@ -596,9 +599,19 @@ mod tests {
         let plan = plan("smoke", Technique::None);
         let floors = floors(&plan);
         assert_eq!(floors.len(), plan.physical.len());
-        let deferred = &floors[0];
+        // The light-space maps come first: a depth-only pass reading nothing.
+        let maps = &floors[0];
+        assert_eq!(maps.pass, "light-space maps");
+        assert!(
+            maps.reads.is_empty() && maps.colour_writes.is_empty(),
+            "{maps:?}"
+        );
+        assert_eq!(maps.depth_write, Some(vk::Format::D32_SFLOAT));
+        let deferred = &floors[1];
         assert_eq!(deferred.pass, "gbuffer + lighting");
-        assert!(deferred.reads.is_empty(), "{deferred:?}");
+        // From outside its group it reads only the light-space atlas.
+        assert_eq!(deferred.reads.len(), 1, "{deferred:?}");
+        assert_eq!(deferred.reads[0].format, vk::Format::D32_SFLOAT);
         assert_eq!(deferred.depth_write, Some(vk::Format::D32_SFLOAT));
         // Albedo, normal and the lit image at least.
         assert!(deferred.colour_writes.len() >= 3, "{deferred:?}");
@@ -607,7 +620,7 @@ mod tests {
             deferred.taps >= 3 && !deferred.taps_declared,
             "{deferred:?}"
         );
-        let tonemap = &floors[1];
+        let tonemap = &floors[2];
         assert_eq!(tonemap.pass, "tonemap");
         assert_eq!(tonemap.reads.len(), 1);
         assert_eq!(tonemap.reads[0].format, vk::Format::R16G16B16A16_SFLOAT);

@@ -77,6 +77,24 @@ impl Dipole {
         self.alpha_prime / (4.0 * PI) * (term(self.z_r, dr) + term(self.z_v, dv))
     }
 
+    /// `2 pi ∫_0^a Rd(r) r dr` in closed form (the reflectance within a disc of radius `a`):
+    /// `(alpha'/2) sum_{z = z_r, z_v} [e^(-sigma_tr z) - z e^(-sigma_tr d(a)) / d(a)]`, `d(a) =
+    /// sqrt(a^2 + z^2)`, since `(sigma_tr d + 1) e^(-sigma_tr d) / d^2` is the derivative of
+    /// `-e^(-sigma_tr d) / d`. Used for the peak of Rd that a surface sample cannot resolve.
+    pub fn reflectance_within(&self, a: f64) -> f64 {
+        let part = |z: f64| {
+            let d = (a * a + z * z).sqrt();
+            // z / d <= 1, and both exponentials only shrink: never NaN for finite inputs.
+            let tail = if d.is_finite() {
+                z / d * (-self.sigma_tr * d).exp()
+            } else {
+                0.0
+            };
+            ((-self.sigma_tr * z).exp() - tail).max(0.0)
+        };
+        0.5 * self.alpha_prime * (part(self.z_r) + part(self.z_v))
+    }
+
     /// Total diffuse reflectance `R_d = 2 pi ∫ Rd(r) r dr` in closed form:
     /// `(alpha'/2) (1 + e^(-4/3 A sqrt(3(1 - alpha')))) e^(-sqrt(3(1 - alpha')))`.
     pub fn total_reflectance(&self) -> f64 {
@@ -166,6 +184,8 @@ mod tests {
             }
             let integral = 2.0 * PI * sum * h / 3.0;
             let closed = d.total_reflectance();
+            assert!((d.reflectance_within(f64::INFINITY) - closed).abs() < 1e-12 * closed.max(1.0));
+            assert!(d.reflectance_within(0.0).abs() < 1e-15);
             assert!(
                 (integral - closed).abs() < 2e-4 * closed.max(1e-3),
                 "sp {sp} sa {sa} eta {eta}: {integral} vs {closed}"

@@ -840,6 +840,47 @@ mod tests {
     }
 
     #[test]
+    fn a_stack_of_two_equal_layers_scatters_as_one() {
+        // Splitting a medium into two equal layers changes nothing; a different second layer
+        // does, and so does the phase function for g != 0.
+        let lights = vec![Light::point(
+            Vec3::new(0.5, 0.8, 1.5),
+            Vec3::ONE,
+            10.0,
+            10.0,
+        )];
+        let x_o = DVec3::new(0.1, 0.05, (0.25f64 - 0.0125).sqrt());
+        let options = SingleScatteringOptions::default();
+        let one = homogeneous(0.5, 3.0, 0.6, 1.3);
+        let mut two = one.clone();
+        two.layers[0].thickness = Thickness::Mm(0.1);
+        two.layers.push(one.layers[0]);
+        let run = |m: LayeredMedium, o: &SingleScatteringOptions| {
+            single_scattering(
+                &sphere_scene(m, 0.5, lights.clone()),
+                0,
+                x_o,
+                DVec3::NEG_Z,
+                o,
+            )
+            .unwrap()
+        };
+        let (a, b) = (run(one.clone(), &options), run(two.clone(), &options));
+        assert!(
+            a.min_element() > 0.0 && ((a - b).abs() / a).max_element() < 1e-9,
+            "{a} {b}"
+        );
+        two.layers[1].sigma_a = Vec3::splat(5.0);
+        assert!(run(two, &options).x < a.x);
+        let schlick = SingleScatteringOptions {
+            phase: Phase::Schlick,
+            ..Default::default()
+        };
+        let c = run(one, &schlick);
+        assert!(c.x != a.x && (c.x / a.x - 1.0).abs() < 0.5, "{a} {c}");
+    }
+
+    #[test]
     fn multiple_scattering_of_a_lit_plane_is_the_total_diffuse_reflectance() {
         // A large plane under a unit directional light at normal incidence, eta = 1: the
         // gather at the centre is (E / pi) 2 pi ∫ Rd r dr, between the closed form within the

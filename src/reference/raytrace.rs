@@ -99,8 +99,9 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> Result<ReferenceImage> 
     })
 }
 
-/// Nearest hit of a ray with a transformed shape: (distance, world unit normal).
-fn intersect(
+/// Nearest hit of a ray with a transformed shape: (distance, world unit normal). Hits closer
+/// than 1e-9 are skipped (a ray leaving a surface does not hit it again).
+pub fn intersect(
     shape: Shape,
     transform: &glam::DMat4,
     origin: DVec3,

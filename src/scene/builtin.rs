@@ -38,7 +38,7 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     (
         "layered",
-        "Li et al.'s Table 1 layered materials on five spheres",
+        "Li et al.'s Table 1 materials (Jensen 2001 media) on five spheres",
     ),
     ("dynamic", "a layered torus deforming every frame"),
     (
@@ -554,7 +554,9 @@ fn skin() -> Result<Scene> {
     Ok(s)
 }
 
-/// Li et al.'s Table 1 coefficient sets, one sphere each.
+/// Li et al.'s Table 1 materials, one sphere each, named as the table names them: its
+/// coefficients are Jensen et al. 2001's media (see [`super::layered`]): frog = apple,
+/// teapot = skin1, bunny = chicken1, buddha = skin2, dragon = skimmilk.
 fn layered() -> Result<Scene> {
     let mut s = base_scene(
         "layered",
@@ -562,11 +564,17 @@ fn layered() -> Result<Scene> {
     );
     s.add_floor();
     let sphere = s.add_mesh(generators::generate(Generator::Icosphere, 4)?);
-    for (i, preset) in ["frog", "teapot", "bunny", "buddha", "dragon"]
-        .iter()
-        .enumerate()
+    for (i, (name, preset)) in [
+        ("frog", "apple"),
+        ("teapot", "skin1"),
+        ("bunny", "chicken1"),
+        ("buddha", "skin2"),
+        ("dragon", "skimmilk"),
+    ]
+    .iter()
+    .enumerate()
     {
-        let mut m = Material::opaque(preset, Vec3::new(0.8, 0.7, 0.6), 0.3, 0.4);
+        let mut m = Material::opaque(name, Vec3::new(0.8, 0.7, 0.6), 0.3, 0.4);
         m.layers = Some(LayeredMedium::preset(preset)?);
         s.add(
             sphere,
@@ -606,7 +614,8 @@ fn dynamic() -> Result<Scene> {
     s.add_floor();
     let torus = s.add_mesh(generators::generate(Generator::Torus, 4)?);
     let mut m = Material::opaque("jelly", Vec3::new(0.7, 0.8, 0.5), 0.4, 0.3);
-    m.layers = Some(LayeredMedium::preset("bunny")?);
+    // Li et al.'s bunny row: Jensen's chicken1.
+    m.layers = Some(LayeredMedium::preset("chicken1")?);
     s.add(
         torus,
         Mat4::from_scale_rotation_translation(
@@ -642,7 +651,8 @@ fn scaling(triangles: u64) -> Result<Scene> {
     let (mesh, _) = generators::generate_with_triangles(Generator::Teapot, triangles)?;
     let teapot = s.add_mesh(mesh);
     let mut m = Material::opaque("scaling", Vec3::new(0.8, 0.75, 0.7), 0.4, 0.35);
-    m.layers = Some(LayeredMedium::preset("teapot")?);
+    // Li et al.'s teapot row: Jensen's skin1.
+    m.layers = Some(LayeredMedium::preset("skin1")?);
     s.add(teapot, Mat4::IDENTITY, m);
     s.lights = vec![Light::point(
         Vec3::new(2.0, 3.0, 2.0),

@@ -14,7 +14,7 @@ use serde::Deserialize;
 use super::generators::{self, Generator};
 use super::material::{
     Gaussian, Layer, LayeredMedium, Light, LightKind, Material, PowMode, SssProfile, TextureSource,
-    ThicknessSource, Translucency,
+    Thickness, ThicknessSource, Translucency,
 };
 use super::{Camera, Deformation, Object, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
@@ -91,21 +91,30 @@ struct SssToml {
     blur: Option<String>,
 }
 
+/// One `[[material.layered.layer]]` table.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LayerToml {
-    thickness: [f32; 3],
-    scattering: [f32; 3],
-    absorption: [f32; 3],
+    sigma_a: Option<[f32; 3]>,
+    sigma_s: Option<[f32; 3]>,
+    sigma_s_prime: Option<[f32; 3]>,
     g: Option<f32>,
+    /// A number (mm), `"texture"` or `"rest"`: read by hand for a message naming all three.
+    thickness: Option<toml::Value>,
+    thickness_scale: Option<f32>,
 }
 
+/// `[material.layered]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct LayersToml {
+struct LayeredToml {
     preset: Option<String>,
-    layers: Option<Vec<LayerToml>>,
+    layer: Option<Vec<LayerToml>>,
     eta: Option<f32>,
+    weights: Option<[f32; 5]>,
+    units_per_mm: Option<f32>,
+    /// A path or an array of paths.
+    depth_texture: Option<toml::Value>,
 }
 
 #[derive(Deserialize)]
@@ -119,7 +128,9 @@ struct MaterialToml {
     normal_texture: Option<PathBuf>,
     translucency: Option<TranslucencyToml>,
     sss: Option<SssToml>,
-    layers: Option<LayersToml>,
+    layered: Option<LayeredToml>,
+    /// Gone: `[material.layered]` replaced it. Kept only to say so.
+    layers: Option<toml::Value>,
 }
 
 /// `scale = 2` or `scale = [x, y, z]`. Deserialized by hand: serde's untagged enum would
@@ -228,11 +239,28 @@ impl Locator<'_> {
         };
         let mut current = (String::new(), 0usize);
         let mut counts: HashMap<String, usize> = HashMap::new();
+        // Entries of nested arrays (`[[material.layered.layer]]`) per (array, owner entry).
+        let mut nested: HashMap<(String, usize), usize> = HashMap::new();
         let mut fallback = None;
         for (number, raw) in self.source.lines().enumerate() {
             let line = raw.trim();
             if let Some(header) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
                 let name = header.trim().to_string();
+                // `[[material.layered.layer]]` belongs to the latest `[[material]]` and is
+                // numbered within it: its keys sit at `layered.layer[k].key` of that entry.
+                let owner = counts
+                    .iter()
+                    .find(|(array, _)| {
+                        name.strip_prefix(array.as_str())
+                            .is_some_and(|rest| rest.starts_with('.'))
+                    })
+                    .map(|(_, n)| n.saturating_sub(1));
+                if let Some(owner) = owner {
+                    let k = nested.entry((name.clone(), owner)).or_insert(0);
+                    current = (format!("{name}[{k}]"), owner);
+                    *k += 1;
+                    continue;
+                }
                 let n = counts.entry(name.clone()).or_insert(0);
                 current = (name, *n);
                 *n += 1;
@@ -886,6 +914,254 @@ fn with_mtl(material: &Material, mtl: &super::obj::ObjMaterial, explicit_albedo:
     m
 }
 
+/// `[material.layered]` of material `i` as a checked [`LayeredMedium`]: every bad value is an
+/// error naming its key (`material[1].layered.layer[0].g`), every key does something or is
+/// refused.
+fn build_layered(
+    l: &LayeredToml,
+    i: usize,
+    at: &Locator<'_>,
+    resolve: &dyn Fn(&Path) -> PathBuf,
+) -> Result<LayeredMedium> {
+    use super::layered::{sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS};
+    let err = |key: &str, message: String| at.error("material", Some(i), key, message);
+    let mut medium = match (&l.preset, &l.layer) {
+        (Some(p), None) => {
+            LayeredMedium::preset(p).map_err(|e| err("layered.preset", e.to_string()))?
+        }
+        (None, Some(layers)) => {
+            if !(1..=MAX_LAYERS).contains(&layers.len()) {
+                return Err(err(
+                    "layered.layer",
+                    format!(
+                        "{} layers; 1 to {MAX_LAYERS} [[material.layered.layer]] tables are \
+                         supported",
+                        layers.len()
+                    ),
+                ));
+            }
+            let mut out = Vec::new();
+            for (k, t) in layers.iter().enumerate() {
+                let key = |leaf: &str| format!("layered.layer[{k}].{leaf}");
+                let coefficient = |leaf: &str, v: [f32; 3]| -> Result<Vec3> {
+                    if v.iter()
+                        .all(|c| c.is_finite() && (0.0..=MAX_COEFFICIENT).contains(c))
+                    {
+                        Ok(Vec3::from(v))
+                    } else {
+                        Err(err(
+                            &key(leaf),
+                            format!("{v:?} must be finite and in [0, {MAX_COEFFICIENT:e}] (mm^-1)"),
+                        ))
+                    }
+                };
+                let sigma_a = match t.sigma_a {
+                    Some(v) => coefficient("sigma_a", v)?,
+                    None => {
+                        return Err(err(
+                            &format!("layered.layer[{k}]"),
+                            "missing `sigma_a` (absorption, RGB, mm^-1)".into(),
+                        ))
+                    }
+                };
+                let g = t.g.unwrap_or(0.0);
+                if !(g.is_finite() && g.abs() <= MAX_ABS_G) {
+                    return Err(err(
+                        &key("g"),
+                        format!(
+                            "{g} must be in [-{MAX_ABS_G}, {MAX_ABS_G}] (Henyey-Greenstein \
+                             anisotropy; |g| = 1 is a delta)"
+                        ),
+                    ));
+                }
+                let sigma_s = match (t.sigma_s, t.sigma_s_prime) {
+                    (Some(v), None) => coefficient("sigma_s", v)?,
+                    (None, Some(v)) => {
+                        let s = sigma_s_from_reduced(coefficient("sigma_s_prime", v)?, g);
+                        if s.max_element() > MAX_COEFFICIENT {
+                            return Err(err(
+                                &key("sigma_s_prime"),
+                                format!("{v:?} / (1 - g) = {s} exceeds {MAX_COEFFICIENT:e} mm^-1"),
+                            ));
+                        }
+                        s
+                    }
+                    (Some(_), Some(_)) => {
+                        return Err(err(
+                            &key("sigma_s_prime"),
+                            "give `sigma_s` or the reduced `sigma_s_prime`, not both".into(),
+                        ))
+                    }
+                    (None, None) => {
+                        return Err(err(
+                            &format!("layered.layer[{k}]"),
+                            "missing `sigma_s` (or the reduced `sigma_s_prime`), RGB, mm^-1".into(),
+                        ))
+                    }
+                };
+                const THICKNESS: &str =
+                    "a number of mm (>= 0), \"texture\" (per texel from depth_texture) or \
+                     \"rest\" (semi-infinite, last layer only)";
+                let thickness = match &t.thickness {
+                    None => {
+                        return Err(err(
+                            &format!("layered.layer[{k}]"),
+                            format!("missing `thickness`: {THICKNESS}"),
+                        ))
+                    }
+                    Some(toml::Value::Float(v)) => Thickness::Mm(*v as f32),
+                    Some(toml::Value::Integer(v)) => Thickness::Mm(*v as f32),
+                    Some(toml::Value::String(s)) if s == "rest" => Thickness::Rest,
+                    Some(toml::Value::String(s)) if s == "texture" => Thickness::Texture {
+                        scale: t.thickness_scale.unwrap_or(1.0),
+                    },
+                    Some(other) => {
+                        return Err(err(
+                            &key("thickness"),
+                            format!("{other} must be {THICKNESS}"),
+                        ))
+                    }
+                };
+                match thickness {
+                    Thickness::Mm(v) if !(v.is_finite() && v >= 0.0) => {
+                        return Err(err(&key("thickness"), format!("{v} must be {THICKNESS}")))
+                    }
+                    Thickness::Rest if k + 1 != layers.len() => {
+                        return Err(err(
+                            &key("thickness"),
+                            format!(
+                                "\"rest\" (semi-infinite) is allowed only on the last layer \
+                                 (layer[{}])",
+                                layers.len() - 1
+                            ),
+                        ))
+                    }
+                    Thickness::Texture { scale } if !(scale.is_finite() && scale > 0.0) => {
+                        return Err(err(
+                            &key("thickness_scale"),
+                            format!("{scale} must be finite and > 0 (mm per texel unit)"),
+                        ))
+                    }
+                    Thickness::Mm(_) | Thickness::Rest if t.thickness_scale.is_some() => {
+                        return Err(err(
+                            &key("thickness_scale"),
+                            "only a layer with thickness = \"texture\" reads a scale".into(),
+                        ))
+                    }
+                    _ => {}
+                }
+                out.push(Layer {
+                    sigma_a,
+                    sigma_s,
+                    g,
+                    thickness,
+                });
+            }
+            let mut medium = LayeredMedium::homogeneous("custom", Vec3::ZERO, Vec3::ZERO, 0.0, 1.3);
+            medium.layers = out;
+            medium
+        }
+        (Some(_), Some(_)) => {
+            return Err(err(
+                "layered.preset",
+                "give a `preset` or [[material.layered.layer]] tables, not both".into(),
+            ))
+        }
+        (None, None) => {
+            return Err(err(
+                "layered",
+                "give a `preset` or [[material.layered.layer]] tables".into(),
+            ))
+        }
+    };
+    if let Some(eta) = l.eta {
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(err(
+                "layered.eta",
+                format!("{eta} must be finite and > 0 (relative index; 1 = no boundary)"),
+            ));
+        }
+        medium.eta = eta;
+    }
+    if let Some(w) = l.weights {
+        if let Some(bad) = w.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
+            return Err(err(
+                "layered.weights",
+                format!(
+                    "{w:?}: {bad} must be finite and >= 0 (lambda_1..lambda_5 of Li et al.'s \
+                     eq. 3: diffuse, specular, transmitted, single, multiple)"
+                ),
+            ));
+        }
+        medium.weights = w;
+    }
+    if let Some(u) = l.units_per_mm {
+        if !(u.is_finite() && u > 0.0) {
+            return Err(err(
+                "layered.units_per_mm",
+                format!(
+                    "{u} must be finite and > 0 (scene units per millimetre: 1 when a unit is \
+                     a millimetre, 0.001 when it is a metre)"
+                ),
+            ));
+        }
+        medium.units_per_mm = u;
+    }
+    let needed = medium.depth_textures_needed();
+    if let Some(v) = &l.depth_texture {
+        let paths: Vec<&str> = match v {
+            toml::Value::String(s) => vec![s.as_str()],
+            toml::Value::Array(a) if a.iter().all(|x| x.is_str()) => {
+                a.iter().filter_map(|x| x.as_str()).collect()
+            }
+            other => {
+                return Err(err(
+                    "layered.depth_texture",
+                    format!("{other} must be a path or an array of paths"),
+                ))
+            }
+        };
+        if needed == 0 {
+            return Err(err(
+                "layered.depth_texture",
+                "no layer reads it: give a layer thickness = \"texture\" or remove the key".into(),
+            ));
+        }
+        if paths.len() != needed {
+            return Err(err(
+                "layered.depth_texture",
+                format!(
+                    "{} textures given, the layers read {needed} (layer i with thickness = \
+                     \"texture\" reads channel i % 4 of texture i / 4)",
+                    paths.len()
+                ),
+            ));
+        }
+        for p in paths {
+            let full = resolve(Path::new(p));
+            if !full.exists() {
+                return Err(err(
+                    "layered.depth_texture",
+                    format!("depth texture {} not found", full.display()),
+                ));
+            }
+            medium.depth_textures.push(TextureSource::File(full));
+        }
+    } else if needed > 0 {
+        return Err(err(
+            "layered.depth_texture",
+            format!(
+                "missing: {needed} depth texture(s) for the layers with thickness = \"texture\""
+            ),
+        ));
+    }
+    // Everything was checked above; this names what a future field would miss.
+    medium
+        .validate()
+        .map_err(|e| err("layered", e.to_string()))?;
+    Ok(medium)
+}
+
 fn build_material(
     m: &MaterialToml,
     i: usize,
@@ -1013,40 +1289,17 @@ fn build_material(
         })?;
         material.sss = Some(profile);
     }
-    if let Some(l) = &m.layers {
-        let mut medium = match (&l.preset, &l.layers) {
-            (Some(p), None) => {
-                LayeredMedium::preset(p).map_err(|e| at.error("material", Some(i), "preset", e))?
-            }
-            (None, Some(layers)) => LayeredMedium {
-                name: "custom".into(),
-                layers: layers
-                    .iter()
-                    .map(|l| Layer {
-                        thickness: Vec3::from(l.thickness),
-                        scattering: Vec3::from(l.scattering),
-                        absorption: Vec3::from(l.absorption),
-                        anisotropy: l.g.unwrap_or(0.0),
-                    })
-                    .collect(),
-                eta: 1.3,
-            },
-            _ => {
-                return Err(at.error(
-                    "material",
-                    Some(i),
-                    "layers",
-                    "give exactly one of `preset` or `layers`",
-                ))
-            }
-        };
-        if let Some(eta) = l.eta {
-            medium.eta = eta;
-        }
-        medium
-            .validate()
-            .map_err(|e| at.error("material", Some(i), "layers", e))?;
-        material.layers = Some(medium);
+    if m.layers.is_some() {
+        return Err(at.error(
+            "material",
+            Some(i),
+            "layers",
+            "`layers` is now `[material.layered]` with a `preset` (Jensen 2001 media: apple, \
+             skin1, ...) or `[[material.layered.layer]]` tables (see docs/scene-format.toml)",
+        ));
+    }
+    if let Some(l) = &m.layered {
+        material.layers = Some(build_layered(l, i, at, resolve)?);
     }
     // Map a range failure to the key it names.
     material.validate().map_err(|e| {
@@ -1244,5 +1497,187 @@ material = "red"
             ThicknessSource::Bake
         );
         assert!(scene.objects[1].material.sss.is_some());
+    }
+
+    /// MINIMAL with a second material `skin` (the object's) whose body is `layered`.
+    fn with_layered(layered: &str) -> String {
+        MINIMAL.replace(
+            "[[object]]\nmesh = \"ball\"\nmaterial = \"red\"",
+            &format!(
+                "[[material]]\nname = \"skin\"\n\n{layered}\n[[object]]\nmesh = \"ball\"\n\
+                 material = \"skin\""
+            ),
+        )
+    }
+
+    const TWO_LAYERS: &str = r#"[material.layered]
+eta = 1.4
+weights = [0.2, 0.3, 0.1, 0.1, 0.3]
+units_per_mm = 0.1
+
+[[material.layered.layer]]
+sigma_a = [0.2, 0.37, 0.82]
+sigma_s_prime = [4.7, 5.9, 8.7]
+g = 0.9
+thickness = 0.25
+
+[[material.layered.layer]]
+sigma_a = [0.03, 0.26, 0.46]
+sigma_s = [2.3, 2.9, 4.4]
+g = -0.5
+thickness = "rest"
+"#;
+
+    #[test]
+    fn layered_media_load_from_presets_and_layer_tables() {
+        let s = parse(&with_layered("[material.layered]\npreset = \"skimmilk\"\n")).unwrap();
+        let m = s.objects[0].material.layers.as_ref().unwrap();
+        assert_eq!(m.name, "skimmilk");
+        assert_eq!(m.weights, crate::scene::layered::DEFAULT_WEIGHTS);
+
+        let s = parse(&with_layered(TWO_LAYERS)).unwrap();
+        let m = s.objects[0].material.layers.as_ref().unwrap();
+        assert_eq!(m.layers.len(), 2);
+        assert_eq!((m.eta, m.units_per_mm), (1.4, 0.1));
+        assert_eq!(m.weights, [0.2, 0.3, 0.1, 0.1, 0.3]);
+        // sigma_s' / (1 - g) is stored; sigma_s as given.
+        assert!(
+            (m.layers[0].sigma_s.x - 47.0).abs() < 1e-3,
+            "{}",
+            m.layers[0].sigma_s
+        );
+        assert_eq!(m.layers[1].sigma_s, Vec3::new(2.3, 2.9, 4.4));
+        assert_eq!(m.layers[0].thickness, Thickness::Mm(0.25));
+        assert_eq!(m.layers[1].thickness, Thickness::Rest);
+    }
+
+    #[test]
+    fn layered_errors_name_file_line_and_key() {
+        let base = with_layered(TWO_LAYERS);
+        // (replace, with, key, message part); the line is that of the replacement.
+        let cases = [
+            (
+                "g = -0.5",
+                "g = -1",
+                "material[1].layered.layer[1].g",
+                "[-0.999, 0.999]",
+            ),
+            (
+                "g = 0.9",
+                "g = nan",
+                "material[1].layered.layer[0].g",
+                "NaN",
+            ),
+            (
+                "sigma_s = [2.3, 2.9, 4.4]",
+                "sigma_s = [2.3, inf, 4.4]",
+                "material[1].layered.layer[1].sigma_s",
+                "finite",
+            ),
+            (
+                "sigma_a = [0.03, 0.26, 0.46]",
+                "sigma_a = [0.03, -0.26, 0.46]",
+                "material[1].layered.layer[1].sigma_a",
+                "[0, 1e6]",
+            ),
+            (
+                "sigma_s_prime = [4.7, 5.9, 8.7]",
+                "sigma_s_prime = [4.7, 5.9, 8.7]\nsigma_s = [1, 1, 1]",
+                "material[1].layered.layer[0].sigma_s_prime",
+                "not both",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = -0.25",
+                "material[1].layered.layer[0].thickness",
+                "rest",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = \"thick\"",
+                "material[1].layered.layer[0].thickness",
+                "texture",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = 0.25\nthickness_scale = 2",
+                "material[1].layered.layer[0].thickness_scale",
+                "only a layer",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = \"texture\"",
+                "material[1].layered.depth_texture",
+                "missing",
+            ),
+            ("eta = 1.4", "eta = 0", "material[1].layered.eta", "> 0"),
+            (
+                "weights = [0.2, 0.3, 0.1, 0.1, 0.3]",
+                "weights = [0.2, 0.3, -0.1, 0.1, 0.3]",
+                "material[1].layered.weights",
+                "-0.1",
+            ),
+            (
+                "units_per_mm = 0.1",
+                "units_per_mm = inf",
+                "material[1].layered.units_per_mm",
+                "finite",
+            ),
+            (
+                "eta = 1.4",
+                "eta = 1.4\npreset = \"apple\"",
+                "material[1].layered.preset",
+                "not both",
+            ),
+            (
+                "eta = 1.4",
+                "eta = 1.4\ndepth_texture = [\"a.exr\", 3]",
+                "material[1].layered.depth_texture",
+                "array of paths",
+            ),
+        ];
+        for (from, to, key, part) in cases {
+            let src = base.replacen(from, to, 1);
+            assert_ne!(src, base, "{from}");
+            let e = parse(&src).unwrap_err().to_string();
+            let leaf = key.rsplit('.').next().unwrap();
+            let first = to.lines().find(|l| l.starts_with(leaf)).unwrap_or(to);
+            let line = format!("line {}", src.lines().position(|l| l == first).unwrap() + 1);
+            let line_ok = key.ends_with("depth_texture") && part == "missing" || e.contains(&line);
+            assert!(
+                e.contains("test.toml") && line_ok && e.contains(key) && e.contains(part),
+                "{to}: {e}"
+            );
+        }
+        // No body, an unknown preset, an unknown key, too many layers.
+        let e = parse(&with_layered("[material.layered]\neta = 1.3\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("material[1].layered") && e.contains("preset"),
+            "{e}"
+        );
+        let e = parse(&with_layered("[material.layered]\npreset = \"frog\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("material[1].layered.preset") && e.contains("apple"),
+            "{e}"
+        );
+        let e = parse(&with_layered(
+            "[material.layered]\npreset = \"apple\"\ncolour = 1\n",
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("colour"), "{e}");
+        let layer =
+            "[[material.layered.layer]]\nsigma_a = [0, 0, 0]\nsigma_s = [1, 1, 1]\nthickness = 1\n";
+        let e = parse(&with_layered(&format!(
+            "[material.layered]\n{}",
+            layer.repeat(9)
+        )))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("9 layers"), "{e}");
     }
 }

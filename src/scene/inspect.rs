@@ -176,13 +176,50 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
                 l.layers.len()
             ));
         }
+        let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
         let parts = if parts.is_empty() {
             "opaque".to_string()
         } else {
             parts.join(", ")
         };
         let _ = writeln!(s, "  material {}: {parts}", m.name);
+        s.push_str(&layer_lines);
     }
+}
+
+/// A layered medium's numbers, one indented line for the medium and one per layer.
+fn layered_lines(l: &super::layered::LayeredMedium) -> String {
+    use super::layered::Thickness;
+    let mut s = String::new();
+    let w = l.weights;
+    let _ = writeln!(
+        s,
+        "    eta {}, weights (diffuse, specular, transmitted, single, multiple) {} {} {} {} {}, \
+         {} units/mm",
+        l.eta, w[0], w[1], w[2], w[3], w[4], l.units_per_mm
+    );
+    for (i, layer) in l.layers.iter().enumerate() {
+        let thickness = match layer.thickness {
+            Thickness::Mm(t) => format!("{t} mm"),
+            Thickness::Rest => "rest (semi-infinite)".into(),
+            Thickness::Texture { scale } => format!(
+                "texture {} channel {} x {scale} mm",
+                l.depth_textures
+                    .get(i / 4)
+                    .map_or_else(|| "?".into(), texture_name),
+                ["r", "g", "b", "a"][i % 4]
+            ),
+        };
+        let v = |v: glam::Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+        let _ = writeln!(
+            s,
+            "    layer {i}: thickness {thickness}, sigma_a {} /mm, sigma_s {} /mm, g {}",
+            v(layer.sigma_a),
+            v(layer.sigma_s),
+            layer.g
+        );
+    }
+    s
 }
 
 fn texture_name(t: &super::material::TextureSource) -> String {
@@ -235,5 +272,26 @@ mod tests {
         let e = inspect_file(&dir.join("README")).unwrap_err().to_string();
         assert!(e.contains("no extension"), "{e}");
         std::fs::remove_dir_all(dir).ok();
+    }
+
+    #[test]
+    fn layered_materials_print_every_layer() {
+        let scene = crate::scene::builtin("layered").unwrap();
+        let mut s = String::new();
+        write_scene_materials(&mut s, &scene);
+        assert!(
+            s.contains("material teapot: layered skin1 (1 layers; not rendered yet)")
+                && s.contains("eta 1.3, weights (diffuse, specular, transmitted, single, multiple) 0.3 0.3 0.05 0.05 0.03, 0.04 units/mm")
+                && s.contains("layer 0: thickness rest (semi-infinite), sigma_a [0.032, 0.17, 0.48] /mm, sigma_s [0.74, 0.88, 1.01] /mm, g 0"),
+            "{s}"
+        );
+        let mut m = crate::scene::Material::opaque("skin", glam::Vec3::ONE, 0.5, 0.5);
+        m.layers = Some(crate::scene::layered::LayeredMedium::preset("skin-layered").unwrap());
+        let s = layered_lines(m.layers.as_ref().unwrap());
+        assert!(
+            s.contains("layer 0: thickness 0.25 mm") && s.contains("layer 1: thickness rest"),
+            "{s}"
+        );
+        assert!(s.contains("g 0.9") && s.contains("g 0.8"), "{s}");
     }
 }

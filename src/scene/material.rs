@@ -7,14 +7,17 @@
 //! - [`Light`]: point, spot or directional, with colour, intensity, range and the talk's
 //!   per-light translucency scale.
 //!
-//! Presets carry their sources: d'Eon's six-Gaussian skin fit (the thesis's Figure 17) and the
-//! coefficient sets of Li et al.'s Table 1.
+//! Presets carry their sources: d'Eon's six-Gaussian skin fit (the thesis's Figure 17); the
+//! layered media (Jensen et al. 2001's measured materials, which Li et al.'s Table 1 uses, and a
+//! two-layer skin) live in [`super::layered`] and are re-exported here.
 
 use std::path::PathBuf;
 
 use glam::Vec3;
 
 use crate::{LucentError, Result};
+
+pub use super::layered::{Layer, LayeredMedium, Thickness};
 
 /// Where a texture comes from.
 #[derive(Clone, Debug, PartialEq)]
@@ -309,109 +312,6 @@ impl SssProfile {
     }
 }
 
-/// One layer of a layered medium (Li et al.).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Layer {
-    /// Thickness per channel, in scene units.
-    pub thickness: Vec3,
-    /// Scattering coefficient σs per channel (1/unit).
-    pub scattering: Vec3,
-    /// Absorption coefficient σa per channel (1/unit).
-    pub absorption: Vec3,
-    /// Henyey-Greenstein anisotropy g, |g| <= 0.99 (guarded where used).
-    pub anisotropy: f32,
-}
-
-/// A stack of layers, outermost first.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LayeredMedium {
-    /// Preset name or "custom".
-    pub name: String,
-    /// Layers, outermost first.
-    pub layers: Vec<Layer>,
-    /// Relative index of refraction at the surface.
-    pub eta: f32,
-}
-
-/// Li et al.'s Table 1 coefficient sets: (name, scattering per layer, absorption per layer).
-/// The table gives one value per layer (not per channel); they apply to all three channels.
-pub const LI_TABLE1: [(&str, [f32; 3], [f32; 3]); 5] = [
-    ("frog", [2.29, 2.39, 1.97], [0.0030, 0.0034, 0.046]),
-    ("teapot", [0.74, 0.88, 1.01], [0.032, 0.17, 0.18]),
-    ("bunny", [0.15, 0.21, 0.38], [0.015, 0.077, 0.19]),
-    ("buddha", [1.09, 1.59, 1.79], [0.013, 0.070, 0.145]),
-    ("dragon", [0.70, 1.22, 1.90], [0.0014, 0.0025, 0.0142]),
-];
-
-impl LayeredMedium {
-    /// A Table 1 preset (`frog`, `teapot`, `bunny`, `buddha`, `dragon`; the table's goddess and
-    /// monster rows share frog's set, maitreya shares buddha's). Layer thicknesses and g are
-    /// not in the table: ours are 0.05, 0.2 and 1.0 units and g = 0.8 for each layer (forward
-    /// scattering typical of tissue-like media).
-    pub fn preset(name: &str) -> Result<Self> {
-        let (_, scattering, absorption) = LI_TABLE1
-            .iter()
-            .find(|(n, _, _)| *n == name)
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "unknown layered preset '{name}'; presets: {}",
-                    LI_TABLE1.iter().map(|p| p.0).collect::<Vec<_>>().join(", ")
-                ))
-            })?;
-        let thickness = [0.05, 0.2, 1.0];
-        Ok(Self {
-            name: name.to_string(),
-            layers: (0..3)
-                .map(|i| Layer {
-                    thickness: Vec3::splat(thickness[i]),
-                    scattering: Vec3::splat(scattering[i]),
-                    absorption: Vec3::splat(absorption[i]),
-                    anisotropy: 0.8,
-                })
-                .collect(),
-            eta: 1.3,
-        })
-    }
-
-    /// Checks every coefficient is finite and in range (thickness, σs, σa >= 0; |g| < 1;
-    /// η > 0; 1 to 8 layers).
-    pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| {
-            Err(LucentError::InvalidInput(format!(
-                "layered '{}': {m}",
-                self.name
-            )))
-        };
-        if !(1..=8).contains(&self.layers.len()) {
-            return bad(format!(
-                "{} layers; 1 to 8 are supported",
-                self.layers.len()
-            ));
-        }
-        for (i, l) in self.layers.iter().enumerate() {
-            for (what, v) in [
-                ("thickness", l.thickness),
-                ("scattering", l.scattering),
-                ("absorption", l.absorption),
-            ] {
-                if !(v.is_finite() && v.min_element() >= 0.0) {
-                    return bad(format!("layer {i} {what} must be finite and >= 0"));
-                }
-            }
-            if !(l.anisotropy.is_finite() && l.anisotropy.abs() < 1.0) {
-                return bad(format!(
-                    "layer {i} anisotropy g = {} must be in (-1, 1)",
-                    l.anisotropy
-                ));
-            }
-        }
-        if !(self.eta.is_finite() && self.eta > 0.0) {
-            return bad(format!("eta {} must be finite and > 0", self.eta));
-        }
-        Ok(())
-    }
-}
-
 /// What a surface is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -642,15 +542,6 @@ mod tests {
         // d'Eon's red weights sum to 1.0 (the table is normalised per channel).
         let red: f32 = p.gaussians.iter().map(|g| g.weight.x).sum();
         assert!((red - 1.0).abs() < 1e-3, "{red}");
-    }
-
-    #[test]
-    fn layered_presets_are_table_1() {
-        let m = LayeredMedium::preset("teapot").unwrap();
-        m.validate().unwrap();
-        assert_eq!(m.layers[1].scattering, Vec3::splat(0.88));
-        assert_eq!(m.layers[2].absorption, Vec3::splat(0.18));
-        assert!(LayeredMedium::preset("nope").is_err());
     }
 
     #[test]

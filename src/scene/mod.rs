@@ -9,6 +9,7 @@ pub mod file;
 pub mod generators;
 pub mod inputs;
 pub mod inspect;
+pub mod layered;
 pub mod lean;
 pub mod material;
 pub mod mesh;

@@ -92,6 +92,13 @@ fn mixed_matches_its_golden_under_auto() {
 }
 
 #[test]
+fn layered_with_point_and_spot_shadows_matches_its_golden() {
+    // Same settings as tests/golden/LIST's `layered` line: five spheres over a floor, each
+    // casting a point light's (cube) and a spot light's shadow.
+    check_golden("layered", "layered", FrameSettings::new(320, 240));
+}
+
+#[test]
 fn sss_scenes_match_their_goldens_under_every_sss_technique() {
     // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
     for scene_name in ["skin", "teapot"] {

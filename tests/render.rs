@@ -396,7 +396,8 @@ fn plan_command_prints_the_merged_group() {
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("[1] \"lighting\""), "{text}");
+    // light-space maps, gbuffer, lighting, tonemap: unmerged, lighting is third.
+    assert!(text.contains("[2] \"lighting\""), "{text}");
 }
 
 #[test]

@@ -17,7 +17,7 @@ use crate::Result;
 
 use super::deferred::{GBuffer, Lit};
 use super::translucency::ThicknessPacking;
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::SceneGpu;
 
 /// What a debug view shows.
@@ -192,18 +192,7 @@ impl PassExec for DebugViewPass {
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &bindings,
-            &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: "debug/view.frag",
-                defines: &defines,
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                push_constant_bytes: 0,
-                name: "debug view",
-            },
+            &GraphicsPipelineDesc::fullscreen("debug/view.frag", &defines, "debug view"),
         )?);
         Ok(())
     }

@@ -590,44 +590,20 @@ impl PassExec for LightingPass {
         if self.layout.fault_injection {
             plain_defines.push(("LUCENT_FAULT_INJECTION", "1"));
         }
-        let plain = GraphicsPipelineDesc {
-            vertex: "fullscreen.vert",
-            fragment: "deferred/lighting.frag",
-            defines: &plain_defines,
-            vertex_input: VertexInput::None,
-            depth_test: false,
-            cull_back: false,
-            additive_attachments: 0,
-            set_layouts: &[],
-            push_constant_bytes: 0,
-            name: "lighting",
-        };
+        let plain =
+            GraphicsPipelineDesc::fullscreen("deferred/lighting.frag", &plain_defines, "lighting");
         let mut pipeline = PassPipeline::new(ctx, &bindings, &plain)?;
         if self.layout.translucency.is_some() {
             // The plain variant's defines (split specular, LEAN slope) plus the translucency's.
-            let mut defines = plain_defines.clone();
-            defines.extend(self.layout.defines());
+            let mut extra = self.layout.defines();
             if shadow_ids {
                 // Only the translucent variant shades transmission: only it reads the IDs.
-                defines.push(("LUCENT_SHADOW_IDS", "1"));
+                extra.push(("LUCENT_SHADOW_IDS", "1"));
             }
-            let layouts = [pipeline.set.layout];
-            let translucent = GraphicsPipeline::new(
-                ctx,
-                &GraphicsPipelineDesc {
-                    defines: &defines,
-                    set_layouts: &layouts,
-                    name: "lighting (translucent)",
-                    ..plain
-                },
-            );
-            match translucent {
-                Ok(p) => self.translucent = Some(p),
-                Err(e) => {
-                    pipeline.destroy(&ctx.gpu.device);
-                    return Err(e);
-                }
-            }
+            let (plain_pipeline, translucent) =
+                pipeline.with_variant(ctx, &plain, &extra, "lighting (translucent)")?;
+            pipeline = plain_pipeline;
+            self.translucent = Some(translucent);
         }
         self.pipeline = Some(pipeline);
         Ok(())

@@ -16,7 +16,7 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::SceneGpu;
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
@@ -78,22 +78,15 @@ impl PassExec for TonemapPass {
                 ),
                 Binding::Sampled(ctx.views[self.input], self.sampler),
             ],
-            &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: "post/tonemap.frag",
-                defines: if self.linear {
+            &GraphicsPipelineDesc::fullscreen(
+                "post/tonemap.frag",
+                if self.linear {
                     &[("LUCENT_OUTPUT_LINEAR", "1")]
                 } else {
                     &[]
                 },
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                push_constant_bytes: 0,
-                name: "tonemap",
-            },
+                "tonemap",
+            ),
         )?);
         Ok(())
     }

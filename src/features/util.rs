@@ -268,6 +268,26 @@ pub struct GraphicsPipelineDesc<'a> {
     pub name: &'a str,
 }
 
+impl<'a> GraphicsPipelineDesc<'a> {
+    /// A fullscreen pass's pipeline: the fullscreen triangle (`fullscreen.vert`, no vertex
+    /// buffer), no depth test, no culling, no blending, no push constants; change the rest
+    /// with struct update syntax.
+    pub fn fullscreen(fragment: &'a str, defines: &'a [(&'a str, &'a str)], name: &'a str) -> Self {
+        Self {
+            vertex: "fullscreen.vert",
+            fragment,
+            defines,
+            vertex_input: VertexInput::None,
+            depth_test: false,
+            cull_back: false,
+            additive_attachments: 0,
+            set_layouts: &[],
+            push_constant_bytes: 0,
+            name,
+        }
+    }
+}
+
 /// A graphics pipeline and its layout.
 pub struct GraphicsPipeline {
     /// The pipeline.
@@ -501,6 +521,38 @@ impl PassPipeline {
             Ok(pipeline) => Ok(Self { pipeline, set }),
             Err(e) => {
                 set.destroy(&ctx.gpu.device);
+                Err(e)
+            }
+        }
+    }
+
+    /// A second pipeline of `desc` with `extra` defines added, bound with this pipeline's set
+    /// (a shader variant the pass draws in some rectangles). On failure this pipeline is
+    /// destroyed too, so the caller's `?` leaves nothing behind.
+    pub fn with_variant(
+        self,
+        ctx: &PrepareContext<'_>,
+        desc: &GraphicsPipelineDesc<'_>,
+        extra: &[(&str, &str)],
+        name: &str,
+    ) -> Result<(Self, GraphicsPipeline)> {
+        let mut defines = desc.defines.to_vec();
+        defines.extend_from_slice(extra);
+        let layouts = [self.set.layout];
+        let variant = GraphicsPipeline::new(
+            ctx,
+            &GraphicsPipelineDesc {
+                defines: &defines,
+                set_layouts: &layouts,
+                name,
+                ..*desc
+            },
+        );
+        match variant {
+            Ok(variant) => Ok((self, variant)),
+            Err(e) => {
+                let mut this = self;
+                this.destroy(&ctx.gpu.device);
                 Err(e)
             }
         }

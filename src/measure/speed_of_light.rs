@@ -35,7 +35,7 @@ use crate::backend::format::{format_info, format_name, FormatKind};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::util::{
-    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
 };
 use crate::frame::FrameRunner;
 use crate::graph::{
@@ -526,16 +526,8 @@ impl PassExec for CopyPass {
             defines.push(("LUCENT_COPY_DEPTH", "1"));
         }
         let desc = GraphicsPipelineDesc {
-            vertex: "fullscreen.vert",
-            fragment: "bench/copy.frag",
-            defines: &defines,
-            vertex_input: VertexInput::None,
             depth_test: self.depth,
-            cull_back: false,
-            additive_attachments: 0,
-            set_layouts: &[],
-            push_constant_bytes: 0,
-            name: "speed-of-light copy",
+            ..GraphicsPipelineDesc::fullscreen("bench/copy.frag", &defines, "speed-of-light copy")
         };
         if self.inputs.is_empty() {
             self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);

@@ -12,9 +12,7 @@ use super::{
     SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
 use crate::features::deferred::HDR_FORMAT;
-use crate::features::util::{
-    clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline, VertexInput,
-};
+use crate::features::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
@@ -296,16 +294,9 @@ impl PassExec for BlurPass {
             ctx,
             &bindings,
             &GraphicsPipelineDesc {
-                vertex: "fullscreen.vert",
-                fragment: "sss/blur.frag",
-                defines: &defines,
-                vertex_input: VertexInput::None,
-                depth_test: false,
-                cull_back: false,
                 additive_attachments: additive,
-                set_layouts: &[],
                 push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-                name: "sss blur",
+                ..GraphicsPipelineDesc::fullscreen("sss/blur.frag", &defines, "sss blur")
             },
         )?);
         Ok(())
@@ -389,39 +380,19 @@ impl PassExec for FinalPass {
             ));
         }
         let desc = GraphicsPipelineDesc {
-            vertex: "fullscreen.vert",
-            fragment: self.fragment,
-            defines: &defines,
-            vertex_input: VertexInput::None,
-            depth_test: false,
-            cull_back: false,
-            additive_attachments: 0,
-            set_layouts: &[],
             push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-            name: self.fragment,
+            ..GraphicsPipelineDesc::fullscreen(self.fragment, &defines, self.fragment)
         };
-        let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
         if self.fragment == LEAN_FINAL_SHADER {
-            let layouts = [pipeline.set.layout];
-            let mut passthrough_defines = defines.to_vec();
-            passthrough_defines.push(("LUCENT_SSS_PASSTHROUGH", "1"));
-            let passthrough = crate::features::util::GraphicsPipeline::new(
+            let (lean, passthrough) = pipeline.with_variant(
                 ctx,
-                &GraphicsPipelineDesc {
-                    defines: &passthrough_defines,
-                    set_layouts: &layouts,
-                    name: "final lighting (pass-through)",
-                    ..desc
-                },
-            );
-            match passthrough {
-                Ok(p) => self.passthrough = Some(p),
-                Err(e) => {
-                    let mut pipeline = pipeline;
-                    pipeline.destroy(&ctx.gpu.device);
-                    return Err(e);
-                }
-            }
+                &desc,
+                &[("LUCENT_SSS_PASSTHROUGH", "1")],
+                "final lighting (pass-through)",
+            )?;
+            pipeline = lean;
+            self.passthrough = Some(passthrough);
         }
         self.pipeline = Some(pipeline);
         Ok(())

@@ -17,7 +17,7 @@ use super::{
 };
 use crate::features::deferred::HDR_FORMAT;
 use crate::features::util::{
-    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline, VertexInput,
+    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
 };
 use crate::gpu_scene::{Region, SceneGpu, TileRect};
 use crate::graph::{
@@ -348,39 +348,19 @@ impl PassExec for TwoPassBlur {
             ));
         }
         let desc = GraphicsPipelineDesc {
-            vertex: "fullscreen.vert",
-            fragment: self.spec.fragment(),
-            defines: &defines,
-            vertex_input: VertexInput::None,
-            depth_test: false,
-            cull_back: false,
-            additive_attachments: 0,
-            set_layouts: &[],
             push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-            name: "sss two-pass blur",
+            ..GraphicsPipelineDesc::fullscreen(self.spec.fragment(), &defines, "sss two-pass blur")
         };
-        let pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
         if self.spec.compose {
-            let layouts = [pipeline.set.layout];
-            let mut passthrough_defines = defines.clone();
-            passthrough_defines.push(("LUCENT_SSS_PASSTHROUGH", "1"));
-            let passthrough = GraphicsPipeline::new(
+            let (blur, passthrough) = pipeline.with_variant(
                 ctx,
-                &GraphicsPipelineDesc {
-                    defines: &passthrough_defines,
-                    set_layouts: &layouts,
-                    name: "sss two-pass blur (pass-through)",
-                    ..desc
-                },
-            );
-            match passthrough {
-                Ok(p) => self.passthrough = Some(p),
-                Err(e) => {
-                    let mut pipeline = pipeline;
-                    pipeline.destroy(&ctx.gpu.device);
-                    return Err(e);
-                }
-            }
+                &desc,
+                &[("LUCENT_SSS_PASSTHROUGH", "1")],
+                "sss two-pass blur (pass-through)",
+            )?;
+            pipeline = blur;
+            self.passthrough = Some(passthrough);
         }
         self.pipeline = Some(pipeline);
         Ok(())

@@ -491,21 +491,13 @@ impl PassExec for GBufferPass {
                     0,
                     bytemuck::bytes_of(&draw.constants),
                 );
-                device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[mesh.vertices.buffer], &[0]);
-                if let (Some(thickness), Some(_)) = (&mesh.thickness, self.layout.translucency) {
-                    device.cmd_bind_vertex_buffers(ctx.cmd, 1, &[thickness.buffer], &[0]);
-                }
-                if let (Some(surface), true) = (&mesh.surface, self.layout.surface_stream()) {
-                    device.cmd_bind_vertex_buffers(ctx.cmd, 2, &[surface.buffer], &[0]);
-                }
-                device.cmd_bind_index_buffer(
-                    ctx.cmd,
-                    mesh.indices.buffer,
-                    0,
-                    vk::IndexType::UINT32,
-                );
-                device.cmd_draw_indexed(ctx.cmd, mesh.index_count, 1, 0, 0, 0);
             }
+            mesh.draw(
+                device,
+                ctx.cmd,
+                self.layout.translucency.is_some(),
+                self.layout.surface_stream(),
+            );
         }
     }
 

@@ -423,17 +423,18 @@ impl PassExec for ShadowPass {
                     height: tile,
                 },
             };
-            // SAFETY: recording inside this pass's render pass with its pipeline bound; the
-            // scene's buffers outlive the frame.
+            // SAFETY: recording inside this pass's render pass with its pipeline bound.
             unsafe {
                 device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
                 device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
-                for draw in &self.scene.draws {
-                    let mesh = &self.scene.meshes[draw.mesh];
-                    let constants = ShadowConstants {
-                        model: draw.constants.model,
-                        face_id: [face as i32, draw.constants.thickness[3] as i32, 0, 0],
-                    };
+            }
+            for draw in &self.scene.draws {
+                let constants = ShadowConstants {
+                    model: draw.constants.model,
+                    face_id: [face as i32, draw.constants.thickness[3] as i32, 0, 0],
+                };
+                // SAFETY: the bound pipeline's layout has this push-constant range.
+                unsafe {
                     device.cmd_push_constants(
                         ctx.cmd,
                         pipeline.pipeline.layout,
@@ -441,15 +442,8 @@ impl PassExec for ShadowPass {
                         0,
                         bytemuck::bytes_of(&constants),
                     );
-                    device.cmd_bind_vertex_buffers(ctx.cmd, 0, &[mesh.vertices.buffer], &[0]);
-                    device.cmd_bind_index_buffer(
-                        ctx.cmd,
-                        mesh.indices.buffer,
-                        0,
-                        vk::IndexType::UINT32,
-                    );
-                    device.cmd_draw_indexed(ctx.cmd, mesh.index_count, 1, 0, 0, 0);
                 }
+                self.scene.meshes[draw.mesh].draw(device, ctx.cmd, false, false);
             }
         }
     }

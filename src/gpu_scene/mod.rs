@@ -67,6 +67,34 @@ pub struct GpuMesh {
     pub surface: Option<GpuBuffer>,
 }
 
+impl GpuMesh {
+    /// Records the mesh's indexed draw into `cmd` (recording inside a subpass whose bound
+    /// pipeline reads the position + normal stream at binding 0): binds the vertex buffer,
+    /// the thickness stream at binding 1 with `thickness`, the UV + tangent stream at binding
+    /// 2 with `surface` (each when the mesh has it), and the index buffer.
+    pub fn draw(
+        &self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        thickness: bool,
+        surface: bool,
+    ) {
+        // SAFETY: the caller records inside a subpass with a compatible pipeline bound; the
+        // buffers live as long as the scene, which outlives its frames.
+        unsafe {
+            device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer], &[0]);
+            if let (Some(stream), true) = (&self.thickness, thickness) {
+                device.cmd_bind_vertex_buffers(cmd, 1, &[stream.buffer], &[0]);
+            }
+            if let (Some(stream), true) = (&self.surface, surface) {
+                device.cmd_bind_vertex_buffers(cmd, 2, &[stream.buffer], &[0]);
+            }
+            device.cmd_bind_index_buffer(cmd, self.indices.buffer, 0, vk::IndexType::UINT32);
+            device.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+        }
+    }
+}
+
 /// The material textures of a frame with normal or albedo maps. Entry 0 of each list is the
 /// neutral texture objects without a map of that kind read (a flat normal, white albedo).
 /// In LEAN frames each normal map is uploaded as its two LEAN maps instead

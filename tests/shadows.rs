@@ -120,13 +120,36 @@ fn lights() -> Vec<(&'static str, Light)> {
     ]
 }
 
+/// `occluder_scene` moved by `offset` (objects, lights and camera).
+fn moved(mut scene: Scene, offset: Vec3) -> Scene {
+    for o in &mut scene.objects {
+        o.transform = Mat4::from_translation(offset) * o.transform;
+    }
+    for l in &mut scene.lights {
+        match &mut l.kind {
+            LightKind::Directional { .. } => {}
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                *position += offset
+            }
+        }
+    }
+    scene.camera.eye += offset;
+    scene.camera.target += offset;
+    scene
+}
+
 #[test]
 fn the_floor_under_an_occluder_is_darker_than_open_floor_for_every_light_type() {
     let test = TestGpu::new();
-    for (name, light) in lights() {
-        let scene = occluder_scene(light);
-        let under = pixel_of(&scene, Vec3::new(0.0, 0.0, 0.0));
-        let open = pixel_of(&scene, Vec3::new(0.0, 0.0, 1.6));
+    // Far from the origin too: a directional light's map must cover the objects wherever
+    // they are (and plain materials, without translucency or SSS).
+    let cases = lights().into_iter().flat_map(|(name, light)| {
+        [Vec3::ZERO, Vec3::new(7.0, 0.0, -5.0)].map(|offset| (name, light, offset))
+    });
+    for (name, light, offset) in cases {
+        let scene = moved(occluder_scene(light), offset);
+        let under = pixel_of(&scene, offset);
+        let open = pixel_of(&scene, offset + Vec3::new(0.0, 0.0, 1.6));
         let lit = render(&test, &scene, settings(false));
         let shadowed = render(&test, &scene, settings(true));
         let (lit_under, lit_open) = (luminance(&lit, under), luminance(&lit, open));

@@ -99,6 +99,12 @@ fn layered_with_point_and_spot_shadows_matches_its_golden() {
 }
 
 #[test]
+fn dynamic_at_half_a_second_matches_its_golden() {
+    // Same settings as tests/golden/LIST's `dynamic` line: the torus deformed at t = 0.5 s.
+    check_golden_at("dynamic", "dynamic", 0.5, FrameSettings::new(320, 240));
+}
+
+#[test]
 fn sss_scenes_match_their_goldens_under_every_sss_technique() {
     // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
     for scene_name in ["skin", "teapot"] {
@@ -125,11 +131,15 @@ fn sss_scenes_match_their_goldens_under_every_sss_technique() {
 /// Renders built-in scene `scene_name` (loaded as the command loads it) and compares it with
 /// tests/golden/NAME.png.
 fn check_golden(name: &str, scene_name: &str, settings: FrameSettings) {
+    check_golden_at(name, scene_name, 0.0, settings);
+}
+
+/// [`check_golden`] with the scene shown at `time` seconds (`render --time`).
+fn check_golden_at(name: &str, scene_name: &str, time: f32, settings: FrameSettings) {
     let (w, h) = (settings.width, settings.height);
-    let (display, _) = render_scene(
-        &lucent::bake::scene::load_scene_baked(scene_name).unwrap(),
-        settings,
-    );
+    let mut scene = lucent::bake::scene::load_scene_baked(scene_name).unwrap();
+    scene.time = time;
+    let (display, _) = render_scene(&scene, settings);
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
     let outcome = compare_with_golden(
         name,

@@ -57,6 +57,7 @@ fn occluder_scene(light: Light) -> Scene {
         sky: Vec3::splat(0.1),
         exposure: 1.0,
         deformation: None,
+        time: 0.0,
     }
 }
 

@@ -267,6 +267,18 @@ struct FrameArgs {
     /// Table 1 uses 512 and 1024). Halved until every face fits an 8192x8192 atlas.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_shadow_size)]
     shadow_size: Option<u32>,
+    /// The instant shown, in seconds (a finite number; default 0): a deforming scene
+    /// (`dynamic`) is deformed at it; `bench` starts its animation there.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_time)]
+    time: Option<f32>,
+}
+
+fn parse_time(text: &str) -> std::result::Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| format!("'{text}' is not a finite number of seconds"))
 }
 
 fn parse_shadow_size(text: &str) -> std::result::Result<u32, String> {
@@ -490,6 +502,12 @@ impl FrameArgs {
             (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
             (self.grayscale, "--grayscale", gdc, translucent),
             (
+                self.time.is_some(),
+                "--time",
+                "a deforming scene (one with a [deformation] table, e.g. dynamic)",
+                scene.deformation.is_some(),
+            ),
+            (
                 self.shadow_size.is_some(),
                 "--shadow-size",
                 "a light that casts shadows (without --no-shadows; lights with shadows = true)",
@@ -565,10 +583,12 @@ fn with_renderer(
     frame: &FrameArgs,
     gpu_args: &GpuArgs,
     export_hdr: bool,
-    work: impl FnOnce(&Session, &Renderer) -> Result<()>,
+    work: impl FnOnce(&Session, &Renderer, &scene::Scene) -> Result<()>,
 ) -> Result<()> {
     let settings = frame.settings(export_hdr)?;
-    let scene = bake::load_scene_baked(&frame.scene)?;
+    let mut scene = bake::load_scene_baked(&frame.scene)?;
+    // Range-checked by the parser (finite).
+    scene.time = frame.time.unwrap_or(0.0);
     frame.warn_inapplicable(&scene, &settings, &FrameDesc::new(&scene, &settings)?);
     // Texture headers first: one too large is refused before the device is even opened.
     scene::texture::scene_texture_sizes(&scene, None)?;
@@ -581,7 +601,7 @@ fn with_renderer(
             &scene,
             settings,
         )?;
-        let worked = work(session, &renderer);
+        let worked = work(session, &renderer, &scene);
         let idle = session.gpu.wait_idle();
         renderer.destroy(&session.gpu);
         worked.and(idle)
@@ -663,7 +683,7 @@ fn render(
     let mut outputs = vec![("--out", out.as_path())];
     outputs.extend(exr.as_deref().map(|e| ("--exr", e)));
     check_scene_outputs(&frame.scene, &outputs)?;
-    with_renderer(frame, gpu_args, exr.is_some(), |session, renderer| {
+    with_renderer(frame, gpu_args, exr.is_some(), |session, renderer, _| {
         let gpu = &session.gpu;
         let (width, height) = (renderer.settings.width, renderer.settings.height);
         let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len())?;
@@ -732,7 +752,7 @@ fn bench_command(
             eprintln!("{text}");
         }
     };
-    with_renderer(frame, gpu_args, false, |session, renderer| {
+    with_renderer(frame, gpu_args, false, |session, renderer, scene| {
         let gpu = &session.gpu;
         let report = if speed_of_light {
             let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
@@ -741,14 +761,20 @@ fn bench_command(
                 &session.pipeline_cache,
                 &renderer.executable.plan,
             )?;
-            let report =
-                bench::run_with_floor(gpu, renderer, Some(&mut copies), &frame.scene, &options);
+            let report = bench::run_with_floor(
+                gpu,
+                renderer,
+                Some(&mut copies),
+                scene,
+                &frame.scene,
+                &options,
+            );
             let idle = gpu.wait_idle();
             copies.destroy(gpu);
             idle?;
             report?
         } else {
-            bench::run(gpu, renderer, &frame.scene, &options)?
+            bench::run(gpu, renderer, scene, &frame.scene, &options)?
         };
         print!("{}", report.format(format));
         if format != bench::Format::Csv {

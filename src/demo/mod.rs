@@ -424,6 +424,11 @@ impl Demo<'_> {
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let dt = self.last_frame.elapsed().as_secs_f32().min(0.25);
         self.last_frame = Instant::now();
+        // A deforming scene animates in real time (each frame's update deforms it at its time;
+        // a long stall advances it at most a quarter of a second).
+        if self.scene.deformation.is_some() {
+            self.scene.time += dt;
+        }
         self.run_script(event_loop)?;
         if self.done {
             return Ok(());

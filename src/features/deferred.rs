@@ -495,6 +495,7 @@ impl PassExec for GBufferPass {
             mesh.draw(
                 device,
                 ctx.cmd,
+                ctx.frame,
                 self.layout.translucency.is_some(),
                 self.layout.surface_stream(),
             );

@@ -443,7 +443,7 @@ impl PassExec for ShadowPass {
                         bytemuck::bytes_of(&constants),
                     );
                 }
-                self.scene.meshes[draw.mesh].draw(device, ctx.cmd, false, false);
+                self.scene.meshes[draw.mesh].draw(device, ctx.cmd, ctx.frame, false, false);
             }
         }
     }

@@ -13,7 +13,9 @@ use super::{
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::sss;
-use crate::gpu_scene::tiles::{mesh_bounds, object_tiles, tile_rects, translucent_tiles};
+use crate::gpu_scene::tiles::{
+    bounds_of, mesh_bounds, object_tiles, tile_rects, translucent_tiles,
+};
 use crate::gpu_scene::{FrameUniforms, Region, SceneGpu, SlotTiles};
 use crate::graph::{Executable, RenderGraph, ResourceId};
 use crate::scene::{Scene, MAX_LIGHTS};
@@ -159,8 +161,9 @@ impl Renderer {
     }
 
     /// Writes `scene`'s per-frame values into slot `slot` (whose previous frame has
-    /// completed): frame uniforms, the translucency material table, the SSS profile table and
-    /// the screen tiles.
+    /// completed): frame uniforms, the translucency material table, the SSS profile table,
+    /// the light-space maps' table, the screen tiles and, in a deforming scene, every mesh
+    /// deformed at `scene.time` (normals recomputed) into the slot's vertex buffers.
     pub fn update_slot(&self, scene: &Scene, slot: usize) -> Result<()> {
         if slot >= self.settings.frames_in_flight {
             return Err(LucentError::InvalidInput(format!(
@@ -178,6 +181,14 @@ impl Renderer {
                 scene.name
             )));
         }
+        let deformed_bounds;
+        let mesh_bounds = match scene.deformation {
+            Some(deformation) => {
+                deformed_bounds = self.deform(scene, deformation, slot)?;
+                &deformed_bounds
+            }
+            None => &self.mesh_bounds,
+        };
         let per_frame = &self.scene_gpu().per_frame;
         let (width, height) = (self.settings.width, self.settings.height);
         let mut uniforms = FrameUniforms::new(scene, width, height);
@@ -186,7 +197,7 @@ impl Renderer {
         }
         per_frame.write(slot, Region::Frame, bytemuck::bytes_of(&uniforms))?;
         if let Some(shadows) = &desc.shadows {
-            let table = shadows.uniforms(scene, &self.mesh_bounds);
+            let table = shadows.uniforms(scene, mesh_bounds);
             per_frame.write(slot, Region::Shadows, bytemuck::bytes_of(&table))?;
         }
         let mut tiles = SlotTiles::default();
@@ -196,7 +207,7 @@ impl Renderer {
                 Region::Translucency,
                 bytemuck::bytes_of(&t.table.gpu()),
             )?;
-            let (columns, _, marked) = translucent_tiles(scene, &self.mesh_bounds, width, height);
+            let (columns, _, marked) = translucent_tiles(scene, mesh_bounds, width, height);
             tiles.lighting = tile_rects(columns, &marked, width, height);
         }
         if let Some(profiles) = &desc.sss {
@@ -210,7 +221,7 @@ impl Renderer {
             for chain in profiles.chains() {
                 let rects = self.settings.sss_tiles.then(|| {
                     let (columns, _, marked) =
-                        object_tiles(scene, &self.mesh_bounds, width, height, |i, o| {
+                        object_tiles(scene, mesh_bounds, width, height, |i, o| {
                             let (_, blur) = profiles.of_object(i)?;
                             let own = o.material.sss.as_ref()?;
                             (*blur == chain).then(|| sss::profile_reach(own))
@@ -224,6 +235,41 @@ impl Renderer {
         }
         *per_frame.tiles(slot) = tiles;
         Ok(())
+    }
+
+    /// Deforms every mesh of `scene` at `scene.time` into slot `slot`'s vertex buffers;
+    /// returns the deformed meshes' boxes (for this frame's tiles and maps). Only the scene's
+    /// own meshes are deformed: the frame was built for them.
+    fn deform(
+        &self,
+        scene: &Scene,
+        deformation: crate::scene::Deformation,
+        slot: usize,
+    ) -> Result<Vec<(Vec3, Vec3)>> {
+        let gpu_meshes = &self.scene_gpu().meshes;
+        if gpu_meshes.len() != scene.meshes.len() {
+            return Err(LucentError::InvalidInput(format!(
+                "scene '{}' has {} meshes; its frame was built for {}",
+                scene.name,
+                scene.meshes.len(),
+                gpu_meshes.len()
+            )));
+        }
+        let mut deformed = Vec::with_capacity(scene.meshes.len());
+        for (i, (mesh, gpu_mesh)) in scene.meshes.iter().zip(gpu_meshes).enumerate() {
+            let mesh = deformation.apply(mesh, scene.time);
+            // Guarded here: a deformation of a finite mesh at a finite time is finite, but a
+            // NaN time or parameter must not reach a vertex buffer.
+            mesh.validate(&format!(
+                "scene '{}' mesh {i} at t = {}",
+                scene.name, scene.time
+            ))?;
+            gpu_mesh
+                .vertices
+                .write(slot, bytemuck::cast_slice(&mesh.gpu_vertices()))?;
+            deformed.push(mesh);
+        }
+        Ok(bounds_of(&deformed))
     }
 
     /// Gives the caller's target its image for the frames recorded from now on (frames built

@@ -13,6 +13,8 @@
 pub mod per_frame;
 pub mod tiles;
 
+use std::sync::Mutex;
+
 use ash::vk;
 
 use crate::backend::{GpuBuffer, GpuContext, GpuImage};
@@ -52,10 +54,73 @@ pub struct ObjectConstants {
     pub thickness: [f32; 4],
 }
 
+/// A mesh's position + normal stream.
+pub enum VertexStream {
+    /// Uploaded once, device-local.
+    Static(GpuBuffer),
+    /// A deforming scene's: one host-visible buffer per frame in flight, rewritten for each
+    /// frame in its slot ([`crate::frame::Renderer::update_slot`]) while the GPU may still
+    /// read the other slots'.
+    PerSlot {
+        /// The buffers' handles, for binding while a slot is written.
+        handles: Vec<vk::Buffer>,
+        /// The buffers, locked only while the CPU writes one.
+        buffers: Vec<Mutex<GpuBuffer>>,
+    },
+}
+
+impl VertexStream {
+    /// The buffer frames recorded for `slot` read.
+    pub fn buffer(&self, slot: usize) -> vk::Buffer {
+        match self {
+            VertexStream::Static(b) => b.buffer,
+            VertexStream::PerSlot { handles, .. } => handles[slot.min(handles.len() - 1)],
+        }
+    }
+
+    /// Writes the vertices of `slot` (a deforming scene's; the GPU must not be reading that
+    /// slot). `bytes` must be the size the stream was made with.
+    pub fn write(&self, slot: usize, bytes: &[u8]) -> Result<()> {
+        let VertexStream::PerSlot { buffers, .. } = self else {
+            return Err(LucentError::InvalidInput(
+                "a static mesh's vertices are uploaded once".into(),
+            ));
+        };
+        let buffer = buffers.get(slot).ok_or_else(|| {
+            LucentError::InvalidInput(format!("vertex slot {slot} of {}", buffers.len()))
+        })?;
+        // A poisoned lock only means a writer panicked mid-copy; the bytes are plain data.
+        let mut buffer = buffer.lock().unwrap_or_else(|e| e.into_inner());
+        let mapped = buffer.mapped_mut().ok_or_else(|| {
+            LucentError::InvalidInput("a deforming mesh's vertices are not host-visible".into())
+        })?;
+        if mapped.len() != bytes.len() {
+            return Err(LucentError::InvalidInput(format!(
+                "deformed mesh of {} bytes written into a vertex buffer of {}",
+                bytes.len(),
+                mapped.len()
+            )));
+        }
+        mapped.copy_from_slice(bytes);
+        Ok(())
+    }
+
+    fn destroy(self, gpu: &GpuContext) {
+        match self {
+            VertexStream::Static(b) => gpu.destroy_buffer(b),
+            VertexStream::PerSlot { buffers, .. } => {
+                for b in buffers {
+                    gpu.destroy_buffer(b.into_inner().unwrap_or_else(|e| e.into_inner()));
+                }
+            }
+        }
+    }
+}
+
 /// A mesh on the GPU.
 pub struct GpuMesh {
-    /// Vertex buffer.
-    pub vertices: GpuBuffer,
+    /// Position + normal stream.
+    pub vertices: VertexStream,
     /// Index buffer (u32).
     pub indices: GpuBuffer,
     /// Number of indices.
@@ -71,18 +136,20 @@ impl GpuMesh {
     /// Records the mesh's indexed draw into `cmd` (recording inside a subpass whose bound
     /// pipeline reads the position + normal stream at binding 0): binds the vertex buffer,
     /// the thickness stream at binding 1 with `thickness`, the UV + tangent stream at binding
-    /// 2 with `surface` (each when the mesh has it), and the index buffer.
+    /// 2 with `surface` (each when the mesh has it), and the index buffer; `slot` is the
+    /// recorded frame's (a deforming mesh's vertices are per slot).
     pub fn draw(
         &self,
         device: &ash::Device,
         cmd: vk::CommandBuffer,
+        slot: usize,
         thickness: bool,
         surface: bool,
     ) {
         // SAFETY: the caller records inside a subpass with a compatible pipeline bound; the
         // buffers live as long as the scene, which outlives its frames.
         unsafe {
-            device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer], &[0]);
+            device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer(slot)], &[0]);
             if let (Some(stream), true) = (&self.thickness, thickness) {
                 device.cmd_bind_vertex_buffers(cmd, 1, &[stream.buffer], &[0]);
             }
@@ -239,17 +306,20 @@ impl SceneGpu {
             self.upload_maps(gpu, scene, upload.lean, normal_maps, albedo_maps)?;
         }
         for (i, mesh) in scene.meshes.iter().enumerate() {
-            // A deforming scene is drawn as it stands at t = 0 (per-frame updates come with
-            // the layered-scattering technique that needs them).
-            let deformed = scene.deformation.map(|d| d.apply(mesh, 0.0));
+            // A deforming scene starts as it stands at its time; each frame rewrites its slot.
+            let deformed = scene.deformation.map(|d| d.apply(mesh, scene.time));
             let mesh = deformed.as_ref().unwrap_or(mesh);
             mesh.validate(&format!("scene '{}' mesh {i}", scene.name))?;
             let name = format!("{} mesh {i}", scene.name);
-            let vertices = gpu.upload_buffer(
-                &mesh.gpu_vertices(),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                &format!("{name} vertices"),
-            )?;
+            let vertices = if deformed.is_some() {
+                per_slot_vertices(gpu, mesh, upload.frames_in_flight, &name)?
+            } else {
+                VertexStream::Static(gpu.upload_buffer(
+                    &mesh.gpu_vertices(),
+                    vk::BufferUsageFlags::VERTEX_BUFFER,
+                    &format!("{name} vertices"),
+                )?)
+            };
             let indices = gpu.upload_buffer(
                 &mesh.indices,
                 vk::BufferUsageFlags::INDEX_BUFFER,
@@ -258,7 +328,7 @@ impl SceneGpu {
             let indices = match indices {
                 Ok(b) => b,
                 Err(e) => {
-                    gpu.destroy_buffer(vertices);
+                    vertices.destroy(gpu);
                     return Err(e);
                 }
             };
@@ -430,7 +500,7 @@ impl SceneGpu {
     /// Frees the GPU memory. The GPU must be done with it.
     pub fn destroy(self, gpu: &GpuContext) {
         for m in self.meshes {
-            gpu.destroy_buffer(m.vertices);
+            m.vertices.destroy(gpu);
             gpu.destroy_buffer(m.indices);
             for b in [m.thickness, m.surface].into_iter().flatten() {
                 gpu.destroy_buffer(b);
@@ -445,6 +515,45 @@ impl SceneGpu {
         }
         self.per_frame.destroy(gpu);
     }
+}
+
+/// A deforming mesh's vertices: one host-visible buffer per frame in flight, each holding
+/// `mesh` until its slot's first frame rewrites it.
+fn per_slot_vertices(
+    gpu: &GpuContext,
+    mesh: &crate::scene::Mesh,
+    slots: usize,
+    name: &str,
+) -> Result<VertexStream> {
+    let data = mesh.gpu_vertices();
+    let bytes: &[u8] = bytemuck::cast_slice(&data);
+    let mut buffers: Vec<GpuBuffer> = Vec::with_capacity(slots);
+    for slot in 0..slots.max(1) {
+        let made = gpu.create_buffer(
+            bytes.len() as u64,
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            gpu_allocator::MemoryLocation::CpuToGpu,
+            &format!("{name} vertices (slot {slot})"),
+        );
+        match made {
+            Ok(mut b) => {
+                if let Some(mapped) = b.mapped_mut() {
+                    mapped.copy_from_slice(bytes);
+                }
+                buffers.push(b);
+            }
+            Err(e) => {
+                for b in buffers {
+                    gpu.destroy_buffer(b);
+                }
+                return Err(e);
+            }
+        }
+    }
+    Ok(VertexStream::PerSlot {
+        handles: buffers.iter().map(|b| b.buffer).collect(),
+        buffers: buffers.into_iter().map(Mutex::new).collect(),
+    })
 }
 
 /// UV + tangent per vertex; meshes without them (drawn without a map in a frame with maps)

@@ -173,8 +173,12 @@ pub fn tile_rects(columns: u32, tiles: &[bool], width: u32, height: u32) -> Vec<
 
 /// Object-space bounding box of each mesh.
 pub fn mesh_bounds(scene: &Scene) -> Vec<(Vec3, Vec3)> {
-    scene
-        .meshes
+    bounds_of(&scene.meshes)
+}
+
+/// Object-space bounding box of each of `meshes`.
+pub fn bounds_of(meshes: &[crate::scene::Mesh]) -> Vec<(Vec3, Vec3)> {
+    meshes
         .iter()
         .map(|m| {
             m.positions.iter().fold(

@@ -27,6 +27,7 @@ use crate::backend::GpuContext;
 use crate::frame::{FrameRunner, FrameTiming, Renderer};
 use crate::measure::speed_of_light::{CopyFrame, FloorRow};
 use crate::measure::stats::Stats;
+use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 /// Estimated run time (from the warm-up) above which a progress bar is drawn.
@@ -139,6 +140,10 @@ pub struct BenchReport {
     /// Each pass against its speed-of-light copy, when measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub speed_of_light: Option<Vec<FloorRow>>,
+    /// A deforming scene: the CPU time per frame to deform its meshes and write them into
+    /// the frame's vertex buffers, before the frame is submitted (not in `frame_ms`). Null
+    /// for static scenes.
+    pub deformation_ms: Option<Stats>,
 }
 
 /// The report formats `lucent bench --format` offers.
@@ -174,14 +179,20 @@ impl Format {
     }
 }
 
-/// Runs the benchmark on a built renderer.
+/// Seconds a benchmarked frame of a deforming scene advances its time (a 60 Hz animation).
+pub const ANIMATION_STEP_S: f32 = 1.0 / 60.0;
+
+/// Runs the benchmark on a built renderer. `scene` is the scene it was built for: a deforming
+/// scene is animated, every frame deformed at its own time ([`ANIMATION_STEP_S`] apart) and
+/// uploaded before it is submitted, and that CPU work is timed and reported with the frame.
 pub fn run(
     gpu: &GpuContext,
     renderer: &Renderer,
+    scene: &Scene,
     scene_name: &str,
     options: &BenchOptions,
 ) -> Result<BenchReport> {
-    run_with_floor(gpu, renderer, None, scene_name, options)
+    run_with_floor(gpu, renderer, None, scene, scene_name, options)
 }
 
 /// [`run`], and with `copies` (built from the renderer's plan) each pass's speed-of-light copy
@@ -190,6 +201,7 @@ pub fn run_with_floor(
     gpu: &GpuContext,
     renderer: &Renderer,
     copies: Option<&mut CopyFrame>,
+    scene: &Scene,
     scene_name: &str,
     options: &BenchOptions,
 ) -> Result<BenchReport> {
@@ -197,11 +209,17 @@ pub fn run_with_floor(
     let exe = &renderer.executable;
     let names: Vec<String> = exe.plan.physical.iter().map(|p| p.name.clone()).collect();
     let mut runner = FrameRunner::new(gpu, names.len())?;
+    let mut animation = scene.deformation.map(|_| Animation {
+        scene: scene.clone(),
+        start: scene.time,
+        frame: 0,
+    });
     let result = measure(
         gpu,
         renderer,
         &mut runner,
         copies,
+        animation.as_mut(),
         &names,
         scene_name,
         options,
@@ -243,11 +261,32 @@ fn collect(samples: &mut [Vec<f64>], timing: &FrameTiming, names: &[String]) -> 
     Ok(())
 }
 
+/// A deforming scene advanced frame by frame.
+struct Animation {
+    scene: Scene,
+    start: f32,
+    frame: u32,
+}
+
+impl Animation {
+    /// Deforms the scene at the next frame's time into the renderer's slot (the previous
+    /// frame has completed: `run_frame` waits for it); returns the CPU milliseconds it took.
+    fn advance(&mut self, renderer: &Renderer) -> Result<f64> {
+        let t = std::time::Instant::now();
+        self.scene.time = self.start + self.frame as f32 * ANIMATION_STEP_S;
+        self.frame += 1;
+        renderer.update_slot(&self.scene, 0)?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn measure(
     gpu: &GpuContext,
     renderer: &Renderer,
     runner: &mut FrameRunner,
     mut copies: Option<&mut CopyFrame>,
+    mut animation: Option<&mut Animation>,
     names: &[String],
     scene_name: &str,
     options: &BenchOptions,
@@ -255,6 +294,9 @@ fn measure(
     let exe = &renderer.executable;
     let warm_start = std::time::Instant::now();
     for _ in 0..options.warmup {
+        if let Some(a) = animation.as_deref_mut() {
+            a.advance(renderer)?;
+        }
         runner.run_frame(gpu, exe)?;
         if options.isolate {
             runner.run_isolated(gpu, exe)?;
@@ -271,6 +313,7 @@ fn measure(
         per_frame_s * options.frames as f64,
         "bench",
     );
+    let mut deformation_ms = Vec::new();
     let mut samples = Samples {
         frame_walls: Vec::with_capacity(options.frames),
         in_frame: vec![Vec::new(); names.len()],
@@ -278,6 +321,9 @@ fn measure(
     };
     // Interleaved, so both modes see the same machine load.
     for _ in 0..options.frames {
+        if let Some(a) = animation.as_deref_mut() {
+            deformation_ms.push(a.advance(renderer)?);
+        }
         let t = runner.run_frame(gpu, exe)?;
         samples.frame_walls.push(t.wall_ms);
         collect(&mut samples.in_frame, &t, names)?;
@@ -331,6 +377,7 @@ fn measure(
         checks: verdict.checks,
         trusted: verdict.trusted,
         speed_of_light,
+        deformation_ms: (!deformation_ms.is_empty()).then(|| Stats::of(&deformation_ms)),
     })
 }
 
@@ -543,6 +590,18 @@ impl BenchReport {
             self.frame_ms.max,
             if isolated { " |" } else { "" }
         ));
+        if let Some(d) = &self.deformation_ms {
+            // The deformation runs on the CPU before each frame is submitted: the frame's cost
+            // to an animation is both.
+            out.push_str(&format!(
+                "- deformation (CPU, before submit): median {:.3} ms (min {:.3}, max {:.3}); \
+                 frame + deformation {:.3} ms\n",
+                d.median,
+                d.min,
+                d.max,
+                self.frame_ms.median + d.median
+            ));
+        }
         for c in &self.checks {
             out.push_str(&format!(
                 "- check {}: {} ({})\n",

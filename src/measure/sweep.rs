@@ -236,6 +236,7 @@ pub fn case_scene(case: &SweepCase) -> Result<Scene> {
         sky: Vec3::splat(0.02),
         exposure: 1.0,
         deformation: None,
+        time: 0.0,
     })
 }
 

@@ -785,6 +785,7 @@ mod tests {
             sky: Vec3::ZERO,
             exposure: 1.0,
             deformation: None,
+            time: 0.0,
         }
     }
 

@@ -223,6 +223,7 @@ pub fn bench_technique(
             ctx.gpu,
             &renderer,
             Some(&mut copies),
+            &scene,
             scene_name,
             &BenchOptions {
                 frames: ctx.options.frames,

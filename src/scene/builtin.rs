@@ -118,6 +118,7 @@ fn base_scene(name: &str, camera: Camera) -> Scene {
         sky: Vec3::new(0.15, 0.2, 0.3),
         exposure: 1.0,
         deformation: None,
+        time: 0.0,
     }
 }
 

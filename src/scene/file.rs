@@ -886,6 +886,7 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
         sky: Vec3::from(raw.sky.unwrap_or([0.15, 0.2, 0.3])),
         exposure,
         deformation,
+        time: 0.0,
     })
 }
 

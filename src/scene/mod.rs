@@ -95,6 +95,9 @@ pub struct Scene {
     pub exposure: f32,
     /// A deformation applied to every object's mesh over time (the `dynamic` scene).
     pub deformation: Option<Deformation>,
+    /// The instant shown, in seconds: the deformation is evaluated at it (`render --time`;
+    /// the benchmark and the demo advance it every frame). 0 for a scene just loaded.
+    pub time: f32,
 }
 
 /// A mesh deformation over time, evaluated on the CPU per frame.

@@ -788,7 +788,7 @@ fn bench_command(
                 gpu,
                 &session.shaders,
                 &session.pipeline_cache,
-                &bake::load_scene_baked(&frame.scene)?,
+                scene,
                 &format!("`{}`", frame.scene),
                 (renderer.settings.width, renderer.settings.height),
                 (options.frames, options.warmup),
@@ -796,12 +796,11 @@ fn bench_command(
             println!("{}", lucent::report::seeds::gdc_beside(&cost));
         }
         if let Some(technique) = against {
-            let scene = bake::load_scene_baked(&frame.scene)?;
             let other = Renderer::new(
                 gpu,
                 &session.shaders,
                 &session.pipeline_cache,
-                &scene,
+                scene,
                 FrameSettings {
                     technique,
                     ..renderer.settings
@@ -813,6 +812,7 @@ fn bench_command(
                     (technique.name(), &other),
                     (renderer.settings.technique.name(), renderer),
                 ],
+                scene,
                 options.frames,
                 options.warmup,
             );

@@ -209,11 +209,7 @@ pub fn run_with_floor(
     let exe = &renderer.executable;
     let names: Vec<String> = exe.plan.physical.iter().map(|p| p.name.clone()).collect();
     let mut runner = FrameRunner::new(gpu, names.len())?;
-    let mut animation = scene.deformation.map(|_| Animation {
-        scene: scene.clone(),
-        start: scene.time,
-        frame: 0,
-    });
+    let mut animation = Animation::of(scene);
     let result = measure(
         gpu,
         renderer,
@@ -269,14 +265,33 @@ struct Animation {
 }
 
 impl Animation {
-    /// Deforms the scene at the next frame's time into the renderer's slot (the previous
-    /// frame has completed: `run_frame` waits for it); returns the CPU milliseconds it took.
-    fn advance(&mut self, renderer: &Renderer) -> Result<f64> {
-        let t = std::time::Instant::now();
+    /// `scene` animated from its own time, when it deforms.
+    fn of(scene: &Scene) -> Option<Self> {
+        scene.deformation.map(|_| Animation {
+            scene: scene.clone(),
+            start: scene.time,
+            frame: 0,
+        })
+    }
+
+    /// Moves to the next frame's time.
+    fn step(&mut self) {
         self.scene.time = self.start + self.frame as f32 * ANIMATION_STEP_S;
         self.frame += 1;
+    }
+
+    /// Deforms the scene at its current time into the renderer's slot (the previous frame
+    /// has completed: `run_frame` waits for it); returns the CPU milliseconds it took.
+    fn upload(&self, renderer: &Renderer) -> Result<f64> {
+        let t = std::time::Instant::now();
         renderer.update_slot(&self.scene, 0)?;
         Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// [`Self::step`], then [`Self::upload`].
+    fn advance(&mut self, renderer: &Renderer) -> Result<f64> {
+        self.step();
+        self.upload(renderer)
     }
 }
 
@@ -836,10 +851,12 @@ pub struct Comparison {
     pub frames: usize,
 }
 
-/// Measures `a` against `b`, alternating frames.
+/// Measures `a` against `b`, alternating frames, both built for `scene` (a deforming scene
+/// is animated: both sides draw the same instant each frame).
 pub fn compare(
     gpu: &GpuContext,
     sides: [(&str, &Renderer); 2],
+    scene: &Scene,
     frames: usize,
     warmup: usize,
 ) -> Result<Comparison> {
@@ -862,8 +879,15 @@ pub fn compare(
             vec![Vec::new(); names[1].len()],
         ];
         let mut walls: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+        let mut animation = Animation::of(scene);
         for frame in 0..warmup + frames {
+            if let Some(a) = animation.as_mut() {
+                a.step();
+            }
             for side in 0..2 {
+                if let Some(a) = &animation {
+                    a.upload(sides[side].1)?;
+                }
                 let t = runners[side].run_frame(gpu, &sides[side].1.executable)?;
                 if frame >= warmup {
                     collect(&mut in_frame[side], &t, &names[side])?;

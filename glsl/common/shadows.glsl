@@ -31,7 +31,7 @@ layout(std140, set = 0, binding = LUCENT_SHADOW_BINDING) uniform Shadows {
 // The light-space maps pass: the object and the face it is drawn into.
 layout(push_constant) uniform ShadowObject {
     mat4 model;
-    ivec4 face_id;  // x: face; y: the object's translucency material ID (0: none)
+    ivec4 face_id;  // x: face; y: the object's translucency material ID (0: none); z: layered ID
 } shadow_object;
 #else
 layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2D shadow_depth;

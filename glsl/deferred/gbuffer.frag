@@ -2,6 +2,8 @@
 // permutation: LUCENT_TRANSLUCENCY
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS
 // permutation: LUCENT_SSS_PROFILE
+// permutation: LUCENT_LAYERED
+// permutation: LUCENT_SSS_PROFILE LUCENT_LAYERED LUCENT_SSS_LOCATION=2 LUCENT_LAYERED_LOCATION=3
 // permutation: LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_LEAN
@@ -23,6 +25,9 @@
 #endif
 #ifndef LUCENT_LEAN_LOCATION
 #define LUCENT_LEAN_LOCATION 3
+#endif
+#ifndef LUCENT_LAYERED_LOCATION
+#define LUCENT_LAYERED_LOCATION 2
 #endif
 #ifndef LUCENT_ALBEDO_BINDING
 #define LUCENT_ALBEDO_BINDING 1
@@ -78,6 +83,11 @@ layout(location = LUCENT_GB2_LOCATION) out vec4 out_gb2;
 layout(location = LUCENT_SSS_LOCATION) out vec4 out_sss;
 #endif
 
+#ifdef LUCENT_LAYERED
+// Li et al.'s layered material ID / 255 (0: not layered), for the scattering passes.
+layout(location = LUCENT_LAYERED_LOCATION) out vec4 out_layered;
+#endif
+
 layout(location = 0) out vec4 out_gb0;
 layout(location = 1) out vec4 out_gb1;
 
@@ -131,5 +141,8 @@ void main() {
 #endif
 #ifdef LUCENT_SSS_PROFILE
     out_sss = vec4(clamp(object.roughness.y, 0.0, 255.0) / 255.0);
+#endif
+#ifdef LUCENT_LAYERED
+    out_layered = vec4(clamp(object.roughness.z, 0.0, 255.0) / 255.0);
 #endif
 }

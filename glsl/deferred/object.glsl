@@ -5,7 +5,7 @@
 layout(push_constant) uniform Object {
     mat4 model;
     vec4 albedo_specular;
-    vec4 roughness;   // x: roughness; y: screen-space SSS profile ID (0: none)
+    vec4 roughness;   // x: roughness; y: screen-space SSS profile ID (0: none); z: layered material ID
     vec4 thickness;   // rgb: tint x constant thickness; w: translucency material ID (0: none)
 } object;
 

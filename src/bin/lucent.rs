@@ -11,6 +11,7 @@ use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
 use lucent::features::deferred::GBufferPrecision;
+use lucent::features::layered::{LayeredKnobs, PhaseForm};
 use lucent::features::shadows::ShadowSettings;
 use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
 use lucent::features::sss::{SssBlur, SssKnobs, SssPrecision};
@@ -267,6 +268,26 @@ struct FrameArgs {
     /// Table 1 uses 512 and 1024). Halved until every face fits an 8192x8192 atlas.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_shadow_size)]
     shadow_size: Option<u32>,
+    /// Layered media (Li et al.): single scattering's march steps along the refracted view
+    /// ray (1 to 64; default 8).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_layered_steps)]
+    layered_steps: Option<u32>,
+    /// Layered media: multiple scattering's pixel lights per pixel (4 to 64; default 12, Li
+    /// et al.'s).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_pixel_lights)]
+    pixel_lights: Option<u32>,
+    /// Layered media: single scattering's phase function: hg (true Henyey-Greenstein, the
+    /// default) or schlick (Li et al.'s eq. 9 form with Schlick's k).
+    #[arg(long, value_parser = parse_phase)]
+    phase: Option<PhaseForm>,
+    /// Layered media: the irradiance image multiple scattering gathers from at half
+    /// resolution per side.
+    #[arg(long)]
+    half_irradiance: bool,
+    /// Layered media: single scattering's depth D_max in mean free paths of the first layer
+    /// (a finite number > 0; default 4).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_single_depth)]
+    single_depth: Option<f32>,
     /// The instant shown, in seconds (a finite number; default 0): a deforming scene
     /// (`dynamic`) is deformed at it; `bench` starts its animation there.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_time)]
@@ -279,6 +300,32 @@ fn parse_time(text: &str) -> std::result::Result<f32, String> {
         .ok()
         .filter(|v| v.is_finite())
         .ok_or_else(|| format!("'{text}' is not a finite number of seconds"))
+}
+
+fn parse_layered_steps(text: &str) -> std::result::Result<u32, String> {
+    let r = lucent::features::layered::STEP_RANGE;
+    count_in(text, u64::from(*r.start())..=u64::from(*r.end())).map(|v| v as u32)
+}
+
+fn parse_pixel_lights(text: &str) -> std::result::Result<u32, String> {
+    let r = lucent::features::layered::PIXEL_LIGHT_RANGE;
+    count_in(text, u64::from(*r.start())..=u64::from(*r.end())).map(|v| v as u32)
+}
+
+fn parse_phase(text: &str) -> std::result::Result<PhaseForm, String> {
+    PhaseForm::ALL
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|&(_, p)| p)
+        .ok_or_else(|| format!("'{text}' is not one of hg, schlick"))
+}
+
+fn parse_single_depth(text: &str) -> std::result::Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0 && *v <= 1e3)
+        .ok_or_else(|| format!("'{text}' is not a number of mean free paths in (0, 1000]"))
 }
 
 fn parse_shadow_size(text: &str) -> std::result::Result<u32, String> {
@@ -455,6 +502,16 @@ impl FrameArgs {
                 enabled: !self.no_shadows,
                 size: self.shadow_size.unwrap_or(ShadowSettings::default().size),
             },
+            layered: {
+                let defaults = LayeredKnobs::default();
+                LayeredKnobs {
+                    steps: self.layered_steps.unwrap_or(defaults.steps),
+                    pixel_lights: self.pixel_lights.unwrap_or(defaults.pixel_lights),
+                    phase: self.phase.unwrap_or(defaults.phase),
+                    half_irradiance: self.half_irradiance,
+                    max_depth_mfp: self.single_depth.unwrap_or(defaults.max_depth_mfp),
+                }
+            },
         })
     }
 
@@ -482,6 +539,8 @@ impl FrameArgs {
                    with one of those blurs)";
         let sep = "the separable blur: --technique separable (or SSS materials with blur = \
                    \"separable\")";
+        let layered = "Li et al.'s layered media: --technique layered (or auto) on a scene \
+                       with layered materials";
         let gdc = "GDC 2011 translucency: --technique translucency (or auto) on a scene with \
                    translucent materials";
         let knobs = [
@@ -506,6 +565,36 @@ impl FrameArgs {
                 "--time",
                 "a deforming scene (one with a [deformation] table, e.g. dynamic)",
                 scene.deformation.is_some(),
+            ),
+            (
+                self.layered_steps.is_some(),
+                "--layered-steps",
+                layered,
+                desc.layered.is_some(),
+            ),
+            (
+                self.pixel_lights.is_some(),
+                "--pixel-lights",
+                layered,
+                desc.layered.is_some(),
+            ),
+            (
+                self.phase.is_some(),
+                "--phase",
+                layered,
+                desc.layered.is_some(),
+            ),
+            (
+                self.half_irradiance,
+                "--half-irradiance",
+                layered,
+                desc.layered.is_some(),
+            ),
+            (
+                self.single_depth.is_some(),
+                "--single-depth",
+                layered,
+                desc.layered.is_some(),
             ),
             (
                 self.shadow_size.is_some(),

@@ -93,6 +93,8 @@ pub struct GBufferLayout {
     /// The separable SSS blur reads linear depth from the lit diffuse's alpha (frames with a
     /// separable chain and no LEAN chain).
     pub depth_in_alpha: bool,
+    /// Layered media (Li et al.): the G-buffer stores each pixel's layered material ID.
+    pub layered: bool,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
     pub fault_injection: bool,
 }
@@ -120,6 +122,8 @@ pub enum ExtraTarget {
     SssProfile,
     /// The view-plane LEAN slope y + moments.
     Lean,
+    /// The layered material ID.
+    Layered,
 }
 
 impl ExtraTarget {
@@ -129,12 +133,13 @@ impl ExtraTarget {
             ExtraTarget::Translucency => "LUCENT_GB2_LOCATION",
             ExtraTarget::SssProfile => "LUCENT_SSS_LOCATION",
             ExtraTarget::Lean => "LUCENT_LEAN_LOCATION",
+            ExtraTarget::Layered => "LUCENT_LAYERED_LOCATION",
         }
     }
 }
 
-/// Location values as shader define strings (at most 2 + three extra targets).
-const LOCATIONS: [&str; 5] = ["0", "1", "2", "3", "4"];
+/// Location values as shader define strings (at most 2 + four extra targets).
+const LOCATIONS: [&str; 6] = ["0", "1", "2", "3", "4", "5"];
 
 impl GBufferLayout {
     /// The targets after GB0 and GB1, in location order (2, 3, ...).
@@ -148,6 +153,9 @@ impl GBufferLayout {
         }
         if self.lean {
             targets.push(ExtraTarget::Lean);
+        }
+        if self.layered {
+            targets.push(ExtraTarget::Layered);
         }
         targets
     }
@@ -201,6 +209,9 @@ impl GBufferLayout {
         if self.lean {
             defines.push(("LUCENT_LEAN", "1"));
         }
+        if self.layered {
+            defines.push(("LUCENT_LAYERED", "1"));
+        }
         if self.albedo_maps {
             defines.push(("LUCENT_ALBEDO_MAP", "1"));
             let binding = 1 + usize::from(self.normal_maps) * (1 + usize::from(self.lean));
@@ -249,6 +260,8 @@ pub struct GBuffer {
     pub sss: Option<Handle<Image>>,
     /// View-plane LEAN slope y + moments, in LCB and LBB frames.
     pub lean: Option<Handle<Image>>,
+    /// Layered material ID per pixel, in frames with layered media.
+    pub layered: Option<Handle<Image>>,
     /// Depth.
     pub depth: Handle<Image>,
     /// The layout it was declared with.
@@ -280,6 +293,9 @@ pub fn gbuffer_pass(
         lean: layout
             .lean
             .then(|| graph.create_image("gbuffer.lean", image(LEAN_FORMAT))),
+        layered: layout.layered.then(|| {
+            graph.create_image("gbuffer.layered", image(super::layered::LAYERED_ID_FORMAT))
+        }),
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
         layout,
     };
@@ -307,6 +323,10 @@ pub fn gbuffer_pass(
             LoadOp::DontCare
         };
         pass.color(lean, load);
+    }
+    if let Some(layered) = &mut gb.layered {
+        // Cleared to 0: the scattering passes leave non-layered pixels alone.
+        pass.color(layered, LoadOp::Clear([0.0; 4]));
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {

@@ -7,12 +7,17 @@
 //! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
 //!   packing (its shading runs inside the deferred lighting pass).
 //! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
+//! - [`shadows`]: light-space maps: shadows for direct light, light entry points for layered
+//!   media.
+//! - [`layered`]: Li et al. 2009's layered media: image-space single and dipole multiple
+//!   scattering.
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 
 pub mod debug_view;
 pub mod deferred;
+pub mod layered;
 pub mod shadows;
 pub mod sss;
 pub mod tonemap;

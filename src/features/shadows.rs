@@ -76,6 +76,9 @@ pub struct ShadowDesc {
     pub rows: u32,
     /// The atlas stores each texel's translucency material (frames with translucency).
     pub transmission_ids: bool,
+    /// The atlas stores each texel's entry normal and layered material (frames with layered
+    /// media: single scattering's light entry points).
+    pub entry: bool,
 }
 
 impl ShadowDesc {
@@ -113,6 +116,7 @@ impl ShadowDesc {
             columns,
             rows,
             transmission_ids: translucency,
+            entry: false,
         })
     }
 
@@ -315,6 +319,8 @@ pub struct ShadowMaps {
     pub depth: Handle<Image>,
     /// Translucency material of each texel's first surface (frames with translucency).
     pub ids: Option<Handle<Image>>,
+    /// Each texel's first surface's normal and layered material (frames with layered media).
+    pub entry: Option<Handle<Image>>,
 }
 
 /// Declares the `light-space maps` pass. `scene` is `None` for plan-only graphs.
@@ -334,11 +340,18 @@ pub fn shadow_pass(
         ids: desc
             .transmission_ids
             .then(|| graph.create_image("light-space.ids", info(SHADOW_ID_FORMAT))),
+        entry: desc
+            .entry
+            .then(|| graph.create_image("light-space.entry", info(super::layered::ENTRY_FORMAT))),
     };
     let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
     if let Some(ids) = &mut maps.ids {
         // 0: no translucent material (texels no object covers are never closer than a point).
         pass.color(ids, LoadOp::Clear([0.0; 4]));
+    }
+    if let Some(entry) = &mut maps.entry {
+        // Layered material 0 where no object is.
+        pass.color(entry, LoadOp::Clear([0.5, 0.5, 0.5, 0.0]));
     }
     pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
     match scene {
@@ -357,7 +370,8 @@ pub fn shadow_pass(
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadowConstants {
     model: [[f32; 4]; 4],
-    /// x: face index; y: the object's translucency material ID (0: none).
+    /// x: face index; y: the object's translucency material ID (0: none); z: its layered
+    /// material ID (0: none).
     face_id: [i32; 4],
 }
 
@@ -369,11 +383,17 @@ struct ShadowPass {
 
 impl PassExec for ShadowPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let defines: &[(&str, &str)] = if self.desc.transmission_ids {
-            &[("LUCENT_SHADOW_IDS", "1")]
-        } else {
-            &[]
-        };
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.desc.transmission_ids {
+            defines.push(("LUCENT_SHADOW_IDS", "1"));
+        }
+        if self.desc.entry {
+            defines.push(("LUCENT_SHADOW_ENTRY", "1"));
+            defines.push((
+                "LUCENT_ENTRY_LOCATION",
+                if self.desc.transmission_ids { "1" } else { "0" },
+            ));
+        }
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &[Binding::PerFrame(
@@ -382,8 +402,16 @@ impl PassExec for ShadowPass {
             &GraphicsPipelineDesc {
                 vertex: "shadow/depth.vert",
                 fragment: "shadow/depth.frag",
-                defines,
-                vertex_input: VertexInput::Positions,
+                defines: &defines,
+                // The entry target needs the normals.
+                vertex_input: if self.desc.entry {
+                    VertexInput::Mesh {
+                        thickness: false,
+                        surface: false,
+                    }
+                } else {
+                    VertexInput::Positions
+                },
                 depth_test: true,
                 // Open meshes (the floor, a leaf) cast from both sides.
                 cull_back: false,
@@ -431,7 +459,12 @@ impl PassExec for ShadowPass {
             for draw in &self.scene.draws {
                 let constants = ShadowConstants {
                     model: draw.constants.model,
-                    face_id: [face as i32, draw.constants.thickness[3] as i32, 0, 0],
+                    face_id: [
+                        face as i32,
+                        draw.constants.thickness[3] as i32,
+                        draw.constants.roughness[2] as i32,
+                        0,
+                    ],
                 };
                 // SAFETY: the bound pipeline's layout has this push-constant range.
                 unsafe {

@@ -10,7 +10,7 @@ use super::{FrameDesc, FrameSettings};
 use crate::backend::access::Access;
 use crate::features::debug_view;
 use crate::features::deferred::GBufferLayout;
-use crate::features::{deferred, shadows, sss, tonemap};
+use crate::features::{deferred, layered, shadows, sss, tonemap};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{CompileOptions, ImageInfo, ImportedImage, Plan, RenderGraph, ResourceId};
 use crate::Result;
@@ -106,6 +106,23 @@ pub fn declare_frame(
             scene_gpu,
         ),
         _ => lit.color,
+    };
+    // Li et al.'s terms add into the lit image after the SSS blurs (layered pixels have no
+    // SSS profile, so the blurs left them as lit).
+    let hdr = match (&desc.layered, &gb.layered) {
+        (Some(_), Some(ids)) => layered::layered_passes(
+            graph,
+            hdr,
+            &layered::LayeredInputs {
+                depth: &gb.depth,
+                gb1: &gb.gb1,
+                ids,
+                shadows: shadow_maps.as_ref(),
+            },
+            &settings.layered,
+            scene_gpu,
+        ),
+        _ => hdr,
     };
     let display = match debug_display {
         Some(display) => display,

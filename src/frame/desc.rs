@@ -4,13 +4,16 @@
 //! [`super::Technique`] override does not leave it out): GB2 and the GDC 2011 term when some material
 //! is translucent, one SSS chain per blur the SSS materials use with every profile in the
 //! profile table, the LEAN targets when some chain is LCB or LBB, normal and albedo maps when
-//! some material has one, light-space maps when some light casts shadows. Everything else
+//! some material has one, light-space maps when some light casts shadows, Li et al.'s
+//! scattering passes (and the G-buffer and light-space targets they read) when some material
+//! is layered. Everything else
 //! costs nothing: [`super::declare_frame`] declares
 //! no pass, image or shader permutation for it, and [`crate::gpu_scene`] uploads no stream,
 //! texture or table.
 
 use super::FrameSettings;
 use crate::features::deferred::{GBufferLayout, TranslucencyLayout};
+use crate::features::layered::LayeredDesc;
 use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
 use crate::features::translucency::{MaterialTable, MaterialTableGpu, ThicknessPacking};
@@ -41,6 +44,8 @@ pub struct FrameDesc {
     pub albedo_maps: bool,
     /// Light-space maps, when some light casts shadows.
     pub shadows: Option<ShadowDesc>,
+    /// Li et al.'s layered media, when some object is layered (and the technique keeps it).
+    pub layered: Option<LayeredDesc>,
 }
 
 impl FrameDesc {
@@ -66,9 +71,19 @@ impl FrameDesc {
         let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
             scene.objects.iter().any(|o| f(&o.material))
         };
-        let shadows = ShadowDesc::new(scene, &settings.shadows, translucency.is_some());
+        let layered = if technique.layered() {
+            LayeredDesc::new(scene)?
+        } else {
+            None
+        };
+        let mut shadows = ShadowDesc::new(scene, &settings.shadows, translucency.is_some());
+        if let Some(s) = &mut shadows {
+            // Single scattering reads each map texel's entry normal and layered material.
+            s.entry = layered.is_some();
+        }
         Ok(Self {
             shadows,
+            layered,
             translucency,
             sss,
             normal_maps: any(&|m| m.normal_texture.is_some()),
@@ -113,6 +128,7 @@ impl FrameDesc {
             normal_maps: self.normal_maps,
             albedo_maps: self.albedo_maps,
             depth_in_alpha: self.sss.as_ref().is_some_and(SssProfiles::depth_in_alpha),
+            layered: self.layered.is_some(),
             fault_injection: settings.fault.is_some(),
         }
     }
@@ -146,6 +162,12 @@ impl FrameDesc {
             } else {
                 0
             },
+            layered_ids: self.layered.as_ref().map(|l| &l.object_ids[..]),
+            layered_table_bytes: if self.layered.is_some() {
+                crate::features::layered::LAYERED_TABLE_BYTES
+            } else {
+                0
+            },
         }
     }
 
@@ -157,6 +179,7 @@ impl FrameDesc {
             (
                 d.translucency.as_ref().map(|t| t.table.object_ids.clone()),
                 d.sss.as_ref().map(|s| s.object_ids.clone()),
+                d.layered.as_ref().map(|l| l.object_ids.clone()),
             )
         };
         let steps = |d: &FrameDesc| {
@@ -173,6 +196,8 @@ impl FrameDesc {
             && steps(self) == steps(other)
             && self.sss.as_ref().map(|s| s.profiles.len())
                 == other.sss.as_ref().map(|s| s.profiles.len())
+            && self.layered.as_ref().map(|l| l.materials.len())
+                == other.layered.as_ref().map(|l| l.materials.len())
     }
 
     /// The features in the frame, for messages and the plan dump's header.
@@ -196,6 +221,10 @@ impl FrameDesc {
                     .collect();
                 names.push(format!("sss {} ({})", chain.name(), profiles.join(", ")));
             }
+        }
+        if let Some(l) = &self.layered {
+            let media: Vec<&str> = l.materials.iter().map(|m| m.name.as_str()).collect();
+            names.push(format!("layered ({})", media.join(", ")));
         }
         if let Some(s) = &self.shadows {
             names.push(s.name());

@@ -233,6 +233,15 @@ impl Renderer {
                 tiles.sss.push(rects);
             }
         }
+        if let Some(layered) = &desc.layered {
+            let table = layered.table(&self.settings.layered);
+            per_frame.write(slot, Region::Layered, bytemuck::bytes_of(&table))?;
+            // The scattering passes stay on the object (the gather rejects other materials).
+            let (columns, _, marked) = object_tiles(scene, mesh_bounds, width, height, |i, _| {
+                (layered.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)
+            });
+            tiles.layered = tile_rects(columns, &marked, width, height);
+        }
         *per_frame.tiles(slot) = tiles;
         Ok(())
     }

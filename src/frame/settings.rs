@@ -3,6 +3,7 @@
 use crate::backend::access::Access;
 use crate::features::debug_view::DebugView;
 use crate::features::deferred::GBufferPrecision;
+use crate::features::layered::LayeredKnobs;
 use crate::features::shadows::ShadowSettings;
 use crate::features::sss;
 use crate::graph::CompileOptions;
@@ -36,6 +37,9 @@ pub enum Technique {
     Separable,
     /// The thesis's bilateral LEAN blur in two passes, tap weights from the whole profile.
     Bilateral,
+    /// Li et al.'s layered media (single + dipole multiple scattering) on layered materials
+    /// only.
+    Layered,
 }
 
 impl Technique {
@@ -49,6 +53,7 @@ impl Technique {
         ("lbb", Technique::Lbb),
         ("separable", Technique::Separable),
         ("bilateral", Technique::Bilateral),
+        ("layered", Technique::Layered),
     ];
 
     /// Parses a command-line name.
@@ -80,7 +85,9 @@ impl Technique {
     /// The screen-space SSS blur this technique forces on every SSS material, if any.
     pub fn sss_blur(self) -> Option<SssBlur> {
         match self {
-            Technique::Auto | Technique::None | Technique::Translucency => None,
+            Technique::Auto | Technique::None | Technique::Translucency | Technique::Layered => {
+                None
+            }
             Technique::Control => Some(SssBlur::Control),
             Technique::Lcb => Some(SssBlur::LeanControl),
             Technique::Lbb => Some(SssBlur::LeanBilateral),
@@ -96,7 +103,15 @@ impl Technique {
 
     /// Whether SSS materials get their screen-space blur.
     pub fn sss(self) -> bool {
-        !matches!(self, Technique::None | Technique::Translucency)
+        !matches!(
+            self,
+            Technique::None | Technique::Translucency | Technique::Layered
+        )
+    }
+
+    /// Whether layered materials get Li et al.'s scattering passes.
+    pub fn layered(self) -> bool {
+        matches!(self, Technique::Auto | Technique::Layered)
     }
 }
 
@@ -143,6 +158,9 @@ pub struct FrameSettings {
     /// Light-space maps: whether lights cast shadows (each light's own switch still applies)
     /// and the map size.
     pub shadows: ShadowSettings,
+    /// Li et al.'s layered passes' knobs (march steps, pixel lights, phase function,
+    /// irradiance resolution, single-scattering depth).
+    pub layered: LayeredKnobs,
 }
 
 /// An image the caller renders into: its format, the state it is in when the frame starts
@@ -194,6 +212,7 @@ impl FrameSettings {
             frames_in_flight: 1,
             target: None,
             shadows: ShadowSettings::default(),
+            layered: LayeredKnobs::default(),
         }
     }
 }

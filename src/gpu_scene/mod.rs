@@ -47,7 +47,7 @@ pub struct ObjectConstants {
     /// Albedo rgb, specular a.
     pub albedo_specular: [f32; 4],
     /// Roughness in x; y: the SSS profile ID (0: the object does not scatter), in frames
-    /// with SSS.
+    /// with SSS; z: the layered material ID (0: not layered), in frames with layered media.
     pub roughness: [f32; 4],
     /// Translucency: thickness factor rgb (tint x constant thickness), material ID in w
     /// (0: not translucent). Zero when the frame has no translucency.
@@ -204,6 +204,11 @@ pub struct SceneUpload<'a> {
     pub kernel_table_bytes: u64,
     /// Bytes of the light-space maps' table (0: no light casts shadows).
     pub shadow_table_bytes: u64,
+    /// Frames with layered materials: each object's layered material ID (0: not layered);
+    /// a layered object's albedo is weighted by its eq. 3 `λ1` and its specular by `λ2`.
+    pub layered_ids: Option<&'a [u8]>,
+    /// Bytes of the layered media's table (0 without layered materials).
+    pub layered_table_bytes: u64,
 }
 
 /// Side of the procedural textures lucent makes, in texels.
@@ -279,6 +284,7 @@ impl SceneGpu {
             upload.profile_table_bytes,
             upload.kernel_table_bytes,
             upload.shadow_table_bytes,
+            upload.layered_table_bytes,
             &scene.name,
         )?;
         let mut out = Self {
@@ -420,13 +426,30 @@ impl SceneGpu {
                 },
                 None => 0,
             };
+            let layered_id = upload
+                .layered_ids
+                .and_then(|ids| ids.get(index).copied())
+                .unwrap_or(0);
+            // Li et al.'s eq. 3 weights the lit diffuse by λ1 and the specular by λ2: lighting
+            // is linear in albedo and specular intensity, so weighting them here is exact.
+            let (diffuse_weight, specular_weight) = match (&o.material.layers, layered_id) {
+                (Some(m), id) if id > 0 => (m.weights[0], m.weights[1]),
+                _ => (1.0, 1.0),
+            };
             self.draws.push(Draw {
                 mesh: o.mesh,
                 maps,
                 constants: ObjectConstants {
                     model: o.transform.to_cols_array_2d(),
-                    albedo_specular: o.material.albedo.extend(o.material.specular).to_array(),
-                    roughness: [o.material.roughness, f32::from(profile_id), 0.0, 0.0],
+                    albedo_specular: (o.material.albedo * diffuse_weight)
+                        .extend(o.material.specular * specular_weight)
+                        .to_array(),
+                    roughness: [
+                        o.material.roughness,
+                        f32::from(profile_id),
+                        f32::from(layered_id),
+                        0.0,
+                    ],
                     thickness,
                 },
             });

@@ -118,9 +118,11 @@ pub enum Region {
     Kernels,
     /// The light-space maps' table (frames where some light casts shadows).
     Shadows,
+    /// The layered media's table (frames with layered materials).
+    Layered,
 }
 
-const REGIONS: usize = 5;
+const REGIONS: usize = 6;
 
 impl Region {
     fn index(self) -> usize {
@@ -130,6 +132,7 @@ impl Region {
             Region::Profiles => 2,
             Region::Kernels => 3,
             Region::Shadows => 4,
+            Region::Layered => 5,
         }
     }
 }
@@ -143,6 +146,9 @@ pub struct SlotTiles {
     /// Per SSS chain (in the frame's chain order): its rectangles, marked where objects of the
     /// chain's blur (widened by their profile's reach) may be; `None`: the whole screen.
     pub sss: Vec<Option<Vec<TileRect>>>,
+    /// The layered passes' rectangles, marked where layered objects may be (frames with
+    /// layered materials).
+    pub layered: Vec<TileRect>,
 }
 
 /// A binding of one region of the per-frame buffer: a dynamic uniform buffer whose offset the
@@ -174,8 +180,8 @@ pub struct PerFrame {
 impl PerFrame {
     /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with a
     /// translucency region of `translucency_bytes`, a profile region of `profile_bytes`, a
-    /// kernel region of `kernel_bytes` and a shadow region of `shadow_bytes` (0: the frame
-    /// has none).
+    /// kernel region of `kernel_bytes`, a shadow region of `shadow_bytes` and a layered region
+    /// of `layered_bytes` (0: the frame has none).
     pub fn new(
         gpu: &GpuContext,
         slots: usize,
@@ -183,6 +189,7 @@ impl PerFrame {
         profile_bytes: u64,
         kernel_bytes: u64,
         shadow_bytes: u64,
+        layered_bytes: u64,
         name: &str,
     ) -> Result<Self> {
         if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&slots) {
@@ -198,6 +205,7 @@ impl PerFrame {
             profile_bytes,
             kernel_bytes,
             shadow_bytes,
+            layered_bytes,
         ];
         let mut offsets = [0u64; REGIONS];
         let mut end = 0u64;

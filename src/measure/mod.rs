@@ -5,9 +5,11 @@
 //!   timing modes, formats and alternating comparisons.
 //! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.
+//! - [`layered_error`]: Li et al.'s layered terms against their f64 references.
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
 
 pub mod bench;
+pub mod layered_error;
 pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;

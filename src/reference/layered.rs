@@ -348,6 +348,10 @@ pub struct SingleScatteringOptions {
     /// Depth-texture texels for layers with thickness from a texture (constant over the
     /// object in the reference: the texel at the shaded point).
     pub depth_texels: Vec<[f32; 4]>,
+    /// Li et al.'s `D_max` (eq. 5): the march stops at depth `D_max` below the surface
+    /// (`D_max / (n . w)` along the refracted ray) if the ray has not left the object before;
+    /// `None` integrates to where it leaves.
+    pub max_depth: Option<f64>,
 }
 
 impl Default for SingleScatteringOptions {
@@ -356,6 +360,7 @@ impl Default for SingleScatteringOptions {
             phase: Phase::HenyeyGreenstein,
             steps: 512,
             depth_texels: Vec::new(),
+            max_depth: None,
         }
     }
 }
@@ -408,7 +413,11 @@ pub fn single_scattering(
         return Ok(DVec3::ZERO);
     };
     let t_o = fresnel_transmittance(cos_o, eta);
-    let s_max = exit_distance(shape, &transform, x_o, w).unwrap_or(0.0);
+    let mut s_max = exit_distance(shape, &transform, x_o, w).unwrap_or(0.0);
+    if let Some(d) = options.max_depth {
+        // The GPU bounds cos beta at 0.05 for grazing refraction; so does this.
+        s_max = s_max.min(d.max(0.0) / (-w.dot(n_o)).max(0.05));
+    }
     let steps = options.steps.max(1);
     let mut out = [0.0; 3];
     for (c, out_c) in out.iter_mut().enumerate() {
@@ -464,6 +473,53 @@ pub fn single_scattering(
         *out_c = t_o * sum;
     }
     Ok(DVec3::from_array(out))
+}
+
+/// Li et al.'s refraction light `L_t` as lucent reads it (see [`crate::features::layered`]):
+/// light that crossed the object unscattered from where it entered on the light's side to
+/// `x_o` on the far side, leaving diffusely towards `-view_dir`:
+///
+/// `L_t = T(x_o) / pi Σ_lights V(P') T(P') E(P') exp(-tau(P' -> x_o))`
+///
+/// for each light `x_o` faces away from (`dot(to_light, n) < 0`); `P'` = where the segment from
+/// `x_o` towards the light leaves the object (exact), `tau` the planar-layer optical depth
+/// relative to `P'`. Needs a sphere.
+pub fn transmitted(
+    scene: &Scene,
+    object: usize,
+    x_o: DVec3,
+    view_dir: DVec3,
+    depth_texels: &[[f32; 4]],
+) -> Result<DVec3> {
+    let medium = medium_of(scene, object)?;
+    let (shape, transform) = shape_of(scene, object)?;
+    let eta = f64::from(medium.eta);
+    let stack = LayerStack::from_medium(medium, depth_texels);
+    let (x_o, n_o) = project_to_surface(shape, &transform, x_o);
+    let cos_o = (-view_dir.normalize()).dot(n_o);
+    if cos_o <= 0.0 {
+        return Ok(DVec3::ZERO);
+    }
+    let mut sum = DVec3::ZERO;
+    for light in &scene.lights {
+        let (to_light, _) = light_incidence(light, x_o);
+        if to_light.dot(n_o) >= 0.0 {
+            continue;
+        }
+        let Some(d) = exit_distance(shape, &transform, x_o, to_light) else {
+            continue;
+        };
+        let (p_in, n_in) = project_to_surface(shape, &transform, x_o + to_light * d);
+        let (_, attenuation) = light_incidence(light, p_in);
+        let cos_in = to_light.dot(n_in);
+        if attenuation == 0.0 || cos_in <= 0.0 || !visible(scene, p_in, n_in, light, to_light) {
+            continue;
+        }
+        let tau = stack.optical_depth(p_in, n_in, p_in, x_o);
+        let e = radiance(light) * (attenuation * fresnel_transmittance(cos_in, eta));
+        sum += e * DVec3::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp());
+    }
+    Ok(sum * (fresnel_transmittance(cos_o, eta) / PI))
 }
 
 /// One area sample of an object's surface.

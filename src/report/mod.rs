@@ -101,6 +101,7 @@ pub fn scene_for(technique: Technique) -> Result<String> {
         Technique::Translucency => "cubes",
         Technique::Control => "skin",
         Technique::Lcb | Technique::Lbb | Technique::Separable | Technique::Bilateral => "teapot",
+        Technique::Layered => "layered",
     }
     .to_string())
 }

@@ -1,0 +1,218 @@
+// Li et al. 2009's layered media (src/features/layered.rs): the per-frame material table, the
+// G-buffer inputs the three layered passes share, and the optics they evaluate. Every
+// function has its f64 twin in src/reference/layered.rs (and the dipole in
+// src/reference/dipole.rs): change both together.
+//
+// Set 0: 0 the frame uniforms, 1 the layered table, 2 depth, 3 GB1 (normal), 4 the layered IDs;
+// then the pass's own bindings.
+#ifndef LUCENT_LAYERED_GLSL
+#define LUCENT_LAYERED_GLSL
+
+#include "gbuffer.glsl"
+#include "lighting.glsl"
+#ifdef LUCENT_SHADOWS
+#include "shadows.glsl"
+#endif
+
+#define MAX_LAYERED_MATERIALS 16
+#define MAX_MEDIUM_LAYERS 8
+// |g| at most 0.999: both phase functions peak like 1 / (1 - |g|)^2 (MAX_ABS_G).
+#define MAX_ABS_G 0.999
+
+struct LayeredMaterial {
+    vec4 info;                                   // x layers, y eta, z D_max, w gather radius
+    vec4 weights;                                // x λ3 (transmitted), y λ4 (single), z λ5
+    vec4 sigma_t_g[MAX_MEDIUM_LAYERS];           // rgb extinction (1/unit), a: g
+    vec4 sigma_s_thickness[MAX_MEDIUM_LAYERS];   // rgb scattering, a: thickness (-1: rest)
+    vec4 sigma_tr;                               // the first layer's dipole, per channel
+    vec4 z_r;
+    vec4 z_v;
+    vec4 alpha_prime;
+    vec4 total;                                  // its total diffuse reflectance
+};
+
+layout(std140, set = 0, binding = 1) uniform Layered {
+    ivec4 knobs;  // x march steps, y pixel lights, z phase (0 HG, 1 Schlick), w downscale
+    LayeredMaterial materials[MAX_LAYERED_MATERIALS];
+} layered;
+
+layout(set = 0, binding = 2) uniform sampler2D gbuffer_depth;
+layout(set = 0, binding = 3) uniform sampler2D gbuffer_normal;
+layout(set = 0, binding = 4) uniform sampler2D gbuffer_layered;
+
+// The layered material ID at a full-resolution pixel (0: not layered).
+int layered_id_at(ivec2 px) {
+    return int(texelFetch(gbuffer_layered, px, 0).r * 255.0 + 0.5);
+}
+
+// The table row of material `id` (read fields through it: copying a row into a local
+// struct makes llvmpipe spill it to scratch memory).
+int layered_row(int id) {
+    return clamp(id - 1, 0, MAX_LAYERED_MATERIALS - 1);
+}
+
+#define MAT layered.materials[mat]
+
+// Exact unpolarised Fresnel transmittance for light arriving at `cos_i` into a medium of
+// relative index `eta` (fresnel_transmittance).
+float fresnel_transmittance(float cos_i, float eta) {
+    if (eta == 1.0) {
+        return 1.0;
+    }
+    if (!(eta > 0.0)) {
+        return 0.0;
+    }
+    float ci = clamp(cos_i, 0.0, 1.0);
+    float sin2_t = (1.0 - ci * ci) / (eta * eta);
+    if (sin2_t >= 1.0) {
+        return 0.0;
+    }
+    float ct = sqrt(1.0 - sin2_t);
+    // Both denominators > 0 here (ct > 0, eta > 0); at ci = 0 rs = -1 and T = 0.
+    float rs = (ci - eta * ct) / (ci + eta * ct);
+    float rp = (eta * ci - ct) / (eta * ci + ct);
+    return clamp(1.0 - 0.5 * (rs * rs + rp * rp), 0.0, 1.0);
+}
+
+// `dir` (unit, travelling towards the surface) refracted into the medium through outward unit
+// normal `n` (refract); false under total internal reflection.
+bool refract_into(vec3 dir, vec3 n, float eta, out vec3 refracted) {
+    float cos_i = clamp(-dot(dir, n), 0.0, 1.0);
+    float sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if (!(sin2_t <= 1.0)) {
+        refracted = -n;
+        return false;
+    }
+    float cos_t = sqrt(1.0 - sin2_t);
+    vec3 t = dir / eta + n * (cos_i / eta - cos_t);
+    float len2 = dot(t, t);
+    refracted = len2 > 1e-20 ? t * inversesqrt(len2) : -n;
+    return true;
+}
+
+// Henyey-Greenstein (henyey_greenstein): the base written (1 - g)^2 + 2 g (1 - cos) so
+// |g| -> 1 near cos = 1 does not cancel.
+float phase_hg(float g, float c) {
+    g = clamp(g, -MAX_ABS_G, MAX_ABS_G);
+    c = clamp(c, -1.0, 1.0);
+    float base = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c);
+    return (1.0 - g * g) / (4.0 * PI * base * sqrt(base));
+}
+
+// Schlick's form with k = 1.55 g - 0.55 g^3 (schlick; Li et al.'s eq. 9 writes g for k).
+float phase_schlick(float g, float c) {
+    g = clamp(g, -MAX_ABS_G, MAX_ABS_G);
+    float k = clamp(1.55 * g - 0.55 * g * g * g, -MAX_ABS_G, MAX_ABS_G);
+    c = clamp(c, -1.0, 1.0);
+    float base = (1.0 - k) + k * (1.0 - c);
+    return (1.0 - k * k) / (4.0 * PI * base * base);
+}
+
+float phase(float g, float c) {
+    return layered.knobs.z == 1 ? phase_schlick(g, c) : phase_hg(g, c);
+}
+
+// The bottom depth of layer j whose top is at depth `top` (units below the reference surface;
+// a `rest` layer has no bottom: 1e30).
+float layer_bottom(int mat, int j, float top) {
+    float t = MAT.sigma_s_thickness[j].a;
+    float bottom = t < 0.0 ? 1e30 : top + t;
+    return bottom;
+}
+
+// The layer holding depth `d` below the reference point (depths above the tangent plane belong
+// to the first layer; below the last layer's bottom: -1, no medium) (LayerStack::layer_at).
+int layer_at(int mat, float d) {
+    int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
+    float top = 0.0;
+    for (int j = 0; j < count; ++j) {
+        float bottom = layer_bottom(mat, j, top);
+        if (d < bottom) {
+            return j;
+        }
+        top = bottom;
+    }
+    return -1;
+}
+
+// Optical depth per channel of segment a-b through the planar layers below surface point p
+// with outward unit normal n (LayerStack::optical_depth): each layer's share of the segment
+// times its extinction.
+vec3 optical_depth(int mat, vec3 p, vec3 n, vec3 a, vec3 b) {
+    float len = length(b - a);
+    if (!(len > 0.0)) {
+        return vec3(0.0);
+    }
+    float da = dot(p - a, n), db = dot(p - b, n);
+    float slope = db - da;
+    int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
+    vec3 tau = vec3(0.0);
+    float top = -1e30;
+    float running = 0.0;
+    for (int j = 0; j < count; ++j) {
+        float bottom = layer_bottom(mat, j, running);
+        running = bottom;
+        float share;
+        if (abs(slope) < 1e-30) {
+            share = (da >= top && da < bottom) ? 1.0 : 0.0;
+        } else {
+            float t0 = (top - da) / slope, t1 = (bottom - da) / slope;
+            share = max(min(max(t0, t1), 1.0) - max(min(t0, t1), 0.0), 0.0);
+        }
+        tau += MAT.sigma_t_g[j].rgb * (share * len);
+        top = bottom;
+        if (bottom >= 1e30) {
+            break;
+        }
+    }
+    return tau;
+}
+
+// Jensen's diffuse reflectance Rd(r) of the first layer per channel (Dipole::rd): each source
+// with its own distance, d_r >= z_r > 0 so r = 0 is finite; exp(-e) of a large e is 0.
+vec3 dipole_rd(int mat, float r) {
+    float r2 = r * r;
+    vec3 dr = sqrt(r2 + MAT.z_r.rgb * MAT.z_r.rgb);
+    vec3 dv = sqrt(r2 + MAT.z_v.rgb * MAT.z_v.rgb);
+    vec3 er = MAT.sigma_tr.rgb * dr, ev = MAT.sigma_tr.rgb * dv;
+    vec3 real = MAT.z_r.rgb * (er + 1.0) * exp(-er) / (dr * dr * dr);
+    vec3 virt = MAT.z_v.rgb * (ev + 1.0) * exp(-ev) / (dv * dv * dv);
+    return MAT.alpha_prime.rgb / (4.0 * PI) * (real + virt);
+}
+
+// The light transmitted into the surface at p (outward normal n): radiance x falloff x cos x
+// Fresnel transmittance of every light, shadowed where the light casts (transmitted_irradiance).
+vec3 transmitted_irradiance(vec3 p, vec3 n, float eta) {
+    vec3 e = vec3(0.0);
+    int count = min(frame.light_count.x, MAX_LIGHTS);
+    for (int i = 0; i < count; ++i) {
+        vec3 to_light;
+        float attenuation;
+        light_incidence(frame.lights[i], p, to_light, attenuation);
+        float c = dot(to_light, n);
+        if (c <= 0.0 || attenuation <= 0.0) {
+            continue;
+        }
+        float visible = 1.0;
+#ifdef LUCENT_SHADOWS
+        visible = shadow_visibility(i, p, n, to_light, 0).x;
+#endif
+        e += frame.lights[i].radiance_range.rgb *
+             (attenuation * c * fresnel_transmittance(c, eta) * visible);
+    }
+    return e;
+}
+
+// e^x - 1 without the cancellation of exp(x) - 1 near 0 (|x| < 1e-3: three Taylor terms).
+float expm1_approx(float x) {
+    return abs(x) < 1e-3 ? x * (1.0 + x * (0.5 + x / 6.0)) : exp(x) - 1.0;
+}
+
+// Keeps a term finite and inside fp16 before it is added to the lit image.
+vec3 finite_term(vec3 v) {
+    bvec3 bad = bvec3(isnan(v.x) || isinf(v.x), isnan(v.y) || isinf(v.y),
+                      isnan(v.z) || isinf(v.z));
+    return clamp(mix(v, vec3(0.0), bad), vec3(0.0), vec3(65504.0));
+}
+
+#endif

@@ -1,0 +1,83 @@
+#version 450
+// Li et al.'s multiple scattering (eqs. 12-13), added into the lit image weighted by eq. 3's
+// λ5 (src/features/layered.rs, `multiple scattering`): Jensen's dipole of the first layer
+// gathered over M pixel lights of the irradiance image. Set 0 as glsl/common/layered.glsl,
+// then the irradiance image (binding 5).
+#include "../common/layered.glsl"
+
+layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 0) out vec4 out_color;
+
+// Per-pixel rotation of the sample spiral (Jimenez's interleaved gradient noise): banding
+// becomes noise, deterministic per pixel.
+float pixel_noise(vec2 p) {
+    return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715))));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    int id = layered_id_at(px);
+    out_color = vec4(0.0);
+    if (id == 0) {
+        return;
+    }
+    int mat = layered_row(id);
+    float eta = MAT.info.y;
+    float depth = texelFetch(gbuffer_depth, px, 0).r;
+    vec3 x_o = world_position(vec2(px) + 0.5, depth);
+    vec3 n_o = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+    vec3 view = x_o - frame.camera_pos.xyz;
+    float view_len2 = dot(view, view);
+    vec3 view_dir = view_len2 > 1e-20 ? view * inversesqrt(view_len2) : -n_o;
+    float cos_o = dot(-view_dir, n_o);
+    if (cos_o <= 0.0) {
+        return;
+    }
+    float radius = MAT.info.w;
+    vec3 helper = abs(n_o.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 t = normalize(cross(helper, n_o));
+    vec3 b = cross(n_o, t);
+    // Radii drawn from p(r) ~ e^(-sigma r) on [0, radius] (sigma: the green channel's
+    // sigma_tr, at least 1 / radius, so a clear medium is sampled nearly uniformly in r).
+    float sigma = max(MAT.sigma_tr.g, 1.0 / radius);
+    float span = 1.0 - exp(-sigma * radius);
+    int count = clamp(layered.knobs.y, 4, 64);
+    int scale = max(layered.knobs.w, 1);
+    ivec2 size = ivec2(frame.viewport.xy);
+    float rotation = 6.28318530718 * pixel_noise(gl_FragCoord.xy);
+    vec3 gathered = vec3(0.0), weight = vec3(0.0);
+    for (int i = 0; i < count; ++i) {
+        float u = (float(i) + 0.5) / float(count);
+        float r_plane = -log(max(1.0 - u * span, 1e-30)) / sigma;
+        // The area a sample stands for: 1 / (count x its density on the tangent plane).
+        float pdf_r = sigma * exp(-sigma * r_plane) / span;
+        float area = 6.28318530718 * r_plane / (float(count) * max(pdf_r, 1e-30));
+        float phi = float(i) * 2.39996323 + rotation; // golden-angle spiral
+        vec3 y = x_o + r_plane * (cos(phi) * t + sin(phi) * b);
+        vec4 clip = frame.view_proj * vec4(y, 1.0);
+        if (!(clip.w > 0.0)) {
+            continue;
+        }
+        vec2 q = (clip.xy / clip.w * 0.5 + 0.5) * frame.viewport.xy;
+        if (any(lessThan(q, vec2(0.0))) || any(greaterThanEqual(q, frame.viewport.xy))) {
+            continue; // off screen
+        }
+        ivec2 qp = min(ivec2(q), size - 1);
+        if (layered_id_at(qp) != id) {
+            continue; // another object or material: rejected
+        }
+        vec3 p = world_position(vec2(qp) + 0.5, texelFetch(gbuffer_depth, qp, 0).r);
+        float r = length(p - x_o);
+        vec3 e = texelFetch(irradiance_tex, qp / scale, 0).rgb;
+        gathered += dipole_rd(mat, r) * e * area;
+        weight += dipole_rd(mat, r_plane) * area;
+    }
+    // Energy normalised: a flat, uniformly lit surface gets exactly E R_d,total, whatever the
+    // rejected samples.
+    // (No accepted sample: both sums are 0, and so is the term.)
+    vec3 l_ms = fresnel_transmittance(cos_o, eta) / PI * MAT.total.rgb * gathered /
+                max(weight, vec3(1e-30));
+    out_color = vec4(finite_term(MAT.weights.z * l_ms), 0.0);
+}

@@ -1,0 +1,192 @@
+#version 450
+// permutation: LUCENT_ENTRY_BINDING=5 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6
+// Li et al.'s single scattering (eqs. 4-11) and the transmitted term L_t, added into the lit
+// image (src/features/layered.rs, `single scattering`), weighted by eq. 3's λ4 and λ3.
+// Set 0 as glsl/common/layered.glsl, then (lights with maps) the entry atlas and the shadow
+// bindings.
+#include "../common/layered.glsl"
+
+#ifdef LUCENT_ENTRY_BINDING
+// Per map texel: the first surface's normal * 0.5 + 0.5 and its layered material ID / 255.
+layout(set = 0, binding = LUCENT_ENTRY_BINDING) uniform sampler2D shadow_entry;
+#endif
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 0) out vec4 out_color;
+
+// Where light `i` reaching `m` (inside material `id`, towards the light `to_light`) entered
+// the object, with the outward normal there. From the light's map when it has one: the map's
+// first surface on the line through m (its distance, normal and material); false when that
+// surface is of another material (the light is blocked before it reaches this object). A
+// light without a map (or a point outside it) takes the tangent plane at the shaded point
+// (x_o, n_o) as the surface: false when the light is below it.
+bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out vec3 p_in,
+                 out vec3 n_in) {
+#ifdef LUCENT_ENTRY_BINDING
+    int index = shadow_face(i, m);
+    if (index >= 0) {
+        // Read through the table (a local copy of the face would spill on llvmpipe).
+#define FACE shadows.faces[index]
+        vec4 clip = FACE.view_proj * vec4(m, 1.0);
+        vec3 ndc = clip.xyz / clip.w;
+        if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
+            ndc.z <= 1.0) {
+            vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
+            ivec2 lo = ivec2(FACE.rect.xy);
+            ivec2 texel = clamp(ivec2(t), lo, lo + ivec2(FACE.rect.z) - 1);
+            vec4 entry = texelFetch(shadow_entry, texel, 0);
+            if (int(entry.a * 255.0 + 0.5) != id) {
+                return false;
+            }
+            // The entry distance interpolated bilinearly between the four texel centres
+            // around t (a nearest texel's staircase is a tenth of a millimetre at 512^2,
+            // as thick as a skin layer), where all four are this material's; else the
+            // nearest texel's.
+            float d_map = shadow_distance(FACE.params, texelFetch(shadow_depth, texel, 0).r);
+            vec2 c = t - 0.5;
+            vec2 base = floor(c);
+            if (all(greaterThanEqual(base, FACE.rect.xy)) &&
+                all(lessThan(base + 1.0, FACE.rect.xy + FACE.rect.z))) {
+                vec2 corner = (base + 1.0) * shadows.atlas.zw;
+                vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
+                if (all(lessThan(abs(ids - float(id)), vec4(0.5)))) {
+                    vec4 d = textureGather(shadow_depth, corner, 0);
+                    vec2 f = c - base;
+                    // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
+                    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y),
+                                  (1.0 - f.x) * (1.0 - f.y));
+                    d_map = dot(w, vec4(shadow_distance(FACE.params, d.x),
+                                        shadow_distance(FACE.params, d.y),
+                                        shadow_distance(FACE.params, d.z),
+                                        shadow_distance(FACE.params, d.w)));
+                }
+            }
+            float d_m = shadow_distance(FACE.params, ndc.z);
+            if (FACE.params.z < 0.0) {
+                // Orthographic (directional): distances run along the light's direction.
+                p_in = m + to_light * max(d_m - d_map, 0.0);
+            } else {
+                // Perspective: axial distances scale with the distance along the ray from
+                // the light; a point nearer than the map's surface is its own entry point.
+                vec3 l = frame.lights[i].position_type.xyz;
+                p_in = l + (m - l) * min(d_map / max(d_m, 1e-12), 1.0);
+            }
+            n_in = sanitize_normal(entry.xyz * 2.0 - 1.0);
+            return true;
+#undef FACE
+        }
+    }
+#endif
+    float c = dot(to_light, n_o);
+    if (c <= 1e-4) {
+        return false;
+    }
+    p_in = m + to_light * (max(dot(x_o - m, n_o), 0.0) / c);
+    n_in = n_o;
+    return true;
+}
+
+// Radiance a light delivers into the medium at entry point p_in (normal n_in, light arriving
+// along -to_light): radiance x falloff x Fresnel transmittance (0 when it arrives from behind).
+vec3 entering(int i, vec3 p_in, vec3 n_in, vec3 to_light, float eta) {
+    float cos_in = dot(to_light, n_in);
+    if (cos_in <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 unused;
+    float attenuation;
+    light_incidence(frame.lights[i], p_in, unused, attenuation);
+    return frame.lights[i].radiance_range.rgb *
+           (max(attenuation, 0.0) * fresnel_transmittance(cos_in, eta));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    int id = layered_id_at(px);
+    out_color = vec4(0.0);
+    if (id == 0) {
+        return;
+    }
+    int mat = layered_row(id);
+    float eta = MAT.info.y;
+    float depth = texelFetch(gbuffer_depth, px, 0).r;
+    vec3 x_o = world_position(vec2(px) + 0.5, depth);
+    vec3 n_o = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+    vec3 view = x_o - frame.camera_pos.xyz;
+    float view_len2 = dot(view, view);
+    vec3 view_dir = view_len2 > 1e-20 ? view * inversesqrt(view_len2) : -n_o;
+    float cos_o = dot(-view_dir, n_o);
+    if (cos_o <= 0.0) {
+        return; // seen from behind (interpolated normals): no light leaves towards the eye
+    }
+    float t_o = fresnel_transmittance(cos_o, eta);
+    int lights = min(frame.light_count.x, MAX_LIGHTS);
+
+    // L_t: light that crossed the object unscattered from its entry on the light's side.
+    vec3 l_t = vec3(0.0);
+    for (int i = 0; i < lights; ++i) {
+        vec3 to_light;
+        float unused;
+        light_incidence(frame.lights[i], x_o, to_light, unused);
+        if (dot(to_light, n_o) >= 0.0) {
+            continue; // a lit point is its own entry point: its light is L_d's
+        }
+        vec3 p_in, n_in;
+        if (!light_entry(i, x_o, to_light, id, x_o, n_o, p_in, n_in)) {
+            continue;
+        }
+        vec3 e = entering(i, p_in, n_in, to_light, eta);
+        l_t += e * exp(-optical_depth(mat, p_in, n_in, p_in, x_o));
+    }
+    l_t *= t_o / PI;
+
+    // L_ss: the refracted view ray marched to D_max / (N . T).
+    vec3 l_ss = vec3(0.0);
+    vec3 w;
+    if (refract_into(view_dir, n_o, eta, w)) {
+        // Grazing refraction is bounded at cos beta = 0.05 (20 D_max along the ray).
+        float s_end = MAT.info.z / max(dot(-n_o, w), 0.05);
+        // Steps equally spaced in the first layer's mean transmittance, so dense media are
+        // resolved near the surface; a clear or thin medium is sampled uniformly.
+        float sigma_bar = dot(MAT.sigma_t_g[0].rgb, vec3(1.0 / 3.0));
+        float span = sigma_bar * s_end > 1e-6 ? -expm1_approx(-sigma_bar * s_end) : 0.0;
+        int steps = clamp(layered.knobs.x, 1, 64);
+        vec3 sum = vec3(0.0);
+        for (int k = 0; k < steps; ++k) {
+            float u = (float(k) + 0.5) / float(steps);
+            float s, ds;
+            if (span > 0.0) {
+                // 1 - u span >= e^(-sigma s_end) > 0 unless it underflows: floor it.
+                float rest = max(1.0 - u * span, 1e-30);
+                s = min(-log(rest) / sigma_bar, s_end);
+                ds = span / (sigma_bar * rest) / float(steps);
+            } else {
+                s = u * s_end;
+                ds = s_end / float(steps);
+            }
+            vec3 m = x_o + w * s;
+            int layer = layer_at(mat, dot(x_o - m, n_o));
+            if (layer < 0) {
+                continue; // below the last layer: no medium scatters
+            }
+            vec3 sigma_s = MAT.sigma_s_thickness[layer].rgb;
+            float g = MAT.sigma_t_g[layer].a;
+            vec3 tau_view = optical_depth(mat, x_o, n_o, m, x_o);
+            for (int i = 0; i < lights; ++i) {
+                vec3 to_light;
+                float unused;
+                light_incidence(frame.lights[i], m, to_light, unused);
+                vec3 p_in, n_in;
+                if (!light_entry(i, m, to_light, id, x_o, n_o, p_in, n_in)) {
+                    continue;
+                }
+                vec3 e = entering(i, p_in, n_in, to_light, eta);
+                vec3 tau_light = optical_depth(mat, p_in, n_in, p_in, m);
+                sum += sigma_s * phase(g, dot(to_light, w)) * e *
+                       exp(-(tau_light + tau_view)) * ds;
+            }
+        }
+        l_ss = t_o * sum;
+    }
+    out_color = vec4(finite_term(MAT.weights.x * l_t + MAT.weights.y * l_ss), 0.0);
+}

@@ -1,0 +1,603 @@
+//! Li et al. 2009: layered media shaded as Li et al.'s eq. 3,
+//! `L = λ1 L_d + λ2 L_s + λ3 L_t + λ4 L_ss + λ5 L_ms`, in image space.
+//!
+//! - `L_d`, `L_s`: the deferred lighting's diffuse and specular. The G-buffer pass writes a
+//!   layered object's albedo times `λ1` and its specular intensity times `λ2` (lighting is
+//!   linear in both, so this is exactly eq. 3's weighting, at no cost).
+//! - `layered irradiance`: the light transmitted into the surface per pixel,
+//!   `E = Σ_lights V T(cos, eta) radiance falloff cos` (shadowed), at full or half resolution
+//!   (`layered.irradiance`).
+//! - `single scattering` (eqs. 4-11): the view ray refracted at the surface and marched `K`
+//!   steps up to `D_max / (N . T)`; at each step `M` the light's entry point `P'` comes from
+//!   the light-space map (its distance, and the entry normal and layered material stored with
+//!   it in `light-space.entry`), attenuated by the planar-layer optical depth with extinction
+//!   `sigma_t`, times `sigma_s`, the phase function (true Henyey-Greenstein or Schlick's form)
+//!   and the light's radiance at `P'`. A light without a map takes the surface at the pixel as
+//!   a plane. The same pass adds `L_t`.
+//! - `L_t`, "refraction light" (the paper's text is garbled there): we read it as light that
+//!   crossed the object without scattering, from where it entered on the light's side (`P'`,
+//!   from the map) to the shaded point on the far side, leaving it diffusely:
+//!   `L_t = T(x_o) / pi Σ_lights T(P') E(P') exp(-tau(P' -> x_o))`, for points facing away from
+//!   the light (a lit point is its own entry point: its light is `L_d`'s).
+//! - `multiple scattering` (eqs. 12-13): Jensen's dipole of the first layer (the corrected
+//!   form, `d_r` in the real source's exponential) gathered over `M` pixel lights of the
+//!   irradiance image: samples on a disc in the tangent plane (radius from the slowest
+//!   channel's `1 / sigma_tr`), importance-sampled in radius, each projected to the screen and
+//!   weighted by `Rd(r)` with `r` from the reconstructed world positions and its area; samples
+//!   on other materials or off screen are rejected and the weights renormalised so a flat,
+//!   uniformly lit surface gets exactly `E R_d,total` (energy normalised); times
+//!   `T(x_o) / pi`.
+//!
+//! Both scattering passes add into the lit image (after the SSS blurs, which layered pixels
+//! are not part of) and draw only the screen rectangles layered objects may cover. A frame
+//! without layered materials has none of this: no pass, no image, no table, no G-buffer
+//! target, no light-space entry target. The f64 twin of every term is
+//! [`crate::reference::layered`].
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::shadows::{self, ShadowMaps};
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use crate::gpu_scene::{Region, SceneGpu};
+use crate::graph::{
+    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
+    RenderGraph, ResourceId,
+};
+use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
+use crate::scene::Scene;
+use crate::{LucentError, Result};
+
+/// The G-buffer's layered material ID per pixel (ID / 255; 0: not layered).
+pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;
+/// The light-space maps' entry data: the first surface's normal (`n * 0.5 + 0.5`) and its
+/// layered material ID / 255.
+pub const ENTRY_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// The transmitted irradiance image.
+pub const IRRADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// Layered materials a frame holds at most (IDs 1 to 16).
+pub const MAX_LAYERED_MATERIALS: usize = 16;
+
+/// March steps the knob takes (Li et al. do not say; 8 is the default).
+pub const STEP_RANGE: std::ops::RangeInclusive<u32> = 1..=64;
+/// Pixel lights the knob takes (Li et al. use 12).
+pub const PIXEL_LIGHT_RANGE: std::ops::RangeInclusive<u32> = 4..=64;
+
+/// Which phase function single scattering evaluates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PhaseForm {
+    /// True Henyey-Greenstein.
+    #[default]
+    HenyeyGreenstein,
+    /// Schlick's approximation (`k = 1.55 g - 0.55 g^3`; Li et al.'s eq. 9).
+    Schlick,
+}
+
+impl PhaseForm {
+    /// Every form with its command-line name.
+    pub const ALL: &'static [(&'static str, PhaseForm)] = &[
+        ("hg", PhaseForm::HenyeyGreenstein),
+        ("schlick", PhaseForm::Schlick),
+    ];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, p)| *p == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+/// The layered passes' knobs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LayeredKnobs {
+    /// Single scattering's march steps `K` ([`STEP_RANGE`]).
+    pub steps: u32,
+    /// Multiple scattering's pixel lights `M` ([`PIXEL_LIGHT_RANGE`]).
+    pub pixel_lights: u32,
+    /// The phase function.
+    pub phase: PhaseForm,
+    /// The irradiance image at half resolution per side.
+    pub half_irradiance: bool,
+    /// Single scattering's depth `D_max` in mean free paths of the first layer's clearest
+    /// channel (> 0; default 4: beyond, `e^-4` of the light is left to multiple scattering).
+    pub max_depth_mfp: f32,
+}
+
+impl Default for LayeredKnobs {
+    fn default() -> Self {
+        Self {
+            steps: 8,
+            pixel_lights: 12,
+            phase: PhaseForm::HenyeyGreenstein,
+            half_irradiance: false,
+            max_depth_mfp: 4.0,
+        }
+    }
+}
+
+/// The layered part of a frame: its materials (ID = index + 1) and each object's ID.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayeredDesc {
+    /// The distinct layered media, in order of first use.
+    pub materials: Vec<LayeredMedium>,
+    /// Per scene object: its layered material ID (0: not layered).
+    pub object_ids: Vec<u8>,
+}
+
+impl LayeredDesc {
+    /// The layered materials of `scene`'s objects; `None` when no object is layered. Errors
+    /// name the material: more than [`MAX_LAYERED_MATERIALS`] distinct media, a medium that
+    /// fails validation, or thickness read from a texture (`TexDep`), which the f64 reference
+    /// evaluates but the GPU passes do not read.
+    pub fn new(scene: &Scene) -> Result<Option<Self>> {
+        let mut materials: Vec<LayeredMedium> = Vec::new();
+        let mut object_ids = Vec::with_capacity(scene.objects.len());
+        for o in &scene.objects {
+            let Some(medium) = &o.material.layers else {
+                object_ids.push(0);
+                continue;
+            };
+            medium.validate().map_err(|e| {
+                LucentError::InvalidInput(format!("material '{}': {e}", o.material.name))
+            })?;
+            if medium
+                .layers
+                .iter()
+                .any(|l| matches!(l.thickness, Thickness::Texture { .. }))
+            {
+                return Err(LucentError::InvalidInput(format!(
+                    "material '{}': layer thickness from a texture (TexDep) is evaluated by \
+                     the f64 reference only; the GPU passes read constant and `rest` \
+                     thicknesses",
+                    o.material.name
+                )));
+            }
+            let id = match materials.iter().position(|m| m == medium) {
+                Some(i) => i,
+                None => {
+                    if materials.len() == MAX_LAYERED_MATERIALS {
+                        return Err(LucentError::InvalidInput(format!(
+                            "scene '{}' has more than {MAX_LAYERED_MATERIALS} distinct layered \
+                             media (at material '{}')",
+                            scene.name, o.material.name
+                        )));
+                    }
+                    materials.push(medium.clone());
+                    materials.len() - 1
+                }
+            };
+            object_ids.push(id as u8 + 1);
+        }
+        Ok((!materials.is_empty()).then_some(Self {
+            materials,
+            object_ids,
+        }))
+    }
+
+    /// The per-frame table of these materials under `knobs`.
+    pub fn table(&self, knobs: &LayeredKnobs) -> LayeredTableGpu {
+        let mut t: LayeredTableGpu = bytemuck::Zeroable::zeroed();
+        t.knobs = [
+            knobs.steps.clamp(*STEP_RANGE.start(), *STEP_RANGE.end()) as i32,
+            knobs
+                .pixel_lights
+                .clamp(*PIXEL_LIGHT_RANGE.start(), *PIXEL_LIGHT_RANGE.end()) as i32,
+            i32::from(knobs.phase == PhaseForm::Schlick),
+            if knobs.half_irradiance { 2 } else { 1 },
+        ];
+        for (row, m) in t.materials.iter_mut().zip(&self.materials) {
+            *row = material_row(m, knobs);
+        }
+        t
+    }
+}
+
+/// Gather radius in units of the slowest channel's diffusion length `1 / sigma_tr`: beyond
+/// 3 lengths the dipole's tail holds a few percent of its energy.
+pub const GATHER_LENGTHS: f64 = 3.0;
+/// Largest gather radius in multiples of the largest `z_r` (a channel without absorption has
+/// `sigma_tr = 0` and an unbounded `1/r^3` tail: the radius is bounded explicitly).
+pub const MAX_GATHER_Z_R: f64 = 200.0;
+
+/// The gather radius of `medium` (scene units): [`GATHER_LENGTHS`] over the smallest nonzero
+/// `sigma_tr`, at most [`MAX_GATHER_Z_R`] times the largest `z_r`.
+pub fn gather_radius(medium: &LayeredMedium) -> f64 {
+    let d = medium.dipole_constants();
+    let z_r = f64::from(d.z_r.max_element());
+    let sigma_tr = d
+        .sigma_tr
+        .to_array()
+        .into_iter()
+        .map(f64::from)
+        .filter(|s| *s > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let bound = MAX_GATHER_Z_R * z_r;
+    let radius = if sigma_tr.is_finite() {
+        (GATHER_LENGTHS / sigma_tr).min(bound)
+    } else {
+        bound
+    };
+    // A vacuum-like medium (sigma_t' -> 0) has z_r -> 1e12: keep the radius a length f32
+    // and the screen projection handle.
+    radius.clamp(1e-6, 1e4)
+}
+
+/// The dipole's total diffuse reflectance `R_d = (alpha'/2) (1 + e^(-4/3 A s)) e^(-s)`,
+/// `s = sqrt(3 (1 - alpha'))` (Jensen 2001; [`crate::reference::dipole`]'s
+/// `total_reflectance` is its f64 twin).
+pub fn total_reflectance(alpha_prime: f32, a: f32) -> f32 {
+    let s = (3.0 * (1.0 - alpha_prime).max(0.0)).sqrt();
+    0.5 * alpha_prime * (1.0 + (-4.0 / 3.0 * a * s).exp()) * (-s).exp()
+}
+
+/// Single scattering's depth `D_max` of `medium` in scene units: `mfp` mean free paths of the
+/// first layer's clearest channel (its smallest `sigma_t`), at least a millionth of a unit.
+pub fn single_depth(medium: &LayeredMedium, mfp: f32) -> f64 {
+    let sigma_t = medium.sigma_t_per_unit(0);
+    let clearest = f64::from(sigma_t.min_element()).max(1e-6);
+    (f64::from(mfp.max(1e-3)) / clearest).clamp(1e-6, 1e6)
+}
+
+fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
+    let mut row: LayeredMaterialGpu = bytemuck::Zeroable::zeroed();
+    let d = m.dipole_constants();
+    let total = d.alpha_prime.to_array().map(|a| total_reflectance(a, d.a));
+    row.info = [
+        m.layers.len().min(MAX_LAYERS) as f32,
+        m.eta,
+        single_depth(m, knobs.max_depth_mfp) as f32,
+        gather_radius(m) as f32,
+    ];
+    row.weights = [m.weights[2], m.weights[3], m.weights[4], 0.0];
+    for (i, l) in m.layers.iter().take(MAX_LAYERS).enumerate() {
+        let sigma_t = m.sigma_t_per_unit(i);
+        let sigma_s = m.sigma_s_per_unit(i);
+        let thickness = match l.thickness {
+            // -1: no bottom (the shader's "rest").
+            Thickness::Rest => -1.0,
+            _ => m.thickness_mm(i, &[]) * m.units_per_mm,
+        };
+        row.sigma_t_g[i] = [sigma_t.x, sigma_t.y, sigma_t.z, l.g];
+        row.sigma_s_thickness[i] = [sigma_s.x, sigma_s.y, sigma_s.z, thickness];
+    }
+    row.sigma_tr = d.sigma_tr.extend(0.0).to_array();
+    row.z_r = d.z_r.extend(0.0).to_array();
+    row.z_v = d.z_v.extend(0.0).to_array();
+    row.alpha_prime = d.alpha_prime.extend(0.0).to_array();
+    row.total = [total[0], total[1], total[2], 0.0];
+    row
+}
+
+/// One layered material, std140 (glsl/common/layered.glsl `LayeredMaterial`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LayeredMaterialGpu {
+    /// x: layer count; y: eta; z: `D_max` (units); w: gather radius (units).
+    pub info: [f32; 4],
+    /// x: λ3 (transmitted); y: λ4 (single); z: λ5 (multiple).
+    pub weights: [f32; 4],
+    /// Per layer: extinction rgb (1/unit), g.
+    pub sigma_t_g: [[f32; 4]; MAX_LAYERS],
+    /// Per layer: scattering rgb (1/unit), thickness (units; -1: the rest of the object).
+    pub sigma_s_thickness: [[f32; 4]; MAX_LAYERS],
+    /// The first layer's dipole: `sigma_tr` rgb (1/unit).
+    pub sigma_tr: [f32; 4],
+    /// `z_r` rgb (units).
+    pub z_r: [f32; 4],
+    /// `z_v` rgb (units).
+    pub z_v: [f32; 4],
+    /// `alpha'` rgb.
+    pub alpha_prime: [f32; 4],
+    /// The dipole's total diffuse reflectance rgb.
+    pub total: [f32; 4],
+}
+
+/// The per-frame layered table, std140 (glsl/common/layered.glsl `Layered`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LayeredTableGpu {
+    /// x: march steps; y: pixel lights; z: phase (0 HG, 1 Schlick); w: irradiance
+    /// downscale (1 or 2).
+    pub knobs: [i32; 4],
+    /// The materials (ID - 1).
+    pub materials: [LayeredMaterialGpu; MAX_LAYERED_MATERIALS],
+}
+
+/// Bytes of the per-frame layered region.
+pub const LAYERED_TABLE_BYTES: u64 = std::mem::size_of::<LayeredTableGpu>() as u64;
+
+/// The G-buffer images the layered passes read.
+pub struct LayeredInputs<'a> {
+    /// Depth.
+    pub depth: &'a Handle<Image>,
+    /// GB1: normal + roughness.
+    pub gb1: &'a Handle<Image>,
+    /// The layered material IDs.
+    pub ids: &'a Handle<Image>,
+    /// The light-space maps (with their entry target), when some light casts.
+    pub shadows: Option<&'a ShadowMaps>,
+}
+
+/// Declares `layered irradiance`, `single scattering` and `multiple scattering`; both
+/// scattering passes add into `hdr`, which is returned.
+pub fn layered_passes(
+    graph: &mut RenderGraph,
+    mut hdr: Handle<Image>,
+    inputs: &LayeredInputs<'_>,
+    knobs: &LayeredKnobs,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let info = graph.resources()[inputs.depth.id()].info;
+    let scale = if knobs.half_irradiance { 2 } else { 1 };
+    let mut irradiance = graph.create_image(
+        "layered.irradiance",
+        ImageInfo {
+            width: info.width.div_ceil(scale),
+            height: info.height.div_ceil(scale),
+            format: IRRADIANCE_FORMAT,
+        },
+    );
+    let shadow_ids = |inputs: &LayeredInputs<'_>| {
+        inputs.shadows.map(|m| {
+            (
+                m.depth.id(),
+                m.entry.as_ref().map(|h| h.id()).unwrap_or(m.depth.id()),
+            )
+        })
+    };
+    let sample_common = |pass: &mut crate::graph::declare::PassBuilder<'_>, with_maps: bool| {
+        pass.sample(inputs.depth)
+            .sample(inputs.gb1)
+            .sample(inputs.ids);
+        if let (true, Some(maps)) = (with_maps, inputs.shadows) {
+            pass.sample(&maps.depth);
+            if let Some(entry) = &maps.entry {
+                pass.sample(entry);
+            }
+        }
+    };
+    let base = LayeredPassInputs {
+        depth: inputs.depth.id(),
+        gb1: inputs.gb1.id(),
+        ids: inputs.ids.id(),
+        shadows: shadow_ids(inputs),
+        irradiance: None,
+    };
+
+    // Cleared: pixels outside the rectangles read 0 (the gather rejects them by ID anyway).
+    let mut pass = graph.add_pass("layered irradiance", PassKind::Raster);
+    sample_common(&mut pass, true);
+    pass.color(&mut irradiance, LoadOp::Clear([0.0; 4]));
+    match scene {
+        Some(scene) => pass.execute(LayeredPass::new(
+            scene,
+            Kind::Irradiance,
+            LayeredPassInputs {
+                shadows: base.shadows,
+                ..base
+            },
+            scale,
+        )),
+        None => pass.finish(),
+    }
+
+    let mut pass = graph.add_pass("single scattering", PassKind::Raster);
+    sample_common(&mut pass, true);
+    pass.color(&mut hdr, LoadOp::Load);
+    match scene {
+        Some(scene) => pass.execute(LayeredPass::new(
+            scene,
+            Kind::Single,
+            LayeredPassInputs {
+                shadows: base.shadows,
+                ..base
+            },
+            1,
+        )),
+        None => pass.finish(),
+    }
+
+    let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
+    sample_common(&mut pass, false);
+    pass.sample(&irradiance);
+    pass.color(&mut hdr, LoadOp::Load);
+    match scene {
+        Some(scene) => pass.execute(LayeredPass::new(
+            scene,
+            Kind::Multiple,
+            LayeredPassInputs {
+                shadows: None,
+                irradiance: Some(irradiance.id()),
+                ..base
+            },
+            1,
+        )),
+        None => pass.finish(),
+    }
+    hdr
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Irradiance,
+    Single,
+    Multiple,
+}
+
+#[derive(Clone, Copy)]
+struct LayeredPassInputs {
+    depth: ResourceId,
+    gb1: ResourceId,
+    ids: ResourceId,
+    /// The depth atlas and the entry atlas.
+    shadows: Option<(ResourceId, ResourceId)>,
+    irradiance: Option<ResourceId>,
+}
+
+struct LayeredPass {
+    scene: Arc<SceneGpu>,
+    kind: Kind,
+    inputs: LayeredPassInputs,
+    /// The pass's downscale of the screen (the irradiance image at half resolution: 2).
+    scale: u32,
+    pipeline: Option<PassPipeline>,
+    nearest: vk::Sampler,
+}
+
+impl LayeredPass {
+    fn new(scene: &Arc<SceneGpu>, kind: Kind, inputs: LayeredPassInputs, scale: u32) -> Self {
+        Self {
+            scene: scene.clone(),
+            kind,
+            inputs,
+            scale,
+            pipeline: None,
+            nearest: vk::Sampler::null(),
+        }
+    }
+}
+
+/// Binding numbers as define strings.
+const NUMBERS: [&str; 12] = ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11"];
+
+impl PassExec for LayeredPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
+        let views = ctx.descriptor_views;
+        let i = &self.inputs;
+        // glsl/common/layered.glsl: 0 frame, 1 layered table, 2 depth, 3 GB1, 4 IDs, then the
+        // pass's own (the irradiance image; or the entry atlas and the shadow bindings).
+        let mut bindings = vec![
+            Binding::PerFrame(self.scene.per_frame.binding(Region::Frame)),
+            Binding::PerFrame(self.scene.per_frame.binding(Region::Layered)),
+            Binding::Sampled(views[i.depth], self.nearest),
+            Binding::Sampled(views[i.gb1], self.nearest),
+            Binding::Sampled(views[i.ids], self.nearest),
+        ];
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        if let Some(irradiance) = i.irradiance {
+            bindings.push(Binding::Sampled(views[irradiance], self.nearest));
+        }
+        if let (Some((depth, entry)), true) = (i.shadows, self.kind != Kind::Multiple) {
+            if self.kind == Kind::Single {
+                defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[bindings.len()]));
+                bindings.push(Binding::Sampled(views[entry], self.nearest));
+            }
+            defines.extend(shadows::lighting_defines(bindings.len()));
+            bindings.extend(shadows::lighting_bindings(
+                &self.scene,
+                depth,
+                None,
+                views,
+                self.nearest,
+            ));
+        }
+        if self.scale == 2 {
+            defines.push(("LUCENT_HALF_RES", "1"));
+        }
+        let (fragment, name) = match self.kind {
+            Kind::Irradiance => ("layered/irradiance.frag", "layered irradiance"),
+            Kind::Single => ("layered/single.frag", "single scattering"),
+            Kind::Multiple => ("layered/multiple.frag", "multiple scattering"),
+        };
+        let additive = if self.kind == Kind::Irradiance { 0 } else { 1 };
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &bindings,
+            &GraphicsPipelineDesc {
+                additive_attachments: additive,
+                ..GraphicsPipelineDesc::fullscreen(fragment, &defines, name)
+            },
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        pipeline.bind(ctx);
+        let rects = self.scene.per_frame.tiles(ctx.frame).layered.clone();
+        let scaled: Vec<_> = rects
+            .iter()
+            .filter(|r| r.translucent)
+            .map(|r| crate::gpu_scene::TileRect {
+                x: r.x / self.scale,
+                y: r.y / self.scale,
+                width: r
+                    .width
+                    .div_ceil(self.scale)
+                    .min(ctx.extent.width.saturating_sub(r.x / self.scale)),
+                height: r
+                    .height
+                    .div_ceil(self.scale)
+                    .min(ctx.extent.height.saturating_sub(r.y / self.scale)),
+                translucent: true,
+            })
+            .collect();
+        PassPipeline::draw_fullscreen_in(ctx, scaled.iter());
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
+        unsafe { gpu.device.destroy_sampler(self.nearest, None) };
+        self.nearest = vk::Sampler::null();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    #[test]
+    fn the_layered_scene_gets_one_row_per_medium() {
+        let scene = builtin::builtin("layered").unwrap();
+        let desc = LayeredDesc::new(&scene).unwrap().unwrap();
+        assert_eq!(desc.materials.len(), 5);
+        // The floor is not layered.
+        assert_eq!(desc.object_ids.iter().filter(|&&i| i == 0).count(), 1);
+        let table = desc.table(&LayeredKnobs::default());
+        let apple = &table.materials[0];
+        assert_eq!(apple.info[0], 1.0);
+        assert!(apple.info[2] > 0.0 && apple.info[3] > apple.info[2]);
+        assert!(apple.total.iter().take(3).all(|t| *t > 0.0 && *t < 1.0));
+        assert!(LayeredDesc::new(&builtin::builtin("smoke").unwrap())
+            .unwrap()
+            .is_none());
+    }
+
+    #[test]
+    fn extreme_media_give_finite_rows() {
+        use crate::scene::layered::Layer;
+        use glam::Vec3;
+        for (sa, ss, g, eta) in [
+            (0.0, 1e-6, 0.0, 1.0),
+            (0.0, 0.0, 0.999, 1.0),
+            (1e6, 1e6, -0.999, 1.5),
+            (0.0, 1e6, 0.999, 3.0),
+        ] {
+            let mut m = LayeredMedium::preset("apple").unwrap();
+            m.eta = eta;
+            m.layers = vec![Layer {
+                sigma_a: Vec3::splat(sa),
+                sigma_s: Vec3::splat(ss),
+                g,
+                thickness: Thickness::Rest,
+            }];
+            let row = material_row(&m, &LayeredKnobs::default());
+            let all = bytemuck::bytes_of(&row);
+            let floats: &[f32] = bytemuck::cast_slice(all);
+            assert!(
+                floats.iter().all(|v| v.is_finite()),
+                "{sa} {ss} {g}: {row:?}"
+            );
+        }
+    }
+}

@@ -66,11 +66,11 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
     };
     let preset = |n| LayeredMedium::preset(n).unwrap();
     vec![
-        ("apple", preset("apple"), Term::Single, default, 0.03),
-        ("apple", preset("apple"), Term::Single, fine, 0.03),
-        ("skin1", preset("skin1"), Term::Single, default, 0.02),
-        ("two layers", two_layers(), Term::Single, default, 0.07),
-        ("two layers", two_layers(), Term::Single, fine, 0.07),
+        ("apple", preset("apple"), Term::Single, default, 0.07),
+        ("apple", preset("apple"), Term::Single, fine, 0.06),
+        ("skin1", preset("skin1"), Term::Single, default, 0.07),
+        ("two layers", two_layers(), Term::Single, default, 0.08),
+        ("two layers", two_layers(), Term::Single, fine, 0.08),
         (
             "two layers schlick",
             two_layers(),
@@ -79,11 +79,11 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
                 phase: PhaseForm::Schlick,
                 ..fine
             },
-            0.07,
+            0.08,
         ),
-        ("apple", preset("apple"), Term::Multiple, default, 0.2),
-        ("apple", preset("apple"), Term::Multiple, fine, 0.12),
-        ("skin1", preset("skin1"), Term::Multiple, default, 0.2),
+        ("apple", preset("apple"), Term::Multiple, default, 0.08),
+        ("apple", preset("apple"), Term::Multiple, fine, 0.06),
+        ("skin1", preset("skin1"), Term::Multiple, default, 0.15),
         (
             "skin1 half irradiance",
             preset("skin1"),
@@ -92,7 +92,7 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
                 half_irradiance: true,
                 ..default
             },
-            0.2,
+            0.15,
         ),
         ("clear", clear_medium(), Term::Transmitted, default, 0.06),
     ]

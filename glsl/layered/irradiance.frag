@@ -26,5 +26,6 @@ void main() {
     float depth = texelFetch(gbuffer_depth, px, 0).r;
     vec3 pos = world_position(vec2(px) + 0.5, depth);
     vec3 n = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
-    out_irradiance = vec4(finite_term(transmitted_irradiance(pos, n, MAT.info.y)), 1.0);
+    // Alpha: the layered material ID, so the gather reads a pixel light's material with it.
+    out_irradiance = vec4(finite_term(transmitted_irradiance(pos, n, MAT.info.y)), float(id));
 }

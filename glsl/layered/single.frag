@@ -20,6 +20,20 @@ layout(location = 0) out vec4 out_color;
 // surface is of another material (the light is blocked before it reaches this object). A
 // light without a map (or a point outside it) takes the tangent plane at the shaded point
 // (x_o, n_o) as the surface: false when the light is below it.
+// The entry point where the surface at the shaded point (x_o, n_o) is taken as a plane:
+// false when the light is below it.
+bool light_entry_plane(vec3 m, vec3 to_light, vec3 x_o, vec3 n_o, out vec3 p_in,
+                       out vec3 n_in) {
+    n_in = n_o;
+    float c = dot(to_light, n_o);
+    p_in = m;
+    if (c <= 1e-4) {
+        return false;
+    }
+    p_in = m + to_light * (max(dot(x_o - m, n_o), 0.0) / c);
+    return true;
+}
+
 bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out vec3 p_in,
                  out vec3 n_in) {
 #ifdef LUCENT_ENTRY_BINDING
@@ -35,31 +49,35 @@ bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out v
             ivec2 lo = ivec2(FACE.rect.xy);
             ivec2 texel = clamp(ivec2(t), lo, lo + ivec2(FACE.rect.z) - 1);
             vec4 entry = texelFetch(shadow_entry, texel, 0);
-            if (int(entry.a * 255.0 + 0.5) != id) {
-                return false;
-            }
-            // The entry distance interpolated bilinearly between the four texel centres
-            // around t (a nearest texel's staircase is a tenth of a millimetre at 512^2,
-            // as thick as a skin layer), where all four are this material's; else the
-            // nearest texel's.
-            float d_map = shadow_distance(FACE.params, texelFetch(shadow_depth, texel, 0).r);
-            vec2 c = t - 0.5;
+            // The entry distance, interpolated bilinearly between the four texel centres
+            // around t where all four are this material's surface (a nearest texel's
+            // staircase is a tenth of a millimetre at 512^2, as thick as a skin layer);
+            // else the nearest texel's. The entry target is not cleared: a texel no surface
+            // was drawn into (depth 1) has no entry data.
+            vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
             vec2 base = floor(c);
-            if (all(greaterThanEqual(base, FACE.rect.xy)) &&
-                all(lessThan(base + 1.0, FACE.rect.xy + FACE.rect.z))) {
-                vec2 corner = (base + 1.0) * shadows.atlas.zw;
-                vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
-                if (all(lessThan(abs(ids - float(id)), vec4(0.5)))) {
-                    vec4 d = textureGather(shadow_depth, corner, 0);
-                    vec2 f = c - base;
-                    // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
-                    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y),
-                                  (1.0 - f.x) * (1.0 - f.y));
-                    d_map = dot(w, vec4(shadow_distance(FACE.params, d.x),
-                                        shadow_distance(FACE.params, d.y),
-                                        shadow_distance(FACE.params, d.z),
-                                        shadow_distance(FACE.params, d.w)));
+            vec2 corner = (base + 1.0) * shadows.atlas.zw;
+            vec4 d = textureGather(shadow_depth, corner, 0);
+            vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
+            float d_map;
+            if (all(lessThan(abs(ids - float(id)), vec4(0.5))) && all(lessThan(d, vec4(1.0)))) {
+                vec2 f = c - base;
+                // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
+                vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y),
+                              (1.0 - f.x) * (1.0 - f.y));
+                d_map = dot(w, vec4(shadow_distance(FACE.params, d.x),
+                                    shadow_distance(FACE.params, d.y),
+                                    shadow_distance(FACE.params, d.z),
+                                    shadow_distance(FACE.params, d.w)));
+            } else {
+                float raw = texelFetch(shadow_depth, texel, 0).r;
+                if (raw >= 1.0) {
+                    return light_entry_plane(m, to_light, x_o, n_o, p_in, n_in);
                 }
+                if (int(entry.a * 255.0 + 0.5) != id) {
+                    return false; // another material's surface is first: blocked
+                }
+                d_map = shadow_distance(FACE.params, raw);
             }
             float d_m = shadow_distance(FACE.params, ndc.z);
             if (FACE.params.z < 0.0) {
@@ -77,13 +95,7 @@ bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out v
         }
     }
 #endif
-    float c = dot(to_light, n_o);
-    if (c <= 1e-4) {
-        return false;
-    }
-    p_in = m + to_light * (max(dot(x_o - m, n_o), 0.0) / c);
-    n_in = n_o;
-    return true;
+    return light_entry_plane(m, to_light, x_o, n_o, p_in, n_in);
 }
 
 // Radiance a light delivers into the medium at entry point p_in (normal n_in, light arriving
@@ -121,37 +133,46 @@ void main() {
     }
     float t_o = fresnel_transmittance(cos_o, eta);
     int lights = min(frame.light_count.x, MAX_LIGHTS);
-
-    // L_t: light that crossed the object unscattered from its entry on the light's side.
-    vec3 l_t = vec3(0.0);
-    for (int i = 0; i < lights; ++i) {
-        vec3 to_light;
-        float unused;
-        light_incidence(frame.lights[i], x_o, to_light, unused);
-        if (dot(to_light, n_o) >= 0.0) {
-            continue; // a lit point is its own entry point: its light is L_d's
-        }
-        vec3 p_in, n_in;
-        if (!light_entry(i, x_o, to_light, id, x_o, n_o, p_in, n_in)) {
-            continue;
-        }
-        vec3 e = entering(i, p_in, n_in, to_light, eta);
-        l_t += e * exp(-optical_depth(mat, p_in, n_in, p_in, x_o));
-    }
-    l_t *= t_o / PI;
-
-    // L_ss: the refracted view ray marched to D_max / (N . T).
-    vec3 l_ss = vec3(0.0);
     vec3 w;
-    if (refract_into(view_dir, n_o, eta, w)) {
-        // Grazing refraction is bounded at cos beta = 0.05 (20 D_max along the ray).
-        float s_end = MAT.info.z / max(dot(-n_o, w), 0.05);
-        // Steps equally spaced in the first layer's mean transmittance, so dense media are
-        // resolved near the surface; a clear or thin medium is sampled uniformly.
-        float sigma_bar = dot(MAT.sigma_t_g[0].rgb, vec3(1.0 / 3.0));
-        float span = sigma_bar * s_end > 1e-6 ? -expm1_approx(-sigma_bar * s_end) : 0.0;
-        int steps = clamp(layered.knobs.x, 1, 64);
-        vec3 sum = vec3(0.0);
+    bool refracted = refract_into(view_dir, n_o, eta, w);
+    // The march (eqs. 4-6): to D_max / (N . T), grazing refraction bounded at cos beta = 0.05
+    // (20 D_max along the ray); steps equally spaced in the first layer's mean transmittance,
+    // so dense media are resolved near the surface (a clear or thin medium: uniformly).
+    float s_end = MAT.info.z / max(dot(-n_o, w), 0.05);
+    float sigma_bar = dot(MAT.sigma_t_g[0].rgb, vec3(1.0 / 3.0));
+    float span = sigma_bar * s_end > 1e-6 ? -expm1_approx(-sigma_bar * s_end) : 0.0;
+    int steps = clamp(layered.knobs.x, 1, 64);
+    // The middle of the march, where each light's entry point is looked up once.
+    float s_mid = span > 0.0 ? min(-log(max(1.0 - 0.5 * span, 1e-30)) / sigma_bar, s_end)
+                             : 0.5 * s_end;
+    vec3 m_mid = x_o + w * s_mid;
+
+    vec3 l_t = vec3(0.0), sum = vec3(0.0);
+    for (int i = 0; i < lights; ++i) {
+        // One map lookup per light and pixel: the entry surface (point and normal) where the
+        // light reaching the middle of the march entered; every step's entry point is where
+        // its own ray to the light crosses that surface's tangent plane. The steps lie within
+        // D_max of the surface (a few mean free paths), so the plane misses only the surface's
+        // curvature over that distance: on a 12.5 mm apple sphere the term comes out 4% low
+        // (against 1% with a lookup per step, which costs 1.5x as much: docs/layered.md).
+        vec3 to_mid;
+        float unused;
+        light_incidence(frame.lights[i], m_mid, to_mid, unused);
+        vec3 p_ref, n_ref;
+        bool entered = refracted && light_entry(i, m_mid, to_mid, id, x_o, n_o, p_ref, n_ref);
+        // L_t: light that crossed the object unscattered from its entry on the light's side
+        // to x_o (a lit point is its own entry point: its light is L_d's); its own lookup,
+        // made only where x_o faces away from the light.
+        vec3 to_light;
+        light_incidence(frame.lights[i], x_o, to_light, unused);
+        vec3 p_t, n_t;
+        if (dot(to_light, n_o) < 0.0 && light_entry(i, x_o, to_light, id, x_o, n_o, p_t, n_t)) {
+            vec3 e = entering(i, p_t, n_t, to_light, eta);
+            l_t += e * exp(-optical_depth(mat, p_t, n_t, p_t, x_o));
+        }
+        if (!entered) {
+            continue; // blocked by another material, or below the plane
+        }
         for (int k = 0; k < steps; ++k) {
             float u = (float(k) + 0.5) / float(steps);
             float s, ds;
@@ -169,24 +190,19 @@ void main() {
             if (layer < 0) {
                 continue; // below the last layer: no medium scatters
             }
-            vec3 sigma_s = MAT.sigma_s_thickness[layer].rgb;
-            float g = MAT.sigma_t_g[layer].a;
-            vec3 tau_view = optical_depth(mat, x_o, n_o, m, x_o);
-            for (int i = 0; i < lights; ++i) {
-                vec3 to_light;
-                float unused;
-                light_incidence(frame.lights[i], m, to_light, unused);
-                vec3 p_in, n_in;
-                if (!light_entry(i, m, to_light, id, x_o, n_o, p_in, n_in)) {
-                    continue;
-                }
-                vec3 e = entering(i, p_in, n_in, to_light, eta);
-                vec3 tau_light = optical_depth(mat, p_in, n_in, p_in, m);
-                sum += sigma_s * phase(g, dot(to_light, w)) * e *
-                       exp(-(tau_light + tau_view)) * ds;
+            light_incidence(frame.lights[i], m, to_light, unused);
+            float c = dot(to_light, n_ref);
+            if (c <= 1e-4) {
+                continue;
             }
+            vec3 p_in = m + to_light * (max(dot(p_ref - m, n_ref), 0.0) / c);
+            vec3 e = entering(i, p_in, n_ref, to_light, eta);
+            vec3 tau = optical_depth(mat, p_in, n_ref, p_in, m) + optical_depth(mat, x_o, n_o, m, x_o);
+            sum += MAT.sigma_s_thickness[layer].rgb * phase(MAT.sigma_t_g[layer].a, dot(to_light, w)) *
+                   e * exp(-tau) * ds;
         }
-        l_ss = t_o * sum;
     }
+    l_t *= t_o / PI;
+    vec3 l_ss = t_o * sum;
     out_color = vec4(finite_term(MAT.weights.x * l_t + MAT.weights.y * l_ss), 0.0);
 }

@@ -269,7 +269,7 @@ struct FrameArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = parse_shadow_size)]
     shadow_size: Option<u32>,
     /// Layered media (Li et al.): single scattering's march steps along the refracted view
-    /// ray (1 to 64; default 8).
+    /// ray (1 to 64; default 4).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_layered_steps)]
     layered_steps: Option<u32>,
     /// Layered media: multiple scattering's pixel lights per pixel (4 to 64; default 12, Li

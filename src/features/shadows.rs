@@ -350,8 +350,9 @@ pub fn shadow_pass(
         pass.color(ids, LoadOp::Clear([0.0; 4]));
     }
     if let Some(entry) = &mut maps.entry {
-        // Layered material 0 where no object is.
-        pass.color(entry, LoadOp::Clear([0.5, 0.5, 0.5, 0.0]));
+        // Not cleared (a clear of the whole atlas cost as much as drawing it on lavapipe):
+        // readers trust a texel's entry only where its depth says a surface was drawn.
+        pass.color(entry, LoadOp::DontCare);
     }
     pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
     match scene {

@@ -97,12 +97,15 @@ impl Renderer {
         };
         // The tiles of translucency and SSS, and the directional lights' maps, which cover
         // every object's box.
-        let mesh_bounds =
-            if desc.translucency.is_some() || desc.sss.is_some() || desc.shadows.is_some() {
-                mesh_bounds(scene)
-            } else {
-                Vec::new()
-            };
+        let mesh_bounds = if desc.translucency.is_some()
+            || desc.sss.is_some()
+            || desc.shadows.is_some()
+            || desc.layered.is_some()
+        {
+            mesh_bounds(scene)
+        } else {
+            Vec::new()
+        };
         let mut renderer = Self {
             executable,
             outputs,

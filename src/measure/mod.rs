@@ -6,9 +6,11 @@
 //! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
+//! - [`sweep_layered`]: the layered media's sweep, the GPU frames and the f64 references.
 
 pub mod bench;
 pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;
 pub mod sweep;
+pub mod sweep_layered;

@@ -125,7 +125,7 @@ enum Command {
     /// Stability sweep: render a technique at extreme parameters and on hostile geometry and
     /// count NaN, Inf, the largest value and fp16 overflows per case (fails on any NaN/Inf).
     Sweep {
-        /// The technique to sweep (`translucency`).
+        /// The technique to sweep (`translucency` or `layered`).
         technique: String,
         /// Resolution of each case as WIDTHxHEIGHT.
         #[arg(long, default_value = "64x48", value_parser = parse_size)]
@@ -133,6 +133,10 @@ enum Command {
         /// Also write the table to this Markdown file.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Only the quick subset of cases (`layered`: every medium back-lit and every
+        /// situation at the two corners).
+        #[arg(long)]
+        quick: bool,
         #[command(flatten)]
         gpu: GpuArgs,
     },
@@ -1029,15 +1033,24 @@ fn sweep_command(
     technique: &str,
     (width, height): (u32, u32),
     out: Option<PathBuf>,
+    quick: bool,
     gpu_args: &GpuArgs,
 ) -> Result<()> {
-    if technique != "translucency" {
+    if !matches!(technique, "translucency" | "layered") {
         return Err(LucentError::InvalidInput(format!(
-            "sweep: unknown technique '{technique}'; available: translucency"
+            "sweep: unknown technique '{technique}'; available: translucency, layered"
         )));
+    }
+    if quick && technique != "layered" {
+        return Err(LucentError::InvalidInput(
+            "sweep: --quick applies to `sweep layered` only".into(),
+        ));
     }
     if let Some(out) = &out {
         lucent::files::check_outputs(&[], &[("--out", out)])?;
+    }
+    if technique == "layered" {
+        return sweep_layered_command((width, height), out, quick, gpu_args);
     }
     let cases = lucent::measure::sweep::translucency_cases();
     let (rows, device) = with_session(gpu_args, |session| {
@@ -1061,6 +1074,66 @@ fn sweep_command(
     if bad > 0 {
         return Err(LucentError::InvalidInput(format!(
             "sweep: {bad} NaN/Inf values (see the table)"
+        )));
+    }
+    Ok(())
+}
+
+fn sweep_layered_command(
+    (width, height): (u32, u32),
+    out: Option<PathBuf>,
+    quick: bool,
+    gpu_args: &GpuArgs,
+) -> Result<()> {
+    use lucent::measure::sweep_layered;
+    let cases = if quick {
+        sweep_layered::quick_layered_cases()?
+    } else {
+        sweep_layered::layered_cases()?
+    };
+    let total = cases.len();
+    let terminal = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let (rows, device) = with_session(gpu_args, |session| {
+        let rows = sweep_layered::run_layered(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            width,
+            height,
+            &cases,
+            |i, row| {
+                if terminal {
+                    eprint!(
+                        "\rsweep layered: {}/{total} ({} / {})\x1b[K",
+                        i + 1,
+                        row.case.label,
+                        row.case.geometry.name()
+                    );
+                }
+            },
+        )?;
+        if terminal {
+            eprintln!();
+        }
+        Ok((rows, session.gpu.info.describe()))
+    })?;
+    let table = sweep_layered::markdown(&rows, width, height, &device);
+    println!("{table}");
+    if let Some(out) = &out {
+        output::write_file_atomic(out, table.as_bytes())?;
+        println!("wrote {}", out.display());
+    }
+    let bad: Vec<String> = rows
+        .iter()
+        .filter(|r| r.bad() > 0)
+        .map(|r| format!("{} / {}", r.case.label, r.case.geometry.name()))
+        .collect();
+    if !bad.is_empty() {
+        let values: usize = rows.iter().map(|r| r.bad()).sum();
+        return Err(LucentError::InvalidInput(format!(
+            "sweep layered: {values} NaN/Inf values in {} cases (see the table): {}",
+            bad.len(),
+            bad.join(", ")
         )));
     }
     Ok(())
@@ -1187,8 +1260,9 @@ fn run(cli: Cli) -> Result<()> {
             technique,
             size,
             out,
+            quick,
             gpu,
-        } => sweep_command(&technique, size, out, &gpu),
+        } => sweep_command(&technique, size, out, quick, &gpu),
         Command::Report {
             technique,
             out,

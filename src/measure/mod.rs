@@ -7,6 +7,7 @@
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.
 //! - [`layered_error`]: Li et al.'s layered terms against their f64 references.
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
+//! - [`sweep_layered`]: the layered media's sweep, the GPU frames and the f64 references.
 
 pub mod bench;
 pub mod layered_error;
@@ -14,3 +15,4 @@ pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;
 pub mod sweep;
+pub mod sweep_layered;

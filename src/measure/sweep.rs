@@ -257,26 +257,46 @@ fn opposed_normal_quad() -> Mesh {
     }
 }
 
-/// Counts what went wrong in RGBA f32 `hdr` (alpha ignored).
-pub fn measure(case: SweepCase, hdr: &[f32]) -> SweepRow {
-    let mut row = SweepRow {
-        case,
-        nan: 0,
-        inf: 0,
-        max: 0.0,
-        fp16_overflow: 0,
-    };
+/// What went wrong in one linear HDR image (see [`count_hdr`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HdrCounts {
+    /// NaN channel values.
+    pub nan: usize,
+    /// Infinite channel values.
+    pub inf: usize,
+    /// Largest finite channel value (0 for an image of none).
+    pub max: f32,
+    /// Channel values at (or above) the fp16 maximum 65504, where the shader clamps.
+    pub fp16_overflow: usize,
+}
+
+/// Counts NaN, Inf, the largest finite value and fp16 overflows in RGBA f32 `hdr` (alpha
+/// ignored): the numbers every stability sweep reports.
+pub fn count_hdr(hdr: &[f32]) -> HdrCounts {
+    let mut c = HdrCounts::default();
     for v in hdr.chunks_exact(4).flat_map(|p| &p[..3]) {
         if v.is_nan() {
-            row.nan += 1;
+            c.nan += 1;
         } else if v.is_infinite() {
-            row.inf += 1;
+            c.inf += 1;
         } else {
-            row.max = row.max.max(*v);
-            row.fp16_overflow += usize::from(*v >= 65504.0);
+            c.max = c.max.max(*v);
+            c.fp16_overflow += usize::from(*v >= 65504.0);
         }
     }
-    row
+    c
+}
+
+/// Counts what went wrong in RGBA f32 `hdr` (alpha ignored).
+pub fn measure(case: SweepCase, hdr: &[f32]) -> SweepRow {
+    let c = count_hdr(hdr);
+    SweepRow {
+        case,
+        nan: c.nan,
+        inf: c.inf,
+        max: c.max,
+        fp16_overflow: c.fp16_overflow,
+    }
 }
 
 /// Renders every case at `width` x `height` and measures it.

@@ -9,11 +9,24 @@ use crate::scene::profile::fit_sum_of_gaussians;
 /// Diffuse Fresnel reflectance of a boundary with relative index `eta` (Jensen's fit). The fit
 /// gives 0.0014 at `eta` = 1, where there is no boundary: `eta` = 1 returns 0 exactly (as
 /// Mitsuba forces it), so the dipole's `A` is exactly 1.
+///
+/// Jensen's polynomial is a fit for `eta > 1` (it goes negative below 0.9993: -3.6 at 0.5);
+/// below 1 the fit for a medium less dense than its surroundings is used instead (Egan and
+/// Hilgeman 1979, as in Jensen's dipole literature): `-0.4399 + 0.7099/eta - 0.3319/eta^2 +
+/// 0.0636/eta^3`. Both are clamped to [0, 0.999] (a reflectance; A stays finite).
 pub fn fresnel_diffuse_reflectance(eta: f64) -> f64 {
     if eta == 1.0 {
         return 0.0;
     }
-    -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
+    let f = if eta > 1.0 {
+        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
+    } else {
+        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
+    };
+    if f.is_nan() {
+        return 0.0;
+    }
+    f.clamp(0.0, 0.999)
 }
 
 /// Smallest `sigma_t'` used (1/length): `sigma_s' = sigma_a = 0` is a vacuum, where `z_r =
@@ -155,6 +168,14 @@ mod tests {
     #[test]
     fn eta_one_has_no_boundary() {
         assert_eq!(fresnel_diffuse_reflectance(1.0), 0.0);
+        // Both fits stay reflectances, and meet near eta = 1.
+        for eta in [1e-3, 0.1, 0.5, 0.9, 0.999, 1.001, 1.3, 2.0, 5.0, 1e3] {
+            let f = fresnel_diffuse_reflectance(eta);
+            assert!((0.0..=0.999).contains(&f), "{eta}: {f}");
+        }
+        assert!(
+            (fresnel_diffuse_reflectance(0.9999) - fresnel_diffuse_reflectance(1.0001)).abs() < 0.01
+        );
         let d = dipole_constants(1.0, 0.1, 1.0);
         assert_eq!(d.a, 1.0);
         assert_eq!(d.z_v, d.z_r * (1.0 + 4.0 / 3.0));

@@ -1097,12 +1097,15 @@ fn build_layered(
         medium.weights = w;
     }
     if let Some(u) = l.units_per_mm {
-        if !(u.is_finite() && u > 0.0) {
+        let range = super::layered::UNITS_PER_MM_RANGE;
+        if !(u.is_finite() && range.contains(&u)) {
             return Err(err(
                 "layered.units_per_mm",
                 format!(
-                    "{u} must be finite and > 0 (scene units per millimetre: 1 when a unit is \
-                     a millimetre, 0.001 when it is a metre)"
+                    "{u} must be in [{:e}, {:e}] (scene units per millimetre: 1 when a unit is \
+                     a millimetre, 0.001 when it is a metre)",
+                    range.start(),
+                    range.end()
                 ),
             ));
         }
@@ -1622,7 +1625,13 @@ thickness = "rest"
                 "units_per_mm = 0.1",
                 "units_per_mm = inf",
                 "material[1].layered.units_per_mm",
-                "finite",
+                "must be in",
+            ),
+            (
+                "units_per_mm = 0.1",
+                "units_per_mm = 1e-33",
+                "material[1].layered.units_per_mm",
+                "must be in [1e-6",
             ),
             (
                 "eta = 1.4",

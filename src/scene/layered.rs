@@ -62,6 +62,11 @@ pub const DEFAULT_UNITS_PER_MM: f32 = 0.04;
 /// the table; 1e6 keeps every product with a thickness or a distance far from overflow in f32.
 pub const MAX_COEFFICIENT: f32 = 1e6;
 
+/// Scene units per millimetre accepted: a micrometre to a kilometre per unit. Beyond, a
+/// coefficient of [`MAX_COEFFICIENT`] mm^-1 divided by `units_per_mm` overflows f32 (the
+/// layered sweep found NaN in the dipole at 1e-33).
+pub const UNITS_PER_MM_RANGE: std::ops::RangeInclusive<f32> = 1e-6..=1e6;
+
 /// Smallest `1 - g` used when converting `sigma_s'` to `sigma_s` (the guard of
 /// [`sigma_s_from_reduced`]): `g` is clamped to [`MAX_ABS_G`] first, so this is `1 - 0.999`.
 const MIN_ONE_MINUS_G: f32 = 1.0 - MAX_ABS_G;
@@ -428,10 +433,12 @@ impl LayeredMedium {
                 self.weights
             ));
         }
-        if !(self.units_per_mm.is_finite() && self.units_per_mm > 0.0) {
+        if !(self.units_per_mm.is_finite() && UNITS_PER_MM_RANGE.contains(&self.units_per_mm)) {
             return bad(format!(
-                "units_per_mm {} must be finite and > 0",
-                self.units_per_mm
+                "units_per_mm {} must be in [{:e}, {:e}]",
+                self.units_per_mm,
+                UNITS_PER_MM_RANGE.start(),
+                UNITS_PER_MM_RANGE.end()
             ));
         }
         Ok(())

@@ -94,7 +94,7 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
             },
             0.15,
         ),
-        ("clear", clear_medium(), Term::Transmitted, default, 0.06),
+        ("clear", clear_medium(), Term::Transmitted, default, 0.12),
     ]
 }
 

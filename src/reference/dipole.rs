@@ -174,7 +174,8 @@ mod tests {
             assert!((0.0..=0.999).contains(&f), "{eta}: {f}");
         }
         assert!(
-            (fresnel_diffuse_reflectance(0.9999) - fresnel_diffuse_reflectance(1.0001)).abs() < 0.01
+            (fresnel_diffuse_reflectance(0.9999) - fresnel_diffuse_reflectance(1.0001)).abs()
+                < 0.01
         );
         let d = dipole_constants(1.0, 0.1, 1.0);
         assert_eq!(d.a, 1.0);

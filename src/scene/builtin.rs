@@ -557,7 +557,8 @@ fn skin() -> Result<Scene> {
 
 /// Li et al.'s Table 1 materials, one sphere each, named as the table names them: its
 /// coefficients are Jensen et al. 2001's media (see [`super::layered`]): frog = apple,
-/// teapot = skin1, bunny = chicken1, buddha = skin2, dragon = skimmilk.
+/// teapot = skin1, bunny = chicken1, buddha = skin2, dragon = skimmilk; eq. 3 weighted
+/// physically ([`super::layered::PHYSICAL_WEIGHTS`]).
 fn layered() -> Result<Scene> {
     let mut s = base_scene(
         "layered",
@@ -576,7 +577,9 @@ fn layered() -> Result<Scene> {
     .enumerate()
     {
         let mut m = Material::opaque(name, Vec3::new(0.8, 0.7, 0.6), 0.3, 0.4);
-        m.layers = Some(LayeredMedium::preset(preset)?);
+        let mut medium = LayeredMedium::preset(preset)?;
+        medium.weights = super::layered::PHYSICAL_WEIGHTS;
+        m.layers = Some(medium);
         s.add(
             sphere,
             Mat4::from_scale_rotation_translation(
@@ -616,7 +619,9 @@ fn dynamic() -> Result<Scene> {
     let torus = s.add_mesh(generators::generate(Generator::Torus, 4)?);
     let mut m = Material::opaque("jelly", Vec3::new(0.7, 0.8, 0.5), 0.4, 0.3);
     // Li et al.'s bunny row: Jensen's chicken1.
-    m.layers = Some(LayeredMedium::preset("chicken1")?);
+    let mut medium = LayeredMedium::preset("chicken1")?;
+    medium.weights = super::layered::PHYSICAL_WEIGHTS;
+    m.layers = Some(medium);
     s.add(
         torus,
         Mat4::from_scale_rotation_translation(

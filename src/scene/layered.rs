@@ -54,6 +54,13 @@ pub const MAX_ABS_G: f32 = 0.999;
 /// Li et al.'s eq. 3 weights of their Fig. 4 (diffuse, specular, transmitted, single, multiple).
 pub const DEFAULT_WEIGHTS: [f32; 5] = [0.3, 0.3, 0.05, 0.05, 0.03];
 
+/// Eq. 3's weights read physically: `λ1 = 0` because the dipole's multiple scattering *is* a
+/// translucent medium's diffuse reflection (Lambert on top would count it twice), and every
+/// other term at its own radiance. The paper's [`DEFAULT_WEIGHTS`] darken an object to 30% of
+/// its Lambert diffuse plus 3-5% of the scattering terms; the built-in layered scenes use
+/// these instead.
+pub const PHYSICAL_WEIGHTS: [f32; 5] = [0.0, 1.0, 1.0, 1.0, 1.0];
+
 /// Scene units per millimetre when a scene names none: 0.04, so a built-in object about one unit
 /// across is 25 mm, a few centimetres (a fruit or a figurine).
 pub const DEFAULT_UNITS_PER_MM: f32 = 0.04;

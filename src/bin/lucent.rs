@@ -138,26 +138,30 @@ enum Command {
     },
     /// The report suite: every technique's passes beside their speed-of-light copies, the
     /// seeds' tables beside ours, scaling curves and error against time, as DIR/report.md with
-    /// PNG plots. With a section name (`translucency`, `sss`), only that error-against-time
+    /// PNG plots. With a section name (`translucency`, `sss`, `li`), only that error-against-time
     /// section.
     Report {
-        /// Only this error-against-time section (`translucency` or `sss`); default: the whole
-        /// suite.
+        /// Only this error-against-time section (`translucency`, `sss` or `li`: Li et al.'s
+        /// layered passes, every knob); default: the whole suite.
         technique: Option<String>,
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// The small preset (about 15 s on the project's 2-core lavapipe machine).
+        /// The small preset (suite: about 15 s on the project's 2-core lavapipe machine; `li`:
+        /// 128x128, fewer variants, 3 rounds; the translucency and sss sections ignore it).
         #[arg(long)]
         quick: bool,
         /// Resolution as WIDTHxHEIGHT (suite: of the per-technique tables; default 1024x768,
-        /// --quick 256x192).
+        /// --quick 256x192; sections: of the timed frames, default 1024x768, `li` 256x256 and
+        /// --quick 128x128).
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
-        /// Measured rounds or frames (1 to 100000; section default 15; suite 25, --quick 3).
+        /// Measured rounds or frames (1 to 100000; section default 15; suite 25, --quick 3;
+        /// `li` --quick 3).
         #[arg(long, value_parser = parse_frames)]
         rounds: Option<usize>,
-        /// Discarded rounds first (0 to 10000; section default 3; suite 3, --quick 1).
+        /// Discarded rounds first (0 to 10000; section default 3; suite 3, --quick 1; `li`
+        /// --quick 1).
         #[arg(long, value_parser = parse_warmup)]
         warmup: Option<usize>,
         #[command(flatten)]
@@ -1083,14 +1087,35 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
         ));
     }
     let (text, files) = match &args.technique {
+        Some(technique) if technique == "li" => {
+            let mut options = if args.quick {
+                lucent::report::li::LiOptions::quick()
+            } else {
+                lucent::report::li::LiOptions::full()
+            };
+            if let Some((w, h)) = args.size {
+                (options.width, options.height) = (w, h);
+            }
+            options.rounds = args.rounds.unwrap_or(options.rounds);
+            options.warmup = args.warmup.unwrap_or(options.warmup);
+            with_session(gpu_args, |session| {
+                lucent::report::li::write_li_report(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &args.out,
+                    &options,
+                )
+            })?
+        }
         Some(technique) => {
             let write = match technique.as_str() {
                 "translucency" => lucent::report::translucency::write_translucency_report,
                 "sss" => lucent::report::sss::write_sss_report,
                 _ => {
                     return Err(LucentError::InvalidInput(format!(
-                        "report: unknown section '{technique}'; available: translucency, sss (or \
-                         no section: the whole suite)"
+                        "report: unknown section '{technique}'; available: translucency, sss, li \
+                         (or no section: the whole suite)"
                     )))
                 }
             };

@@ -31,6 +31,7 @@ use crate::report::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, P
 use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
 
+pub mod li;
 pub mod plot;
 pub mod section;
 pub mod seeds;

@@ -84,8 +84,9 @@ enum Command {
         /// Print the seeds' published numbers beside ours: the LEAN-mapping thesis's Table 2
         /// (`control`) or Table 1 (`lbb`), each row as a share of its frame; for
         /// `translucency`, GDC 2011's full-screen cost beside the extra cost of translucency
-        /// in this scene's lighting pass (measured against `none`, alternating frames).
-        /// Alias: --compare-seeds.
+        /// in this scene's lighting pass (measured against `none`, alternating frames); for
+        /// `auto` or `layered` on a scene with layered materials, the row of Li et al.'s Table
+        /// 1 nearest its triangle count. Alias: --compare-seeds.
         #[arg(long, alias = "compare-seeds")]
         compare_thesis: bool,
     },
@@ -818,11 +819,14 @@ fn bench_command(
     let thesis_table =
         lucent::report::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
     let gdc = compare_thesis && technique == Technique::Translucency;
-    if compare_thesis && thesis_table.is_none() && !gdc {
+    // Li et al.'s Table 1: their technique, alone or in `auto` (checked against the scene's
+    // materials once it is loaded).
+    let li = compare_thesis && matches!(technique, Technique::Auto | Technique::Layered);
+    if compare_thesis && thesis_table.is_none() && !gdc && !li {
         return Err(LucentError::InvalidInput(format!(
             "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
-             Table 1) or translucency (GDC 2011's cost); '{}' has no published table (Li et \
-             al.'s Table 1 is in `lucent report`)",
+             Table 1), translucency (GDC 2011's cost), or auto or layered on a scene with \
+             layered materials (Li et al.'s Table 1); '{}' has no published table",
             technique.name()
         )));
     }
@@ -847,6 +851,14 @@ fn bench_command(
     };
     with_renderer(frame, gpu_args, false, |session, renderer, scene| {
         let gpu = &session.gpu;
+        if li && FrameDesc::new(scene, &renderer.settings)?.layered.is_none() {
+            return Err(LucentError::InvalidInput(format!(
+                "--compare-seeds with --technique {}: scene '{}' has no layered material, so \
+                 Li et al.'s Table 1 has nothing to compare (try --scene scaling:N or layered)",
+                technique.name(),
+                frame.scene
+            )));
+        }
         let report = if speed_of_light {
             let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
                 gpu,
@@ -875,6 +887,17 @@ fn bench_command(
         }
         if let Some(table) = &thesis_table {
             println!("{}", lucent::report::seeds::beside(&report, table));
+        }
+        if li {
+            let shadows = renderer.settings.shadows;
+            println!(
+                "{}",
+                lucent::report::seeds::li_bench_beside(
+                    &report,
+                    lucent::measure::scaling::triangles(scene),
+                    shadows.enabled.then_some(shadows.size),
+                )
+            );
         }
         if gdc {
             let cost = lucent::report::gdc_cost(

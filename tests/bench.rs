@@ -130,6 +130,77 @@ fn markdown_names_the_passes_far_above_their_floor_and_the_seeds_alias_works() {
 }
 
 #[test]
+fn a_layered_bench_prints_li_et_al_s_nearest_row_and_other_scenes_refuse() {
+    let bench = |scene: &str, technique: &str, maps: &str| {
+        run_bench(&[
+            "bench",
+            "--validation",
+            "--scene",
+            scene,
+            "--technique",
+            technique,
+            "--size",
+            "96x64",
+            "--shadow-size",
+            maps,
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+            "--compare-seeds",
+        ])
+    };
+    for (technique, maps) in [("auto", "512"), ("layered", "1024")] {
+        let text = bench("scaling:2900", technique, maps);
+        assert!(
+            text.contains("Beside Li et al.'s Table 1 (the row nearest"),
+            "{text}"
+        );
+        assert!(
+            text.contains("row `deformed frog`, 2900 triangles"),
+            "{text}"
+        );
+        assert!(
+            text.contains("| theirs | 2900 | 512 | 231 | 4.33 |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("| theirs | 2900 | 1024 | 71 | 14.08 |"),
+            "{text}"
+        );
+        let ours = text
+            .lines()
+            .find(|l| l.starts_with("| ours | "))
+            .unwrap_or_else(|| panic!("{text}"));
+        let cells: Vec<&str> = ours.trim_matches('|').split('|').map(str::trim).collect();
+        assert_eq!(cells[2], maps, "{ours}");
+        for c in [3, 4, 5] {
+            let v: f64 = cells[c].parse().unwrap_or_else(|_| panic!("{ours}"));
+            assert!(v.is_finite() && v > 0.0, "{ours}");
+        }
+        assert!(text.contains("`single scattering"), "{text}");
+    }
+    // auto on a scene without layered materials: one clear error line.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "bench",
+            "--scene",
+            "smoke",
+            "--size",
+            "64x48",
+            "--frames",
+            "1",
+            "--compare-seeds",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("has no layered material"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
 fn packed_lbb_bench_with_its_copies_is_validation_clean() {
     // The issue-12 case: the packed RGBA32UI target's copy read it as float (88 errors).
     let text = run_bench(&[

@@ -84,8 +84,9 @@ enum Command {
         /// Print the seeds' published numbers beside ours: the LEAN-mapping thesis's Table 2
         /// (`control`) or Table 1 (`lbb`), each row as a share of its frame; for
         /// `translucency`, GDC 2011's full-screen cost beside the extra cost of translucency
-        /// in this scene's lighting pass (measured against `none`, alternating frames).
-        /// Alias: --compare-seeds.
+        /// in this scene's lighting pass (measured against `none`, alternating frames); for
+        /// `auto` or `layered` on a scene with layered materials, the row of Li et al.'s Table
+        /// 1 nearest its triangle count. Alias: --compare-seeds.
         #[arg(long, alias = "compare-seeds")]
         compare_thesis: bool,
     },
@@ -142,26 +143,30 @@ enum Command {
     },
     /// The report suite: every technique's passes beside their speed-of-light copies, the
     /// seeds' tables beside ours, scaling curves and error against time, as DIR/report.md with
-    /// PNG plots. With a section name (`translucency`, `sss`), only that error-against-time
+    /// PNG plots. With a section name (`translucency`, `sss`, `li`), only that error-against-time
     /// section.
     Report {
-        /// Only this error-against-time section (`translucency` or `sss`); default: the whole
-        /// suite.
+        /// Only this error-against-time section (`translucency`, `sss` or `li`: Li et al.'s
+        /// layered passes, every knob); default: the whole suite.
         technique: Option<String>,
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// The small preset (about 15 s on the project's 2-core lavapipe machine).
+        /// The small preset (suite: about 15 s on the project's 2-core lavapipe machine; `li`:
+        /// 128x128, fewer variants, 3 rounds; the translucency and sss sections ignore it).
         #[arg(long)]
         quick: bool,
         /// Resolution as WIDTHxHEIGHT (suite: of the per-technique tables; default 1024x768,
-        /// --quick 256x192).
+        /// --quick 256x192; sections: of the timed frames, default 1024x768, `li` 256x256 and
+        /// --quick 128x128).
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
-        /// Measured rounds or frames (1 to 100000; section default 15; suite 25, --quick 3).
+        /// Measured rounds or frames (1 to 100000; section default 15; suite 25, --quick 3;
+        /// `li` --quick 3).
         #[arg(long, value_parser = parse_frames)]
         rounds: Option<usize>,
-        /// Discarded rounds first (0 to 10000; section default 3; suite 3, --quick 1).
+        /// Discarded rounds first (0 to 10000; section default 3; suite 3, --quick 1; `li`
+        /// --quick 1).
         #[arg(long, value_parser = parse_warmup)]
         warmup: Option<usize>,
         #[command(flatten)]
@@ -818,11 +823,14 @@ fn bench_command(
     let thesis_table =
         lucent::report::seeds::thesis_table(technique.name()).filter(|_| compare_thesis);
     let gdc = compare_thesis && technique == Technique::Translucency;
-    if compare_thesis && thesis_table.is_none() && !gdc {
+    // Li et al.'s Table 1: their technique, alone or in `auto` (checked against the scene's
+    // materials once it is loaded).
+    let li = compare_thesis && matches!(technique, Technique::Auto | Technique::Layered);
+    if compare_thesis && thesis_table.is_none() && !gdc && !li {
         return Err(LucentError::InvalidInput(format!(
             "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
-             Table 1) or translucency (GDC 2011's cost); '{}' has no published table (Li et \
-             al.'s Table 1 is in `lucent report`)",
+             Table 1), translucency (GDC 2011's cost), or auto or layered on a scene with \
+             layered materials (Li et al.'s Table 1); '{}' has no published table",
             technique.name()
         )));
     }
@@ -847,6 +855,14 @@ fn bench_command(
     };
     with_renderer(frame, gpu_args, false, |session, renderer, scene| {
         let gpu = &session.gpu;
+        if li && FrameDesc::new(scene, &renderer.settings)?.layered.is_none() {
+            return Err(LucentError::InvalidInput(format!(
+                "--compare-seeds with --technique {}: scene '{}' has no layered material, so \
+                 Li et al.'s Table 1 has nothing to compare (try --scene scaling:N or layered)",
+                technique.name(),
+                frame.scene
+            )));
+        }
         let report = if speed_of_light {
             let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
                 gpu,
@@ -875,6 +891,17 @@ fn bench_command(
         }
         if let Some(table) = &thesis_table {
             println!("{}", lucent::report::seeds::beside(&report, table));
+        }
+        if li {
+            let shadows = renderer.settings.shadows;
+            println!(
+                "{}",
+                lucent::report::seeds::li_bench_beside(
+                    &report,
+                    lucent::measure::scaling::triangles(scene),
+                    shadows.enabled.then_some(shadows.size),
+                )
+            );
         }
         if gdc {
             let cost = lucent::report::gdc_cost(
@@ -1156,14 +1183,35 @@ fn report_command(args: ReportArgs, gpu_args: &GpuArgs) -> Result<()> {
         ));
     }
     let (text, files) = match &args.technique {
+        Some(technique) if technique == "li" => {
+            let mut options = if args.quick {
+                lucent::report::li::LiOptions::quick()
+            } else {
+                lucent::report::li::LiOptions::full()
+            };
+            if let Some((w, h)) = args.size {
+                (options.width, options.height) = (w, h);
+            }
+            options.rounds = args.rounds.unwrap_or(options.rounds);
+            options.warmup = args.warmup.unwrap_or(options.warmup);
+            with_session(gpu_args, |session| {
+                lucent::report::li::write_li_report(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &args.out,
+                    &options,
+                )
+            })?
+        }
         Some(technique) => {
             let write = match technique.as_str() {
                 "translucency" => lucent::report::translucency::write_translucency_report,
                 "sss" => lucent::report::sss::write_sss_report,
                 _ => {
                     return Err(LucentError::InvalidInput(format!(
-                        "report: unknown section '{technique}'; available: translucency, sss (or \
-                         no section: the whole suite)"
+                        "report: unknown section '{technique}'; available: translucency, sss, li \
+                         (or no section: the whole suite)"
                     )))
                 }
             };

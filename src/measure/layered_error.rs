@@ -137,7 +137,8 @@ pub fn pixel_ray(camera: &Camera, width: u32, height: u32, x: u32, y: u32) -> (D
 }
 
 /// Renders `term` of `scene`'s object 0 (a layered sphere) under `settings` and compares
-/// every `stride`-th pixel with the reference.
+/// every `stride`-th pixel with the reference (evaluated with the phase function the GPU
+/// frame uses).
 pub fn term_error(
     gpu: &GpuContext,
     shaders: &ShaderCompiler,
@@ -146,6 +147,33 @@ pub fn term_error(
     settings: &FrameSettings,
     term: Term,
     stride: u32,
+) -> Result<TermError> {
+    term_error_against(
+        gpu,
+        shaders,
+        cache,
+        scene,
+        settings,
+        term,
+        stride,
+        settings.layered.phase,
+    )
+}
+
+/// [`term_error`] with the reference's phase function chosen apart from the GPU frame's:
+/// Schlick's form on the GPU against the true Henyey-Greenstein reference is what the
+/// approximation costs (`lucent report li`), against a Schlick reference only the
+/// implementation's error.
+#[allow(clippy::too_many_arguments)]
+pub fn term_error_against(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    scene: &Scene,
+    settings: &FrameSettings,
+    term: Term,
+    stride: u32,
+    reference_phase: PhaseForm,
 ) -> Result<TermError> {
     let mut scene = scene.clone();
     scene.ambient = Vec3::ZERO;
@@ -192,7 +220,7 @@ pub fn term_error(
         _ => None,
     };
     let options = SingleScatteringOptions {
-        phase: match settings.layered.phase {
+        phase: match reference_phase {
             PhaseForm::HenyeyGreenstein => Phase::HenyeyGreenstein,
             PhaseForm::Schlick => Phase::Schlick,
         },

@@ -7,8 +7,9 @@
 //!    pass beside its speed-of-light copy ([`crate::measure::speed_of_light`]), measured in the same run;
 //!    a bar plot of pass against copy; beside the thesis's table where the thesis has one.
 //! 2. **The seeds' tables**: GDC 2011's full-screen translucency cost beside ours as a share of
-//!    the lighting pass, and Li et al.'s Table 1 beside our frame times at its triangle counts
-//!    and resolutions ([`crate::report::seeds`]).
+//!    the lighting pass, and Li et al.'s Table 1 beside our frame times (technique `auto`, their
+//!    passes included) at its triangle counts and dynamic-texture (light-space map)
+//!    resolutions, with their claim as ratios ([`crate::report::seeds`]).
 //! 3. **Scaling** ([`crate::measure::scaling`]): frame and per-pass time against triangles, resolution
 //!    and light count, with curves and which passes grow with what.
 //! 4. **Error against time**: one section per technique with approximation knobs
@@ -31,6 +32,7 @@ use crate::report::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, P
 use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
 
+pub mod li;
 pub mod plot;
 pub mod section;
 pub mod seeds;
@@ -386,19 +388,52 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     out.markdown
         .push_str(&crate::report::seeds::gdc_beside(&cost).replacen("## ", "### ", 1));
     out.markdown.push('\n');
-    // Li et al.: scaling:N at their counts, 512x512 and 1024x1024.
-    let li = li_points(ctx)?;
+    // Li et al.: scaling:N at their counts, technique auto (their passes included), 512^2 and
+    // 1024^2 light-space maps, one output size, all in one round-robin run.
+    let (li, side) = li_points(ctx)?;
     let ours: Vec<LiOurs> = li[0]
         .iter()
         .zip(&li[1])
         .map(|(a, b)| LiOurs {
             triangles: a.triangles,
             frame_ms: [a.frame.median, b.frame.median],
+            maps_ms: [a.pass_ms("light-space maps"), b.pass_ms("light-space maps")],
+            layered_ms: [
+                crate::report::li::layered_sum(a),
+                crate::report::li::layered_sum(b),
+            ],
         })
         .collect();
+    let ratios = crate::report::seeds::li_ratios(&ours);
+    let shown = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.2}x"));
+    out.summary.push(format!(
+        "Li et al.'s Table 1 (`scaling:N`, technique `auto`, {side}x{side}): frame time 1024 / \
+         512 light-space maps {} at {} triangles (theirs {:.2}x), triangles {} / {} {} at 512 \
+         maps (theirs {:.2}x)",
+        shown(ratios.ours_resolution[0]),
+        li_counts(ctx.options.quick)[0],
+        ratios.theirs_resolution[0],
+        LI_TABLE_1[ratios.rows - 1].triangles,
+        LI_TABLE_1[0].triangles,
+        shown(ratios.ours_triangles[0]),
+        ratios.theirs_triangles[0],
+    ));
     out.markdown.push_str(
-        &crate::report::seeds::li_beside(&device, Technique::None.name(), &ours)
-            .replacen("## ", "### ", 1),
+        &crate::report::seeds::li_beside(
+            &device,
+            &format!(
+                "`scaling:N` (a procedural teapot of N triangles, Jensen's skin1 as a layered \
+                 medium, one point light) under technique `{}` at {side}x{side} output, \
+                 subpasses unmerged, medians of {} round-robin frames after {} warm-up (every \
+                 row and both texture sizes in one run)",
+                Technique::Auto.name(),
+                ctx.options.frames,
+                ctx.options.warmup
+            ),
+            &ours,
+        )
+        .replacen("## ", "### ", 1)
+        .replace("\n### Cost follows", "\n#### Cost follows"),
     );
     let png = ctx.dir.join("li-table-1.png");
     let mut series = Vec::new();
@@ -415,9 +450,9 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                 .collect(),
         });
     }
-    for (i, size) in [512, 1024].iter().enumerate() {
+    for (i, size) in LI_MAP_SIZES.iter().enumerate() {
         series.push(PlotSeries {
-            name: format!("lucent {size}x{size} (ours, {device})"),
+            name: format!("lucent, {size}^2 maps (ours, {device})"),
             points: li[i]
                 .iter()
                 .map(|m| PlotPoint {
@@ -487,30 +522,52 @@ pub fn gdc_cost(
     })
 }
 
-/// `scaling:N` at Li et al.'s counts, at 512x512 and 1024x1024 (one round-robin run each).
-fn li_points(ctx: &SuiteContext<'_>) -> Result<[Vec<Measured>; 2]> {
+/// Li et al.'s dynamic-texture resolutions: lucent's light-space map texels per face.
+pub const LI_MAP_SIZES: [u32; 2] = [512, 1024];
+
+/// The output size (square) Li et al.'s Table 1 is measured at: 1024x1024, `--quick` 256x256.
+pub fn li_output_side(quick: bool) -> u32 {
+    if quick {
+        256
+    } else {
+        1024
+    }
+}
+
+/// `scaling:N` at Li et al.'s counts under technique `auto` (Li et al.'s passes on the
+/// layered teapot) with 512^2 and 1024^2 light-space maps at [`li_output_side`], every point
+/// in one round-robin run; per map size the points in count order, and the output side.
+fn li_points(ctx: &SuiteContext<'_>) -> Result<([Vec<Measured>; 2], u32)> {
     let counts = li_counts(ctx.options.quick);
+    let side = li_output_side(ctx.options.quick);
     let mut scenes = Vec::new();
     for &n in &counts {
         scenes.push(crate::bake::scene::load_scene_baked(&format!(
             "scaling:{n}"
         ))?);
     }
-    let mut out: [Vec<Measured>; 2] = [Vec::new(), Vec::new()];
-    for (i, size) in [512u32, 1024].iter().enumerate() {
-        let configs: Vec<Config> = counts
-            .iter()
-            .zip(&scenes)
-            .map(|(&n, scene)| Config {
-                label: format!("{n}"),
-                x: crate::measure::scaling::triangles(scene) as f64,
-                scene: scene.clone(),
-                settings: crate::measure::scaling::settings(Technique::None, *size, *size),
-            })
-            .collect();
-        out[i] = measure_with_progress(ctx, &format!("Li et al. {size}x{size}"), &configs)?;
+    let mut configs = Vec::new();
+    for &size in &LI_MAP_SIZES {
+        for (&n, scene) in counts.iter().zip(&scenes) {
+            let scene = scene.clone();
+            let mut settings = crate::measure::scaling::settings(Technique::Auto, side, side);
+            settings.shadows.enabled = true;
+            settings.shadows.size = size;
+            configs.push(Config {
+                label: format!("{n}, {size}^2 maps"),
+                x: crate::measure::scaling::triangles(&scene) as f64,
+                scene,
+                settings,
+            });
+        }
     }
-    Ok(out)
+    let mut measured = measure_with_progress(
+        ctx,
+        &format!("Li et al.'s Table 1, {side}x{side}"),
+        &configs,
+    )?;
+    let at_1024 = measured.split_off(counts.len());
+    Ok(([measured, at_1024], side))
 }
 
 fn curves(points: &[Measured]) -> Vec<PlotSeries> {

@@ -5,7 +5,8 @@
 //! - the LEAN-mapping thesis's Tables 1 and 2 (per-pass ms of LBB and the control): [`beside`];
 //! - GDC 2011's full-screen translucency cost per platform: [`gdc_beside`];
 //! - Li et al.'s Table 1 (FPS from 2,900 to 1,084,450 triangles at 512 and 1024 dynamic-texture
-//!   resolution): [`li_beside`].
+//!   resolution): [`li_beside`] (with their claim as ratios, [`li_claim`]) and, for one bench,
+//!   [`li_bench_beside`].
 //!
 //! Absolute times on a CPU Vulkan driver and on 2008-2013 GPUs are not comparable; every table
 //! shows shares and ratios beside the milliseconds, and names both devices.
@@ -321,65 +322,287 @@ pub const LI_TABLE_1: &[LiRow] = &[
 /// The machine Li et al. measured on.
 pub const LI_DEVICE: &str = "Pentium 4 3.0 GHz, NVIDIA GeForce 8800 GTS 512M, DirectX 9.0c, SM 3.0";
 
-/// Our frame at one of Li et al.'s triangle counts, at 512x512 and 1024x1024 output.
+/// Our frame at one of Li et al.'s triangle counts, with 512^2 and 1024^2 light-space maps
+/// (their "dynamic texture" resolutions) at one output size.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LiOurs {
     /// Triangles drawn.
     pub triangles: u64,
-    /// Frame medians at 512x512 and 1024x1024, ms.
+    /// Frame medians with 512^2 and 1024^2 maps, ms.
     pub frame_ms: [f64; 2],
+    /// The `light-space maps` pass's medians, ms (`None`: no such pass).
+    pub maps_ms: [Option<f64>; 2],
+    /// Li et al.'s three passes (irradiance, single and multiple scattering), sums of their
+    /// medians, ms (`None`: a pass is missing).
+    pub layered_ms: [Option<f64>; 2],
 }
 
-/// Li et al.'s Table 1 beside our frame times at the same triangle counts. Their resolution is
-/// that of their dynamic textures; lucent does not implement their technique yet, so ours is
-/// the output resolution of `technique`'s frame of a procedural teapot (`scaling:N`): the table
-/// compares how each grows with triangles and resolution, as ratios to its own first row.
-pub fn li_beside(device: &str, technique: &str, ours: &[LiOurs]) -> String {
+/// `x / of` when both are positive finite numbers.
+fn ratio_of(x: f64, of: f64) -> Option<f64> {
+    (x.is_finite() && of.is_finite() && x > 0.0 && of > 0.0).then(|| x / of)
+}
+
+/// `Some(x)` as "1.23x", `None` as "-".
+fn times(x: Option<f64>) -> String {
+    x.map_or("-".into(), |x| format!("{x:.2}x"))
+}
+
+/// `Some(ms)` with 2 decimals, 0, missing or not finite as "-".
+fn ms_cell(x: Option<f64>) -> String {
+    match x {
+        Some(v) if v.is_finite() && v > 0.0 => format!("{v:.2}"),
+        _ => "-".into(),
+    }
+}
+
+/// Li et al.'s claim "cost follows the texture resolution, not the triangle count", as
+/// frame-time ratios, theirs (from 1000 / FPS) over the rows we measured and ours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LiRatios {
+    /// Rows compared (the first `rows` of [`LI_TABLE_1`]).
+    pub rows: usize,
+    /// Theirs: 1024 / 512 at the smallest and at the largest triangle count compared.
+    pub theirs_resolution: [f64; 2],
+    /// Ours: the same.
+    pub ours_resolution: [Option<f64>; 2],
+    /// Theirs: largest / smallest triangle count at 512 and at 1024.
+    pub theirs_triangles: [f64; 2],
+    /// Ours: the same.
+    pub ours_triangles: [Option<f64>; 2],
+}
+
+/// The ratios of [`LiRatios`] over `ours` (in [`LI_TABLE_1`]'s order, its first rows).
+pub fn li_ratios(ours: &[LiOurs]) -> LiRatios {
+    let rows = ours.len().clamp(1, LI_TABLE_1.len());
+    let (first, last) = (LI_TABLE_1[0], LI_TABLE_1[rows - 1]);
+    let ms = |fps: f64| 1000.0 / fps;
+    let (o_first, o_last) = (ours.first(), ours.last());
+    let ours_res = |o: Option<&LiOurs>| o.and_then(|o| ratio_of(o.frame_ms[1], o.frame_ms[0]));
+    let ours_tri = |i: usize| match (o_first, o_last) {
+        (Some(a), Some(b)) => ratio_of(b.frame_ms[i], a.frame_ms[i]),
+        _ => None,
+    };
+    LiRatios {
+        rows,
+        theirs_resolution: [first.fps_512 / first.fps_1024, last.fps_512 / last.fps_1024],
+        ours_resolution: [ours_res(o_first), ours_res(o_last)],
+        theirs_triangles: [
+            ms(last.fps_512) / ms(first.fps_512),
+            ms(last.fps_1024) / ms(first.fps_1024),
+        ],
+        ours_triangles: [ours_tri(0), ours_tri(1)],
+    }
+}
+
+/// Which of the two a set of ratios says the cost follows (stated whatever it shows).
+fn follows(resolution: Option<f64>, triangles: Option<f64>) -> &'static str {
+    match (resolution, triangles) {
+        (Some(r), Some(t)) if r > 1.1 * t => "the texture resolution more than the triangle count",
+        (Some(r), Some(t)) if t > 1.1 * r => "the triangle count more than the texture resolution",
+        (Some(_), Some(_)) => "both about alike (within 10%)",
+        _ => "nothing measurable (a ratio is missing)",
+    }
+}
+
+/// Li et al.'s Table 1 beside our frame times at the same triangle counts: lucent's frame of
+/// `setup` (Li et al.'s technique included) with 512^2 and 1024^2 light-space maps, their
+/// dynamic-texture resolutions, at one output size; then their claim as ratios.
+pub fn li_beside(device: &str, setup: &str, ours: &[LiOurs]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
         "## Beside Li et al.'s Table 1 (FPS against triangles)\n\n\
          - theirs: {LI_DEVICE}; 512 and 1024 are their dynamic-texture resolutions\n\
-         - ours: {device}; `scaling:N` (a procedural teapot at N triangles) under technique \
-          `{technique}` at 512x512 and 1024x1024 output. **Li et al.'s layered dynamic-texture \
-          technique is not implemented in lucent yet**: these are the frames of the techniques \
-          we have, at the same triangle counts and resolutions\n\
-         - \"x first\": frame time over the first row's (theirs from 1000 / FPS), so the growth \
-          with triangles compares without comparing devices; \"1024 / 512\": the frame-time ratio \
-          between the two resolutions\n\n\
-         | object | triangles | theirs FPS 512 | theirs FPS 1024 | theirs ms 512 | theirs x first | theirs 1024 / 512 | ours triangles | ours ms 512 | ours ms 1024 | ours x first | ours 1024 / 512 |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+         - ours: {device}; {setup}, with Li et al.'s passes (layered irradiance, single and \
+          multiple scattering) in the frame; 512 and 1024 are the light-space maps' texels per \
+          face, the textures lucent's passes read the light's entry points from (a point light: \
+          six faces)\n\
+         - \"1024 / 512\": the frame-time ratio between the two texture resolutions (theirs \
+          from 1000 / FPS); \"maps\": the `light-space maps` pass; \"Li passes\": the sum of \
+          the three layered passes' medians\n\n\
+         | object | triangles | theirs FPS 512 | theirs FPS 1024 | theirs ms 512 | theirs 1024 / 512 | ours triangles | ours ms 512 | ours ms 1024 | ours FPS 512 | ours FPS 1024 | ours 1024 / 512 | ours maps ms 512 / 1024 | ours Li passes ms 512 / 1024 |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
-    let their_first = LI_TABLE_1.first().map_or(1.0, |r| 1000.0 / r.fps_512);
-    let our_first = ours.first().map_or(0.0, |o| o.frame_ms[0]);
-    // Guarded: a missing or 0 ms first row gives no ratio.
-    let ratio = |x: f64, of: f64| {
-        if of > 0.0 {
-            format!("{:.2}x", x / of)
-        } else {
-            "-".into()
-        }
-    };
+    let fps = |ms: f64| ratio_of(1000.0, ms).map_or("-".into(), |f| format!("{f:.1}"));
     for (i, row) in LI_TABLE_1.iter().enumerate() {
-        let theirs_ms = 1000.0 / row.fps_512;
         let o = ours.get(i);
-        let _ = writeln!(
+        let _ =
+            writeln!(
             out,
-            "| {} | {} | {:.0} | {:.0} | {:.2} | {:.2}x | {:.2}x | {} | {} | {} | {} | {} |",
+            "| {} | {} | {:.0} | {:.0} | {:.2} | {:.2}x | {} | {} | {} | {} | {} | {} | {} | {} |",
             row.object,
             row.triangles,
             row.fps_512,
             row.fps_1024,
-            theirs_ms,
-            theirs_ms / their_first,
+            1000.0 / row.fps_512,
             row.fps_512 / row.fps_1024,
             o.map_or("-".into(), |o| o.triangles.to_string()),
-            o.map_or("-".into(), |o| format!("{:.2}", o.frame_ms[0])),
-            o.map_or("-".into(), |o| format!("{:.2}", o.frame_ms[1])),
-            o.map_or("-".into(), |o| ratio(o.frame_ms[0], our_first)),
-            o.map_or("-".into(), |o| ratio(o.frame_ms[1], o.frame_ms[0])),
+            o.map_or("-".into(), |o| ms_cell(Some(o.frame_ms[0]))),
+            o.map_or("-".into(), |o| ms_cell(Some(o.frame_ms[1]))),
+            o.map_or("-".into(), |o| fps(o.frame_ms[0])),
+            o.map_or("-".into(), |o| fps(o.frame_ms[1])),
+            o.map_or("-".into(), |o| times(ratio_of(o.frame_ms[1], o.frame_ms[0]))),
+            o.map_or("-".into(), |o| format!(
+                "{} / {}",
+                ms_cell(o.maps_ms[0]),
+                ms_cell(o.maps_ms[1])
+            )),
+            o.map_or("-".into(), |o| format!(
+                "{} / {}",
+                ms_cell(o.layered_ms[0]),
+                ms_cell(o.layered_ms[1])
+            )),
         );
     }
+    out.push_str(&li_claim(ours));
+    out
+}
+
+/// Li et al.'s claim, "cost follows the texture resolution, not the triangle count", as
+/// ratios of frame times: theirs and ours over the same rows.
+pub fn li_claim(ours: &[LiOurs]) -> String {
+    let r = li_ratios(ours);
+    let (first, last) = (LI_TABLE_1[0], LI_TABLE_1[r.rows - 1]);
+    let whole = LI_TABLE_1[LI_TABLE_1.len() - 1];
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "\n### Cost follows the texture resolution, not the triangle count?\n\n\
+         Li et al. find their cost follows the dynamic textures' resolution rather than the \
+         triangle count (their whole table: {:.0} times the triangles cost {:.2}x at 512 and \
+         {:.2}x at 1024; the resolution 1024 / 512 costs {:.2}x at {} triangles). As \
+         frame-time ratios over the rows measured here ({} to {} triangles):\n\n\
+         | | texture 1024 / 512 at {} triangles | texture 1024 / 512 at {} triangles | triangles {} / {} at 512 | triangles {} / {} at 1024 |\n\
+         |---|---:|---:|---:|---:|\n\
+         | theirs | {:.2}x | {:.2}x | {:.2}x | {:.2}x |\n\
+         | ours | {} | {} | {} | {} |\n",
+        whole.triangles as f64 / LI_TABLE_1[0].triangles as f64,
+        LI_TABLE_1[0].fps_512 / whole.fps_512,
+        LI_TABLE_1[0].fps_1024 / whole.fps_1024,
+        LI_TABLE_1[0].fps_512 / LI_TABLE_1[0].fps_1024,
+        LI_TABLE_1[0].triangles,
+        first.triangles,
+        last.triangles,
+        first.triangles,
+        last.triangles,
+        last.triangles,
+        first.triangles,
+        last.triangles,
+        first.triangles,
+        r.theirs_resolution[0],
+        r.theirs_resolution[1],
+        r.theirs_triangles[0],
+        r.theirs_triangles[1],
+        times(r.ours_resolution[0]),
+        times(r.ours_resolution[1]),
+        times(r.ours_triangles[0]),
+        times(r.ours_triangles[1]),
+    );
+    let _ = writeln!(
+        out,
+        "At the smallest count and 512 textures, theirs follows {}; ours follows {}. With \
+         1024 textures and the largest count: theirs {}, ours {}.",
+        follows(Some(r.theirs_resolution[0]), Some(r.theirs_triangles[0])),
+        follows(r.ours_resolution[0], r.ours_triangles[0]),
+        follows(Some(r.theirs_resolution[1]), Some(r.theirs_triangles[1])),
+        follows(r.ours_resolution[1], r.ours_triangles[1]),
+    );
+    out
+}
+
+/// The row of Li et al.'s Table 1 nearest `triangles` (in ratio).
+pub fn li_nearest_row(triangles: u64) -> LiRow {
+    let t = (triangles.max(1) as f64).ln();
+    *LI_TABLE_1
+        .iter()
+        .min_by(|a, b| {
+            let d = |r: &LiRow| ((r.triangles as f64).ln() - t).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .expect("the table has rows")
+}
+
+/// `lucent bench --compare-seeds` on a layered scene: the row of Li et al.'s Table 1 nearest
+/// the scene's triangle count beside the bench (`map_size`: the light-space maps' texels per
+/// face, `None` when no light casts).
+pub fn li_bench_beside(report: &BenchReport, triangles: u64, map_size: Option<u32>) -> String {
+    let row = li_nearest_row(triangles);
+    let layered: Vec<&crate::measure::bench::PassRow> = report
+        .passes
+        .iter()
+        .filter(|p| {
+            [
+                "layered irradiance",
+                "single scattering",
+                "multiple scattering",
+            ]
+            .iter()
+            .any(|n| p.name.contains(n))
+        })
+        .collect();
+    let layered_ms: f64 = layered.iter().map(|p| p.median_ms).sum();
+    let maps = report
+        .passes
+        .iter()
+        .find(|p| p.name.contains("light-space maps"));
+    let frame = report.frame_ms.median;
+    let share = |x: f64| ratio_of(x, frame).map_or("-".into(), |s| format!("{:.1}%", s * 100.0));
+    let fps = ratio_of(1000.0, frame).map_or("-".into(), |f| format!("{f:.1}"));
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "## Beside Li et al.'s Table 1 (the row nearest this scene's triangles)\n\n\
+         - theirs: {LI_DEVICE}; row `{}`, {} triangles; 512 and 1024 are their dynamic-texture \
+          resolutions\n\
+         - ours: {}, {}x{}, scene `{}` ({triangles} triangles), technique `{}`, {}; Li et al.'s \
+          passes: {}\n\n\
+         | | triangles | texture | FPS | frame ms | Li passes ms | Li passes share | light-space maps ms |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|\n\
+         | theirs | {} | 512 | {:.0} | {:.2} | - | - | - |\n\
+         | theirs | {} | 1024 | {:.0} | {:.2} | - | - | - |\n\
+         | ours | {triangles} | {} | {fps} | {} | {} | {} | {} |",
+        row.object,
+        row.triangles,
+        report.device,
+        report.width,
+        report.height,
+        report.scene,
+        report.technique,
+        map_size.map_or("no light-space maps (no light casts)".into(), |s| format!(
+            "light-space maps {s}^2 texels per face"
+        )),
+        if layered.is_empty() {
+            "none in this frame".to_string()
+        } else {
+            layered
+                .iter()
+                .map(|p| format!("`{}`", p.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        },
+        row.triangles,
+        row.fps_512,
+        1000.0 / row.fps_512,
+        row.triangles,
+        row.fps_1024,
+        1000.0 / row.fps_1024,
+        map_size.map_or("-".into(), |s| s.to_string()),
+        ms_cell(Some(frame)),
+        ms_cell((!layered.is_empty()).then_some(layered_ms)),
+        if layered.is_empty() {
+            "-".into()
+        } else {
+            share(layered_ms)
+        },
+        ms_cell(maps.map(|p| p.median_ms)),
+    );
+    let _ = writeln!(
+        out,
+        "\nTheirs 1024 / 512 at this row: {:.2}x. Ours at one texture size only; `lucent \
+         report` measures both sizes at every row in one run (and bench with `--shadow-size \
+         512` or `1024` picks the size).",
+        row.fps_512 / row.fps_1024
+    );
     out
 }
 
@@ -396,18 +619,58 @@ mod tests {
         assert!((LI_TABLE_1[0].fps_512 / LI_TABLE_1[0].fps_1024 - 3.25).abs() < 0.01);
         let ours: Vec<LiOurs> = LI_TABLE_1
             .iter()
-            .map(|r| LiOurs {
+            .enumerate()
+            .map(|(i, r)| LiOurs {
                 triangles: r.triangles,
-                frame_ms: [2.0, 6.0],
+                frame_ms: [2.0 + i as f64, 6.0 + i as f64],
+                maps_ms: [Some(1.0), Some(4.0)],
+                layered_ms: [Some(0.5), None],
             })
             .collect();
-        let text = li_beside("llvmpipe", "none", &ours);
+        let text = li_beside("llvmpipe", "`scaling:N`, technique `auto`", &ours);
         assert!(
             text.contains("| Happy buddha | 1084450 | 63 | 42 |"),
             "{text}"
         );
-        assert!(text.contains("| 1.00x | 3.00x |"), "{text}");
-        assert!(text.contains("not implemented in lucent yet"), "{text}");
+        assert!(
+            text.contains("| 2.00 | 6.00 | 500.0 | 166.7 | 3.00x | 1.00 / 4.00 | 0.50 / - |"),
+            "{text}"
+        );
+        assert!(!text.contains("not implemented"), "{text}");
+        assert!(
+            text.contains("374 times the triangles cost 3.67x at 512 and 1.69x at 1024"),
+            "{text}"
+        );
+        // The claim: theirs 231 / 71 against 231 / 63 (ms ratios), ours 6 / 2 against 9 / 2.
+        let r = li_ratios(&ours);
+        assert!((r.theirs_resolution[0] - 231.0 / 71.0).abs() < 1e-9);
+        assert!((r.theirs_triangles[0] - 231.0 / 63.0).abs() < 1e-9);
+        assert_eq!(r.ours_resolution[0], Some(3.0));
+        assert_eq!(r.ours_triangles[0], Some(4.5));
+        assert!(
+            text.contains("| theirs | 3.25x | 1.50x | 3.67x | 1.69x |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("| ours | 3.00x | 1.44x | 4.50x | 2.17x |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("ours follows the triangle count more than the texture resolution"),
+            "{text}"
+        );
+        // Guarded: no frame gives "-", never NaN.
+        let none = [LiOurs {
+            triangles: 2_900,
+            frame_ms: [0.0, f64::NAN],
+            maps_ms: [None, None],
+            layered_ms: [None, None],
+        }];
+        let text = li_beside("llvmpipe", "x", &none);
+        assert!(!text.contains("NaN") && !text.contains("inf |"), "{text}");
+        assert_eq!(li_ratios(&none).ours_resolution, [None, None]);
+        assert_eq!(li_nearest_row(5_000).object, "teapot");
+        assert_eq!(li_nearest_row(2_000_000).triangles, 1_084_450);
     }
 
     #[test]

@@ -280,11 +280,13 @@ impl SceneGpu {
         let per_frame = PerFrame::new(
             gpu,
             upload.frames_in_flight,
-            upload.translucency_table_bytes,
-            upload.profile_table_bytes,
-            upload.kernel_table_bytes,
-            upload.shadow_table_bytes,
-            upload.layered_table_bytes,
+            &per_frame::TableBytes {
+                translucency: upload.translucency_table_bytes,
+                profiles: upload.profile_table_bytes,
+                kernels: upload.kernel_table_bytes,
+                shadows: upload.shadow_table_bytes,
+                layered: upload.layered_table_bytes,
+            },
             &scene.name,
         )?;
         let mut out = Self {

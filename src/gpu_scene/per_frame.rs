@@ -165,6 +165,21 @@ pub struct PerFrameBinding {
     pub stride: u64,
 }
 
+/// Bytes of each table region of the per-frame buffer (0: the frame has no such table).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TableBytes {
+    /// The GDC 2011 material table.
+    pub translucency: u64,
+    /// The SSS profile table.
+    pub profiles: u64,
+    /// The separable kernel table.
+    pub kernels: u64,
+    /// The light-space maps' table.
+    pub shadows: u64,
+    /// The layered media's table.
+    pub layered: u64,
+}
+
 /// The per-frame buffer and tiles, one slot per frame in flight (see the module docs).
 pub struct PerFrame {
     /// Locked only while the CPU writes a slot (passes bind `handle`).
@@ -178,18 +193,12 @@ pub struct PerFrame {
 }
 
 impl PerFrame {
-    /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with a
-    /// translucency region of `translucency_bytes`, a profile region of `profile_bytes`, a
-    /// kernel region of `kernel_bytes`, a shadow region of `shadow_bytes` and a layered region
-    /// of `layered_bytes` (0: the frame has none).
+    /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with
+    /// the tables' regions `table_bytes` long (0: the frame has none).
     pub fn new(
         gpu: &GpuContext,
         slots: usize,
-        translucency_bytes: u64,
-        profile_bytes: u64,
-        kernel_bytes: u64,
-        shadow_bytes: u64,
-        layered_bytes: u64,
+        table_bytes: &TableBytes,
         name: &str,
     ) -> Result<Self> {
         if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&slots) {
@@ -201,11 +210,11 @@ impl PerFrame {
         let round = |v: u64| v.div_ceil(align) * align;
         let sizes = [
             std::mem::size_of::<FrameUniforms>() as u64,
-            translucency_bytes,
-            profile_bytes,
-            kernel_bytes,
-            shadow_bytes,
-            layered_bytes,
+            table_bytes.translucency,
+            table_bytes.profiles,
+            table_bytes.kernels,
+            table_bytes.shadows,
+            table_bytes.layered,
         ];
         let mut offsets = [0u64; REGIONS];
         let mut end = 0u64;

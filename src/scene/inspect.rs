@@ -170,10 +170,20 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
             ));
         }
         if let Some(l) = &m.layers {
+            let textured = l
+                .layers
+                .iter()
+                .any(|x| matches!(x.thickness, super::layered::Thickness::Texture { .. }));
             parts.push(format!(
-                "layered {} ({} layers; not rendered yet)",
+                "layered {} ({} layer{}{})",
                 l.name,
-                l.layers.len()
+                l.layers.len(),
+                if l.layers.len() == 1 { "" } else { "s" },
+                if textured {
+                    "; thickness textures: the f64 reference reads them, a render refuses them"
+                } else {
+                    ""
+                }
             ));
         }
         let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
@@ -280,7 +290,7 @@ mod tests {
         let mut s = String::new();
         write_scene_materials(&mut s, &scene);
         assert!(
-            s.contains("material teapot: layered skin1 (1 layers; not rendered yet)")
+            s.contains("material teapot: layered skin1 (1 layer)")
                 && s.contains("eta 1.3, weights (diffuse, specular, transmitted, single, multiple) 0.3 0.3 0.05 0.05 0.03, 0.04 units/mm")
                 && s.contains("layer 0: thickness rest (semi-infinite), sigma_a [0.032, 0.17, 0.48] /mm, sigma_s [0.74, 0.88, 1.01] /mm, g 0"),
             "{s}"

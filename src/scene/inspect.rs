@@ -291,7 +291,7 @@ mod tests {
         write_scene_materials(&mut s, &scene);
         assert!(
             s.contains("material teapot: layered skin1 (1 layer)")
-                && s.contains("eta 1.3, weights (diffuse, specular, transmitted, single, multiple) 0.3 0.3 0.05 0.05 0.03, 0.04 units/mm")
+                && s.contains("eta 1.3, weights (diffuse, specular, transmitted, single, multiple) 0 1 1 1 1, 0.04 units/mm")
                 && s.contains("layer 0: thickness rest (semi-infinite), sigma_a [0.032, 0.17, 0.48] /mm, sigma_s [0.74, 0.88, 1.01] /mm, g 0"),
             "{s}"
         );

@@ -6,7 +6,9 @@ use glam::Vec3;
 use lucent::features::layered::{LayeredKnobs, PhaseForm};
 use lucent::frame::{plan_frame, FrameDesc, FrameSettings, Renderer, Technique};
 use lucent::graph::Plan;
-use lucent::measure::layered_error::{comparison_lights, sphere_scene, term_error, Term};
+use lucent::measure::layered_error::{
+    clear_medium, comparison_lights, sphere_scene, term_error, Term,
+};
 use lucent::scene::builtin;
 use lucent::scene::layered::{Layer, LayeredMedium, Thickness};
 use lucent::scene::Scene;
@@ -19,18 +21,6 @@ fn settings(w: u32, h: u32) -> FrameSettings {
     let mut s = FrameSettings::new(w, h);
     s.shadows.size = 512;
     s
-}
-
-/// A clear medium (a 12.5 mm sphere lets e^-1.5 of the light through): the transmitted term
-/// is large.
-fn clear_medium() -> LayeredMedium {
-    LayeredMedium::homogeneous(
-        "clear",
-        Vec3::new(0.04, 0.05, 0.06),
-        Vec3::new(0.01, 0.02, 0.04),
-        0.0,
-        1.3,
-    )
 }
 
 /// Two layers with a forward-scattering top (skin-layered's epidermis over a clearer rest).

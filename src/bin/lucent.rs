@@ -576,45 +576,24 @@ impl FrameArgs {
                 scene.deformation.is_some(),
             ),
             (
-                self.layered_steps.is_some(),
-                "--layered-steps",
-                layered,
-                desc.layered.is_some(),
-            ),
-            (
-                self.pixel_lights.is_some(),
-                "--pixel-lights",
-                layered,
-                desc.layered.is_some(),
-            ),
-            (
-                self.phase.is_some(),
-                "--phase",
-                layered,
-                desc.layered.is_some(),
-            ),
-            (
-                self.half_irradiance,
-                "--half-irradiance",
-                layered,
-                desc.layered.is_some(),
-            ),
-            (
-                self.single_depth.is_some(),
-                "--single-depth",
-                layered,
-                desc.layered.is_some(),
-            ),
-            (
                 self.shadow_size.is_some(),
                 "--shadow-size",
                 "a light that casts shadows (without --no-shadows; lights with shadows = true)",
                 desc.shadows.is_some(),
             ),
         ];
+        let layered_knobs = [
+            (self.layered_steps.is_some(), "--layered-steps"),
+            (self.pixel_lights.is_some(), "--pixel-lights"),
+            (self.phase.is_some(), "--phase"),
+            (self.half_irradiance, "--half-irradiance"),
+            (self.single_depth.is_some(), "--single-depth"),
+        ]
+        .map(|(given, flag)| (given, flag, layered, desc.layered.is_some()));
         let technique = settings.technique;
         knobs
             .iter()
+            .chain(&layered_knobs)
             .filter(|(given, _, _, applies)| *given && !applies)
             .map(|(_, flag, needs, _)| {
                 format!(

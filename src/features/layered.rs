@@ -54,9 +54,6 @@ use crate::{LucentError, Result};
 
 /// The G-buffer's layered material ID per pixel (ID / 255; 0: not layered).
 pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;
-/// The light-space maps' entry data: the first surface's normal (`n * 0.5 + 0.5`) and its
-/// layered material ID / 255.
-pub const ENTRY_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// The transmitted irradiance image.
 pub const IRRADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Layered materials a frame holds at most (IDs 1 to 16).

@@ -37,6 +37,10 @@ use crate::gpu_scene::{Region, SceneGpu};
 pub const SHADOW_DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// The translucency material ID of each map texel's first surface (frames with translucency).
 pub const SHADOW_ID_FORMAT: vk::Format = vk::Format::R8_UINT;
+/// The light-space maps' entry data in frames with layered media (single scattering's light
+/// entry points, src/features/layered.rs): the first surface's normal (`n * 0.5 + 0.5`) and
+/// its layered material ID / 255.
+pub const ENTRY_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// Faces the atlas holds at most: six per light (glsl/common/shadows.glsl).
 pub const MAX_SHADOW_FACES: usize = 6 * MAX_LIGHTS;
 /// Largest atlas edge in texels: when a scene's faces do not fit at the asked size, the tile
@@ -342,7 +346,7 @@ pub fn shadow_pass(
             .then(|| graph.create_image("light-space.ids", info(SHADOW_ID_FORMAT))),
         entry: desc
             .entry
-            .then(|| graph.create_image("light-space.entry", info(super::layered::ENTRY_FORMAT))),
+            .then(|| graph.create_image("light-space.entry", info(ENTRY_FORMAT))),
     };
     let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
     if let Some(ids) = &mut maps.ids {

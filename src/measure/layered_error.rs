@@ -92,6 +92,18 @@ pub fn sphere_scene(medium: LayeredMedium, lights: Vec<Light>) -> Result<Scene> 
     })
 }
 
+/// A clear medium (a 12.5 mm sphere lets e^-1.5 of the light through): the transmitted term
+/// is large (the layered tests' and `report li`'s).
+pub fn clear_medium() -> LayeredMedium {
+    LayeredMedium::homogeneous(
+        "clear",
+        Vec3::new(0.04, 0.05, 0.06),
+        Vec3::new(0.01, 0.02, 0.04),
+        0.0,
+        1.3,
+    )
+}
+
 /// The lights of the comparison: a point light above and to the side (it lights about half of
 /// what the camera sees, the rest is lit through the object) and a dimmer one behind.
 pub fn comparison_lights() -> Vec<Light> {

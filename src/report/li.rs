@@ -27,7 +27,7 @@ use crate::backend::GpuContext;
 use crate::features::layered::{LayeredKnobs, PhaseForm};
 use crate::frame::{FrameSettings, Technique};
 use crate::measure::layered_error::{
-    comparison_lights, sphere_scene, term_error_against, Term, TermError,
+    clear_medium, comparison_lights, sphere_scene, term_error_against, Term, TermError,
 };
 use crate::measure::scaling::{Config, Measured};
 use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
@@ -198,18 +198,6 @@ fn sum_positive(parts: [Option<f64>; 3]) -> Option<f64> {
 /// Li et al.'s teapot medium in lucent's `scaling:N` (Jensen's skin1).
 fn skin1() -> LayeredMedium {
     LayeredMedium::preset("skin1").expect("a preset")
-}
-
-/// A clear medium (a 12.5 mm sphere lets e^-1.5 of the light through): the transmitted term
-/// is large (the layered tests' medium).
-pub fn clear_medium() -> LayeredMedium {
-    LayeredMedium::homogeneous(
-        "clear",
-        Vec3::new(0.04, 0.05, 0.06),
-        Vec3::new(0.01, 0.02, 0.04),
-        0.0,
-        1.3,
-    )
 }
 
 /// Jensen's skin1 with forward scattering `g` (the presets are isotropic; the reduced

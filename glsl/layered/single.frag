@@ -35,8 +35,7 @@ bool light_entry_plane(vec3 m, vec3 to_light, vec3 x_o, vec3 n_o, out vec3 p_in,
 }
 
 bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out vec3 p_in,
-                 out vec3 n_in, out bool interpolated) {
-    interpolated = false;
+                 out vec3 n_in) {
 #ifdef LUCENT_ENTRY_BINDING
     int index = shadow_face(i, m);
     if (index >= 0) {
@@ -70,7 +69,6 @@ bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, out v
                                     shadow_distance(FACE.params, d.y),
                                     shadow_distance(FACE.params, d.z),
                                     shadow_distance(FACE.params, d.w)));
-                interpolated = true;
             } else {
                 float raw = texelFetch(shadow_depth, texel, 0).r;
                 if (raw >= 1.0) {
@@ -222,9 +220,7 @@ void main() {
         float unused;
         light_incidence(frame.lights[i], m_mid, to_mid, unused);
         vec3 p_ref, n_ref;
-        bool interpolated;
-        bool entered = refracted &&
-                       light_entry(i, m_mid, to_mid, id, x_o, n_o, p_ref, n_ref, interpolated);
+        bool entered = refracted && light_entry(i, m_mid, to_mid, id, x_o, n_o, p_ref, n_ref);
         // L_t: light that crossed the object unscattered from its entry on the light's side
         // to x_o (a lit point is its own entry point: its light is L_d's); its own lookup,
         // made only where x_o faces away from the light.

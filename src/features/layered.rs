@@ -341,21 +341,15 @@ pub fn layered_passes(
             format: IRRADIANCE_FORMAT,
         },
     );
-    let shadow_ids = |inputs: &LayeredInputs<'_>| {
-        inputs.shadows.map(|m| {
-            (
-                m.depth.id(),
-                m.entry.as_ref().map(|h| h.id()).unwrap_or(m.depth.id()),
-            )
-        })
-    };
-    let sample_common = |pass: &mut crate::graph::declare::PassBuilder<'_>, with_maps: bool| {
+    // Every pass reads the G-buffer; irradiance the depth atlas (shadows), single scattering
+    // the depth and entry atlases (entry points).
+    let sample = |pass: &mut crate::graph::declare::PassBuilder<'_>, kind: Kind| {
         pass.sample(inputs.depth)
             .sample(inputs.gb1)
             .sample(inputs.ids);
-        if let (true, Some(maps)) = (with_maps, inputs.shadows) {
+        if let (Kind::Irradiance | Kind::Single, Some(maps)) = (kind, inputs.shadows) {
             pass.sample(&maps.depth);
-            if let Some(entry) = &maps.entry {
+            if let (Kind::Single, Some(entry)) = (kind, &maps.entry) {
                 pass.sample(entry);
             }
         }
@@ -364,45 +358,32 @@ pub fn layered_passes(
         depth: inputs.depth.id(),
         gb1: inputs.gb1.id(),
         ids: inputs.ids.id(),
-        shadows: shadow_ids(inputs),
+        shadow_depth: inputs.shadows.map(|m| m.depth.id()),
+        entry: inputs
+            .shadows
+            .and_then(|m| m.entry.as_ref().map(|h| h.id())),
         irradiance: None,
     };
 
     // Cleared: pixels outside the rectangles read 0 (the gather rejects them by ID anyway).
     let mut pass = graph.add_pass("layered irradiance", PassKind::Raster);
-    sample_common(&mut pass, true);
+    sample(&mut pass, Kind::Irradiance);
     pass.color(&mut irradiance, LoadOp::Clear([0.0; 4]));
     match scene {
-        Some(scene) => pass.execute(LayeredPass::new(
-            scene,
-            Kind::Irradiance,
-            LayeredPassInputs {
-                shadows: base.shadows,
-                ..base
-            },
-            scale,
-        )),
+        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Irradiance, base, scale)),
         None => pass.finish(),
     }
 
     let mut pass = graph.add_pass("single scattering", PassKind::Raster);
-    sample_common(&mut pass, true);
+    sample(&mut pass, Kind::Single);
     pass.color(&mut hdr, LoadOp::Load);
     match scene {
-        Some(scene) => pass.execute(LayeredPass::new(
-            scene,
-            Kind::Single,
-            LayeredPassInputs {
-                shadows: base.shadows,
-                ..base
-            },
-            1,
-        )),
+        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Single, base, 1)),
         None => pass.finish(),
     }
 
     let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
-    sample_common(&mut pass, false);
+    sample(&mut pass, Kind::Multiple);
     pass.sample(&irradiance);
     pass.color(&mut hdr, LoadOp::Load);
     match scene {
@@ -410,7 +391,6 @@ pub fn layered_passes(
             scene,
             Kind::Multiple,
             LayeredPassInputs {
-                shadows: None,
                 irradiance: Some(irradiance.id()),
                 ..base
             },
@@ -433,8 +413,10 @@ struct LayeredPassInputs {
     depth: ResourceId,
     gb1: ResourceId,
     ids: ResourceId,
-    /// The depth atlas and the entry atlas.
-    shadows: Option<(ResourceId, ResourceId)>,
+    /// The light-space depth atlas, when some light casts.
+    shadow_depth: Option<ResourceId>,
+    /// Its entry atlas (present with the depth atlas in layered frames).
+    entry: Option<ResourceId>,
     irradiance: Option<ResourceId>,
 }
 
@@ -482,8 +464,8 @@ impl PassExec for LayeredPass {
         if let Some(irradiance) = i.irradiance {
             bindings.push(Binding::Sampled(views[irradiance], self.nearest));
         }
-        if let (Some((depth, entry)), true) = (i.shadows, self.kind != Kind::Multiple) {
-            if self.kind == Kind::Single {
+        if let (Some(depth), true) = (i.shadow_depth, self.kind != Kind::Multiple) {
+            if let (Kind::Single, Some(entry)) = (self.kind, i.entry) {
                 defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[bindings.len()]));
                 bindings.push(Binding::Sampled(views[entry], self.nearest));
             }

@@ -338,6 +338,45 @@ fn visible(scene: &Scene, from: DVec3, normal: DVec3, light: &Light, to_light: D
     true
 }
 
+/// Light from `light` entering the closed `shape` on its way to inside point `m`: where the
+/// segment from `m` towards the light leaves the shape, and what crosses the boundary there.
+struct EnteringLight {
+    /// Direction from `m` towards the light.
+    to_light: DVec3,
+    /// The entry point `P'` on the analytic surface.
+    point: DVec3,
+    /// The outward normal there.
+    normal: DVec3,
+    /// Radiance x falloff at `P'` x Fresnel transmittance (RGB).
+    radiance: DVec3,
+}
+
+/// [`EnteringLight`] of `light` for `m`, or `None` when none enters: the light arrives from
+/// behind the entry surface, its falloff is 0 there, or another object blocks it.
+fn entering_light(
+    scene: &Scene,
+    shape: Shape,
+    transform: &glam::DMat4,
+    light: &Light,
+    m: DVec3,
+    eta: f64,
+) -> Option<EnteringLight> {
+    let (to_light, _) = light_incidence(light, m);
+    let d = exit_distance(shape, transform, m, to_light)?;
+    let (point, normal) = project_to_surface(shape, transform, m + to_light * d);
+    let (_, attenuation) = light_incidence(light, point);
+    let cos_in = to_light.dot(normal);
+    if attenuation == 0.0 || cos_in <= 0.0 || !visible(scene, point, normal, light, to_light) {
+        return None;
+    }
+    Some(EnteringLight {
+        to_light,
+        point,
+        normal,
+        radiance: radiance(light) * (attenuation * fresnel_transmittance(cos_in, eta)),
+    })
+}
+
 /// Settings of [`single_scattering`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SingleScatteringOptions {
@@ -450,24 +489,13 @@ pub fn single_scattering(
             }
             let tau_view = stack.optical_depth(x_o, n_o, m, x_o)[c];
             for light in &scene.lights {
-                let (to_light, _) = light_incidence(light, m);
-                let Some(d) = exit_distance(shape, &transform, m, to_light) else {
+                let Some(entry) = entering_light(scene, shape, &transform, light, m, eta) else {
                     continue;
                 };
-                let (p_in, n_in) = project_to_surface(shape, &transform, m + to_light * d);
-                let (_, attenuation) = light_incidence(light, p_in);
-                let cos_in = to_light.dot(n_in);
-                if attenuation == 0.0 || cos_in <= 0.0 {
-                    continue;
-                }
-                if !visible(scene, p_in, n_in, light, to_light) {
-                    continue;
-                }
                 // The same stack, placed at the entry point.
-                let tau_light = stack.optical_depth(p_in, n_in, p_in, m)[c];
-                let phase = options.phase.eval(layer.g, to_light.dot(w));
-                let e = radiance(light)[c] * attenuation * fresnel_transmittance(cos_in, eta);
-                sum += sigma_s * phase * e * (-(tau_light + tau_view)).exp() * ds;
+                let tau_light = stack.optical_depth(entry.point, entry.normal, entry.point, m)[c];
+                let phase = options.phase.eval(layer.g, entry.to_light.dot(w));
+                sum += sigma_s * phase * entry.radiance[c] * (-(tau_light + tau_view)).exp() * ds;
             }
         }
         *out_c = t_o * sum;
@@ -506,18 +534,11 @@ pub fn transmitted(
         if to_light.dot(n_o) >= 0.0 {
             continue;
         }
-        let Some(d) = exit_distance(shape, &transform, x_o, to_light) else {
+        let Some(entry) = entering_light(scene, shape, &transform, light, x_o, eta) else {
             continue;
         };
-        let (p_in, n_in) = project_to_surface(shape, &transform, x_o + to_light * d);
-        let (_, attenuation) = light_incidence(light, p_in);
-        let cos_in = to_light.dot(n_in);
-        if attenuation == 0.0 || cos_in <= 0.0 || !visible(scene, p_in, n_in, light, to_light) {
-            continue;
-        }
-        let tau = stack.optical_depth(p_in, n_in, p_in, x_o);
-        let e = radiance(light) * (attenuation * fresnel_transmittance(cos_in, eta));
-        sum += e * DVec3::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp());
+        let tau = stack.optical_depth(entry.point, entry.normal, entry.point, x_o);
+        sum += entry.radiance * DVec3::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp());
     }
     Ok(sum * (fresnel_transmittance(cos_o, eta) / PI))
 }

@@ -95,17 +95,11 @@ impl Renderer {
                 return Err(e);
             }
         };
-        // The tiles of translucency and SSS, and the directional lights' maps, which cover
-        // every object's box.
-        let mesh_bounds = if desc.translucency.is_some()
-            || desc.sss.is_some()
-            || desc.shadows.is_some()
-            || desc.layered.is_some()
-        {
-            mesh_bounds(scene)
-        } else {
-            Vec::new()
-        };
+        // Every object's box, for the tiles of translucency, SSS and layered media and the
+        // directional lights' maps. Computed whatever the frame has (one pass over the
+        // vertices): a list of the features that need it missed one twice (a plain scene's
+        // maps, a layered scene without shadows).
+        let mesh_bounds = mesh_bounds(scene);
         let mut renderer = Self {
             executable,
             outputs,

@@ -21,7 +21,8 @@
 
 struct LayeredMaterial {
     vec4 info;                                   // x layers, y eta, z D_max, w gather radius
-    vec4 weights;                                // x λ3 (transmitted), y λ4 (single), z λ5
+    vec4 weights;                                // x λ3 (transmitted), y λ4 (single), z λ5,
+                                                 // w 1 - F_dr (the ambient let in)
     vec4 sigma_t_g[MAX_MEDIUM_LAYERS];           // rgb extinction (1/unit), a: g
     vec4 sigma_s_thickness[MAX_MEDIUM_LAYERS];   // rgb scattering, a: thickness (-1: rest)
     vec4 sigma_tr;                               // the first layer's dipole, per channel
@@ -181,9 +182,12 @@ vec3 dipole_rd(int mat, float r) {
 }
 
 // The light transmitted into the surface at p (outward normal n): radiance x falloff x cos x
-// Fresnel transmittance of every light, shadowed where the light casts (transmitted_irradiance).
-vec3 transmitted_irradiance(vec3 p, vec3 n, float eta) {
-    vec3 e = vec3(0.0);
+// Fresnel transmittance of every light, shadowed where the light casts, and the ambient's
+// (transmitted_irradiance).
+vec3 transmitted_irradiance(vec3 p, vec3 n, float eta, float ambient_transmittance) {
+    // The ambient, a uniform radiance over the hemisphere: irradiance pi L_a, of which the
+    // boundary lets 1 - F_dr through (unshadowed, as every pass's ambient).
+    vec3 e = frame.ambient.rgb * (PI * ambient_transmittance);
     int count = min(frame.light_count.x, MAX_LIGHTS);
     for (int i = 0; i < count; ++i) {
         vec3 to_light;
@@ -206,6 +210,15 @@ vec3 transmitted_irradiance(vec3 p, vec3 n, float eta) {
 // e^x - 1 without the cancellation of exp(x) - 1 near 0 (|x| < 1e-3: three Taylor terms).
 float expm1_approx(float x) {
     return abs(x) < 1e-3 ? x * (1.0 + x * (0.5 + x / 6.0)) : exp(x) - 1.0;
+}
+
+// The shading normal bent into the hemisphere the eye sees (cos at least 0.05): at
+// silhouettes an interpolated normal can face away from the eye while its facet faces it, and
+// the terms, which need light to leave towards the eye, left those pixels black.
+vec3 facing_normal(vec3 n, vec3 view_dir) {
+    const float MIN_COS = 0.05;
+    float c = dot(-view_dir, n);
+    return c >= MIN_COS ? n : normalize(n - view_dir * (MIN_COS - c));
 }
 
 // Keeps a term finite and inside fp16 before it is added to the lit image.

@@ -27,5 +27,5 @@ void main() {
     vec3 pos = world_position(vec2(px) + 0.5, depth);
     vec3 n = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
     // Alpha: the layered material ID, so the gather reads a pixel light's material with it.
-    out_irradiance = vec4(finite_term(transmitted_irradiance(pos, n, MAT.info.y)), float(id));
+    out_irradiance = vec4(finite_term(transmitted_irradiance(pos, n, MAT.info.y, MAT.weights.w)), float(id));
 }

@@ -31,10 +31,8 @@ void main() {
     vec3 view = x_o - frame.camera_pos.xyz;
     float view_len2 = dot(view, view);
     vec3 view_dir = view_len2 > 1e-20 ? view * inversesqrt(view_len2) : -n_o;
+    n_o = facing_normal(n_o, view_dir);
     float cos_o = dot(-view_dir, n_o);
-    if (cos_o <= 0.0) {
-        return;
-    }
     float radius = MAT.info.w;
     vec3 helper = abs(n_o.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 t = normalize(cross(helper, n_o));

@@ -188,10 +188,8 @@ void main() {
     vec3 view = x_o - frame.camera_pos.xyz;
     float view_len2 = dot(view, view);
     vec3 view_dir = view_len2 > 1e-20 ? view * inversesqrt(view_len2) : -n_o;
+    n_o = facing_normal(n_o, view_dir);
     float cos_o = dot(-view_dir, n_o);
-    if (cos_o <= 0.0) {
-        return; // seen from behind (interpolated normals): no light leaves towards the eye
-    }
     float t_o = fresnel_transmittance(cos_o, eta);
     int lights = min(frame.light_count.x, MAX_LIGHTS);
     vec3 w;

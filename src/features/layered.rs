@@ -5,7 +5,8 @@
 //!   layered object's albedo times `λ1` and its specular intensity times `λ2` (lighting is
 //!   linear in both, so this is exactly eq. 3's weighting, at no cost).
 //! - `layered irradiance`: the light transmitted into the surface per pixel,
-//!   `E = Σ_lights V T(cos, eta) radiance falloff cos` (shadowed), at full or half resolution
+//!   `E = Σ_lights V T(cos, eta) radiance falloff cos` (shadowed) plus the ambient's
+//!   `pi L_a (1 - F_dr)`, at full or half resolution
 //!   (`layered.irradiance`).
 //! - `single scattering` (eqs. 4-11): the view ray refracted at the surface and marched `K`
 //!   steps up to `D_max / (N . T)`; at each step `M` the light's entry point `P'` comes from
@@ -252,7 +253,7 @@ fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
         single_depth(m, knobs.max_depth_mfp) as f32,
         gather_radius(m) as f32,
     ];
-    row.weights = [m.weights[2], m.weights[3], m.weights[4], 0.0];
+    row.weights = [m.weights[2], m.weights[3], m.weights[4], 1.0 - d.f_dr];
     for (i, l) in m.layers.iter().take(MAX_LAYERS).enumerate() {
         let sigma_t = m.sigma_t_per_unit(i);
         let sigma_s = m.sigma_s_per_unit(i);
@@ -278,7 +279,8 @@ fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
 pub struct LayeredMaterialGpu {
     /// x: layer count; y: eta; z: `D_max` (units); w: gather radius (units).
     pub info: [f32; 4],
-    /// x: λ3 (transmitted); y: λ4 (single); z: λ5 (multiple).
+    /// x: λ3 (transmitted); y: λ4 (single); z: λ5 (multiple); w: `1 - F_dr`, the share of
+    /// the ambient the boundary lets in.
     pub weights: [f32; 4],
     /// Per layer: extinction rgb (1/unit), g.
     pub sigma_t_g: [[f32; 4]; MAX_LAYERS],

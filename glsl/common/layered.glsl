@@ -10,6 +10,7 @@
 
 #include "gbuffer.glsl"
 #include "lighting.glsl"
+#include "layer_depths.glsl"
 #ifdef LUCENT_SHADOWS
 #include "shadows.glsl"
 #endif
@@ -25,6 +26,8 @@ struct LayeredMaterial {
                                                  // w 1 - F_dr (the ambient let in)
     vec4 sigma_t_g[MAX_MEDIUM_LAYERS];           // rgb extinction (1/unit), a: g
     vec4 sigma_s_thickness[MAX_MEDIUM_LAYERS];   // rgb scattering, a: thickness (-1: rest)
+    vec4 thickness_scale[2];                     // layer j: units per texel of its TexDep
+                                                 // texel ([j / 4][j % 4]; 0: not a texture)
     vec4 sigma_tr;                               // the first layer's dipole, per channel
     vec4 z_r;
     vec4 z_v;
@@ -113,21 +116,36 @@ float phase(float g, float c) {
     return layered.knobs.z == 1 ? phase_schlick(g, c) : phase_hg(g, c);
 }
 
+// Layer j's thickness (units; -1: the semi-infinite rest). `texels` are the depth-texture
+// texels at the point the layers hang below (layer_depths.glsl; frames without TexDep media
+// pass uvec4(0) and read the table's constants only).
+float layer_thickness(int mat, int j, uvec4 texels) {
+    float t = MAT.sigma_s_thickness[j].a;
+#ifdef LUCENT_LAYER_DEPTHS
+    float scale = MAT.thickness_scale[j >> 2][j & 3];
+    if (scale > 0.0) {
+        // Sanitized when packed: finite and >= 0; times a finite scale, at most ~6.6e4 x 1e6.
+        t = layer_texel(texels, j) * scale;
+    }
+#endif
+    return t;
+}
+
 // The bottom depth of layer j whose top is at depth `top` (units below the reference surface;
 // a `rest` layer has no bottom: 1e30).
-float layer_bottom(int mat, int j, float top) {
-    float t = MAT.sigma_s_thickness[j].a;
+float layer_bottom(int mat, int j, float top, uvec4 texels) {
+    float t = layer_thickness(mat, j, texels);
     float bottom = t < 0.0 ? 1e30 : top + t;
     return bottom;
 }
 
 // The layer holding depth `d` below the reference point (depths above the tangent plane belong
 // to the first layer; below the last layer's bottom: -1, no medium) (LayerStack::layer_at).
-int layer_at(int mat, float d) {
+int layer_at(int mat, float d, uvec4 texels) {
     int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
     float top = 0.0;
     for (int j = 0; j < count; ++j) {
-        float bottom = layer_bottom(mat, j, top);
+        float bottom = layer_bottom(mat, j, top, texels);
         if (d < bottom) {
             return j;
         }
@@ -137,9 +155,9 @@ int layer_at(int mat, float d) {
 }
 
 // Optical depth per channel of segment a-b through the planar layers below surface point p
-// with outward unit normal n (LayerStack::optical_depth): each layer's share of the segment
-// times its extinction.
-vec3 optical_depth(int mat, vec3 p, vec3 n, vec3 a, vec3 b) {
+// with outward unit normal n and depth texels `texels` (LayerStack::optical_depth): each
+// layer's share of the segment times its extinction.
+vec3 optical_depth(int mat, vec3 p, vec3 n, vec3 a, vec3 b, uvec4 texels) {
     float len = length(b - a);
     if (!(len > 0.0)) {
         return vec3(0.0);
@@ -151,7 +169,7 @@ vec3 optical_depth(int mat, vec3 p, vec3 n, vec3 a, vec3 b) {
     float top = -1e30;
     float running = 0.0;
     for (int j = 0; j < count; ++j) {
-        float bottom = layer_bottom(mat, j, running);
+        float bottom = layer_bottom(mat, j, running, texels);
         running = bottom;
         float share;
         if (abs(slope) < 1e-30) {

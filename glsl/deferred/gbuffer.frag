@@ -4,6 +4,8 @@
 // permutation: LUCENT_SSS_PROFILE
 // permutation: LUCENT_LAYERED
 // permutation: LUCENT_SSS_PROFILE LUCENT_LAYERED LUCENT_SSS_LOCATION=2 LUCENT_LAYERED_LOCATION=3
+// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_LOCATION=3 LUCENT_DEPTH_MAP_BINDING=1
+// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_LOCATION=3 LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=1 LUCENT_DEPTH_MAP_BINDING=2
 // permutation: LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_LEAN
@@ -14,9 +16,10 @@
 // permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=3 LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3 LUCENT_LEAN_LOCATION=4
 // The G-buffer pass (src/features/deferred.rs): GB0 and GB1 at locations 0 and 1, then the
 // targets the frame's materials need at the locations the defines give (GB2 with
-// translucency, the SSS profile ID with SSS, the LEAN target with LCB or LBB blurs). Set 0:
-// binding 0 the frame uniforms, then the material textures the frame has (normal or LEAN map
-// 1, LEAN map 2, albedo map at LUCENT_ALBEDO_BINDING).
+// translucency, the SSS profile ID with SSS, the LEAN target with LCB or LBB blurs, the
+// layered ID and TexDep texels with layered media). Set 0: binding 0 the frame uniforms, then
+// the material textures the frame has (normal or LEAN map 1, LEAN map 2, albedo map at
+// LUCENT_ALBEDO_BINDING, the layer depth textures from LUCENT_DEPTH_MAP_BINDING).
 #ifndef LUCENT_GB2_LOCATION
 #define LUCENT_GB2_LOCATION 2
 #endif
@@ -32,6 +35,12 @@
 #ifndef LUCENT_ALBEDO_BINDING
 #define LUCENT_ALBEDO_BINDING 1
 #endif
+#ifndef LUCENT_LAYER_DEPTH_LOCATION
+#define LUCENT_LAYER_DEPTH_LOCATION 3
+#endif
+#ifndef LUCENT_DEPTH_MAP_BINDING
+#define LUCENT_DEPTH_MAP_BINDING 1
+#endif
 #include "../common/gbuffer.glsl"
 #include "object.glsl"
 #ifdef LUCENT_LEAN
@@ -42,7 +51,7 @@ layout(location = LUCENT_LEAN_LOCATION) out vec4 out_lean;
 #endif
 
 layout(location = 0) in vec3 in_normal;
-#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP)
+#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP) || defined(LUCENT_LAYER_DEPTHS)
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec4 in_tangent;
 #endif
@@ -86,6 +95,17 @@ layout(location = LUCENT_SSS_LOCATION) out vec4 out_sss;
 #ifdef LUCENT_LAYERED
 // Li et al.'s layered material ID / 255 (0: not layered), for the scattering passes.
 layout(location = LUCENT_LAYERED_LOCATION) out vec4 out_layered;
+#endif
+
+#ifdef LUCENT_LAYER_DEPTHS
+#include "../common/layer_depths.glsl"
+// Li et al.'s TexDep: the draw's depth textures (linear data; a draw without them binds a
+// zero texture) and their texels at this pixel, packed for single scattering.
+layout(set = 0, binding = LUCENT_DEPTH_MAP_BINDING) uniform sampler2D depth_map0;
+#if LUCENT_LAYER_DEPTHS > 1
+layout(set = 0, binding = LUCENT_DEPTH_MAP_BINDING + 1) uniform sampler2D depth_map1;
+#endif
+layout(location = LUCENT_LAYER_DEPTH_LOCATION) out uvec4 out_layer_depths;
 #endif
 
 layout(location = 0) out vec4 out_gb0;
@@ -144,5 +164,12 @@ void main() {
 #endif
 #ifdef LUCENT_LAYERED
     out_layered = vec4(clamp(object.roughness.z, 0.0, 255.0) / 255.0);
+#endif
+#ifdef LUCENT_LAYER_DEPTHS
+    vec4 second = vec4(0.0);
+#if LUCENT_LAYER_DEPTHS > 1
+    second = texture(depth_map1, in_uv);
+#endif
+    out_layer_depths = pack_layer_texels(texture(depth_map0, in_uv), second);
 #endif
 }

@@ -3,7 +3,8 @@
 // permutation: LUCENT_NORMAL_MAP
 // permutation: LUCENT_TRANSLUCENCY LUCENT_NORMAL_MAP
 // permutation: LUCENT_ALBEDO_MAP
-// UV + tangent stream (binding 2) in frames with normal or albedo maps.
+// permutation: LUCENT_LAYER_DEPTHS=1
+// UV + tangent stream (binding 2) in frames with normal or albedo maps or TexDep layers.
 #include "../common/scene.glsl"
 #include "object.glsl"
 
@@ -13,7 +14,7 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec3 in_thickness; // binding 1: vertex colours, or white
 layout(location = 1) out vec3 out_thickness;
 #endif
-#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP)
+#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP) || defined(LUCENT_LAYER_DEPTHS)
 layout(location = 3) in vec2 in_uv;        // binding 2
 layout(location = 4) in vec4 in_tangent;   // xyz unit, w: bitangent handedness
 layout(location = 2) out vec2 out_uv;
@@ -29,7 +30,7 @@ void main() {
 #ifdef LUCENT_TRANSLUCENCY
     out_thickness = in_thickness * object.thickness.rgb;
 #endif
-#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP)
+#if defined(LUCENT_NORMAL_MAP) || defined(LUCENT_ALBEDO_MAP) || defined(LUCENT_LAYER_DEPTHS)
     out_uv = in_uv;
     // Tangents are directions on the surface: they transform with the model matrix.
     out_tangent = vec4(mat3(object.model) * in_tangent.xyz, in_tangent.w);

@@ -95,6 +95,9 @@ pub struct GBufferLayout {
     pub depth_in_alpha: bool,
     /// Layered media (Li et al.): the G-buffer stores each pixel's layered material ID.
     pub layered: bool,
+    /// `TexDep` depth textures the layered media read per object (0: none, 1 or 2): the
+    /// G-buffer samples them at each pixel's UV and stores the texels (layer depth target).
+    pub layer_depth_textures: usize,
     /// Robustness tests: the lighting pass poisons the pixel the frame uniforms name.
     pub fault_injection: bool,
 }
@@ -124,6 +127,8 @@ pub enum ExtraTarget {
     Lean,
     /// The layered material ID.
     Layered,
+    /// The `TexDep` texels at each pixel (glsl/common/layer_depths.glsl).
+    LayerDepths,
 }
 
 impl ExtraTarget {
@@ -134,12 +139,33 @@ impl ExtraTarget {
             ExtraTarget::SssProfile => "LUCENT_SSS_LOCATION",
             ExtraTarget::Lean => "LUCENT_LEAN_LOCATION",
             ExtraTarget::Layered => "LUCENT_LAYERED_LOCATION",
+            ExtraTarget::LayerDepths => "LUCENT_LAYER_DEPTH_LOCATION",
         }
     }
 }
 
-/// Location values as shader define strings (at most 2 + four extra targets).
-const LOCATIONS: [&str; 6] = ["0", "1", "2", "3", "4", "5"];
+/// Location values as shader define strings (at most 2 + five extra targets).
+const LOCATIONS: [&str; 8] = ["0", "1", "2", "3", "4", "5", "6", "7"];
+
+/// The `TexDep` texels of a G-buffer or light-space map texel for `textures` depth textures
+/// (glsl/common/layer_depths.glsl: two fp16 texels per 32-bit component): RG32UI holds four
+/// layers, RGBA32UI eight; `None` for 0.
+pub fn layer_depth_format(textures: usize) -> Option<vk::Format> {
+    match textures {
+        0 => None,
+        1 => Some(vk::Format::R32G32_UINT),
+        _ => Some(vk::Format::R32G32B32A32_UINT),
+    }
+}
+
+/// The LUCENT_LAYER_DEPTHS define's value for `textures` depth textures (1 or 2).
+pub fn layer_depths_define(textures: usize) -> &'static str {
+    if textures > 1 {
+        "2"
+    } else {
+        "1"
+    }
+}
 
 impl GBufferLayout {
     /// The targets after GB0 and GB1, in location order (2, 3, ...).
@@ -157,12 +183,20 @@ impl GBufferLayout {
         if self.layered {
             targets.push(ExtraTarget::Layered);
         }
+        if self.layered && self.layer_depth_textures > 0 {
+            targets.push(ExtraTarget::LayerDepths);
+        }
         targets
     }
 
     /// The G-buffer pass reads the UV + tangent stream.
     pub fn surface_stream(&self) -> bool {
-        self.normal_maps || self.albedo_maps
+        self.normal_maps || self.albedo_maps || self.layer_depths()
+    }
+
+    /// The G-buffer stores `TexDep` texels.
+    pub fn layer_depths(&self) -> bool {
+        self.layered && self.layer_depth_textures > 0
     }
 
     /// GB0: albedo rgb + specular.
@@ -217,6 +251,16 @@ impl GBufferLayout {
             let binding = 1 + usize::from(self.normal_maps) * (1 + usize::from(self.lean));
             defines.push(("LUCENT_ALBEDO_BINDING", LOCATIONS[binding]));
         }
+        if self.layer_depths() {
+            defines.push((
+                "LUCENT_LAYER_DEPTHS",
+                layer_depths_define(self.layer_depth_textures),
+            ));
+            let binding = 1
+                + usize::from(self.normal_maps) * (1 + usize::from(self.lean))
+                + usize::from(self.albedo_maps);
+            defines.push(("LUCENT_DEPTH_MAP_BINDING", LOCATIONS[binding]));
+        }
         for (i, target) in self.extra_targets().into_iter().enumerate() {
             defines.push((target.location_define(), LOCATIONS[2 + i]));
         }
@@ -262,6 +306,8 @@ pub struct GBuffer {
     pub lean: Option<Handle<Image>>,
     /// Layered material ID per pixel, in frames with layered media.
     pub layered: Option<Handle<Image>>,
+    /// `TexDep` texels per pixel, in frames whose layered media read depth textures.
+    pub layer_depths: Option<Handle<Image>>,
     /// Depth.
     pub depth: Handle<Image>,
     /// The layout it was declared with.
@@ -296,6 +342,11 @@ pub fn gbuffer_pass(
         layered: layout.layered.then(|| {
             graph.create_image("gbuffer.layered", image(super::layered::LAYERED_ID_FORMAT))
         }),
+        layer_depths: layout
+            .layer_depths()
+            .then(|| layer_depth_format(layout.layer_depth_textures))
+            .flatten()
+            .map(|f| graph.create_image("gbuffer.layer-depth", image(f))),
         depth: graph.create_image("gbuffer.depth", image(DEPTH_FORMAT)),
         layout,
     };
@@ -328,6 +379,11 @@ pub fn gbuffer_pass(
         // Cleared to 0: the scattering passes leave non-layered pixels alone.
         pass.color(layered, LoadOp::Clear([0.0; 4]));
     }
+    if let Some(depths) = &mut gb.layer_depths {
+        // Not cleared: single scattering reads it only at layered pixels, which every draw
+        // writes (zero texels for media without TexDep layers).
+        pass.color(depths, LoadOp::DontCare);
+    }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
     match scene {
         Some(scene) => pass.execute(GBufferPass {
@@ -339,6 +395,21 @@ pub fn gbuffer_pass(
         None => pass.finish(),
     }
     gb
+}
+
+/// The bindings of a draw's `TexDep` depth textures (`textures` of them, 1 or 2) from pair
+/// `depth` of [`crate::gpu_scene::MaterialMaps::depth`].
+pub fn depth_map_bindings(
+    maps: &crate::gpu_scene::MaterialMaps,
+    depth: [usize; 2],
+    textures: usize,
+) -> Vec<Binding> {
+    depth
+        .iter()
+        .take(textures.clamp(1, 2))
+        .filter_map(|&i| maps.depth.get(i).or(maps.depth.first()))
+        .map(|map| Binding::Sampled(map.view, maps.sampler))
+        .collect()
 }
 
 /// What the lighting pass writes.
@@ -425,15 +496,16 @@ struct GBufferPass {
 }
 
 impl GBufferPass {
-    /// Set 0's bindings with material-texture pair `index` of the scene's maps
+    /// Set 0's bindings with material-texture set `index` of the scene's maps
     /// (glsl/deferred/gbuffer.frag): the frame uniforms, then the normal (or LEAN 1) map, LEAN
-    /// map 2 and the albedo map, those the frame has.
+    /// map 2, the albedo map and the depth maps, those the frame has.
     fn bindings(&self, index: usize) -> Vec<Binding> {
         let mut bindings = vec![Binding::PerFrame(
             self.scene.per_frame.binding(Region::Frame),
         )];
         if let Some(maps) = &self.scene.maps {
-            let (normal, albedo) = maps.sets.get(index).copied().unwrap_or((0, 0));
+            let set = maps.sets.get(index).copied().unwrap_or_default();
+            let (normal, albedo) = (set.normal, set.albedo);
             if let Some(map) = maps.normal.get(normal) {
                 bindings.push(Binding::Sampled(map.view, maps.sampler));
                 // LEAN frames: the second LEAN map follows.
@@ -443,6 +515,13 @@ impl GBufferPass {
             }
             if let Some(map) = maps.albedo.get(albedo) {
                 bindings.push(Binding::Sampled(map.view, maps.sampler));
+            }
+            if self.layout.layer_depths() {
+                bindings.extend(depth_map_bindings(
+                    maps,
+                    set.depth,
+                    self.layout.layer_depth_textures,
+                ));
             }
         }
         bindings

@@ -132,8 +132,8 @@ pub struct LayeredDesc {
 impl LayeredDesc {
     /// The layered materials of `scene`'s objects; `None` when no object is layered. Errors
     /// name the material: more than [`MAX_LAYERED_MATERIALS`] distinct media, a medium that
-    /// fails validation, or thickness read from a texture (`TexDep`), which the f64 reference
-    /// evaluates but the GPU passes do not read.
+    /// fails validation, or one that reads layer thickness from a texture (`TexDep`) on a mesh
+    /// without texture coordinates.
     pub fn new(scene: &Scene) -> Result<Option<Self>> {
         let mut materials: Vec<LayeredMedium> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
@@ -145,16 +145,14 @@ impl LayeredDesc {
             medium.validate().map_err(|e| {
                 LucentError::InvalidInput(format!("material '{}': {e}", o.material.name))
             })?;
-            if medium
-                .layers
-                .iter()
-                .any(|l| matches!(l.thickness, Thickness::Texture { .. }))
+            let mesh = scene.meshes.get(o.mesh);
+            if medium.depth_textures_needed() > 0
+                && mesh.is_some_and(|m| m.uvs.len() != m.positions.len())
             {
                 return Err(LucentError::InvalidInput(format!(
-                    "material '{}': layer thickness from a texture (TexDep) is evaluated by \
-                     the f64 reference only; the GPU passes read constant and `rest` \
-                     thicknesses",
-                    o.material.name
+                    "material '{}' reads layer thickness from a depth texture (TexDep) but mesh \
+                     {} has no texture coordinates",
+                    o.material.name, o.mesh
                 )));
             }
             let id = match materials.iter().position(|m| m == medium) {
@@ -177,6 +175,16 @@ impl LayeredDesc {
             materials,
             object_ids,
         }))
+    }
+
+    /// `TexDep` depth textures one object reads at most (0, 1 or 2): the G-buffer and the
+    /// light-space maps store that many textures' texels per pixel.
+    pub fn depth_textures(&self) -> usize {
+        self.materials
+            .iter()
+            .map(LayeredMedium::depth_textures_needed)
+            .max()
+            .unwrap_or(0)
     }
 
     /// The per-frame table of these materials under `knobs`.
@@ -260,7 +268,12 @@ fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
         let thickness = match l.thickness {
             // -1: no bottom (the shader's "rest").
             Thickness::Rest => -1.0,
-            _ => m.thickness_mm(i, &[]) * m.units_per_mm,
+            // TexDep: the texel times this scale (units per texel unit); no constant part.
+            Thickness::Texture { scale } => {
+                row.thickness_scale[i / 4][i % 4] = scale * m.units_per_mm;
+                0.0
+            }
+            Thickness::Mm(_) => m.thickness_mm(i, &[]) * m.units_per_mm,
         };
         row.sigma_t_g[i] = [sigma_t.x, sigma_t.y, sigma_t.z, l.g];
         row.sigma_s_thickness[i] = [sigma_s.x, sigma_s.y, sigma_s.z, thickness];
@@ -284,8 +297,12 @@ pub struct LayeredMaterialGpu {
     pub weights: [f32; 4],
     /// Per layer: extinction rgb (1/unit), g.
     pub sigma_t_g: [[f32; 4]; MAX_LAYERS],
-    /// Per layer: scattering rgb (1/unit), thickness (units; -1: the rest of the object).
+    /// Per layer: scattering rgb (1/unit), thickness (units; -1: the rest of the object; 0
+    /// for a `TexDep` layer).
     pub sigma_s_thickness: [[f32; 4]; MAX_LAYERS],
+    /// Layer `j`'s `TexDep` scale at `[j / 4][j % 4]`: units per texel unit (0: the layer's
+    /// thickness is the constant above).
+    pub thickness_scale: [[f32; 4]; 2],
     /// The first layer's dipole: `sigma_tr` rgb (1/unit).
     pub sigma_tr: [f32; 4],
     /// `z_r` rgb (units).
@@ -320,6 +337,10 @@ pub struct LayeredInputs<'a> {
     pub gb1: &'a Handle<Image>,
     /// The layered material IDs.
     pub ids: &'a Handle<Image>,
+    /// The `TexDep` texels per pixel (frames whose media read depth textures).
+    pub layer_depths: Option<&'a Handle<Image>>,
+    /// Depth textures per object those texels come from (1 or 2; 0 without them).
+    pub layer_depth_textures: usize,
     /// The light-space maps (with their entry target), when some light casts.
     pub shadows: Option<&'a ShadowMaps>,
 }
@@ -349,10 +370,16 @@ pub fn layered_passes(
         pass.sample(inputs.depth)
             .sample(inputs.gb1)
             .sample(inputs.ids);
+        if let (Kind::Single, Some(depths)) = (kind, inputs.layer_depths) {
+            pass.sample(depths);
+        }
         if let (Kind::Irradiance | Kind::Single, Some(maps)) = (kind, inputs.shadows) {
             pass.sample(&maps.depth);
             if let (Kind::Single, Some(entry)) = (kind, &maps.entry) {
                 pass.sample(entry);
+                if let Some(depths) = &maps.layer_depths {
+                    pass.sample(depths);
+                }
             }
         }
     };
@@ -364,6 +391,11 @@ pub fn layered_passes(
         entry: inputs
             .shadows
             .and_then(|m| m.entry.as_ref().map(|h| h.id())),
+        layer_depths: inputs.layer_depths.map(|h| h.id()),
+        entry_depths: inputs
+            .shadows
+            .and_then(|m| m.layer_depths.as_ref().map(|h| h.id())),
+        layer_depth_textures: inputs.layer_depth_textures,
         irradiance: None,
     };
 
@@ -419,6 +451,12 @@ struct LayeredPassInputs {
     shadow_depth: Option<ResourceId>,
     /// Its entry atlas (present with the depth atlas in layered frames).
     entry: Option<ResourceId>,
+    /// The G-buffer's `TexDep` texels (frames whose media read depth textures).
+    layer_depths: Option<ResourceId>,
+    /// The entry atlas's `TexDep` texels (with `layer_depths` and the atlas).
+    entry_depths: Option<ResourceId>,
+    /// Depth textures per object in `layer_depths` (0, 1 or 2).
+    layer_depth_textures: usize,
     irradiance: Option<ResourceId>,
 }
 
@@ -466,10 +504,25 @@ impl PassExec for LayeredPass {
         if let Some(irradiance) = i.irradiance {
             bindings.push(Binding::Sampled(views[irradiance], self.nearest));
         }
+        // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
+        // first layer's, semi-infinite, as in the paper).
+        let texdep = self.kind == Kind::Single && i.layer_depths.is_some();
+        if let (true, Some(depths)) = (texdep, i.layer_depths) {
+            defines.push((
+                "LUCENT_LAYER_DEPTHS",
+                super::deferred::layer_depths_define(i.layer_depth_textures),
+            ));
+            defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[bindings.len()]));
+            bindings.push(Binding::Sampled(views[depths], self.nearest));
+        }
         if let (Some(depth), true) = (i.shadow_depth, self.kind != Kind::Multiple) {
             if let (Kind::Single, Some(entry)) = (self.kind, i.entry) {
                 defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[bindings.len()]));
                 bindings.push(Binding::Sampled(views[entry], self.nearest));
+                if let (true, Some(depths)) = (texdep, i.entry_depths) {
+                    defines.push(("LUCENT_ENTRY_DEPTH_BINDING", NUMBERS[bindings.len()]));
+                    bindings.push(Binding::Sampled(views[depths], self.nearest));
+                }
             }
             defines.extend(shadows::lighting_defines(bindings.len()));
             bindings.extend(shadows::lighting_bindings(

@@ -83,6 +83,9 @@ pub struct ShadowDesc {
     /// The atlas stores each texel's entry normal and layered material (frames with layered
     /// media: single scattering's light entry points).
     pub entry: bool,
+    /// With `entry`: the `TexDep` depth textures the layered media read per object (0: none;
+    /// 1 or 2): the atlas stores each texel's depth texels too.
+    pub layer_depth_textures: usize,
 }
 
 impl ShadowDesc {
@@ -121,6 +124,7 @@ impl ShadowDesc {
             rows,
             transmission_ids: translucency,
             entry: false,
+            layer_depth_textures: 0,
         })
     }
 
@@ -325,6 +329,9 @@ pub struct ShadowMaps {
     pub ids: Option<Handle<Image>>,
     /// Each texel's first surface's normal and layered material (frames with layered media).
     pub entry: Option<Handle<Image>>,
+    /// Each texel's first surface's `TexDep` texels (frames whose layered media read depth
+    /// textures; glsl/common/layer_depths.glsl).
+    pub layer_depths: Option<Handle<Image>>,
 }
 
 /// Declares the `light-space maps` pass. `scene` is `None` for plan-only graphs.
@@ -347,6 +354,11 @@ pub fn shadow_pass(
         entry: desc
             .entry
             .then(|| graph.create_image("light-space.entry", info(ENTRY_FORMAT))),
+        layer_depths: desc
+            .entry
+            .then(|| super::deferred::layer_depth_format(desc.layer_depth_textures))
+            .flatten()
+            .map(|f| graph.create_image("light-space.layer-depth", info(f))),
     };
     let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
     if let Some(ids) = &mut maps.ids {
@@ -358,12 +370,17 @@ pub fn shadow_pass(
         // readers trust a texel's entry only where its depth says a surface was drawn.
         pass.color(entry, LoadOp::DontCare);
     }
+    if let Some(depths) = &mut maps.layer_depths {
+        // Not cleared, as the entry target (read only where the depth says a surface is).
+        pass.color(depths, LoadOp::DontCare);
+    }
     pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
     match scene {
         Some(scene) => pass.execute(ShadowPass {
             scene: scene.clone(),
             desc: desc.clone(),
             pipeline: None,
+            depth_sets: Vec::new(),
         }),
         None => pass.finish(),
     }
@@ -384,6 +401,33 @@ struct ShadowPass {
     scene: Arc<SceneGpu>,
     desc: ShadowDesc,
     pipeline: Option<PassPipeline>,
+    /// Frames with `TexDep` media: one set per depth-texture pair after the first (the
+    /// pipeline's own), each `maps table + the pair`, bound per draw.
+    depth_sets: Vec<super::util::DescriptorSet>,
+}
+
+impl ShadowPass {
+    /// The atlas stores `TexDep` texels.
+    fn layer_depths(&self) -> bool {
+        self.desc.entry && self.desc.layer_depth_textures > 0
+    }
+
+    /// Set 0 with depth-texture pair `index` (glsl/shadow/depth.frag): the maps' table, then
+    /// in frames with `TexDep` media the pair's textures.
+    fn bindings(&self, index: usize) -> Vec<Binding> {
+        let mut bindings = vec![Binding::PerFrame(
+            self.scene.per_frame.binding(Region::Shadows),
+        )];
+        if let (true, Some(maps)) = (self.layer_depths(), &self.scene.maps) {
+            let pair = maps.depth_sets.get(index).copied().unwrap_or([0, 0]);
+            bindings.extend(super::deferred::depth_map_bindings(
+                maps,
+                pair,
+                self.desc.layer_depth_textures,
+            ));
+        }
+        bindings
+    }
 }
 
 impl PassExec for ShadowPass {
@@ -399,11 +443,19 @@ impl PassExec for ShadowPass {
                 if self.desc.transmission_ids { "1" } else { "0" },
             ));
         }
+        if self.layer_depths() {
+            defines.push((
+                "LUCENT_LAYER_DEPTHS",
+                super::deferred::layer_depths_define(self.desc.layer_depth_textures),
+            ));
+            defines.push((
+                "LUCENT_LAYER_DEPTH_LOCATION",
+                if self.desc.transmission_ids { "2" } else { "1" },
+            ));
+        }
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[Binding::PerFrame(
-                self.scene.per_frame.binding(Region::Shadows),
-            )],
+            &self.bindings(0),
             &GraphicsPipelineDesc {
                 vertex: "shadow/depth.vert",
                 fragment: "shadow/depth.frag",
@@ -412,7 +464,8 @@ impl PassExec for ShadowPass {
                 vertex_input: if self.desc.entry {
                     VertexInput::Mesh {
                         thickness: false,
-                        surface: false,
+                        // TexDep: the UVs where the depth textures are read.
+                        surface: self.layer_depths(),
                     }
                 } else {
                     VertexInput::Positions
@@ -426,6 +479,21 @@ impl PassExec for ShadowPass {
                 name: "light-space maps",
             },
         )?);
+        let pairs = if self.layer_depths() {
+            self.scene.maps.as_ref().map_or(0, |m| m.depth_sets.len())
+        } else {
+            0
+        };
+        for index in 1..pairs {
+            // Identically defined layouts are compatible: these sets bind to the pipeline's.
+            let set = super::util::DescriptorSet::new(
+                ctx,
+                &self.bindings(index),
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                "light-space depth maps",
+            )?;
+            self.depth_sets.push(set);
+        }
         Ok(())
     }
 
@@ -461,7 +529,16 @@ impl PassExec for ShadowPass {
                 device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
                 device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
             }
+            let mut bound_pair = 0usize;
             for draw in &self.scene.draws {
+                if self.layer_depths() && draw.depth_maps != bound_pair {
+                    let set = match draw.depth_maps {
+                        0 => &pipeline.set,
+                        i => &self.depth_sets[i - 1],
+                    };
+                    set.bind(ctx, pipeline.pipeline.layout, 0);
+                    bound_pair = draw.depth_maps;
+                }
                 let constants = ShadowConstants {
                     model: draw.constants.model,
                     face_id: [
@@ -481,7 +558,17 @@ impl PassExec for ShadowPass {
                         bytemuck::bytes_of(&constants),
                     );
                 }
-                self.scene.meshes[draw.mesh].draw(device, ctx.cmd, ctx.frame, false, false);
+                self.scene.meshes[draw.mesh].draw(
+                    device,
+                    ctx.cmd,
+                    ctx.frame,
+                    false,
+                    self.layer_depths(),
+                );
+            }
+            if bound_pair != 0 {
+                // The next face starts with the pipeline's own set bound (pair 0).
+                pipeline.set.bind(ctx, pipeline.pipeline.layout, 0);
             }
         }
     }
@@ -489,6 +576,9 @@ impl PassExec for ShadowPass {
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
         if let Some(mut p) = self.pipeline.take() {
             p.destroy(&gpu.device);
+        }
+        for mut set in self.depth_sets.drain(..) {
+            set.destroy(&gpu.device);
         }
     }
 }

@@ -117,6 +117,8 @@ pub fn declare_frame(
                 depth: &gb.depth,
                 gb1: &gb.gb1,
                 ids,
+                layer_depths: gb.layer_depths.as_ref(),
+                layer_depth_textures: gb.layout.layer_depth_textures,
                 shadows: shadow_maps.as_ref(),
             },
             &settings.layered,

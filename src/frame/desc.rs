@@ -78,8 +78,10 @@ impl FrameDesc {
         };
         let mut shadows = ShadowDesc::new(scene, &settings.shadows, translucency.is_some());
         if let Some(s) = &mut shadows {
-            // Single scattering reads each map texel's entry normal and layered material.
+            // Single scattering reads each map texel's entry normal and layered material, and
+            // with TexDep media its depth texels.
             s.entry = layered.is_some();
+            s.layer_depth_textures = layered.as_ref().map_or(0, LayeredDesc::depth_textures);
         }
         Ok(Self {
             shadows,
@@ -89,6 +91,11 @@ impl FrameDesc {
             normal_maps: any(&|m| m.normal_texture.is_some()),
             albedo_maps: any(&|m| m.albedo_texture.is_some()),
         })
+    }
+
+    /// `TexDep` depth textures the frame's layered media read per object (0, 1 or 2).
+    pub fn layer_depth_textures(&self) -> usize {
+        self.layered.as_ref().map_or(0, LayeredDesc::depth_textures)
     }
 
     /// Whether the frame blurs the LEAN G-buffer (some SSS chain is LCB, LBB or bilateral).
@@ -129,6 +136,7 @@ impl FrameDesc {
             albedo_maps: self.albedo_maps,
             depth_in_alpha: self.sss.as_ref().is_some_and(SssProfiles::depth_in_alpha),
             layered: self.layered.is_some(),
+            layer_depth_textures: self.layer_depth_textures(),
             fault_injection: settings.fault.is_some(),
         }
     }
@@ -163,6 +171,7 @@ impl FrameDesc {
                 0
             },
             layered_ids: self.layered.as_ref().map(|l| &l.object_ids[..]),
+            layer_depth_textures: self.layer_depth_textures(),
             layered_table_bytes: if self.layered.is_some() {
                 crate::features::layered::LAYERED_TABLE_BYTES
             } else {
@@ -225,6 +234,12 @@ impl FrameDesc {
         if let Some(l) = &self.layered {
             let media: Vec<&str> = l.materials.iter().map(|m| m.name.as_str()).collect();
             names.push(format!("layered ({})", media.join(", ")));
+            if l.depth_textures() > 0 {
+                names.push(format!(
+                    "layer depth textures ({} per object)",
+                    l.depth_textures()
+                ));
+            }
         }
         if let Some(s) = &self.shadows {
             names.push(s.name());

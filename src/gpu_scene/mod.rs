@@ -34,6 +34,9 @@ pub struct Draw {
     pub mesh: usize,
     /// Index into [`MaterialMaps::sets`] (0 in frames without maps).
     pub maps: usize,
+    /// Index into [`MaterialMaps::depth_sets`] (0 in frames without `TexDep` media, and for
+    /// objects whose medium reads no depth texture): the light-space maps pass binds it.
+    pub depth_maps: usize,
     /// Push constants of the G-buffer pass.
     pub constants: ObjectConstants,
 }
@@ -162,8 +165,20 @@ impl GpuMesh {
     }
 }
 
-/// The material textures of a frame with normal or albedo maps. Entry 0 of each list is the
-/// neutral texture objects without a map of that kind read (a flat normal, white albedo).
+/// The material textures a draw binds: indices into [`MaterialMaps`]' lists.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MapSet {
+    /// Into [`MaterialMaps::normal`] (and `lean2`).
+    pub normal: usize,
+    /// Into [`MaterialMaps::albedo`].
+    pub albedo: usize,
+    /// Into [`MaterialMaps::depth`]: the medium's first and second `TexDep` textures.
+    pub depth: [usize; 2],
+}
+
+/// The material textures of a frame with normal or albedo maps or layered media whose
+/// thickness comes from a texture (`TexDep`). Entry 0 of each list is the neutral texture
+/// objects without a map of that kind read (a flat normal, white albedo, zero depth).
 /// In LEAN frames each normal map is uploaded as its two LEAN maps instead
 /// ([`crate::scene::lean`]): `normal` holds LEAN map 1, `lean2` LEAN map 2.
 pub struct MaterialMaps {
@@ -174,10 +189,16 @@ pub struct MaterialMaps {
     /// Albedo maps (decoded from sRGB to linear), RGBA16F mipmapped; empty without albedo
     /// maps.
     pub albedo: Vec<GpuImage>,
+    /// `TexDep` depth textures (linear data), RGBA16F mipmapped; empty in frames without
+    /// them.
+    pub depth: Vec<GpuImage>,
     /// Trilinear, repeating sampler.
     pub sampler: vk::Sampler,
-    /// The distinct (normal index, albedo index) pairs the draws use: one descriptor set each.
-    pub sets: Vec<(usize, usize)>,
+    /// The distinct texture sets the G-buffer draws use: one descriptor set each.
+    pub sets: Vec<MapSet>,
+    /// The distinct depth-texture pairs the draws use (the light-space maps pass binds only
+    /// these): one descriptor set each. Entry 0 is the zero pair.
+    pub depth_sets: Vec<[usize; 2]>,
 }
 
 /// What the frame needs of the scene on the GPU (the frame description decides it).
@@ -209,10 +230,12 @@ pub struct SceneUpload<'a> {
     pub layered_ids: Option<&'a [u8]>,
     /// Bytes of the layered media's table (0 without layered materials).
     pub layered_table_bytes: u64,
+    /// `TexDep` depth textures the frame's layered media read per object (0: none; 1 or 2:
+    /// [`crate::features::layered::LayeredDesc::depth_textures`]).
+    pub layer_depth_textures: usize,
 }
 
-/// Side of the procedural textures lucent makes, in texels.
-pub const PROCEDURAL_TEXTURE_SIZE: u32 = 512;
+pub use crate::scene::texture::PROCEDURAL_TEXTURE_SIZE;
 
 /// The scene's GPU data the passes share (see the module docs).
 pub struct SceneGpu {
@@ -267,6 +290,43 @@ fn distinct_sources<'s>(
     sources
 }
 
+/// The distinct `TexDep` textures of the layered objects `upload` draws as layered, in order
+/// of first use (none when the frame reads no depth texture).
+fn distinct_depth_sources<'s>(
+    scene: &'s Scene,
+    upload: &SceneUpload<'_>,
+) -> Vec<&'s TextureSource> {
+    let mut sources: Vec<&TextureSource> = Vec::new();
+    let Some(ids) = upload.layered_ids else {
+        return sources;
+    };
+    if upload.layer_depth_textures == 0 {
+        return sources;
+    }
+    for (o, id) in scene.objects.iter().zip(ids) {
+        let Some(medium) = o.material.layers.as_ref().filter(|_| *id > 0) else {
+            continue;
+        };
+        for t in &medium.depth_textures {
+            if !sources.contains(&t) {
+                sources.push(t);
+            }
+        }
+    }
+    sources
+}
+
+/// The index of `value` in `list`, pushed first if it is not there.
+fn index_of_or_push<T: PartialEq + Copy>(list: &mut Vec<T>, value: T) -> usize {
+    match list.iter().position(|v| *v == value) {
+        Some(i) => i,
+        None => {
+            list.push(value);
+            list.len() - 1
+        }
+    }
+}
+
 fn load_source(source: &TextureSource, usage: TextureUsage) -> Result<Texture> {
     match source {
         TextureSource::File(path) => load_texture(path, usage),
@@ -308,10 +368,19 @@ impl SceneGpu {
     fn upload(&mut self, gpu: &GpuContext, scene: &Scene, upload: &SceneUpload<'_>) -> Result<()> {
         let normal_sources = distinct_sources(scene, |o| o.material.normal_texture.as_ref());
         let albedo_sources = distinct_sources(scene, |o| o.material.albedo_texture.as_ref());
+        let depth_sources = distinct_depth_sources(scene, upload);
         let normal_maps = upload.normal_maps && !normal_sources.is_empty();
         let albedo_maps = upload.albedo_maps && !albedo_sources.is_empty();
-        if normal_maps || albedo_maps {
-            self.upload_maps(gpu, scene, upload.lean, normal_maps, albedo_maps)?;
+        let depth_maps = !depth_sources.is_empty();
+        if normal_maps || albedo_maps || depth_maps {
+            self.upload_maps(
+                gpu,
+                scene,
+                upload.lean,
+                normal_maps,
+                albedo_maps,
+                &depth_sources,
+            )?;
         }
         for (i, mesh) in scene.meshes.iter().enumerate() {
             // A deforming scene starts as it stands at its time; each frame rewrites its slot.
@@ -406,32 +475,37 @@ impl SceneGpu {
                 t.and_then(|t| sources.iter().position(|s| *s == t))
                     .map_or(0, |i| i + 1)
             };
-            let pair = (
-                if normal_maps {
-                    position_in(&normal_sources, o.material.normal_texture.as_ref())
-                } else {
-                    0
-                },
-                if albedo_maps {
-                    position_in(&albedo_sources, o.material.albedo_texture.as_ref())
-                } else {
-                    0
-                },
-            );
-            let maps = match &mut self.maps {
-                Some(maps) => match maps.sets.iter().position(|&p| p == pair) {
-                    Some(i) => i,
-                    None => {
-                        maps.sets.push(pair);
-                        maps.sets.len() - 1
-                    }
-                },
-                None => 0,
-            };
             let layered_id = upload
                 .layered_ids
                 .and_then(|ids| ids.get(index).copied())
                 .unwrap_or(0);
+            // A layered object's depth textures (TexDep), each after the zero texture.
+            let mut depth = [0usize; 2];
+            if let (Some(medium), true) = (&o.material.layers, layered_id > 0 && depth_maps) {
+                for (slot, t) in depth.iter_mut().zip(&medium.depth_textures) {
+                    *slot = position_in(&depth_sources, Some(t));
+                }
+            }
+            let set = MapSet {
+                normal: if normal_maps {
+                    position_in(&normal_sources, o.material.normal_texture.as_ref())
+                } else {
+                    0
+                },
+                albedo: if albedo_maps {
+                    position_in(&albedo_sources, o.material.albedo_texture.as_ref())
+                } else {
+                    0
+                },
+                depth,
+            };
+            let (maps, depth_maps_index) = match &mut self.maps {
+                Some(maps) => (
+                    index_of_or_push(&mut maps.sets, set),
+                    index_of_or_push(&mut maps.depth_sets, depth),
+                ),
+                None => (0, 0),
+            };
             // Li et al.'s eq. 3 weights the lit diffuse by λ1 and the specular by λ2: lighting
             // is linear in albedo and specular intensity, so weighting them here is exact.
             let (diffuse_weight, specular_weight) = match (&o.material.layers, layered_id) {
@@ -441,6 +515,7 @@ impl SceneGpu {
             self.draws.push(Draw {
                 mesh: o.mesh,
                 maps,
+                depth_maps: depth_maps_index,
                 constants: ObjectConstants {
                     model: o.transform.to_cols_array_2d(),
                     albedo_specular: (o.material.albedo * diffuse_weight)
@@ -459,8 +534,8 @@ impl SceneGpu {
         Ok(())
     }
 
-    /// Loads and uploads the normal (or LEAN) and albedo maps, each list after its neutral
-    /// texture.
+    /// Loads and uploads the normal (or LEAN), albedo and depth maps, each list after its
+    /// neutral texture.
     fn upload_maps(
         &mut self,
         gpu: &GpuContext,
@@ -468,13 +543,17 @@ impl SceneGpu {
         lean: bool,
         normal_maps: bool,
         albedo_maps: bool,
+        depth_sources: &[&TextureSource],
     ) -> Result<()> {
         self.maps = Some(MaterialMaps {
             normal: Vec::new(),
             lean2: Vec::new(),
             albedo: Vec::new(),
+            depth: Vec::new(),
             sampler: create_repeat_sampler(gpu)?,
             sets: Vec::new(),
+            // The zero pair first: objects without TexDep layers bind it.
+            depth_sets: vec![[0, 0]],
         });
         let maps = self.maps.as_mut().expect("just set");
         if normal_maps {
@@ -519,6 +598,21 @@ impl SceneGpu {
                 maps.albedo.push(upload_texture(gpu, &texture, &name)?);
             }
         }
+        if !depth_sources.is_empty() {
+            // Layers of a medium with one depth texture read 0 from the second: never read,
+            // since only texture layers read texels.
+            let zero =
+                Texture::from_texels("zero depth", 1, 1, TextureUsage::Data, vec![[0.0; 4]])?;
+            maps.depth
+                .push(upload_texture(gpu, &zero, "zero depth map")?);
+            for (i, source) in depth_sources.iter().enumerate() {
+                // Linear data: the loader keeps float and 16-bit precision and replaces NaN
+                // and infinite texels with 0 (fp16 on the GPU: 3 significant digits).
+                let texture = load_source(source, TextureUsage::Data)?;
+                let name = format!("{} layer depth map {i}", scene.name);
+                maps.depth.push(upload_texture(gpu, &texture, &name)?);
+            }
+        }
         Ok(())
     }
 
@@ -532,7 +626,13 @@ impl SceneGpu {
             }
         }
         if let Some(maps) = self.maps {
-            for image in maps.normal.into_iter().chain(maps.lean2).chain(maps.albedo) {
+            for image in maps
+                .normal
+                .into_iter()
+                .chain(maps.lean2)
+                .chain(maps.albedo)
+                .chain(maps.depth)
+            {
                 gpu.destroy_image(image);
             }
             // SAFETY: created by `create_repeat_sampler`; the GPU is done with it.

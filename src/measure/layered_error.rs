@@ -118,6 +118,17 @@ pub fn comparison_lights() -> Vec<Light> {
     ]
 }
 
+/// The texture coordinates of a point of the unit sphere as [`Generator::Icosphere`] lays
+/// them out: u the longitude `atan2(z, x) / 2π` in [0, 1), v the colatitude `acos(y) / π`
+/// (0 at +y, the top row). (The generator rescales u by at most a seam triangle's width;
+/// textures that vary only in v read exactly the same texels.)
+pub fn sphere_uv(p: DVec3) -> glam::Vec2 {
+    let n = p.normalize_or_zero();
+    let u = n.z.atan2(n.x).rem_euclid(std::f64::consts::TAU) / std::f64::consts::TAU;
+    let v = n.y.clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+    glam::Vec2::new(u as f32, v as f32)
+}
+
 /// The result of one comparison.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TermError {
@@ -231,7 +242,18 @@ pub fn term_error_against(
         )?),
         _ => None,
     };
-    let options = SingleScatteringOptions {
+    // TexDep media: the reference reads the texel at each shaded point (the sphere's UV,
+    // sphere_uv), the GPU the one its G-buffer sampled there and the entry point's own.
+    let depth_textures = medium.load_depth_textures()?;
+    let inverse = transform.inverse();
+    let texels_at = |p: DVec3| -> Vec<[f32; 4]> {
+        let uv = sphere_uv(inverse.transform_point3(p));
+        depth_textures
+            .iter()
+            .map(|t| t.sample_bilinear(uv))
+            .collect()
+    };
+    let mut options = SingleScatteringOptions {
         phase: match reference_phase {
             PhaseForm::HenyeyGreenstein => Phase::HenyeyGreenstein,
             PhaseForm::Schlick => Phase::Schlick,
@@ -263,9 +285,13 @@ pub fn term_error_against(
             if !interior {
                 continue;
             }
+            let texels = texels_at(p);
             let reference = match term {
-                Term::Transmitted => transmitted(&scene, 0, p, d, &[])?,
-                Term::Single => single_scattering(&scene, 0, p, d, &options)?,
+                Term::Transmitted => transmitted(&scene, 0, p, d, &texels)?,
+                Term::Single => {
+                    options.depth_texels = texels;
+                    single_scattering(&scene, 0, p, d, &options)?
+                }
                 Term::Multiple => {
                     multiple_scattering(&scene, samples.as_ref().expect("built above"), p, d)?
                 }

@@ -180,7 +180,8 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
                 l.layers.len(),
                 if l.layers.len() == 1 { "" } else { "s" },
                 if textured {
-                    "; thickness textures: the f64 reference reads them, a render refuses them"
+                    "; thickness from depth textures (TexDep), read per pixel at the shaded \
+                     point and at the light's entry point"
                 } else {
                     ""
                 }

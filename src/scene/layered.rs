@@ -367,7 +367,9 @@ impl LayeredMedium {
             .iter()
             .map(|t| match t {
                 TextureSource::File(p) => load_texture(p, TextureUsage::Data),
-                TextureSource::Procedural(p) => super::texture::procedural_texture(p, 64),
+                TextureSource::Procedural(p) => {
+                    super::texture::procedural_texture(p, super::texture::PROCEDURAL_TEXTURE_SIZE)
+                }
             })
             .collect()
     }

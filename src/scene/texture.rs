@@ -151,6 +151,10 @@ fn bilinear(
     })
 }
 
+/// Side of the procedural textures lucent makes, in texels (the GPU upload and the f64
+/// references make the same texture).
+pub const PROCEDURAL_TEXTURE_SIZE: u32 = 512;
+
 /// Makes a procedural texture at `size` x `size` (linear data, with mips).
 ///
 /// `MarbleNormal`: the tileable height field `h = sin(2 pi (f x + t(x, y)))` with a periodic

@@ -222,18 +222,10 @@ void layer_span(int mat, int j, float top, float bottom, float cos_w, out float 
 #define MARCH_DENSITY 2.0
 #endif
 
-// Step u (in (0, 1)) of `steps` along the refracted ray (length s_end): the point s and its
-// share ds of the ray, placed by the importance sigma_s(s) e^(-MARCH_DENSITY tau(s)) of the
-// stack below x_o (rgb means per layer; tau the view ray's optical depth): in each layer it
-// integrates to sigma_s / (D sigma_t) (e^-T(s0) - e^-T(s1)), T = D tau, inverted in closed
-// form. Each layer gets steps in proportion to the light it can scatter back, so a thin top
-// over a denser layer resolves both (spacing by the first layer's transmittance alone put
-// the steps into the top: 28% error at K = 4 on a 0.1 mm top over a 20 mm^-1 layer). Layers
-// that scatter nothing hold no step; a stack that scatters ~nothing gets uniform steps.
-void march_step(int mat, float cos_w, float s_end, float u, int steps, uvec4 texels,
-                out float s, out float ds) {
+// The march's whole importance (the normaliser of march_step), once per pixel; < 0 when the
+// stack scatters ~nothing along the ray (uniform steps).
+float march_total(int mat, float cos_w, float s_end, uvec4 texels) {
     int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
-    // Pass 1: the importance of the whole march.
     float total = 0.0, top = 0.0, t_acc = 0.0;
     for (int j = 0; j < count; ++j) {
         float bottom = layer_bottom(mat, j, top, texels);
@@ -252,17 +244,31 @@ void march_step(int mat, float cos_w, float s_end, float u, int steps, uvec4 tex
         t_acc += t_seg;
         top = bottom;
     }
-    if (!(total > 1e-30) || !(t_acc > 1e-6)) {
+    return (total > 1e-30 && t_acc > 1e-6) ? total : -1.0;
+}
+
+// Step u (in (0, 1)) of `steps` along the refracted ray (length s_end): the point s and its
+// share ds of the ray, placed by the importance sigma_s(s) e^(-MARCH_DENSITY tau(s)) of the
+// stack below x_o (rgb means per layer; tau the view ray's optical depth): in each layer it
+// integrates to sigma_s / (D sigma_t) (e^-T(s0) - e^-T(s1)), T = D tau, inverted in closed
+// form. Each layer gets steps in proportion to the light it can scatter back, so a thin top
+// over a denser layer resolves both (spacing by the first layer's transmittance alone put
+// the steps into the top: 28% error at K = 4 on a 0.1 mm top over a 20 mm^-1 layer). Layers
+// that scatter nothing hold no step; a stack that scatters ~nothing (total < 0) gets uniform
+// steps.
+void march_step(int mat, float cos_w, float s_end, float total, float u, int steps,
+                uvec4 texels, out float s, out float ds) {
+    if (!(total > 0.0)) {
         s = u * s_end;
         ds = s_end / float(steps);
         return;
     }
-    // Pass 2: the layer where the importance reaches u of the total, and the point in it
-    // (rounding can leave the target past the last layer that scatters: its end).
+    int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
+    float top = 0.0, t_acc = 0.0;
+    // The layer where the importance reaches u of the total, and the point in it (rounding
+    // can leave the target past the last layer that scatters: its end).
     float target = u * total;
     float acc = 0.0;
-    top = 0.0;
-    t_acc = 0.0;
     s = s_end;
     ds = s_end / float(steps);
     for (int j = 0; j < count; ++j) {
@@ -328,8 +334,9 @@ void main() {
     float s_end = MAT.info.z / max(cos_w, 0.05);
     int steps = clamp(layered.knobs.x, 1, 64);
     // The middle of the march, where each light's entry point is looked up once.
+    float total = march_total(mat, cos_w, s_end, texels_o);
     float s_mid, unused_ds;
-    march_step(mat, cos_w, s_end, 0.5, steps, texels_o, s_mid, unused_ds);
+    march_step(mat, cos_w, s_end, total, 0.5, steps, texels_o, s_mid, unused_ds);
     vec3 m_mid = x_o + w * s_mid;
 
     vec3 l_t = vec3(0.0), sum = vec3(0.0);
@@ -361,7 +368,7 @@ void main() {
         for (int k = 0; k < steps; ++k) {
             float u = (float(k) + 0.5) / float(steps);
             float s, ds;
-            march_step(mat, cos_w, s_end, u, steps, texels_o, s, ds);
+            march_step(mat, cos_w, s_end, total, u, steps, texels_o, s, ds);
             vec3 m = x_o + w * s;
             int layer = layer_at(mat, dot(x_o - m, n_o), texels_o);
             if (layer < 0) {

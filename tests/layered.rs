@@ -84,6 +84,26 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
             },
             0.15,
         ),
+        (
+            "apple half gather",
+            preset("apple"),
+            Term::Multiple,
+            LayeredKnobs {
+                half_gather: true,
+                ..default
+            },
+            0.08,
+        ),
+        (
+            "skin1 half gather",
+            preset("skin1"),
+            Term::Multiple,
+            LayeredKnobs {
+                half_gather: true,
+                ..default
+            },
+            0.15,
+        ),
         ("clear", clear_medium(), Term::Transmitted, default, 0.12),
     ]
 }
@@ -103,10 +123,10 @@ fn each_term_agrees_with_its_reference() {
             knobs.steps,
             knobs.pixel_lights,
             knobs.phase.name(),
-            if knobs.half_irradiance {
-                ", half irradiance"
-            } else {
-                ""
+            match (knobs.half_irradiance, knobs.half_gather) {
+                (true, _) => ", half irradiance",
+                (_, true) => ", half gather",
+                _ => "",
             },
             e.pixels,
             e.relative_l1,
@@ -180,6 +200,24 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
         .find(|r| r.name == "layered.irradiance")
         .unwrap();
     assert_eq!((irradiance.info.width, irradiance.info.height), (160, 120));
+    // The half-resolution gather: its half-size term, drawn before single scattering (which
+    // upsamples it); the full gather (default) has no such image.
+    assert!(!images(&p).iter().any(|n| n == "layered.multiple"));
+    let mut half_gather = s;
+    half_gather.layered.half_gather = true;
+    let p = plan(&layered, &half_gather);
+    let term = p
+        .resources
+        .iter()
+        .find(|r| r.name == "layered.multiple")
+        .expect("the half-resolution term");
+    assert_eq!((term.info.width, term.info.height), (160, 120));
+    let order = passes(&p);
+    let at = |name: &str| order.iter().position(|n| n == name).unwrap();
+    assert!(
+        at("multiple scattering") < at("single scattering"),
+        "{order:?}"
+    );
     // Without shadows the passes stay (lights without a map take the surface as a plane)
     // but there is no light-space map, so no entry target.
     let mut no_shadows = s;

@@ -1,8 +1,11 @@
 #version 450
+// permutation: LUCENT_HALF_GATHER
 // Li et al.'s multiple scattering (eqs. 12-13), added into the lit image weighted by eq. 3's
 // λ5 (src/features/layered.rs, `multiple scattering`): Jensen's dipole of the first layer
 // gathered over M pixel lights of the irradiance image. Set 0 as glsl/common/layered.glsl,
-// then the irradiance image (binding 5).
+// then the irradiance image (binding 5). With LUCENT_HALF_GATHER each texel of a
+// half-resolution target gathers for its 2x2 block's top-left pixel and stores the weighted
+// term with the material ID in alpha, for glsl/layered/upsample.frag.
 #include "../common/layered.glsl"
 
 layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
@@ -17,7 +20,11 @@ float pixel_noise(vec2 p) {
 }
 
 void main() {
+#ifdef LUCENT_HALF_GATHER
+    ivec2 px = min(ivec2(gl_FragCoord.xy) * 2, ivec2(frame.viewport.xy) - 1);
+#else
     ivec2 px = ivec2(gl_FragCoord.xy);
+#endif
     int id = layered_id_at(px);
     out_color = vec4(0.0);
     if (id == 0) {
@@ -44,7 +51,8 @@ void main() {
     int count = clamp(layered.knobs.y, 4, 64);
     int scale = max(layered.knobs.w, 1);
     ivec2 size = ivec2(frame.viewport.xy);
-    float rotation = 6.28318530718 * pixel_noise(gl_FragCoord.xy);
+    // Noise of the full-resolution pixel gathered for (at half resolution, its block's).
+    float rotation = 6.28318530718 * pixel_noise(vec2(px) + 0.5);
     vec3 gathered = vec3(0.0), weight = vec3(0.0);
     for (int i = 0; i < count; ++i) {
         float u = (float(i) + 0.5) / float(count);
@@ -82,5 +90,9 @@ void main() {
     // (No accepted sample: both sums are 0, and so is the term.)
     vec3 l_ms = fresnel_transmittance(cos_o, eta) / PI * MAT.total.rgb * gathered /
                 max(weight, vec3(1e-30));
+#ifdef LUCENT_HALF_GATHER
+    out_color = vec4(finite_term(MAT.weights.z * l_ms), float(id));
+#else
     out_color = vec4(finite_term(MAT.weights.z * l_ms), 0.0);
+#endif
 }

@@ -1,13 +1,18 @@
 #version 450
 // permutation: LUCENT_ENTRY_BINDING=5 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6
 // permutation: LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_BINDING=5
+// permutation: LUCENT_HALF_TERM_BINDING=5
 // permutation: LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_BINDING=5 LUCENT_ENTRY_BINDING=6 LUCENT_ENTRY_DEPTH_BINDING=7 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=8
 // Li et al.'s single scattering (eqs. 4-11) and the transmitted term L_t, added into the lit
 // image (src/features/layered.rs, `single scattering`), weighted by eq. 3's λ4 and λ3.
 // Set 0 as glsl/common/layered.glsl, then (media with TexDep layers) the G-buffer's layer
 // depth texels, then (lights with maps) the entry atlas, its layer depth texels (with TexDep)
-// and the shadow bindings.
+// and the shadow bindings; with `--half-gather` the half-resolution multiple-scattering term
+// (LUCENT_HALF_TERM_BINDING), which this pass upsamples and adds.
 #include "../common/layered.glsl"
+#ifdef LUCENT_HALF_TERM_BINDING
+#include "../common/layered_upsample.glsl"
+#endif
 
 #ifdef LUCENT_LAYER_DEPTHS
 // Per pixel: the depth-texture texels at x_o (layer_depths.glsl).
@@ -389,5 +394,9 @@ void main() {
     }
     l_t *= t_o / PI;
     vec3 l_ss = t_o * sum;
-    out_color = vec4(finite_term(MAT.weights.x * l_t + MAT.weights.y * l_ss), 0.0);
+    vec3 terms = MAT.weights.x * l_t + MAT.weights.y * l_ss;
+#ifdef LUCENT_HALF_TERM_BINDING
+    terms += upsampled_multiple(px, id); // already weighted by λ5
+#endif
+    out_color = vec4(finite_term(terms), 0.0);
 }

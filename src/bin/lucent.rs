@@ -293,6 +293,10 @@ struct FrameArgs {
     /// resolution per side.
     #[arg(long)]
     half_irradiance: bool,
+    /// Layered media: multiple scattering gathered once per 2x2 block and upsampled by
+    /// material and depth (cheaper; a coarser mottling than the full gather's grain).
+    #[arg(long)]
+    half_gather: bool,
     /// Layered media: single scattering's depth D_max in mean free paths of the first layer
     /// (a finite number > 0; default 4).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_single_depth)]
@@ -518,6 +522,7 @@ impl FrameArgs {
                     pixel_lights: self.pixel_lights.unwrap_or(defaults.pixel_lights),
                     phase: self.phase.unwrap_or(defaults.phase),
                     half_irradiance: self.half_irradiance,
+                    half_gather: self.half_gather,
                     max_depth_mfp: self.single_depth.unwrap_or(defaults.max_depth_mfp),
                 }
             },
@@ -587,6 +592,7 @@ impl FrameArgs {
             (self.pixel_lights.is_some(), "--pixel-lights"),
             (self.phase.is_some(), "--phase"),
             (self.half_irradiance, "--half-irradiance"),
+            (self.half_gather, "--half-gather"),
             (self.single_depth.is_some(), "--single-depth"),
         ]
         .map(|(given, flag)| (given, flag, layered, desc.layered.is_some()));

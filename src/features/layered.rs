@@ -103,6 +103,12 @@ pub struct LayeredKnobs {
     pub phase: PhaseForm,
     /// The irradiance image at half resolution per side.
     pub half_irradiance: bool,
+    /// Multiple scattering gathered at half resolution per side (one gather per 2x2 block),
+    /// brought back by a material- and depth-aware upsample in the single scattering pass.
+    /// Cheaper and, by the error metric, closer to the reference (the upsample averages four
+    /// differently rotated gathers), but the gather's noise becomes a coarser mottling than
+    /// the full-resolution gather's fine grain (docs/layered.md): off by default.
+    pub half_gather: bool,
     /// Single scattering's depth `D_max` in mean free paths of the first layer's clearest
     /// channel (> 0; default 4: beyond, `e^-4` of the light is left to multiple scattering).
     pub max_depth_mfp: f32,
@@ -115,6 +121,7 @@ impl Default for LayeredKnobs {
             pixel_lights: 12,
             phase: PhaseForm::HenyeyGreenstein,
             half_irradiance: false,
+            half_gather: false,
             max_depth_mfp: 4.0,
         }
     }
@@ -397,6 +404,7 @@ pub fn layered_passes(
             .and_then(|m| m.layer_depths.as_ref().map(|h| h.id())),
         layer_depth_textures: inputs.layer_depth_textures,
         irradiance: None,
+        half_term: None,
     };
 
     // Cleared: pixels outside the rectangles read 0 (the gather rejects them by ID anyway).
@@ -408,24 +416,57 @@ pub fn layered_passes(
         None => pass.finish(),
     }
 
-    let mut pass = graph.add_pass("single scattering", PassKind::Raster);
-    sample(&mut pass, Kind::Single);
-    pass.color(&mut hdr, LoadOp::Load);
-    match scene {
-        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Single, base, 1)),
-        None => pass.finish(),
+    let gather = LayeredPassInputs {
+        irradiance: Some(irradiance.id()),
+        ..base
+    };
+    if !knobs.half_gather {
+        let mut pass = graph.add_pass("single scattering", PassKind::Raster);
+        sample(&mut pass, Kind::Single);
+        pass.color(&mut hdr, LoadOp::Load);
+        match scene {
+            Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Single, base, 1)),
+            None => pass.finish(),
+        }
+        let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
+        sample(&mut pass, Kind::Multiple);
+        pass.sample(&irradiance);
+        pass.color(&mut hdr, LoadOp::Load);
+        match scene {
+            Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Multiple, gather, 1)),
+            None => pass.finish(),
+        }
+        return hdr;
     }
-
+    // Half-resolution gather: the term per 2x2 block (alpha: its material) first, then single
+    // scattering adds its own terms and the upsampled one (glsl/common/layered_upsample.glsl).
+    let mut half_term = graph.create_image(
+        "layered.multiple",
+        ImageInfo {
+            width: info.width.div_ceil(2),
+            height: info.height.div_ceil(2),
+            format: IRRADIANCE_FORMAT,
+        },
+    );
     let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
     sample(&mut pass, Kind::Multiple);
     pass.sample(&irradiance);
+    // Cleared: texels outside the rectangles read material 0, which the upsample skips.
+    pass.color(&mut half_term, LoadOp::Clear([0.0; 4]));
+    match scene {
+        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::HalfGather, gather, 2)),
+        None => pass.finish(),
+    }
+    let mut pass = graph.add_pass("single scattering", PassKind::Raster);
+    sample(&mut pass, Kind::Single);
+    pass.sample(&half_term);
     pass.color(&mut hdr, LoadOp::Load);
     match scene {
         Some(scene) => pass.execute(LayeredPass::new(
             scene,
-            Kind::Multiple,
+            Kind::Single,
             LayeredPassInputs {
-                irradiance: Some(irradiance.id()),
+                half_term: Some(half_term.id()),
                 ..base
             },
             1,
@@ -440,6 +481,8 @@ enum Kind {
     Irradiance,
     Single,
     Multiple,
+    /// Multiple scattering into the half-resolution target.
+    HalfGather,
 }
 
 #[derive(Clone, Copy)]
@@ -457,7 +500,11 @@ struct LayeredPassInputs {
     entry_depths: Option<ResourceId>,
     /// Depth textures per object in `layer_depths` (0, 1 or 2).
     layer_depth_textures: usize,
+    /// The gather's irradiance image.
     irradiance: Option<ResourceId>,
+    /// Single scattering with `--half-gather`: the half-resolution multiple-scattering term
+    /// it upsamples and adds.
+    half_term: Option<ResourceId>,
 }
 
 struct LayeredPass {
@@ -504,6 +551,10 @@ impl PassExec for LayeredPass {
         if let Some(irradiance) = i.irradiance {
             bindings.push(Binding::Sampled(views[irradiance], self.nearest));
         }
+        if let (Kind::Single, Some(half_term)) = (self.kind, i.half_term) {
+            defines.push(("LUCENT_HALF_TERM_BINDING", NUMBERS[bindings.len()]));
+            bindings.push(Binding::Sampled(views[half_term], self.nearest));
+        }
         // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
         // first layer's, semi-infinite, as in the paper).
         let texdep = self.kind == Kind::Single && i.layer_depths.is_some();
@@ -515,7 +566,7 @@ impl PassExec for LayeredPass {
             defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[bindings.len()]));
             bindings.push(Binding::Sampled(views[depths], self.nearest));
         }
-        if let (Some(depth), true) = (i.shadow_depth, self.kind != Kind::Multiple) {
+        if let (Some(depth), Kind::Irradiance | Kind::Single) = (i.shadow_depth, self.kind) {
             if let (Kind::Single, Some(entry)) = (self.kind, i.entry) {
                 defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[bindings.len()]));
                 bindings.push(Binding::Sampled(views[entry], self.nearest));
@@ -533,15 +584,21 @@ impl PassExec for LayeredPass {
                 self.nearest,
             ));
         }
-        if self.scale == 2 {
-            defines.push(("LUCENT_HALF_RES", "1"));
+        match (self.kind, self.scale) {
+            (Kind::Irradiance, 2) => defines.push(("LUCENT_HALF_RES", "1")),
+            (Kind::HalfGather, _) => defines.push(("LUCENT_HALF_GATHER", "1")),
+            _ => {}
         }
         let (fragment, name) = match self.kind {
             Kind::Irradiance => ("layered/irradiance.frag", "layered irradiance"),
             Kind::Single => ("layered/single.frag", "single scattering"),
-            Kind::Multiple => ("layered/multiple.frag", "multiple scattering"),
+            Kind::Multiple | Kind::HalfGather => ("layered/multiple.frag", "multiple scattering"),
         };
-        let additive = if self.kind == Kind::Irradiance { 0 } else { 1 };
+        // The irradiance and the half-resolution term are written; the others add.
+        let additive = match self.kind {
+            Kind::Irradiance | Kind::HalfGather => 0,
+            Kind::Single | Kind::Multiple => 1,
+        };
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &bindings,

@@ -1,7 +1,8 @@
 //! Error against run time for Li et al.'s layered passes: `lucent report li --out DIR`.
 //!
 //! Every knob of the technique ([`KNOBS`]: march steps `K`, pixel lights `M`, the light-space
-//! map resolution, the phase function, the layer count, the irradiance resolution) is turned
+//! map resolution, the phase function, the layer count, the irradiance and the multiple
+//! scattering gather resolutions) is turned
 //! one at a time from the defaults, and each variant is measured two ways:
 //! - **error**: the term of eq. 3 the knob changes, alone (its weight 1, the others 0), on the
 //!   comparison sphere ([`crate::measure::layered_error::sphere_scene`] under
@@ -42,13 +43,14 @@ pub const LAYERED_PASSES: [&str; 3] = [
 ];
 
 /// Every knob the report turns, in order (the Markdown names each).
-pub const KNOBS: [&str; 6] = [
+pub const KNOBS: [&str; 7] = [
     "march steps K",
     "pixel lights M",
     "light-map resolution",
     "phase function",
     "layer count",
     "irradiance resolution",
+    "gather resolution",
 ];
 
 /// The light-map resolution's second series: the transmitted term on the clear medium.
@@ -342,6 +344,17 @@ pub fn li_variants(quick: bool) -> Vec<LiVariant> {
             Term::Multiple,
         );
         x.layered.half_irradiance = half;
+        v.push(x);
+    }
+    for half in [false, true] {
+        let mut x = base(
+            KNOBS[6],
+            if half { "half" } else { "full" }.to_string(),
+            skin1(),
+            "skin1",
+            Term::Multiple,
+        );
+        x.layered.half_gather = half;
         v.push(x);
     }
     v

@@ -1,0 +1,45 @@
+// Multiple scattering gathered at half resolution (src/features/layered.rs, `--half-gather`),
+// brought back to full resolution by the single scattering pass, which adds it with its own
+// terms (one full-screen pass fewer: on lavapipe a pass over the screen costs ~15 ms at
+// 1024^2 whatever it does). Each pixel takes the four half-resolution texels around it,
+// bilinearly weighted, keeping only those of its own material and at its own depth (a texel
+// holds its 2x2 block's top-left pixel), so no term leaks across silhouettes or between
+// objects. Include after layered.glsl with LUCENT_HALF_TERM_BINDING defined.
+#ifndef LUCENT_LAYERED_UPSAMPLE_GLSL
+#define LUCENT_LAYERED_UPSAMPLE_GLSL
+
+// rgb: the weighted multiple-scattering term; alpha: the texel's layered material ID.
+layout(set = 0, binding = LUCENT_HALF_TERM_BINDING) uniform sampler2D half_term;
+
+// The half-resolution term at full-resolution pixel `px` of material `id` (0 where no texel
+// around it is of that material at that depth: a sliver thinner than a texel).
+vec3 upsampled_multiple(ivec2 px, int id) {
+    ivec2 size = ivec2(frame.viewport.xy);
+    ivec2 half_size = textureSize(half_term, 0);
+    float here = linear_depth(texelFetch(gbuffer_depth, px, 0).r);
+    // Texel k samples pixel 2k: pixel px lies at px / 2 in texel units.
+    vec2 t = vec2(px) * 0.5;
+    ivec2 base = ivec2(floor(t));
+    vec2 f = t - vec2(base);
+    vec3 sum = vec3(0.0);
+    float total = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        ivec2 q = min(base + o, half_size - 1);
+        vec4 texel = texelFetch(half_term, q, 0);
+        if (int(texel.a + 0.5) != id) {
+            continue;
+        }
+        float d = linear_depth(texelFetch(gbuffer_depth, min(q * 2, size - 1), 0).r);
+        // Depth agreement within ~1% of the depth: a texel across a fold of the same object
+        // (or behind it) gets no say.
+        float rel = abs(d - here) / max(0.01 * here, 1e-6);
+        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) + 1e-4;
+        w /= 1.0 + rel * rel;
+        sum += texel.rgb * w;
+        total += w;
+    }
+    return total > 0.0 ? sum / total : vec3(0.0);
+}
+
+#endif

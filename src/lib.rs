@@ -29,6 +29,7 @@ pub mod demo;
 pub mod error;
 pub mod features;
 pub mod files;
+mod font;
 pub mod frame;
 pub mod gpu_scene;
 pub mod graph;

@@ -18,7 +18,8 @@
 //! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
 //! versions of every shading equation, used by tests and reports, never by features),
 //! [`images`] (PNG/EXR files and FLIP comparison), [`files`] (every file read is a regular file
-//! read with a cap; a command's outputs are checked against its inputs). Above the frame: [`measure`] (benchmark,
+//! read with a cap; a command's outputs are checked against its inputs), [`progress`] (the
+//! bake's and the benchmark's progress). Above the frame: [`measure`] (benchmark,
 //! speed of light, scaling, sweeps), [`report`] (`lucent report`: the suite, its sections,
 //! the seeds' tables, plots) and, with the `window` feature, `demo` (the interactive window).
 
@@ -35,6 +36,7 @@ pub mod gpu_scene;
 pub mod graph;
 pub mod images;
 pub mod measure;
+pub mod progress;
 pub mod reference;
 pub mod report;
 pub mod scene;

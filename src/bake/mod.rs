@@ -92,7 +92,8 @@ pub struct BakeOptions {
     pub seed: u64,
     /// Width and height of a baked texture in texels (default 512; 1 ..= [`MAX_TEXTURE_SIZE`]).
     pub texture_size: u32,
-    /// Draw a progress bar on stderr (hidden when stderr is not a terminal).
+    /// Draw a progress bar on stderr (hidden when stderr is not a terminal); without the
+    /// `report` feature, log the count at info level instead ([`crate::progress`]).
     pub progress: bool,
 }
 

@@ -17,7 +17,8 @@
 //! With a [`CopyFrame`] the same run also times every pass's
 //! speed-of-light copy, alternating with the frames, and the report gains the pass / copy table.
 //! Output: [`BenchReport::markdown`], [`BenchReport::csv`], [`BenchReport::json`]. Runs longer
-//! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal.
+//! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal (without the
+//! `report` feature, log lines instead: [`crate::progress`]).
 
 use std::io::IsTerminal as _;
 
@@ -226,7 +227,8 @@ pub fn run_with_floor(
 }
 
 /// A progress bar on stderr for `total` steps, drawn only when stderr is a terminal and the run
-/// is expected to take longer than [`PROGRESS_AFTER_S`].
+/// is expected to take longer than [`PROGRESS_AFTER_S`] (without the `report` feature, under
+/// the same conditions, coarse log lines: [`Progress`]).
 pub fn progress_bar(total: u64, expected_s: f64, what: &str) -> Progress {
     if !std::io::stderr().is_terminal() || expected_s < PROGRESS_AFTER_S {
         return Progress::hidden();

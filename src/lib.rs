@@ -18,9 +18,18 @@
 //! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
 //! versions of every shading equation, used by tests and reports, never by features),
 //! [`images`] (PNG/EXR files and FLIP comparison), [`files`] (every file read is a regular file
-//! read with a cap; a command's outputs are checked against its inputs). Above the frame: [`measure`] (benchmark,
-//! speed of light, scaling, sweeps), [`report`] (`lucent report`: the suite, its sections,
-//! the seeds' tables, plots) and, with the `window` feature, `demo` (the interactive window).
+//! read with a cap; a command's outputs are checked against its inputs), [`progress`] (the
+//! bake's and the benchmark's progress). Above the frame: [`measure`] (benchmark, speed of
+//! light, scaling, sweeps) and, with their features, `report` (`lucent report`: the suite, its
+//! sections, the seeds' tables, plots) and `demo` (the interactive window).
+//!
+//! Cargo features, all on by default: `window` (winit, ash-window, ab_glyph: the `demo`
+//! module and `lucent demo`), `cli` (clap, env_logger: the `lucent` binary's command line) and
+//! `report` (plotters, indicatif: the `report` module and progress bars on stderr). The `lucent`
+//! binary needs `cli` and `report`. With `--no-default-features` the library keeps everything
+//! else (context, graph, scene, bake, renderer, measure, reference, images) and depends on none
+//! of those crates; the bake and the benchmark then report progress through `log` (info level,
+//! every tenth) instead of a bar.
 
 pub mod backend;
 pub mod bake;
@@ -29,12 +38,16 @@ pub mod demo;
 pub mod error;
 pub mod features;
 pub mod files;
+#[cfg(any(feature = "window", feature = "report"))]
+mod font;
 pub mod frame;
 pub mod gpu_scene;
 pub mod graph;
 pub mod images;
 pub mod measure;
+pub mod progress;
 pub mod reference;
+#[cfg(feature = "report")]
 pub mod report;
 pub mod scene;
 

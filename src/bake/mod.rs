@@ -92,7 +92,8 @@ pub struct BakeOptions {
     pub seed: u64,
     /// Width and height of a baked texture in texels (default 512; 1 ..= [`MAX_TEXTURE_SIZE`]).
     pub texture_size: u32,
-    /// Draw a progress bar on stderr (hidden when stderr is not a terminal).
+    /// Draw a progress bar on stderr (hidden when stderr is not a terminal); without the
+    /// `report` feature, log the count at info level instead ([`crate::progress`]).
     pub progress: bool,
 }
 
@@ -320,17 +321,12 @@ impl Baker {
     /// Bakes every point in parallel; `start` is when the bake began (for the stats).
     pub(crate) fn run(&self, points: &[SamplePoint], start: Instant) -> (Vec<f32>, BakeStats) {
         let bar = self.progress.then(|| {
-            let bar = indicatif::ProgressBar::with_draw_target(
-                Some(points.len() as u64),
-                indicatif::ProgressDrawTarget::stderr(),
-            );
-            bar.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "baking thickness [{bar:40}] {pos}/{len} samples ({eta} left)",
-                )
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            bar
+            crate::progress::Progress::stderr(
+                points.len() as u64,
+                "baking thickness",
+                "{msg} [{bar:40}] {pos}/{len} samples ({eta} left)",
+                None,
+            )
         });
         let values: Vec<f32> = points
             .par_iter()

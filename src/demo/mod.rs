@@ -127,7 +127,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
     let pipeline_cache = PipelineCache::load_default(&gpu)?;
     // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
     // the timing columns line up.
-    let font = crate::report::plot::font_file().map(|p| {
+    let font = crate::font::font_file().map(|p| {
         let mono = p.with_file_name("DejaVuSansMono.ttf");
         if mono.is_file() {
             mono

@@ -168,7 +168,7 @@ mod tests {
 
     #[test]
     fn text_draws_foreground_pixels_within_the_limits() {
-        let Ok(path) = crate::report::plot::font_file() else {
+        let Ok(path) = crate::font::font_file() else {
             panic!("no font: run tools/setup.sh (fonts-dejavu-core)");
         };
         let text = TextRenderer::load(&path).unwrap();

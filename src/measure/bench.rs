@@ -17,7 +17,8 @@
 //! With a [`CopyFrame`] the same run also times every pass's
 //! speed-of-light copy, alternating with the frames, and the report gains the pass / copy table.
 //! Output: [`BenchReport::markdown`], [`BenchReport::csv`], [`BenchReport::json`]. Runs longer
-//! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal.
+//! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal (without the
+//! `report` feature, log lines instead: [`crate::progress`]).
 
 use std::io::IsTerminal as _;
 
@@ -27,6 +28,7 @@ use crate::backend::GpuContext;
 use crate::frame::{FrameRunner, FrameTiming, Renderer};
 use crate::measure::speed_of_light::{CopyFrame, FloorRow};
 use crate::measure::stats::Stats;
+use crate::progress::Progress;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
@@ -225,22 +227,18 @@ pub fn run_with_floor(
 }
 
 /// A progress bar on stderr for `total` steps, drawn only when stderr is a terminal and the run
-/// is expected to take longer than [`PROGRESS_AFTER_S`].
-pub fn progress_bar(total: u64, expected_s: f64, what: &str) -> indicatif::ProgressBar {
+/// is expected to take longer than [`PROGRESS_AFTER_S`] (without the `report` feature, under
+/// the same conditions, coarse log lines: [`Progress`]).
+pub fn progress_bar(total: u64, expected_s: f64, what: &str) -> Progress {
     if !std::io::stderr().is_terminal() || expected_s < PROGRESS_AFTER_S {
-        return indicatif::ProgressBar::hidden();
+        return Progress::hidden();
     }
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(total),
-        indicatif::ProgressDrawTarget::stderr(),
-    );
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    bar.set_message(what.to_string());
-    bar
+    Progress::stderr(
+        total,
+        what,
+        "{msg} [{bar:40}] {pos}/{len} ({eta} left)",
+        Some("=> "),
+    )
 }
 
 fn collect(samples: &mut [Vec<f64>], timing: &FrameTiming, names: &[String]) -> Result<()> {

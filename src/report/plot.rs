@@ -28,6 +28,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::error::{LucentError, Result};
+use crate::font::{FONT_CANDIDATES, FONT_ENV};
 
 /// One labelled point of a plot.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,23 +57,6 @@ const HEIGHT: u32 = 640;
 
 /// Smallest value drawn on a log axis when no value is positive.
 const LOG_FLOOR: f64 = 1e-6;
-
-/// Environment variable naming a `.ttf` file to use instead of the system fonts below.
-const FONT_ENV: &str = "LUCENT_PLOT_FONT";
-
-/// Fonts tried in order; the first that exists and parses is used.
-const FONT_CANDIDATES: &[&str] = &[
-    // Debian/Ubuntu: fonts-dejavu-core (installed by tools/setup.sh).
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    // Arch.
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    // Fedora.
-    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
-    // Alpine, older Fedora.
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-    // Debian/Ubuntu: fonts-liberation.
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-];
 
 /// Series colours (the "tab10" palette, then six darker hues so the SSS report's dozen series
 /// each get their own), reused in order when there are more series.
@@ -183,30 +167,6 @@ fn load_font() -> std::result::Result<(), (PathBuf, String)> {
             FONT_CANDIDATES.join(", ")
         ),
     ))
-}
-
-/// The font file text is drawn with elsewhere (the demo's overlay): the file named by
-/// `LUCENT_PLOT_FONT` when set, else the first of the system candidates above that exists.
-/// Errors say what was looked for and how to install one.
-pub fn font_file() -> Result<PathBuf> {
-    if let Some(wanted) = std::env::var_os(FONT_ENV).filter(|v| !v.is_empty()) {
-        return Ok(PathBuf::from(wanted));
-    }
-    FONT_CANDIDATES
-        .iter()
-        .map(Path::new)
-        .find(|p| p.is_file())
-        .map(Path::to_path_buf)
-        .ok_or_else(|| {
-            LucentError::file(
-                FONT_CANDIDATES[0],
-                format!(
-                    "no font found (looked for {}); install one: apt-get install \
-                     fonts-dejavu-core, or set {FONT_ENV} to a .ttf file",
-                    FONT_CANDIDATES.join(", ")
-                ),
-            )
-        })
 }
 
 /// Reads `path` and registers it as "sans-serif". The bytes are leaked only after they were read.

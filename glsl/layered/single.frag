@@ -206,20 +206,6 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
 #endif
 }
 
-// The march's layers along the refracted ray: layer j of the stack below x_o (depths from
-// `top` to its bottom) holds ray lengths [top, bottom) / cos_w, where cos_w = -n_o . w (a ray
-// along the surface stays in the first layer).
-void layer_span(int mat, int j, float top, float bottom, float cos_w, out float s0,
-                out float s1) {
-    if (cos_w > 1e-6) {
-        s0 = top / cos_w;
-        s1 = bottom >= 1e30 ? 1e30 : bottom / cos_w;
-    } else {
-        s0 = j == 0 ? 0.0 : 1e30;
-        s1 = 1e30;
-    }
-}
-
 // How fast the march's importance falls with the view ray's optical depth: light scattered
 // at depth reaches it through the medium and leaves through it, e^-(tau_view + tau_light),
 // and tau_light is about tau_view for light from above, so 2.
@@ -227,21 +213,39 @@ void layer_span(int mat, int j, float top, float bottom, float cos_w, out float 
 #define MARCH_DENSITY 2.0
 #endif
 
+// Layer j of the stack below x_o (its top at depth `top`) along the refracted ray of length
+// s_end: its bottom depth, the ray lengths [s0, s1) it holds (depth / cos_w, cos_w = -n_o . w;
+// a ray along the surface stays in the first layer; s1 at most s_end), and its rgb-mean
+// extinction times MARCH_DENSITY and scattering. False when the layer starts past the march.
+bool march_segment(int mat, int j, float top, float cos_w, float s_end, uvec4 texels,
+                   out float bottom, out float s0, out float s1, out float sigma_t,
+                   out float sigma_s) {
+    bottom = layer_bottom(mat, j, top, texels);
+    if (cos_w > 1e-6) {
+        s0 = top / cos_w;
+        s1 = bottom >= 1e30 ? 1e30 : bottom / cos_w;
+    } else {
+        s0 = j == 0 ? 0.0 : 1e30;
+        s1 = 1e30;
+    }
+    s1 = min(s1, s_end);
+    sigma_t = MARCH_DENSITY * dot(MAT.sigma_t_g[j].rgb, vec3(1.0 / 3.0));
+    sigma_s = dot(MAT.sigma_s_thickness[j].rgb, vec3(1.0 / 3.0));
+    return s0 < s_end;
+}
+
 // The march's whole importance (the normaliser of march_step), once per pixel; < 0 when the
 // stack scatters ~nothing along the ray (uniform steps).
 float march_total(int mat, float cos_w, float s_end, uvec4 texels) {
     int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
     float total = 0.0, top = 0.0, t_acc = 0.0;
     for (int j = 0; j < count; ++j) {
-        float bottom = layer_bottom(mat, j, top, texels);
-        float s0, s1;
-        layer_span(mat, j, top, bottom, cos_w, s0, s1);
-        if (s0 >= s_end) {
+        float bottom, s0, s1, sigma_t, sigma_s;
+        if (!march_segment(mat, j, top, cos_w, s_end, texels, bottom, s0, s1, sigma_t,
+                           sigma_s)) {
             break;
         }
-        float sigma_t = MARCH_DENSITY * dot(MAT.sigma_t_g[j].rgb, vec3(1.0 / 3.0));
-        float sigma_s = dot(MAT.sigma_s_thickness[j].rgb, vec3(1.0 / 3.0));
-        float t_seg = sigma_t * (min(s1, s_end) - s0);
+        float t_seg = sigma_t * (s1 - s0);
         if (sigma_t > 0.0) {
             // e^-a (1 - e^-b) without cancellation for a thin segment.
             total += sigma_s / sigma_t * exp(-t_acc) * -expm1_approx(-t_seg);
@@ -263,29 +267,23 @@ float march_total(int mat, float cos_w, float s_end, uvec4 texels) {
 // steps.
 void march_step(int mat, float cos_w, float s_end, float total, float u, int steps,
                 uvec4 texels, out float s, out float ds) {
-    if (!(total > 0.0)) {
-        s = u * s_end;
-        ds = s_end / float(steps);
-        return;
-    }
-    int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
-    float top = 0.0, t_acc = 0.0;
-    // The layer where the importance reaches u of the total, and the point in it (rounding
-    // can leave the target past the last layer that scatters: its end).
-    float target = u * total;
-    float acc = 0.0;
     s = s_end;
     ds = s_end / float(steps);
+    if (!(total > 0.0)) {
+        s = u * s_end;
+        return;
+    }
+    // The layer where the importance reaches u of the total, and the point in it (rounding
+    // can leave the target past the last layer that scatters: its end).
+    int count = clamp(int(MAT.info.x + 0.5), 1, MAX_MEDIUM_LAYERS);
+    float target = u * total;
+    float acc = 0.0, top = 0.0, t_acc = 0.0;
     for (int j = 0; j < count; ++j) {
-        float bottom = layer_bottom(mat, j, top, texels);
-        float s0, s1;
-        layer_span(mat, j, top, bottom, cos_w, s0, s1);
-        if (s0 >= s_end) {
+        float bottom, s0, s1, sigma_t, sigma_s;
+        if (!march_segment(mat, j, top, cos_w, s_end, texels, bottom, s0, s1, sigma_t,
+                           sigma_s)) {
             break;
         }
-        s1 = min(s1, s_end);
-        float sigma_t = MARCH_DENSITY * dot(MAT.sigma_t_g[j].rgb, vec3(1.0 / 3.0));
-        float sigma_s = dot(MAT.sigma_s_thickness[j].rgb, vec3(1.0 / 3.0));
         float t_seg = sigma_t * (s1 - s0);
         if (sigma_t > 0.0 && sigma_s > 0.0) {
             float a = sigma_s / sigma_t;

@@ -503,6 +503,9 @@ impl PassExec for ShadowPass {
         };
         pipeline.bind(ctx);
         let device = &ctx.gpu.device;
+        // The depth-texture set bound (pair 0 is the pipeline's own); bindings outlast the
+        // viewport changes between faces.
+        let mut bound_pair = 0usize;
         for face in 0..self.desc.faces() {
             let (x, y) = self.desc.tile_origin(face);
             let tile = self.desc.tile;
@@ -529,7 +532,6 @@ impl PassExec for ShadowPass {
                 device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
                 device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
             }
-            let mut bound_pair = 0usize;
             for draw in &self.scene.draws {
                 if self.layer_depths() && draw.depth_maps != bound_pair {
                     let set = match draw.depth_maps {
@@ -565,10 +567,6 @@ impl PassExec for ShadowPass {
                     false,
                     self.layer_depths(),
                 );
-            }
-            if bound_pair != 0 {
-                // The next face starts with the pipeline's own set bound (pair 0).
-                pipeline.set.bind(ctx, pipeline.pipeline.layout, 0);
             }
         }
     }

@@ -23,7 +23,7 @@
 use std::fmt;
 use std::mem::ManuallyDrop;
 use std::sync::atomic::Ordering;
-use std::sync::{Mutex, MutexGuard};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -62,7 +62,8 @@ pub struct GpuContext {
     pub queue_family: u32,
     /// Names, versions, limits and enabled optional features of the device.
     pub info: DeviceInfo,
-    allocator: ManuallyDrop<Mutex<Allocator>>,
+    /// lucent's own allocator, or the host's shared one (an `Arc` either way).
+    allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -135,16 +136,21 @@ impl GpuContext {
             .as_ref()
             .map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
 
-        let parts =
-            match create_owned_parts(&instance, physical_device, &device, probe.queue_family) {
-                Ok(parts) => parts,
-                Err(e) => {
-                    // SAFETY: the device was created above and has no child objects left.
-                    unsafe { device.destroy_device(None) };
-                    destroy_instance();
-                    return Err(e);
-                }
-            };
+        let parts = match create_owned_parts(
+            &instance,
+            physical_device,
+            &device,
+            probe.queue_family,
+            None,
+        ) {
+            Ok(parts) => parts,
+            Err(e) => {
+                // SAFETY: the device was created above and has no child objects left.
+                unsafe { device.destroy_device(None) };
+                destroy_instance();
+                return Err(e);
+            }
+        };
         // SAFETY: the queue family was requested with one queue at device creation.
         let queue = unsafe { device.get_device_queue(probe.queue_family, 0) };
         log::info!(
@@ -166,7 +172,7 @@ impl GpuContext {
             queue,
             queue_family: probe.queue_family,
             info: probe.info,
-            allocator: ManuallyDrop::new(Mutex::new(parts.allocator)),
+            allocator: ManuallyDrop::new(parts.allocator),
             debug_instance,
             debug_device,
             messenger,
@@ -210,6 +216,37 @@ impl GpuContext {
         device: ash::Device,
         queue: vk::Queue,
         queue_family: u32,
+    ) -> Result<Self> {
+        // SAFETY: the caller's contract is this function's.
+        unsafe {
+            Self::wrap_with_allocator(
+                entry,
+                instance,
+                physical_device,
+                device,
+                queue,
+                queue_family,
+                None,
+            )
+        }
+    }
+
+    /// [`GpuContext::wrap`] with the host's own `gpu-allocator` (`Some`), shared with lucent:
+    /// every buffer and image lucent creates is allocated from it and freed back to it;
+    /// dropping the context drops only lucent's reference. `None`: lucent creates its own.
+    ///
+    /// # Safety
+    ///
+    /// As [`GpuContext::wrap`]; a shared allocator must have been created for the same
+    /// instance, physical device and device.
+    pub unsafe fn wrap_with_allocator(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        physical_device: vk::PhysicalDevice,
+        device: ash::Device,
+        queue: vk::Queue,
+        queue_family: u32,
+        shared_allocator: Option<Arc<Mutex<Allocator>>>,
     ) -> Result<Self> {
         let mut probe = probe_device(&instance, physical_device, false)?;
         let families =
@@ -270,7 +307,13 @@ impl GpuContext {
             None => vk::DebugUtilsMessengerEXT::null(),
         };
 
-        let parts = match create_owned_parts(&instance, physical_device, &device, queue_family) {
+        let parts = match create_owned_parts(
+            &instance,
+            physical_device,
+            &device,
+            queue_family,
+            shared_allocator,
+        ) {
             Ok(parts) => parts,
             Err(e) => {
                 if let Some(debug) = &debug_instance {
@@ -293,7 +336,7 @@ impl GpuContext {
             queue,
             queue_family,
             info: probe.info,
-            allocator: ManuallyDrop::new(Mutex::new(parts.allocator)),
+            allocator: ManuallyDrop::new(parts.allocator),
             debug_instance,
             debug_device,
             messenger,
@@ -445,7 +488,8 @@ impl Drop for GpuContext {
                 .unwrap_or_else(|poisoned| poisoned.into_inner());
             self.device.destroy_fence(one_shot.fence, None);
             self.device.destroy_command_pool(one_shot.pool, None);
-            // Reports leaked allocations (log_leaks_on_shutdown) and frees its memory blocks.
+            // lucent's own allocator reports leaked allocations (log_leaks_on_shutdown) and
+            // frees its memory blocks here; a host's shared one only loses this reference.
             ManuallyDrop::drop(&mut self.allocator);
             if self.owns_handles {
                 self.device.destroy_device(None);
@@ -464,17 +508,17 @@ impl Drop for GpuContext {
 
 /// What lucent creates on any device, owned or wrapped.
 struct OwnedParts {
-    allocator: Allocator,
+    allocator: Arc<Mutex<Allocator>>,
     one_shot: OneShot,
 }
 
-fn create_owned_parts(
+/// lucent's own allocator for a device (leaks logged when it is dropped).
+fn own_allocator(
     instance: &ash::Instance,
     pd: vk::PhysicalDevice,
     device: &ash::Device,
-    queue_family: u32,
-) -> Result<OwnedParts> {
-    let allocator = Allocator::new(&AllocatorCreateDesc {
+) -> Result<Allocator> {
+    Allocator::new(&AllocatorCreateDesc {
         instance: instance.clone(),
         device: device.clone(),
         physical_device: pd,
@@ -489,7 +533,20 @@ fn create_owned_parts(
         LucentError::InvalidInput(format!(
             "the GPU memory allocator could not be created: {source}"
         ))
-    })?;
+    })
+}
+
+fn create_owned_parts(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    device: &ash::Device,
+    queue_family: u32,
+    shared_allocator: Option<Arc<Mutex<Allocator>>>,
+) -> Result<OwnedParts> {
+    let allocator = match shared_allocator {
+        Some(shared) => shared,
+        None => Arc::new(Mutex::new(own_allocator(instance, pd, device)?)),
+    };
     let pool_info = vk::CommandPoolCreateInfo::default()
         .flags(vk::CommandPoolCreateFlags::TRANSIENT)
         .queue_family_index(queue_family);

@@ -22,9 +22,9 @@ pub(super) fn device_type_score(t: vk::PhysicalDeviceType) -> u32 {
 }
 
 /// The result of checking a physical device against lucent's requirements.
-pub(super) struct Probe {
-    pub(super) info: DeviceInfo,
-    pub(super) queue_family: u32,
+pub(crate) struct Probe {
+    pub(crate) info: DeviceInfo,
+    pub(crate) queue_family: u32,
 }
 
 pub(super) fn queue_family_usable(family: &vk::QueueFamilyProperties) -> bool {
@@ -38,7 +38,7 @@ pub(super) fn queue_family_usable(family: &vk::QueueFamilyProperties) -> bool {
 /// Checks that `pd` supports what lucent needs (and `VK_KHR_swapchain` when `swapchain`) and
 /// collects its [`DeviceInfo`]; the optional feature flags say what is supported (and will be
 /// enabled by [`create_device`]).
-pub(super) fn probe_device(
+pub(crate) fn probe_device(
     instance: &ash::Instance,
     pd: vk::PhysicalDevice,
     swapchain: bool,

@@ -10,7 +10,7 @@
 pub mod access;
 pub mod context;
 mod desc;
-mod device;
+pub(crate) mod device;
 pub mod format;
 mod instance;
 pub mod resources;

@@ -777,6 +777,12 @@ impl PipelineCache {
         Ok(Self { handle, path })
     }
 
+    /// A host's pipeline cache, used as it is: never loaded, saved or (the host owns it)
+    /// destroyed by lucent; do not call [`PipelineCache::destroy`] on the result.
+    pub fn borrowed(handle: vk::PipelineCache) -> Self {
+        Self { handle, path: None }
+    }
+
     /// The file this cache is loaded from and saved to, if any.
     pub fn path(&self) -> Option<&Path> {
         self.path.as_deref()

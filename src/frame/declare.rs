@@ -46,6 +46,8 @@ pub struct FrameOutputs {
     pub hdr: Option<ResourceId>,
     /// The G-buffer, when exported.
     pub gbuffer: Option<GBufferOutputs>,
+    /// The lit diffuse and specular before the SSS blurs, when exported (frames with SSS).
+    pub lit: Option<(ResourceId, ResourceId)>,
 }
 
 /// Declares every pass of a frame. `scene_gpu` is `None` for plan-only graphs.
@@ -88,6 +90,16 @@ pub fn declare_frame(
     let debug_display = settings.debug_view.and_then(|view| {
         debug_view::debug_view_pass(graph, view, &gb, &lit, new_display, scene_gpu)
     });
+    // Exported before the blurs are declared; they only read the two images, so the
+    // exported contents are the lighting pass's.
+    let lit_ids = match (&lit.specular, settings.export_lit && desc.sss.is_some()) {
+        (Some(specular), true) => {
+            graph.export_image(&lit.color, Access::TransferRead);
+            graph.export_image(specular, Access::TransferRead);
+            Some((lit.color.id(), specular.id()))
+        }
+        _ => None,
+    };
     let hdr = match (&desc.sss, &lit.specular, &gb.sss) {
         (Some(profiles), Some(specular), Some(profile_ids)) => sss::sss_passes(
             graph,
@@ -96,14 +108,18 @@ pub fn declare_frame(
                 specular,
                 depth: &gb.depth,
                 profile_ids,
-                lean: gb.lean.as_ref(),
-                gb0: &gb.gb0,
-                gb1: &gb.gb1,
+                lean: gb.lean.as_ref().map(|view_plane| sss::LeanInputs {
+                    view_plane,
+                    gb0: &gb.gb0,
+                    gb1: &gb.gb1,
+                }),
                 shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
+                depth_in_alpha: profiles.depth_in_alpha(),
             },
             profiles,
             &settings.sss,
             scene_gpu,
+            None,
         ),
         _ => lit.color,
     };
@@ -166,6 +182,7 @@ pub fn declare_frame(
         display: display.id(),
         target: settings.target.is_some(),
         hdr: hdr_id,
+        lit: lit_ids,
         gbuffer,
     }
 }

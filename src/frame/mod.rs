@@ -20,7 +20,7 @@ pub mod settings;
 
 pub use declare::{compile_options, declare_frame, plan_frame, FrameOutputs, GBufferOutputs};
 pub use desc::{FrameDesc, TranslucencyDesc};
-pub use readback::{decode_texels, FrameImages, GBufferReadback};
+pub use readback::{decode_texels, FrameImages, GBufferReadback, LitReadback};
 pub use renderer::{render_frame, Renderer};
 pub use runner::{destroy_after_idle, FrameRunner, FrameTiming};
 pub use settings::{Fault, FrameSettings, TargetDesc, Technique};

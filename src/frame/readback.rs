@@ -20,6 +20,16 @@ pub struct FrameImages {
     pub timing: FrameTiming,
 }
 
+/// The lighting pass's diffuse and specular before the SSS blurs, read back and decoded
+/// (frames with SSS and `export_lit`), rows top first.
+#[derive(Clone, Debug)]
+pub struct LitReadback {
+    /// Lit diffuse light; its alpha is the frame's own (linear depth, or a LEAN slope).
+    pub diffuse: Vec<[f32; 4]>,
+    /// Lit specular.
+    pub specular: Vec<[f32; 4]>,
+}
+
 /// A G-buffer read back and decoded: one `[f32; 4]` per pixel and target (missing channels
 /// are 0), rows top first.
 #[derive(Clone, Debug)]

@@ -8,7 +8,7 @@ use ash::vk;
 use super::declare::compile_options;
 use super::{
     declare_frame, decode_texels, FrameDesc, FrameImages, FrameOutputs, FrameRunner, FrameSettings,
-    GBufferReadback,
+    GBufferReadback, LitReadback,
 };
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
@@ -339,6 +339,26 @@ impl Renderer {
         Ok(crate::images::output::f16_bytes_to_f32(
             &self.read_export(gpu, id)?,
         ))
+    }
+
+    /// Reads the lighting pass's diffuse and specular of the last frame (before the SSS
+    /// blurs), decoded to f32 RGBA (needs `export_lit` in a frame with SSS).
+    pub fn read_lit(&self, gpu: &GpuContext) -> Result<LitReadback> {
+        let (diffuse, specular) = self.outputs.lit.ok_or_else(|| {
+            LucentError::InvalidInput(
+                "the lit diffuse and specular are not exported in this frame (export_lit, \
+                 frames with SSS)"
+                    .into(),
+            )
+        })?;
+        let read = |id: ResourceId| -> Result<Vec<[f32; 4]>> {
+            let format = self.executable.plan.resources[id].info.format;
+            decode_texels(&self.read_export(gpu, id)?, format)
+        };
+        Ok(LitReadback {
+            diffuse: read(diffuse)?,
+            specular: read(specular)?,
+        })
     }
 
     /// Runs one frame in one command buffer and reads back everything it exports.

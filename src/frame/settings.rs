@@ -130,6 +130,10 @@ pub struct FrameSettings {
     pub export_hdr: bool,
     /// Also export the G-buffer (for the CPU reference); otherwise it stays transient.
     pub export_gbuffer: bool,
+    /// Frames with SSS: also export the lighting pass's diffuse and specular, apart, before
+    /// the blurs (what a host hands [`crate::embed::PostProcessSss`]; tests compare the two
+    /// paths); otherwise they stay transient.
+    pub export_lit: bool,
     /// Precision of the G-buffer's colour targets.
     pub gbuffer: GBufferPrecision,
     /// Write coloured thickness as grayscale (its luminance) even when the scene has colour:
@@ -203,6 +207,7 @@ impl FrameSettings {
             compile: CompileOptions::default(),
             export_hdr: false,
             export_gbuffer: false,
+            export_lit: false,
             gbuffer: GBufferPrecision::Compact,
             force_grayscale: false,
             sss_tiles: true,

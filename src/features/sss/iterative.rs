@@ -27,6 +27,7 @@ pub(super) fn chain_passes(
     base: Option<&Handle<Image>>,
     knobs: &SssKnobs,
     scene: Option<&Arc<SceneGpu>>,
+    output: Option<Handle<Image>>,
 ) -> Handle<Image> {
     let blur = chain.blur;
     let info = ImageInfo {
@@ -87,7 +88,9 @@ pub(super) fn chain_passes(
         let n = step + 1;
         // Horizontal: the previous result (the lit diffuse the first time) into the temporary.
         let source_handles: Vec<&Handle<Image>> = if step == 0 {
-            std::iter::once(inputs.diffuse).chain(lean).collect()
+            std::iter::once(inputs.diffuse)
+                .chain(lean.map(|l| l.view_plane))
+                .collect()
         } else {
             current.iter().collect()
         };
@@ -161,14 +164,16 @@ pub(super) fn chain_passes(
             None => pass.finish(),
         }
     }
-    let mut hdr = graph.create_image(
-        &if chain.last {
-            "hdr".to_string()
-        } else {
-            chain.image_name("result")
-        },
-        info,
-    );
+    let mut hdr = output.unwrap_or_else(|| {
+        graph.create_image(
+            &if chain.last {
+                "hdr".to_string()
+            } else {
+                chain.image_name("result")
+            },
+            info,
+        )
+    });
     let (name, fragment) = match lean {
         None => ("combine", "sss/combine.frag"),
         Some(_) => ("final lighting", LEAN_FINAL_SHADER),
@@ -177,8 +182,8 @@ pub(super) fn chain_passes(
     // Inputs in the shader's binding order (after the frame uniforms and the profile table).
     let mut reads: Vec<&Handle<Image>> = sum.iter().collect();
     reads.extend([inputs.diffuse, inputs.specular, inputs.profile_ids]);
-    if lean.is_some() {
-        reads.extend([inputs.depth, inputs.gb0, inputs.gb1]);
+    if let Some(l) = lean {
+        reads.extend([inputs.depth, l.gb0, l.gb1]);
     }
     reads.extend(base);
     for h in &reads {

@@ -385,26 +385,40 @@ pub struct SssInputs<'a> {
     pub depth: &'a Handle<Image>,
     /// SSS profile ID per pixel (R8: ID / 255).
     pub profile_ids: &'a Handle<Image>,
-    /// LEAN frames: the G-buffer's view-plane LEAN target (slope y, moments).
-    pub lean: Option<&'a Handle<Image>>,
+    /// LEAN frames: what LCB's and LBB's chains read of the G-buffer (`None`: no LEAN chain
+    /// can run; their blurs fall back to their non-LEAN passes).
+    pub lean: Option<LeanInputs<'a>>,
+    /// The light-space maps' depth, when some light casts shadows (LEAN specular is shadowed).
+    pub shadow_depth: Option<&'a Handle<Image>>,
+    /// The lit diffuse's alpha holds linear depth for the separable chain's taps (the lighting
+    /// pass wrote it: [`SssProfiles::depth_in_alpha`]); otherwise the taps read `depth`.
+    pub depth_in_alpha: bool,
+}
+
+/// The G-buffer images LCB's and LBB's chains read besides the lit light.
+#[derive(Clone, Copy)]
+pub struct LeanInputs<'a> {
+    /// The G-buffer's view-plane LEAN target (slope y, moments).
+    pub view_plane: &'a Handle<Image>,
     /// G-buffer albedo + specular intensity (LEAN specular).
     pub gb0: &'a Handle<Image>,
     /// G-buffer normal + roughness (LEAN specular's roughness bound).
     pub gb1: &'a Handle<Image>,
-    /// The light-space maps' depth, when some light casts shadows (LEAN specular is shadowed).
-    pub shadow_depth: Option<&'a Handle<Image>>,
 }
 
 /// Declares every chain's passes after the lighting pass (see the module docs): per chain, one
 /// horizontal + vertical blur pair per step, then its final pass (`combine` for the control,
 /// `final lighting` with LEAN specular for LCB and LBB), which keeps the previous chain's
-/// result on the pixels the chain does not own. Returns the final HDR image.
+/// result on the pixels the chain does not own. Returns the final HDR image: `output` when
+/// given (an image the last chain's final pass writes as a colour attachment, e.g. a host's),
+/// else a new one.
 pub fn sss_passes(
     graph: &mut RenderGraph,
     inputs: &SssInputs<'_>,
     profiles: &SssProfiles,
     knobs: &SssKnobs,
     scene: Option<&Arc<SceneGpu>>,
+    mut output: Option<Handle<Image>>,
 ) -> Handle<Image> {
     let chains = profiles.chains();
     let edges = profiles.profiles.len() > 1;
@@ -424,18 +438,11 @@ pub fn sss_passes(
             prefix,
             last: index + 1 == chains.len(),
         };
+        let result = if chain.last { output.take() } else { None };
         base = Some(if blur.iterative() {
-            iterative::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene)
+            iterative::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene, result)
         } else {
-            two_pass::chain_passes(
-                graph,
-                inputs,
-                &chain,
-                base.as_ref(),
-                knobs,
-                profiles.depth_in_alpha(),
-                scene,
-            )
+            two_pass::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene, result)
         });
     }
     base.expect("SssProfiles is never empty")

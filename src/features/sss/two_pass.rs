@@ -26,18 +26,19 @@ use crate::graph::{
 };
 use crate::Result;
 
-/// Declares a two-pass chain (see the module docs); `depth_in_alpha`: the lit diffuse's alpha
-/// holds linear depth (frames without a LEAN chain). Returns the chain's result.
+/// Declares a two-pass chain (see the module docs). Returns the chain's result (`output`
+/// when given).
 pub(super) fn chain_passes(
     graph: &mut RenderGraph,
     inputs: &SssInputs<'_>,
     chain: &Chain,
     base: Option<&Handle<Image>>,
     knobs: &SssKnobs,
-    depth_in_alpha: bool,
     scene: Option<&Arc<SceneGpu>>,
+    mut output: Option<Handle<Image>>,
 ) -> Handle<Image> {
     let blur = chain.blur;
+    let depth_in_alpha = inputs.depth_in_alpha;
     let full = ImageInfo {
         format: HDR_FORMAT,
         ..graph.resources()[inputs.diffuse.id()].info
@@ -91,7 +92,7 @@ pub(super) fn chain_passes(
         PassKind::Raster,
     );
     let mut reads: Vec<&Handle<Image>> = vec![inputs.diffuse, inputs.depth, inputs.profile_ids];
-    reads.extend(lean);
+    reads.extend(lean.map(|l| l.view_plane));
     for h in &reads {
         pass.sample(h);
     }
@@ -119,18 +120,23 @@ pub(super) fn chain_passes(
             chain.image_name("result")
         }
     };
+    let mut result = |graph: &mut RenderGraph| {
+        output
+            .take()
+            .unwrap_or_else(|| graph.create_image(&result_name(chain), full))
+    };
     let mut vertical_out = if half_res {
         graph.create_image(&chain.image_name("blurred"), blur_info)
     } else {
-        graph.create_image(&result_name(chain), full)
+        result(graph)
     };
     let mut pass = graph.add_pass(&format!("{}vertical blur", chain.prefix), PassKind::Raster);
     let mut reads: Vec<&Handle<Image>> = vec![&temp, inputs.depth, inputs.profile_ids];
     reads.extend(temp_lean.as_ref());
     if !half_res {
         reads.extend([inputs.diffuse, inputs.specular]);
-        if lean.is_some() {
-            reads.extend([inputs.gb0, inputs.gb1]);
+        if let Some(l) = lean {
+            reads.extend([l.gb0, l.gb1]);
         }
         reads.extend(base);
     }
@@ -160,7 +166,7 @@ pub(super) fn chain_passes(
     }
 
     // Upsample: the half-resolution blur composed at full resolution.
-    let mut hdr = graph.create_image(&result_name(chain), full);
+    let mut hdr = result(graph);
     let mut pass = graph.add_pass(&format!("{}upsample", chain.prefix), PassKind::Raster);
     let mut reads: Vec<&Handle<Image>> = vec![
         &vertical_out,

@@ -35,6 +35,7 @@ pub mod backend;
 pub mod bake;
 #[cfg(feature = "window")]
 pub mod demo;
+pub mod embed;
 pub mod error;
 pub mod features;
 pub mod files;

@@ -1,0 +1,134 @@
+//! [`SceneRenderer`]: a lucent scene drawn into a host's colour image, recorded into the host's
+//! command buffer with frames in flight.
+
+use ash::vk;
+
+use super::image::{check_image, record_transition, HostImage, ImageState, Role};
+use super::Lucent;
+use crate::backend::access::Access;
+use crate::frame::{FrameSettings, Renderer, TargetDesc};
+use crate::scene::Scene;
+use crate::{LucentError, Result};
+
+/// A scene's whole frame (G-buffer, lighting and every feature its materials ask for,
+/// tonemapped) rendered into a host image.
+///
+/// Built once per scene shape and output size and format; between frames the host may change
+/// whatever [`Renderer::can_update`] allows (camera, lights, material values, the time of a
+/// deforming scene) by passing the changed scene to [`SceneRenderer::record`]. A scene with
+/// other objects, features or profiles needs a new renderer.
+pub struct SceneRenderer {
+    renderer: Renderer,
+    extent: vk::Extent2D,
+    format: vk::Format,
+}
+
+impl SceneRenderer {
+    /// Builds the frame of `scene` at `width` x `height` for output images of `format`
+    /// (8-bit UNORM or SRGB RGBA/BGRA — the tonemapped display values, sRGB-encoded — or
+    /// RGBA16F/RGBA32F, the same values linear), with lucent's default settings.
+    ///
+    /// Uploads the scene: **one submission on the host's queue, waited for** (the only time
+    /// lucent uses the queue; see the module docs).
+    pub fn new(
+        lucent: &Lucent,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        format: vk::Format,
+    ) -> Result<Self> {
+        Self::with_settings(lucent, scene, FrameSettings::new(width, height), format)
+    }
+
+    /// [`SceneRenderer::new`] with the caller's frame settings (technique, SSS and layered
+    /// knobs, shadows...). Their size is the output's; their frames in flight and target are
+    /// lucent's to set (the embedding's frames in flight, the host image).
+    pub fn with_settings(
+        lucent: &Lucent,
+        scene: &Scene,
+        settings: FrameSettings,
+        format: vk::Format,
+    ) -> Result<Self> {
+        let settings = FrameSettings {
+            frames_in_flight: lucent.frames_in_flight(),
+            // lucent's barriers move the image between the host's declared states and the
+            // colour-attachment state the frame's passes use, before and after the frame.
+            target: Some(TargetDesc {
+                format,
+                initial: Access::ColorAttachmentWrite,
+                final_access: Access::ColorAttachmentWrite,
+            }),
+            ..settings
+        };
+        let extent = vk::Extent2D {
+            width: settings.width,
+            height: settings.height,
+        };
+        let renderer = Renderer::new(
+            lucent.gpu(),
+            lucent.shaders(),
+            lucent.pipeline_cache(),
+            scene,
+            settings,
+        )?;
+        Ok(Self {
+            renderer,
+            extent,
+            format,
+        })
+    }
+
+    /// The renderer underneath (its plan, passes and settings).
+    pub fn renderer(&self) -> &Renderer {
+        &self.renderer
+    }
+
+    /// Records the frame of `scene` for frame slot `slot` into `cmd` (recording, outside any
+    /// render pass), drawing into `output` and leaving it in `final_state`, which it returns.
+    ///
+    /// Writes slot `slot`'s per-frame parameters from `scene` first (camera, lights, material
+    /// values, a deforming scene's vertices at `scene.time`): the frame last recorded with
+    /// this slot must have completed. Everything is checked before anything is recorded; on an
+    /// error `cmd` holds nothing of this call.
+    pub fn record(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        slot: usize,
+        scene: &Scene,
+        output: &HostImage,
+        final_state: ImageState,
+    ) -> Result<ImageState> {
+        lucent.check_slot(slot)?;
+        if output.format != self.format {
+            return Err(LucentError::InvalidInput(format!(
+                "host image '{}': format {:?}, but the renderer was built for {:?}",
+                output.name, output.format, self.format
+            )));
+        }
+        check_image(
+            lucent.gpu(),
+            output,
+            Role::Output,
+            self.extent,
+            &final_state,
+            |_| true,
+            "the renderer's output format",
+        )?;
+        self.renderer.update_slot(scene, slot)?;
+        self.renderer
+            .bind_target(lucent.gpu(), output.image, output.view)?;
+        let gpu = lucent.gpu();
+        let working = Role::Output.working_state();
+        record_transition(gpu, cmd, output, &output.state, &working);
+        self.renderer.record(gpu, cmd, slot, None)?;
+        record_transition(gpu, cmd, output, &working, &final_state);
+        Ok(final_state)
+    }
+
+    /// Destroys the frame and the scene's GPU data. lucent's work must be complete (the host
+    /// waited for every frame it recorded).
+    pub fn destroy(self, lucent: &Lucent) {
+        self.renderer.destroy(lucent.gpu());
+    }
+}

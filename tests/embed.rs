@@ -738,3 +738,202 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
     drop(allocator);
     test.finish();
 }
+
+/// A scene a host builds itself: its own meshes (handed over for lucent to upload), transforms,
+/// lucent materials and lights.
+fn host_built_scene() -> lucent::scene::Scene {
+    use glam::{Mat4, Vec3};
+    use lucent::scene::material::{
+        Light, LightKind, Material, SssProfile, ThicknessSource, Translucency,
+    };
+    use lucent::scene::mesh::{Mesh, Shape};
+    use lucent::scene::{Camera, Object, Scene};
+    let sphere = Mesh::generate(Shape::Sphere { radius: 0.5 }, 48, 24);
+    let floor = Mesh::generate(Shape::Plane { half_size: 3.0 }, 4, 0);
+    let mut skin = Material::opaque("host skin", Vec3::new(0.8, 0.55, 0.45), 0.3, 0.5);
+    skin.sss = Some(SssProfile {
+        // Widened so the blur spans many pixels at this size.
+        units_per_mm: 0.05,
+        ..SssProfile::preset("skin").unwrap()
+    });
+    let mut jade = Material::opaque("host jade", Vec3::new(0.3, 0.6, 0.4), 0.4, 0.3);
+    jade.translucency = Some(Translucency {
+        color: Vec3::new(0.4, 1.0, 0.6),
+        ..Translucency::new(ThicknessSource::Bake)
+    });
+    let object = |mesh, x: f32, material| Object {
+        mesh,
+        transform: Mat4::from_translation(Vec3::new(x, 0.5, 0.0)),
+        material,
+    };
+    Scene {
+        name: "host-built".into(),
+        meshes: vec![sphere, floor],
+        objects: vec![
+            object(0, -0.6, skin),
+            object(0, 0.6, jade),
+            Object {
+                mesh: 1,
+                transform: Mat4::IDENTITY,
+                material: Material::opaque("floor", Vec3::splat(0.5), 0.1, 0.8),
+            },
+        ],
+        lights: vec![
+            Light {
+                kind: LightKind::Directional {
+                    direction: Vec3::new(-0.4, -1.0, -0.3),
+                },
+                color: Vec3::ONE,
+                intensity: 2.0,
+                translucency_scale: 1.0,
+                shadows: true,
+            },
+            Light {
+                kind: LightKind::Point {
+                    position: Vec3::new(0.6, 0.6, -1.2),
+                    range: 5.0,
+                },
+                color: Vec3::new(1.0, 0.8, 0.6),
+                intensity: 3.0,
+                translucency_scale: 1.0,
+                shadows: true,
+            },
+        ],
+        camera: Camera {
+            eye: Vec3::new(0.0, 1.2, 3.0),
+            target: Vec3::new(0.0, 0.4, 0.0),
+            fov_y_degrees: 40.0,
+            near: 0.05,
+            far: 50.0,
+        },
+        ambient: Vec3::splat(0.03),
+        sky: Vec3::new(0.4, 0.5, 0.7),
+        exposure: 1.0,
+        deformation: None,
+        time: 0.0,
+    }
+}
+
+#[test]
+fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_time() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (120, 90);
+    let lucent = wrap(
+        &test,
+        EmbedOptions {
+            frames_in_flight: 3,
+            ..Default::default()
+        },
+    );
+    let mut scene = host_built_scene();
+    lucent.prepare_scene(&mut scene).unwrap();
+    assert!(
+        !scene.meshes[0].colors.is_empty(),
+        "prepare_scene baked the translucent sphere's thickness"
+    );
+    // Three cameras, so a frame reading another slot's parameters would show.
+    let scenes: Vec<_> = (0..3)
+        .map(|k| {
+            let mut s = scene.clone();
+            s.camera.eye.x += 0.8 * (k as f32 - 1.0);
+            s
+        })
+        .collect();
+    let expected: Vec<Vec<u8>> = scenes
+        .iter()
+        .map(|s| {
+            lucent::frame::render_frame(
+                gpu,
+                &test.shaders,
+                &test.cache,
+                s,
+                FrameSettings::new(w, h),
+            )
+            .unwrap()
+            .display
+        })
+        .collect();
+    assert_ne!(expected[0], expected[2], "the cameras differ");
+
+    let mut renderer =
+        SceneRenderer::new(&lucent, &scene, w, h, vk::Format::R8G8B8A8_UNORM).unwrap();
+    let desc = &renderer.renderer().desc;
+    assert!(desc.sss.is_some() && desc.translucency.is_some() && desc.shadows.is_some());
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let images: Vec<GpuImage> = (0..3).map(|_| output_image(&test, w, h, usage)).collect();
+    let device = &gpu.device;
+    // SAFETY: the test's device; the pool, buffers and fence are used only here and destroyed
+    // after the wait.
+    unsafe {
+        let pool = device
+            .create_command_pool(
+                &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
+                None,
+            )
+            .unwrap();
+        let cmds = device
+            .allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(3),
+            )
+            .unwrap();
+        for (k, (s, image)) in scenes.iter().zip(&images).enumerate() {
+            device
+                .begin_command_buffer(cmds[k], &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            let output = HostImage {
+                name: format!("frame {k}"),
+                image: image.image,
+                view: image.view,
+                format: vk::Format::R8G8B8A8_UNORM,
+                extent: vk::Extent2D {
+                    width: w,
+                    height: h,
+                },
+                usage,
+                state: ImageState::UNDEFINED,
+            };
+            renderer
+                .record(&lucent, cmds[k], k, s, &output, ImageState::transfer_src())
+                .unwrap();
+            device.end_command_buffer(cmds[k]).unwrap();
+        }
+        // Submitted back to back; waited for once.
+        let fence = device
+            .create_fence(&vk::FenceCreateInfo::default(), None)
+            .unwrap();
+        for (k, &cmd) in cmds.iter().enumerate() {
+            let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
+            let signal = if k == 2 { fence } else { vk::Fence::null() };
+            device.queue_submit2(gpu.queue, &[submit], signal).unwrap();
+        }
+        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+        device.destroy_fence(fence, None);
+        device.destroy_command_pool(pool, None);
+    }
+    for (k, image) in images.iter().enumerate() {
+        let got = gpu
+            .read_image(image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .unwrap();
+        let worst = got
+            .iter()
+            .zip(&expected[k])
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap();
+        assert!(
+            worst <= 1,
+            "frame {k} differs from its frame alone by {worst}/255"
+        );
+    }
+    renderer.destroy(&lucent);
+    drop(lucent);
+    for image in images {
+        gpu.destroy_image(image);
+    }
+    test.finish();
+}

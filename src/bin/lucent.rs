@@ -489,6 +489,7 @@ impl FrameArgs {
             },
             export_hdr,
             export_gbuffer: false,
+            export_lit: false,
             gbuffer: self.gbuffer,
             force_grayscale: self.grayscale,
             sss_tiles: !self.no_sss_tiles,

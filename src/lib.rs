@@ -14,6 +14,9 @@
 //! - [`backend`]: a thin layer over `ash`: context (own or wrapped), memory, images, the one
 //!   access table, the one format table, debug labels, GPU timer, shader compilation.
 //!
+//! Above the frame, for a host engine: [`embed`] (lucent on the host's device, allocator,
+//! images and command buffers: a whole frame into a host image, or SSS as a post-process).
+//!
 //! Beside them: [`scene`] (the CPU model of what is drawn; no GPU), [`bake`] (the thickness
 //! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
 //! versions of every shading equation, used by tests and reports, never by features),

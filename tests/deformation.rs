@@ -3,14 +3,13 @@
 //! uploads its own vertices, nothing is precomputed), the shadows follow, every slot of frames
 //! in flight holds its own instant, and the benchmark times the deformation.
 
-use ash::vk;
 use lucent::bake::scene::load_scene_baked;
 use lucent::frame::{FrameSettings, Renderer};
 use lucent::scene::Scene;
 
 mod common;
 
-use common::{run_bench, TestGpu};
+use common::{run_bench, submit_back_to_back, TestGpu};
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -70,40 +69,9 @@ fn dynamic_deforms_and_an_updated_renderer_draws_the_new_instant() {
 
 /// Records and submits one frame of `slot` and waits for it.
 fn run_slot(test: &TestGpu, renderer: &Renderer, slot: usize) {
-    let gpu = &test.gpu;
-    let device = &gpu.device;
-    // SAFETY: valid device; the pool, buffer and fence are used only here and freed after
-    // the wait.
-    unsafe {
-        let pool = device
-            .create_command_pool(
-                &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
-                None,
-            )
-            .unwrap();
-        let cmd = device
-            .allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(1),
-            )
-            .unwrap()[0];
-        device
-            .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
-            .unwrap();
-        renderer.record(gpu, cmd, slot, None).unwrap();
-        device.end_command_buffer(cmd).unwrap();
-        let fence = device
-            .create_fence(&vk::FenceCreateInfo::default(), None)
-            .unwrap();
-        let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
-        device.queue_submit2(gpu.queue, &[submit], fence).unwrap();
-        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
-        device.destroy_fence(fence, None);
-        device.destroy_command_pool(pool, None);
-    }
+    submit_back_to_back(&test.gpu, 1, |_, cmd| {
+        renderer.record(&test.gpu, cmd, slot, None).unwrap()
+    });
 }
 
 #[test]

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use ash::vk;
-use common::TestGpu;
+use common::{submit_back_to_back, TestGpu};
 use glam::DVec3;
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -465,70 +465,80 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() 
         .unwrap();
         result.unwrap()
     };
-    // An image declared without COLOR_ATTACHMENT usage.
-    let no_usage = HostImage {
-        usage: vk::ImageUsageFlags::TRANSFER_SRC,
-        ..good.clone()
+    let with = |change: &dyn Fn(&mut HostImage)| {
+        let mut image = good.clone();
+        change(&mut image);
+        image
     };
-    expect_refused(
-        cmd_result(&mut renderer, &no_usage, 0, ImageState::transfer_src()),
-        &["'back buffer'", "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT"],
-    );
-    // A final layout its usage does not allow (no SAMPLED usage for SHADER_READ_ONLY).
-    expect_refused(
-        cmd_result(&mut renderer, &good, 0, ImageState::fragment_sampled()),
-        &["'back buffer'", "SHADER_READ_ONLY_OPTIMAL", "SAMPLED"],
-    );
-    // A current state that contradicts itself: written as colour attachment, declared in
-    // TRANSFER_SRC_OPTIMAL.
-    let wrong_layout = HostImage {
-        state: ImageState {
-            layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            ..ImageState::color_attachment()
-        },
-        ..good.clone()
-    };
-    expect_refused(
-        cmd_result(&mut renderer, &wrong_layout, 0, ImageState::transfer_src()),
-        &["'back buffer'", "TRANSFER_SRC_OPTIMAL", "cannot hold"],
-    );
-    // A depth layout on a colour image, an UNDEFINED final layout.
-    let depth_layout = HostImage {
-        state: ImageState::depth_attachment(),
-        ..good.clone()
-    };
-    expect_refused(
-        cmd_result(&mut renderer, &depth_layout, 0, ImageState::transfer_src()),
-        &["'back buffer'", "DEPTH_STENCIL_ATTACHMENT_OPTIMAL"],
-    );
-    expect_refused(
-        cmd_result(&mut renderer, &good, 0, ImageState::UNDEFINED),
-        &["'back buffer'", "final"],
-    );
-    // Wrong size, wrong format, a slot beyond the frames in flight.
-    let small = HostImage {
-        extent: vk::Extent2D {
-            width: w / 2,
-            height: h,
-        },
-        ..good.clone()
-    };
-    expect_refused(
-        cmd_result(&mut renderer, &small, 0, ImageState::transfer_src()),
-        &["'back buffer'", "32x48"],
-    );
-    let other_format = HostImage {
-        format: vk::Format::R16G16B16A16_SFLOAT,
-        ..good.clone()
-    };
-    expect_refused(
-        cmd_result(&mut renderer, &other_format, 0, ImageState::transfer_src()),
-        &["'back buffer'", "format"],
-    );
-    expect_refused(
-        cmd_result(&mut renderer, &good, 2, ImageState::transfer_src()),
-        &["slot 2", "2 frame(s) in flight"],
-    );
+    let transfer = ImageState::transfer_src();
+    // (what is wrong, the image as declared, slot, final state, what the error must say)
+    let cases: Vec<(&str, HostImage, usize, ImageState, Vec<&str>)> = vec![
+        (
+            "no COLOR_ATTACHMENT usage",
+            with(&|i| i.usage = vk::ImageUsageFlags::TRANSFER_SRC),
+            0,
+            transfer,
+            vec!["'back buffer'", "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT"],
+        ),
+        (
+            "a final layout its usage does not allow (SHADER_READ_ONLY without SAMPLED)",
+            good.clone(),
+            0,
+            ImageState::fragment_sampled(),
+            vec!["'back buffer'", "SHADER_READ_ONLY_OPTIMAL", "SAMPLED"],
+        ),
+        (
+            "written as a colour attachment, declared in TRANSFER_SRC_OPTIMAL",
+            with(&|i| {
+                i.state = ImageState {
+                    layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    ..ImageState::color_attachment()
+                }
+            }),
+            0,
+            transfer,
+            vec!["'back buffer'", "TRANSFER_SRC_OPTIMAL", "cannot hold"],
+        ),
+        (
+            "a depth layout on a colour image",
+            with(&|i| i.state = ImageState::depth_attachment()),
+            0,
+            transfer,
+            vec!["'back buffer'", "DEPTH_STENCIL_ATTACHMENT_OPTIMAL"],
+        ),
+        (
+            "an UNDEFINED final layout",
+            good.clone(),
+            0,
+            ImageState::UNDEFINED,
+            vec!["'back buffer'", "final"],
+        ),
+        (
+            "half the frame's width",
+            with(&|i| i.extent.width = w / 2),
+            0,
+            transfer,
+            vec!["'back buffer'", "32x48"],
+        ),
+        (
+            "another format than the renderer's",
+            with(&|i| i.format = vk::Format::R16G16B16A16_SFLOAT),
+            0,
+            transfer,
+            vec!["'back buffer'", "format"],
+        ),
+        (
+            "a slot beyond the frames in flight",
+            good.clone(),
+            2,
+            transfer,
+            vec!["slot 2", "2 frame(s) in flight"],
+        ),
+    ];
+    for (what, image, slot, finals, wanted) in cases {
+        println!("refused: {what}");
+        expect_refused(cmd_result(&mut renderer, &image, slot, finals), &wanted);
+    }
     // After all of that, a correct frame still renders (nothing half-recorded).
     let state = cmd_result(&mut renderer, &good, 1, ImageState::transfer_src()).unwrap();
     assert_eq!(state, ImageState::transfer_src());
@@ -862,59 +872,31 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
     assert!(desc.sss.is_some() && desc.translucency.is_some() && desc.shadows.is_some());
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
     let images: Vec<GpuImage> = (0..3).map(|_| output_image(&test, w, h, usage)).collect();
-    let device = &gpu.device;
-    // SAFETY: the test's device; the pool, buffers and fence are used only here and destroyed
-    // after the wait.
-    unsafe {
-        let pool = device
-            .create_command_pool(
-                &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
-                None,
+    // Recorded into three command buffers, submitted back to back, waited for once.
+    submit_back_to_back(gpu, 3, |k, cmd| {
+        let output = HostImage {
+            name: format!("frame {k}"),
+            image: images[k].image,
+            view: images[k].view,
+            format: vk::Format::R8G8B8A8_UNORM,
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+            usage,
+            state: ImageState::UNDEFINED,
+        };
+        renderer
+            .record(
+                &lucent,
+                cmd,
+                k,
+                &scenes[k],
+                &output,
+                ImageState::transfer_src(),
             )
             .unwrap();
-        let cmds = device
-            .allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(3),
-            )
-            .unwrap();
-        for (k, (s, image)) in scenes.iter().zip(&images).enumerate() {
-            device
-                .begin_command_buffer(cmds[k], &vk::CommandBufferBeginInfo::default())
-                .unwrap();
-            let output = HostImage {
-                name: format!("frame {k}"),
-                image: image.image,
-                view: image.view,
-                format: vk::Format::R8G8B8A8_UNORM,
-                extent: vk::Extent2D {
-                    width: w,
-                    height: h,
-                },
-                usage,
-                state: ImageState::UNDEFINED,
-            };
-            renderer
-                .record(&lucent, cmds[k], k, s, &output, ImageState::transfer_src())
-                .unwrap();
-            device.end_command_buffer(cmds[k]).unwrap();
-        }
-        // Submitted back to back; waited for once.
-        let fence = device
-            .create_fence(&vk::FenceCreateInfo::default(), None)
-            .unwrap();
-        for (k, &cmd) in cmds.iter().enumerate() {
-            let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
-            let signal = if k == 2 { fence } else { vk::Fence::null() };
-            device.queue_submit2(gpu.queue, &[submit], signal).unwrap();
-        }
-        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
-        device.destroy_fence(fence, None);
-        device.destroy_command_pool(pool, None);
-    }
+    });
     for (k, image) in images.iter().enumerate() {
         let got = gpu
             .read_image(image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)

@@ -21,7 +21,7 @@ use lucent::scene::Scene;
 
 mod common;
 
-use common::TestGpu;
+use common::{submit_back_to_back, TestGpu};
 
 fn settings(technique: Technique, w: u32, h: u32) -> FrameSettings {
     FrameSettings {
@@ -655,8 +655,8 @@ fn target_image(test: &TestGpu, w: u32, h: u32, format: vk::Format, name: &str) 
         .unwrap()
 }
 
-/// Records `count` frames of `renderer` (slot k, camera k, target k) into their own command
-/// buffers and submits them back to back, waiting only once at the end.
+/// Records frame k of `renderer` (slot k, camera k, target k) into its own command buffer
+/// and submits them back to back, waiting only once at the end.
 fn frames_in_flight(
     test: &TestGpu,
     renderer: &mut Renderer,
@@ -664,51 +664,14 @@ fn frames_in_flight(
     targets: &[GpuImage],
 ) {
     let gpu = &test.gpu;
-    let device = &gpu.device;
-    // SAFETY: valid device; the pool and buffers are used only here and freed after the wait.
-    unsafe {
-        let pool = device
-            .create_command_pool(
-                &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
-                None,
-            )
+    submit_back_to_back(gpu, scenes.len(), |slot, cmd| {
+        renderer.update_slot(&scenes[slot], slot).unwrap();
+        let target = &targets[slot];
+        renderer
+            .bind_target(gpu, target.image, target.view)
             .unwrap();
-        let cmds = device
-            .allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(scenes.len() as u32),
-            )
-            .unwrap();
-        for (slot, (scene, target)) in scenes.iter().zip(targets).enumerate() {
-            renderer.update_slot(scene, slot).unwrap();
-            renderer
-                .bind_target(gpu, target.image, target.view)
-                .unwrap();
-            device
-                .begin_command_buffer(cmds[slot], &vk::CommandBufferBeginInfo::default())
-                .unwrap();
-            renderer.record(gpu, cmds[slot], slot, None).unwrap();
-            device.end_command_buffer(cmds[slot]).unwrap();
-        }
-        let fence = device
-            .create_fence(&vk::FenceCreateInfo::default(), None)
-            .unwrap();
-        for (i, &cmd) in cmds.iter().enumerate() {
-            let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
-            let signal = if i + 1 == cmds.len() {
-                fence
-            } else {
-                vk::Fence::null()
-            };
-            device.queue_submit2(gpu.queue, &[submit], signal).unwrap();
-        }
-        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
-        device.destroy_fence(fence, None);
-        device.destroy_command_pool(pool, None);
-    }
+        renderer.record(gpu, cmd, slot, None).unwrap();
+    });
 }
 
 #[test]

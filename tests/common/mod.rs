@@ -1,6 +1,7 @@
 //! What the GPU test files share: a validated device with the shader compiler and a pipeline
 //! cache, that fails the test on any validation error when it is finished.
 
+use ash::vk;
 use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 
@@ -61,4 +62,57 @@ pub fn run_bench(args: &[&str]) -> String {
         assert!(stderr.contains("lucent: error: timing:"), "{stderr}");
     }
     String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Records `count` primary command buffers, `record(k, cmd)` into the k-th (begun and ended
+/// here), submits them back to back on the queue and waits once, after the last: frames in
+/// flight as a host submits them.
+#[allow(dead_code)] // not every test file records frames itself
+pub fn submit_back_to_back(
+    gpu: &GpuContext,
+    count: usize,
+    mut record: impl FnMut(usize, vk::CommandBuffer),
+) {
+    let device = &gpu.device;
+    // SAFETY: valid device; the pool, buffers and fence are used only here and freed after
+    // the wait.
+    unsafe {
+        let pool = device
+            .create_command_pool(
+                &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
+                None,
+            )
+            .unwrap();
+        let cmds = device
+            .allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(count as u32),
+            )
+            .unwrap();
+        for (k, &cmd) in cmds.iter().enumerate() {
+            device
+                .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            record(k, cmd);
+            device.end_command_buffer(cmd).unwrap();
+        }
+        let fence = device
+            .create_fence(&vk::FenceCreateInfo::default(), None)
+            .unwrap();
+        for (k, &cmd) in cmds.iter().enumerate() {
+            let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
+            let signal = if k + 1 == count {
+                fence
+            } else {
+                vk::Fence::null()
+            };
+            device.queue_submit2(gpu.queue, &[submit], signal).unwrap();
+        }
+        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+        device.destroy_fence(fence, None);
+        device.destroy_command_pool(pool, None);
+    }
 }

@@ -5,7 +5,10 @@
 //!    shaderc, in parallel, into `$OUT_DIR/shaders.bundle`, which the library embeds
 //!    (`include_bytes!`) and `ShaderCompiler::shipped` serves. The options and the `#include`
 //!    lookup are the run-time compiler's own (`src/backend/glsl_compile.rs`, included below).
-//!    A compile error stops the build with shaderc's `file:line: error:` messages.
+//!    A compile error stops the build with shaderc's `file:line: error:` messages. Only distinct
+//!    compiles run: a define that no file of the shader's include tree mentions cannot change
+//!    its SPIR-V, so it is left out of the compile's key (the fullscreen vertex shader, compiled
+//!    with every fullscreen pass's defines, compiles once), and identical SPIR-V is stored once.
 //! 2. With the `runtime-shaders` feature the library links shaderc too. Debian's
 //!    `libshaderc.so` leaves glslang symbols unresolved and rust-lld refuses it (DESIGN.md,
 //!    "Facts measured"). With shaderc's `prefer-static-linking` feature the crate links
@@ -13,7 +16,7 @@
 //!    needs are linked here explicitly, in dependency order, from the system library directory.
 //!    (This script's own link gets them from the `lucent-shaderc-link` build-dependency.)
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -138,6 +141,32 @@ fn write_bundle() -> Result<(), String> {
         });
     }
 
+    // Compile each distinct (shader, defines it can see) once: a define whose name appears
+    // nowhere in the shader's sources cannot change its SPIR-V (fullscreen.vert reads none of
+    // the fragment shaders' defines it is compiled with).
+    let mut visible: HashMap<String, Option<HashSet<String>>> = HashMap::new();
+    let mut compile_of: HashMap<(String, BTreeMap<String, String>), usize> = HashMap::new();
+    let mut compiles: Vec<usize> = Vec::new();
+    let mut job_compile = Vec::with_capacity(jobs.len());
+    for (index, job) in jobs.iter().enumerate() {
+        let names = visible
+            .entry(job.name.clone())
+            .or_insert_with(|| identifiers(&root, &job.name));
+        let seen: BTreeMap<String, String> = job
+            .defines
+            .iter()
+            .filter(|(define, _)| names.as_ref().is_none_or(|n| n.contains(*define)))
+            .map(|(d, v)| (d.clone(), v.clone()))
+            .collect();
+        let compile = *compile_of
+            .entry((job.name.clone(), seen))
+            .or_insert_with(|| {
+                compiles.push(index);
+                compiles.len() - 1
+            });
+        job_compile.push(compile);
+    }
+
     let compiler = shaderc::Compiler::new()
         .map_err(|e| format!("the shaderc compiler could not be created: {e}"))?;
     // Cargo's -j (NUM_JOBS); one thread per job slot.
@@ -148,13 +177,13 @@ fn write_bundle() -> Result<(), String> {
         .clamp(1, 64);
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<JobResult>>> =
-        Mutex::new((0..jobs.len()).map(|_| None).collect());
+        Mutex::new((0..compiles.len()).map(|_| None).collect());
     let sources: Mutex<HashMap<String, Result<String, String>>> = Mutex::new(HashMap::new());
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| loop {
                 let index = next.fetch_add(1, Ordering::Relaxed);
-                let Some(job) = jobs.get(index) else {
+                let Some(job) = compiles.get(index).map(|&j| &jobs[j]) else {
                     break;
                 };
                 let source = {
@@ -192,25 +221,37 @@ fn write_bundle() -> Result<(), String> {
     let mut modules: Vec<Vec<u32>> = Vec::new();
     let mut module_of: HashMap<Vec<u32>, u32> = HashMap::new();
     let results = results.into_inner().unwrap_or_else(|e| e.into_inner());
-    for (job, result) in jobs.iter().zip(results) {
+    let mut module_of_compile = Vec::with_capacity(compiles.len());
+    for (&job, result) in compiles.iter().zip(results) {
         match result {
             Some(Ok(spirv)) => {
                 let index = *module_of.entry(spirv.clone()).or_insert_with(|| {
                     modules.push(spirv);
                     (modules.len() - 1) as u32
                 });
-                entries.push((job.line.clone(), index));
+                module_of_compile.push(Some(index));
             }
-            Some(Err(message)) => failures.push(format!("{}:\n{message}", job.line)),
-            None => failures.push(format!("{}: not compiled", job.line)),
+            Some(Err(message)) => {
+                failures.push(format!("{}:\n{message}", jobs[job].line));
+                module_of_compile.push(None);
+            }
+            None => {
+                failures.push(format!("{}: not compiled", jobs[job].line));
+                module_of_compile.push(None);
+            }
+        }
+    }
+    for (job, &compile) in jobs.iter().zip(&job_compile) {
+        if let Some(module) = module_of_compile[compile] {
+            entries.push((job.line.clone(), module));
         }
     }
     if !failures.is_empty() {
         return Err(format!(
-            "{} of {} shipped shader permutations ({MANIFEST}) failed to compile \
+            "{} of {} distinct compiles of the shipped shader permutations ({MANIFEST}) failed \
              (GLSL files are named relative to glsl/):\n\n{}",
             failures.len(),
-            jobs.len(),
+            compiles.len(),
             failures.join("\n\n")
         ));
     }
@@ -218,4 +259,53 @@ fn write_bundle() -> Result<(), String> {
     let bundle = shader_files::encode_bundle(&entries, &modules);
     let path = out_dir.join("shaders.bundle");
     std::fs::write(&path, bundle).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Every identifier in shader `name` and the files it includes (all of them, whatever `#if`
+/// guards them); `None` when an include cannot be followed, and then every define counts.
+fn identifiers(root: &Path, name: &str) -> Option<HashSet<String>> {
+    let mut names = HashSet::new();
+    let mut pending = vec![name.to_string()];
+    let mut read = HashSet::new();
+    while let Some(file) = pending.pop() {
+        if !read.insert(file.clone()) {
+            continue;
+        }
+        let text = glsl_compile::read_source(&root.join(&file)).ok()?;
+        // Token pasting could build a name from pieces: count every define then.
+        if text.contains("##") {
+            return None;
+        }
+        for line in text.lines() {
+            if let Some(rest) = line.trim_start().strip_prefix('#') {
+                if let Some(target) = rest.trim_start().strip_prefix("include") {
+                    let target = target.trim();
+                    let requested = target.get(1..target.len().checked_sub(1)?)?;
+                    // Where the include callback looks (beside the including file, then the
+                    // root): both, when both exist.
+                    let dir = Path::new(&file).parent().unwrap_or(Path::new(""));
+                    let found: Vec<String> = [
+                        glsl_compile::candidate_name(root, dir, requested),
+                        glsl_compile::candidate_name(root, Path::new(""), requested),
+                    ]
+                    .into_iter()
+                    .filter(|candidate| root.join(candidate).is_file())
+                    .collect();
+                    if found.is_empty() {
+                        return None;
+                    }
+                    pending.extend(found);
+                }
+            }
+        }
+        let mut word = String::new();
+        for c in text.chars().chain(std::iter::once(' ')) {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                word.push(c);
+            } else if !word.is_empty() {
+                names.insert(std::mem::take(&mut word));
+            }
+        }
+    }
+    Some(names)
 }

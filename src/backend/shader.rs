@@ -11,7 +11,7 @@
 //!   file differs from it. Asking for a permutation the bundle lacks is
 //!   [`LucentError::ShaderNotShipped`]. This is what the `lucent` command, the tests and an
 //!   embedding host use.
-//! - [`ShaderCompiler::new`] (feature `runtime-shaders`, on by default): compiles a GLSL file
+//! - `ShaderCompiler::new` (feature `runtime-shaders`, on by default): compiles a GLSL file
 //!   under the GLSL root (`glsl/` in the repository, or `LUCENT_GLSL_DIR`) at run time. The
 //!   demo uses it so that edited shaders reload while it runs; `tests/shaders.rs` uses it to
 //!   compile what is not in a frame. The stage comes from the extension (`.vert`, `.frag`,
@@ -21,7 +21,7 @@
 //!   program: creating a shaderc compiler is costly.
 //! - Both take macro permutations as `defines` through the same [`ShaderCompiler::compile`];
 //!   pipelines (`features/util.rs`) do not know which kind they have.
-//! - The run-time compiler's SPIR-V disk cache (the `cache_dir` of [`ShaderCompiler::new`], by
+//! - The run-time compiler's SPIR-V disk cache (the `cache_dir` of `ShaderCompiler::new`, by
 //!   default [`ShaderCompiler::default_cache_dir`], never the source tree) skips glslang
 //!   entirely when nothing changed; see `shader_runtime.rs`. Pass `None` to always compile
 //!   (tests that must see the compiler run). One case is not detected: a new file that would
@@ -177,7 +177,7 @@ enum Source {
 
 /// Gives pipelines their SPIR-V: from the bundle compiled with the crate
 /// ([`ShaderCompiler::shipped`]) or, with the `runtime-shaders` feature, from GLSL files compiled
-/// at run time ([`ShaderCompiler::new`]). See the module docs.
+/// at run time (`ShaderCompiler::new`). See the module docs.
 ///
 /// `ShaderCompiler` is `Send + Sync`; one instance can serve several threads.
 #[derive(Debug)]
@@ -240,8 +240,8 @@ impl ShaderCompiler {
     /// other Unixes, `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's
     /// temporary directory when none of those is known. Per user, so another user's run neither
     /// warns nor writes into someone else's tree, and never the source tree. A host passes its
-    /// own directory instead ([`ShaderCompiler::new`], [`PipelineCache::load_for_device`],
-    /// [`crate::bake::scene::prepare_thickness`]).
+    /// own directory instead (`ShaderCompiler::new`, [`PipelineCache::load_for_device`],
+    /// [`crate::bake::scene::load_scene_baked_in`]).
     pub fn default_cache_dir() -> PathBuf {
         if let Some(dir) = std::env::var_os("LUCENT_CACHE_DIR").filter(|d| !d.is_empty()) {
             return PathBuf::from(dir);

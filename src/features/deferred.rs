@@ -773,8 +773,8 @@ impl PassExec for LightingPass {
                 self.scene.per_frame.binding(Region::Translucency),
             ));
         }
-        let shadows = inputs.shadow_depth.map(|_| inputs.shadow_ids.is_some());
-        let (plain_defines, translucent_defines) = lighting_defines(&self.layout, shadows);
+        let shadow_ids = inputs.shadow_depth.map(|_| inputs.shadow_ids.is_some());
+        let (plain_defines, translucent_defines) = lighting_defines(&self.layout, shadow_ids);
         if let Some(depth) = inputs.shadow_depth {
             self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
             // The shadow table, then the atlases (glsl/common/shadows.glsl).

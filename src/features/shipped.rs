@@ -23,7 +23,8 @@
 //!
 //! To add a permutation: change the pass's define function (and, for a new knob value or flag,
 //! the domain its `shader_permutations` walks), then regenerate the manifest with the command
-//! above. A permutation the bundle lacks fails at pipeline creation with
+//! above. A new pass or shader: give its module a `shader_permutations` that calls the pass's
+//! define function over every shape it can have, add it to [`pipelines`], regenerate. A permutation the bundle lacks fails at pipeline creation with
 //! [`crate::LucentError::ShaderNotShipped`], which the test suite (shipped SPIR-V only) catches.
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -48,6 +48,15 @@ pub enum LucentError {
     /// A shader failed to compile; `message` carries file:line diagnostics from shaderc.
     #[error("shader {path} failed to compile:\n{message}")]
     ShaderCompile { path: String, message: String },
+    /// A shader permutation (path and defines, as one `glsl/permutations.txt` line) that the
+    /// shipped SPIR-V bundle does not hold.
+    #[error(
+        "shader permutation not in the shipped SPIR-V: {permutation}; glsl/permutations.txt is \
+         stale (or the permutation is not one lucent's frames build): regenerate it with `{}` \
+         and rebuild",
+        crate::backend::shader::MANIFEST_COMMAND
+    )]
+    ShaderNotShipped { permutation: String },
     /// The render graph is malformed (e.g. a pass reads a resource nothing wrote).
     #[error("render graph: {0}")]
     Graph(String),

@@ -26,12 +26,15 @@
 //! light, scaling, sweeps) and, with their features, `report` (`lucent report`: the suite, its
 //! sections, the seeds' tables, plots) and `demo` (the interactive window).
 //!
-//! Cargo features, all on by default: `window` (winit, ash-window, ab_glyph: the `demo`
-//! module and `lucent demo`), `cli` (clap, env_logger: the `lucent` binary's command line) and
+//! Cargo features, all on by default: `runtime-shaders` (shaderc: GLSL compiled at run time,
+//! `backend::shader::ShaderCompiler::new`; without it pipelines use only the SPIR-V shipped
+//! with the crate, [`backend::shader::ShaderCompiler::shipped`]), `window` (winit, ash-window,
+//! ab_glyph: the `demo` module and `lucent demo`, which needs `runtime-shaders` for hot
+//! reload), `cli` (clap, env_logger: the `lucent` binary's command line) and
 //! `report` (plotters, indicatif: the `report` module and progress bars on stderr). The `lucent`
 //! binary needs `cli` and `report`. With `--no-default-features` the library keeps everything
-//! else (context, graph, scene, bake, renderer, measure, reference, images) and depends on none
-//! of those crates; the bake and the benchmark then report progress through `log` (info level,
+//! else (context, graph, scene, bake, renderer, measure, reference, images, shipped shaders)
+//! and depends on none of those crates, nor on shaderc at run time; the bake and the benchmark then report progress through `log` (info level,
 //! every tenth) instead of a bar.
 
 pub mod backend;

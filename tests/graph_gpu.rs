@@ -72,7 +72,7 @@ fn run_chain(options: CompileOptions) -> (Vec<u8>, usize) {
     let last = prev.id();
     let (plan, execs) = graph.compile(options).unwrap();
     let shared_slots = plan.slots.iter().filter(|s| s.resources.len() > 1).count();
-    let shaders = ShaderCompiler::new(ShaderCompiler::default_glsl_root(), None).unwrap();
+    let shaders = ShaderCompiler::shipped().unwrap();
     let cache = PipelineCache::load(&gpu.device, None).unwrap();
     let exe = Executable::new(&gpu, plan, execs, &shaders, cache.handle).unwrap();
     let mut runner = FrameRunner::new(&gpu, exe.plan.physical.len()).unwrap();

@@ -13,6 +13,9 @@
 //! Each `permutation:` line is one define set (`NAME` alone means `NAME=1`), compiled in addition
 //! to the compile without defines, unless `permutations-only` says the file cannot compile without.
 
+// Run-time compilation only exists with the feature (on by default).
+#![cfg(feature = "runtime-shaders")]
+
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;

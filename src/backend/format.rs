@@ -2,8 +2,8 @@
 //! its size, channel count, how its values are encoded and its short name.
 //!
 //! Everything that needs to know about a format asks [`format_info`]: the plan's memory
-//! estimates, readback and decoding, the benchmark's speed-of-light copies (which must read
-//! integer formats as integers), the tonemap's output encoding for a caller's target image and
+//! estimates, readback and decoding, the benchmark's speed-of-light copies (which give
+//! integer images the float format of the same size), the tonemap's output encoding for a caller's target image and
 //! the names in tables. A format that is not here is refused where it enters (the graph
 //! compiler names it), never guessed.
 

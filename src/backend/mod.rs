@@ -4,7 +4,8 @@
 //! - [`resources`]: images and buffers with named allocations, readback.
 //! - [`access`]: the one access table every barrier is derived from.
 //! - [`format`](mod@format): the one format table (sizes, channels, encodings, names).
-//! - [`shader`]: GLSL compiled at run time with shaderc, SPIR-V cache, pipeline cache.
+//! - [`shader`]: SPIR-V shipped with the crate or compiled at run time (feature
+//!   `runtime-shaders`), shader modules, pipeline cache.
 //! - [`timer`]: GPU timestamp scopes, read without stalling.
 
 pub mod access;
@@ -12,9 +13,14 @@ pub mod context;
 mod desc;
 pub(crate) mod device;
 pub mod format;
+#[cfg(feature = "runtime-shaders")]
+mod glsl_compile;
 mod instance;
 pub mod resources;
 pub mod shader;
+mod shader_files;
+#[cfg(feature = "runtime-shaders")]
+mod shader_runtime;
 pub mod timer;
 
 pub use context::*;

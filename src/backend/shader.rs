@@ -1,48 +1,66 @@
-//! Run-time GLSL compilation, the SPIR-V disk cache, shader modules and the Vulkan pipeline cache.
+//! Shaders: where pipelines get their SPIR-V ([`ShaderCompiler`]), shader modules, and the Vulkan
+//! pipeline cache.
 //!
 //! # When to use what
 //!
-//! - [`ShaderCompiler`]: turn a GLSL file under the GLSL root (`glsl/` in the repository, or
-//!   `LUCENT_GLSL_DIR`) into SPIR-V with [`ShaderCompiler::compile`]. The stage comes from the
-//!   extension (`.vert`, `.frag`, `.comp`), the GLSL version from the file's `#version` line.
-//!   `#include "x.glsl"` is looked up next to the including file first, then under the GLSL root,
-//!   so `#include "common/gbuffer.glsl"` works from any directory. Macro permutations are passed
-//!   as `defines`. Keep one compiler for the whole program: creating a shaderc compiler is costly.
-//! - The SPIR-V disk cache (the `cache_dir` of [`ShaderCompiler::new`], by default
-//!   [`ShaderCompiler::default_cache_dir`]) skips glslang entirely when nothing changed. An entry
-//!   is found by a hash of the file's path, stage, defines, source text and the compiler settings,
-//!   and is only used when every included file still has the content hash recorded with it, so
-//!   editing an include recompiles every shader that uses it. The cache is an optimisation and
-//!   never an error source: unreadable or corrupt entries are misses, an unwritable directory
-//!   only logs a warning. Pass `None` to always compile (tests that must see the compiler run).
-//!   One case is not detected: a new file that would shadow an include previously found
-//!   elsewhere (e.g. a new `pass/x.glsl` beside a shader that included the root's `x.glsl`);
-//!   delete the cache directory after such a move.
+//! - [`ShaderCompiler::shipped`]: the SPIR-V compiled with the crate. `build.rs` compiles every
+//!   permutation in `glsl/permutations.txt` (a shader path and its defines per line) with shaderc
+//!   into a bundle the library embeds, so a host needs neither `glsl/` nor shaderc at run time.
+//!   That manifest is generated from [`crate::features::shipped::permutations`], which enumerates
+//!   every permutation any frame lucent can build may ask for; a test fails when the committed
+//!   file differs from it. Asking for a permutation the bundle lacks is
+//!   [`LucentError::ShaderNotShipped`]. This is what the `lucent` command, the tests and an
+//!   embedding host use.
+//! - `ShaderCompiler::new` (feature `runtime-shaders`, on by default): compiles a GLSL file
+//!   under the GLSL root (`glsl/` in the repository, or `LUCENT_GLSL_DIR`) at run time. The
+//!   demo uses it so that edited shaders reload while it runs; `tests/shaders.rs` uses it to
+//!   compile what is not in a frame. The stage comes from the extension (`.vert`, `.frag`,
+//!   `.comp`), the GLSL version from the file's `#version` line. `#include "x.glsl"` is looked
+//!   up next to the including file first, then under the GLSL root, so
+//!   `#include "common/gbuffer.glsl"` works from any directory. Keep one compiler for the whole
+//!   program: creating a shaderc compiler is costly.
+//! - Both take macro permutations as `defines` through the same [`ShaderCompiler::compile`];
+//!   pipelines (`features/util.rs`) do not know which kind they have.
+//! - The run-time compiler's SPIR-V disk cache (the `cache_dir` of `ShaderCompiler::new`, by
+//!   default [`ShaderCompiler::default_cache_dir`], never the source tree) skips glslang
+//!   entirely when nothing changed; see `shader_runtime.rs`. Pass `None` to always compile
+//!   (tests that must see the compiler run). One case is not detected: a new file that would
+//!   shadow an include previously found elsewhere (e.g. a new `pass/x.glsl` beside a shader
+//!   that included the root's `x.glsl`); delete the cache directory after such a move.
 //! - [`CompiledShader::dependencies`] lists the main file and every include (absolute paths), which
 //!   is what a hot-reloader watches.
 //! - [`create_shader_module`] wraps the SPIR-V in a `VkShaderModule`. The SPIR-V targets
 //!   Vulkan 1.3 / SPIR-V 1.6, so the device must enable `maintenance4` (DESIGN.md, "Facts measured").
 //! - [`PipelineCache`] is the driver's own pipeline cache (compiled machine code), loaded from and
-//!   saved to one file. It is independent of the SPIR-V cache: that one saves glslang time, this one
+//!   saved to one file. It is independent of the SPIR-V: that saves glslang time, this one
 //!   saves the driver's time in `vkCreate*Pipelines`. A file written by another driver or device is
-//!   detected from its header and ignored.
+//!   detected from its header and ignored. [`PipelineCache::load_default`] keeps it in the
+//!   default cache directory, [`PipelineCache::load_for_device`] wherever the host says.
 //!
-//! Compile errors are [`LucentError::ShaderCompile`] whose message holds shaderc's
-//! `file:line: error: ...` lines, with files named relative to the GLSL root (an error inside an
-//! include names the include, not the shader that included it).
+//! Compile errors (run time, or `build.rs` for the shipped bundle) are
+//! [`LucentError::ShaderCompile`] whose message holds shaderc's `file:line: error: ...` lines,
+//! with files named relative to the GLSL root (an error inside an include names the include, not
+//! the shader that included it).
 
-use std::cell::RefCell;
-use std::collections::BTreeMap;
-use std::fmt::Write as _;
-use std::path::{Component, Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use ash::vk;
-use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
+use super::shader_files::{decode_bundle, define_problem};
+pub(crate) use super::shader_files::{permutation_line, shader_name};
+#[cfg(feature = "runtime-shaders")]
+use super::shader_runtime::RuntimeCompiler;
 use crate::error::{LucentError, Result, VkResultExt};
-use crate::files::{read_capped, read_optional};
+use crate::files::read_optional;
 use crate::images::output::write_file_atomic;
+
+/// The bundle `build.rs` compiled from `glsl/permutations.txt`.
+static SHIPPED_BUNDLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/shaders.bundle"));
+
+/// The command that regenerates `glsl/permutations.txt` (named in errors and docs).
+pub const MANIFEST_COMMAND: &str = "LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders";
 
 /// The platform's per-user cache directory (see [`ShaderCompiler::default_cache_dir`]).
 fn user_cache_dir() -> PathBuf {
@@ -63,30 +81,11 @@ fn user_cache_dir_from(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> Path
     found.unwrap_or_else(std::env::temp_dir)
 }
 
-/// Everything besides the inputs that changes the SPIR-V; part of every cache key. Change it when a
-/// compile option below changes, so old cache entries stop matching. (A newer system shaderc does
-/// not invalidate entries: their SPIR-V stays valid, only possibly less optimised.)
-const COMPILER_SETTINGS: &str =
-    "lucent-spirv-cache-v1;shaderc-rs-0.10;glsl;vulkan1.3;spirv1.6;opt=performance;debug-info=off";
-
-/// First bytes of a SPIR-V cache entry (format version in the last byte).
-const CACHE_MAGIC: &[u8; 8] = b"LUCSPV\0\x01";
-
-/// File name extension of SPIR-V cache entries.
-const CACHE_EXTENSION: &str = "spvcache";
-
-/// Largest GLSL source or include read.
-const MAX_SOURCE_BYTES: u64 = 4 << 20;
-/// Largest SPIR-V cache entry read.
-const MAX_CACHE_ENTRY_BYTES: u64 = 64 << 20;
 /// Largest pipeline cache file read.
 const MAX_PIPELINE_CACHE_BYTES: u64 = 1 << 30;
 
-/// Deepest `#include` nesting accepted; deeper is taken to be an include cycle.
-const MAX_INCLUDE_DEPTH: usize = 32;
-
 /// The SPIR-V magic number, first word of every module.
-const SPIRV_MAGIC: u32 = 0x0723_0203;
+pub(crate) const SPIRV_MAGIC: u32 = 0x0723_0203;
 
 /// A programmable pipeline stage, decided by the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -127,14 +126,6 @@ impl ShaderStage {
             Self::Compute => "comp",
         }
     }
-
-    fn shaderc_kind(self) -> shaderc::ShaderKind {
-        match self {
-            Self::Vertex => shaderc::ShaderKind::Vertex,
-            Self::Fragment => shaderc::ShaderKind::Fragment,
-            Self::Compute => shaderc::ShaderKind::Compute,
-        }
-    }
 }
 
 /// The result of [`ShaderCompiler::compile`].
@@ -144,69 +135,85 @@ pub struct CompiledShader {
     pub spirv: Vec<u32>,
     /// The stage, from the file extension.
     pub stage: ShaderStage,
-    /// Absolute paths of the main file (first) and every file it included, each once.
+    /// Absolute paths of the main file (first) and every file it included, each once (empty
+    /// for shipped SPIR-V: no file is read).
     pub dependencies: Vec<PathBuf>,
-    /// True when the SPIR-V came from the disk cache and glslang did not run.
+    /// True when the SPIR-V came from the run-time compiler's disk cache and glslang did not
+    /// run (false for shipped SPIR-V).
     pub from_cache: bool,
 }
 
-/// Compiles GLSL files under one root directory to SPIR-V, with an optional disk cache.
+/// The decoded shipped bundle: permutation line -> module, and the modules.
+struct ShippedBundle {
+    index: HashMap<String, u32>,
+    modules: Vec<Vec<u32>>,
+}
+
+/// The embedded bundle, decoded on first use.
+fn shipped_bundle() -> Result<&'static ShippedBundle> {
+    static BUNDLE: OnceLock<std::result::Result<ShippedBundle, String>> = OnceLock::new();
+    BUNDLE
+        .get_or_init(|| {
+            decode_bundle(SHIPPED_BUNDLE).map(|b| ShippedBundle {
+                index: b.entries.into_iter().collect(),
+                modules: b.modules,
+            })
+        })
+        .as_ref()
+        .map_err(|e| {
+            LucentError::InvalidInput(format!("the shipped SPIR-V bundle is corrupt: {e}"))
+        })
+}
+
+/// Where a [`ShaderCompiler`] gets SPIR-V.
+#[derive(Debug)]
+enum Source {
+    /// The embedded bundle.
+    Shipped,
+    /// shaderc at run time.
+    #[cfg(feature = "runtime-shaders")]
+    Runtime(RuntimeCompiler),
+}
+
+/// Gives pipelines their SPIR-V: from the bundle compiled with the crate
+/// ([`ShaderCompiler::shipped`]) or, with the `runtime-shaders` feature, from GLSL files compiled
+/// at run time (`ShaderCompiler::new`). See the module docs.
 ///
 /// `ShaderCompiler` is `Send + Sync`; one instance can serve several threads.
 #[derive(Debug)]
 pub struct ShaderCompiler {
-    compiler: shaderc::Compiler,
-    glsl_root: PathBuf,
-    cache_dir: Option<PathBuf>,
-    /// Set once the "cache directory not writable" warning has been logged, to log it only once.
-    cache_write_warned: AtomicBool,
-}
-
-/// One file the compile read: its name (relative to the GLSL root, or absolute outside it) and
-/// the xxh3 of its content.
-#[derive(Debug, Clone, PartialEq, Eq)]
-struct Dependency {
-    name: String,
-    hash: u64,
+    source: Source,
 }
 
 impl ShaderCompiler {
-    /// A compiler for the GLSL files under `glsl_root`, caching SPIR-V in `cache_dir` if given.
-    ///
-    /// Fails when `glsl_root` is not a directory or shaderc cannot be initialised. The cache
-    /// directory is created on first use; if it cannot be, compiles still work (with a warning).
-    pub fn new(glsl_root: impl Into<PathBuf>, cache_dir: Option<PathBuf>) -> Result<Self> {
-        let glsl_root = glsl_root.into();
-        if !glsl_root.is_dir() {
-            return Err(LucentError::file(
-                &glsl_root,
-                "GLSL root is not a directory; lucent looks in $LUCENT_GLSL_DIR, then beside \
-                 the executable (glsl/, ../share/lucent/glsl, glsl/ in a directory above it), \
-                 then in the source tree it was built from: set LUCENT_GLSL_DIR to lucent's \
-                 glsl/ folder",
-            ));
-        }
-        // Absolute, so dependencies and cache-hit checks do not depend on the working directory.
-        let glsl_root = glsl_root
-            .canonicalize()
-            .map_err(|e| LucentError::file(&glsl_root, e))?;
-        let compiler = shaderc::Compiler::new().map_err(|e| {
-            LucentError::InvalidInput(format!("the shaderc compiler could not be created: {e}"))
-        })?;
+    /// Serves the SPIR-V compiled with the crate (no GLSL files, no shaderc). Fails only when
+    /// the embedded bundle is corrupt.
+    pub fn shipped() -> Result<Self> {
+        shipped_bundle()?;
         Ok(Self {
-            compiler,
-            glsl_root,
-            cache_dir,
-            cache_write_warned: AtomicBool::new(false),
+            source: Source::Shipped,
         })
     }
 
-    /// The GLSL root used when none is given: `$LUCENT_GLSL_DIR`; else the first shader tree
-    /// found from the running executable: `glsl/` beside it, `../share/lucent/glsl` (an
-    /// installed layout), or `glsl/` in a directory above it (the repository a `target/`
-    /// build runs from: `cargo run`, the tests); else the source tree the library was
-    /// compiled from, when it still exists (a host embedding the library). A tree is
-    /// recognised by its `fullscreen.vert`.
+    /// A run-time compiler for the GLSL files under `glsl_root`, caching SPIR-V in `cache_dir`
+    /// if given (feature `runtime-shaders`).
+    ///
+    /// Fails when `glsl_root` is not a directory or shaderc cannot be initialised. The cache
+    /// directory is created on first use; if it cannot be, compiles still work (with a warning).
+    #[cfg(feature = "runtime-shaders")]
+    pub fn new(glsl_root: impl Into<PathBuf>, cache_dir: Option<PathBuf>) -> Result<Self> {
+        Ok(Self {
+            source: Source::Runtime(RuntimeCompiler::new(glsl_root.into(), cache_dir)?),
+        })
+    }
+
+    /// The GLSL root a run-time compiler uses when none is given: `$LUCENT_GLSL_DIR`; else the
+    /// first shader tree found from the running executable: `glsl/` beside it,
+    /// `../share/lucent/glsl` (an installed layout), or `glsl/` in a directory above it (the
+    /// repository a `target/` build runs from: `cargo run`, the tests); else the source tree the
+    /// library was compiled from, when it still exists. A tree is recognised by its
+    /// `fullscreen.vert`. Only run-time compilation reads GLSL: shipped SPIR-V needs no tree.
+    #[cfg(feature = "runtime-shaders")]
     pub fn default_glsl_root() -> PathBuf {
         if let Some(dir) = std::env::var_os("LUCENT_GLSL_DIR").filter(|d| !d.is_empty()) {
             return PathBuf::from(dir);
@@ -227,12 +234,14 @@ impl ShaderCompiler {
         compiled_from
     }
 
-    /// The SPIR-V cache directory used when none is given (the thickness bake cache and the
-    /// pipeline cache live in it too): `$LUCENT_CACHE_DIR`, else `lucent` in the user's cache
-    /// directory: `$XDG_CACHE_HOME` or `~/.cache` on Linux and other Unixes,
-    /// `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's temporary
-    /// directory when none of those is known. Per user, so another user's run neither warns
-    /// nor writes into someone else's tree.
+    /// The cache directory used when the caller names none (the run-time SPIR-V cache, the
+    /// thickness bake cache and the pipeline cache live in it): `$LUCENT_CACHE_DIR`, else
+    /// `lucent` in the user's cache directory: `$XDG_CACHE_HOME` or `~/.cache` on Linux and
+    /// other Unixes, `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's
+    /// temporary directory when none of those is known. Per user, so another user's run neither
+    /// warns nor writes into someone else's tree, and never the source tree. A host passes its
+    /// own directory instead (`ShaderCompiler::new`, [`PipelineCache::load_for_device`],
+    /// [`crate::bake::scene::load_scene_baked_in`]).
     pub fn default_cache_dir() -> PathBuf {
         if let Some(dir) = std::env::var_os("LUCENT_CACHE_DIR").filter(|d| !d.is_empty()) {
             return PathBuf::from(dir);
@@ -240,429 +249,98 @@ impl ShaderCompiler {
         user_cache_dir().join("lucent")
     }
 
-    /// The (absolute) GLSL root directory.
-    pub fn glsl_root(&self) -> &Path {
-        &self.glsl_root
+    /// Whether this compiler serves the shipped bundle (no GLSL is read).
+    pub fn is_shipped(&self) -> bool {
+        matches!(self.source, Source::Shipped)
     }
 
-    /// The SPIR-V cache directory, if caching is on.
+    /// The (absolute) GLSL root directory of a run-time compiler; `None` for shipped SPIR-V.
+    pub fn glsl_root(&self) -> Option<&Path> {
+        match &self.source {
+            Source::Shipped => None,
+            #[cfg(feature = "runtime-shaders")]
+            Source::Runtime(r) => Some(&r.glsl_root),
+        }
+    }
+
+    /// The SPIR-V cache directory of a run-time compiler, if caching is on.
     pub fn cache_dir(&self) -> Option<&Path> {
-        self.cache_dir.as_deref()
+        match &self.source {
+            Source::Shipped => None,
+            #[cfg(feature = "runtime-shaders")]
+            Source::Runtime(r) => r.cache_dir.as_deref(),
+        }
     }
 
-    /// Compiles `path` (relative to the GLSL root, `/`-separated, e.g. `"smoke/gbuffer.frag"`) with
-    /// the given macro definitions (`("NAME", "VALUE")`; an empty value defines the name as empty;
-    /// when a name repeats, the last value wins).
+    /// The SPIR-V of `path` (relative to the GLSL root, `/`-separated, e.g.
+    /// `"smoke/gbuffer.frag"`) with the given macro definitions (`("NAME", "VALUE")`; an empty
+    /// value defines the name as empty; when a name repeats, the last value wins).
     ///
-    /// Errors: an unknown extension or a bad define is [`LucentError::InvalidInput`], an unreadable
-    /// main file is [`LucentError::File`], and a GLSL error (including a missing include) is
-    /// [`LucentError::ShaderCompile`] with shaderc's `file:line: error:` lines.
+    /// Errors: an unknown extension or a bad define is [`LucentError::InvalidInput`]; shipped,
+    /// a permutation the bundle lacks is [`LucentError::ShaderNotShipped`]; at run time, an
+    /// unreadable main file is [`LucentError::File`], and a GLSL error (including a missing
+    /// include) is [`LucentError::ShaderCompile`] with shaderc's `file:line: error:` lines.
     pub fn compile(&self, path: &str, defines: &[(&str, &str)]) -> Result<CompiledShader> {
         let stage = ShaderStage::from_path(path).ok_or_else(|| {
             LucentError::InvalidInput(format!(
                 "shader {path}: unknown stage; the file name must end in .vert, .frag or .comp"
             ))
         })?;
-        let name = normalize_relative(Path::new(path))
-            .filter(|p| !p.as_os_str().is_empty())
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "shader {path}: the path must be relative to the GLSL root and stay inside it"
-                ))
-            })?;
-        let name = path_to_name(&name);
-        let defines = sorted_defines(path, defines)?;
-        let file = self.glsl_root.join(&name);
-        let source = read_capped(&file, MAX_SOURCE_BYTES, "GLSL source")
-            .and_then(|b| String::from_utf8(b).map_err(|_| "not UTF-8 text".to_string()))
-            .map_err(|e| LucentError::file(&file, e))?;
-        if source.contains('\0') {
-            return Err(LucentError::file(&file, "GLSL source contains a NUL byte"));
-        }
-
-        let key = cache_key(&name, stage, &defines, &source);
-        if let Some((spirv, deps)) = self.cache_lookup(key) {
-            log::debug!("shader {name}: SPIR-V from cache");
-            return Ok(CompiledShader {
-                spirv,
-                stage,
-                dependencies: self.dependency_paths(&deps),
-                from_cache: true,
-            });
-        }
-
-        let (spirv, deps) = self.compile_uncached(&name, stage, &defines, &source)?;
-        self.cache_store(key, &spirv, &deps);
-        Ok(CompiledShader {
-            spirv,
-            stage,
-            dependencies: self.dependency_paths(&deps),
-            from_cache: false,
-        })
-    }
-
-    /// Runs glslang + spirv-opt through shaderc; returns the SPIR-V and every file read.
-    fn compile_uncached(
-        &self,
-        name: &str,
-        stage: ShaderStage,
-        defines: &BTreeMap<&str, &str>,
-        source: &str,
-    ) -> Result<(Vec<u32>, Vec<Dependency>)> {
-        let deps = RefCell::new(vec![Dependency {
-            name: name.to_string(),
-            hash: xxh3_64(source.as_bytes()),
-        }]);
-        let root = self.glsl_root.as_path();
-        let mut options = shaderc::CompileOptions::new().map_err(|e| {
-            LucentError::InvalidInput(format!("shaderc compile options could not be created: {e}"))
+        let name = shader_name(path).ok_or_else(|| {
+            LucentError::InvalidInput(format!(
+                "shader {path}: the path must be relative to the GLSL root and stay inside it"
+            ))
         })?;
-        options.set_source_language(shaderc::SourceLanguage::GLSL);
-        options.set_target_env(
-            shaderc::TargetEnv::Vulkan,
-            shaderc::EnvVersion::Vulkan1_3 as u32,
-        );
-        options.set_target_spirv(shaderc::SpirvVersion::V1_6);
-        options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        for (define, value) in defines {
-            options.add_macro_definition(define, Some(value));
-        }
-        options.set_include_callback(|requested, include_type, requester, depth| {
-            if depth > MAX_INCLUDE_DEPTH {
-                return Err(format!(
-                    "#include nesting deeper than {MAX_INCLUDE_DEPTH} (an include cycle without a guard?)"
-                ));
+        let defines = sorted_defines(path, defines, self.is_shipped())?;
+        match &self.source {
+            Source::Shipped => {
+                let bundle = shipped_bundle()?;
+                let line = permutation_line(&name, defines.iter().map(|(n, v)| (*n, *v)));
+                let module =
+                    bundle
+                        .index
+                        .get(&line)
+                        .ok_or_else(|| LucentError::ShaderNotShipped {
+                            permutation: line.clone(),
+                        })?;
+                Ok(CompiledShader {
+                    spirv: bundle.modules[*module as usize].clone(),
+                    stage,
+                    dependencies: Vec::new(),
+                    from_cache: false,
+                })
             }
-            let (resolved_name, content) = resolve_include(root, requested, include_type, requester)?;
-            let mut deps = deps.borrow_mut();
-            if !deps.iter().any(|d| d.name == resolved_name) {
-                deps.push(Dependency {
-                    name: resolved_name.clone(),
-                    hash: xxh3_64(content.as_bytes()),
-                });
-            }
-            Ok(shaderc::ResolvedInclude {
-                resolved_name,
-                content,
-            })
-        });
-
-        let artifact = self
-            .compiler
-            .compile_into_spirv(source, stage.shaderc_kind(), name, "main", Some(&options))
-            .map_err(|e| {
-                let mut message = match e {
-                    shaderc::Error::CompilationError(_, text) => text.trim_end().to_string(),
-                    other => other.to_string(),
-                };
-                if !defines.is_empty() {
-                    let _ = write!(message, "\n(defines: {})", format_defines(defines));
-                }
-                LucentError::ShaderCompile {
-                    path: name.to_string(),
-                    message,
-                }
-            })?;
-        if artifact.get_num_warnings() > 0 {
-            log::warn!(
-                "shader {name}: {}",
-                artifact.get_warning_messages().trim_end()
-            );
+            #[cfg(feature = "runtime-shaders")]
+            Source::Runtime(runtime) => runtime.compile(&name, stage, &defines),
         }
-        let spirv = artifact.as_binary().to_vec();
-        drop(options);
-        Ok((spirv, deps.into_inner()))
     }
 
-    fn dependency_paths(&self, deps: &[Dependency]) -> Vec<PathBuf> {
-        deps.iter().map(|d| self.glsl_root.join(&d.name)).collect()
-    }
-
-    fn cache_entry_path(&self, key: u128) -> Option<PathBuf> {
-        self.cache_dir
-            .as_ref()
-            .map(|dir| dir.join(format!("{key:032x}.{CACHE_EXTENSION}")))
-    }
-
-    /// A cache hit: an entry for `key` exists, parses, and every dependency still has its hash.
-    fn cache_lookup(&self, key: u128) -> Option<(Vec<u32>, Vec<Dependency>)> {
-        let path = self.cache_entry_path(key)?;
-        let bytes = match read_optional(&path, MAX_CACHE_ENTRY_BYTES, "SPIR-V cache entry") {
-            Ok(Some(bytes)) => bytes,
-            Ok(None) => return None,
-            Err(e) => {
-                log::warn!(
-                    "SPIR-V cache entry {} unreadable ({e}); recompiling",
-                    path.display()
-                );
-                return None;
-            }
-        };
-        let Some((spirv, deps)) = decode_cache_entry(&bytes, key) else {
-            log::warn!(
-                "SPIR-V cache entry {} is corrupt; recompiling",
-                path.display()
-            );
-            return None;
-        };
-        for dep in &deps {
-            let file = self.glsl_root.join(&dep.name);
-            match read_capped(&file, MAX_SOURCE_BYTES, "GLSL source") {
-                Ok(content) if xxh3_64(&content) == dep.hash => {}
-                _ => {
-                    log::debug!(
-                        "SPIR-V cache entry {} is stale: {} changed",
-                        path.display(),
-                        dep.name
-                    );
-                    return None;
-                }
-            }
-        }
-        Some((spirv, deps))
-    }
-
-    /// Writes a cache entry; failures only warn (once per compiler) because the cache is optional.
-    fn cache_store(&self, key: u128, spirv: &[u32], deps: &[Dependency]) {
-        let Some(path) = self.cache_entry_path(key) else {
-            return;
-        };
-        if let Err(e) = write_file_atomic(&path, &encode_cache_entry(key, spirv, deps)) {
-            if !self.cache_write_warned.swap(true, Ordering::Relaxed) {
-                log::warn!("SPIR-V cache not written, shaders will be recompiled next run: {e}");
-            }
-        }
+    /// Every permutation line the shipped bundle holds, sorted (what `glsl/permutations.txt`
+    /// held when the crate was built).
+    pub fn shipped_permutations() -> Result<Vec<String>> {
+        let mut lines: Vec<String> = shipped_bundle()?.index.keys().cloned().collect();
+        lines.sort();
+        Ok(lines)
     }
 }
 
-/// Lexically normalises a relative path (`a/./b/../c` -> `a/c`); `None` if it is absolute or
-/// climbs above its start.
-fn normalize_relative(path: &Path) -> Option<PathBuf> {
-    let mut out = PathBuf::new();
-    for component in path.components() {
-        match component {
-            Component::Normal(part) => out.push(part),
-            Component::CurDir => {}
-            Component::ParentDir => {
-                if !out.pop() {
-                    return None;
-                }
-            }
-            Component::RootDir | Component::Prefix(_) => return None,
-        }
-    }
-    Some(out)
-}
-
-/// Lexically normalises an absolute path.
-fn normalize_absolute(path: &Path) -> PathBuf {
-    let mut out = PathBuf::new();
-    for component in path.components() {
-        match component {
-            Component::ParentDir => {
-                out.pop();
-            }
-            Component::CurDir => {}
-            other => out.push(other.as_os_str()),
-        }
-    }
-    out
-}
-
-/// A path as a `/`-separated name for messages and cache entries.
-fn path_to_name(path: &Path) -> String {
-    path.components()
-        .map(|c| c.as_os_str().to_string_lossy())
-        .collect::<Vec<_>>()
-        .join("/")
-        .replace("//", "/")
-}
-
-/// Candidate name for `requested` seen from `base_dir` (a name relative to the root, or absolute):
-/// relative to the root when it stays inside it, else absolute.
-fn candidate_name(root: &Path, base_dir: &Path, requested: &str) -> String {
-    let joined = base_dir.join(requested);
-    if joined.is_absolute() {
-        let absolute = normalize_absolute(&joined);
-        return match absolute.strip_prefix(root) {
-            Ok(inside) => path_to_name(inside),
-            Err(_) => absolute.to_string_lossy().into_owned(),
-        };
-    }
-    match normalize_relative(&joined) {
-        Some(inside) => path_to_name(&inside),
-        None => path_to_name(&normalize_absolute(&root.join(joined))),
-    }
-}
-
-/// The include callback's lookup: `#include "x"` next to the including file first, then (and for
-/// `#include <x>` only) under the GLSL root. Returns the file's name and content.
-fn resolve_include(
-    root: &Path,
-    requested: &str,
-    include_type: shaderc::IncludeType,
-    requester: &str,
-) -> std::result::Result<(String, String), String> {
-    let mut candidates = Vec::with_capacity(2);
-    if include_type == shaderc::IncludeType::Relative {
-        let requester_dir = Path::new(requester).parent().unwrap_or(Path::new(""));
-        candidates.push(candidate_name(root, requester_dir, requested));
-    }
-    let from_root = candidate_name(root, Path::new(""), requested);
-    if !candidates.contains(&from_root) {
-        candidates.push(from_root);
-    }
-    for name in &candidates {
-        let file = root.join(name);
-        if file.exists() {
-            let content = read_capped(&file, MAX_SOURCE_BYTES, "GLSL source")
-                .and_then(|b| String::from_utf8(b).map_err(|_| "not UTF-8 text".to_string()))
-                .map_err(|e| format!("cannot read include {}: {e}", file.display()))?;
-            if content.contains('\0') {
-                return Err(format!("include {} contains a NUL byte", file.display()));
-            }
-            return Ok((name.clone(), content));
-        }
-    }
-    // shaderc retries a failed `#include "x"` as `#include <x>`, so this message (root only) is
-    // the one users see for both forms; it names both places.
-    let next_to = Path::new(requester)
-        .parent()
-        .map(path_to_name)
-        .filter(|dir| !dir.is_empty())
-        .unwrap_or_else(|| ".".to_string());
-    Err(format!(
-        "include \"{requested}\" not found: #include \"...\" looks next to the including file \
-         (in {next_to}/), then under the GLSL root {} (as {})",
-        root.display(),
-        candidate_name(root, Path::new(""), requested)
-    ))
-}
-
-/// Validates defines and orders them by name (last value of a repeated name wins, as in shaderc).
-fn sorted_defines<'a>(
+/// Validates defines and orders them by name (last value of a repeated name wins, as in
+/// shaderc). `line_safe`: values must also fit a permutation line (no whitespace).
+pub(crate) fn sorted_defines<'a>(
     path: &str,
     defines: &[(&'a str, &'a str)],
+    line_safe: bool,
 ) -> Result<BTreeMap<&'a str, &'a str>> {
     let mut sorted = BTreeMap::new();
     for &(name, value) in defines {
-        let valid_name = name
-            .chars()
-            .next()
-            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
-            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-        if !valid_name {
+        if let Some(problem) = define_problem(name, value, line_safe) {
             return Err(LucentError::InvalidInput(format!(
-                "shader {path}: define name '{name}' is not a GLSL identifier"
-            )));
-        }
-        if value.contains(['\0', '\n', '\r']) {
-            return Err(LucentError::InvalidInput(format!(
-                "shader {path}: the value of define {name} contains a NUL or line break"
+                "shader {path}: {problem}"
             )));
         }
         sorted.insert(name, value);
     }
     Ok(sorted)
-}
-
-fn format_defines(defines: &BTreeMap<&str, &str>) -> String {
-    defines
-        .iter()
-        .map(|(name, value)| format!("{name}={value}"))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-/// xxh3-128 of everything that selects one SPIR-V output apart from the included files (which are
-/// checked by content hash on every hit).
-fn cache_key(name: &str, stage: ShaderStage, defines: &BTreeMap<&str, &str>, source: &str) -> u128 {
-    let mut hasher = Xxh3::new();
-    // Every field is length-prefixed so that no two different inputs hash the same byte stream.
-    let mut field = |bytes: &[u8]| {
-        hasher.update(&(bytes.len() as u64).to_le_bytes());
-        hasher.update(bytes);
-    };
-    field(COMPILER_SETTINGS.as_bytes());
-    field(name.as_bytes());
-    field(stage.extension().as_bytes());
-    field(&(defines.len() as u64).to_le_bytes());
-    for (define, value) in defines {
-        field(define.as_bytes());
-        field(value.as_bytes());
-    }
-    field(source.as_bytes());
-    hasher.digest128()
-}
-
-/// Cache entry layout (little-endian): magic, key (u128), dependency count (u32), per dependency
-/// name length (u32) + UTF-8 name + content hash (u64), SPIR-V word count (u32) + words, and an
-/// xxh3-64 of everything before it, so a truncated or damaged file is detected.
-fn encode_cache_entry(key: u128, spirv: &[u32], deps: &[Dependency]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(64 + spirv.len() * 4);
-    out.extend_from_slice(CACHE_MAGIC);
-    out.extend_from_slice(&key.to_le_bytes());
-    out.extend_from_slice(&(deps.len() as u32).to_le_bytes());
-    for dep in deps {
-        out.extend_from_slice(&(dep.name.len() as u32).to_le_bytes());
-        out.extend_from_slice(dep.name.as_bytes());
-        out.extend_from_slice(&dep.hash.to_le_bytes());
-    }
-    out.extend_from_slice(&(spirv.len() as u32).to_le_bytes());
-    for word in spirv {
-        out.extend_from_slice(&word.to_le_bytes());
-    }
-    let checksum = xxh3_64(&out);
-    out.extend_from_slice(&checksum.to_le_bytes());
-    out
-}
-
-/// Parses a cache entry; `None` for anything malformed or written for another key.
-fn decode_cache_entry(bytes: &[u8], key: u128) -> Option<(Vec<u32>, Vec<Dependency>)> {
-    let (body, checksum) = bytes.split_at_checked(bytes.len().checked_sub(8)?)?;
-    if xxh3_64(body) != u64::from_le_bytes(checksum.try_into().ok()?) {
-        return None;
-    }
-    let mut reader = ByteReader(body);
-    if reader.take(CACHE_MAGIC.len())? != CACHE_MAGIC {
-        return None;
-    }
-    if u128::from_le_bytes(reader.take(16)?.try_into().ok()?) != key {
-        return None;
-    }
-    let dep_count = reader.u32()? as usize;
-    let mut deps = Vec::with_capacity(dep_count.min(1024));
-    for _ in 0..dep_count {
-        let len = reader.u32()? as usize;
-        let name = std::str::from_utf8(reader.take(len)?).ok()?.to_string();
-        let hash = u64::from_le_bytes(reader.take(8)?.try_into().ok()?);
-        deps.push(Dependency { name, hash });
-    }
-    let word_count = reader.u32()? as usize;
-    let words = reader.take(word_count.checked_mul(4)?)?;
-    if !reader.0.is_empty() || deps.is_empty() {
-        return None;
-    }
-    let spirv: Vec<u32> = words
-        .chunks_exact(4)
-        .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
-        .collect();
-    (spirv.first() == Some(&SPIRV_MAGIC)).then_some((spirv, deps))
-}
-
-/// Minimal cursor over a byte slice for [`decode_cache_entry`].
-struct ByteReader<'a>(&'a [u8]);
-
-impl<'a> ByteReader<'a> {
-    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
-        let (head, tail) = self.0.split_at_checked(n)?;
-        self.0 = tail;
-        Some(head)
-    }
-
-    fn u32(&mut self) -> Option<u32> {
-        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
-    }
 }
 
 /// Creates a `VkShaderModule` from SPIR-V words (e.g. [`CompiledShader::spirv`]).
@@ -843,13 +521,6 @@ fn check_pipeline_cache_header(
 mod tests {
     use super::*;
 
-    fn temp_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("lucent-shader-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
     #[test]
     fn stage_from_extension() {
         assert_eq!(
@@ -869,87 +540,67 @@ mod tests {
     }
 
     #[test]
-    fn include_names_are_normalised() {
-        let root = Path::new("/r");
-        assert_eq!(
-            candidate_name(root, Path::new("smoke"), "../common/x.glsl"),
-            "common/x.glsl"
-        );
-        assert_eq!(
-            candidate_name(root, Path::new("smoke"), "./x.glsl"),
-            "smoke/x.glsl"
-        );
-        assert_eq!(candidate_name(root, Path::new(""), "x.glsl"), "x.glsl");
-        assert_eq!(candidate_name(root, Path::new(""), "../x.glsl"), "/x.glsl");
-        assert_eq!(
-            candidate_name(root, Path::new("/r/a"), "b.glsl"),
-            "a/b.glsl"
-        );
-    }
-
-    #[test]
-    fn cache_entry_round_trip_and_corruption() {
-        let deps = vec![
-            Dependency {
-                name: "a.frag".into(),
-                hash: 1,
-            },
-            Dependency {
-                name: "common/b.glsl".into(),
-                hash: 2,
-            },
-        ];
-        let spirv = vec![SPIRV_MAGIC, 0x0001_0600, 7, 8];
-        let bytes = encode_cache_entry(42, &spirv, &deps);
-        assert_eq!(decode_cache_entry(&bytes, 42), Some((spirv, deps)));
-        assert_eq!(decode_cache_entry(&bytes, 43), None);
-        for cut in [0, 1, 8, bytes.len() / 2, bytes.len() - 1] {
-            assert_eq!(
-                decode_cache_entry(&bytes[..cut], 42),
-                None,
-                "truncated at {cut}"
-            );
-        }
-        let mut flipped = bytes.clone();
-        flipped[30] ^= 0x10;
-        assert_eq!(decode_cache_entry(&flipped, 42), None);
-    }
-
-    #[test]
     fn defines_are_validated_and_sorted() {
-        let sorted = sorted_defines("x", &[("B", "1"), ("A", "2"), ("B", "3")]).unwrap();
-        assert_eq!(format_defines(&sorted), "A=2 B=3");
-        assert!(sorted_defines("x", &[("1A", "1")]).is_err());
-        assert!(sorted_defines("x", &[("A B", "1")]).is_err());
-        assert!(sorted_defines("x", &[("A", "1\n#define X")]).is_err());
+        let sorted = sorted_defines("x", &[("B", "1"), ("A", "2"), ("B", "3")], false).unwrap();
+        assert_eq!(permutation_line("x.frag", sorted), "x.frag A=2 B=3");
+        assert!(sorted_defines("x", &[("1A", "1")], false).is_err());
+        assert!(sorted_defines("x", &[("A B", "1")], false).is_err());
+        assert!(sorted_defines("x", &[("A", "1\n#define X")], false).is_err());
+        assert!(sorted_defines("x", &[("A", "1 2")], false).is_ok());
+        assert!(sorted_defines("x", &[("A", "1 2")], true).is_err());
     }
 
     #[test]
-    fn corrupt_cache_entry_is_a_miss_and_unwritable_cache_is_not_an_error() {
-        let root = temp_dir("corrupt");
-        std::fs::write(
-            root.join("a.comp"),
-            "#version 450\nlayout(local_size_x = 1) in;\nvoid main() {}\n",
-        )
-        .unwrap();
-        let cache = root.join("cache");
-        let compiler = ShaderCompiler::new(&root, Some(cache.clone())).unwrap();
-        assert!(!compiler.compile("a.comp", &[]).unwrap().from_cache);
-        assert!(compiler.compile("a.comp", &[]).unwrap().from_cache);
-        for entry in std::fs::read_dir(&cache).unwrap() {
-            std::fs::write(entry.unwrap().path(), b"garbage").unwrap();
+    fn permutation_lines_round_trip() {
+        use super::super::shader_files::parse_permutation_line;
+        let (name, defines) = parse_permutation_line("sss/blur.frag A=1 B= C=x").unwrap();
+        assert_eq!(name, "sss/blur.frag");
+        let pairs: Vec<(&str, &str)> = defines
+            .iter()
+            .map(|(n, v)| (n.as_str(), v.as_str()))
+            .collect();
+        assert_eq!(pairs, [("A", "1"), ("B", ""), ("C", "x")]);
+        assert_eq!(permutation_line(&name, pairs), "sss/blur.frag A=1 B= C=x");
+        for bad in [
+            "../a.frag",
+            "a.frag B=1 A=1",
+            "a.frag A=1 A=2",
+            "a.frag A",
+            "a.frag 1A=1",
+        ] {
+            assert!(parse_permutation_line(bad).is_err(), "{bad}");
         }
-        let again = compiler.compile("a.comp", &[]).unwrap();
-        assert!(!again.from_cache);
-        assert_eq!(again.spirv[0], SPIRV_MAGIC);
+    }
 
-        // A cache "directory" that is a file: compiles still succeed, never from the cache.
-        let blocked = root.join("blocked");
-        std::fs::write(&blocked, b"not a directory").unwrap();
-        let compiler = ShaderCompiler::new(&root, Some(blocked.join("cache"))).unwrap();
-        assert!(!compiler.compile("a.comp", &[]).unwrap().from_cache);
-        assert!(!compiler.compile("a.comp", &[]).unwrap().from_cache);
-        std::fs::remove_dir_all(&root).unwrap();
+    #[test]
+    fn shipped_bundle_serves_its_permutations_and_names_a_miss() {
+        let shaders = ShaderCompiler::shipped().unwrap();
+        assert!(shaders.is_shipped() && shaders.glsl_root().is_none());
+        let lines = ShaderCompiler::shipped_permutations().unwrap();
+        let first = lines.first().expect("the shipped bundle is empty");
+        let (name, defines) = super::super::shader_files::parse_permutation_line(first).unwrap();
+        let pairs: Vec<(&str, &str)> = defines
+            .iter()
+            .map(|(n, v)| (n.as_str(), v.as_str()))
+            .collect();
+        let shader = shaders.compile(&name, &pairs).unwrap();
+        assert_eq!(shader.spirv[0], SPIRV_MAGIC);
+        assert!(!shader.from_cache && shader.dependencies.is_empty());
+        let mut extra = pairs.clone();
+        extra.push(("LUCENT_NOT_A_PERMUTATION", "1"));
+        match shaders.compile(&name, &extra) {
+            Err(LucentError::ShaderNotShipped { permutation }) => {
+                assert!(
+                    permutation.starts_with(&name)
+                        && permutation.contains("LUCENT_NOT_A_PERMUTATION=1")
+                );
+            }
+            other => panic!("expected ShaderNotShipped, got {other:?}"),
+        }
+        assert!(matches!(
+            shaders.compile("../x.frag", &[]),
+            Err(LucentError::InvalidInput(_))
+        ));
     }
 
     #[test]
@@ -977,7 +628,9 @@ mod tests {
         if std::env::var_os("LUCENT_CACHE_DIR").is_none() {
             assert!(ShaderCompiler::default_cache_dir().ends_with("lucent"));
         }
-        // This test runs from target/<profile>/deps: the repository's tree is found above it.
+        // This test runs from target/<profile>/deps: the repository's tree is found above it
+        // (unless the target directory is elsewhere: then the source tree it was built from).
+        #[cfg(feature = "runtime-shaders")]
         if std::env::var_os("LUCENT_GLSL_DIR").is_none() {
             let found = ShaderCompiler::default_glsl_root().canonicalize().unwrap();
             let repo = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -986,25 +639,6 @@ mod tests {
                 .unwrap();
             assert_eq!(found, repo);
         }
-    }
-
-    #[test]
-    fn bad_paths_are_input_errors() {
-        let root = temp_dir("badpath");
-        let compiler = ShaderCompiler::new(&root, None).unwrap();
-        assert!(matches!(
-            compiler.compile("x.glsl", &[]),
-            Err(LucentError::InvalidInput(_))
-        ));
-        assert!(matches!(
-            compiler.compile("../x.frag", &[]),
-            Err(LucentError::InvalidInput(_))
-        ));
-        assert!(matches!(
-            compiler.compile("missing.frag", &[]),
-            Err(LucentError::File { .. })
-        ));
-        std::fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]

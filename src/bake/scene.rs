@@ -3,18 +3,33 @@
 //!
 //! [`prepare_thickness`] puts every translucent mesh's local thickness into its vertex colours:
 //! `thickness = "bake"` through the on-disk cache, thickness textures sampled at the vertices.
-//! [`load_scene_baked`] is the two steps together, with the default cache directory.
+//! [`load_scene_baked`] is the two steps together, with the default cache directory
+//! ([`default_thickness_cache_dir`]: per user, never the source tree); [`load_scene_baked_in`]
+//! with the directory the caller chooses (a host engine's own cache).
 
 use glam::Vec3;
 
 use crate::scene::{self, material, texture, Scene};
 
+/// The thickness bake cache used when the caller names none: `thickness` in
+/// [`crate::backend::shader::ShaderCompiler::default_cache_dir`].
+pub fn default_thickness_cache_dir() -> std::path::PathBuf {
+    crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness")
+}
+
 /// Loads a scene by built-in name or `.toml` path ([`scene::load_scene`]) and prepares its
-/// thickness ([`prepare_thickness`]) with the bake cache under the default cache directory.
+/// thickness ([`prepare_thickness`]) with the bake cache in [`default_thickness_cache_dir`].
 pub fn load_scene_baked(name_or_path: &str) -> crate::Result<Scene> {
+    load_scene_baked_in(name_or_path, &default_thickness_cache_dir())
+}
+
+/// [`load_scene_baked`] with the bake cache in `cache_dir` (created on first use).
+pub fn load_scene_baked_in(
+    name_or_path: &str,
+    cache_dir: &std::path::Path,
+) -> crate::Result<Scene> {
     let mut scene = scene::load_scene(name_or_path)?;
-    let cache = crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness");
-    prepare_thickness(&mut scene, &cache)?;
+    prepare_thickness(&mut scene, cache_dir)?;
     Ok(scene)
 }
 

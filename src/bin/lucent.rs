@@ -632,10 +632,8 @@ impl Session {
     fn new(args: &GpuArgs) -> Result<Self> {
         let gpu = GpuContext::new(&ContextDesc::from_env(args.validation, args.device.clone()))?;
         log::info!("device: {} ({})", gpu.info.describe(), gpu.info.driver());
-        let shaders = ShaderCompiler::new(
-            ShaderCompiler::default_glsl_root(),
-            Some(ShaderCompiler::default_cache_dir()),
-        )?;
+        // The SPIR-V compiled with the crate (the demo compiles at run time, for hot reload).
+        let shaders = ShaderCompiler::shipped()?;
         let pipeline_cache = PipelineCache::load_default(&gpu)?;
         Ok(Self {
             gpu,

@@ -124,6 +124,10 @@ pub fn run(options: DemoOptions) -> Result<()> {
         ShaderCompiler::default_glsl_root(),
         Some(ShaderCompiler::default_cache_dir()),
     )?;
+    // Run-time compilation (not the shipped SPIR-V): edited shaders reload while the demo runs.
+    let glsl_root = shaders.glsl_root().ok_or_else(|| {
+        crate::LucentError::InvalidInput("hot reload needs a run-time shader compiler".into())
+    })?;
     let pipeline_cache = PipelineCache::load_default(&gpu)?;
     // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
     // the timing columns line up.
@@ -150,7 +154,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
         gpu: &gpu,
         shaders: &shaders,
         pipeline_cache: &pipeline_cache,
-        watcher: ShaderWatcher::new(shaders.glsl_root()),
+        watcher: ShaderWatcher::new(glsl_root),
         text,
         technique,
         debug_view: None,

@@ -207,7 +207,8 @@ pub struct EmbedOptions {
     /// The host's `gpu-allocator` (the same version: [`gpu_allocator`] is re-exported),
     /// shared for every buffer and image lucent creates. `None`: lucent's own allocator.
     pub allocator: Option<Arc<Mutex<Allocator>>>,
-    /// Where lucent keeps what it caches between runs (the thickness bake, compiled shaders):
+    /// Where lucent keeps what it caches between runs (the thickness bake; shaders come
+    /// compiled with the crate):
     /// a directory the host chooses. `None`: the platform's per-user cache
     /// ([`ShaderCompiler::default_cache_dir`]: `$LUCENT_CACHE_DIR`, else e.g.
     /// `~/.cache/lucent`), never the source tree.
@@ -269,10 +270,8 @@ impl Lucent {
         let cache_dir = options
             .cache_dir
             .unwrap_or_else(ShaderCompiler::default_cache_dir);
-        let shaders = ShaderCompiler::new(
-            ShaderCompiler::default_glsl_root(),
-            Some(cache_dir.join("spirv")),
-        )?;
+        // The SPIR-V built with the crate: no `glsl/`, no shaderc at run time.
+        let shaders = ShaderCompiler::shipped()?;
         let (pipeline_cache, owns_pipeline_cache) = match options.pipeline_cache {
             Some(handle) if handle != vk::PipelineCache::null() => {
                 (PipelineCache::borrowed(handle), false)

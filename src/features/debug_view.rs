@@ -135,6 +135,58 @@ pub fn debug_view_pass(
     Some(ldr)
 }
 
+/// The debug view's fragment shader.
+const VIEW_FRAGMENT: &str = "debug/view.frag";
+
+/// What the debug view samples besides its source.
+#[derive(Clone, Copy, Debug)]
+enum ViewInputs {
+    /// The source alone.
+    One,
+    /// A second image (the pre-blur specular).
+    Second,
+    /// The translucency term's GB1, GB2, depth and material table.
+    Term,
+}
+
+/// The debug view's defines: the view, what it samples, GB2's packing and the output encoding.
+fn view_defines(
+    view: DebugView,
+    inputs: ViewInputs,
+    colored: bool,
+    linear: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut defines = vec![(view.define(), "1")];
+    match inputs {
+        ViewInputs::Term => defines.push(("LUCENT_POW_MODES", "3")),
+        ViewInputs::Second => defines.push(("LUCENT_VIEW_SECOND", "1")),
+        ViewInputs::One => {}
+    }
+    if colored {
+        defines.push(("LUCENT_COLORED_THICKNESS", "1"));
+    }
+    if linear {
+        defines.push(("LUCENT_OUTPUT_LINEAR", "1"));
+    }
+    defines
+}
+
+/// The pipelines the debug view of any frame builds.
+pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+    for &(_, view) in DebugView::ALL {
+        for inputs in [ViewInputs::One, ViewInputs::Second, ViewInputs::Term] {
+            for colored in [false, true] {
+                for linear in [false, true] {
+                    out.push(super::shipped::PipelineShaders::fullscreen(
+                        VIEW_FRAGMENT,
+                        &view_defines(view, inputs, colored, linear),
+                    ));
+                }
+            }
+        }
+    }
+}
+
 struct DebugViewPass {
     scene: Arc<SceneGpu>,
     view: DebugView,
@@ -159,12 +211,11 @@ impl PassExec for DebugViewPass {
             ),
             Binding::Sampled(ctx.views[self.inputs.0], self.sampler),
         ];
-        let mut defines = vec![(self.view.define(), "1")];
         let has_table = self
             .scene
             .per_frame
             .has(crate::gpu_scene::Region::Translucency);
-        match (self.inputs.1, self.term, has_table) {
+        let inputs = match (self.inputs.1, self.term, has_table) {
             (Some(gb1), Some((gb2, depth)), true) => {
                 for id in [gb1, gb2] {
                     bindings.push(Binding::Sampled(ctx.views[id], self.sampler));
@@ -175,24 +226,19 @@ impl PassExec for DebugViewPass {
                         .per_frame
                         .binding(crate::gpu_scene::Region::Translucency),
                 ));
-                defines.push(("LUCENT_POW_MODES", "3"));
+                ViewInputs::Term
             }
             (Some(second), _, _) => {
                 bindings.push(Binding::Sampled(ctx.views[second], self.sampler));
-                defines.push(("LUCENT_VIEW_SECOND", "1"));
+                ViewInputs::Second
             }
-            _ => {}
-        }
-        if self.colored {
-            defines.push(("LUCENT_COLORED_THICKNESS", "1"));
-        }
-        if self.linear {
-            defines.push(("LUCENT_OUTPUT_LINEAR", "1"));
-        }
+            _ => ViewInputs::One,
+        };
+        let defines = view_defines(self.view, inputs, self.colored, self.linear);
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &bindings,
-            &GraphicsPipelineDesc::fullscreen("debug/view.frag", &defines, "debug view"),
+            &GraphicsPipelineDesc::fullscreen(VIEW_FRAGMENT, &defines, "debug view"),
         )?);
         Ok(())
     }

@@ -22,10 +22,11 @@ use crate::graph::{
 use crate::Result;
 
 use super::shadows::{self, ShadowMaps};
+use super::shipped::PipelineShaders;
 use super::translucency::ThicknessPacking;
 use super::util::{
-    clamp_sampler, Binding, DescriptorSet, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
-    VertexInput,
+    check_bindings, clamp_sampler, Binding, Defines, DescriptorSet, GraphicsPipeline,
+    GraphicsPipelineDesc, PassPipeline, VertexInput,
 };
 use crate::gpu_scene::{Region, SceneGpu};
 
@@ -232,7 +233,7 @@ impl GBufferLayout {
     /// G-buffer pass defines: the features, each extra target's location, and the binding of
     /// each material texture (set 0: 0 the frame uniforms, then normal or LEAN map 1, LEAN
     /// map 2, albedo map, those the frame has).
-    fn gbuffer_defines(&self) -> Vec<(&'static str, &'static str)> {
+    pub(crate) fn gbuffer_defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut defines = self.defines();
         if self.sss {
             defines.push(("LUCENT_SSS_PROFILE", "1"));
@@ -269,7 +270,7 @@ impl GBufferLayout {
 
     /// Shader defines selecting the translucency code, its packing, pow forms and material
     /// lookup (nothing for frames without translucency).
-    fn defines(&self) -> Vec<(&'static str, &'static str)> {
+    pub(crate) fn defines(&self) -> Vec<(&'static str, &'static str)> {
         let Some(t) = self.translucency else {
             return Vec::new();
         };
@@ -486,6 +487,123 @@ pub fn lighting_pass(
     }
 }
 
+/// The G-buffer pass's shaders.
+const GBUFFER_VERTEX: &str = "deferred/gbuffer.vert";
+const GBUFFER_FRAGMENT: &str = "deferred/gbuffer.frag";
+/// The lighting pass's fragment shader.
+const LIGHTING_FRAGMENT: &str = "deferred/lighting.frag";
+
+/// The lighting pass's descriptor bindings before the shadow bindings
+/// (glsl/deferred/lighting.frag): 0-3 always, 4 (GB2) and 5 (material table) with translucency.
+fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
+    4 + 2 * usize::from(layout.translucency.is_some())
+}
+
+/// The lighting pass's defines: the plain shader's, and with translucency the extra ones of the
+/// translucent variant (drawn on the tiles translucent objects may cover). `shadows`: some
+/// light casts shadows, `Some(true)` when the atlas stores translucency IDs.
+pub(crate) fn lighting_defines(
+    layout: &GBufferLayout,
+    shadows: Option<bool>,
+) -> (Defines, Option<Defines>) {
+    let mut plain: Vec<(&'static str, &'static str)> = Vec::new();
+    if shadows.is_some() {
+        plain.extend(shadows::lighting_defines(lighting_bindings_before_shadows(
+            layout,
+        )));
+    }
+    if layout.sss {
+        plain.push(("LUCENT_SPLIT_SPECULAR", "1"));
+    }
+    if layout.lean {
+        plain.push(("LUCENT_LEAN", "1"));
+    }
+    if layout.depth_in_alpha {
+        plain.push(("LUCENT_DEPTH_IN_ALPHA", "1"));
+    }
+    if layout.fault_injection {
+        plain.push(("LUCENT_FAULT_INJECTION", "1"));
+    }
+    let translucent = layout.translucency.map(|_| {
+        // The plain variant's defines (split specular, LEAN slope) plus the translucency's.
+        let mut extra = layout.defines();
+        if shadows == Some(true) {
+            // Only the translucent variant shades transmission: only it reads the IDs.
+            extra.push(("LUCENT_SHADOW_IDS", "1"));
+        }
+        extra
+    });
+    (plain, translucent)
+}
+
+/// Every G-buffer layout that differs in a way a shader sees (precision and the LEAN clear
+/// only change formats and load ops): translucency off or each packing, pow-form set and
+/// material lookup, and every combination of the other features that
+/// [`crate::frame::FrameDesc::gbuffer_layout`] can give.
+pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
+    let mut translucency = vec![None];
+    for packing in [ThicknessPacking::Grayscale, ThicknessPacking::Colored] {
+        for pow_modes in [1, 2, 3] {
+            for single_material in [false, true] {
+                translucency.push(Some(TranslucencyLayout {
+                    packing,
+                    pow_modes,
+                    single_material,
+                }));
+            }
+        }
+    }
+    let mut layouts = Vec::new();
+    for &translucency in &translucency {
+        for flags in 0u32..1 << 7 {
+            let bit = |i: u32| flags & (1 << i) != 0;
+            // LEAN and depth-in-alpha are properties of SSS chains
+            // (`FrameDesc::gbuffer_layout`): a frame without SSS has neither.
+            if !bit(0) && (bit(1) || bit(4)) {
+                continue;
+            }
+            for layer_depth_textures in 0..=2 {
+                layouts.push(GBufferLayout {
+                    precision: GBufferPrecision::Compact,
+                    translucency,
+                    sss: bit(0),
+                    lean: bit(1),
+                    lean_clear: false,
+                    normal_maps: bit(2),
+                    albedo_maps: bit(3),
+                    depth_in_alpha: bit(4),
+                    layered: bit(5),
+                    layer_depth_textures,
+                    fault_injection: bit(6),
+                });
+            }
+        }
+    }
+    layouts
+}
+
+/// The pipelines the G-buffer and lighting passes of any frame build.
+pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
+    for layout in all_layouts() {
+        out.push(PipelineShaders::new(
+            GBUFFER_VERTEX,
+            GBUFFER_FRAGMENT,
+            &layout.gbuffer_defines(),
+        ));
+        for shadows in [None, Some(false), Some(true)] {
+            let (plain, translucent) = lighting_defines(&layout, shadows);
+            let fullscreen =
+                |defines: &[(&str, &str)]| PipelineShaders::fullscreen(LIGHTING_FRAGMENT, defines);
+            out.push(fullscreen(&plain));
+            if let Some(extra) = translucent {
+                let mut all = plain.clone();
+                all.extend(extra);
+                out.push(fullscreen(&all));
+            }
+        }
+    }
+}
+
 struct GBufferPass {
     scene: Arc<SceneGpu>,
     layout: GBufferLayout,
@@ -534,8 +652,8 @@ impl PassExec for GBufferPass {
             ctx,
             &self.bindings(0),
             &GraphicsPipelineDesc {
-                vertex: "deferred/gbuffer.vert",
-                fragment: "deferred/gbuffer.frag",
+                vertex: GBUFFER_VERTEX,
+                fragment: GBUFFER_FRAGMENT,
                 defines: &self.layout.gbuffer_defines(),
                 vertex_input: VertexInput::Mesh {
                     thickness: self.layout.translucency.is_some(),
@@ -655,12 +773,16 @@ impl PassExec for LightingPass {
                 self.scene.per_frame.binding(Region::Translucency),
             ));
         }
-        let mut plain_defines: Vec<(&str, &str)> = Vec::new();
-        let mut shadow_ids = false;
+        let shadow_ids = inputs.shadow_depth.map(|_| inputs.shadow_ids.is_some());
+        let (plain_defines, translucent_defines) = lighting_defines(&self.layout, shadow_ids);
         if let Some(depth) = inputs.shadow_depth {
             self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
             // The shadow table, then the atlases (glsl/common/shadows.glsl).
-            plain_defines.extend(shadows::lighting_defines(bindings.len()));
+            check_bindings(
+                "lighting",
+                bindings.len(),
+                lighting_bindings_before_shadows(&self.layout),
+            )?;
             bindings.extend(shadows::lighting_bindings(
                 &self.scene,
                 depth,
@@ -668,30 +790,10 @@ impl PassExec for LightingPass {
                 views,
                 self.sampler,
             ));
-            shadow_ids = inputs.shadow_ids.is_some();
         }
-        if self.layout.sss {
-            plain_defines.push(("LUCENT_SPLIT_SPECULAR", "1"));
-        }
-        if self.layout.lean {
-            plain_defines.push(("LUCENT_LEAN", "1"));
-        }
-        if self.layout.depth_in_alpha {
-            plain_defines.push(("LUCENT_DEPTH_IN_ALPHA", "1"));
-        }
-        if self.layout.fault_injection {
-            plain_defines.push(("LUCENT_FAULT_INJECTION", "1"));
-        }
-        let plain =
-            GraphicsPipelineDesc::fullscreen("deferred/lighting.frag", &plain_defines, "lighting");
+        let plain = GraphicsPipelineDesc::fullscreen(LIGHTING_FRAGMENT, &plain_defines, "lighting");
         let mut pipeline = PassPipeline::new(ctx, &bindings, &plain)?;
-        if self.layout.translucency.is_some() {
-            // The plain variant's defines (split specular, LEAN slope) plus the translucency's.
-            let mut extra = self.layout.defines();
-            if shadow_ids {
-                // Only the translucent variant shades transmission: only it reads the IDs.
-                extra.push(("LUCENT_SHADOW_IDS", "1"));
-            }
+        if let Some(extra) = translucent_defines {
             let (plain_pipeline, translucent) =
                 pipeline.with_variant(ctx, &plain, &extra, "lighting (translucent)")?;
             pipeline = plain_pipeline;

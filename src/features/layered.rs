@@ -43,7 +43,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::shadows::{self, ShadowMaps};
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use super::util::{check_bindings, clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::{Region, SceneGpu};
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
@@ -530,6 +530,104 @@ impl LayeredPass {
     }
 }
 
+impl Kind {
+    const ALL: [Kind; 4] = [
+        Kind::Irradiance,
+        Kind::Single,
+        Kind::Multiple,
+        Kind::HalfGather,
+    ];
+
+    fn fragment(self) -> &'static str {
+        match self {
+            Kind::Irradiance => "layered/irradiance.frag",
+            Kind::Single => "layered/single.frag",
+            Kind::Multiple | Kind::HalfGather => "layered/multiple.frag",
+        }
+    }
+}
+
+/// What a layered pass's shader permutation depends on: its kind and which inputs it reads.
+#[derive(Clone, Copy, Debug)]
+struct LayeredShape {
+    kind: Kind,
+    /// The pass runs at half resolution (scale 2).
+    half_res: bool,
+    irradiance: bool,
+    half_term: bool,
+    /// The G-buffer's `TexDep` texels, of this many depth textures.
+    layer_depths: Option<usize>,
+    shadows: bool,
+    entry: bool,
+    entry_depths: bool,
+}
+
+impl LayeredShape {
+    /// The defines, with the bindings number before the shadow bindings (glsl/common/layered.glsl:
+    /// 0 frame, 1 layered table, 2 depth, 3 GB1, 4 IDs, then the pass's own in this order).
+    fn defines(&self) -> (Vec<(&'static str, &'static str)>, usize) {
+        let mut defines: Vec<(&str, &str)> = Vec::new();
+        let mut next = 5;
+        let single = self.kind == Kind::Single;
+        next += usize::from(self.irradiance);
+        if single && self.half_term {
+            defines.push(("LUCENT_HALF_TERM_BINDING", NUMBERS[next]));
+            next += 1;
+        }
+        let texdep = single && self.layer_depths.is_some();
+        if let (true, Some(textures)) = (texdep, self.layer_depths) {
+            defines.push((
+                "LUCENT_LAYER_DEPTHS",
+                super::deferred::layer_depths_define(textures),
+            ));
+            defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[next]));
+            next += 1;
+        }
+        if self.shadows && matches!(self.kind, Kind::Irradiance | Kind::Single) {
+            if single && self.entry {
+                defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[next]));
+                next += 1;
+                if texdep && self.entry_depths {
+                    defines.push(("LUCENT_ENTRY_DEPTH_BINDING", NUMBERS[next]));
+                    next += 1;
+                }
+            }
+            defines.extend(shadows::lighting_defines(next));
+        }
+        match (self.kind, self.half_res) {
+            (Kind::Irradiance, true) => defines.push(("LUCENT_HALF_RES", "1")),
+            (Kind::HalfGather, _) => defines.push(("LUCENT_HALF_GATHER", "1")),
+            _ => {}
+        }
+        (defines, next)
+    }
+}
+
+/// The pipelines the layered passes of any frame build: every kind with every set of inputs.
+pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+    for kind in Kind::ALL {
+        for flags in 0u32..1 << 6 {
+            let bit = |i: u32| flags & (1 << i) != 0;
+            for layer_depths in [None, Some(1), Some(2)] {
+                let shape = LayeredShape {
+                    kind,
+                    half_res: bit(0),
+                    irradiance: bit(1),
+                    half_term: bit(2),
+                    layer_depths,
+                    shadows: bit(3),
+                    entry: bit(4),
+                    entry_depths: bit(5),
+                };
+                out.push(super::shipped::PipelineShaders::fullscreen(
+                    kind.fragment(),
+                    &shape.defines().0,
+                ));
+            }
+        }
+    }
+}
+
 /// Binding numbers as define strings.
 const NUMBERS: [&str; 12] = ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11"];
 
@@ -547,35 +645,37 @@ impl PassExec for LayeredPass {
             Binding::Sampled(views[i.gb1], self.nearest),
             Binding::Sampled(views[i.ids], self.nearest),
         ];
-        let mut defines: Vec<(&str, &str)> = Vec::new();
+        let shape = LayeredShape {
+            kind: self.kind,
+            half_res: self.scale == 2,
+            irradiance: i.irradiance.is_some(),
+            half_term: i.half_term.is_some(),
+            layer_depths: i.layer_depths.map(|_| i.layer_depth_textures),
+            shadows: i.shadow_depth.is_some(),
+            entry: i.entry.is_some(),
+            entry_depths: i.entry_depths.is_some(),
+        };
+        let (defines, before_shadows) = shape.defines();
         if let Some(irradiance) = i.irradiance {
             bindings.push(Binding::Sampled(views[irradiance], self.nearest));
         }
         if let (Kind::Single, Some(half_term)) = (self.kind, i.half_term) {
-            defines.push(("LUCENT_HALF_TERM_BINDING", NUMBERS[bindings.len()]));
             bindings.push(Binding::Sampled(views[half_term], self.nearest));
         }
         // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
         // first layer's, semi-infinite, as in the paper).
         let texdep = self.kind == Kind::Single && i.layer_depths.is_some();
         if let (true, Some(depths)) = (texdep, i.layer_depths) {
-            defines.push((
-                "LUCENT_LAYER_DEPTHS",
-                super::deferred::layer_depths_define(i.layer_depth_textures),
-            ));
-            defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[bindings.len()]));
             bindings.push(Binding::Sampled(views[depths], self.nearest));
         }
         if let (Some(depth), Kind::Irradiance | Kind::Single) = (i.shadow_depth, self.kind) {
             if let (Kind::Single, Some(entry)) = (self.kind, i.entry) {
-                defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[bindings.len()]));
                 bindings.push(Binding::Sampled(views[entry], self.nearest));
                 if let (true, Some(depths)) = (texdep, i.entry_depths) {
-                    defines.push(("LUCENT_ENTRY_DEPTH_BINDING", NUMBERS[bindings.len()]));
                     bindings.push(Binding::Sampled(views[depths], self.nearest));
                 }
             }
-            defines.extend(shadows::lighting_defines(bindings.len()));
+            check_bindings("layered", bindings.len(), before_shadows)?;
             bindings.extend(shadows::lighting_bindings(
                 &self.scene,
                 depth,
@@ -584,15 +684,11 @@ impl PassExec for LayeredPass {
                 self.nearest,
             ));
         }
-        match (self.kind, self.scale) {
-            (Kind::Irradiance, 2) => defines.push(("LUCENT_HALF_RES", "1")),
-            (Kind::HalfGather, _) => defines.push(("LUCENT_HALF_GATHER", "1")),
-            _ => {}
-        }
-        let (fragment, name) = match self.kind {
-            Kind::Irradiance => ("layered/irradiance.frag", "layered irradiance"),
-            Kind::Single => ("layered/single.frag", "single scattering"),
-            Kind::Multiple | Kind::HalfGather => ("layered/multiple.frag", "multiple scattering"),
+        let fragment = self.kind.fragment();
+        let name = match self.kind {
+            Kind::Irradiance => "layered irradiance",
+            Kind::Single => "single scattering",
+            Kind::Multiple | Kind::HalfGather => "multiple scattering",
         };
         // The irradiance and the half-resolution term are written; the others add.
         let additive = match self.kind {

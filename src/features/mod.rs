@@ -14,11 +14,13 @@
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
+//! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 
 pub mod debug_view;
 pub mod deferred;
 pub mod layered;
 pub mod shadows;
+pub mod shipped;
 pub mod sss;
 pub mod tonemap;
 pub mod translucency;

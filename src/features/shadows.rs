@@ -432,33 +432,17 @@ impl ShadowPass {
 
 impl PassExec for ShadowPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let mut defines: Vec<(&str, &str)> = Vec::new();
-        if self.desc.transmission_ids {
-            defines.push(("LUCENT_SHADOW_IDS", "1"));
-        }
-        if self.desc.entry {
-            defines.push(("LUCENT_SHADOW_ENTRY", "1"));
-            defines.push((
-                "LUCENT_ENTRY_LOCATION",
-                if self.desc.transmission_ids { "1" } else { "0" },
-            ));
-        }
-        if self.layer_depths() {
-            defines.push((
-                "LUCENT_LAYER_DEPTHS",
-                super::deferred::layer_depths_define(self.desc.layer_depth_textures),
-            ));
-            defines.push((
-                "LUCENT_LAYER_DEPTH_LOCATION",
-                if self.desc.transmission_ids { "2" } else { "1" },
-            ));
-        }
+        let defines = shadow_map_defines(
+            self.desc.transmission_ids,
+            self.desc.entry,
+            self.desc.layer_depth_textures,
+        );
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &self.bindings(0),
             &GraphicsPipelineDesc {
-                vertex: "shadow/depth.vert",
-                fragment: "shadow/depth.frag",
+                vertex: SHADOW_VERTEX,
+                fragment: SHADOW_FRAGMENT,
                 defines: &defines,
                 // The entry target needs the normals.
                 vertex_input: if self.desc.entry {
@@ -577,6 +561,51 @@ impl PassExec for ShadowPass {
         }
         for mut set in self.depth_sets.drain(..) {
             set.destroy(&gpu.device);
+        }
+    }
+}
+
+/// The light-space maps pass's shaders.
+const SHADOW_VERTEX: &str = "shadow/depth.vert";
+const SHADOW_FRAGMENT: &str = "shadow/depth.frag";
+
+/// The light-space maps pass's defines: the translucency ID target (`ids`), the entry target
+/// (`entry`: frames with layered media) and, with `entry`, the `TexDep` texels of
+/// `layer_depth_textures` depth textures (0: none).
+pub(crate) fn shadow_map_defines(
+    ids: bool,
+    entry: bool,
+    layer_depth_textures: usize,
+) -> Vec<(&'static str, &'static str)> {
+    let mut defines: Vec<(&str, &str)> = Vec::new();
+    if ids {
+        defines.push(("LUCENT_SHADOW_IDS", "1"));
+    }
+    if entry {
+        defines.push(("LUCENT_SHADOW_ENTRY", "1"));
+        defines.push(("LUCENT_ENTRY_LOCATION", if ids { "1" } else { "0" }));
+    }
+    if entry && layer_depth_textures > 0 {
+        defines.push((
+            "LUCENT_LAYER_DEPTHS",
+            super::deferred::layer_depths_define(layer_depth_textures),
+        ));
+        defines.push(("LUCENT_LAYER_DEPTH_LOCATION", if ids { "2" } else { "1" }));
+    }
+    defines
+}
+
+/// The pipelines the light-space maps pass of any frame builds.
+pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+    for ids in [false, true] {
+        for entry in [false, true] {
+            for textures in 0..=2 {
+                out.push(super::shipped::PipelineShaders::new(
+                    SHADOW_VERTEX,
+                    SHADOW_FRAGMENT,
+                    &shadow_map_defines(ids, entry, textures),
+                ));
+            }
         }
     }
 }

@@ -56,6 +56,28 @@ pub fn tonemap_pass(
     display
 }
 
+/// The tonemap's fragment shader.
+const TONEMAP_FRAGMENT: &str = "post/tonemap.frag";
+
+/// The tonemap's defines: `linear` for sRGB and float targets (the hardware or nobody encodes).
+fn tonemap_defines(linear: bool) -> &'static [(&'static str, &'static str)] {
+    if linear {
+        &[("LUCENT_OUTPUT_LINEAR", "1")]
+    } else {
+        &[]
+    }
+}
+
+/// The pipelines the tonemap of any frame builds.
+pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+    for linear in [false, true] {
+        out.push(super::shipped::PipelineShaders::fullscreen(
+            TONEMAP_FRAGMENT,
+            tonemap_defines(linear),
+        ));
+    }
+}
+
 struct TonemapPass {
     scene: Arc<SceneGpu>,
     input: ResourceId,
@@ -79,12 +101,8 @@ impl PassExec for TonemapPass {
                 Binding::Sampled(ctx.views[self.input], self.sampler),
             ],
             &GraphicsPipelineDesc::fullscreen(
-                "post/tonemap.frag",
-                if self.linear {
-                    &[("LUCENT_OUTPUT_LINEAR", "1")]
-                } else {
-                    &[]
-                },
+                TONEMAP_FRAGMENT,
+                tonemap_defines(self.linear),
                 "tonemap",
             ),
         )?);

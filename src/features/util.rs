@@ -20,6 +20,22 @@ pub fn clamp_sampler(ctx: &PrepareContext<'_>, filter: vk::Filter) -> Result<vk:
     unsafe { ctx.gpu.device.create_sampler(&info, None) }.vk("vkCreateSampler")
 }
 
+/// A pass's shader defines, `("NAME", "VALUE")` (see [`crate::features::shipped`]).
+pub type Defines = Vec<(&'static str, &'static str)>;
+
+/// Checks that a pass built the descriptor bindings its shader permutation numbers from:
+/// binding numbers in defines come from the pass's shape ([`crate::features::shipped`] lists
+/// every permutation), so `built` (the bindings made) must be `expected` (what the defines say).
+pub fn check_bindings(pass: &str, built: usize, expected: usize) -> Result<()> {
+    if built == expected {
+        return Ok(());
+    }
+    Err(crate::LucentError::Graph(format!(
+        "pass '{pass}': {built} descriptor bindings before the next group, but its shader \
+         permutation numbers them from {expected} (the pass's bindings and its defines disagree)"
+    )))
+}
+
 /// What one descriptor binding points at.
 pub enum Binding {
     /// A uniform buffer (whole range).

@@ -31,7 +31,7 @@ use std::collections::HashSet;
 use ash::vk;
 use serde::Serialize;
 
-use crate::backend::format::{format_info, format_name, FormatKind};
+use crate::backend::format::{format_info, format_name};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::util::{
@@ -200,7 +200,7 @@ impl CopyFrame {
                 let info = ImageInfo {
                     width: read.width,
                     height: read.height,
-                    format: read.format,
+                    format: copy_format(read.format),
                 };
                 let mut image = graph.create_image(&format!("floor {f} in {k}"), info);
                 let mut fill = graph.add_pass(&format!("fill floor {f} in {k}"), PassKind::Raster);
@@ -223,7 +223,7 @@ impl CopyFrame {
                         ImageInfo {
                             width,
                             height,
-                            format,
+                            format: copy_format(format),
                         },
                     )
                 })
@@ -251,12 +251,7 @@ impl CopyFrame {
             pass.taps(inputs.len() as u32).side_effects();
             pass.execute(CopyPass {
                 inputs: inputs.iter().map(|h| h.id()).collect(),
-                input_kinds: floor.reads.iter().map(|r| shader_kind(r.format)).collect(),
-                output_kinds: floor
-                    .colour_writes
-                    .iter()
-                    .map(|&f| shader_kind(f))
-                    .collect(),
+                outputs: floor.colour_writes.len(),
                 depth: depth.is_some(),
                 sampler: vk::Sampler::null(),
                 pipeline: None,
@@ -476,23 +471,64 @@ impl PassExec for FillPass {
     fn destroy(&mut self, _gpu: &GpuContext) {}
 }
 
-/// How `glsl/bench/copy.frag` reads or writes an image of `format` (its `LUCENT_COPY_*_KIND`):
-/// 0 as floats, 1 as unsigned integers, 2 as signed integers. The one format table decides.
-fn shader_kind(format: vk::Format) -> u8 {
-    match format_info(format).map(|f| f.kind) {
-        Some(FormatKind::Uint) => 1,
-        Some(FormatKind::Sint) => 2,
-        _ => 0,
+/// The format the copy frame gives an image that the pass reads or writes as `format`: the
+/// format itself, or for an integer format the float format of the same texel size. A texel
+/// fetch moves the same bytes, and `glsl/bench/copy.frag` then reads and writes floats only, so
+/// its permutations are the image counts alone (reading an integer image through a float
+/// sampler would be undefined: VUID-vkCmdDraw-format-07753). The one format table decides.
+fn copy_format(format: vk::Format) -> vk::Format {
+    match format_info(format) {
+        Some(info) if info.kind.is_integer() => match info.bytes {
+            1 => vk::Format::R8_UNORM,
+            2 => vk::Format::R16_SFLOAT,
+            4 => vk::Format::R32_SFLOAT,
+            8 => vk::Format::R32G32_SFLOAT,
+            _ => vk::Format::R32G32B32A32_SFLOAT,
+        },
+        _ => format,
+    }
+}
+
+/// The copy's fragment shader.
+const COPY_FRAGMENT: &str = "bench/copy.frag";
+
+/// Image counts as define strings (at most [`MAX_COPY_INPUTS`]).
+const COUNTS: [&str; MAX_COPY_INPUTS + 1] =
+    ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10"];
+
+/// The copy's defines: images read, colour images written, and whether it writes depth.
+fn copy_defines(inputs: usize, outputs: usize, depth: bool) -> Vec<(&'static str, &'static str)> {
+    let count = |n: usize| COUNTS[n.min(MAX_COPY_INPUTS)];
+    let mut defines = vec![
+        ("LUCENT_COPY_INPUTS", count(inputs)),
+        ("LUCENT_COPY_OUTPUTS", count(outputs)),
+    ];
+    if depth {
+        defines.push(("LUCENT_COPY_DEPTH", "1"));
+    }
+    defines
+}
+
+/// The pipelines the copies of any plan's passes build ([`PassFloor::unsupported`] leaves out
+/// passes with more images than the copy has).
+pub(crate) fn shader_permutations(out: &mut Vec<crate::features::shipped::PipelineShaders>) {
+    for inputs in 0..=MAX_COPY_INPUTS {
+        for outputs in 0..=MAX_COPY_IMAGES {
+            for depth in [false, true] {
+                out.push(crate::features::shipped::PipelineShaders::fullscreen(
+                    COPY_FRAGMENT,
+                    &copy_defines(inputs, outputs, depth),
+                ));
+            }
+        }
     }
 }
 
 /// `glsl/bench/copy.frag` over the whole render area.
 struct CopyPass {
     inputs: Vec<ResourceId>,
-    /// [`shader_kind`] of each input.
-    input_kinds: Vec<u8>,
-    /// [`shader_kind`] of each colour output.
-    output_kinds: Vec<u8>,
+    /// Colour images written.
+    outputs: usize,
     depth: bool,
     sampler: vk::Sampler,
     /// With inputs: pipeline and descriptor set.
@@ -503,31 +539,10 @@ struct CopyPass {
 
 impl PassExec for CopyPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let inputs = self.inputs.len().to_string();
-        let outputs = self.output_kinds.len().to_string();
-        // Integer images are read with integer samplers and written as integer vectors.
-        let kinds: Vec<(String, String)> = (self.input_kinds.iter().enumerate())
-            .map(|(k, kind)| (format!("LUCENT_COPY_IN{k}_KIND"), kind))
-            .chain(
-                self.output_kinds
-                    .iter()
-                    .enumerate()
-                    .map(|(k, kind)| (format!("LUCENT_COPY_OUT{k}_KIND"), kind)),
-            )
-            .filter(|(_, &kind)| kind != 0)
-            .map(|(name, kind)| (name, kind.to_string()))
-            .collect();
-        let mut defines = vec![
-            ("LUCENT_COPY_INPUTS", inputs.as_str()),
-            ("LUCENT_COPY_OUTPUTS", outputs.as_str()),
-        ];
-        defines.extend(kinds.iter().map(|(n, v)| (n.as_str(), v.as_str())));
-        if self.depth {
-            defines.push(("LUCENT_COPY_DEPTH", "1"));
-        }
+        let defines = copy_defines(self.inputs.len(), self.outputs, self.depth);
         let desc = GraphicsPipelineDesc {
             depth_test: self.depth,
-            ..GraphicsPipelineDesc::fullscreen("bench/copy.frag", &defines, "speed-of-light copy")
+            ..GraphicsPipelineDesc::fullscreen(COPY_FRAGMENT, &defines, "speed-of-light copy")
         };
         if self.inputs.is_empty() {
             self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);
@@ -655,10 +670,18 @@ mod tests {
             .filter(|f| f.colour_writes.contains(&packed))
             .count();
         assert!(reads_packed > 0 && writes_packed > 0, "{floors:?}");
-        assert_eq!(shader_kind(packed), 1);
-        assert_eq!(shader_kind(vk::Format::R32G32B32A32_SINT), 2);
-        assert_eq!(shader_kind(vk::Format::R16G16B16A16_SFLOAT), 0);
-        assert_eq!(shader_kind(vk::Format::D32_SFLOAT), 0);
+        // The copy moves the same bytes through a float format.
+        assert_eq!(copy_format(packed), vk::Format::R32G32B32A32_SFLOAT);
+        assert_eq!(copy_format(vk::Format::R8_UINT), vk::Format::R8_UNORM);
+        assert_eq!(
+            copy_format(vk::Format::R32G32_SINT),
+            vk::Format::R32G32_SFLOAT
+        );
+        assert_eq!(
+            copy_format(vk::Format::R16G16B16A16_SFLOAT),
+            vk::Format::R16G16B16A16_SFLOAT
+        );
+        assert_eq!(copy_format(vk::Format::D32_SFLOAT), vk::Format::D32_SFLOAT);
     }
 
     #[test]

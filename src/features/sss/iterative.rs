@@ -12,7 +12,10 @@ use super::{
     SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
 use crate::features::deferred::HDR_FORMAT;
-use crate::features::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use crate::features::shipped::PipelineShaders;
+use crate::features::util::{
+    check_bindings, clamp_sampler, Binding, Defines, GraphicsPipelineDesc, PassPipeline,
+};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
@@ -44,7 +47,7 @@ pub(super) fn chain_passes(
         _ => None,
     };
     let targets = if lean.is_some() { 2 } else { 1 };
-    let packed = lean.is_some() && blur.bilateral() && knobs.packed;
+    let packed = packed_pingpong(blur, lean.is_some(), knobs.packed);
     let names = ["", ".lean"];
     // The ping-pong targets: one packed RGBA32UI texel, or one RGBA16F per blurred texel.
     let (pingpong, pingpong_info) = if packed {
@@ -175,7 +178,7 @@ pub(super) fn chain_passes(
         )
     });
     let (name, fragment) = match lean {
-        None => ("combine", "sss/combine.frag"),
+        None => ("combine", COMBINE_FRAGMENT),
         Some(_) => ("final lighting", LEAN_FINAL_SHADER),
     };
     let mut pass = graph.add_pass(&format!("{}{name}", chain.prefix), PassKind::Raster);
@@ -211,6 +214,120 @@ pub(super) fn chain_passes(
         None => pass.finish(),
     }
     hdr
+}
+
+/// The iterative blur's fragment shader.
+const BLUR_FRAGMENT: &str = "sss/blur.frag";
+/// The control chain's final pass.
+const COMBINE_FRAGMENT: &str = "sss/combine.frag";
+
+/// Whether a chain's ping-pong targets are one packed RGBA32UI texel: LBB with the LEAN
+/// target, when the `packed` knob asks.
+fn packed_pingpong(blur: SssBlur, lean: bool, packed: bool) -> bool {
+    lean && blur.bilateral() && packed
+}
+
+/// The iterative blur pass's defines: the chain's blur, bilateral `taps` per direction,
+/// profile edges, LBB's packed input and output, and whether it accumulates into the sums.
+fn blur_defines(
+    blur: SssBlur,
+    taps: u32,
+    edges: bool,
+    packed_in: bool,
+    packed_out: bool,
+    accumulate: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut defines: Vec<(&str, &str)> = Vec::new();
+    if blur.bilateral() {
+        defines.push((
+            "LUCENT_SSS_HALF_TAPS",
+            match taps {
+                3 => "1",
+                5 => "2",
+                _ => "3",
+            },
+        ));
+    }
+    if blur.lean() {
+        defines.push(("LUCENT_SSS_LEAN", "1"));
+    }
+    if blur.bilateral() {
+        defines.push(("LUCENT_SSS_BILATERAL", "1"));
+    }
+    if edges {
+        defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
+    }
+    if packed_in {
+        defines.push(("LUCENT_SSS_PACKED_IN", "1"));
+    }
+    if packed_out {
+        defines.push(("LUCENT_SSS_PACKED_OUT", "1"));
+    }
+    if accumulate {
+        defines.push(("LUCENT_SSS_ACCUMULATE", "1"));
+    }
+    defines
+}
+
+/// The final pass's bindings before the shadow bindings: the per-frame pair, the sums (two
+/// with LEAN), diffuse, specular, profile IDs, with LEAN depth, GB0 and GB1, and the previous
+/// chain's result (`base`).
+fn final_bindings(lean: bool, base: bool) -> usize {
+    let sums = if lean { 2 } else { 1 };
+    2 + sums + 3 + 3 * usize::from(lean) + usize::from(base)
+}
+
+/// The final pass's defines (`lean`: LEAN `final lighting`, else `combine`), and with LEAN the
+/// pass-through variant's extra define. `shadows`: LEAN specular reads the light-space maps.
+fn final_defines(lean: bool, base: bool, shadows: bool) -> (Defines, Option<Defines>) {
+    let mut defines: Vec<(&str, &str)> = Vec::new();
+    if base {
+        defines.push(("LUCENT_SSS_BASE", "1"));
+    }
+    if shadows {
+        defines.extend(crate::features::shadows::lighting_defines(final_bindings(
+            lean, base,
+        )));
+    }
+    (defines, lean.then(|| vec![("LUCENT_SSS_PASSTHROUGH", "1")]))
+}
+
+/// The pipelines the iterative chains of any frame build.
+pub(super) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
+    for &(_, blur) in SssBlur::ALL {
+        for taps in [3, 5, 7] {
+            for flags in 0u32..1 << 5 {
+                let bit = |i: u32| flags & (1 << i) != 0;
+                let (edges, accumulate) = (bit(0), bit(1));
+                // The LEAN target is there (blur.lean()) or not; the packed knob.
+                let packed = packed_pingpong(blur, blur.lean() && bit(2), bit(3));
+                // A packed chain's first horizontal pass reads the unpacked light.
+                let packed_in = packed && bit(4);
+                out.push(PipelineShaders::fullscreen(
+                    BLUR_FRAGMENT,
+                    &blur_defines(blur, taps, edges, packed_in, packed, accumulate),
+                ));
+            }
+        }
+    }
+    for lean in [false, true] {
+        let fragment = if lean {
+            LEAN_FINAL_SHADER
+        } else {
+            COMBINE_FRAGMENT
+        };
+        for base in [false, true] {
+            for shadows in [false, true] {
+                let (defines, passthrough) = final_defines(lean, base, shadows);
+                out.push(PipelineShaders::fullscreen(fragment, &defines));
+                if let Some(extra) = passthrough {
+                    let mut all = defines.clone();
+                    all.extend(extra);
+                    out.push(PipelineShaders::fullscreen(fragment, &all));
+                }
+            }
+        }
+    }
 }
 
 struct BlurPass {
@@ -260,35 +377,14 @@ impl PassExec for BlurPass {
         if let Some(&lean) = self.colors.get(1) {
             bindings.push(Binding::Sampled(views[lean], color_sampler));
         }
-        let mut defines: Vec<(&str, &str)> = Vec::new();
-        if self.blur.bilateral() {
-            defines.push((
-                "LUCENT_SSS_HALF_TAPS",
-                match self.taps {
-                    3 => "1",
-                    5 => "2",
-                    _ => "3",
-                },
-            ));
-        }
-        if self.blur.lean() {
-            defines.push(("LUCENT_SSS_LEAN", "1"));
-        }
-        if self.blur.bilateral() {
-            defines.push(("LUCENT_SSS_BILATERAL", "1"));
-        }
-        if self.edges {
-            defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
-        }
-        if self.packed_in {
-            defines.push(("LUCENT_SSS_PACKED_IN", "1"));
-        }
-        if self.packed_out {
-            defines.push(("LUCENT_SSS_PACKED_OUT", "1"));
-        }
-        if self.sums > 0 {
-            defines.push(("LUCENT_SSS_ACCUMULATE", "1"));
-        }
+        let defines = blur_defines(
+            self.blur,
+            self.taps,
+            self.edges,
+            self.packed_in,
+            self.packed_out,
+            self.sums > 0,
+        );
         // The sums follow the results (one packed attachment, or one per blurred texel).
         let results = match (self.packed_out, self.blur.lean()) {
             (true, _) | (false, false) => 1,
@@ -301,7 +397,7 @@ impl PassExec for BlurPass {
             &GraphicsPipelineDesc {
                 additive_attachments: additive,
                 push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-                ..GraphicsPipelineDesc::fullscreen("sss/blur.frag", &defines, "sss blur")
+                ..GraphicsPipelineDesc::fullscreen(BLUR_FRAGMENT, &defines, "sss blur")
             },
         )?);
         Ok(())
@@ -370,12 +466,14 @@ impl PassExec for FinalPass {
                 .iter()
                 .map(|&id| Binding::Sampled(views[id], self.sampler)),
         );
-        let mut defines: Vec<(&str, &str)> = Vec::new();
-        if self.base {
-            defines.push(("LUCENT_SSS_BASE", "1"));
-        }
+        let lean = self.fragment == LEAN_FINAL_SHADER;
+        let (defines, passthrough) = final_defines(lean, self.base, self.shadow_depth.is_some());
         if let Some(depth) = self.shadow_depth {
-            defines.extend(crate::features::shadows::lighting_defines(bindings.len()));
+            check_bindings(
+                self.fragment,
+                bindings.len(),
+                final_bindings(lean, self.base),
+            )?;
             bindings.extend(crate::features::shadows::lighting_bindings(
                 &self.scene,
                 depth,
@@ -389,13 +487,9 @@ impl PassExec for FinalPass {
             ..GraphicsPipelineDesc::fullscreen(self.fragment, &defines, self.fragment)
         };
         let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
-        if self.fragment == LEAN_FINAL_SHADER {
-            let (lean, passthrough) = pipeline.with_variant(
-                ctx,
-                &desc,
-                &[("LUCENT_SSS_PASSTHROUGH", "1")],
-                "final lighting (pass-through)",
-            )?;
+        if let Some(extra) = passthrough {
+            let (lean, passthrough) =
+                pipeline.with_variant(ctx, &desc, &extra, "final lighting (pass-through)")?;
             pipeline = lean;
             self.passthrough = Some(passthrough);
         }

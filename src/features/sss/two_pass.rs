@@ -16,8 +16,10 @@ use super::{
     SssKnobs,
 };
 use crate::features::deferred::HDR_FORMAT;
+use crate::features::shipped::PipelineShaders;
 use crate::features::util::{
-    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
+    check_bindings, clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc,
+    PassPipeline,
 };
 use crate::gpu_scene::{Region, SceneGpu, TileRect};
 use crate::graph::{
@@ -221,6 +223,46 @@ struct PassSpec {
 }
 
 impl PassSpec {
+    /// What its shader permutation depends on.
+    fn shape(&self) -> PassShape {
+        PassShape {
+            bilateral: self.blur == SssBlur::Bilateral,
+            vertical: self.vertical,
+            compose: self.compose,
+            half_res: self.half_res,
+            base: self.base,
+            edges: self.edges,
+            depth_in_alpha: self.depth_in_alpha,
+            point_taps: self.point_taps,
+            samples: self.samples,
+            inputs: self.inputs.len(),
+        }
+    }
+
+    /// Whether the pass reads the kernel table (binding 2): all of them.
+    fn kernels(&self) -> bool {
+        true
+    }
+}
+
+/// The fields of a [`PassSpec`] its shader permutation depends on.
+#[derive(Clone, Copy, Debug)]
+struct PassShape {
+    /// The bilateral blur (else separable).
+    bilateral: bool,
+    vertical: bool,
+    compose: bool,
+    half_res: bool,
+    base: bool,
+    edges: bool,
+    depth_in_alpha: bool,
+    point_taps: bool,
+    samples: u32,
+    /// Images sampled (after the per-frame bindings and the kernel table).
+    inputs: usize,
+}
+
+impl PassShape {
     /// The upsample pass of a half-resolution chain.
     fn upsample(&self) -> bool {
         self.half_res && self.compose
@@ -234,16 +276,21 @@ impl PassSpec {
         }
     }
 
-    fn defines(&self) -> Vec<(&'static str, &'static str)> {
+    /// Bindings before the shadow bindings: the per-frame pair, the kernel table, the inputs.
+    fn bindings(&self) -> usize {
+        3 + self.inputs
+    }
+
+    /// The defines (`shadows`: the bilateral vertical pass's LEAN specular reads the
+    /// light-space maps), and for composing passes the pass-through variant's extra define.
+    fn defines(&self, shadows: bool) -> (Defines, Option<Defines>) {
         let mut defines: Vec<(&str, &str)> = Vec::new();
         if self.upsample() {
             if self.base {
                 defines.push(("LUCENT_SSS_BASE", "1"));
             }
-            return defines;
-        }
-        match self.blur {
-            SssBlur::Bilateral => {
+        } else {
+            if self.bilateral {
                 defines.push(("LUCENT_SSS_BILATERAL2", "1"));
                 defines.push((
                     "LUCENT_SSS_SAMPLES",
@@ -253,35 +300,68 @@ impl PassSpec {
                         _ => "17",
                     },
                 ));
-            }
-            _ => {
+            } else {
                 defines.push(("LUCENT_SSS_SEPARABLE", "1"));
                 if self.point_taps {
                     defines.push(("LUCENT_SSS_POINT_TAPS", "1"));
                 }
             }
+            if self.vertical {
+                defines.push(("LUCENT_SSS_VERTICAL", "1"));
+            }
+            if self.half_res {
+                defines.push(("LUCENT_SSS_HALF_RES", "1"));
+            }
+            if self.depth_in_alpha && !self.vertical {
+                defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
+            }
+            if self.edges {
+                defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
+            }
+            if self.base {
+                defines.push(("LUCENT_SSS_BASE", "1"));
+            }
         }
-        if self.vertical {
-            defines.push(("LUCENT_SSS_VERTICAL", "1"));
+        if shadows {
+            defines.extend(crate::features::shadows::lighting_defines(self.bindings()));
         }
-        if self.half_res {
-            defines.push(("LUCENT_SSS_HALF_RES", "1"));
-        }
-        if self.depth_in_alpha && !self.vertical {
-            defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
-        }
-        if self.edges {
-            defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
-        }
-        if self.base {
-            defines.push(("LUCENT_SSS_BASE", "1"));
-        }
-        defines
+        (
+            defines,
+            self.compose.then(|| vec![("LUCENT_SSS_PASSTHROUGH", "1")]),
+        )
     }
+}
 
-    /// Whether the pass reads the kernel table (binding 2): all of them.
-    fn kernels(&self) -> bool {
-        true
+/// The pipelines the two-pass chains of any frame build. Only the shadowed pass (the
+/// bilateral chain's full-resolution vertical pass with LEAN) numbers bindings after its
+/// inputs: temp, depth, profile IDs, the LEAN temp, diffuse, specular, GB0, GB1 and the
+/// previous chain's result (`base`), as `chain_passes` reads them.
+pub(super) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
+    for flags in 0u32..1 << 8 {
+        let bit = |i: u32| flags & (1 << i) != 0;
+        for samples in [11, 17, 25] {
+            let shape = PassShape {
+                bilateral: bit(0),
+                vertical: bit(1),
+                compose: bit(2),
+                half_res: bit(3),
+                base: bit(4),
+                edges: bit(5),
+                depth_in_alpha: bit(6),
+                point_taps: bit(7),
+                samples,
+                inputs: 8 + usize::from(bit(4)),
+            };
+            for shadows in [false, true] {
+                let (defines, passthrough) = shape.defines(shadows);
+                out.push(PipelineShaders::fullscreen(shape.fragment(), &defines));
+                if let Some(extra) = passthrough {
+                    let mut all = defines.clone();
+                    all.extend(extra);
+                    out.push(PipelineShaders::fullscreen(shape.fragment(), &all));
+                }
+            }
+        }
     }
 }
 
@@ -342,9 +422,13 @@ impl PassExec for TwoPassBlur {
             };
             bindings.push(Binding::Sampled(views[id], sampler));
         }
-        let mut defines = self.spec.defines();
+        let (defines, passthrough) = self.spec.shape().defines(self.spec.shadow_depth.is_some());
         if let Some(depth) = self.spec.shadow_depth {
-            defines.extend(crate::features::shadows::lighting_defines(bindings.len()));
+            check_bindings(
+                "sss two-pass blur",
+                bindings.len(),
+                self.spec.shape().bindings(),
+            )?;
             bindings.extend(crate::features::shadows::lighting_bindings(
                 &self.scene,
                 depth,
@@ -355,16 +439,16 @@ impl PassExec for TwoPassBlur {
         }
         let desc = GraphicsPipelineDesc {
             push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-            ..GraphicsPipelineDesc::fullscreen(self.spec.fragment(), &defines, "sss two-pass blur")
+            ..GraphicsPipelineDesc::fullscreen(
+                self.spec.shape().fragment(),
+                &defines,
+                "sss two-pass blur",
+            )
         };
         let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
-        if self.spec.compose {
-            let (blur, passthrough) = pipeline.with_variant(
-                ctx,
-                &desc,
-                &[("LUCENT_SSS_PASSTHROUGH", "1")],
-                "sss two-pass blur (pass-through)",
-            )?;
+        if let Some(extra) = passthrough {
+            let (blur, passthrough) =
+                pipeline.with_variant(ctx, &desc, &extra, "sss two-pass blur (pass-through)")?;
             pipeline = blur;
             self.passthrough = Some(passthrough);
         }
@@ -381,7 +465,7 @@ impl PassExec for TwoPassBlur {
         let tiles = chain_tiles(&self.scene, ctx, self.spec.chain);
         // Half-resolution passes (all but the upsample) draw halved rectangles.
         let scaled = |rects: Vec<TileRect>| {
-            if self.spec.half_res && !self.spec.upsample() {
+            if self.spec.half_res && !self.spec.shape().upsample() {
                 rects.iter().map(halved).collect()
             } else {
                 rects

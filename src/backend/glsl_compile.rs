@@ -1,0 +1,224 @@
+//! GLSL to SPIR-V with shaderc, as both the run-time compiler ([`super::shader::ShaderCompiler`]
+//! with the `runtime-shaders` feature) and `build.rs` (the shipped bundle) run it: the same
+//! options and the same `#include` lookup, so the shipped SPIR-V is what a run-time compile of
+//! the same sources gives.
+//!
+//! `build.rs` includes this file (`#[path]`) next to [`super::shader_files`]; it depends on
+//! `std`, shaderc and that module only.
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Component, Path, PathBuf};
+
+use super::shader_files::{normalize_relative, path_to_name};
+
+/// Everything besides the inputs that changes the SPIR-V; part of every run-time cache key.
+/// Change it when an option of [`compile_glsl`] changes, so old cache entries stop matching. (A
+/// newer system shaderc does not invalidate entries: their SPIR-V stays valid, only possibly
+/// less optimised.)
+pub const COMPILER_SETTINGS: &str =
+    "lucent-spirv-cache-v1;shaderc-rs-0.10;glsl;vulkan1.3;spirv1.6;opt=performance;debug-info=off";
+
+/// Largest GLSL source or include read.
+pub const MAX_SOURCE_BYTES: u64 = 4 << 20;
+
+/// Deepest `#include` nesting accepted; deeper is taken to be an include cycle.
+const MAX_INCLUDE_DEPTH: usize = 32;
+
+/// What one compile produced.
+pub struct GlslOutput {
+    /// SPIR-V words.
+    pub spirv: Vec<u32>,
+    /// Every file read, main file first, each once: its name (relative to the root, or
+    /// absolute outside it) and its content.
+    pub files: Vec<(String, String)>,
+    /// shaderc's warnings (empty when none).
+    pub warnings: String,
+}
+
+/// Reads a GLSL file: UTF-8, at most [`MAX_SOURCE_BYTES`], without NUL bytes.
+pub fn read_source(file: &Path) -> Result<String, String> {
+    let size = std::fs::metadata(file).map_err(|e| e.to_string())?.len();
+    if size > MAX_SOURCE_BYTES {
+        return Err(format!(
+            "GLSL source of {size} bytes, more than the {MAX_SOURCE_BYTES} accepted"
+        ));
+    }
+    let bytes = std::fs::read(file).map_err(|e| e.to_string())?;
+    let text = String::from_utf8(bytes).map_err(|_| "not UTF-8 text".to_string())?;
+    if text.contains('\0') {
+        return Err("GLSL source contains a NUL byte".to_string());
+    }
+    Ok(text)
+}
+
+/// Compiles `source` (the file `name` under `root`) for `kind` with `defines` through glslang
+/// and spirv-opt. The error is shaderc's `file:line: error: ...` text, with the defines after
+/// it when there are any.
+pub fn compile_glsl(
+    compiler: &shaderc::Compiler,
+    root: &Path,
+    name: &str,
+    kind: shaderc::ShaderKind,
+    defines: &BTreeMap<&str, &str>,
+    source: &str,
+) -> Result<GlslOutput, String> {
+    let files = RefCell::new(vec![(name.to_string(), source.to_string())]);
+    let mut options = shaderc::CompileOptions::new()
+        .map_err(|e| format!("shaderc compile options could not be created: {e}"))?;
+    options.set_source_language(shaderc::SourceLanguage::GLSL);
+    options.set_target_env(
+        shaderc::TargetEnv::Vulkan,
+        shaderc::EnvVersion::Vulkan1_3 as u32,
+    );
+    options.set_target_spirv(shaderc::SpirvVersion::V1_6);
+    options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+    for (define, value) in defines {
+        options.add_macro_definition(define, Some(value));
+    }
+    options.set_include_callback(|requested, include_type, requester, depth| {
+        if depth > MAX_INCLUDE_DEPTH {
+            return Err(format!(
+                "#include nesting deeper than {MAX_INCLUDE_DEPTH} (an include cycle without a guard?)"
+            ));
+        }
+        let (resolved_name, content) = resolve_include(root, requested, include_type, requester)?;
+        let mut files = files.borrow_mut();
+        if !files.iter().any(|(n, _)| *n == resolved_name) {
+            files.push((resolved_name.clone(), content.clone()));
+        }
+        Ok(shaderc::ResolvedInclude {
+            resolved_name,
+            content,
+        })
+    });
+    let artifact = compiler
+        .compile_into_spirv(source, kind, name, "main", Some(&options))
+        .map_err(|e| {
+            let mut message = match e {
+                shaderc::Error::CompilationError(_, text) => text.trim_end().to_string(),
+                other => other.to_string(),
+            };
+            if !defines.is_empty() {
+                message.push_str(&format!("\n(defines: {})", format_defines(defines)));
+            }
+            message
+        })?;
+    let warnings = if artifact.get_num_warnings() > 0 {
+        artifact.get_warning_messages().trim_end().to_string()
+    } else {
+        String::new()
+    };
+    let spirv = artifact.as_binary().to_vec();
+    drop(options);
+    Ok(GlslOutput {
+        spirv,
+        files: files.into_inner(),
+        warnings,
+    })
+}
+
+/// `NAME=VALUE` pairs separated by spaces, for messages.
+pub fn format_defines(defines: &BTreeMap<&str, &str>) -> String {
+    defines
+        .iter()
+        .map(|(name, value)| format!("{name}={value}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Lexically normalises an absolute path.
+pub fn normalize_absolute(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for component in path.components() {
+        match component {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+/// Candidate name for `requested` seen from `base_dir` (a name relative to the root, or absolute):
+/// relative to the root when it stays inside it, else absolute.
+pub fn candidate_name(root: &Path, base_dir: &Path, requested: &str) -> String {
+    let joined = base_dir.join(requested);
+    if joined.is_absolute() {
+        let absolute = normalize_absolute(&joined);
+        return match absolute.strip_prefix(root) {
+            Ok(inside) => path_to_name(inside),
+            Err(_) => absolute.to_string_lossy().into_owned(),
+        };
+    }
+    match normalize_relative(&joined) {
+        Some(inside) => path_to_name(&inside),
+        None => path_to_name(&normalize_absolute(&root.join(joined))),
+    }
+}
+
+/// The include callback's lookup: `#include "x"` next to the including file first, then (and for
+/// `#include <x>` only) under the GLSL root. Returns the file's name and content.
+fn resolve_include(
+    root: &Path,
+    requested: &str,
+    include_type: shaderc::IncludeType,
+    requester: &str,
+) -> Result<(String, String), String> {
+    let mut candidates = Vec::with_capacity(2);
+    if include_type == shaderc::IncludeType::Relative {
+        let requester_dir = Path::new(requester).parent().unwrap_or(Path::new(""));
+        candidates.push(candidate_name(root, requester_dir, requested));
+    }
+    let from_root = candidate_name(root, Path::new(""), requested);
+    if !candidates.contains(&from_root) {
+        candidates.push(from_root);
+    }
+    for name in &candidates {
+        let file = root.join(name);
+        if file.exists() {
+            let content = read_source(&file)
+                .map_err(|e| format!("cannot read include {}: {e}", file.display()))?;
+            return Ok((name.clone(), content));
+        }
+    }
+    // shaderc retries a failed `#include "x"` as `#include <x>`, so this message (root only) is
+    // the one users see for both forms; it names both places.
+    let next_to = Path::new(requester)
+        .parent()
+        .map(path_to_name)
+        .filter(|dir| !dir.is_empty())
+        .unwrap_or_else(|| ".".to_string());
+    Err(format!(
+        "include \"{requested}\" not found: #include \"...\" looks next to the including file \
+         (in {next_to}/), then under the GLSL root {} (as {})",
+        root.display(),
+        candidate_name(root, Path::new(""), requested)
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn include_names_are_normalised() {
+        let root = Path::new("/r");
+        assert_eq!(
+            candidate_name(root, Path::new("smoke"), "../common/x.glsl"),
+            "common/x.glsl"
+        );
+        assert_eq!(
+            candidate_name(root, Path::new("smoke"), "./x.glsl"),
+            "smoke/x.glsl"
+        );
+        assert_eq!(candidate_name(root, Path::new(""), "x.glsl"), "x.glsl");
+        assert_eq!(candidate_name(root, Path::new(""), "../x.glsl"), "/x.glsl");
+        assert_eq!(
+            candidate_name(root, Path::new("/r/a"), "b.glsl"),
+            "a/b.glsl"
+        );
+    }
+}

@@ -1,0 +1,118 @@
+//! The closed set of shader permutations lucent's frames compile, which `build.rs` ships as
+//! SPIR-V ([`crate::backend::shader::ShaderCompiler::shipped`]).
+//!
+//! A build script cannot call the library, so the set is written down: [`permutations`]
+//! enumerates every (shader, defines) pair any pass of any frame may ask for, and
+//! `glsl/permutations.txt` holds its [`manifest`] text, which `build.rs` compiles. The test
+//! `tests/shipped_shaders.rs` fails when the committed file differs from [`manifest`] and prints
+//! the command that regenerates it:
+//!
+//! ```text
+//! LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders
+//! ```
+//!
+//! Each pass builds its defines with a function of its shape (the G-buffer layout, which inputs
+//! it reads, its knobs), and that same function is what its module's `shader_permutations`
+//! calls over every shape the pass can have, so the two cannot drift apart. Binding numbers in
+//! defines are derived from the shape too; the pass checks, when it builds its descriptor set,
+//! that it made as many bindings as the defines number ([`super::util::check_bindings`]). The
+//! shapes enumerated are the whole input space of each function (every G-buffer layout flag,
+//! every knob value the defines distinguish), not only the scenes in the tests. Combinations
+//! one frame can never hold (LEAN without SSS, say) are included when the shader compiles them:
+//! a few extra permutations are cheaper than a proof that no frame reaches them.
+//!
+//! To add a permutation: change the pass's define function (and, for a new knob value or flag,
+//! the domain its `shader_permutations` walks), then regenerate the manifest with the command
+//! above. A new pass or shader: give its module a `shader_permutations` that calls the pass's
+//! define function over every shape it can have, add it to [`pipelines`], regenerate. A permutation the bundle lacks fails at pipeline creation with
+//! [`crate::LucentError::ShaderNotShipped`], which the test suite (shipped SPIR-V only) catches.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::util::GraphicsPipelineDesc;
+use crate::backend::shader::sorted_defines;
+use crate::{LucentError, Result};
+
+/// The shaders one pipeline compiles: its vertex and fragment shader, both with the same
+/// defines (as [`super::util::GraphicsPipeline::new`] compiles them).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PipelineShaders {
+    /// Vertex shader path under `glsl/`.
+    pub vertex: String,
+    /// Fragment shader path under `glsl/`.
+    pub fragment: String,
+    /// The defines, in the order the pass gives them.
+    pub defines: Vec<(String, String)>,
+}
+
+impl PipelineShaders {
+    /// A pipeline of `vertex` and `fragment` with `defines`.
+    pub fn new(vertex: &str, fragment: &str, defines: &[(&str, &str)]) -> Self {
+        Self {
+            vertex: vertex.to_string(),
+            fragment: fragment.to_string(),
+            defines: defines
+                .iter()
+                .map(|(n, v)| (n.to_string(), v.to_string()))
+                .collect(),
+        }
+    }
+
+    /// A fullscreen pass's pipeline ([`GraphicsPipelineDesc::fullscreen`]'s vertex shader).
+    pub fn fullscreen(fragment: &str, defines: &[(&str, &str)]) -> Self {
+        let desc = GraphicsPipelineDesc::fullscreen(fragment, defines, fragment);
+        Self::new(desc.vertex, desc.fragment, defines)
+    }
+}
+
+/// Every pipeline any frame (and the speed-of-light copies of its passes) may build, in the
+/// features' order, repeats included.
+pub fn pipelines() -> Vec<PipelineShaders> {
+    let mut out = Vec::new();
+    super::shadows::shader_permutations(&mut out);
+    super::deferred::shader_permutations(&mut out);
+    super::sss::shader_permutations(&mut out);
+    super::layered::shader_permutations(&mut out);
+    super::debug_view::shader_permutations(&mut out);
+    super::tonemap::shader_permutations(&mut out);
+    crate::measure::speed_of_light::shader_permutations(&mut out);
+    out
+}
+
+/// Every (shader path, defines) permutation of [`pipelines`], as permutation lines
+/// (`path NAME=VALUE ...`, defines sorted by name, a repeated name's last value kept: what
+/// [`crate::backend::shader::ShaderCompiler::compile`] looks up), sorted, each once.
+pub fn permutations() -> Result<Vec<String>> {
+    let mut lines = BTreeSet::new();
+    for pipeline in pipelines() {
+        let defines: Vec<(&str, &str)> = pipeline
+            .defines
+            .iter()
+            .map(|(n, v)| (n.as_str(), v.as_str()))
+            .collect();
+        for path in [&pipeline.vertex, &pipeline.fragment] {
+            let sorted: BTreeMap<&str, &str> = sorted_defines(path, &defines, true)?;
+            let name = crate::backend::shader::shader_name(path).ok_or_else(|| {
+                LucentError::InvalidInput(format!("shader {path}: not a relative path"))
+            })?;
+            lines.insert(crate::backend::shader::permutation_line(&name, sorted));
+        }
+    }
+    Ok(lines.into_iter().collect())
+}
+
+/// The text of `glsl/permutations.txt`: a header, then [`permutations`], one per line.
+pub fn manifest() -> Result<String> {
+    let mut text = format!(
+        "# Generated: every shader permutation lucent's frames compile \
+         (lucent::features::shipped).\n\
+         # build.rs compiles each line into the shipped SPIR-V bundle. Do not edit: \
+         regenerate with\n#   {}\n",
+        crate::backend::shader::MANIFEST_COMMAND
+    );
+    for line in permutations()? {
+        text.push_str(&line);
+        text.push('\n');
+    }
+    Ok(text)
+}

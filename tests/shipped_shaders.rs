@@ -1,0 +1,86 @@
+//! The shipped SPIR-V: `glsl/permutations.txt` is exactly what the features enumerate
+//! (`lucent::features::shipped`), the bundle build.rs compiled holds exactly that, and its SPIR-V
+//! is what the run-time compiler makes of the same sources.
+//!
+//! Regenerate the manifest after changing a pass's defines (or adding a shader):
+//!
+//! ```text
+//! LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders
+//! ```
+
+use std::path::Path;
+
+use lucent::backend::shader::{ShaderCompiler, MANIFEST_COMMAND};
+use lucent::features::shipped;
+
+fn manifest_path() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl/permutations.txt")
+}
+
+#[test]
+fn the_manifest_is_what_the_features_enumerate() {
+    let expected = shipped::manifest().unwrap();
+    let path = manifest_path();
+    if std::env::var_os("LUCENT_WRITE_MANIFEST").is_some() {
+        std::fs::write(&path, &expected).unwrap();
+        eprintln!(
+            "wrote {} ({} permutations); rebuild to ship them",
+            path.display(),
+            shipped::permutations().unwrap().len()
+        );
+        return;
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    if committed != expected {
+        let committed: std::collections::BTreeSet<&str> = committed.lines().collect();
+        let expected: std::collections::BTreeSet<&str> = expected.lines().collect();
+        let missing: Vec<&&str> = expected.difference(&committed).take(5).collect();
+        let extra: Vec<&&str> = committed.difference(&expected).take(5).collect();
+        panic!(
+            "glsl/permutations.txt is stale: {} permutations missing (first: {missing:?}), {} no \
+             longer built (first: {extra:?}); regenerate it with `{MANIFEST_COMMAND}`",
+            expected.difference(&committed).count(),
+            committed.difference(&expected).count(),
+        );
+    }
+}
+
+#[test]
+fn the_bundle_holds_the_manifest() {
+    let shipped = ShaderCompiler::shipped_permutations().unwrap();
+    let committed: Vec<String> = std::fs::read_to_string(manifest_path())
+        .unwrap()
+        .lines()
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(str::to_string)
+        .collect();
+    assert_eq!(
+        shipped, committed,
+        "the bundle was built from another manifest (cargo rebuilds it when glsl/ changes)"
+    );
+    assert!(!shipped.is_empty());
+}
+
+/// Every `step`-th permutation compiled at run time gives the shipped words: build.rs and the
+/// run-time compiler share their options and include lookup.
+#[cfg(feature = "runtime-shaders")]
+#[test]
+fn shipped_spirv_is_what_the_run_time_compiler_makes() {
+    let shipped = ShaderCompiler::shipped().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
+    let runtime = ShaderCompiler::new(&root, None).unwrap();
+    let lines = ShaderCompiler::shipped_permutations().unwrap();
+    let step = (lines.len() / 40).max(1);
+    for line in lines.iter().step_by(step) {
+        let mut parts = line.split(' ');
+        let path = parts.next().unwrap();
+        let defines: Vec<(&str, &str)> = parts.map(|p| p.split_once('=').unwrap()).collect();
+        let a = shipped.compile(path, &defines).unwrap();
+        let b = runtime.compile(path, &defines).unwrap();
+        assert!(
+            a.spirv == b.spirv,
+            "{line}: shipped and run-time SPIR-V differ"
+        );
+        assert_eq!(a.stage, b.stage);
+    }
+}

@@ -465,16 +465,13 @@ pub(crate) fn record_transition(
     from: &ImageState,
     to: &ImageState,
 ) {
-    let aspect = if is_depth(image.format) {
-        vk::ImageAspectFlags::DEPTH
-            | if has_stencil(image.format) {
-                vk::ImageAspectFlags::STENCIL
-            } else {
-                vk::ImageAspectFlags::empty()
-            }
-    } else {
-        vk::ImageAspectFlags::COLOR
-    };
+    // The aspect the graph's own barriers use for an image of this format.
+    let aspect = crate::graph::ImageInfo {
+        width: image.extent.width,
+        height: image.extent.height,
+        format: image.format,
+    }
+    .aspect();
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(from.stage)
         .src_access_mask(from.access)
@@ -497,15 +494,6 @@ pub(crate) fn record_transition(
     // SAFETY: `cmd` is recording (the caller's contract) and the image is the host's valid
     // image, whose declared states were checked by `check_image`.
     unsafe { gpu.device.cmd_pipeline_barrier2(cmd, &dependency) };
-}
-
-fn has_stencil(format: vk::Format) -> bool {
-    matches!(
-        format,
-        vk::Format::D24_UNORM_S8_UINT
-            | vk::Format::D32_SFLOAT_S8_UINT
-            | vk::Format::D16_UNORM_S8_UINT
-    )
 }
 
 #[cfg(test)]

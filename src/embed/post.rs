@@ -189,7 +189,7 @@ impl PostProcessSss {
             profiles,
             object_ids: Vec::new(),
         };
-        let two_pass = profiles.chains().iter().any(|b| !b.iterative());
+        let two_pass = profiles.two_pass();
         let no_objects = frame_scene(PLACEHOLDER_CAMERA);
         let upload = SceneUpload {
             translucency_ids: None,
@@ -382,7 +382,7 @@ impl PostProcessSss {
         let per_frame = &self.scene_gpu().per_frame;
         let table = self.profiles.table(&self.desc.knobs);
         per_frame.write(slot, Region::Profiles, bytemuck::bytes_of(&table))?;
-        if self.profiles.chains().iter().any(|b| !b.iterative()) {
+        if self.profiles.two_pass() {
             let knobs = &self.desc.knobs;
             let kernels = sss::kernel::kernel_table(&self.profiles, knobs.samples, knobs.shape);
             per_frame.write(slot, Region::Kernels, bytemuck::bytes_of(&kernels))?;

@@ -106,12 +106,7 @@ impl FrameDesc {
     /// Whether some SSS chain is a two-pass blur (separable or bilateral): the frame needs
     /// the kernel table those passes read their weights from.
     pub fn two_pass(&self) -> bool {
-        use crate::features::sss::SssBlur;
-        self.sss.as_ref().is_some_and(|s| {
-            s.chains()
-                .iter()
-                .any(|b| matches!(b, SssBlur::Separable | SssBlur::Bilateral))
-        })
+        self.sss.as_ref().is_some_and(|s| s.two_pass())
     }
 
     /// The G-buffer layout this description and `settings` call for.

@@ -128,6 +128,12 @@ impl SssProfiles {
             .unwrap_or(0)
     }
 
+    /// Whether some chain is a two-pass blur (separable or bilateral), whose passes read the
+    /// kernel table.
+    pub fn two_pass(&self) -> bool {
+        self.chains().iter().any(|b| !b.iterative())
+    }
+
     /// Whether some chain blurs the LEAN G-buffer.
     pub fn lean(&self) -> bool {
         self.profiles.iter().any(|(_, b)| b.lean())

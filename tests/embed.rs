@@ -816,7 +816,7 @@ fn host_built_scene() -> lucent::scene::Scene {
             near: 0.05,
             far: 50.0,
         },
-        ambient: Vec3::splat(0.03),
+        environment: lucent::scene::Environment::constant(Vec3::splat(0.03)),
         sky: Vec3::new(0.4, 0.5, 0.7),
         exposure: 1.0,
         deformation: None,

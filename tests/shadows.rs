@@ -53,7 +53,7 @@ fn occluder_scene(light: Light) -> Scene {
             near: 0.1,
             far: 50.0,
         },
-        ambient: Vec3::ZERO,
+        environment: lucent::scene::Environment::constant(Vec3::ZERO),
         sky: Vec3::splat(0.1),
         exposure: 1.0,
         deformation: None,

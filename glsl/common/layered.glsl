@@ -203,9 +203,9 @@ vec3 dipole_rd(int mat, float r) {
 // Fresnel transmittance of every light, shadowed where the light casts, and the ambient's
 // (transmitted_irradiance).
 vec3 transmitted_irradiance(vec3 p, vec3 n, float eta, float ambient_transmittance) {
-    // The ambient, a uniform radiance over the hemisphere: irradiance pi L_a, of which the
+    // The environment's irradiance at the normal, pi ambient_radiance(n), of which the
     // boundary lets 1 - F_dr through (unshadowed, as every pass's ambient).
-    vec3 e = frame.ambient.rgb * (PI * ambient_transmittance);
+    vec3 e = ambient_radiance(n) * (PI * ambient_transmittance);
     int count = min(frame.light_count.x, MAX_LIGHTS);
     for (int i = 0; i < count; ++i) {
         vec3 to_light;

@@ -20,7 +20,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     mat4 inv_view_proj;
     mat4 view;            // world to view space (right-handed, the camera looks down -z)
     vec4 camera_pos;      // xyz
-    vec4 ambient;         // rgb
+    vec4 ambient_sh[9];   // rgb: the environment's E(n) / pi as nine polynomial coefficients
     vec4 sky;             // rgb: colour of pixels no geometry covers
     vec4 viewport;        // xy: size in pixels, zw: 1 / size
     vec4 exposure;        // x: exposure multiplier applied before tonemapping
@@ -29,6 +29,21 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     ivec4 fault;          // robustness tests (LUCENT_FAULT_INJECTION): x, y pixel; z 1 NaN, 2 +Inf
     Light lights[MAX_LIGHTS];
 } frame;
+
+// The environment's diffuse light at unit normal n: E(n) / pi, the radiance a Lambertian
+// albedo multiplies (src/scene/environment.rs: nine SH coefficients with the clamped cosine
+// convolved in and the basis constants folded in). Clamped at 0: the series of a map with a
+// small bright sun rings below zero opposite it, and irradiance cannot be negative.
+vec3 ambient_radiance(vec3 n) {
+    vec3 e = frame.ambient_sh[0].rgb
+           + frame.ambient_sh[1].rgb * n.y + frame.ambient_sh[2].rgb * n.z
+           + frame.ambient_sh[3].rgb * n.x + frame.ambient_sh[4].rgb * (n.x * n.y)
+           + frame.ambient_sh[5].rgb * (n.y * n.z)
+           + frame.ambient_sh[6].rgb * (3.0 * n.z * n.z - 1.0)
+           + frame.ambient_sh[7].rgb * (n.x * n.z)
+           + frame.ambient_sh[8].rgb * (n.x * n.x - n.y * n.y);
+    return max(e, vec3(0.0));
+}
 
 // World position of the surface at window position `frag_coord` (gl_FragCoord.xy) with device
 // depth `device_depth`.

@@ -73,7 +73,7 @@ void main() {
     Surface s = unpack_gbuffer(subpassLoad(gb0), subpassLoad(gb1));
     vec3 pos = world_position(gl_FragCoord.xy, d);
     vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
-    vec3 color = frame.ambient.rgb * s.albedo;
+    vec3 color = ambient_radiance(s.normal) * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
 #ifdef LUCENT_TRANSLUCENCY
     // This variant runs only on tiles translucent objects may cover (the plain variant shades

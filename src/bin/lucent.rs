@@ -118,6 +118,24 @@ enum Command {
         #[command(flatten)]
         gpu: GpuArgs,
     },
+    /// The gallery: every showcase scene under its techniques, beside plain lighting and
+    /// their difference, as PNGs and an index.md with pixels changed and halos per scene.
+    Gallery {
+        /// Folder for the PNGs and index.md (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Resolution as WIDTHxHEIGHT.
+        #[arg(long, default_value = "640x480", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Only these scenes (repeatable; default: every showcase scene and `mixed`).
+        #[arg(long)]
+        scene: Vec<String>,
+        /// Anti-aliasing after the tonemap: `off` (default) or `fxaa`.
+        #[arg(long, default_value = "off")]
+        aa: String,
+        #[command(flatten)]
+        gpu: GpuArgs,
+    },
     /// Print the compiled render graph: passes, merged groups, barriers, lifetimes, memory.
     Plan {
         #[command(flatten)]
@@ -305,6 +323,35 @@ struct FrameArgs {
     /// (`dynamic`) is deformed at it; `bench` starts its animation there.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_time)]
     time: Option<f32>,
+    /// Light from the environment, replacing the scene's: `scene` (default: the scene's own),
+    /// `none`, `constant`, `hemisphere`, `sky` (the built-in procedural sky map) or the path of
+    /// an equirectangular map (HDR, EXR, PNG, ...), reduced to nine SH irradiance coefficients.
+    #[arg(long, default_value = "scene")]
+    environment: String,
+    /// Multiplies the environment's radiance (a finite number >= 0; default 1).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    environment_intensity: f32,
+    /// Anti-aliasing after the tonemap: `off` (default) or `fxaa`.
+    #[arg(long, default_value = "off")]
+    aa: String,
+}
+
+impl FrameArgs {
+    /// Loads the scene (thickness baked, cached), at `--time`, with `--environment`.
+    fn load_scene(&self) -> Result<scene::Scene> {
+        // Parsed first: a bad environment is refused before a bake.
+        let environment =
+            scene::environment::from_command_line(&self.environment, self.environment_intensity)?;
+        let mut scene = bake::load_scene_baked(&self.scene)?;
+        // Range-checked by the parser (finite).
+        scene.time = self.time.unwrap_or(0.0);
+        if let Some(environment) = environment {
+            scene.environment = environment;
+        } else if self.environment_intensity != 1.0 {
+            scene.environment = scene.environment.scaled(self.environment_intensity);
+        }
+        Ok(scene)
+    }
 }
 
 fn parse_time(text: &str) -> std::result::Result<f32, String> {
@@ -516,6 +563,8 @@ impl FrameArgs {
                 enabled: !self.no_shadows,
                 size: self.shadow_size.unwrap_or(ShadowSettings::default().size),
             },
+            antialias: lucent::features::antialias::Antialias::parse(&self.aa)?,
+            export_ldr: false,
             layered: {
                 let defaults = LayeredKnobs::default();
                 LayeredKnobs {
@@ -668,9 +717,7 @@ fn with_renderer(
     work: impl FnOnce(&Session, &Renderer, &scene::Scene) -> Result<()>,
 ) -> Result<()> {
     let settings = frame.settings(export_hdr)?;
-    let mut scene = bake::load_scene_baked(&frame.scene)?;
-    // Range-checked by the parser (finite).
-    scene.time = frame.time.unwrap_or(0.0);
+    let scene = frame.load_scene()?;
     frame.warn_inapplicable(&scene, &settings, &FrameDesc::new(&scene, &settings)?);
     // Texture headers first: one too large is refused before the device is even opened.
     scene::texture::scene_texture_sizes(&scene, None)?;
@@ -1349,6 +1396,47 @@ fn run(cli: Cli) -> Result<()> {
             device: gpu.device,
             base: FrameSettings::new(size.0, size.1),
         }),
+        Command::Gallery {
+            out,
+            size,
+            scene,
+            aa,
+            gpu,
+        } => {
+            let settings = FrameSettings {
+                antialias: lucent::features::antialias::Antialias::parse(&aa)?,
+                ..FrameSettings::new(size.0, size.1)
+            };
+            let scenes: Vec<&str> = if scene.is_empty() {
+                lucent::measure::gallery::GALLERY_SCENES
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect()
+            } else {
+                scene.iter().map(String::as_str).collect()
+            };
+            with_session(&gpu, |session| {
+                let entries = lucent::measure::gallery::gallery(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &scenes,
+                    settings,
+                    &out,
+                    |name| eprintln!("gallery: {name}"),
+                )?;
+                for e in &entries {
+                    println!(
+                        "{}: {:.1}% of pixels changed, {} halo pixels",
+                        e.scene,
+                        100.0 * e.look.changed,
+                        e.look.halo_pixels
+                    );
+                }
+                println!("wrote {}", out.join("index.md").display());
+                Ok(())
+            })
+        }
         Command::Plan { frame } => {
             let settings = frame.settings(false)?;
             let scene = bake::load_scene_baked(&frame.scene)?;

@@ -512,7 +512,7 @@ fn frame_scene(camera: Camera) -> Scene {
         objects: Vec::new(),
         lights: Vec::new(),
         camera,
-        ambient: glam::Vec3::ZERO,
+        environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
         sky: glam::Vec3::ZERO,
         exposure: 1.0,
         deformation: None,

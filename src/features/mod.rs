@@ -12,10 +12,12 @@
 //! - [`layered`]: Li et al. 2009's layered media: image-space single and dipole multiple
 //!   scattering.
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
+//! - [`antialias`]: FXAA after the tonemap (a knob, off by default).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 //! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 
+pub mod antialias;
 pub mod debug_view;
 pub mod deferred;
 pub mod layered;

@@ -75,6 +75,7 @@ pub fn pipelines() -> Vec<PipelineShaders> {
     super::layered::shader_permutations(&mut out);
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
+    super::antialias::shader_permutations(&mut out);
     crate::measure::speed_of_light::shader_permutations(&mut out);
     out
 }

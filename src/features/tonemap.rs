@@ -33,47 +33,84 @@ pub fn writes_linear(format: vk::Format) -> bool {
     })
 }
 
+/// What the tonemap writes into its image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Encoding {
+    /// sRGB-encoded colour (lucent's own display, a host's UNORM target).
+    Srgb,
+    /// Linear colour (sRGB and float targets: the hardware or nobody encodes).
+    Linear,
+    /// sRGB-encoded colour with its luma in alpha: the anti-aliasing pass's input.
+    SrgbLumaInAlpha,
+}
+
 /// Declares the tonemap pass: samples `hdr`, writes `display` (encoded for its format).
 pub fn tonemap_pass(
     graph: &mut RenderGraph,
     hdr: &Handle<Image>,
-    mut display: Handle<Image>,
+    display: Handle<Image>,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
-    let linear = writes_linear(graph.resources()[display.id()].info.format);
+    let encoding = if writes_linear(graph.resources()[display.id()].info.format) {
+        Encoding::Linear
+    } else {
+        Encoding::Srgb
+    };
+    declare(graph, hdr, display, encoding, scene)
+}
+
+/// Declares the tonemap of a frame with anti-aliasing: samples `hdr`, writes `ldr` (an
+/// [`LDR_FORMAT`] image) sRGB-encoded with the luma of each pixel in alpha, what
+/// [`super::antialias`] reads.
+pub fn tonemap_with_luma_pass(
+    graph: &mut RenderGraph,
+    hdr: &Handle<Image>,
+    ldr: Handle<Image>,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    declare(graph, hdr, ldr, Encoding::SrgbLumaInAlpha, scene)
+}
+
+fn declare(
+    graph: &mut RenderGraph,
+    hdr: &Handle<Image>,
+    mut output: Handle<Image>,
+    encoding: Encoding,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
     let mut pass = graph.add_pass("tonemap", PassKind::Raster);
-    pass.sample(hdr).color(&mut display, LoadOp::DontCare);
+    pass.sample(hdr).color(&mut output, LoadOp::DontCare);
     match scene {
         Some(scene) => pass.execute(TonemapPass {
             scene: scene.clone(),
             input: hdr.id(),
-            linear,
+            encoding,
             sampler: vk::Sampler::null(),
             pipeline: None,
         }),
         None => pass.finish(),
     }
-    display
+    output
 }
 
 /// The tonemap's fragment shader.
 const TONEMAP_FRAGMENT: &str = "post/tonemap.frag";
 
-/// The tonemap's defines: `linear` for sRGB and float targets (the hardware or nobody encodes).
-fn tonemap_defines(linear: bool) -> &'static [(&'static str, &'static str)] {
-    if linear {
-        &[("LUCENT_OUTPUT_LINEAR", "1")]
-    } else {
-        &[]
+/// The tonemap's defines for an encoding.
+fn tonemap_defines(encoding: Encoding) -> &'static [(&'static str, &'static str)] {
+    match encoding {
+        Encoding::Srgb => &[],
+        Encoding::Linear => &[("LUCENT_OUTPUT_LINEAR", "1")],
+        Encoding::SrgbLumaInAlpha => &[("LUCENT_LUMA_IN_ALPHA", "1")],
     }
 }
 
 /// The pipelines the tonemap of any frame builds.
 pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
-    for linear in [false, true] {
+    for encoding in [Encoding::Srgb, Encoding::Linear, Encoding::SrgbLumaInAlpha] {
         out.push(super::shipped::PipelineShaders::fullscreen(
             TONEMAP_FRAGMENT,
-            tonemap_defines(linear),
+            tonemap_defines(encoding),
         ));
     }
 }
@@ -81,8 +118,7 @@ pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>
 struct TonemapPass {
     scene: Arc<SceneGpu>,
     input: ResourceId,
-    /// Write linear values (sRGB or float targets).
-    linear: bool,
+    encoding: Encoding,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
 }
@@ -102,7 +138,7 @@ impl PassExec for TonemapPass {
             ],
             &GraphicsPipelineDesc::fullscreen(
                 TONEMAP_FRAGMENT,
-                tonemap_defines(self.linear),
+                tonemap_defines(self.encoding),
                 "tonemap",
             ),
         )?);

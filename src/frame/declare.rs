@@ -8,6 +8,7 @@ use ash::vk;
 
 use super::{FrameDesc, FrameSettings};
 use crate::backend::access::Access;
+use crate::features::antialias::{self, Antialias};
 use crate::features::debug_view;
 use crate::features::deferred::GBufferLayout;
 use crate::features::{deferred, layered, shadows, sss, tonemap};
@@ -48,6 +49,9 @@ pub struct FrameOutputs {
     pub gbuffer: Option<GBufferOutputs>,
     /// The lit diffuse and specular before the SSS blurs, when exported (frames with SSS).
     pub lit: Option<(ResourceId, ResourceId)>,
+    /// The tonemapped image the anti-aliasing reads (sRGB RGBA8, luma in alpha), when
+    /// exported (`export_ldr` in a frame with anti-aliasing).
+    pub ldr: Option<ResourceId>,
 }
 
 /// Declares every pass of a frame. `scene_gpu` is `None` for plan-only graphs.
@@ -142,11 +146,31 @@ pub fn declare_frame(
         ),
         _ => hdr,
     };
-    let display = match debug_display {
-        Some(display) => display,
-        None => {
+    let mut ldr_id = None;
+    let display = match (debug_display, settings.antialias) {
+        (Some(display), _) => display,
+        (None, Antialias::Off) => {
             let display = new_display(graph);
             tonemap::tonemap_pass(graph, &hdr, display, scene_gpu)
+        }
+        (None, Antialias::Fxaa) => {
+            // The tonemap writes an intermediate image (colour + luma) the FXAA pass samples
+            // around each pixel: a neighbourhood read, so the two stay separate passes.
+            let ldr = graph.create_image(
+                "ldr",
+                ImageInfo {
+                    width: settings.width,
+                    height: settings.height,
+                    format: tonemap::LDR_FORMAT,
+                },
+            );
+            let ldr = tonemap::tonemap_with_luma_pass(graph, &hdr, ldr, scene_gpu);
+            if settings.export_ldr {
+                graph.export_image(&ldr, Access::TransferRead);
+                ldr_id = Some(ldr.id());
+            }
+            let display = new_display(graph);
+            antialias::fxaa_pass(graph, &ldr, display, scene_gpu)
         }
     };
     graph.export_image(
@@ -183,6 +207,7 @@ pub fn declare_frame(
         target: settings.target.is_some(),
         hdr: hdr_id,
         lit: lit_ids,
+        ldr: ldr_id,
         gbuffer,
     }
 }

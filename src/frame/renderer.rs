@@ -331,6 +331,19 @@ impl Renderer {
         self.read_export(gpu, self.outputs.display)
     }
 
+    /// Reads the tonemapped image the anti-aliasing read in the last frame: RGBA8, sRGB-encoded
+    /// colour, luma in alpha (needs `export_ldr` in a frame with anti-aliasing).
+    pub fn read_ldr(&self, gpu: &GpuContext) -> Result<Vec<u8>> {
+        let id = self.outputs.ldr.ok_or_else(|| {
+            LucentError::InvalidInput(
+                "the tonemapped image is not exported in this frame (export_ldr, frames with \
+                 anti-aliasing)"
+                    .into(),
+            )
+        })?;
+        self.read_export(gpu, id)
+    }
+
     /// Reads the linear HDR image of the last frame as f32 RGBA (needs `export_hdr`).
     pub fn read_hdr(&self, gpu: &GpuContext) -> Result<Vec<f32>> {
         let id = self.outputs.hdr.ok_or_else(|| {

@@ -1,6 +1,7 @@
 //! How a frame is built: [`FrameSettings`], and the [`Technique`] override for A/B runs.
 
 use crate::backend::access::Access;
+use crate::features::antialias::Antialias;
 use crate::features::debug_view::DebugView;
 use crate::features::deferred::GBufferPrecision;
 use crate::features::layered::LayeredKnobs;
@@ -165,6 +166,11 @@ pub struct FrameSettings {
     /// Li et al.'s layered passes' knobs (march steps, pixel lights, phase function,
     /// irradiance resolution, single-scattering depth).
     pub layered: LayeredKnobs,
+    /// Anti-aliasing after the tonemap (off by default: see [`Antialias`]).
+    pub antialias: Antialias,
+    /// Frames with anti-aliasing: also export the tonemapped image before it (sRGB-encoded,
+    /// luma in alpha) for the CPU reference of the pass ([`crate::reference::fxaa`]).
+    pub export_ldr: bool,
 }
 
 /// An image the caller renders into: its format, the state it is in when the frame starts
@@ -218,6 +224,8 @@ impl FrameSettings {
             target: None,
             shadows: ShadowSettings::default(),
             layered: LayeredKnobs::default(),
+            antialias: Antialias::Off,
+            export_ldr: false,
         }
     }
 }

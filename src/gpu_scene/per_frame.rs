@@ -28,7 +28,8 @@ pub struct FrameUniforms {
     inv_view_proj: [[f32; 4]; 4],
     view: [[f32; 4]; 4],
     camera_pos: [f32; 4],
-    ambient: [f32; 4],
+    /// The environment's nine SH irradiance coefficients (`E(n) / π` as a polynomial in n).
+    ambient_sh: [[f32; 4]; 9],
     sky: [f32; 4],
     viewport: [f32; 4],
     exposure: [f32; 4],
@@ -83,7 +84,7 @@ impl FrameUniforms {
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             view: scene.camera.view().to_cols_array_2d(),
             camera_pos: scene.camera.eye.extend(1.0).to_array(),
-            ambient: scene.ambient.extend(0.0).to_array(),
+            ambient_sh: scene.environment.coefficients(),
             sky: scene.sky.extend(0.0).to_array(),
             viewport: [
                 width as f32,

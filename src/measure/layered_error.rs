@@ -84,7 +84,7 @@ pub fn sphere_scene(medium: LayeredMedium, lights: Vec<Light>) -> Result<Scene> 
             near: 0.1,
             far: 20.0,
         },
-        ambient: Vec3::ZERO,
+        environment: crate::scene::Environment::constant(Vec3::ZERO),
         sky: Vec3::ZERO,
         exposure: 1.0,
         deformation: None,
@@ -199,7 +199,7 @@ pub fn term_error_against(
     reference_phase: PhaseForm,
 ) -> Result<TermError> {
     let mut scene = scene.clone();
-    scene.ambient = Vec3::ZERO;
+    scene.environment = crate::scene::Environment::constant(Vec3::ZERO);
     let medium = {
         let m = scene
             .objects

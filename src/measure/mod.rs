@@ -5,12 +5,16 @@
 //!   timing modes, formats and alternating comparisons.
 //! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.
+//! - [`look`]: how much a technique changes a frame against plain lighting, and its halos.
+//! - [`gallery`](mod@gallery): `lucent gallery`, the showcase scenes as PNGs and a Markdown page.
 //! - [`layered_error`]: Li et al.'s layered terms against their f64 references.
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
 //! - [`sweep_layered`]: the layered media's sweep, the GPU frames and the f64 references.
 
 pub mod bench;
+pub mod gallery;
 pub mod layered_error;
+pub mod look;
 pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;

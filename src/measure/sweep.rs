@@ -232,7 +232,7 @@ pub fn case_scene(case: &SweepCase) -> Result<Scene> {
             near: 0.1,
             far: 100.0,
         },
-        ambient: Vec3::splat(0.03),
+        environment: crate::scene::Environment::constant(Vec3::splat(0.03)),
         sky: Vec3::splat(0.02),
         exposure: 1.0,
         deformation: None,

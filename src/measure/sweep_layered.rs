@@ -494,7 +494,7 @@ pub fn case_scene(case: &LayeredCase) -> Result<Scene> {
         ],
         lights: lights(case.geometry),
         camera: camera(case.geometry),
-        ambient: Vec3::splat(0.03),
+        environment: crate::scene::Environment::constant(Vec3::splat(0.03)),
         sky: Vec3::splat(0.02),
         exposure: 1.0,
         deformation: None,

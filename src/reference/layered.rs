@@ -572,12 +572,13 @@ pub struct SurfaceSamples {
 pub const MAX_SURFACE_SAMPLES: usize = 1 << 20;
 
 /// Irradiance transmitted into the medium at surface point `p` (outward normal `n`):
-/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the ambient's `pi L_a (1 - F_dr)`.
+/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the environment's `E(n) (1 - F_dr)`.
 fn transmitted_irradiance(scene: &Scene, p: DVec3, n: DVec3, eta: f64) -> DVec3 {
-    // The scene's ambient is a uniform radiance over the hemisphere: irradiance pi L_a, of
-    // which the boundary lets 1 - F_dr through (unshadowed, as every pass's ambient).
+    // The environment's irradiance at the normal, E(n) = pi ambient_radiance(n), of which the
+    // boundary lets 1 - F_dr through (diffuse light: the hemispherical average of the Fresnel
+    // transmittance; unshadowed, as every pass's ambient).
     let ambient_in = PI * (1.0 - super::dipole::fresnel_diffuse_reflectance(eta));
-    let mut e = scene.ambient.as_dvec3() * ambient_in;
+    let mut e = scene.environment.ambient_radiance(n) * ambient_in;
     for light in &scene.lights {
         let (to_light, attenuation) = light_incidence(light, p);
         let cos = to_light.dot(n);
@@ -861,7 +862,7 @@ mod tests {
                 near: 0.1,
                 far: 100.0,
             },
-            ambient: Vec3::ZERO,
+            environment: crate::scene::Environment::constant(Vec3::ZERO),
             sky: Vec3::ZERO,
             exposure: 1.0,
             deformation: None,

@@ -79,7 +79,8 @@ pub fn shade_direct_split(
     (diffuse, f64::from(material.specular) * spec * incident)
 }
 
-/// Ambient plus every light, as the deferred lighting pass computes it.
+/// Ambient plus every light, as the deferred lighting pass computes it; `ambient` is the
+/// environment's `E(n) / π` at this normal ([`crate::scene::Environment::ambient_radiance`]).
 pub fn shade(
     material: &Material,
     normal: DVec3,

@@ -5,6 +5,7 @@
 //! meshes approximate, as an independent end-to-end reference.
 
 pub mod dipole;
+pub mod fxaa;
 pub mod layered;
 pub mod lighting;
 pub mod raytrace;

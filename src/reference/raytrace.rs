@@ -78,7 +78,7 @@ pub fn render(scene: &Scene, width: u32, height: u32) -> Result<ReferenceImage> 
                         n,
                         pos,
                         eye,
-                        scene.ambient.as_dvec3(),
+                        scene.environment.ambient_radiance(n),
                         &scene.lights,
                     );
                     hdr.push(c);

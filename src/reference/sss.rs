@@ -191,7 +191,6 @@ pub fn reference_image(
     let view = DMat3::from_mat4(scene.camera.view().as_dmat4());
     let eye = scene.camera.eye.as_dvec3();
     let focal = f64::from(scene.camera.focal_px(gbuffer.height));
-    let ambient = scene.ambient.as_dvec3();
     let strength = gbuffer.sss.as_deref().unwrap_or(&[]);
     let pixels = gbuffer_pixels(gbuffer, &scene.camera);
     let mut out = vec![DVec3::ZERO; pixels.len()];
@@ -202,7 +201,8 @@ pub fn reference_image(
             continue;
         };
         let to_eye = (eye - p.position).normalize();
-        let mut diffuse = ambient * p.material.albedo.as_dvec3();
+        let mut diffuse =
+            scene.environment.ambient_radiance(p.normal) * p.material.albedo.as_dvec3();
         let mut blinn_phong = DVec3::ZERO;
         for light in &scene.lights {
             let (d, s) = shade_direct_split(&p.material, p.normal, p.position, to_eye, light);

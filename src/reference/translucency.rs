@@ -52,7 +52,6 @@ pub struct LightingInputs<'a> {
 pub fn shade_gbuffer(gbuffer: &GBufferReadback, inputs: &LightingInputs<'_>) -> Vec<DVec3> {
     let scene = inputs.scene;
     let eye = scene.camera.eye.as_dvec3();
-    let ambient = scene.ambient.as_dvec3();
     gbuffer_pixels(gbuffer, &scene.camera)
         .into_iter()
         .map(|pixel| {
@@ -61,7 +60,7 @@ pub fn shade_gbuffer(gbuffer: &GBufferReadback, inputs: &LightingInputs<'_>) -> 
             };
             let albedo = p.material.albedo.as_dvec3();
             let to_eye = (eye - p.position).normalize();
-            let mut color = ambient * albedo;
+            let mut color = scene.environment.ambient_radiance(p.normal) * albedo;
             let translucent = inputs.translucency.and_then(|(rows, packing)| {
                 let t = gbuffer.gb2.as_ref()?[p.index];
                 let (thickness, id) = match packing {

@@ -45,6 +45,22 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
         "scaling",
         "one teapot at a chosen triangle count: `scaling` (100k) or `scaling:N`",
     ),
+    (
+        "showcase-translucency",
+        "GDC 2011 translucency at its best: an ear, two leaves and a wax panel, thin, baked thickness, lit from behind",
+    ),
+    (
+        "showcase-skin",
+        "a sculpted head with ears, skin profile at 10x scale, side-lit: the red terminator, ears glowing from a back light",
+    ),
+    (
+        "showcase-marble",
+        "veined marble (procedural albedo and fine normal map) under a grazing light: the waxy look of SSS",
+    ),
+    (
+        "showcase-layered",
+        "Li et al.'s layered media as jade and wax: a thin jade leaf, a jade ring, wax candles, lit from behind",
+    ),
 ];
 
 /// A built-in scene by name (`scaling:N` picks the triangle count of `scaling`).
@@ -78,6 +94,10 @@ pub fn builtin(name: &str) -> Result<Scene> {
         "edges" => edges(),
         "layered" => layered(),
         "dynamic" => dynamic(),
+        "showcase-translucency" => super::showcase::translucency(),
+        "showcase-skin" => super::showcase::skin(),
+        "showcase-marble" => super::showcase::marble(),
+        "showcase-layered" => super::showcase::layered(),
         "scaling" => {
             let triangles = match parameter {
                 None => 100_000,
@@ -100,21 +120,21 @@ pub fn builtin(name: &str) -> Result<Scene> {
     }
 }
 
-fn floor() -> (Mesh, Material) {
+pub(super) fn floor() -> (Mesh, Material) {
     (
         Mesh::generate(Shape::Plane { half_size: 12.0 }, 1, 1),
         Material::opaque("floor", Vec3::new(0.55, 0.55, 0.5), 0.1, 0.8),
     )
 }
 
-fn base_scene(name: &str, camera: Camera) -> Scene {
+pub(super) fn base_scene(name: &str, camera: Camera) -> Scene {
     Scene {
         name: name.to_string(),
         meshes: Vec::new(),
         objects: Vec::new(),
         lights: Vec::new(),
         camera,
-        ambient: Vec3::new(0.03, 0.035, 0.04),
+        environment: super::Environment::constant(Vec3::new(0.03, 0.035, 0.04)),
         sky: Vec3::new(0.15, 0.2, 0.3),
         exposure: 1.0,
         deformation: None,
@@ -122,7 +142,7 @@ fn base_scene(name: &str, camera: Camera) -> Scene {
     }
 }
 
-fn camera(eye: Vec3, target: Vec3) -> Camera {
+pub(super) fn camera(eye: Vec3, target: Vec3) -> Camera {
     Camera {
         eye,
         target,
@@ -134,13 +154,13 @@ fn camera(eye: Vec3, target: Vec3) -> Camera {
 
 impl Scene {
     /// Adds a mesh, returning its index.
-    fn add_mesh(&mut self, mesh: Mesh) -> usize {
+    pub(super) fn add_mesh(&mut self, mesh: Mesh) -> usize {
         self.meshes.push(mesh);
         self.meshes.len() - 1
     }
 
     /// Adds an object.
-    fn add(&mut self, mesh: usize, transform: Mat4, material: Material) {
+    pub(super) fn add(&mut self, mesh: usize, transform: Mat4, material: Material) {
         self.objects.push(Object {
             mesh,
             transform,
@@ -149,7 +169,7 @@ impl Scene {
     }
 
     /// Adds the floor plane at y = 0.
-    fn add_floor(&mut self) {
+    pub(super) fn add_floor(&mut self) {
         let (mesh, material) = floor();
         let m = self.add_mesh(mesh);
         self.add(m, Mat4::IDENTITY, material);
@@ -189,7 +209,12 @@ fn smoke() -> Scene {
 }
 
 /// A translucent material in the talk's style.
-fn translucent(name: &str, albedo: Vec3, thickness: ThicknessSource, color: Vec3) -> Material {
+pub(super) fn translucent(
+    name: &str,
+    albedo: Vec3,
+    thickness: ThicknessSource,
+    color: Vec3,
+) -> Material {
     let mut m = Material::opaque(name, albedo, 0.3, 0.4);
     let mut t = Translucency::new(thickness);
     t.color = color;

@@ -3,7 +3,7 @@
 //! output onto the scene's normal map is refused before any work.
 //!
 //! This reads only the keys that name files (`[[mesh]] obj`, `[[material]] albedo_texture`,
-//! `normal_texture`, and `translucency.thickness` when it is a path; see
+//! `normal_texture`, `translucency.thickness` when it is a path, `[environment] file`; see
 //! `docs/scene-format.toml`), resolved against the scene file's directory as the loader
 //! resolves them. A file that does not parse names only itself: the loader reports the error.
 
@@ -57,6 +57,13 @@ pub fn scene_inputs(name_or_path: &str) -> Vec<(String, PathBuf)> {
                 resolve(obj),
             ));
         }
+    }
+    if let Some(file) = table
+        .get("environment")
+        .and_then(|e| e.get("file"))
+        .and_then(toml::Value::as_str)
+    {
+        inputs.push(("the environment map".to_string(), resolve(file)));
     }
     for material in entries("material") {
         let name = name_of(&material);

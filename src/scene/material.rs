@@ -39,6 +39,16 @@ pub enum ProceduralTexture {
         /// Bump strength (slope scale).
         strength: f32,
     },
+    /// A veined marble albedo (linear RGB, multiplied with the material's albedo): white
+    /// crossed by thin `vein_color` veins along the zero crossings of the same height field as
+    /// `MarbleNormal` at the same `frequency`, so veins and bumps line up, and a fainter,
+    /// finer second net.
+    MarbleAlbedo {
+        /// Vein frequency across the texture (as `MarbleNormal`'s).
+        frequency: f32,
+        /// Colour at the centre of a vein (linear, each channel in [0, 1]).
+        vein_color: Vec3,
+    },
 }
 
 /// Where the GDC 2011 local thickness comes from.

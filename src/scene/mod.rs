@@ -5,6 +5,7 @@
 //! approximation of.
 
 pub mod builtin;
+pub mod environment;
 pub mod file;
 pub mod generators;
 pub mod inputs;
@@ -17,11 +18,13 @@ pub mod normals;
 pub mod obj;
 pub mod polygon;
 pub mod profile;
+pub mod showcase;
 pub mod texture;
 
 use glam::{Mat4, Vec3};
 
 pub use builtin::{builtin, BUILTIN_SCENES};
+pub use environment::Environment;
 pub use file::load_scene;
 pub use material::{Light, LightKind, Material};
 pub use mesh::{Mesh, Shape};
@@ -87,8 +90,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Camera.
     pub camera: Camera,
-    /// Ambient radiance (linear RGB), multiplied by albedo.
-    pub ambient: Vec3,
+    /// Light from the environment (constant, hemisphere or radiance map): the ambient every
+    /// technique's diffuse receives, as nine SH irradiance coefficients ([`environment`]).
+    pub environment: Environment,
     /// Radiance of pixels no geometry covers.
     pub sky: Vec3,
     /// Exposure multiplier before tonemapping.

@@ -155,29 +155,71 @@ fn bilinear(
 /// references make the same texture).
 pub const PROCEDURAL_TEXTURE_SIZE: u32 = 512;
 
-/// Makes a procedural texture at `size` x `size` (linear data, with mips).
+/// The tileable marble height field at texel (`x`, `y`) of an `n` x `n` map:
+/// `h = sin(2 pi (f u + t(u, v)))` with a periodic turbulence `t` (whole frequencies, so the map
+/// tiles).
+fn marble_height(frequency: f32, n: usize, x: usize, y: usize) -> f32 {
+    let tau = std::f32::consts::TAU;
+    let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
+    let turbulence = 0.35 * (tau * (2.0 * v + 0.6 * (tau * u).sin())).sin()
+        + 0.15 * (tau * (5.0 * (u + v))).sin()
+        + 0.08 * (tau * (11.0 * u - 7.0 * v)).sin();
+    (tau * (frequency * u + turbulence)).sin()
+}
+
+/// Makes a procedural texture at `size` x `size` (linear, with mips).
 ///
-/// `MarbleNormal`: the tileable height field `h = sin(2 pi (f x + t(x, y)))` with a periodic
-/// turbulence `t`, differentiated by central differences (wrapping) into a tangent-space normal
-/// `normalize(-s dh/dx, -s dh/dy, 1)`, stored as a normal map file would store it
-/// (`n * 0.5 + 0.5`).
+/// `MarbleNormal`: the height field of `marble_height`, differentiated by central differences
+/// (wrapping) into a tangent-space normal `normalize(-s dh/dx, -s dh/dy, 1)`, stored as a
+/// normal map file would store it (`n * 0.5 + 0.5`).
+///
+/// `MarbleAlbedo`: white mixed toward the vein colour by `(1 - |h|)^10` (thin veins where the
+/// field crosses zero) and by a third of that of a field at 2.7 times the frequency (rounded)
+/// turned
+/// across it (the finer net); linear RGB.
 pub fn procedural_texture(
     texture: &super::material::ProceduralTexture,
     size: u32,
 ) -> Result<Texture> {
-    let super::material::ProceduralTexture::MarbleNormal {
-        frequency,
-        strength,
-    } = *texture;
     let n = size.max(1) as usize;
-    let tau = std::f32::consts::TAU;
-    let height = |x: usize, y: usize| {
-        let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
-        let turbulence = 0.35 * (tau * (2.0 * v + 0.6 * (tau * u).sin())).sin()
-            + 0.15 * (tau * (5.0 * (u + v))).sin()
-            + 0.08 * (tau * (11.0 * u - 7.0 * v)).sin();
-        (tau * (frequency * u + turbulence)).sin()
+    let (frequency, strength) = match *texture {
+        super::material::ProceduralTexture::MarbleNormal {
+            frequency,
+            strength,
+        } => (frequency, strength),
+        super::material::ProceduralTexture::MarbleAlbedo {
+            frequency,
+            vein_color,
+        } => {
+            // Guarded where it is born: a colour outside [0, 1] is no reflectance.
+            let vein = vein_color.clamp(glam::Vec3::ZERO, glam::Vec3::ONE);
+            let vein = if vein.is_finite() {
+                vein
+            } else {
+                glam::Vec3::ZERO
+            };
+            // A whole frequency, so the finer net tiles too.
+            let fine_frequency = (frequency * 2.7).round().max(1.0);
+            let mut texels = Vec::with_capacity(n * n);
+            for y in 0..n {
+                for x in 0..n {
+                    let main = (1.0 - marble_height(frequency, n, x, y).abs()).powi(10);
+                    let fine = (1.0 - marble_height(fine_frequency, n, y, x).abs()).powi(10);
+                    let w = (main + fine / 3.0).min(1.0);
+                    let c = glam::Vec3::ONE.lerp(vein, w);
+                    texels.push([c.x, c.y, c.z, 1.0]);
+                }
+            }
+            return Texture::from_texels(
+                "procedural marble albedo",
+                size.max(1),
+                size.max(1),
+                TextureUsage::Color,
+                texels,
+            );
+        }
     };
+    let height = |x: usize, y: usize| marble_height(frequency, n, x, y);
     let mut texels = Vec::with_capacity(n * n);
     for y in 0..n {
         for x in 0..n {

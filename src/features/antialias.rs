@@ -1,0 +1,153 @@
+//! Anti-aliasing: FXAA as a post pass after the tonemap (`--aa fxaa`, off by default).
+//!
+//! A frame with anti-aliasing tonemaps into an intermediate RGBA8 image (sRGB-encoded colour,
+//! the luma of each pixel in alpha: [`super::tonemap::tonemap_with_luma_pass`]) and the `fxaa`
+//! pass samples it bilinearly into the display image, encoded for the display's format
+//! (`glsl/post/fxaa.frag`; its f64 twin is [`crate::reference::fxaa`]). Pixels below the
+//! contrast thresholds are copied unchanged, so flat regions keep their exact values and the
+//! goldens of frames without anti-aliasing stay what they were: a frame without it has neither
+//! the pass nor the intermediate image.
+//!
+//! Why off by default: on lavapipe the pass costs 11-17% of the plain frame (docs/antialias.md,
+//! `lucent bench --aa fxaa --against ...`), more than "cheap"; on a GPU it is a fraction of a
+//! millisecond and a host may well turn it on.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::graph::{
+    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
+    ResourceId,
+};
+use crate::{LucentError, Result};
+
+use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use crate::gpu_scene::SceneGpu;
+
+/// The anti-aliasing a frame applies after the tonemap.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Antialias {
+    /// None: the tonemap writes the display image directly.
+    #[default]
+    Off,
+    /// FXAA (Lottes' 3.11 "quality" form) on the tonemapped image.
+    Fxaa,
+}
+
+impl Antialias {
+    /// Every mode with its command-line name.
+    pub const ALL: &'static [(&'static str, Antialias)] =
+        &[("off", Antialias::Off), ("fxaa", Antialias::Fxaa)];
+
+    /// Parses a command-line name.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, a)| a)
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "unknown anti-aliasing '{name}'; available: off, fxaa"
+                ))
+            })
+    }
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, a)| *a == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+/// The FXAA pass's fragment shader.
+const FXAA_FRAGMENT: &str = "post/fxaa.frag";
+
+/// Its defines: `linear` for sRGB and float display images (decoded back to linear).
+fn fxaa_defines(linear: bool) -> &'static [(&'static str, &'static str)] {
+    if linear {
+        &[("LUCENT_OUTPUT_LINEAR", "1")]
+    } else {
+        &[]
+    }
+}
+
+/// The pipelines the anti-aliasing of any frame builds.
+pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+    for linear in [false, true] {
+        out.push(super::shipped::PipelineShaders::fullscreen(
+            FXAA_FRAGMENT,
+            fxaa_defines(linear),
+        ));
+    }
+}
+
+/// Declares the `fxaa` pass: samples `ldr` (the tonemap's sRGB + luma image), writes
+/// `display` encoded for its format.
+pub fn fxaa_pass(
+    graph: &mut RenderGraph,
+    ldr: &Handle<Image>,
+    mut display: Handle<Image>,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let linear = super::tonemap::writes_linear(graph.resources()[display.id()].info.format);
+    let mut pass = graph.add_pass("fxaa", PassKind::Raster);
+    pass.sample(ldr).color(&mut display, LoadOp::DontCare);
+    match scene {
+        Some(scene) => pass.execute(FxaaPass {
+            scene: scene.clone(),
+            input: ldr.id(),
+            linear,
+            sampler: vk::Sampler::null(),
+            pipeline: None,
+        }),
+        None => pass.finish(),
+    }
+    display
+}
+
+struct FxaaPass {
+    scene: Arc<SceneGpu>,
+    input: ResourceId,
+    /// Write linear values (sRGB or float targets).
+    linear: bool,
+    sampler: vk::Sampler,
+    pipeline: Option<PassPipeline>,
+}
+
+impl PassExec for FxaaPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        // Bilinear: the edge search and the final tap sample between texels.
+        self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &[
+                Binding::PerFrame(
+                    self.scene
+                        .per_frame
+                        .binding(crate::gpu_scene::Region::Frame),
+                ),
+                Binding::Sampled(ctx.views[self.input], self.sampler),
+            ],
+            &GraphicsPipelineDesc::fullscreen(FXAA_FRAGMENT, fxaa_defines(self.linear), "fxaa"),
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        if let Some(pipeline) = &self.pipeline {
+            pipeline.draw_fullscreen(ctx);
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
+        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
+        self.sampler = vk::Sampler::null();
+    }
+}

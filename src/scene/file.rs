@@ -879,131 +879,132 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
 
     check3("", None, "ambient", raw.ambient, 0.0)?;
     check3("", None, "sky", raw.sky, 0.0)?;
-    let environment =
-        match (&raw.environment, raw.ambient) {
-            (Some(_), Some(_)) => return Err(at.error(
+    let environment = match (&raw.environment, raw.ambient) {
+        (Some(_), Some(_)) => {
+            return Err(at.error(
                 "",
                 None,
                 "ambient",
                 "give either `ambient` (a constant radiance) or an `[environment]` table, not both",
-            )),
-            (None, ambient) => {
-                super::Environment::constant(Vec3::from(ambient.unwrap_or([0.03; 3])))
-            }
-            (Some(e), None) => {
-                let section = "environment";
-                check3(section, None, "radiance", e.radiance, 0.0)?;
-                check3(section, None, "sky", e.sky, 0.0)?;
-                check3(section, None, "ground", e.ground, 0.0)?;
-                // Keys that belong to another kind are refused, not ignored: a parsed key does
-                // what it says or is an error.
-                let refuse = |keys: &[(&str, bool)]| -> Result<()> {
-                    match keys.iter().find(|(_, given)| *given) {
-                        Some((key, _)) => Err(at.error(
+            ))
+        }
+        (None, ambient) => super::Environment::constant(Vec3::from(ambient.unwrap_or([0.03; 3]))),
+        (Some(e), None) => {
+            let section = "environment";
+            check3(section, None, "radiance", e.radiance, 0.0)?;
+            check3(section, None, "sky", e.sky, 0.0)?;
+            check3(section, None, "ground", e.ground, 0.0)?;
+            // Keys that belong to another kind are refused, not ignored: a parsed key does
+            // what it says or is an error.
+            let refuse = |keys: &[(&str, bool)]| -> Result<()> {
+                match keys.iter().find(|(_, given)| *given) {
+                    Some((key, _)) => Err(at.error(
+                        section,
+                        None,
+                        key,
+                        format!("`{key}` does not apply to kind = \"{}\"", e.kind),
+                    )),
+                    None => Ok(()),
+                }
+            };
+            let map_keys = [
+                ("file", e.file.is_some()),
+                ("builtin", e.builtin.is_some()),
+                ("intensity", e.intensity.is_some()),
+                ("rotation_degrees", e.rotation_degrees.is_some()),
+            ];
+            match e.kind.as_str() {
+                "constant" => {
+                    refuse(&[("sky", e.sky.is_some()), ("ground", e.ground.is_some())])?;
+                    refuse(&map_keys)?;
+                    let radiance = e.radiance.ok_or_else(|| {
+                        at.error(
                             section,
                             None,
-                            key,
-                            format!("`{key}` does not apply to kind = \"{}\"", e.kind),
-                        )),
-                        None => Ok(()),
+                            "radiance",
+                            "kind = \"constant\" needs `radiance`",
+                        )
+                    })?;
+                    super::Environment::constant(Vec3::from(radiance))
+                }
+                "hemisphere" => {
+                    refuse(&[("radiance", e.radiance.is_some())])?;
+                    refuse(&map_keys)?;
+                    let (Some(sky), Some(ground)) = (e.sky, e.ground) else {
+                        return Err(at.error(
+                            section,
+                            None,
+                            if e.sky.is_none() { "sky" } else { "ground" },
+                            "kind = \"hemisphere\" needs `sky` and `ground`",
+                        ));
+                    };
+                    super::Environment::hemisphere(Vec3::from(sky), Vec3::from(ground))
+                }
+                "map" => {
+                    refuse(&[
+                        ("radiance", e.radiance.is_some()),
+                        ("sky", e.sky.is_some()),
+                        ("ground", e.ground.is_some()),
+                    ])?;
+                    let intensity = e.intensity.unwrap_or(1.0);
+                    if !(intensity.is_finite() && intensity >= 0.0) {
+                        return Err(at.error(
+                            section,
+                            None,
+                            "intensity",
+                            format!("{intensity} must be finite and >= 0"),
+                        ));
                     }
-                };
-                let map_keys = [
-                    ("file", e.file.is_some()),
-                    ("builtin", e.builtin.is_some()),
-                    ("intensity", e.intensity.is_some()),
-                    ("rotation_degrees", e.rotation_degrees.is_some()),
-                ];
-                match e.kind.as_str() {
-                    "constant" => {
-                        refuse(&[("sky", e.sky.is_some()), ("ground", e.ground.is_some())])?;
-                        refuse(&map_keys)?;
-                        let radiance = e.radiance.ok_or_else(|| {
-                            at.error(
-                                section,
-                                None,
-                                "radiance",
-                                "kind = \"constant\" needs `radiance`",
-                            )
-                        })?;
-                        super::Environment::constant(Vec3::from(radiance))
+                    let rotation = e.rotation_degrees.unwrap_or(0.0);
+                    if !rotation.is_finite() {
+                        return Err(at.error(
+                            section,
+                            None,
+                            "rotation_degrees",
+                            format!("{rotation} must be finite"),
+                        ));
                     }
-                    "hemisphere" => {
-                        refuse(&[("radiance", e.radiance.is_some())])?;
-                        refuse(&map_keys)?;
-                        let (Some(sky), Some(ground)) = (e.sky, e.ground) else {
+                    match (&e.file, &e.builtin) {
+                        (Some(file), None) => {
+                            super::Environment::from_file(&resolve(file), intensity, rotation)?
+                        }
+                        (None, Some(name)) if name == super::environment::BUILTIN_SKY => {
+                            super::Environment::builtin_sky(intensity, rotation)?
+                        }
+                        (None, Some(name)) => {
                             return Err(at.error(
                                 section,
                                 None,
-                                if e.sky.is_none() { "sky" } else { "ground" },
-                                "kind = \"hemisphere\" needs `sky` and `ground`",
-                            ));
-                        };
-                        super::Environment::hemisphere(Vec3::from(sky), Vec3::from(ground))
-                    }
-                    "map" => {
-                        refuse(&[
-                            ("radiance", e.radiance.is_some()),
-                            ("sky", e.sky.is_some()),
-                            ("ground", e.ground.is_some()),
-                        ])?;
-                        let intensity = e.intensity.unwrap_or(1.0);
-                        if !(intensity.is_finite() && intensity >= 0.0) {
+                                "builtin",
+                                format!(
+                                    "unknown built-in map '{name}'; available: {}",
+                                    super::environment::BUILTIN_SKY
+                                ),
+                            ))
+                        }
+                        _ => {
                             return Err(at.error(
                                 section,
                                 None,
-                                "intensity",
-                                format!("{intensity} must be finite and >= 0"),
-                            ));
-                        }
-                        let rotation = e.rotation_degrees.unwrap_or(0.0);
-                        if !rotation.is_finite() {
-                            return Err(at.error(
-                                section,
-                                None,
-                                "rotation_degrees",
-                                format!("{rotation} must be finite"),
-                            ));
-                        }
-                        match (&e.file, &e.builtin) {
-                            (Some(file), None) => {
-                                super::Environment::from_file(&resolve(file), intensity, rotation)?
-                            }
-                            (None, Some(name)) if name == super::environment::BUILTIN_SKY => {
-                                super::Environment::builtin_sky(intensity, rotation)?
-                            }
-                            (None, Some(name)) => {
-                                return Err(at.error(
-                                    section,
-                                    None,
-                                    "builtin",
-                                    format!(
-                                        "unknown built-in map '{name}'; available: {}",
-                                        super::environment::BUILTIN_SKY
-                                    ),
-                                ))
-                            }
-                            _ => {
-                                return Err(at.error(
-                                    section,
-                                    None,
-                                    "file",
-                                    "kind = \"map\" needs exactly one of `file` and `builtin`",
-                                ))
-                            }
+                                "file",
+                                "kind = \"map\" needs exactly one of `file` and `builtin`",
+                            ))
                         }
                     }
-                    other => return Err(at.error(
+                }
+                other => {
+                    return Err(at.error(
                         section,
                         None,
                         "kind",
                         format!(
                             "unknown environment kind '{other}'; use constant, hemisphere or map"
                         ),
-                    )),
+                    ))
                 }
             }
-        };
+        }
+    };
     let exposure = raw.exposure.unwrap_or(1.0);
     if !(exposure.is_finite() && exposure > 0.0) {
         return Err(at.error(

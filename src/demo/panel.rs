@@ -100,6 +100,7 @@ impl Demo<'_> {
         egui::Window::new("lucent")
             .default_pos([8.0, 8.0])
             .min_width(330.0)
+            .default_height(max_height)
             .max_height(max_height)
             .vscroll(true)
             .show(&ctx, |ui| {

@@ -29,8 +29,8 @@
 //! Cargo features, all on by default: `runtime-shaders` (shaderc: GLSL compiled at run time,
 //! `backend::shader::ShaderCompiler::new`; without it pipelines use only the SPIR-V shipped
 //! with the crate, [`backend::shader::ShaderCompiler::shipped`]), `window` (winit, ash-window,
-//! ab_glyph: the `demo` module and `lucent demo`, which needs `runtime-shaders` for hot
-//! reload), `cli` (clap, env_logger: the `lucent` binary's command line) and
+//! egui, egui-winit, egui-ash-renderer: the `demo` module and `lucent demo`, which needs
+//! `runtime-shaders` for hot reload), `cli` (clap, env_logger: the `lucent` binary's command line) and
 //! `report` (plotters, indicatif: the `report` module and progress bars on stderr). The `lucent`
 //! binary needs `cli` and `report`. With `--no-default-features` the library keeps everything
 //! else (context, graph, scene, bake, renderer, measure, reference, images, shipped shaders)
@@ -45,7 +45,7 @@ pub mod embed;
 pub mod error;
 pub mod features;
 pub mod files;
-#[cfg(any(feature = "window", feature = "report"))]
+#[cfg(feature = "report")]
 mod font;
 pub mod frame;
 pub mod gpu_scene;

@@ -294,3 +294,230 @@ fn shader_edits_rebuild_the_frame_and_a_broken_shader_keeps_the_old_one() {
     assert!(!log.contains("Validation Error"), "{log}");
     std::fs::remove_dir_all(&glsl).unwrap();
 }
+
+/// A small scene of the test's own: a translucent block lit from behind by one point light
+/// (casting shadows) over a floor, so that the technique (translucency) differs from plain
+/// lighting and a moved light moves both the lit areas and the shadow.
+fn light_scene(light: [f32; 3], intensity: f32) -> String {
+    format!(
+        r#"name = "demo-lights"
+ambient = [0.03, 0.035, 0.04]
+sky = [0.15, 0.2, 0.3]
+[camera]
+eye = [0.0, 2.0, 6.0]
+target = [0.0, 0.8, 0.0]
+[[mesh]]
+name = "block"
+generator = "cube"
+level = 2
+[[mesh]]
+name = "ground"
+generator = "plane"
+level = 0
+[[material]]
+name = "jade"
+albedo = [0.35, 0.75, 0.45]
+roughness = 0.3
+[material.translucency]
+thickness = 0.3
+color = [0.4, 1.0, 0.5]
+power = 4.0
+distortion = 0.2
+ambient = 0.1
+[[material]]
+name = "floor"
+albedo = [0.55, 0.55, 0.5]
+specular = 0.1
+roughness = 0.8
+[[object]]
+mesh = "block"
+material = "jade"
+translate = [0.0, 0.8, 0.0]
+rotate_degrees = [0.0, 30.0, 0.0]
+scale = 0.8
+[[object]]
+mesh = "ground"
+material = "floor"
+scale = [8.0, 1.0, 8.0]
+[[light]]
+type = "point"
+position = [{}, {}, {}]
+color = [1.0, 0.95, 0.9]
+intensity = {intensity}
+range = 20.0
+"#,
+        light[0], light[1], light[2]
+    )
+}
+
+/// Columns `from..to` of a `w`-wide RGBA8 image.
+fn columns(pixels: &[u8], w: u32, h: u32, from: u32, to: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(((to - from) * h * 4) as usize);
+    for y in 0..h {
+        let row = (y * w) as usize * 4;
+        out.extend_from_slice(&pixels[row + from as usize * 4..row + to as usize * 4]);
+    }
+    out
+}
+
+/// |a - b| x 4 per channel (alpha opaque): the difference view, computed on the CPU.
+fn amplified_difference(a: &[u8], b: &[u8]) -> Vec<u8> {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .flat_map(|(p, q)| {
+            let d = |i: usize| ((i32::from(p[i]) - i32::from(q[i])).abs() * 4).min(255) as u8;
+            [d(0), d(1), d(2), 255]
+        })
+        .collect()
+}
+
+fn assert_flip(what: &str, expected: &[u8], got: &[u8], w: u32, h: u32) {
+    let flip = flip_rgba8(expected, got, w, h).unwrap();
+    assert!(
+        flip.within(&FlipThresholds::default()),
+        "{what}: mean FLIP {:.4}, {:.3}% above threshold",
+        flip.mean,
+        flip.fraction_above * 100.0
+    );
+}
+
+#[test]
+fn scripted_light_move_split_and_difference_views_match_render() {
+    let xvfb = Xvfb::start();
+    let dir = out_dir().join(format!("lights-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let start = [1.0, 2.2, -2.0];
+    let scene = dir.join("lights.toml");
+    std::fs::write(&scene, light_scene(start, 20.0)).unwrap();
+    let shot = |name: &str| dir.join(format!("{name}.png"));
+    // Keys move the light (camera-relative: right, right, right, up) and brighten it twice;
+    // then the split view, split + difference, and the difference alone, a screenshot of each.
+    let script = dir.join("lights.script");
+    std::fs::write(
+        &script,
+        format!(
+            "2 key Right\n3 key Right\n4 key Right\n5 key Up\n6 key ]\n7 key ]\n\
+             9 screenshot {}\n10 key C\n12 screenshot {}\n13 key X\n15 screenshot {}\n\
+             16 key C\n18 screenshot {}\n",
+            shot("moved").display(),
+            shot("split").display(),
+            shot("split-difference").display(),
+            shot("difference").display()
+        ),
+    )
+    .unwrap();
+    let out = lucent(&xvfb.display)
+        .args(["demo", "--technique", "translucency", "--size", "240x180"])
+        .arg("--scene")
+        .arg(&scene)
+        .args(["--frames", "20"])
+        .arg("--script")
+        .arg(&script)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "demo failed ({}):\n{stdout}\n{stderr}",
+        out.status
+    );
+    assert!(!stderr.contains("Validation Error"), "{stderr}");
+    // Where the keys put the light: the demo prints every light at exit.
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("demo light 1: point position"))
+        .unwrap_or_else(|| panic!("no light line:\n{stdout}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let number = |i: usize| -> f32 { words[i].parse().unwrap_or_else(|_| panic!("{line}")) };
+    let moved = [number(5), number(6), number(7)];
+    let intensity = number(9);
+    assert!((intensity - 20.0 * 1.25 * 1.25).abs() < 1e-3, "{line}");
+    // Three steps right and one up: the camera looks down -Z (right is +X), so x grew and z
+    // did not change (the up vector tilts towards the camera).
+    assert!(moved[0] > start[0] + 0.5 && moved[1] > start[1], "{line}");
+    let moved_scene = dir.join("moved.toml");
+    std::fs::write(&moved_scene, light_scene(moved, intensity)).unwrap();
+
+    let (w, h, demo_moved) = read_png_rgba8(&shot("moved")).unwrap();
+    let render = |scene: &Path, technique: &str| -> Vec<u8> {
+        let file = dir.join(format!(
+            "render-{}-{technique}.png",
+            scene.file_stem().unwrap().to_string_lossy()
+        ));
+        let rendered = lucent(&xvfb.display)
+            .args(["render", "--technique", technique])
+            .args(["--size", &format!("{w}x{h}")])
+            .arg("--scene")
+            .arg(scene)
+            .arg("--out")
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert!(
+            rendered.status.success(),
+            "{}",
+            String::from_utf8_lossy(&rendered.stderr)
+        );
+        let (rw, rh, pixels) = read_png_rgba8(&file).unwrap();
+        assert_eq!((rw, rh), (w, h));
+        pixels
+    };
+    let technique = render(&moved_scene, "translucency");
+    let plain = render(&moved_scene, "none");
+    let before = render(&scene, "translucency");
+
+    // The moved light is where `render` puts a light at that position (shadow included), and
+    // the picture did change with the move.
+    assert_flip("moved light", &technique, &demo_moved, w, h);
+    let unmoved = flip_rgba8(&before, &demo_moved, w, h).unwrap();
+    assert!(
+        !unmoved.within(&FlipThresholds::default()),
+        "moving the light changed nothing: mean FLIP {:.4} against the start",
+        unmoved.mean
+    );
+
+    // Split: left half plain lighting, right half the technique.
+    let half = w / 2;
+    let (_, _, split) = read_png_rgba8(&shot("split")).unwrap();
+    assert_flip(
+        "split, left half vs render --technique none",
+        &columns(&plain, w, h, 0, half),
+        &columns(&split, w, h, 0, half),
+        half,
+        h,
+    );
+    assert_flip(
+        "split, right half vs render --technique translucency",
+        &columns(&technique, w, h, half, w),
+        &columns(&split, w, h, half, w),
+        w - half,
+        h,
+    );
+    // The technique differs from plain lighting in this scene, so the two halves are not the
+    // same frame.
+    let same = flip_rgba8(&plain, &technique, w, h).unwrap();
+    assert!(!same.within(&FlipThresholds::default()), "{}", same.mean);
+
+    // Difference: |technique - plain| x 4 over the whole window; with the split, on the right.
+    let expected = amplified_difference(&technique, &plain);
+    let (_, _, difference) = read_png_rgba8(&shot("difference")).unwrap();
+    assert_flip("difference view", &expected, &difference, w, h);
+    let (_, _, split_difference) = read_png_rgba8(&shot("split-difference")).unwrap();
+    assert_flip(
+        "split + difference, right half",
+        &columns(&expected, w, h, half, w),
+        &columns(&split_difference, w, h, half, w),
+        w - half,
+        h,
+    );
+    assert_flip(
+        "split + difference, left half",
+        &columns(&plain, w, h, 0, half),
+        &columns(&split_difference, w, h, 0, half),
+        half,
+        h,
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::frame::FrameSettings;
 use crate::scene::material::PowMode;
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Light, LightKind, Scene};
 
 /// Smallest camera distance to its target: zooming further in would make the view matrix
 /// degenerate (eye == target).
@@ -102,8 +102,8 @@ impl OrbitCamera {
         (self.target, self.yaw, self.pitch, self.distance) = self.initial;
     }
 
-    /// Forward, right and up of the view.
-    fn basis(&self) -> (Vec3, Vec3, Vec3) {
+    /// Forward, right and up of the view (unit vectors; right is horizontal).
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
         let forward = (self.target - self.eye()).normalize_or(Vec3::NEG_Z);
         let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
         let up = right.cross(forward);
@@ -240,6 +240,173 @@ pub const KNOBS: &[Knob] = &[
     },
 ];
 
+/// One press of a light key moves a positioned light by this fraction of the camera's distance
+/// to its target (so a step looks the same whatever the scene's scale).
+pub const LIGHT_STEP: f32 = 0.05;
+/// One press of a light key tilts a directional light by this much (radians, about 5.7°).
+pub const LIGHT_TILT: f32 = 0.1;
+/// One intensity key press multiplies or divides the light's intensity by this.
+pub const INTENSITY_STEP: f32 = 1.25;
+/// Range of the intensity the keys and the slider set.
+pub const INTENSITY_RANGE: (f32, f32) = (1e-3, 1e5);
+
+/// A direction a light key moves the selected light, in the camera's frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightMove {
+    /// Along the view's right vector (horizontal).
+    Right,
+    /// Against it.
+    Left,
+    /// Along the view's up vector.
+    Up,
+    /// Against it.
+    Down,
+    /// Away from the camera (the view direction).
+    Forward,
+    /// Towards the camera.
+    Back,
+}
+
+impl LightMove {
+    /// The world-space unit vector of this move for a camera with `basis` (forward, right, up,
+    /// as [`OrbitCamera::basis`] gives them).
+    pub fn vector(self, (forward, right, up): (Vec3, Vec3, Vec3)) -> Vec3 {
+        match self {
+            LightMove::Right => right,
+            LightMove::Left => -right,
+            LightMove::Up => up,
+            LightMove::Down => -up,
+            LightMove::Forward => forward,
+            LightMove::Back => -forward,
+        }
+    }
+}
+
+/// Moves `light` one key step in direction `dir` of a camera with `basis` at `distance` from
+/// its target: a point or spot light moves by [`LIGHT_STEP`] x `distance`; a directional light
+/// (which has no position) tilts its direction by [`LIGHT_TILT`] towards `dir` (a forward or
+/// back move, along the view, leaves it as it is: returns false then).
+pub fn move_light(
+    light: &mut Light,
+    dir: LightMove,
+    basis: (Vec3, Vec3, Vec3),
+    distance: f32,
+) -> bool {
+    let v = dir.vector(basis);
+    match &mut light.kind {
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+            *position += v * LIGHT_STEP * distance;
+            true
+        }
+        LightKind::Directional { direction } => {
+            if matches!(dir, LightMove::Forward | LightMove::Back) {
+                return false;
+            }
+            let d = direction.normalize_or(Vec3::NEG_Y);
+            *direction = (d + v * LIGHT_TILT).normalize_or(d);
+            true
+        }
+    }
+}
+
+/// The light's position (point and spot lights) or direction (directional), as shown and
+/// edited in the panel.
+pub fn light_vector(light: &Light) -> Vec3 {
+    match light.kind {
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+        LightKind::Directional { direction } => direction,
+    }
+}
+
+/// Sets what [`light_vector`] returns. A zero or non-finite direction is ignored.
+pub fn set_light_vector(light: &mut Light, v: Vec3) {
+    if !v.is_finite() {
+        return;
+    }
+    match &mut light.kind {
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => *position = v,
+        LightKind::Directional { direction } => {
+            if v.length_squared() > 1e-12 {
+                *direction = v;
+            }
+        }
+    }
+}
+
+/// The light's kind in words.
+pub fn light_kind_name(light: &Light) -> &'static str {
+    match light.kind {
+        LightKind::Point { .. } => "point",
+        LightKind::Spot { .. } => "spot",
+        LightKind::Directional { .. } => "directional",
+    }
+}
+
+/// The intensity one key press up (`up`) or down from `intensity`, within
+/// [`INTENSITY_RANGE`].
+pub fn stepped_intensity(intensity: f32, up: bool) -> f32 {
+    let next = if up {
+        intensity * INTENSITY_STEP
+    } else {
+        intensity / INTENSITY_STEP
+    };
+    next.clamp(INTENSITY_RANGE.0, INTENSITY_RANGE.1)
+}
+
+/// The light index after `current` (`forward`) or before it among `count` lights, wrapping;
+/// 0 when there are none.
+pub fn cycle_light(current: usize, count: usize, forward: bool) -> usize {
+    if count == 0 {
+        return 0;
+    }
+    let current = current.min(count - 1);
+    if forward {
+        (current + 1) % count
+    } else {
+        (current + count - 1) % count
+    }
+}
+
+/// How the window shows the frame: the technique alone, or compared with plain lighting
+/// (technique `none`) rendered from the same view.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Comparison {
+    /// Left half plain lighting, right half the technique (or the difference, with
+    /// `difference`).
+    pub split: bool,
+    /// |technique - plain| x [`DIFFERENCE_GAIN`], over the whole window (or its right half with
+    /// `split`).
+    pub difference: bool,
+}
+
+/// How much the difference view amplifies |technique - plain| (display-encoded values).
+pub const DIFFERENCE_GAIN: f32 = 4.0;
+
+impl Comparison {
+    /// Whether the plain-lighting frame is needed at all.
+    pub fn active(self) -> bool {
+        self.split || self.difference
+    }
+
+    /// The words the window shows over each half: `(left, right)`; `right` is `None` when the
+    /// whole window shows one thing (then `left` names it).
+    pub fn labels(self, technique: &str) -> (String, Option<String>) {
+        let diff = format!("|{technique} - plain| x{DIFFERENCE_GAIN}");
+        match (self.split, self.difference) {
+            (false, false) => (format!("technique: {technique}"), None),
+            (false, true) => (format!("difference: {diff}"), None),
+            (true, false) => (
+                "left: plain lighting (none)".into(),
+                Some(format!("right: {technique}")),
+            ),
+            (true, true) => (
+                "left: plain lighting (none)".into(),
+                Some(format!("right: difference {diff}")),
+            ),
+        }
+    }
+}
+
 /// The pow forms the pow key cycles through, in order.
 pub const POW_MODES: &[(PowMode, &str)] = &[
     (PowMode::Exact, "exact pow"),
@@ -296,14 +463,28 @@ pub enum Action {
     ResetCamera,
     /// Shows or hides the key list.
     ToggleHelp,
-    /// Shows or hides the whole overlay (timings, messages).
+    /// Shows or hides the panel (knobs, timings, messages).
     ToggleOverlay,
-    /// Writes the frame (without the overlay) as a PNG.
+    /// Writes the frame (or the comparison the window shows, without the panel) as a PNG.
     Screenshot,
     /// Rebuilds every pipeline from the shaders on disk now.
     ReloadShaders,
     /// Switches the timing mode: in-frame timestamps or isolated passes (as `bench --isolate`).
     ToggleTiming,
+    /// Selects the next light.
+    NextLight,
+    /// Selects the previous light.
+    PreviousLight,
+    /// Moves the selected light one step (camera-relative).
+    MoveLight(LightMove),
+    /// Raises the selected light's intensity one step.
+    LightBrighter,
+    /// Lowers the selected light's intensity one step.
+    LightDimmer,
+    /// Split view on or off: left plain lighting, right the technique.
+    ToggleSplit,
+    /// Difference view on or off: |technique - plain| amplified.
+    ToggleDifference,
     /// Ends the demo.
     Quit,
 }
@@ -387,6 +568,66 @@ pub const KEYS: &[KeyBinding] = &[
         help: "lower the selected knob (also PageDown)",
     },
     KeyBinding {
+        name: "L",
+        action: Action::NextLight,
+        help: "select the next light",
+    },
+    KeyBinding {
+        name: "Shift+L",
+        action: Action::PreviousLight,
+        help: "select the previous light",
+    },
+    KeyBinding {
+        name: "Left",
+        action: Action::MoveLight(LightMove::Left),
+        help: "move the selected light left (a directional one tilts)",
+    },
+    KeyBinding {
+        name: "Right",
+        action: Action::MoveLight(LightMove::Right),
+        help: "move the selected light right",
+    },
+    KeyBinding {
+        name: "Up",
+        action: Action::MoveLight(LightMove::Up),
+        help: "move the selected light up (on screen)",
+    },
+    KeyBinding {
+        name: "Down",
+        action: Action::MoveLight(LightMove::Down),
+        help: "move the selected light down",
+    },
+    KeyBinding {
+        name: "Shift+Up",
+        action: Action::MoveLight(LightMove::Forward),
+        help: "move the selected light away from the camera",
+    },
+    KeyBinding {
+        name: "Shift+Down",
+        action: Action::MoveLight(LightMove::Back),
+        help: "move the selected light towards the camera",
+    },
+    KeyBinding {
+        name: "]",
+        action: Action::LightBrighter,
+        help: "selected light brighter (x1.25)",
+    },
+    KeyBinding {
+        name: "[",
+        action: Action::LightDimmer,
+        help: "selected light dimmer (/1.25)",
+    },
+    KeyBinding {
+        name: "C",
+        action: Action::ToggleSplit,
+        help: "split view: left plain lighting (none), right the technique",
+    },
+    KeyBinding {
+        name: "X",
+        action: Action::ToggleDifference,
+        help: "difference view: |technique - plain| x4 (the right half with C)",
+    },
+    KeyBinding {
         name: "R",
         action: Action::ResetCamera,
         help: "reset the camera to the scene's",
@@ -394,7 +635,7 @@ pub const KEYS: &[KeyBinding] = &[
     KeyBinding {
         name: "H",
         action: Action::ToggleOverlay,
-        help: "hide / show the overlay",
+        help: "hide / show the panel",
     },
     KeyBinding {
         name: "I",
@@ -409,7 +650,7 @@ pub const KEYS: &[KeyBinding] = &[
     KeyBinding {
         name: "F12",
         action: Action::Screenshot,
-        help: "screenshot (PNG, without the overlay)",
+        help: "screenshot (PNG: the frame or the comparison, without the panel)",
     },
     KeyBinding {
         name: "Esc",
@@ -439,14 +680,6 @@ pub fn action_named(name: &str) -> Option<Action> {
     KEYS.iter()
         .find(|k| k.name.eq_ignore_ascii_case(alias))
         .map(|k| k.action)
-}
-
-/// The key list as lines of text.
-pub fn help_lines() -> Vec<String> {
-    let mut lines = vec!["keys (F1 hides):".to_string()];
-    lines.extend(KEYS.iter().map(|k| format!("  {:<8} {}", k.name, k.help)));
-    lines.extend(CAMERA_HELP.iter().map(|(k, h)| format!("  {k:<8} {h}")));
-    lines
 }
 
 #[cfg(test)]
@@ -513,6 +746,73 @@ mod tests {
     }
 
     #[test]
+    fn light_moves_follow_the_camera_and_directional_lights_tilt() {
+        let scene = cubes();
+        let mut orbit = OrbitCamera::from_camera(&scene.camera);
+        orbit.orbit(37.0, 12.0);
+        let basis = orbit.basis();
+        let (forward, right, up) = basis;
+        assert!((forward.dot(right)).abs() < 1e-5 && (right.dot(up)).abs() < 1e-5);
+        assert!(right.y.abs() < 1e-6, "right is horizontal");
+        let start = Vec3::new(1.0, 2.0, 3.0);
+        let mut light = Light::point(start, Vec3::ONE, 5.0, 10.0);
+        let step = LIGHT_STEP * orbit.distance;
+        for (dir, expected) in [
+            (LightMove::Right, right),
+            (LightMove::Left, -right),
+            (LightMove::Up, up),
+            (LightMove::Down, -up),
+            (LightMove::Forward, forward),
+            (LightMove::Back, -forward),
+        ] {
+            set_light_vector(&mut light, start);
+            assert!(move_light(&mut light, dir, basis, orbit.distance));
+            let moved = light_vector(&light) - start;
+            assert!(
+                (moved - expected * step).length() < 1e-5,
+                "{dir:?}: {moved}"
+            );
+        }
+        // Right then left is back where it started.
+        set_light_vector(&mut light, start);
+        move_light(&mut light, LightMove::Right, basis, orbit.distance);
+        move_light(&mut light, LightMove::Left, basis, orbit.distance);
+        assert!((light_vector(&light) - start).length() < 1e-5);
+
+        let down = Vec3::new(0.0, -1.0, 0.0);
+        let mut sun = Light::directional(down, Vec3::ONE, 1.0);
+        assert!(!move_light(&mut sun, LightMove::Forward, basis, 1.0));
+        assert_eq!(light_vector(&sun), down);
+        assert!(move_light(&mut sun, LightMove::Right, basis, 1.0));
+        let tilted = light_vector(&sun);
+        assert!((tilted.length() - 1.0).abs() < 1e-5);
+        assert!((tilted.angle_between(down) - LIGHT_TILT.atan()).abs() < 1e-4);
+        assert!(tilted.dot(right) > 0.0);
+        // A zero or NaN direction is refused; the light stays valid.
+        set_light_vector(&mut sun, Vec3::ZERO);
+        set_light_vector(&mut sun, Vec3::NAN);
+        assert_eq!(light_vector(&sun), tilted);
+        sun.validate("sun").unwrap();
+        assert_eq!(light_kind_name(&sun), "directional");
+    }
+
+    #[test]
+    fn intensity_steps_and_light_selection_wrap() {
+        assert_eq!(stepped_intensity(4.0, true), 5.0);
+        assert_eq!(stepped_intensity(5.0, false), 4.0);
+        assert_eq!(
+            stepped_intensity(INTENSITY_RANGE.1, true),
+            INTENSITY_RANGE.1
+        );
+        assert_eq!(stepped_intensity(0.0, false), INTENSITY_RANGE.0);
+        assert_eq!(cycle_light(0, 3, true), 1);
+        assert_eq!(cycle_light(2, 3, true), 0);
+        assert_eq!(cycle_light(0, 3, false), 2);
+        assert_eq!(cycle_light(7, 3, false), 1);
+        assert_eq!(cycle_light(0, 0, true), 0);
+    }
+
+    #[test]
     fn pow_cycles_through_every_form_and_back() {
         let mut scene = cubes();
         let first = pow_mode(&scene).unwrap();
@@ -532,6 +832,17 @@ mod tests {
         assert_eq!(action_named("PageUp"), Some(Action::KnobUp));
         assert_eq!(action_named("Shift+T"), Some(Action::PreviousTechnique));
         assert_eq!(action_named("nope"), None);
-        assert!(help_lines().len() > KEYS.len());
+        assert_eq!(action_named("shift+l"), Some(Action::PreviousLight));
+        assert_eq!(action_named("]"), Some(Action::LightBrighter));
+        // Names are unique (a script's key names one action).
+        for (i, k) in KEYS.iter().enumerate() {
+            assert!(
+                KEYS[i + 1..]
+                    .iter()
+                    .all(|o| !o.name.eq_ignore_ascii_case(k.name)),
+                "{}",
+                k.name
+            );
+        }
     }
 }

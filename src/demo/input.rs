@@ -8,7 +8,7 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{KeyCode, PhysicalKey};
 
-use super::controls::{self, Action, KNOBS};
+use super::controls::{self, Action, LightMove, KNOBS};
 use super::script::Command;
 use super::{Demo, FLY_SPEED, ORBIT_PER_PIXEL};
 use crate::frame::Technique;
@@ -20,6 +20,11 @@ impl Demo<'_> {
         event_loop: &ActiveEventLoop,
         event: WindowEvent,
     ) -> Result<()> {
+        if let (Some(window), Some(gui)) = (self.window.as_ref(), self.gui.as_mut()) {
+            gui.on_event(window, &event);
+        }
+        let panel_pointer = self.gui.as_ref().is_some_and(|g| g.wants_pointer());
+        let panel_keys = self.gui.as_ref().is_some_and(|g| g.wants_keys());
         match event {
             WindowEvent::CloseRequested => {
                 self.done = true;
@@ -42,8 +47,12 @@ impl Demo<'_> {
                     self.input.held.remove(&code);
                     return Ok(());
                 }
+                // Typing into one of the panel's fields: the keys are the field's.
+                if panel_keys {
+                    return Ok(());
+                }
                 self.input.held.insert(code);
-                if event.repeat && !matches!(code, KeyCode::Equal | KeyCode::Minus) {
+                if event.repeat && !repeats(code) {
                     return Ok(());
                 }
                 if let Some(action) = key_action(code, self.input.shift) {
@@ -52,6 +61,10 @@ impl Demo<'_> {
             }
             WindowEvent::MouseInput { state, button, .. } => {
                 let down = state == ElementState::Pressed;
+                // A press on the panel is the panel's; a release always ends a drag.
+                if down && panel_pointer {
+                    return Ok(());
+                }
                 match button {
                     MouseButton::Left => self.input.orbiting = down,
                     MouseButton::Right | MouseButton::Middle => self.input.panning = down,
@@ -74,7 +87,7 @@ impl Demo<'_> {
                 }
                 self.input.cursor = Some((x, y));
             }
-            WindowEvent::MouseWheel { delta, .. } => {
+            WindowEvent::MouseWheel { delta, .. } if !panel_pointer => {
                 let lines = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 50.0,
@@ -120,20 +133,50 @@ impl Demo<'_> {
                 match (knob.get)(&self.scene, &self.options.base) {
                     Some(value) => {
                         let next = knob.stepped(value, action == Action::KnobUp);
-                        (knob.set)(&mut self.scene, &mut self.options.base, next);
-                        // Values only (lights, material and profile tables): the next frame
-                        // writes them into its per-frame slot. A new shape (two materials'
-                        // parameters became equal, or apart) needs a new frame.
-                        let in_place = match self.renderer.as_mut() {
-                            Some(r) => r.retune(&self.options.base) && r.can_update(&self.scene)?,
-                            None => false,
-                        };
-                        if knob.rebuild || !in_place {
-                            self.rebuild_pending = true;
-                        }
+                        self.set_knob(self.view.knob, next)?;
                     }
                     None => self.say(format!("nothing in this scene uses {}", knob.name), false),
                 }
+            }
+            Action::NextLight | Action::PreviousLight => {
+                let next = controls::cycle_light(
+                    self.light,
+                    self.scene.lights.len(),
+                    action == Action::NextLight,
+                );
+                self.select_light(next);
+            }
+            Action::MoveLight(dir) => self.move_light(dir)?,
+            Action::LightBrighter | Action::LightDimmer => {
+                let Some(light) = self.scene.lights.get_mut(self.light) else {
+                    self.say("this scene has no light".into(), false);
+                    return Ok(());
+                };
+                light.intensity =
+                    controls::stepped_intensity(light.intensity, action == Action::LightBrighter);
+                let message = format!("light {} intensity {:.4}", self.light + 1, light.intensity);
+                self.values_changed()?;
+                self.say(message, false);
+            }
+            Action::ToggleSplit | Action::ToggleDifference => {
+                let was = self.comparison;
+                if action == Action::ToggleSplit {
+                    self.comparison.split = !self.comparison.split;
+                } else {
+                    self.comparison.difference = !self.comparison.difference;
+                }
+                if !self.comparison.active() && was.active() {
+                    // Nothing compares any more: the second renderer goes (the GPU is idle
+                    // between frames).
+                    self.gpu.wait_idle()?;
+                    self.drop_comparison();
+                }
+                let (left, right) = self.comparison.labels(self.technique_name());
+                let text = match right {
+                    Some(right) => format!("{left} | {right}"),
+                    None => left,
+                };
+                self.say(text, false);
             }
             Action::ResetCamera => self.orbit.reset(),
             Action::ToggleHelp => self.view.help = !self.view.help,
@@ -155,6 +198,65 @@ impl Demo<'_> {
                 event_loop.exit();
             }
         }
+        Ok(())
+    }
+
+    /// Sets knob `index` to `value` (clamped to its range) everywhere it applies.
+    pub(super) fn set_knob(&mut self, index: usize, value: f32) -> Result<()> {
+        let Some(knob) = KNOBS.get(index) else {
+            return Ok(());
+        };
+        let value = value.clamp(knob.range.0, knob.range.1);
+        (knob.set)(&mut self.scene, &mut self.options.base, value);
+        // Values only (lights, material and profile tables): the next frame writes them into
+        // its per-frame slot. A new shape (two materials' parameters became equal, or apart)
+        // needs a new frame.
+        if knob.rebuild {
+            self.rebuild_pending = true;
+        }
+        self.values_changed()
+    }
+
+    /// Selects light `index` (when the scene has it).
+    pub(super) fn select_light(&mut self, index: usize) {
+        let Some(light) = self.scene.lights.get(index) else {
+            self.say("this scene has no such light".into(), false);
+            return;
+        };
+        let kind = controls::light_kind_name(light);
+        self.light = index;
+        self.say(format!("light {} ({kind}) selected", index + 1), false);
+    }
+
+    /// Moves the selected light one step in the camera's frame.
+    fn move_light(&mut self, dir: LightMove) -> Result<()> {
+        let (basis, distance) = (self.orbit.basis(), self.orbit.distance);
+        let Some(light) = self.scene.lights.get_mut(self.light) else {
+            self.say("this scene has no light".into(), false);
+            return Ok(());
+        };
+        if !controls::move_light(light, dir, basis, distance) {
+            self.say(
+                "a directional light has no position: it tilts left, right, up and down".into(),
+                false,
+            );
+            return Ok(());
+        }
+        let v = controls::light_vector(light);
+        let message = format!(
+            "light {} {} {:.3} {:.3} {:.3}",
+            self.light + 1,
+            if matches!(light.kind, crate::scene::LightKind::Directional { .. }) {
+                "direction"
+            } else {
+                "at"
+            },
+            v.x,
+            v.y,
+            v.z
+        );
+        self.values_changed()?;
+        self.say(message, false);
         Ok(())
     }
 
@@ -239,8 +341,28 @@ impl Demo<'_> {
     }
 }
 
+/// Whether holding `code` repeats its action (steps of a value; toggles do not repeat).
+fn repeats(code: KeyCode) -> bool {
+    matches!(
+        code,
+        KeyCode::Equal
+            | KeyCode::Minus
+            | KeyCode::ArrowLeft
+            | KeyCode::ArrowRight
+            | KeyCode::ArrowUp
+            | KeyCode::ArrowDown
+            | KeyCode::BracketLeft
+            | KeyCode::BracketRight
+    )
+}
+
 /// The action of a key press (camera keys are held, not actions).
 pub(super) fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
+    controls::action_named(key_name(code, shift)?)
+}
+
+/// The name (as the key list and scripts write it) of a key press, if it has an action.
+fn key_name(code: KeyCode, shift: bool) -> Option<&'static str> {
     let name = match code {
         KeyCode::F1 => "F1",
         KeyCode::KeyT if shift => "Shift+T",
@@ -252,6 +374,19 @@ pub(super) fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Digit3 | KeyCode::Numpad3 => "3",
         KeyCode::Digit4 | KeyCode::Numpad4 => "4",
         KeyCode::Digit5 | KeyCode::Numpad5 => "5",
+        KeyCode::Digit6 | KeyCode::Numpad6 => "6",
+        KeyCode::KeyL if shift => "Shift+L",
+        KeyCode::KeyL => "L",
+        KeyCode::ArrowLeft => "Left",
+        KeyCode::ArrowRight => "Right",
+        KeyCode::ArrowUp if shift => "Shift+Up",
+        KeyCode::ArrowUp => "Up",
+        KeyCode::ArrowDown if shift => "Shift+Down",
+        KeyCode::ArrowDown => "Down",
+        KeyCode::BracketRight => "]",
+        KeyCode::BracketLeft => "[",
+        KeyCode::KeyC => "C",
+        KeyCode::KeyX => "X",
         KeyCode::Equal | KeyCode::NumpadAdd | KeyCode::PageUp => "+",
         KeyCode::Minus | KeyCode::NumpadSubtract | KeyCode::PageDown => "-",
         KeyCode::KeyR => "R",
@@ -262,5 +397,99 @@ pub(super) fn key_action(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Escape => "Esc",
         _ => return None,
     };
-    controls::action_named(name)
+    Some(name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::demo::controls::Comparison;
+
+    #[test]
+    fn every_key_of_the_list_has_a_keyboard_key_and_back() {
+        let codes = [
+            KeyCode::F1,
+            KeyCode::KeyT,
+            KeyCode::KeyP,
+            KeyCode::KeyV,
+            KeyCode::Digit1,
+            KeyCode::Digit2,
+            KeyCode::Digit3,
+            KeyCode::Digit4,
+            KeyCode::Digit5,
+            KeyCode::Digit6,
+            KeyCode::Equal,
+            KeyCode::Minus,
+            KeyCode::KeyL,
+            KeyCode::ArrowLeft,
+            KeyCode::ArrowRight,
+            KeyCode::ArrowUp,
+            KeyCode::ArrowDown,
+            KeyCode::BracketLeft,
+            KeyCode::BracketRight,
+            KeyCode::KeyC,
+            KeyCode::KeyX,
+            KeyCode::KeyR,
+            KeyCode::KeyH,
+            KeyCode::KeyI,
+            KeyCode::F5,
+            KeyCode::F12,
+            KeyCode::Escape,
+        ];
+        let mut named: Vec<&str> = Vec::new();
+        for code in codes {
+            for shift in [false, true] {
+                let name = key_name(code, shift).unwrap_or_else(|| panic!("{code:?}"));
+                assert_eq!(
+                    key_action(code, shift),
+                    controls::action_named(name),
+                    "{name}"
+                );
+                named.push(name);
+            }
+        }
+        // Every key of the list is reachable from the keyboard.
+        for k in controls::KEYS {
+            assert!(named.contains(&k.name), "no keyboard key for {}", k.name);
+        }
+        assert_eq!(
+            key_action(KeyCode::ArrowUp, true),
+            Some(Action::MoveLight(LightMove::Forward))
+        );
+        assert_eq!(
+            key_action(KeyCode::ArrowUp, false),
+            Some(Action::MoveLight(LightMove::Up))
+        );
+        assert_eq!(key_action(KeyCode::KeyL, true), Some(Action::PreviousLight));
+        assert_eq!(key_action(KeyCode::KeyC, false), Some(Action::ToggleSplit));
+        assert_eq!(
+            key_action(KeyCode::KeyX, false),
+            Some(Action::ToggleDifference)
+        );
+        assert_eq!(key_action(KeyCode::KeyW, false), None);
+        // Steps repeat while held; toggles do not.
+        assert!(repeats(KeyCode::ArrowLeft) && repeats(KeyCode::BracketRight));
+        assert!(!repeats(KeyCode::KeyC) && !repeats(KeyCode::KeyT));
+    }
+
+    #[test]
+    fn comparison_labels_say_which_side_is_which() {
+        let split = Comparison {
+            split: true,
+            difference: false,
+        };
+        let (left, right) = split.labels("translucency");
+        assert_eq!(left, "left: plain lighting (none)");
+        assert_eq!(right.as_deref(), Some("right: translucency"));
+        let both = Comparison {
+            split: true,
+            difference: true,
+        };
+        assert!(both
+            .labels("lbb")
+            .1
+            .unwrap()
+            .contains("difference |lbb - plain| x4"));
+        assert!(!Comparison::default().active());
+    }
 }

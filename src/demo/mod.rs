@@ -1,25 +1,32 @@
-//! The interactive demo (`lucent demo`): a window to fly around a scene in, switch techniques,
-//! turn the knobs and watch the per-pass GPU times move. Built with the `window` feature.
+//! The interactive demo (`lucent demo`): a window to fly around a scene in, switch techniques
+//! and scenes, move the lights, turn the knobs, compare the technique with plain lighting and
+//! watch the per-pass GPU times move. Built with the `window` feature.
 //!
 //! - [`present`]: surface, swapchain, per-frame submit and present (resize, minimize,
-//!   `OUT_OF_DATE`/`SUBOPTIMAL`, bounded waits).
-//! - [`controls`]: the orbit/fly camera, the knobs, the key list (no window needed).
+//!   `OUT_OF_DATE`/`SUBOPTIMAL`, bounded waits), the panel drawn over the frame.
+//! - [`controls`]: the orbit/fly camera, light moves, the knobs, the comparison views, the key
+//!   list (no window needed).
 //! - `input`: window events, keys and the mouse, and script commands, turned into actions.
-//! - [`overlay`]: on-screen text rasterized on the CPU.
+//! - `panel`: the egui panel (pickers, sliders, the timing table) and the comparison labels.
+//! - [`compare`]: the split and difference views' pass (plain lighting against the technique).
 //! - [`script`]: `--script FILE`, scripted input for tests.
 //! - [`watch`]: shader hot reload's file polling.
 //!
-//! The frame itself is the ordinary [`Renderer`]: it is rebuilt on resize, on a technique
-//! change, on a knob change that changes the frame's shape (a pow form) and when a file under
-//! the GLSL root changes; knobs that change only values (lights, translucency parameters, SSS
-//! width and sensitivity) are written into the next frame's per-frame parameters without
-//! re-uploading the scene. A rebuild that fails (a shader typo) keeps the previous renderer
-//! running and shows the error. Layering: the binary calls
-//! this module, which uses the renderer and passes; nothing below knows about windows.
+//! The frame itself is the ordinary [`Renderer`]: it is rebuilt on resize, on a technique or
+//! scene change, on a knob change that changes the frame's shape (a pow form) and when a file
+//! under the GLSL root changes; changes of values only (light positions and intensities,
+//! translucency parameters, SSS width and sensitivity) are written into the next frame's
+//! per-frame parameters without re-uploading the scene (the light-space shadow maps are drawn
+//! every frame from those parameters, so a moved light's shadow follows it). While a
+//! comparison view is on, a second renderer with technique `none` renders the same view and is
+//! rebuilt with the first. A rebuild that fails (a shader typo, a scene that cannot be built)
+//! keeps the previous renderer (and scene) running and shows the error. Layering: the binary
+//! calls this module, which uses the renderer and passes; nothing below knows about windows.
 
+pub mod compare;
 pub mod controls;
 mod input;
-pub mod overlay;
+mod panel;
 pub mod present;
 pub mod script;
 pub mod watch;
@@ -45,9 +52,10 @@ use crate::images::output;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-use controls::{OrbitCamera, KNOBS};
-use overlay::{Panel, TextRenderer, Tone};
-use present::{Drawn, Presenter};
+use compare::Comparer;
+use controls::{Comparison, OrbitCamera};
+use panel::{Gui, PanelAction};
+use present::{Drawn, FrameInput, Presenter, UiFrame};
 use script::Script;
 use watch::ShaderWatcher;
 
@@ -78,7 +86,7 @@ pub struct DemoOptions {
     pub frames: Option<u64>,
     /// Scripted input.
     pub script: Option<PathBuf>,
-    /// Write the last frame (without the overlay) here on exit.
+    /// Write the last frame (what the window shows, without the panel) here on exit.
     pub screenshot: Option<PathBuf>,
     /// Validation layer (also `LUCENT_VALIDATION=1`).
     pub validation: bool,
@@ -129,23 +137,6 @@ pub fn run(options: DemoOptions) -> Result<()> {
         crate::LucentError::InvalidInput("hot reload needs a run-time shader compiler".into())
     })?;
     let pipeline_cache = PipelineCache::load_default(&gpu)?;
-    // The monospaced sibling of the plot font when there is one (fonts-dejavu-core has both):
-    // the timing columns line up.
-    let font = crate::font::font_file().map(|p| {
-        let mono = p.with_file_name("DejaVuSansMono.ttf");
-        if mono.is_file() {
-            mono
-        } else {
-            p
-        }
-    });
-    let text = match font.and_then(|p| TextRenderer::load(&p)) {
-        Ok(t) => Some(t),
-        Err(e) => {
-            log::warn!("no on-screen text: {e}");
-            None
-        }
-    };
     // Default: what the scene's materials ask for.
     let technique = options.technique.unwrap_or(Technique::Auto);
     let orbit = OrbitCamera::from_camera(&scene.camera);
@@ -155,12 +146,17 @@ pub fn run(options: DemoOptions) -> Result<()> {
         shaders: &shaders,
         pipeline_cache: &pipeline_cache,
         watcher: ShaderWatcher::new(glsl_root),
-        text,
+        gui: None,
         technique,
         debug_view: None,
         isolated: false,
         runner: None,
         scene,
+        previous_scene: None,
+        light: 0,
+        comparison: Comparison::default(),
+        plain: None,
+        comparer: None,
         orbit,
         script,
         options,
@@ -221,7 +217,7 @@ struct Input {
     cursor: Option<(f64, f64)>,
 }
 
-/// What the overlay shows besides the timings.
+/// What the panel shows besides the timings.
 #[derive(Default)]
 struct View {
     help: bool,
@@ -230,8 +226,6 @@ struct View {
     /// The latest message and whether it is an error (shader compile errors stay until a
     /// rebuild succeeds).
     message: Option<(String, bool)>,
-    panel: Option<Panel>,
-    panel_text: Vec<(String, Tone)>,
 }
 
 /// Pass times averaged over the frames since the last refresh.
@@ -303,7 +297,8 @@ struct Demo<'a> {
     shaders: &'a ShaderCompiler,
     pipeline_cache: &'a PipelineCache,
     watcher: ShaderWatcher,
-    text: Option<TextRenderer>,
+    /// The panel's egui state (created with the window).
+    gui: Option<Gui>,
     technique: Technique,
     debug_view: Option<DebugView>,
     /// Isolated timing (each physical pass its own submission) instead of in-frame.
@@ -311,6 +306,17 @@ struct Demo<'a> {
     /// Runs the isolated frames (sized for the current renderer's passes).
     runner: Option<FrameRunner>,
     scene: Scene,
+    /// The scene and camera before a scene switch, until the new scene's renderer is built (a
+    /// failed build goes back to them).
+    previous_scene: Option<(Scene, OrbitCamera)>,
+    /// The selected light (index into `scene.lights`).
+    light: usize,
+    /// The comparison view shown.
+    comparison: Comparison,
+    /// Plain lighting (technique `none`) of the same view, while a comparison is shown.
+    plain: Option<Renderer>,
+    /// The comparison pass, while a comparison is shown.
+    comparer: Option<Comparer>,
     orbit: OrbitCamera,
     script: Option<Script>,
     options: DemoOptions,
@@ -402,6 +408,7 @@ impl Demo<'_> {
         .map_err(|e| LucentError::vulkan("vkCreate*SurfaceKHR", e))?;
         let size = window.inner_size();
         self.window_zero = size.width == 0 || size.height == 0;
+        self.gui = Some(Gui::new(&window));
         self.window = Some(window);
         let presenter = Presenter::new(
             self.gpu,
@@ -476,7 +483,13 @@ impl Demo<'_> {
         }
         self.minimized_since = None;
         event_loop.set_control_flow(ControlFlow::Poll);
-        if self.rebuild_pending || self.renderer.is_none() {
+        self.stats.refresh();
+        let ui = self.run_ui(event_loop)?;
+        if self.done {
+            return Ok(());
+        }
+        let plain_missing = self.comparison.active() && self.plain.is_none();
+        if self.rebuild_pending || self.renderer.is_none() || plain_missing {
             self.rebuild_pending = false;
             self.rebuild()?;
         }
@@ -485,7 +498,9 @@ impl Demo<'_> {
             return Ok(());
         };
         renderer.update(&self.scene)?;
-        let panel = self.overlay_panel();
+        if let Some(plain) = self.plain.as_mut() {
+            plain.update(&self.scene)?;
+        }
         let (Some(presenter), Some(renderer)) = (self.presenter.as_mut(), self.renderer.as_ref())
         else {
             return Ok(());
@@ -495,7 +510,19 @@ impl Demo<'_> {
             (true, Some(runner)) => Some(runner.run_isolated(self.gpu, &renderer.executable)?),
             _ => None,
         };
-        match presenter.draw(self.gpu, renderer, panel.as_ref(), isolated.is_none())? {
+        let compare = match (self.plain.as_ref(), self.comparer.as_mut()) {
+            (Some(plain), Some(comparer)) if self.comparison.active() => {
+                Some((plain, comparer, self.comparison))
+            }
+            _ => None,
+        };
+        let input = FrameInput {
+            renderer,
+            render: isolated.is_none(),
+            compare,
+            ui,
+        };
+        match presenter.draw(self.gpu, input)? {
             Drawn::OutOfDate => self.swapchain_stale = true,
             Drawn::Presented { passes, stale } => {
                 let passes = isolated.map_or(passes, |t| t.passes);
@@ -555,8 +582,10 @@ impl Demo<'_> {
             .map_or((0, 0), |w| (w.inner_size().width, w.inner_size().height))
     }
 
-    /// Builds the renderer for the current size, technique and scene. A failure keeps the
-    /// previous renderer (if any) and shows the error; without a previous one it is fatal.
+    /// Builds the renderer for the current size, technique and scene, and, while a comparison
+    /// is shown, the plain-lighting renderer and the comparison pass. A failure keeps the
+    /// previous renderers (if any) and the previous scene (after a scene switch) and shows the
+    /// error; without a previous renderer it is fatal.
     fn rebuild(&mut self) -> Result<()> {
         let Some(presenter) = self.presenter.as_ref() else {
             return Ok(());
@@ -570,14 +599,8 @@ impl Demo<'_> {
         };
         self.orbit.apply(&mut self.scene.camera);
         let started = Instant::now();
-        match Renderer::new(
-            self.gpu,
-            self.shaders,
-            self.pipeline_cache,
-            &self.scene,
-            settings,
-        ) {
-            Ok(new) => {
+        match self.build(settings) {
+            Ok((new, compared)) => {
                 self.gpu.wait_idle()?;
                 let runner = FrameRunner::new(self.gpu, new.executable.plan.physical.len());
                 if let Some(old) = self.runner.take() {
@@ -586,29 +609,112 @@ impl Demo<'_> {
                 if let Some(old) = self.renderer.replace(new) {
                     old.destroy(self.gpu);
                 }
+                self.drop_comparison();
+                if let Some((plain, comparer)) = compared {
+                    self.plain = Some(plain);
+                    self.comparer = Some(comparer);
+                }
+                self.previous_scene = None;
                 self.runner = Some(runner?);
                 self.stats.clear();
                 if self.view.message.as_ref().is_some_and(|(_, error)| *error) {
                     self.view.message = None;
                 }
                 log::info!(
-                    "renderer {}x{} {} built in {:.0} ms",
+                    "renderer {}x{} {} built in {:.0} ms{}",
                     settings.width,
                     settings.height,
                     settings.technique.name(),
-                    started.elapsed().as_secs_f64() * 1e3
+                    started.elapsed().as_secs_f64() * 1e3,
+                    if self.plain.is_some() {
+                        " (with plain lighting for the comparison)"
+                    } else {
+                        ""
+                    }
                 );
                 Ok(())
             }
             Err(e @ (LucentError::DeviceLost { .. } | LucentError::SurfaceLost { .. })) => Err(e),
             Err(e) if self.renderer.is_some() => {
+                let scene = match self.previous_scene.take() {
+                    Some((scene, orbit)) => {
+                        let failed = std::mem::replace(&mut self.scene, scene);
+                        self.orbit = orbit;
+                        self.light = self.light.min(self.scene.lights.len().saturating_sub(1));
+                        self.set_title();
+                        format!(
+                            " (back to scene {}, {} failed)",
+                            self.scene.name, failed.name
+                        )
+                    }
+                    None => String::new(),
+                };
+                if self.comparison.active() && self.plain.is_none() {
+                    // The comparison cannot be shown without its renderer.
+                    self.comparison = Comparison::default();
+                }
                 self.say(
-                    format!("rebuild failed, the previous frame keeps running:\n{e}"),
+                    format!("rebuild failed, the previous frame keeps running{scene}:\n{e}"),
                     true,
                 );
                 Ok(())
             }
             Err(e) => Err(e),
+        }
+    }
+
+    /// The renderer for `settings` and, while a comparison is shown, the plain-lighting
+    /// renderer of the same view and the comparison pass.
+    fn build(&self, settings: FrameSettings) -> Result<(Renderer, Option<(Renderer, Comparer)>)> {
+        let new = |settings| {
+            Renderer::new(
+                self.gpu,
+                self.shaders,
+                self.pipeline_cache,
+                &self.scene,
+                settings,
+            )
+        };
+        let renderer = new(settings)?;
+        if !self.comparison.active() {
+            return Ok((renderer, None));
+        }
+        let plain_settings = FrameSettings {
+            technique: Technique::None,
+            debug_view: None,
+            ..settings
+        };
+        let compared = new(plain_settings).and_then(|plain| {
+            match Comparer::new(self.gpu, self.shaders, self.pipeline_cache) {
+                Ok(comparer) => Ok((plain, comparer)),
+                Err(e) => {
+                    plain.destroy(self.gpu);
+                    Err(e)
+                }
+            }
+        });
+        match compared {
+            Ok(c) => Ok((renderer, Some(c))),
+            Err(e) => {
+                renderer.destroy(self.gpu);
+                Err(e)
+            }
+        }
+    }
+
+    /// Destroys the comparison's renderer and pass (the GPU is idle).
+    fn drop_comparison(&mut self) {
+        if let Some(old) = self.plain.take() {
+            old.destroy(self.gpu);
+        }
+        if let Some(old) = self.comparer.take() {
+            old.destroy(self.gpu);
+        }
+    }
+
+    fn set_title(&self) {
+        if let Some(window) = &self.window {
+            window.set_title(&format!("lucent demo — {}", self.scene.name));
         }
     }
 
@@ -644,132 +750,126 @@ impl Demo<'_> {
             .find(|v| self.view_available(*v))
     }
 
+    /// Writes what the window shows without the panel: the frame, or the comparison.
     fn write_screenshot(&mut self, path: &std::path::Path) -> Result<()> {
-        let Some(renderer) = self.renderer.as_ref() else {
-            return Ok(());
+        let compared = match (self.comparison.active(), self.comparer.as_ref()) {
+            (true, Some(comparer)) => comparer.read(self.gpu)?,
+            _ => None,
         };
-        let (w, h) = (renderer.settings.width, renderer.settings.height);
-        output::write_png_rgba8(path, w, h, &renderer.read_display(self.gpu)?)?;
+        let (w, h, pixels) = match compared {
+            Some(c) => c,
+            None => {
+                let Some(renderer) = self.renderer.as_ref() else {
+                    return Ok(());
+                };
+                (
+                    renderer.settings.width,
+                    renderer.settings.height,
+                    renderer.read_display(self.gpu)?,
+                )
+            }
+        };
+        output::write_png_rgba8(path, w, h, &pixels)?;
         self.say(format!("wrote {} ({w}x{h})", path.display()), false);
         println!("wrote {} ({w}x{h})", path.display());
         Ok(())
     }
 
-    /// The overlay's lines, re-rasterized only when they changed.
-    fn overlay_panel(&mut self) -> Option<Panel> {
-        if self.view.hidden {
-            return None;
+    /// Builds this frame's panel from the window's input and applies what the user changed in
+    /// it. `None` without a window.
+    fn run_ui(&mut self, event_loop: &ActiveEventLoop) -> Result<Option<UiFrame>> {
+        let (Some(window), Some(gui)) = (self.window.as_ref(), self.gui.as_mut()) else {
+            return Ok(None);
+        };
+        let raw = gui.state.take_egui_input(window);
+        let ctx = gui.ctx.clone();
+        let mut actions = Vec::new();
+        let output = ctx.run_ui(raw, |ui| self.panel_ui(ui, &mut actions));
+        if let (Some(window), Some(gui)) = (self.window.as_ref(), self.gui.as_mut()) {
+            gui.state
+                .handle_platform_output(window, output.platform_output);
         }
-        let text = self.text.as_ref()?;
-        let presenter = self.presenter.as_ref()?;
-        let refreshed = self.stats.refresh();
-        if !refreshed && self.view.panel.is_some() && !self.view.panel_text.is_empty() {
-            let lines = self.overlay_lines();
-            if lines == self.view.panel_text {
-                return self.view.panel.clone();
+        let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);
+        match self.presenter.as_mut() {
+            Some(presenter) => presenter.queue_textures(output.textures_delta),
+            None => {
+                let mut unused = output.textures_delta;
+                unused.clear();
             }
         }
-        let lines = self.overlay_lines();
-        let extent = presenter.extent;
-        self.view.panel = text.render(
-            &lines,
-            extent.width,
-            extent.height,
-            present::is_bgra(presenter.format()),
-        );
-        self.view.panel_text = lines;
-        self.view.panel.clone()
+        for action in actions {
+            self.apply_panel(event_loop, action)?;
+        }
+        Ok(Some(UiFrame {
+            primitives,
+            pixels_per_point: output.pixels_per_point,
+        }))
     }
 
-    fn overlay_lines(&self) -> Vec<(String, Tone)> {
-        let mut lines = Vec::new();
-        let (w, h) = self
-            .presenter
-            .as_ref()
-            .map_or((0, 0), |p| (p.extent.width, p.extent.height));
-        let mode = self
-            .presenter
-            .as_ref()
-            .map_or("?".to_string(), |p| format!("{:?}", p.present_mode));
-        lines.push((
-            format!(
-                "{} — technique {} (T) — {w}x{h} — {mode} — F1 keys",
-                self.scene.name,
-                self.technique.name()
-            ),
-            Tone::Accent,
-        ));
-        lines.push((
-            format!(
-                "GPU ms per pass, {} (I), mean of {} frames:",
-                if self.isolated {
-                    "isolated: each pass its own submission"
-                } else {
-                    "in-frame timestamps"
-                },
-                self.stats.shown_frames
-            ),
-            Tone::Normal,
-        ));
-        let mut total = 0.0;
-        for (name, ms) in &self.stats.shown {
-            total += ms;
-            lines.push((format!("  {name:<22} {ms:8.3}"), Tone::Normal));
-        }
-        lines.push((
-            format!("  {:<22} {total:8.3}", "sum of passes"),
-            Tone::Normal,
-        ));
-        lines.push((
-            format!(
-                "  {:<22} {:8.3}   ({:.1} fps)",
-                "frame (CPU wall)",
-                self.stats.shown_wall,
-                if self.stats.shown_wall > 0.0 {
-                    1e3 / self.stats.shown_wall
-                } else {
-                    0.0
-                }
-            ),
-            Tone::Normal,
-        ));
-        let knob = &KNOBS[self.view.knob];
-        let value = (knob.get)(&self.scene, &self.options.base)
-            .map_or("not used by this scene".to_string(), |v| format!("{v:.4}"));
-        lines.push((
-            format!(
-                "knob {} ({}): {value}   (+/-)",
-                self.view.knob + 1,
-                knob.name
-            ),
-            Tone::Normal,
-        ));
-        let shown = self.renderer.as_ref().and_then(|r| r.settings.debug_view);
-        lines.push((
-            format!("view (V): {}", shown.map_or("frame", DebugView::name)),
-            Tone::Normal,
-        ));
-        if let Some(mode) = controls::pow_mode(&self.scene) {
-            let name = controls::POW_MODES
-                .iter()
-                .find(|(m, _)| *m == mode)
-                .map_or("?", |(_, n)| n);
-            lines.push((format!("pow form (P): {name}"), Tone::Normal));
-        }
-        if let Some((message, error)) = &self.view.message {
-            let tone = if *error { Tone::Error } else { Tone::Normal };
-            for line in message.lines().take(12) {
-                lines.push((line.to_string(), tone));
+    /// Carries out a change made in the panel.
+    fn apply_panel(&mut self, event_loop: &ActiveEventLoop, action: PanelAction) -> Result<()> {
+        match action {
+            PanelAction::Act(action) => self.act(event_loop, action)?,
+            PanelAction::Technique(technique) => {
+                self.technique = technique;
+                self.rebuild_pending = true;
             }
+            PanelAction::Scene(name) => self.switch_scene(&name),
+            PanelAction::SelectLight(i) => self.select_light(i),
+            PanelAction::LightVector(v) => {
+                if let Some(light) = self.scene.lights.get_mut(self.light) {
+                    controls::set_light_vector(light, v);
+                    self.values_changed()?;
+                }
+            }
+            PanelAction::LightIntensity(intensity) => {
+                if let Some(light) = self.scene.lights.get_mut(self.light) {
+                    light.intensity =
+                        intensity.clamp(controls::INTENSITY_RANGE.0, controls::INTENSITY_RANGE.1);
+                    self.values_changed()?;
+                }
+            }
+            PanelAction::Knob(i, value) => self.set_knob(i, value)?,
         }
-        if self.view.help {
-            lines.extend(
-                controls::help_lines()
-                    .into_iter()
-                    .map(|l| (l, Tone::Accent)),
-            );
+        Ok(())
+    }
+
+    /// Loads built-in scene `name` and rebuilds; an error is shown, and the current scene
+    /// stays.
+    fn switch_scene(&mut self, name: &str) {
+        match crate::bake::scene::load_scene_baked(name) {
+            Ok(mut scene) => {
+                let orbit = OrbitCamera::from_camera(&scene.camera);
+                orbit.apply(&mut scene.camera);
+                let old_scene = std::mem::replace(&mut self.scene, scene);
+                let old_orbit = std::mem::replace(&mut self.orbit, orbit);
+                // Kept until the new scene's renderer is built (see `rebuild`).
+                if self.previous_scene.is_none() {
+                    self.previous_scene = Some((old_scene, old_orbit));
+                }
+                self.light = 0;
+                self.rebuild_pending = true;
+                self.set_title();
+                self.say(format!("scene {name}"), false);
+            }
+            Err(e) => self.say(format!("scene {name} not loaded: {e}"), true),
         }
-        lines
+    }
+
+    /// After a change of values only (a light, a knob): the next frame writes them into its
+    /// per-frame parameters, unless the frame's shape changed with them (then it is rebuilt).
+    fn values_changed(&mut self) -> Result<()> {
+        let mut in_place = true;
+        for r in [self.renderer.as_mut(), self.plain.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            in_place &= r.retune(&self.options.base) && r.can_update(&self.scene)?;
+        }
+        if !in_place {
+            self.rebuild_pending = true;
+        }
+        Ok(())
     }
 
     /// Writes `--screenshot`, prints the final state, and tears down the GPU objects in order.
@@ -804,6 +904,22 @@ impl Demo<'_> {
                     c.target.z
                 );
             }
+            for (i, light) in self.scene.lights.iter().enumerate() {
+                let v = controls::light_vector(light);
+                println!(
+                    "demo light {}: {} {} {:.5} {:.5} {:.5} intensity {:.5}",
+                    i + 1,
+                    controls::light_kind_name(light),
+                    match light.kind {
+                        crate::scene::LightKind::Directional { .. } => "direction",
+                        _ => "position",
+                    },
+                    v.x,
+                    v.y,
+                    v.z,
+                    light.intensity
+                );
+            }
             if let Some(script) = &self.script {
                 if !script.finished() {
                     log::warn!("the demo ended before the script's last commands");
@@ -817,6 +933,7 @@ impl Demo<'_> {
         if let Some(r) = self.renderer.take() {
             r.destroy(self.gpu);
         }
+        self.drop_comparison();
         if let Some(p) = self.presenter.take() {
             p.destroy(self.gpu);
         }

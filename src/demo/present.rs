@@ -3,9 +3,13 @@
 //! One frame is in flight at a time: the frame's fence is waited for before the next one is
 //! recorded, which is what [`Renderer::update`] needs (the uniforms are written between frames)
 //! and what makes every rebuild and resize safe (nothing is pending when objects are replaced).
-//! Each frame records the renderer's whole frame, blits its display image (RGBA8, sRGB-encoded)
-//! onto the acquired swapchain image (a UNORM format, so the bytes are shown as they are),
-//! copies the overlay panel over its top-left corner, and transitions it for presentation.
+//! Each frame records the renderer's whole frame (and, for a comparison view, the plain-lighting
+//! renderer's frame and the comparison pass, [`super::compare`]), blits the result (RGBA8,
+//! sRGB-encoded) onto the acquired swapchain image (a UNORM format, so the bytes are shown as
+//! they are), draws the panel over it with egui-ash-renderer in a render pass of its own
+//! (load, draw, store), and transitions it for presentation. egui's textures (the font atlas)
+//! are uploaded before the frame is recorded (egui-ash-renderer submits and waits for its own
+//! copies) and freed after the frame is done.
 //!
 //! Sizes: the swapchain follows the surface's current extent (or the window's size where the
 //! surface leaves it to the application). A zero extent (a minimized window) creates no
@@ -19,15 +23,16 @@
 //! [`LucentError::SurfaceLost`].
 
 use ash::vk;
-use gpu_allocator::MemoryLocation;
+use egui_ash_renderer::allocator::DefaultAllocator;
 
 use crate::backend::timer::{GpuTimer, ScopeTime};
-use crate::backend::{GpuBuffer, GpuContext};
+use crate::backend::GpuContext;
 use crate::error::VkResultExt;
 use crate::frame::Renderer;
 use crate::{LucentError, Result};
 
-use super::overlay::Panel;
+use super::compare::Comparer;
+use super::controls::Comparison;
 
 /// Longest wait for a swapchain image, nanoseconds.
 pub const ACQUIRE_TIMEOUT_NS: u64 = 5_000_000_000;
@@ -53,6 +58,29 @@ pub enum Drawn {
     OutOfDate,
 }
 
+/// The panel of one frame: egui's triangles (its texture changes go through
+/// [`Presenter::queue_textures`]).
+pub struct UiFrame {
+    /// What to draw, in points.
+    pub primitives: Vec<egui::ClippedPrimitive>,
+    /// Pixels per point.
+    pub pixels_per_point: f32,
+}
+
+/// What one frame puts on the window.
+pub struct FrameInput<'a> {
+    /// The frame with the current technique.
+    pub renderer: &'a Renderer,
+    /// Record that frame here (false: the caller rendered it already, pass by pass, for
+    /// isolated timing).
+    pub render: bool,
+    /// A comparison view: the plain-lighting renderer (same view and size), the comparison
+    /// pass, and what it shows. Its frame is recorded here, untimed.
+    pub compare: Option<(&'a Renderer, &'a mut Comparer, Comparison)>,
+    /// The panel, drawn over the frame.
+    pub ui: Option<UiFrame>,
+}
+
 /// The window's surface, its swapchain, and what a frame needs to reach it.
 pub struct Presenter {
     surface_fn: ash::khr::surface::Instance,
@@ -71,11 +99,24 @@ pub struct Presenter {
     /// again once the presentation that waited on it is known to be done (it is, once the same
     /// image was acquired again).
     rendered: Vec<vk::Semaphore>,
+    /// One view and framebuffer per swapchain image, for the panel's render pass.
+    views: Vec<vk::ImageView>,
+    framebuffers: Vec<vk::Framebuffer>,
+    /// The panel's render pass (one colour attachment in the swapchain's format: load, store)
+    /// and the format it was made for.
+    render_pass: vk::RenderPass,
+    render_pass_format: vk::Format,
+    /// Draws the panel; created with the first render pass.
+    egui: Option<egui_ash_renderer::Renderer<DefaultAllocator>>,
+    /// egui-ash-renderer's texture uploads allocate their command buffers here.
+    upload_pool: vk::CommandPool,
+    /// egui's texture changes not applied yet: new textures go in before the next frame that
+    /// is drawn, freed ones after it.
+    textures: egui::TexturesDelta,
     pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
     timer: Option<(GpuTimer, u32)>,
-    overlay: Option<GpuBuffer>,
 }
 
 impl Presenter {
@@ -123,11 +164,17 @@ impl Presenter {
             vsync,
             acquired: vk::Semaphore::null(),
             rendered: Vec::new(),
+            views: Vec::new(),
+            framebuffers: Vec::new(),
+            render_pass: vk::RenderPass::null(),
+            render_pass_format: vk::Format::UNDEFINED,
+            egui: None,
+            upload_pool: vk::CommandPool::null(),
+            textures: egui::TexturesDelta::default(),
             pool: vk::CommandPool::null(),
             cmd: vk::CommandBuffer::null(),
             fence: vk::Fence::null(),
             timer: None,
-            overlay: None,
         };
         // From here on `destroy` cleans up whatever exists.
         match presenter
@@ -150,6 +197,14 @@ impl Presenter {
                 .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
                 .vk("vkCreateSemaphore")?;
             self.pool = device
+                .create_command_pool(
+                    &vk::CommandPoolCreateInfo::default()
+                        .queue_family_index(gpu.queue_family)
+                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+                    None,
+                )
+                .vk("vkCreateCommandPool")?;
+            self.upload_pool = device
                 .create_command_pool(
                     &vk::CommandPoolCreateInfo::default()
                         .queue_family_index(gpu.queue_family)
@@ -221,6 +276,7 @@ impl Presenter {
         } else {
             extent
         };
+        self.destroy_framebuffers(gpu);
         let old = std::mem::replace(&mut self.swapchain, vk::SwapchainKHR::null());
         self.images.clear();
         self.extent = vk::Extent2D::default();
@@ -232,13 +288,13 @@ impl Presenter {
             }
             return Ok(());
         }
-        if !caps
-            .supported_usage_flags
-            .contains(vk::ImageUsageFlags::TRANSFER_DST)
-        {
+        let usage = vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::COLOR_ATTACHMENT;
+        if !caps.supported_usage_flags.contains(usage) {
             return Err(LucentError::MissingFeature {
                 device: gpu.info.name.clone(),
-                feature: "swapchain images that can be a transfer destination".into(),
+                feature: "swapchain images that can be a transfer destination and a colour \
+                          attachment"
+                    .into(),
             });
         }
         self.format = pick_format(&formats).ok_or_else(|| LucentError::MissingFeature {
@@ -266,7 +322,7 @@ impl Presenter {
             .image_color_space(self.format.color_space)
             .image_extent(extent)
             .image_array_layers(1)
-            .image_usage(vk::ImageUsageFlags::TRANSFER_DST)
+            .image_usage(usage)
             .image_sharing_mode(vk::SharingMode::EXCLUSIVE)
             .pre_transform(caps.current_transform)
             .composite_alpha(alpha)
@@ -285,6 +341,7 @@ impl Presenter {
         self.images = unsafe { self.swapchain_fn.get_swapchain_images(self.swapchain) }
             .vk("vkGetSwapchainImagesKHR")?;
         self.extent = extent;
+        self.create_framebuffers(gpu)?;
         while self.rendered.len() < self.images.len() {
             // SAFETY: valid device; destroyed in `destroy`.
             let semaphore = unsafe {
@@ -306,21 +363,121 @@ impl Presenter {
         Ok(())
     }
 
-    /// Renders `renderer`'s frame onto the next swapchain image with `overlay` on top, and
-    /// presents it. With `render` false the frame was already rendered (isolated timing: pass
-    /// by pass, by the caller) and only its display image is put on screen. The GPU is idle
-    /// when it returns.
-    pub fn draw(
-        &mut self,
-        gpu: &GpuContext,
-        renderer: &Renderer,
-        overlay: Option<&Panel>,
-        render: bool,
-    ) -> Result<Drawn> {
+    /// The panel's render pass for the swapchain's format (made again when the format
+    /// changes), egui's renderer for it, and one view and framebuffer per swapchain image.
+    fn create_framebuffers(&mut self, gpu: &GpuContext) -> Result<()> {
+        let device = &gpu.device;
+        if self.render_pass_format != self.format.format {
+            let attachments = [vk::AttachmentDescription::default()
+                .format(self.format.format)
+                .samples(vk::SampleCountFlags::TYPE_1)
+                .load_op(vk::AttachmentLoadOp::LOAD)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+                .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+                // The frame is blitted there first; `record` moves the image into and out of
+                // this layout with barriers of its own.
+                .initial_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .final_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)];
+            let color = [vk::AttachmentReference::default()
+                .attachment(0)
+                .layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)];
+            let subpasses = [vk::SubpassDescription::default()
+                .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+                .color_attachments(&color)];
+            // SAFETY: valid create info; the old render pass is unused (the GPU is idle in
+            // `recreate`) and destroyed after egui's pipeline moved to the new one.
+            let render_pass = unsafe {
+                device.create_render_pass(
+                    &vk::RenderPassCreateInfo::default()
+                        .attachments(&attachments)
+                        .subpasses(&subpasses),
+                    None,
+                )
+            }
+            .vk("vkCreateRenderPass")?;
+            let old = std::mem::replace(&mut self.render_pass, render_pass);
+            self.render_pass_format = self.format.format;
+            let mode = egui_ash_renderer::RenderMode::RenderPass(render_pass);
+            let egui = match self.egui.as_mut() {
+                Some(egui) => egui.set_render_mode(mode).map(|()| None),
+                None => egui_ash_renderer::Renderer::with_default_allocator(
+                    &gpu.instance,
+                    gpu.physical_device,
+                    gpu.device.clone(),
+                    mode,
+                    egui_ash_renderer::Options {
+                        in_flight_frames: 1,
+                        // A UNORM swapchain holding sRGB-encoded bytes: egui's shader encodes.
+                        srgb_framebuffer: false,
+                        ..Default::default()
+                    },
+                )
+                .map(Some),
+            }
+            .map_err(|e| LucentError::InvalidInput(format!("egui renderer: {e}")))?;
+            if let Some(egui) = egui {
+                self.egui = Some(egui);
+            }
+            if old != vk::RenderPass::null() {
+                // SAFETY: see above.
+                unsafe { device.destroy_render_pass(old, None) };
+            }
+        }
+        for &image in &self.images {
+            let info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(self.format.format)
+                .subresource_range(
+                    vk::ImageSubresourceRange::default()
+                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .level_count(1)
+                        .layer_count(1),
+                );
+            // SAFETY: the image is this swapchain's; the view is destroyed before it.
+            let view = unsafe { device.create_image_view(&info, None) }.vk("vkCreateImageView")?;
+            self.views.push(view);
+            let attachments = [view];
+            let info = vk::FramebufferCreateInfo::default()
+                .render_pass(self.render_pass)
+                .attachments(&attachments)
+                .width(self.extent.width)
+                .height(self.extent.height)
+                .layers(1);
+            // SAFETY: the view and render pass are alive; destroyed in `destroy_framebuffers`.
+            let framebuffer =
+                unsafe { device.create_framebuffer(&info, None) }.vk("vkCreateFramebuffer")?;
+            self.framebuffers.push(framebuffer);
+        }
+        Ok(())
+    }
+
+    /// Destroys the views and framebuffers of the swapchain's images (the GPU is idle).
+    fn destroy_framebuffers(&mut self, gpu: &GpuContext) {
+        // SAFETY: the GPU is idle (callers wait first); every handle is ours.
+        unsafe {
+            for f in self.framebuffers.drain(..) {
+                gpu.device.destroy_framebuffer(f, None);
+            }
+            for v in self.views.drain(..) {
+                gpu.device.destroy_image_view(v, None);
+            }
+        }
+    }
+
+    /// Takes egui's texture changes of a frame (applied around the next frame drawn).
+    pub fn queue_textures(&mut self, delta: egui::TexturesDelta) {
+        self.textures.append(delta);
+    }
+
+    /// Renders `frame` onto the next swapchain image with the panel on top, and presents it.
+    /// The GPU is idle when it returns.
+    pub fn draw(&mut self, gpu: &GpuContext, mut frame: FrameInput<'_>) -> Result<Drawn> {
         if self.is_zero_sized() {
             return Ok(Drawn::OutOfDate);
         }
-        let passes = renderer.executable.plan.physical.len() as u32 + 1;
+        let passes = frame.renderer.executable.plan.physical.len() as u32 + 1;
         if self
             .timer
             .as_ref()
@@ -331,6 +488,16 @@ impl Presenter {
                 old.destroy(gpu);
             }
             self.timer = Some((GpuTimer::new(gpu, passes)?, passes));
+        }
+        // egui's new textures first: egui-ash-renderer records, submits and waits for the
+        // copies itself (nothing of ours is pending: the previous frame was waited for).
+        if let Some(egui) = self.egui.as_mut() {
+            for (id, deltas) in std::mem::take(&mut self.textures.set) {
+                for delta in deltas {
+                    egui.set_texture(gpu.queue, self.upload_pool, id, &delta)
+                        .map_err(|e| LucentError::InvalidInput(format!("egui texture: {e}")))?;
+                }
+            }
         }
         // SAFETY: the swapchain and semaphore are valid; the semaphore is unsignalled (its last
         // signal was waited on by the previous frame's submission, which has completed).
@@ -353,12 +520,7 @@ impl Presenter {
             }
             Err(e) => return Err(LucentError::vulkan("vkAcquireNextImageKHR", e)),
         };
-        let image = self.images[index as usize];
-        let panel = match overlay {
-            Some(p) => self.upload_overlay(gpu, p)?,
-            None => None,
-        };
-        self.record(gpu, renderer, image, panel, render)?;
+        self.record(gpu, &mut frame, index as usize)?;
         let device = &gpu.device;
         let waits = [vk::SemaphoreSubmitInfo::default()
             .semaphore(self.acquired)
@@ -390,6 +552,13 @@ impl Presenter {
         }
         // SAFETY: the fence is signalled and no longer used by a pending submission.
         unsafe { device.reset_fences(&[self.fence]) }.vk("vkResetFences")?;
+        // The frame is done with the textures egui let go of.
+        if let Some(egui) = self.egui.as_mut() {
+            for id in std::mem::take(&mut self.textures.free) {
+                egui.free_texture(id)
+                    .map_err(|e| LucentError::InvalidInput(format!("egui texture: {e}")))?;
+            }
+        }
         let wait = [self.rendered[index as usize]];
         let swapchains = [self.swapchain];
         let indices = [index];
@@ -404,70 +573,18 @@ impl Presenter {
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => true,
             Err(e) => return Err(LucentError::vulkan("vkQueuePresentKHR", e)),
         };
-        let passes = match (&self.timer, render) {
+        let passes = match (&self.timer, frame.render) {
             (Some((timer, _)), true) => timer.results(gpu)?.unwrap_or_default(),
             _ => Vec::new(),
         };
         Ok(Drawn::Presented { passes, stale })
     }
 
-    /// Copies the panel into the host-visible overlay buffer; returns its size, clipped to the
-    /// swapchain, or `None` when it does not fit at all.
-    fn upload_overlay(&mut self, gpu: &GpuContext, panel: &Panel) -> Result<Option<(u32, u32)>> {
-        let width = panel.width.min(self.extent.width);
-        let height = panel.height.min(self.extent.height);
-        if width == 0
-            || height == 0
-            || panel.pixels.len() as u64 != u64::from(panel.width) * u64::from(panel.height) * 4
-        {
-            return Ok(None);
-        }
-        let bytes = u64::from(width) * u64::from(height) * 4;
-        if self.overlay.as_ref().is_none_or(|b| b.size < bytes) {
-            if let Some(old) = self.overlay.take() {
-                // The GPU is idle between frames.
-                gpu.destroy_buffer(old);
-            }
-            self.overlay = Some(gpu.create_buffer(
-                bytes.max(256 * 1024),
-                vk::BufferUsageFlags::TRANSFER_SRC,
-                MemoryLocation::CpuToGpu,
-                "demo overlay",
-            )?);
-        }
-        let mapped = self
-            .overlay
-            .as_mut()
-            .and_then(GpuBuffer::mapped_mut)
-            .ok_or_else(|| {
-                LucentError::InvalidInput("overlay buffer is not host-visible".into())
-            })?;
-        let row = width as usize * 4;
-        for y in 0..height as usize {
-            let src = y * panel.width as usize * 4;
-            mapped[y * row..(y + 1) * row].copy_from_slice(&panel.pixels[src..src + row]);
-        }
-        Ok(Some((width, height)))
-    }
-
-    fn record(
-        &mut self,
-        gpu: &GpuContext,
-        renderer: &Renderer,
-        target: vk::Image,
-        panel: Option<(u32, u32)>,
-        render: bool,
-    ) -> Result<()> {
+    fn record(&mut self, gpu: &GpuContext, frame: &mut FrameInput<'_>, index: usize) -> Result<()> {
         let device = &gpu.device;
         let cmd = self.cmd;
-        let display = renderer
-            .executable
-            .owned_image(renderer.outputs.display)
-            .ok_or_else(|| LucentError::Graph("the display image is not readable".into()))?;
-        let display_layout = renderer
-            .executable
-            .export_layout(renderer.outputs.display)
-            .unwrap_or(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        let target = self.images[index];
+        let renderer = frame.renderer;
         // SAFETY: the previous frame finished (its fence was waited for), so the pool's command
         // buffer is not pending.
         unsafe {
@@ -482,7 +599,7 @@ impl Presenter {
                 )
                 .vk("vkBeginCommandBuffer")?;
         }
-        if render {
+        if frame.render {
             let timer = self.timer.as_mut().map(|(t, _)| t);
             if let Some(t) = timer {
                 t.reset(gpu, cmd);
@@ -491,6 +608,38 @@ impl Presenter {
                 renderer.executable.record_frame(gpu, cmd, 0, None);
             }
         }
+        // What goes on screen: the frame's display image in its export layout, or the
+        // comparison's output.
+        let (source, source_layout, (w, h)) = match frame.compare.as_mut() {
+            Some((plain, comparer, comparison)) => {
+                gpu.begin_label(cmd, "plain lighting");
+                plain.executable.record_frame(gpu, cmd, 0, None);
+                gpu.end_label(cmd);
+                let image = comparer.record(gpu, cmd, plain, renderer, *comparison)?;
+                (
+                    image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    (renderer.settings.width, renderer.settings.height),
+                )
+            }
+            None => {
+                let display = renderer
+                    .executable
+                    .owned_image(renderer.outputs.display)
+                    .ok_or_else(|| {
+                        LucentError::Graph("the display image is not readable".into())
+                    })?;
+                let layout = renderer
+                    .executable
+                    .export_layout(renderer.outputs.display)
+                    .unwrap_or(vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                (
+                    display.image,
+                    layout,
+                    (display.desc.width, display.desc.height),
+                )
+            }
+        };
         gpu.begin_label(cmd, "present");
         let color = vk::ImageSubresourceRange::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
@@ -506,13 +655,19 @@ impl Presenter {
             .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
             .image(target)
             .subresource_range(color);
-        let (w, h) = (display.desc.width as i32, display.desc.height as i32);
         let layers = vk::ImageSubresourceLayers::default()
             .aspect_mask(vk::ImageAspectFlags::COLOR)
             .layer_count(1);
         let blit = vk::ImageBlit::default()
             .src_subresource(layers)
-            .src_offsets([vk::Offset3D::default(), vk::Offset3D { x: w, y: h, z: 1 }])
+            .src_offsets([
+                vk::Offset3D::default(),
+                vk::Offset3D {
+                    x: w as i32,
+                    y: h as i32,
+                    z: 1,
+                },
+            ])
             .dst_subresource(layers)
             .dst_offsets([
                 vk::Offset3D::default(),
@@ -522,8 +677,21 @@ impl Presenter {
                     z: 1,
                 },
             ]);
-        // SAFETY: recording; the display image is in its export layout (readable by transfer,
-        // made visible by the frame's export barrier), the target was just transitioned.
+        // The panel's render pass loads what the blit wrote.
+        let to_attachment = vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+            .dst_access_mask(
+                vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+            )
+            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .new_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .image(target)
+            .subresource_range(color);
+        // SAFETY: recording; the source is in `source_layout` and readable by transfer (the
+        // frame's export barrier, or the comparison's last barrier), the target was just
+        // transitioned.
         unsafe {
             device.cmd_pipeline_barrier2(
                 cmd,
@@ -531,59 +699,48 @@ impl Presenter {
             );
             device.cmd_blit_image(
                 cmd,
-                display.image,
-                display_layout,
+                source,
+                source_layout,
                 target,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &[blit],
                 vk::Filter::NEAREST,
             );
+            device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to_attachment]),
+            );
+            device.cmd_begin_render_pass(
+                cmd,
+                &vk::RenderPassBeginInfo::default()
+                    .render_pass(self.render_pass)
+                    .framebuffer(self.framebuffers[index])
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent: self.extent,
+                    }),
+                vk::SubpassContents::INLINE,
+            );
         }
-        if let (Some((pw, ph)), Some(buffer)) = (panel, &self.overlay) {
-            let after_blit = vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                .image(target)
-                .subresource_range(color);
-            let region = vk::BufferImageCopy::default()
-                .image_subresource(layers)
-                .image_extent(vk::Extent3D {
-                    width: pw,
-                    height: ph,
-                    depth: 1,
-                });
-            // SAFETY: recording; the buffer holds pw*ph tightly packed texels written by the
-            // host before the submit (host writes before a submit are visible to it).
-            unsafe {
-                device.cmd_pipeline_barrier2(
-                    cmd,
-                    &vk::DependencyInfo::default().image_memory_barriers(&[after_blit]),
-                );
-                device.cmd_copy_buffer_to_image(
-                    cmd,
-                    buffer.buffer,
-                    target,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[region],
-                );
-            }
-        }
+        let drawn = match (frame.ui.as_ref(), self.egui.as_mut()) {
+            (Some(ui), Some(egui)) => egui
+                .cmd_draw(cmd, self.extent, ui.pixels_per_point, &ui.primitives)
+                .map_err(|e| LucentError::InvalidInput(format!("egui draw: {e}"))),
+            _ => Ok(()),
+        };
         let to_present = vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
+            .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
             // Presentation waits on the frame's semaphore, signalled after ALL_COMMANDS.
             .dst_stage_mask(vk::PipelineStageFlags2::NONE)
             .dst_access_mask(vk::AccessFlags2::NONE)
-            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .old_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
             .new_layout(vk::ImageLayout::PRESENT_SRC_KHR)
             .image(target)
             .subresource_range(color);
-        // SAFETY: recording.
+        // SAFETY: recording, inside the render pass begun above.
         unsafe {
+            device.cmd_end_render_pass(cmd);
             device.cmd_pipeline_barrier2(
                 cmd,
                 &vk::DependencyInfo::default().image_memory_barriers(&[to_present]),
@@ -591,7 +748,8 @@ impl Presenter {
         }
         gpu.end_label(cmd);
         // SAFETY: recording is complete.
-        unsafe { device.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")
+        let ended = unsafe { device.end_command_buffer(cmd) }.vk("vkEndCommandBuffer");
+        drawn.and(ended)
     }
 
     /// Destroys everything (the surface too). Waits for the device first.
@@ -602,15 +760,18 @@ impl Presenter {
         if let Some((timer, _)) = self.timer.take() {
             timer.destroy(gpu);
         }
-        if let Some(buffer) = self.overlay.take() {
-            gpu.destroy_buffer(buffer);
-        }
+        // egui's pipeline, buffers and textures go before the render pass they were made for.
+        self.egui = None;
+        self.textures.clear();
+        self.destroy_framebuffers(gpu);
         let device = &gpu.device;
         // SAFETY: the device is idle; every handle was created by this presenter (null ones
         // are ignored by Vulkan); the swapchain goes before its surface.
         unsafe {
             device.destroy_fence(self.fence, None);
             device.destroy_command_pool(self.pool, None);
+            device.destroy_command_pool(self.upload_pool, None);
+            device.destroy_render_pass(self.render_pass, None);
             device.destroy_semaphore(self.acquired, None);
             for s in self.rendered.drain(..) {
                 device.destroy_semaphore(s, None);
@@ -654,12 +815,4 @@ fn pick_present_mode(modes: &[vk::PresentModeKHR], vsync: bool) -> vk::PresentMo
             log::info!("no tearing present mode; falling back to FIFO (vsync)");
             vk::PresentModeKHR::FIFO
         })
-}
-
-/// Whether the overlay panel must be written as B, G, R, A for `format`.
-pub fn is_bgra(format: vk::Format) -> bool {
-    matches!(
-        format,
-        vk::Format::B8G8R8A8_UNORM | vk::Format::B8G8R8A8_SRGB
-    )
 }

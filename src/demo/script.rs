@@ -33,7 +33,8 @@ pub enum Command {
     Reset,
     /// `key NAME`: press a key (its name as the key list gives it, e.g. `F1`, `T`, `2`, `+`).
     Key(String),
-    /// `screenshot FILE`: write the frame (without the overlay) as PNG.
+    /// `screenshot FILE`: write what the window shows (the frame or a comparison view, without
+    /// the panel) as PNG.
     Screenshot(PathBuf),
     /// `quit`: end the demo (exit 0).
     Quit,

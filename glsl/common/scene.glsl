@@ -20,7 +20,8 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     mat4 inv_view_proj;
     mat4 view;            // world to view space (right-handed, the camera looks down -z)
     vec4 camera_pos;      // xyz
-    vec4 ambient_sh[9];   // rgb: the environment's E(n) / pi as nine polynomial coefficients
+    vec4 ambient_sh[9];   // rgb: the environment's E(n) / pi as nine polynomial coefficients;
+                          // [0].w: SH bands in use (1 constant, 2 hemisphere, 3 map)
     vec4 sky;             // rgb: colour of pixels no geometry covers
     vec4 viewport;        // xy: size in pixels, zw: 1 / size
     vec4 exposure;        // x: exposure multiplier applied before tonemapping
@@ -33,15 +34,21 @@ layout(std140, set = 0, binding = 0) uniform Frame {
 // The environment's diffuse light at unit normal n: E(n) / pi, the radiance a Lambertian
 // albedo multiplies (src/scene/environment.rs: nine SH coefficients with the clamped cosine
 // convolved in and the basis constants folded in). Clamped at 0: the series of a map with a
-// small bright sun rings below zero opposite it, and irradiance cannot be negative.
+// small bright sun rings below zero opposite it, and irradiance cannot be negative. Only the
+// bands in use are evaluated (a uniform branch): a constant environment is one read.
 vec3 ambient_radiance(vec3 n) {
-    vec3 e = frame.ambient_sh[0].rgb
-           + frame.ambient_sh[1].rgb * n.y + frame.ambient_sh[2].rgb * n.z
-           + frame.ambient_sh[3].rgb * n.x + frame.ambient_sh[4].rgb * (n.x * n.y)
-           + frame.ambient_sh[5].rgb * (n.y * n.z)
+    vec3 e = frame.ambient_sh[0].rgb;
+    float bands = frame.ambient_sh[0].w;
+    if (bands > 1.5) {
+        e += frame.ambient_sh[1].rgb * n.y + frame.ambient_sh[2].rgb * n.z
+           + frame.ambient_sh[3].rgb * n.x;
+    }
+    if (bands > 2.5) {
+        e += frame.ambient_sh[4].rgb * (n.x * n.y) + frame.ambient_sh[5].rgb * (n.y * n.z)
            + frame.ambient_sh[6].rgb * (3.0 * n.z * n.z - 1.0)
            + frame.ambient_sh[7].rgb * (n.x * n.z)
            + frame.ambient_sh[8].rgb * (n.x * n.x - n.y * n.y);
+    }
     return max(e, vec3(0.0));
 }
 

@@ -238,6 +238,37 @@ pub const KNOBS: &[Knob] = &[
         set: |_, f, v| f.sss.sensitivity = v,
         rebuild: false,
     },
+    Knob {
+        name: "environment intensity",
+        step: 1.25,
+        additive: false,
+        range: (1e-3, 100.0),
+        get: |s, _| Some(s.environment.intensity()),
+        // The nine coefficients are per-frame uniforms: a value change.
+        set: |s, _, v| s.environment.set_intensity(v),
+        rebuild: false,
+    },
+    Knob {
+        name: "anti-aliasing (0 off, 1 FXAA)",
+        step: 1.0,
+        additive: true,
+        range: (0.0, 1.0),
+        get: |_, f| {
+            Some(match f.antialias {
+                crate::features::antialias::Antialias::Off => 0.0,
+                crate::features::antialias::Antialias::Fxaa => 1.0,
+            })
+        },
+        set: |_, f, v| {
+            f.antialias = if v >= 0.5 {
+                crate::features::antialias::Antialias::Fxaa
+            } else {
+                crate::features::antialias::Antialias::Off
+            }
+        },
+        // A pass and an image more or less.
+        rebuild: true,
+    },
 ];
 
 /// One press of a light key moves a positioned light by this fraction of the camera's distance
@@ -556,6 +587,16 @@ pub const KEYS: &[KeyBinding] = &[
         name: "6",
         action: Action::SelectKnob(5),
         help: "select knob: bilateral sensitivity (LBB)",
+    },
+    KeyBinding {
+        name: "7",
+        action: Action::SelectKnob(6),
+        help: "select knob: environment intensity",
+    },
+    KeyBinding {
+        name: "8",
+        action: Action::SelectKnob(7),
+        help: "select knob: anti-aliasing (FXAA on/off)",
     },
     KeyBinding {
         name: "+",

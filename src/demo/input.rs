@@ -375,6 +375,8 @@ fn key_name(code: KeyCode, shift: bool) -> Option<&'static str> {
         KeyCode::Digit4 | KeyCode::Numpad4 => "4",
         KeyCode::Digit5 | KeyCode::Numpad5 => "5",
         KeyCode::Digit6 | KeyCode::Numpad6 => "6",
+        KeyCode::Digit7 | KeyCode::Numpad7 => "7",
+        KeyCode::Digit8 | KeyCode::Numpad8 => "8",
         KeyCode::KeyL if shift => "Shift+L",
         KeyCode::KeyL => "L",
         KeyCode::ArrowLeft => "Left",

@@ -116,6 +116,20 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let _ = writeln!(s, "  objects: {}", scene.objects.len());
             write_scene_materials(&mut s, &scene);
             let _ = writeln!(s, "  lights: {}", scene.lights.len());
+            let _ = writeln!(s, "  environment: {}", scene.environment.describe());
+            if matches!(
+                scene.environment.kind,
+                super::environment::EnvironmentKind::Map { .. }
+            ) {
+                // What the nine coefficients cost in accuracy for this map.
+                let (max, mean) = scene.environment.max_error(200);
+                let _ = writeln!(
+                    s,
+                    "  environment SH9 error against the exact integral: max {:.2}%, mean {:.2}% of the mean irradiance",
+                    100.0 * max,
+                    100.0 * mean
+                );
+            }
             let _ = writeln!(
                 s,
                 "  camera: eye {} target {} fov {} deg",

@@ -102,6 +102,8 @@ fn quick_report_has_every_table_and_plot() {
         "Growth along lights",
         "error against run time",
         "Screen-space SSS: error against run time",
+        "## Anti-aliasing: FXAA",
+        "| `showcase-skin` |",
     ] {
         assert!(report.contains(needle), "missing '{needle}'");
     }

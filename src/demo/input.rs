@@ -420,6 +420,8 @@ mod tests {
             KeyCode::Digit4,
             KeyCode::Digit5,
             KeyCode::Digit6,
+            KeyCode::Digit7,
+            KeyCode::Digit8,
             KeyCode::Equal,
             KeyCode::Minus,
             KeyCode::KeyL,

@@ -16,13 +16,10 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::graph::{
-    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
-    ResourceId,
-};
+use crate::graph::{Handle, Image, LoadOp, PassKind, RenderGraph};
 use crate::{LucentError, Result};
 
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use super::util::SampleOnePass;
 use crate::gpu_scene::SceneGpu;
 
 /// The anti-aliasing a frame applies after the tonemap.
@@ -96,58 +93,16 @@ pub fn fxaa_pass(
     let mut pass = graph.add_pass("fxaa", PassKind::Raster);
     pass.sample(ldr).color(&mut display, LoadOp::DontCare);
     match scene {
-        Some(scene) => pass.execute(FxaaPass {
-            scene: scene.clone(),
-            input: ldr.id(),
-            linear,
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-        }),
+        // Bilinear: the edge search and the final tap sample between texels.
+        Some(scene) => pass.execute(SampleOnePass::new(
+            scene.clone(),
+            ldr.id(),
+            vk::Filter::LINEAR,
+            FXAA_FRAGMENT,
+            fxaa_defines(linear),
+            "fxaa",
+        )),
         None => pass.finish(),
     }
     display
-}
-
-struct FxaaPass {
-    scene: Arc<SceneGpu>,
-    input: ResourceId,
-    /// Write linear values (sRGB or float targets).
-    linear: bool,
-    sampler: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-}
-
-impl PassExec for FxaaPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        // Bilinear: the edge search and the final tap sample between texels.
-        self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &[
-                Binding::PerFrame(
-                    self.scene
-                        .per_frame
-                        .binding(crate::gpu_scene::Region::Frame),
-                ),
-                Binding::Sampled(ctx.views[self.input], self.sampler),
-            ],
-            &GraphicsPipelineDesc::fullscreen(FXAA_FRAGMENT, fxaa_defines(self.linear), "fxaa"),
-        )?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
-            pipeline.draw_fullscreen(ctx);
-        }
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
-    }
 }

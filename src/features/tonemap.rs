@@ -10,13 +10,9 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::graph::{
-    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
-    ResourceId,
-};
-use crate::Result;
+use crate::graph::{Handle, Image, LoadOp, PassKind, RenderGraph};
 
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
+use super::util::SampleOnePass;
 use crate::gpu_scene::SceneGpu;
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
@@ -81,13 +77,14 @@ fn declare(
     let mut pass = graph.add_pass("tonemap", PassKind::Raster);
     pass.sample(hdr).color(&mut output, LoadOp::DontCare);
     match scene {
-        Some(scene) => pass.execute(TonemapPass {
-            scene: scene.clone(),
-            input: hdr.id(),
-            encoding,
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-        }),
+        Some(scene) => pass.execute(SampleOnePass::new(
+            scene.clone(),
+            hdr.id(),
+            vk::Filter::NEAREST,
+            TONEMAP_FRAGMENT,
+            tonemap_defines(encoding),
+            "tonemap",
+        )),
         None => pass.finish(),
     }
     output
@@ -112,51 +109,5 @@ pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>
             TONEMAP_FRAGMENT,
             tonemap_defines(encoding),
         ));
-    }
-}
-
-struct TonemapPass {
-    scene: Arc<SceneGpu>,
-    input: ResourceId,
-    encoding: Encoding,
-    sampler: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-}
-
-impl PassExec for TonemapPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &[
-                Binding::PerFrame(
-                    self.scene
-                        .per_frame
-                        .binding(crate::gpu_scene::Region::Frame),
-                ),
-                Binding::Sampled(ctx.views[self.input], self.sampler),
-            ],
-            &GraphicsPipelineDesc::fullscreen(
-                TONEMAP_FRAGMENT,
-                tonemap_defines(self.encoding),
-                "tonemap",
-            ),
-        )?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
-            pipeline.draw_fullscreen(ctx);
-        }
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
     }
 }

@@ -635,3 +635,80 @@ impl PassPipeline {
         self.set.destroy(device);
     }
 }
+
+/// A full-screen pass that reads one image through a sampler: the frame uniforms at binding 0,
+/// the image at binding 1, one fragment shader with fixed defines (the tonemap, FXAA). The
+/// pass that declares it owns nothing else.
+pub(crate) struct SampleOnePass {
+    /// The scene on the GPU (the per-frame uniforms).
+    pub scene: std::sync::Arc<crate::gpu_scene::SceneGpu>,
+    /// The image sampled.
+    pub input: crate::graph::ResourceId,
+    /// Nearest (one texel per pixel) or linear (taps between texels).
+    pub filter: vk::Filter,
+    /// Fragment shader under `glsl/`.
+    pub fragment: &'static str,
+    /// Its defines.
+    pub defines: &'static [(&'static str, &'static str)],
+    /// The pipeline's debug name.
+    pub name: &'static str,
+    sampler: vk::Sampler,
+    pipeline: Option<PassPipeline>,
+}
+
+impl SampleOnePass {
+    /// The pass, its sampler and pipeline made in `prepare`.
+    pub fn new(
+        scene: std::sync::Arc<crate::gpu_scene::SceneGpu>,
+        input: crate::graph::ResourceId,
+        filter: vk::Filter,
+        fragment: &'static str,
+        defines: &'static [(&'static str, &'static str)],
+        name: &'static str,
+    ) -> Self {
+        Self {
+            scene,
+            input,
+            filter,
+            fragment,
+            defines,
+            name,
+            sampler: vk::Sampler::null(),
+            pipeline: None,
+        }
+    }
+}
+
+impl crate::graph::PassExec for SampleOnePass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        self.sampler = clamp_sampler(ctx, self.filter)?;
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &[
+                Binding::PerFrame(
+                    self.scene
+                        .per_frame
+                        .binding(crate::gpu_scene::Region::Frame),
+                ),
+                Binding::Sampled(ctx.views[self.input], self.sampler),
+            ],
+            &GraphicsPipelineDesc::fullscreen(self.fragment, self.defines, self.name),
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &crate::graph::RecordContext<'_>) {
+        if let Some(pipeline) = &self.pipeline {
+            pipeline.draw_fullscreen(ctx);
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
+        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
+        self.sampler = vk::Sampler::null();
+    }
+}

@@ -13,7 +13,8 @@
 //! 3. **Scaling** ([`crate::measure::scaling`]): frame and per-pass time against triangles, resolution
 //!    and light count, with curves and which passes grow with what.
 //! 4. **Error against time**: one section per technique with approximation knobs
-//!    ([`ERROR_SECTIONS`]; a section is one [`SectionFn`], so a technique plugs its own in).
+//!    ([`ERROR_SECTIONS`]; a section is one [`SectionFn`], so a technique plugs its own in),
+//!    and the anti-aliasing pass's cost and effect ([`antialias`]).
 //!
 //! Numbers compared with each other are always measured in one run, alternating or round-robin
 //! (the machine is shared and noisy: separate runs differ by up to 15%).
@@ -32,6 +33,7 @@ use crate::report::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, P
 use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
 
+pub mod antialias;
 pub mod li;
 pub mod plot;
 pub mod section;
@@ -48,6 +50,10 @@ pub const ERROR_SECTIONS: &[(&str, SectionFn)] = &[
         crate::report::translucency::translucency_section as SectionFn,
     ),
     ("sss", sss_section as SectionFn),
+    (
+        "anti-aliasing",
+        crate::report::antialias::antialias_section as SectionFn,
+    ),
 ];
 
 /// The SSS error-against-time report ([`crate::report::sss`]) as a section, written beside

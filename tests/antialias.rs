@@ -101,3 +101,82 @@ fn fxaa_leaves_flat_regions_alone_and_softens_silhouettes() {
     // And only a few percent of the frame: FXAA is not a blur.
     assert!(changed * 10 < (w * h) as usize, "{changed}");
 }
+
+#[test]
+fn fxaa_into_a_hosts_srgb_and_float_targets_matches_lucents_own_display() {
+    use ash::vk;
+    use lucent::backend::access::Access;
+    use lucent::backend::resources::ImageDesc;
+    use lucent::frame::TargetDesc;
+    let (w, h) = (160, 120);
+    let (expected, _) = render("cubes", w, h, Antialias::Fxaa);
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let scene = lucent::bake::scene::load_scene_baked("cubes").unwrap();
+    for format in [vk::Format::R8G8B8A8_SRGB, vk::Format::R16G16B16A16_SFLOAT] {
+        let settings = FrameSettings {
+            antialias: Antialias::Fxaa,
+            target: Some(TargetDesc {
+                format,
+                initial: Access::Undefined,
+                final_access: Access::TransferRead,
+            }),
+            ..FrameSettings::new(w, h)
+        };
+        let mut renderer =
+            Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
+        let target = gpu
+            .create_image(
+                &ImageDesc::color(
+                    w,
+                    h,
+                    format,
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                ),
+                "host target",
+            )
+            .unwrap();
+        common::submit_back_to_back(gpu, 1, |slot, cmd| {
+            renderer.update_slot(&scene, slot).unwrap();
+            renderer
+                .bind_target(gpu, target.image, target.view)
+                .unwrap();
+            renderer.record(gpu, cmd, slot, None).unwrap();
+        });
+        let bytes = gpu
+            .read_image(&target, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .unwrap();
+        // The float target holds linear values (FXAA decodes what it blended): encode them as
+        // lucent's own display is encoded.
+        let got: Vec<u8> = if format == vk::Format::R16G16B16A16_SFLOAT {
+            lucent::images::output::f16_bytes_to_f32(&bytes)
+                .iter()
+                .map(|&v| {
+                    let v = f64::from(v).clamp(0.0, 1.0);
+                    (lucent::reference::tonemap::linear_to_srgb(v) * 255.0).round() as u8
+                })
+                .collect()
+        } else {
+            bytes
+        };
+        let worst = got
+            .chunks_exact(4)
+            .zip(expected.chunks_exact(4))
+            .map(|(a, b)| {
+                a[..3]
+                    .iter()
+                    .zip(&b[..3])
+                    .map(|(x, y)| x.abs_diff(*y))
+                    .max()
+                    .unwrap()
+            })
+            .max()
+            .unwrap();
+        eprintln!("{format:?}: largest difference {worst}/255");
+        assert!(worst <= 1, "{format:?}: {worst}/255 off");
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        gpu.destroy_image(target);
+    }
+    test.finish();
+}

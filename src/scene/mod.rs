@@ -4,6 +4,7 @@
 //! reference in [`crate::reference`] can ray-trace the exact surface the GPU rasterises an
 //! approximation of.
 
+mod build;
 pub mod builtin;
 pub mod environment;
 pub mod file;

@@ -18,7 +18,7 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use super::builtin::{base_scene, camera, translucent};
+use super::build::{base_scene, camera, translucent};
 use super::environment::Environment;
 use super::generators::{self, Generator};
 use super::layered::{LayeredMedium, PHYSICAL_WEIGHTS};

@@ -97,8 +97,8 @@ mod tests {
         let scene = dir.join("s.toml");
         std::fs::write(
             &scene,
-            "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n[[mesh]]\nname = \"m\"\nobj = \
-             \"m.obj\"\n[[material]]\nname = \"a\"\nnormal_texture = \"n.png\"\n\
+            "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n[environment]\nkind = \"map\"\n\
+             file = \"env.hdr\"\n[[mesh]]\nname = \"m\"\nobj = \"m.obj\"\n[[material]]\nname = \"a\"\nnormal_texture = \"n.png\"\n\
              translucency = { thickness = \"t.png\" }\n[[material]]\nname = \"b\"\n\
              translucency = { thickness = \"bake\" }\n",
         )
@@ -110,6 +110,7 @@ mod tests {
             [
                 scene.clone(),
                 dir.join("m.obj"),
+                dir.join("env.hdr"),
                 dir.join("n.png"),
                 dir.join("t.png")
             ]

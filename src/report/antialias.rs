@@ -15,7 +15,7 @@ use crate::Result;
 /// The scenes measured.
 const SCENES: [&str; 2] = ["cubes", "showcase-skin"];
 
-/// Measures FXAA on [`SCENES`] at the suite's size.
+/// Measures FXAA on `cubes` and `showcase-skin` at the suite's size.
 pub fn antialias_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     let o = ctx.options;
     let mut out = SectionOutput::default();

@@ -68,6 +68,30 @@ pub fn gallery(
 ) -> Result<Vec<GalleryEntry>> {
     std::fs::create_dir_all(out)
         .map_err(|e| LucentError::file(out, format!("cannot create the gallery folder: {e}")))?;
+    // Nothing the gallery writes may be a file a scene reads (a scene file, its mesh or a
+    // texture in the same folder), checked before any work.
+    let inputs: Vec<(String, PathBuf)> = scenes
+        .iter()
+        .flat_map(|name| crate::scene::inputs::scene_inputs(name))
+        .collect();
+    let outputs: Vec<PathBuf> = scenes
+        .iter()
+        .flat_map(|name| {
+            ["", "-none", "-difference"]
+                .map(|suffix| out.join(format!("{}{suffix}.png", file_stem(name))))
+        })
+        .chain([out.join("index.md")])
+        .collect();
+    crate::files::check_outputs(
+        &inputs
+            .iter()
+            .map(|(what, path)| (what.as_str(), path.as_path()))
+            .collect::<Vec<_>>(),
+        &outputs
+            .iter()
+            .map(|p| ("--out", p.as_path()))
+            .collect::<Vec<_>>(),
+    )?;
     let mut entries = Vec::new();
     for &name in scenes {
         progress(name);

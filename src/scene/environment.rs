@@ -510,10 +510,10 @@ pub fn load_radiance_map(path: &Path) -> Result<RadianceMap> {
         ));
     }
     let (w, h) = (decoded.width as usize, decoded.height as usize);
-    if w < 2 || h < 1 {
+    if w == 0 || h == 0 {
         return Err(LucentError::file(
             path,
-            format!("environment map is {w}x{h}; an equirectangular map needs at least 2x1 texels"),
+            format!("environment map is {w}x{h}: it has no texels"),
         ));
     }
     if w != 2 * h {

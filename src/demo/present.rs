@@ -196,22 +196,18 @@ impl Presenter {
             self.acquired = device
                 .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
                 .vk("vkCreateSemaphore")?;
-            self.pool = device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(gpu.queue_family)
-                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
-                    None,
-                )
-                .vk("vkCreateCommandPool")?;
-            self.upload_pool = device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(gpu.queue_family)
-                        .flags(vk::CommandPoolCreateFlags::TRANSIENT),
-                    None,
-                )
-                .vk("vkCreateCommandPool")?;
+            let transient_pool = || {
+                device
+                    .create_command_pool(
+                        &vk::CommandPoolCreateInfo::default()
+                            .queue_family_index(gpu.queue_family)
+                            .flags(vk::CommandPoolCreateFlags::TRANSIENT),
+                        None,
+                    )
+                    .vk("vkCreateCommandPool")
+            };
+            self.pool = transient_pool()?;
+            self.upload_pool = transient_pool()?;
             self.cmd = device
                 .allocate_command_buffers(
                     &vk::CommandBufferAllocateInfo::default()

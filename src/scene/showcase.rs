@@ -250,9 +250,9 @@ pub fn skin() -> Result<Scene> {
         s.add(
             ear,
             Mat4::from_scale_rotation_translation(
-                Vec3::new(0.2, 0.3, 0.3),
-                turn * Quat::from_rotation_y(side * 0.95),
-                Vec3::new(0.0, 1.1, 0.0) + turn * Vec3::new(side * 0.7, 0.0, -0.12),
+                Vec3::new(0.22, 0.32, 0.3),
+                turn * Quat::from_rotation_y(side * 1.15),
+                Vec3::new(0.0, 1.1, 0.0) + turn * Vec3::new(side * 0.8, -0.02, -0.08),
             ),
             ear_material.clone(),
         );

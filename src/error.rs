@@ -115,6 +115,30 @@ impl LucentError {
     }
 }
 
+/// The value named `name` in a table of command-line names (`ALL` of [`crate::frame::Technique`],
+/// the benchmark's formats, [`crate::features::antialias::Antialias`]), or the error
+/// `unknown WHAT 'NAME'; available: a, b, c`.
+pub fn parse_named<T: Copy>(table: &[(&str, T)], name: &str, what: &str) -> Result<T> {
+    table
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|&(_, value)| value)
+        .ok_or_else(|| {
+            LucentError::InvalidInput(format!(
+                "unknown {what} '{name}'; available: {}",
+                table.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+            ))
+        })
+}
+
+/// The name of `value` in a table of command-line names (`?` when it is not there).
+pub fn name_of<T: PartialEq>(table: &[(&'static str, T)], value: &T) -> &'static str {
+    table
+        .iter()
+        .find(|(_, v)| v == value)
+        .map_or("?", |(n, _)| n)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

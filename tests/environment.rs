@@ -50,17 +50,7 @@ fn against_reference(environment: Environment) -> (f64, f64) {
         for x in 1..w - 1 {
             let i = (y * w + x) as usize;
             // Interior pixels only: the tessellated and the exact sphere differ at silhouettes.
-            let interior = (-1i32..=1).all(|dy| {
-                (-1i32..=1).all(|dx| {
-                    let j = ((y as i32 + dy) as u32 * w + (x as i32 + dx) as u32) as usize;
-                    match (reference.hit[i], reference.hit[j]) {
-                        (Some(a), Some(b)) => (a - b).abs() < 0.05 * a,
-                        (None, None) => true,
-                        _ => false,
-                    }
-                })
-            });
-            if !interior {
+            if !common::interior(&reference, w, x, y) {
                 continue;
             }
             for c in 0..3 {

@@ -188,18 +188,7 @@ fn smoke_matches_the_raytraced_f64_reference() {
     for y in 1..h - 1 {
         for x in 1..w - 1 {
             let i = (y * w + x) as usize;
-            // Interior pixels: the same surface (or sky) covers this pixel and its 8 neighbours.
-            let same_surface = (-1i32..=1).all(|dy| {
-                (-1i32..=1).all(|dx| {
-                    let j = ((y as i32 + dy) as u32 * w + (x as i32 + dx) as u32) as usize;
-                    match (reference.hit[i], reference.hit[j]) {
-                        (Some(a), Some(b)) => (a - b).abs() < 0.05 * a,
-                        (None, None) => true,
-                        _ => false,
-                    }
-                })
-            });
-            if !same_surface {
+            if !common::interior(&reference, w, x, y) {
                 edge_pixels += 1;
                 continue;
             }

@@ -329,7 +329,7 @@ struct FrameArgs {
     #[arg(long, default_value = "scene")]
     environment: String,
     /// Multiplies the environment's radiance (a finite number >= 0; default 1).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0, value_parser = parse_environment_intensity)]
     environment_intensity: f32,
     /// Anti-aliasing after the tonemap: `off` (default) or `fxaa`.
     #[arg(long, default_value = "off")]
@@ -340,18 +340,25 @@ impl FrameArgs {
     /// Loads the scene (thickness baked, cached), at `--time`, with `--environment`.
     fn load_scene(&self) -> Result<scene::Scene> {
         // Parsed first: a bad environment is refused before a bake.
-        let environment =
-            scene::environment::from_command_line(&self.environment, self.environment_intensity)?;
+        let environment = scene::environment::from_command_line(&self.environment)?;
         let mut scene = bake::load_scene_baked(&self.scene)?;
         // Range-checked by the parser (finite).
         scene.time = self.time.unwrap_or(0.0);
         if let Some(environment) = environment {
             scene.environment = environment;
-        } else if self.environment_intensity != 1.0 {
-            scene.environment = scene.environment.scaled(self.environment_intensity);
         }
+        // Range-checked by the parser (finite, >= 0).
+        scene.environment = scene.environment.scaled(self.environment_intensity);
         Ok(scene)
     }
+}
+
+fn parse_environment_intensity(text: &str) -> std::result::Result<f32, String> {
+    text.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("'{text}' is not a finite number >= 0"))
 }
 
 fn parse_time(text: &str) -> std::result::Result<f32, String> {

@@ -8,16 +8,16 @@
 //! goldens of frames without anti-aliasing stay what they were: a frame without it has neither
 //! the pass nor the intermediate image.
 //!
-//! Why off by default: on lavapipe the pass costs 11-17% of the plain frame (docs/antialias.md,
-//! `lucent bench --aa fxaa --against ...`), more than "cheap"; on a GPU it is a fraction of a
-//! millisecond and a host may well turn it on.
+//! Why off by default: on lavapipe the pass costs 12.6-13.8% of the frame at 1024x768
+//! (docs/antialias.md, `lucent bench --aa fxaa`), more than "cheap"; on a GPU a full-screen
+//! pass of this kind is far cheaper and a host may well turn it on.
 
 use std::sync::Arc;
 
 use ash::vk;
 
 use crate::graph::{Handle, Image, LoadOp, PassKind, RenderGraph};
-use crate::{LucentError, Result};
+use crate::Result;
 
 use super::util::SampleOnePass;
 use crate::gpu_scene::SceneGpu;
@@ -39,23 +39,12 @@ impl Antialias {
 
     /// Parses a command-line name.
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, a)| a)
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "unknown anti-aliasing '{name}'; available: off, fxaa"
-                ))
-            })
+        crate::error::parse_named(Self::ALL, name, "anti-aliasing")
     }
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, a)| *a == self)
-            .map_or("?", |(n, _)| n)
+        crate::error::name_of(Self::ALL, &self)
     }
 }
 

@@ -641,17 +641,17 @@ impl PassPipeline {
 /// pass that declares it owns nothing else.
 pub(crate) struct SampleOnePass {
     /// The scene on the GPU (the per-frame uniforms).
-    pub scene: std::sync::Arc<crate::gpu_scene::SceneGpu>,
+    scene: std::sync::Arc<crate::gpu_scene::SceneGpu>,
     /// The image sampled.
-    pub input: crate::graph::ResourceId,
+    input: crate::graph::ResourceId,
     /// Nearest (one texel per pixel) or linear (taps between texels).
-    pub filter: vk::Filter,
+    filter: vk::Filter,
     /// Fragment shader under `glsl/`.
-    pub fragment: &'static str,
+    fragment: &'static str,
     /// Its defines.
-    pub defines: &'static [(&'static str, &'static str)],
+    defines: &'static [(&'static str, &'static str)],
     /// The pipeline's debug name.
-    pub name: &'static str,
+    name: &'static str,
     sampler: vk::Sampler,
     pipeline: Option<PassPipeline>,
 }

@@ -9,7 +9,7 @@ use crate::features::shadows::ShadowSettings;
 use crate::features::sss;
 use crate::graph::CompileOptions;
 use crate::scene::material::SssBlur;
-use crate::{LucentError, Result};
+use crate::Result;
 
 /// What the frame shades. `Auto` (the default) is what the scene's materials ask for: every
 /// feature some material has, composed in one frame. The named techniques restrict the frame
@@ -59,28 +59,12 @@ impl Technique {
 
     /// Parses a command-line name.
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, t)| t)
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "unknown technique '{name}'; available: {}",
-                    Self::ALL
-                        .iter()
-                        .map(|(n, _)| *n)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })
+        crate::error::parse_named(Self::ALL, name, "technique")
     }
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, t)| *t == self)
-            .map_or("?", |(n, _)| n)
+        crate::error::name_of(Self::ALL, &self)
     }
 
     /// The screen-space SSS blur this technique forces on every SSS material, if any.

@@ -169,15 +169,7 @@ impl Format {
 
     /// Parses a command-line name.
     pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, f)| f)
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "unknown format '{name}'; available: markdown, csv, json"
-                ))
-            })
+        crate::error::parse_named(Self::ALL, name, "format")
     }
 }
 

@@ -86,7 +86,8 @@ pub struct Environment {
     /// `E(n) / π` as the polynomial of the module docs: coefficient `k` multiplies basis term
     /// `k` (1, y, z, x, xy, yz, 3z² - 1, xz, x² - y²), per channel.
     coefficients: [DVec3; 9],
-    /// The radiance map (kind `Map`), kept for the brute-force reference and error reports.
+    /// The radiance map (kind `Map`) as it was projected (box-filtered to at most
+    /// [`MAX_INTEGRATED_TEXELS`]), kept for the brute-force reference and error reports.
     map: Option<std::sync::Arc<RadianceMap>>,
     /// A multiplier over everything above (`--environment-intensity`, the demo's knob): 1 as
     /// loaded.
@@ -197,6 +198,8 @@ impl Environment {
                 name()
             )));
         }
+        // Filtered once: the projection and every later brute-force integral read this copy.
+        let map = integration_copy(map);
         let coefficients = project(&map, f64::from(intensity), rotation_degrees);
         Ok(Self {
             kind: EnvironmentKind::Map {
@@ -235,9 +238,8 @@ impl Environment {
                 },
                 Some(map),
             ) => {
-                let map = integration_copy(map);
                 let mut e = DVec3::ZERO;
-                for_each_texel(&map, *rotation_degrees, |d, solid_angle, radiance| {
+                for_each_texel(map, *rotation_degrees, |d, solid_angle, radiance| {
                     let cos = d.dot(n);
                     if cos > 0.0 {
                         e += radiance * (cos * solid_angle);
@@ -366,13 +368,8 @@ pub const COMMAND_LINE_ENVIRONMENTS: &[(&str, &str)] = &[
 ];
 
 /// The environment a command line asks for: one of [`COMMAND_LINE_ENVIRONMENTS`] or the path
-/// of an equirectangular map; `None` for `scene` (keep the scene's). `intensity` scales it.
-pub fn from_command_line(spec: &str, intensity: f32) -> Result<Option<Environment>> {
-    if !(intensity.is_finite() && intensity >= 0.0) {
-        return Err(LucentError::InvalidInput(format!(
-            "--environment-intensity {intensity} must be finite and >= 0"
-        )));
-    }
+/// of an equirectangular map; `None` for `scene` (keep the scene's).
+pub fn from_command_line(spec: &str) -> Result<Option<Environment>> {
     let environment = match spec {
         "scene" => return Ok(None),
         "none" => Environment::constant(Vec3::ZERO),
@@ -399,11 +396,7 @@ pub fn from_command_line(spec: &str, intensity: f32) -> Result<Option<Environmen
             Environment::from_file(path, 1.0, 0.0)?
         }
     };
-    Ok(Some(if intensity == 1.0 {
-        environment
-    } else {
-        environment.scaled(intensity)
-    }))
+    Ok(Some(environment))
 }
 
 fn fmt3(v: Vec3) -> String {
@@ -421,9 +414,8 @@ pub fn fibonacci_direction(i: usize, count: usize) -> DVec3 {
 
 /// The map's SH projection with the cosine convolved in, in polynomial form.
 fn project(map: &RadianceMap, intensity: f64, rotation_degrees: f32) -> [DVec3; 9] {
-    let map = integration_copy(map);
     let mut sh = [DVec3::ZERO; 9];
-    for_each_texel(&map, rotation_degrees, |d, solid_angle, radiance| {
+    for_each_texel(map, rotation_degrees, |d, solid_angle, radiance| {
         for (k, b) in basis(d).into_iter().enumerate() {
             // L_k = ∫ L Y_k dω with Y_k = K_k b_k.
             sh[k] += radiance * (b * SH_K[k] * solid_angle);
@@ -433,13 +425,13 @@ fn project(map: &RadianceMap, intensity: f64, rotation_degrees: f32) -> [DVec3; 
 }
 
 /// `map`, or a box-filtered copy of at most [`MAX_INTEGRATED_TEXELS`] texels.
-fn integration_copy(map: &RadianceMap) -> std::borrow::Cow<'_, RadianceMap> {
+fn integration_copy(map: RadianceMap) -> RadianceMap {
     let mut factor = 1;
     while (map.width / factor).max(1) * (map.height / factor).max(1) > MAX_INTEGRATED_TEXELS {
         factor *= 2;
     }
     if factor == 1 {
-        return std::borrow::Cow::Borrowed(map);
+        return map;
     }
     let (w, h) = ((map.width / factor).max(1), (map.height / factor).max(1));
     let mut texels = vec![[0.0f32; 3]; w * h];
@@ -459,11 +451,11 @@ fn integration_copy(map: &RadianceMap) -> std::borrow::Cow<'_, RadianceMap> {
             *out = sum.map(|s| (s / n.max(1.0)) as f32);
         }
     }
-    std::borrow::Cow::Owned(RadianceMap {
+    RadianceMap {
         width: w,
         height: h,
         texels,
-    })
+    }
 }
 
 /// Calls `f(direction, solid angle, radiance)` for every texel of an equirectangular map

@@ -84,10 +84,6 @@ fn leaf_mesh() -> Result<Mesh> {
     ))
 }
 
-fn hemisphere_environment(sky: Vec3, ground: Vec3) -> Environment {
-    Environment::hemisphere(sky, ground)
-}
-
 /// GDC 2011 translucency: thin objects with baked thickness, lit from behind.
 pub fn translucency() -> Result<Scene> {
     let mut s = base_scene(
@@ -96,7 +92,7 @@ pub fn translucency() -> Result<Scene> {
     );
     s.sky = Vec3::new(0.015, 0.018, 0.03);
     s.environment =
-        hemisphere_environment(Vec3::new(0.05, 0.06, 0.09), Vec3::new(0.02, 0.018, 0.015));
+        Environment::hemisphere(Vec3::new(0.05, 0.06, 0.09), Vec3::new(0.02, 0.018, 0.015));
     s.add_floor();
     let ear = s.add_mesh(ear_mesh(0.09)?);
     let leaf = s.add_mesh(leaf_mesh()?);
@@ -217,7 +213,7 @@ pub fn skin() -> Result<Scene> {
     );
     s.sky = Vec3::new(0.02, 0.022, 0.03);
     s.environment =
-        hemisphere_environment(Vec3::new(0.045, 0.05, 0.065), Vec3::new(0.02, 0.016, 0.014));
+        Environment::hemisphere(Vec3::new(0.045, 0.05, 0.065), Vec3::new(0.02, 0.016, 0.014));
     let head = s.add_mesh(head_mesh()?);
     let ear = s.add_mesh(ear_mesh(0.16)?);
     // The head is about 1.9 units for a real 230 mm: 0.008 units per mm; the profile at 10x
@@ -289,7 +285,7 @@ pub fn marble() -> Result<Scene> {
     );
     s.sky = Vec3::new(0.03, 0.03, 0.04);
     s.environment =
-        hemisphere_environment(Vec3::new(0.05, 0.055, 0.07), Vec3::new(0.025, 0.022, 0.02));
+        Environment::hemisphere(Vec3::new(0.05, 0.055, 0.07), Vec3::new(0.025, 0.022, 0.02));
     s.add_floor();
     let teapot = s.add_mesh(generators::generate(Generator::Teapot, 5)?);
     let ring = s.add_mesh(generators::generate(Generator::Torus, 5)?);
@@ -396,7 +392,7 @@ pub fn layered() -> Result<Scene> {
     );
     s.sky = Vec3::new(0.02, 0.022, 0.03);
     s.environment =
-        hemisphere_environment(Vec3::new(0.04, 0.045, 0.06), Vec3::new(0.02, 0.018, 0.015));
+        Environment::hemisphere(Vec3::new(0.04, 0.045, 0.06), Vec3::new(0.02, 0.018, 0.015));
     s.add_floor();
     // Jade: scatters little, absorbs red and blue, so what comes through is green. Wax:
     // scatters a lot and absorbs a little blue: a warm, milky glow.

@@ -114,3 +114,27 @@ pub fn submit_back_to_back(
         device.destroy_command_pool(pool, None);
     }
 }
+
+/// Whether pixel (`x`, `y`) of a ray-traced reference `w` pixels wide is interior: the same
+/// surface (hit distances within 5%), or the sky, covers it and its 8 neighbours. At
+/// silhouettes the tessellated mesh and the exact shape cover different pixels, so GPU-against-
+/// reference comparisons skip them. `x` and `y` must be at least 1 pixel from the border.
+#[allow(dead_code)] // not every test file compares with the ray tracer
+pub fn interior(
+    reference: &lucent::reference::raytrace::ReferenceImage,
+    w: u32,
+    x: u32,
+    y: u32,
+) -> bool {
+    let i = (y * w + x) as usize;
+    (-1i32..=1).all(|dy| {
+        (-1i32..=1).all(|dx| {
+            let j = ((y as i32 + dy) as u32 * w + (x as i32 + dx) as u32) as usize;
+            match (reference.hit[i], reference.hit[j]) {
+                (Some(a), Some(b)) => (a - b).abs() < 0.05 * a,
+                (None, None) => true,
+                _ => false,
+            }
+        })
+    })
+}

@@ -476,7 +476,7 @@ pub fn cycle_pow_mode(scene: &mut Scene) -> Option<&'static str> {
 /// Something a key press does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
-    /// Next technique of `Technique::ALL`.
+    /// Next technique of `Technique::all`.
     NextTechnique,
     /// Previous technique.
     PreviousTechnique,

@@ -103,7 +103,7 @@ impl Demo<'_> {
     pub(super) fn act(&mut self, event_loop: &ActiveEventLoop, action: Action) -> Result<()> {
         match action {
             Action::NextTechnique | Action::PreviousTechnique => {
-                let all = Technique::ALL;
+                let all = Technique::all();
                 let i = all
                     .iter()
                     .position(|(_, t)| *t == self.technique)

@@ -197,13 +197,14 @@ impl Demo<'_> {
         egui::ComboBox::from_label("technique (T)")
             .selected_text(self.technique.name())
             .show_ui(ui, |ui| {
-                for (name, technique) in Technique::ALL {
+                for (name, technique) in Technique::all() {
                     if ui
-                        .selectable_label(self.technique == *technique, *name)
+                        .selectable_label(self.technique == technique, name)
+                        .on_hover_text(technique.summary())
                         .clicked()
-                        && self.technique != *technique
+                        && self.technique != technique
                     {
-                        actions.push(PanelAction::Technique(*technique));
+                        actions.push(PanelAction::Technique(technique));
                     }
                 }
             });

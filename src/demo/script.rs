@@ -19,7 +19,7 @@ pub enum Command {
     /// minimizes: the demo enters the state a zero-sized window puts it in, whether or not the
     /// window system can show a zero-sized window (X servers cannot).
     Resize(u32, u32),
-    /// `technique NAME`: switch to a technique of `Technique::ALL`.
+    /// `technique NAME`: switch to a technique of `Technique::all`.
     Technique(String),
     /// `orbit DX DY`: turn the camera around its target by DX degrees (yaw) and DY (pitch).
     Orbit(f32, f32),

@@ -34,6 +34,7 @@ use super::image::{check_image, is_depth, record_transition, HostImage, ImageSta
 use super::Lucent;
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, FormatKind};
+use crate::features::registry;
 use crate::features::sss::{self, SssKnobs, SssProfiles};
 use crate::gpu_scene::{FrameUniforms, Region, SceneGpu, SceneUpload, SlotTiles};
 use crate::graph::{
@@ -164,14 +165,18 @@ impl PostProcessSss {
         let mut profiles = Vec::with_capacity(desc.profiles.len());
         for p in &desc.profiles {
             p.validate()?;
-            let blur = p.blur_or_default();
+            let blur = registry::blur_of(p)?;
             if blur.lean() {
+                let usable: Vec<&str> = registry::sss_blurs()
+                    .filter(|b| !b.lean())
+                    .map(|b| b.name())
+                    .collect();
                 return Err(LucentError::InvalidInput(format!(
                     "post-process SSS: profile '{}' asks for the {} blur, which blurs the \
-                     G-buffer's LEAN data a host's lit image does not carry; use the control, \
-                     separable or bilateral blur",
+                     G-buffer's LEAN data a host's lit image does not carry; use one of: {}",
                     p.name,
-                    blur.name()
+                    blur.name(),
+                    usable.join(", ")
                 )));
             }
             profiles.push((p.clone(), blur));
@@ -380,13 +385,7 @@ impl PostProcessSss {
 
     fn write_tables(&self, slot: usize) -> Result<()> {
         let per_frame = &self.scene_gpu().per_frame;
-        let table = self.profiles.table(&self.desc.knobs);
-        per_frame.write(slot, Region::Profiles, bytemuck::bytes_of(&table))?;
-        if self.profiles.two_pass() {
-            let knobs = &self.desc.knobs;
-            let kernels = sss::kernel::kernel_table(&self.profiles, knobs.samples, knobs.shape);
-            per_frame.write(slot, Region::Kernels, bytemuck::bytes_of(&kernels))?;
-        }
+        sss::tables::write(per_frame, slot, &self.profiles, &self.desc.knobs)?;
         // No tiles: every chain covers the whole screen (the host's mask decides per pixel).
         *per_frame.tiles(slot) = SlotTiles::default();
         Ok(())

@@ -43,6 +43,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::shadows::{self, ShadowMaps};
+use super::technique::{Shades, TechniqueModule};
 use super::util::{check_bindings, clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::{Region, SceneGpu};
 use crate::graph::{
@@ -604,7 +605,7 @@ impl LayeredShape {
 }
 
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
     for kind in Kind::ALL {
         for flags in 0u32..1 << 6 {
             let bit = |i: u32| flags & (1 << i) != 0;
@@ -739,6 +740,46 @@ impl PassExec for LayeredPass {
         // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
         unsafe { gpu.device.destroy_sampler(self.nearest, None) };
         self.nearest = vk::Sampler::null();
+    }
+}
+
+/// Li et al.'s layered media as a registered technique (`--technique layered`).
+pub struct LiLayeredMedia;
+
+/// The technique's instance, listed in [`super::registry`].
+pub static LAYERED: LiLayeredMedia = LiLayeredMedia;
+
+impl TechniqueModule for LiLayeredMedia {
+    fn name(&self) -> &'static str {
+        "layered"
+    }
+
+    fn summary(&self) -> &'static str {
+        "Li et al.'s layered media: image-space single and dipole multiple scattering on \
+         layered materials"
+    }
+
+    fn shades(&'static self) -> Shades {
+        Shades::Layered
+    }
+
+    fn knobs(&self) -> &'static [&'static str] {
+        &[
+            "--layered-steps",
+            "--pixel-lights",
+            "--phase",
+            "--half-irradiance",
+            "--half-gather",
+            "--single-depth",
+        ]
+    }
+
+    fn scene(&self) -> &'static str {
+        "layered"
+    }
+
+    fn shader_permutations(&self, out: &mut Vec<super::shipped::PipelineShaders>) {
+        shader_permutations(out);
     }
 }
 

@@ -16,14 +16,18 @@
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 //! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
+//! - [`technique`] and [`registry`]: the contract a technique module implements and the one
+//!   list of them, which everything that names techniques iterates.
 
 pub mod antialias;
 pub mod debug_view;
 pub mod deferred;
 pub mod layered;
+pub mod registry;
 pub mod shadows;
 pub mod shipped;
 pub mod sss;
+pub mod technique;
 pub mod tonemap;
 pub mod translucency;
 pub mod util;

@@ -71,8 +71,9 @@ pub fn pipelines() -> Vec<PipelineShaders> {
     let mut out = Vec::new();
     super::shadows::shader_permutations(&mut out);
     super::deferred::shader_permutations(&mut out);
-    super::sss::shader_permutations(&mut out);
-    super::layered::shader_permutations(&mut out);
+    for technique in super::registry::TECHNIQUES {
+        technique.shader_permutations(&mut out);
+    }
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
     super::antialias::shader_permutations(&mut out);

@@ -16,6 +16,8 @@
 
 use glam::Vec3;
 
+use super::shipped::PipelineShaders;
+use super::technique::{Shades, TechniqueModule};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -162,6 +164,39 @@ pub fn material_row(t: &Translucency) -> MaterialRow {
 pub struct MaterialTableGpu {
     /// Rows by material ID.
     pub rows: [MaterialRow; MAX_TRANSLUCENT_MATERIALS + 1],
+}
+
+/// GDC 2011 translucency as a registered technique (`--technique translucency`).
+pub struct Gdc2011Translucency;
+
+/// The technique's instance, listed in [`super::registry`].
+pub static TRANSLUCENCY: Gdc2011Translucency = Gdc2011Translucency;
+
+impl TechniqueModule for Gdc2011Translucency {
+    fn name(&self) -> &'static str {
+        "translucency"
+    }
+
+    fn summary(&self) -> &'static str {
+        "GDC 2011 thickness-based translucency (Frostbite 2) on translucent materials, in the \
+         deferred lighting pass"
+    }
+
+    fn shades(&'static self) -> Shades {
+        Shades::Translucent
+    }
+
+    fn knobs(&self) -> &'static [&'static str] {
+        &["--grayscale"]
+    }
+
+    fn scene(&self) -> &'static str {
+        "cubes"
+    }
+
+    /// None of its own: its term is compiled into the lighting pass, whose permutations
+    /// ([`super::deferred`]) walk every translucency layout.
+    fn shader_permutations(&self, _out: &mut Vec<PipelineShaders>) {}
 }
 
 #[cfg(test)]

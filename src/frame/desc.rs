@@ -14,6 +14,7 @@
 use super::FrameSettings;
 use crate::features::deferred::{GBufferLayout, TranslucencyLayout};
 use crate::features::layered::LayeredDesc;
+use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
 use crate::features::translucency::{MaterialTable, MaterialTableGpu, ThicknessPacking};
@@ -52,8 +53,15 @@ impl FrameDesc {
     /// What `scene` asks for under `settings` (its technique and knobs).
     pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
         let technique = settings.technique;
+        // Every technique a material names must exist, whichever technique this frame runs.
+        registry::check_names(scene)?;
         let sss = if technique.sss() {
-            SssProfiles::new(scene, technique.sss_blur(), settings.sss.gaussians)?
+            SssProfiles::new(
+                scene,
+                technique.sss_blur(),
+                settings.sss.gaussians,
+                &registry::blur_of,
+            )?
         } else {
             None
         };
@@ -202,6 +210,31 @@ impl FrameDesc {
                 == other.sss.as_ref().map(|s| s.profiles.len())
             && self.layered.as_ref().map(|l| l.materials.len())
                 == other.layered.as_ref().map(|l| l.materials.len())
+    }
+
+    /// The registered techniques this frame runs, in registry order: GDC 2011 translucency,
+    /// each SSS chain's blur, Li et al.'s layered media, as far as the frame has them.
+    pub fn techniques(&self) -> Vec<&'static dyn TechniqueModule> {
+        let chains = self
+            .sss
+            .as_ref()
+            .map(SssProfiles::chains)
+            .unwrap_or_default();
+        registry::TECHNIQUES
+            .iter()
+            .copied()
+            .filter(|t| match t.shades() {
+                Shades::Translucent => self.translucency.is_some(),
+                Shades::Scattering(_) => chains.iter().any(|c| c.name() == t.name()),
+                Shades::Layered => self.layered.is_some(),
+            })
+            .collect()
+    }
+
+    /// Whether some technique of the frame acts on the knob `flag` (a registry knob, see
+    /// [`TechniqueModule::knobs`]).
+    pub fn uses_knob(&self, flag: &str) -> bool {
+        self.techniques().iter().any(|t| t.knobs().contains(&flag))
     }
 
     /// The features in the frame, for messages and the plan dump's header.

@@ -208,13 +208,7 @@ impl Renderer {
             tiles.lighting = tile_rects(columns, &marked, width, height);
         }
         if let Some(profiles) = &desc.sss {
-            let table = profiles.table(&self.settings.sss);
-            per_frame.write(slot, Region::Profiles, bytemuck::bytes_of(&table))?;
-            if desc.two_pass() {
-                let knobs = &self.settings.sss;
-                let kernels = sss::kernel::kernel_table(profiles, knobs.samples, knobs.shape);
-                per_frame.write(slot, Region::Kernels, bytemuck::bytes_of(&kernels))?;
-            }
+            sss::tables::write(per_frame, slot, profiles, &self.settings.sss)?;
             for chain in profiles.chains() {
                 let rects = self.settings.sss_tiles.then(|| {
                     let (columns, _, marked) =

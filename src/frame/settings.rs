@@ -5,98 +5,116 @@ use crate::features::antialias::Antialias;
 use crate::features::debug_view::DebugView;
 use crate::features::deferred::GBufferPrecision;
 use crate::features::layered::LayeredKnobs;
+use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowSettings;
 use crate::features::sss;
+use crate::features::sss::SssBlur;
 use crate::graph::CompileOptions;
-use crate::scene::material::SssBlur;
 use crate::Result;
 
 /// What the frame shades. `Auto` (the default) is what the scene's materials ask for: every
-/// feature some material has, composed in one frame. The named techniques restrict the frame
-/// to one technique for A/B runs and the seeds' tables: the materials' parts of other
-/// techniques are left out, and an SSS technique blurs every SSS material with its blur.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// feature some material has, composed in one frame. `None` is plain deferred lighting. A
+/// registered technique ([`registry::TECHNIQUES`]) restricts the frame to that technique for
+/// A/B runs and the seeds' tables: the materials' parts of other techniques are left out, and
+/// an SSS technique blurs every SSS material with its blur.
+#[derive(Clone, Copy)]
 pub enum Technique {
     /// Whatever the materials ask for: GDC 2011 translucency on translucent materials, each
-    /// SSS material's profile with its own blur, normal and albedo maps.
+    /// SSS material's profile with its own blur, layered media, normal and albedo maps.
     Auto,
-    /// Plain deferred lighting (no translucency, no SSS).
+    /// Plain deferred lighting (no translucency, no SSS, no layered media).
     None,
-    /// Deferred lighting plus GDC 2011 thickness-based translucency for translucent materials.
-    Translucency,
-    /// Screen-space SSS, the thesis's control: Jimenez's separable sum-of-Gaussians blur of the
-    /// lit diffuse light for materials with an SSS profile.
-    Control,
-    /// The thesis's LEAN pipeline with the control's blur: LEAN maps projected to the view
-    /// plane, the lit diffuse and the LEAN moments blurred with Jimenez's kernel, LEAN specular
-    /// with Fresnel evaluated on the blurred moments.
-    Lcb,
-    /// The thesis's technique: the LEAN pipeline with a separable bilateral (depth-weighted)
-    /// blur of the projected G-buffer in ping-pong targets.
-    Lbb,
-    /// Jimenez's separable SSS: two passes, a kernel pre-integrated from each profile.
-    Separable,
-    /// The thesis's bilateral LEAN blur in two passes, tap weights from the whole profile.
-    Bilateral,
-    /// Li et al.'s layered media (single + dipole multiple scattering) on layered materials
-    /// only.
-    Layered,
+    /// One registered technique alone.
+    Only(&'static dyn TechniqueModule),
+}
+
+impl PartialEq for Technique {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for Technique {}
+
+impl std::fmt::Debug for Technique {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl From<&'static dyn TechniqueModule> for Technique {
+    fn from(technique: &'static dyn TechniqueModule) -> Self {
+        Technique::Only(technique)
+    }
 }
 
 impl Technique {
-    /// Every technique with its command-line name.
-    pub const ALL: &'static [(&'static str, Technique)] = &[
-        ("auto", Technique::Auto),
-        ("none", Technique::None),
-        ("translucency", Technique::Translucency),
-        ("control", Technique::Control),
-        ("lcb", Technique::Lcb),
-        ("lbb", Technique::Lbb),
-        ("separable", Technique::Separable),
-        ("bilateral", Technique::Bilateral),
-        ("layered", Technique::Layered),
-    ];
+    /// Every choice with its command-line name: `auto`, `none`, then the registry's techniques
+    /// in registry order.
+    pub fn all() -> Vec<(&'static str, Technique)> {
+        [("auto", Technique::Auto), ("none", Technique::None)]
+            .into_iter()
+            .chain(
+                registry::TECHNIQUES
+                    .iter()
+                    .map(|&t| (t.name(), Technique::Only(t))),
+            )
+            .collect()
+    }
 
     /// Parses a command-line name.
     pub fn parse(name: &str) -> Result<Self> {
-        crate::error::parse_named(Self::ALL, name, "technique")
+        crate::error::parse_named(&Self::all(), name, "technique")
     }
 
     /// Command-line name.
     pub fn name(self) -> &'static str {
-        crate::error::name_of(Self::ALL, &self)
+        match self {
+            Technique::Auto => "auto",
+            Technique::None => "none",
+            Technique::Only(t) => t.name(),
+        }
+    }
+
+    /// One line saying what it shades (help texts, the demo's panel).
+    pub fn summary(self) -> &'static str {
+        match self {
+            Technique::Auto => "what the materials ask for, every technique composed in one frame",
+            Technique::None => "plain deferred lighting",
+            Technique::Only(t) => t.summary(),
+        }
+    }
+
+    /// The registered technique this restricts the frame to, if any.
+    pub fn module(self) -> Option<&'static dyn TechniqueModule> {
+        match self {
+            Technique::Only(t) => Some(t),
+            Technique::Auto | Technique::None => None,
+        }
+    }
+
+    fn shades(self) -> Option<Shades> {
+        self.module().map(|t| t.shades())
     }
 
     /// The screen-space SSS blur this technique forces on every SSS material, if any.
     pub fn sss_blur(self) -> Option<SssBlur> {
-        match self {
-            Technique::Auto | Technique::None | Technique::Translucency | Technique::Layered => {
-                None
-            }
-            Technique::Control => Some(SssBlur::Control),
-            Technique::Lcb => Some(SssBlur::LeanControl),
-            Technique::Lbb => Some(SssBlur::LeanBilateral),
-            Technique::Separable => Some(SssBlur::Separable),
-            Technique::Bilateral => Some(SssBlur::Bilateral),
-        }
+        self.module().and_then(registry::blur_of_technique)
     }
 
     /// Whether translucent materials get GDC 2011 translucency.
     pub fn translucency(self) -> bool {
-        matches!(self, Technique::Auto | Technique::Translucency)
+        self == Technique::Auto || matches!(self.shades(), Some(Shades::Translucent))
     }
 
     /// Whether SSS materials get their screen-space blur.
     pub fn sss(self) -> bool {
-        !matches!(
-            self,
-            Technique::None | Technique::Translucency | Technique::Layered
-        )
+        self == Technique::Auto || matches!(self.shades(), Some(Shades::Scattering(_)))
     }
 
     /// Whether layered materials get Li et al.'s scattering passes.
     pub fn layered(self) -> bool {
-        matches!(self, Technique::Auto | Technique::Layered)
+        self == Technique::Auto || matches!(self.shades(), Some(Shades::Layered))
     }
 }
 

@@ -309,7 +309,7 @@ pub fn run_translucency(
     cases: &[SweepCase],
 ) -> Result<Vec<SweepRow>> {
     let settings = FrameSettings {
-        technique: Technique::Translucency,
+        technique: Technique::Only(&crate::features::translucency::TRANSLUCENCY),
         export_hdr: true,
         ..FrameSettings::new(width, height)
     };

@@ -2,7 +2,7 @@
 //! writes `DIR/report.md` with its tables and PNG plots.
 //!
 //! In order:
-//! 1. **Per technique** (every entry of [`Technique::ALL`], on the scene made for it, see
+//! 1. **Per technique** (every entry of [`Technique::all`], on the scene made for it, see
 //!    [`scene_for`]): the verified benchmark ([`crate::measure::bench`], with `--isolate`) and every
 //!    pass beside its speed-of-light copy ([`crate::measure::speed_of_light`]), measured in the same run;
 //!    a bar plot of pass against copy; beside the thesis's table where the thesis has one.
@@ -100,16 +100,13 @@ pub fn sss_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
     })
 }
 
-/// The built-in scene a technique is measured on: the scene made to show it (`auto`: `mixed`,
-/// where every technique meets in one frame).
+/// The built-in scene a technique is measured on: the scene its module names (`auto`:
+/// `mixed`, where every technique meets in one frame; `none`: `smoke`).
 pub fn scene_for(technique: Technique) -> Result<String> {
     Ok(match technique {
         Technique::Auto => "mixed",
         Technique::None => "smoke",
-        Technique::Translucency => "cubes",
-        Technique::Control => "skin",
-        Technique::Lcb | Technique::Lbb | Technique::Separable | Technique::Bilateral => "teapot",
-        Technique::Layered => "layered",
+        Technique::Only(t) => t.scene(),
     }
     .to_string())
 }
@@ -258,7 +255,7 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
          pass's copy reads and writes the pass's own formats at its resolution and is timed in \
          the same run (see `src/speed_of_light.rs`).\n"
     );
-    for &(name, technique) in Technique::ALL {
+    for (name, technique) in Technique::all() {
         let scene = scene_for(technique)?;
         eprintln!("report:   bench `{name}` on `{scene}`");
         let report = bench_technique(ctx, technique, &scene)?;
@@ -373,12 +370,7 @@ fn seeds_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         out.markdown,
         "## The seeds' tables beside ours\n\n\
          The thesis's Tables 1 and 2 are beside the per-technique tables above (`control`: \
-         Table 2{}).\n",
-        if Technique::parse("lbb").is_ok() {
-            "; `lbb`: Table 1"
-        } else {
-            "; Table 1 is LBB's, which lucent does not have yet"
-        }
+         Table 2; `lbb`: Table 1).\n"
     );
     // GDC 2011: grid125 all translucent, none against translucency, lighting separate.
     let (w, h) = (ctx.options.width, ctx.options.height);
@@ -497,15 +489,18 @@ pub fn gdc_cost(
     (width, height): (u32, u32),
     (frames, warmup): (usize, usize),
 ) -> Result<TranslucencyCost> {
-    let configs: Vec<Config> = [Technique::None, Technique::Translucency]
-        .iter()
-        .map(|&t| Config {
-            label: t.name().into(),
-            x: 1.0,
-            scene: scene.clone(),
-            settings: crate::measure::scaling::settings(t, width, height),
-        })
-        .collect();
+    let configs: Vec<Config> = [
+        Technique::None,
+        Technique::Only(&crate::features::translucency::TRANSLUCENCY),
+    ]
+    .iter()
+    .map(|&t| Config {
+        label: t.name().into(),
+        x: 1.0,
+        scene: scene.clone(),
+        settings: crate::measure::scaling::settings(t, width, height),
+    })
+    .collect();
     let m = crate::measure::scaling::measure(
         gpu,
         shaders,
@@ -656,7 +651,11 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                 label: format!("{s}x{s}"),
                 x: f64::from(s) * f64::from(s),
                 scene: skin.clone(),
-                settings: crate::measure::scaling::settings(Technique::Control, s, s),
+                settings: crate::measure::scaling::settings(
+                    Technique::Only(&crate::features::sss::control::CONTROL),
+                    s,
+                    s,
+                ),
             })
             .collect(),
     ));
@@ -677,7 +676,11 @@ fn scaling_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                 label: format!("{n}"),
                 x: n as f64,
                 scene: crate::report::section::with_lights(&grid, n),
-                settings: crate::measure::scaling::settings(Technique::Translucency, w, h),
+                settings: crate::measure::scaling::settings(
+                    Technique::Only(&crate::features::translucency::TRANSLUCENCY),
+                    w,
+                    h,
+                ),
             })
             .collect(),
     ));
@@ -727,8 +730,17 @@ mod tests {
     #[test]
     fn every_technique_gets_a_scene_it_does_something_in() {
         assert_eq!(scene_for(Technique::None).unwrap(), "smoke");
-        assert_eq!(scene_for(Technique::Translucency).unwrap(), "cubes");
-        assert_eq!(scene_for(Technique::Control).unwrap(), "skin");
+        assert_eq!(
+            scene_for(Technique::Only(
+                &crate::features::translucency::TRANSLUCENCY
+            ))
+            .unwrap(),
+            "cubes"
+        );
+        assert_eq!(
+            scene_for(Technique::Only(&crate::features::sss::control::CONTROL)).unwrap(),
+            "skin"
+        );
     }
 
     #[test]

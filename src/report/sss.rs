@@ -61,7 +61,7 @@ pub struct SssResult {
     pub fit_error: Option<f64>,
 }
 
-/// Every variant: the five techniques at their defaults, then one knob at a time (the
+/// Every variant: the SSS techniques of the registry at their defaults, then one knob at a time (the
 /// per-Gaussian blurs' Gaussian counts and LBB's knobs, the two-pass blurs' samples, taps,
 /// kernel and resolution).
 pub fn sss_variants() -> Vec<SssVariant> {
@@ -70,13 +70,7 @@ pub fn sss_variants() -> Vec<SssVariant> {
         ..FrameSettings::new(1, 1)
     };
     let mut v = Vec::new();
-    for t in [
-        Technique::Control,
-        Technique::Lcb,
-        Technique::Lbb,
-        Technique::Separable,
-        Technique::Bilateral,
-    ] {
+    for t in crate::features::registry::sss_techniques().map(Technique::Only) {
         v.push(SssVariant {
             knob: "technique",
             name: t.name().into(),
@@ -84,11 +78,14 @@ pub fn sss_variants() -> Vec<SssVariant> {
         });
     }
     for n in [4, 3, 2] {
-        for t in [Technique::Control, Technique::Lbb] {
+        for t in [
+            Technique::Only(&crate::features::sss::control::CONTROL),
+            Technique::Only(&crate::features::sss::lbb::LBB),
+        ] {
             let mut s = base(t);
             s.sss.gaussians = Some(n);
             v.push(SssVariant {
-                knob: if t == Technique::Lbb {
+                knob: if t == Technique::Only(&crate::features::sss::lbb::LBB) {
                     "LBB Gaussians"
                 } else {
                     "control Gaussians"
@@ -99,7 +96,7 @@ pub fn sss_variants() -> Vec<SssVariant> {
         }
     }
     for taps in [7, 3] {
-        let mut s = base(Technique::Lbb);
+        let mut s = base(Technique::Only(&crate::features::sss::lbb::LBB));
         s.sss.taps = taps;
         v.push(SssVariant {
             knob: "LBB taps",
@@ -107,21 +104,21 @@ pub fn sss_variants() -> Vec<SssVariant> {
             settings: s,
         });
     }
-    let mut half = base(Technique::Lbb);
+    let mut half = base(Technique::Only(&crate::features::sss::lbb::LBB));
     half.sss.precision = SssPrecision::Half;
     v.push(SssVariant {
         knob: "LBB sum precision",
         name: "lbb fp16 sums".into(),
         settings: half,
     });
-    let mut packed = base(Technique::Lbb);
+    let mut packed = base(Technique::Only(&crate::features::sss::lbb::LBB));
     packed.sss.packed = true;
     v.push(SssVariant {
         knob: "LBB packed ping-pong",
         name: "lbb packed".into(),
         settings: packed,
     });
-    let mut whole = base(Technique::Lbb);
+    let mut whole = base(Technique::Only(&crate::features::sss::lbb::LBB));
     whole.sss_tiles = false;
     v.push(SssVariant {
         knob: "LBB screen tiles",
@@ -129,7 +126,10 @@ pub fn sss_variants() -> Vec<SssVariant> {
         settings: whole,
     });
     let defaults = crate::features::sss::SssKnobs::default();
-    for t in [Technique::Separable, Technique::Bilateral] {
+    for t in [
+        Technique::Only(&crate::features::sss::separable::SEPARABLE),
+        Technique::Only(&crate::features::sss::bilateral::BILATERAL),
+    ] {
         for samples in crate::features::sss::kernel::SAMPLE_COUNTS {
             if samples == defaults.samples {
                 continue;
@@ -137,7 +137,7 @@ pub fn sss_variants() -> Vec<SssVariant> {
             let mut s = base(t);
             s.sss.samples = samples;
             v.push(SssVariant {
-                knob: if t == Technique::Separable {
+                knob: if t == Technique::Only(&crate::features::sss::separable::SEPARABLE) {
                     "separable samples"
                 } else {
                     "bilateral samples"
@@ -147,7 +147,7 @@ pub fn sss_variants() -> Vec<SssVariant> {
             });
         }
     }
-    let mut filter = base(Technique::Separable);
+    let mut filter = base(Technique::Only(&crate::features::sss::separable::SEPARABLE));
     filter.sss.point_taps = !defaults.point_taps;
     v.push(SssVariant {
         knob: "separable taps",
@@ -161,14 +161,14 @@ pub fn sss_variants() -> Vec<SssVariant> {
         ),
         settings: filter,
     });
-    let mut line = base(Technique::Separable);
+    let mut line = base(Technique::Only(&crate::features::sss::separable::SEPARABLE));
     line.sss.shape = crate::features::sss::kernel::KernelShape::Line;
     v.push(SssVariant {
         knob: "separable kernel",
         name: "separable line kernel".into(),
         settings: line,
     });
-    let mut half_res = base(Technique::Separable);
+    let mut half_res = base(Technique::Only(&crate::features::sss::separable::SEPARABLE));
     half_res.sss.half_res = true;
     v.push(SssVariant {
         knob: "separable resolution",
@@ -225,7 +225,7 @@ pub fn run(
     let edges = crate::bake::scene::load_scene_baked("edges")?;
     let edges = error_scene(&edges, 4.0, true);
     let reference_frame = FrameSettings {
-        technique: Technique::Lbb,
+        technique: Technique::Only(&crate::features::sss::lbb::LBB),
         export_hdr: true,
         export_gbuffer: true,
         ..FrameSettings::new(ew, eh)

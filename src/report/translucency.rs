@@ -110,7 +110,10 @@ fn with_pow(scene: &Scene, mode: PowMode) -> Scene {
 /// with exact pow instead of the grid's exp2).
 pub fn translucency_variants(opts: &ReportOptions) -> Result<Vec<Variant>> {
     let cubes = crate::bake::scene::load_scene_baked("cubes")?;
-    let t = settings(opts, Technique::Translucency);
+    let t = settings(
+        opts,
+        Technique::Only(&crate::features::translucency::TRANSLUCENCY),
+    );
     let exact = with_pow(&cubes, PowMode::Exact);
     let mut variants = vec![
         Variant {
@@ -190,7 +193,10 @@ pub fn translucency_variants(opts: &ReportOptions) -> Result<Vec<Variant>> {
         ),
     ];
     for (label, scene) in coverage {
-        for technique in [Technique::None, Technique::Translucency] {
+        for technique in [
+            Technique::None,
+            Technique::Only(&crate::features::translucency::TRANSLUCENCY),
+        ] {
             variants.push(Variant {
                 knob: format!("grid125 {label}"),
                 name: technique.name().into(),
@@ -284,7 +290,10 @@ fn image_error(
     let settings = FrameSettings {
         export_gbuffer: true,
         gbuffer: GBufferPrecision::Full,
-        ..settings(opts, Technique::Translucency)
+        ..settings(
+            opts,
+            Technique::Only(&crate::features::translucency::TRANSLUCENCY),
+        )
     };
     let features = FrameDesc::new(&exact, &settings)?;
     let gbuffer = render_frame(gpu, shaders, pipeline_cache, &exact, settings)?

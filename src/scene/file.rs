@@ -13,8 +13,8 @@ use serde::Deserialize;
 
 use super::generators::{self, Generator};
 use super::material::{
-    Gaussian, Layer, LayeredMedium, Light, LightKind, Material, PowMode, SssProfile, TextureSource,
-    Thickness, ThicknessSource, Translucency,
+    Gaussian, Layer, LayeredMedium, Light, LightKind, Material, PowMode, SssProfile, TechniqueName,
+    TextureSource, Thickness, ThicknessSource, Translucency,
 };
 use super::{Camera, Deformation, Object, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
@@ -336,6 +336,19 @@ impl Locator<'_> {
         fallback
     }
 
+    /// Where a key is: `line N, key `section[i].key`` (the line when found).
+    fn location(&self, section: &str, index: Option<usize>, key: &str) -> String {
+        let full_key = match (section.is_empty(), index) {
+            (true, _) => key.to_string(),
+            (false, Some(i)) => format!("{section}[{i}].{key}"),
+            (false, None) => format!("{section}.{key}"),
+        };
+        match self.line(section, index, key) {
+            Some(line) => format!("line {line}, key `{full_key}`"),
+            None => format!("key `{full_key}`"),
+        }
+    }
+
     /// An error naming the file, the line (when found) and the key.
     fn error(
         &self,
@@ -344,15 +357,7 @@ impl Locator<'_> {
         key: &str,
         message: impl std::fmt::Display,
     ) -> LucentError {
-        let full_key = match (section.is_empty(), index) {
-            (true, _) => key.to_string(),
-            (false, Some(i)) => format!("{section}[{i}].{key}"),
-            (false, None) => format!("{section}.{key}"),
-        };
-        let location = match self.line(section, index, key) {
-            Some(line) => format!("line {line}, key `{full_key}`"),
-            None => format!("key `{full_key}`"),
-        };
+        let location = self.location(section, index, key);
         LucentError::file(self.path, format!("{location}: {message}"))
     }
 }
@@ -1423,10 +1428,13 @@ fn build_material(
             profile.units_per_mm = u;
         }
         if let Some(b) = &s.blur {
-            profile.blur = Some(
-                crate::scene::material::SssBlur::parse(b)
-                    .map_err(|e| at.error("material", Some(i), "blur", e))?,
-            );
+            // The name stays a name: the technique registry, above the scene, resolves it (and
+            // its error names this file, line and key).
+            profile.blur = Some(TechniqueName::written_at(
+                b.as_str(),
+                at.path,
+                at.location("material", Some(i), "blur"),
+            ));
         }
         profile.validate().map_err(|e| {
             at.error(

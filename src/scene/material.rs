@@ -143,93 +143,58 @@ pub struct SssProfile {
     pub gaussians: Vec<Gaussian>,
     /// World units per millimetre of the profile (scene scale).
     pub units_per_mm: f32,
-    /// The screen-space blur the material asks for (`[material.sss] blur`); `None`: the
-    /// project's default, [`SssBlur::DEFAULT`].
-    pub blur: Option<SssBlur>,
+    /// The screen-space blur the material asks for (`[material.sss] blur`, a registered SSS
+    /// technique's name); `None`: the registry's default blur.
+    pub blur: Option<TechniqueName>,
 }
 
-/// The screen-space blurs a material's profile can be diffused with. Each pixel is blurred by
-/// its own material's blur and profile; a frame runs one chain of passes per blur its
-/// materials use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum SssBlur {
-    /// Jimenez's separable sum-of-Gaussians blur of the lit diffuse light (the LEAN-mapping
-    /// thesis's control, C): a horizontal and a vertical pass per Gaussian.
-    Control,
-    /// The thesis's LEAN pipeline with Jimenez's blur (LCB).
-    LeanControl,
-    /// The thesis's LEAN pipeline with the separable bilateral blur (LBB), per Gaussian.
-    LeanBilateral,
-    /// Jimenez's separable SSS (2012/2015): one horizontal and one vertical pass with a kernel
-    /// pre-integrated from the whole profile, following the surface's depth.
-    Separable,
-    /// The thesis's idea in two passes: the lit diffuse and the LEAN G-buffer blurred by a
-    /// bilateral kernel whose tap weights are the whole profile at each tap's 3D distance, then
-    /// LEAN specular.
-    Bilateral,
+/// A technique a scene names (`[material.sss] blur`), kept as written. The scene knows no
+/// techniques: the technique registry (`lucent::features::registry`), a layer above, resolves
+/// the name, and [`TechniqueName::error`] words its complaint with the file, line and key the
+/// name came from. Two names are equal when they are spelled the same.
+#[derive(Clone, Debug)]
+pub struct TechniqueName {
+    /// The name as written.
+    pub name: String,
+    /// Where it was written: the scene file and `line N, key `...``.
+    origin: Option<(PathBuf, String)>,
 }
 
-impl SssBlur {
-    /// Every blur with its name (scene files, `--technique`), in chain order.
-    pub const ALL: &'static [(&'static str, SssBlur)] = &[
-        ("control", SssBlur::Control),
-        ("lcb", SssBlur::LeanControl),
-        ("lbb", SssBlur::LeanBilateral),
-        ("separable", SssBlur::Separable),
-        ("bilateral", SssBlur::Bilateral),
-    ];
-
-    /// The blur of materials that name none: the one measured best for its error at its cost,
-    /// artefacts included (docs/sss.md, "Two passes"): the separable blur, with a lower mean
-    /// error against the brute-force reference than the 12-pass control on `skin` and
-    /// `teapot`, at about 2x the plain frame where the control costs 9x.
-    pub const DEFAULT: SssBlur = SssBlur::Separable;
-
-    /// Its name.
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, b)| *b == self)
-            .map_or("?", |(n, _)| n)
+impl TechniqueName {
+    /// A name given in code (no file to point at).
+    pub fn new(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            origin: None,
+        }
     }
 
-    /// Parses a name.
-    pub fn parse(name: &str) -> Result<Self> {
-        Self::ALL
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|&(_, b)| b)
-            .ok_or_else(|| {
-                LucentError::InvalidInput(format!(
-                    "unknown SSS blur '{name}'; use {}",
-                    Self::ALL
-                        .iter()
-                        .map(|(n, _)| *n)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })
+    /// A name read from `path` at `location` (`line N, key `material[i].blur``).
+    pub fn written_at(name: impl Into<String>, path: &std::path::Path, location: String) -> Self {
+        Self {
+            name: name.into(),
+            origin: Some((path.to_path_buf(), location)),
+        }
     }
 
-    /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
-    pub fn lean(self) -> bool {
-        !matches!(self, SssBlur::Control | SssBlur::Separable)
+    /// `message` about this name, naming where it was written when it came from a file.
+    pub fn error(&self, message: impl std::fmt::Display) -> LucentError {
+        match &self.origin {
+            Some((path, location)) => LucentError::file(path, format!("{location}: {message}")),
+            None => LucentError::InvalidInput(message.to_string()),
+        }
     }
+}
 
-    /// Whether it blurs one horizontal + vertical pair per Gaussian of the profile (the
-    /// thesis's iterative scheme); else one pair for the whole profile.
-    pub fn iterative(self) -> bool {
-        matches!(
-            self,
-            SssBlur::Control | SssBlur::LeanControl | SssBlur::LeanBilateral
-        )
+impl PartialEq for TechniqueName {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
     }
+}
 
-    /// Whether taps are point taps weighted by depth (LBB's per-Gaussian depth Gaussian, the
-    /// two-pass bilateral's profile at the 3D distance); else bilinear taps lerped back to the
-    /// centre across depth edges.
-    pub fn bilateral(self) -> bool {
-        matches!(self, SssBlur::LeanBilateral | SssBlur::Bilateral)
+impl From<&str> for TechniqueName {
+    fn from(name: &str) -> Self {
+        Self::new(name)
     }
 }
 
@@ -281,11 +246,6 @@ impl SssProfile {
             units_per_mm: 0.01,
             blur: None,
         })
-    }
-
-    /// The blur this profile is diffused with: its own, or the default.
-    pub fn blur_or_default(&self) -> SssBlur {
-        self.blur.unwrap_or(SssBlur::DEFAULT)
     }
 
     /// Checks the profile can be blurred safely: 1 to 8 Gaussians, finite positive variances,

@@ -159,7 +159,7 @@ pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 
             })
             .collect(),
         units_per_mm: profile.units_per_mm,
-        blur: profile.blur,
+        blur: profile.blur.clone(),
     };
     Ok((refit, errors))
 }

@@ -8,11 +8,12 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::{
-    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur, SssInputs,
-    SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
+    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur,
+    SssBlurTechnique, SssInputs, SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
 use crate::features::deferred::HDR_FORMAT;
 use crate::features::shipped::PipelineShaders;
+use crate::features::technique::{Shades, TechniqueModule};
 use crate::features::util::{
     check_bindings, clamp_sampler, Binding, Defines, GraphicsPipelineDesc, PassPipeline,
 };
@@ -23,6 +24,8 @@ use crate::graph::{
 };
 use crate::Result;
 
+/// Declares an iterative chain (see the module docs). Returns the chain's result (`output`
+/// when given).
 pub(super) fn chain_passes(
     graph: &mut RenderGraph,
     inputs: &SssInputs<'_>,
@@ -47,7 +50,7 @@ pub(super) fn chain_passes(
         _ => None,
     };
     let targets = if lean.is_some() { 2 } else { 1 };
-    let packed = packed_pingpong(blur, lean.is_some(), knobs.packed);
+    let packed = packed_pingpong(blur.technique(), lean.is_some(), knobs.packed);
     let names = ["", ".lean"];
     // The ping-pong targets: one packed RGBA32UI texel, or one RGBA16F per blurred texel.
     let (pingpong, pingpong_info) = if packed {
@@ -223,14 +226,14 @@ const COMBINE_FRAGMENT: &str = "sss/combine.frag";
 
 /// Whether a chain's ping-pong targets are one packed RGBA32UI texel: LBB with the LEAN
 /// target, when the `packed` knob asks.
-fn packed_pingpong(blur: SssBlur, lean: bool, packed: bool) -> bool {
+fn packed_pingpong(blur: &dyn SssBlurTechnique, lean: bool, packed: bool) -> bool {
     lean && blur.bilateral() && packed
 }
 
 /// The iterative blur pass's defines: the chain's blur, bilateral `taps` per direction,
 /// profile edges, LBB's packed input and output, and whether it accumulates into the sums.
 fn blur_defines(
-    blur: SssBlur,
+    blur: &dyn SssBlurTechnique,
     taps: u32,
     edges: bool,
     packed_in: bool,
@@ -292,22 +295,20 @@ fn final_defines(lean: bool, base: bool, shadows: bool) -> (Defines, Option<Defi
     (defines, lean.then(|| vec![("LUCENT_SSS_PASSTHROUGH", "1")]))
 }
 
-/// The pipelines the iterative chains of any frame build.
-pub(super) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
-    for &(_, blur) in SssBlur::ALL {
-        for taps in [3, 5, 7] {
-            for flags in 0u32..1 << 5 {
-                let bit = |i: u32| flags & (1 << i) != 0;
-                let (edges, accumulate) = (bit(0), bit(1));
-                // The LEAN target is there (blur.lean()) or not; the packed knob.
-                let packed = packed_pingpong(blur, blur.lean() && bit(2), bit(3));
-                // A packed chain's first horizontal pass reads the unpacked light.
-                let packed_in = packed && bit(4);
-                out.push(PipelineShaders::fullscreen(
-                    BLUR_FRAGMENT,
-                    &blur_defines(blur, taps, edges, packed_in, packed, accumulate),
-                ));
-            }
+/// The pipelines an iterative chain of `blur` builds in any frame.
+pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<PipelineShaders>) {
+    for taps in [3, 5, 7] {
+        for flags in 0u32..1 << 5 {
+            let bit = |i: u32| flags & (1 << i) != 0;
+            let (edges, accumulate) = (bit(0), bit(1));
+            // The LEAN target is there (blur.lean()) or not; the packed knob.
+            let packed = packed_pingpong(blur, blur.lean() && bit(2), bit(3));
+            // A packed chain's first horizontal pass reads the unpacked light.
+            let packed_in = packed && bit(4);
+            out.push(PipelineShaders::fullscreen(
+                BLUR_FRAGMENT,
+                &blur_defines(blur, taps, edges, packed_in, packed, accumulate),
+            ));
         }
     }
     for lean in [false, true] {
@@ -378,7 +379,7 @@ impl PassExec for BlurPass {
             bindings.push(Binding::Sampled(views[lean], color_sampler));
         }
         let defines = blur_defines(
-            self.blur,
+            self.blur.technique(),
             self.taps,
             self.edges,
             self.packed_in,
@@ -533,5 +534,75 @@ impl PassExec for FinalPass {
         }
         // SAFETY: created by `prepare`; the GPU is done with it.
         unsafe { gpu.device.destroy_sampler(self.sampler, None) };
+    }
+}
+
+/// A technique whose chain is iterative (the control, LCB, LBB): what tells them apart. Each
+/// one's module holds its instance; [`crate::features::registry`] lists it.
+pub struct IterativeChain {
+    /// Its name (`--technique`, `blur = "..."`).
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// It blurs the LEAN G-buffer too and ends in LEAN `final lighting` (else `combine`).
+    pub lean: bool,
+    /// Point taps weighted by a depth Gaussian (else bilinear taps lerped across edges).
+    pub bilateral: bool,
+    /// The knobs that act on it.
+    pub knobs: &'static [&'static str],
+    /// The built-in scene it is measured on.
+    pub scene: &'static str,
+}
+
+impl TechniqueModule for IterativeChain {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn summary(&self) -> &'static str {
+        self.summary
+    }
+
+    fn shades(&'static self) -> Shades {
+        Shades::Scattering(self)
+    }
+
+    fn knobs(&self) -> &'static [&'static str] {
+        self.knobs
+    }
+
+    fn scene(&self) -> &'static str {
+        self.scene
+    }
+
+    fn shader_permutations(&self, out: &mut Vec<PipelineShaders>) {
+        shader_permutations(self, out);
+    }
+}
+
+impl SssBlurTechnique for IterativeChain {
+    fn lean(&self) -> bool {
+        self.lean
+    }
+
+    fn bilateral(&self) -> bool {
+        self.bilateral
+    }
+
+    fn iterative(&self) -> bool {
+        true
+    }
+
+    fn declare_chain(
+        &self,
+        graph: &mut RenderGraph,
+        inputs: &SssInputs<'_>,
+        chain: &Chain,
+        base: Option<&Handle<Image>>,
+        knobs: &SssKnobs,
+        scene: Option<&Arc<SceneGpu>>,
+        output: Option<Handle<Image>>,
+    ) -> Handle<Image> {
+        chain_passes(graph, inputs, chain, base, knobs, scene, output)
     }
 }

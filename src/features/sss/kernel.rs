@@ -234,7 +234,8 @@ pub fn kernel_table(profiles: &SssProfiles, samples: u32, shape: KernelShape) ->
         inverse_falloff: [[0.0; 4]; MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES],
     };
     for (i, (profile, blur)) in profiles.profiles.iter().enumerate() {
-        if !matches!(blur, super::SssBlur::Separable | super::SssBlur::Bilateral) {
+        // Iterative chains blur per Gaussian and read no kernel.
+        if blur.iterative() {
             continue;
         }
         let id = i + 1;
@@ -258,7 +259,7 @@ pub fn kernel_table(profiles: &SssProfiles, samples: u32, shape: KernelShape) ->
                 (tap.offset_mm * units) as f32,
             ];
         }
-        if *blur == super::SssBlur::Bilateral {
+        if blur.bilateral() {
             let last = (FALLOFF_ENTRIES - 1) as f64;
             for k in 0..FALLOFF_ENTRIES {
                 let u = k as f64 / last;

@@ -22,8 +22,9 @@
 //! pixel counts as a depth discontinuity (no light bleeds from one profile's object into
 //! another's).
 //!
-//! **Chains.** Materials choose their blur ([`SssBlur`]: control, LCB, LBB). The frame runs one
-//! chain of blur passes per blur in use, each touching only the pixels of its profiles, and
+//! **Chains.** Materials choose their blur ([`SssBlur`]: a registered technique that implements
+//! [`SssBlurTechnique`], see [`super::registry`]). The frame runs one chain of blur passes per
+//! blur in use, in registry order, each touching only the pixels of its profiles, and
 //! each chain's final pass keeps the previous chain's result elsewhere; a frame with one
 //! blur (every frame under a named technique) has exactly the passes the thesis's tables
 //! list. With tiles on (the default), each chain draws only over the screen rectangles of its
@@ -39,10 +40,14 @@ use crate::scene::material::SssProfile;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-pub use crate::scene::material::SssBlur;
-
+pub mod bilateral;
+pub mod control;
 mod iterative;
 pub mod kernel;
+pub mod lbb;
+pub mod lcb;
+pub mod separable;
+pub mod tables;
 mod two_pass;
 
 use super::util::{Binding, PassPipeline};
@@ -52,6 +57,134 @@ use super::util::{Binding, PassPipeline};
 pub const MAX_SSS_PROFILES: usize = 32;
 /// Most blur steps (Gaussians) of one profile ([`SssProfile::validate`] allows 8).
 pub const MAX_SSS_STEPS: usize = 8;
+
+/// A screen-space SSS technique's chain of passes: what its module implements besides
+/// [`super::technique::TechniqueModule`] (whose [`Shades::Scattering`](super::technique::Shades)
+/// returns it). The two kinds of chain are built by shared code ([`iterative`]: one blur pair
+/// per Gaussian; [`two_pass`]: one pair for the whole profile), parametrised by the
+/// properties below, never by a technique's name.
+pub trait SssBlurTechnique: Sync {
+    /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.
+    fn lean(&self) -> bool;
+    /// Whether its taps are point taps weighted by depth (LBB's per-Gaussian depth Gaussian,
+    /// the two-pass bilateral's profile at the 3D distance); else bilinear taps lerped back to
+    /// the centre across depth edges.
+    fn bilateral(&self) -> bool;
+    /// Whether it blurs one horizontal + vertical pair per Gaussian of the profile (the
+    /// thesis's iterative scheme); else one pair for the whole profile with a kernel table.
+    fn iterative(&self) -> bool;
+    /// Whether it can blur at half resolution per side (`--sss-half-res`).
+    fn half_resolution(&self) -> bool {
+        false
+    }
+    /// Whether its taps read linear depth from the lit diffuse's alpha, which the lighting
+    /// pass then writes there (when no LEAN chain keeps its slope x there).
+    fn depth_in_alpha(&self) -> bool {
+        false
+    }
+    /// Declares the chain's passes after the lighting pass: its blurs and its final pass,
+    /// which keeps `base` (the previous chain's result) on the pixels the chain does not own.
+    /// Returns the chain's result (`output` when given).
+    #[allow(clippy::too_many_arguments)]
+    fn declare_chain(
+        &self,
+        graph: &mut RenderGraph,
+        inputs: &SssInputs<'_>,
+        chain: &Chain,
+        base: Option<&Handle<Image>>,
+        knobs: &SssKnobs,
+        scene: Option<&Arc<SceneGpu>>,
+        output: Option<Handle<Image>>,
+    ) -> Handle<Image>;
+}
+
+/// A registered SSS blur, as materials and frames hold it: its technique's name, its place in
+/// the registry (chains run in that order) and its chain. Made by
+/// [`super::registry`] (`sss_blurs`, `sss_blur`, `blur_of`); two blurs are equal when they are
+/// the same technique.
+#[derive(Clone, Copy)]
+pub struct SssBlur {
+    name: &'static str,
+    rank: usize,
+    technique: &'static dyn SssBlurTechnique,
+}
+
+impl SssBlur {
+    /// The blur of the technique `name`, `rank`-th in the registry (the registry makes these).
+    pub(crate) fn new(
+        name: &'static str,
+        rank: usize,
+        technique: &'static dyn SssBlurTechnique,
+    ) -> Self {
+        Self {
+            name,
+            rank,
+            technique,
+        }
+    }
+
+    /// Its chain's properties and declaration.
+    pub fn technique(self) -> &'static dyn SssBlurTechnique {
+        self.technique
+    }
+
+    /// Its technique's name.
+    pub fn name(self) -> &'static str {
+        self.name
+    }
+
+    /// See [`SssBlurTechnique::lean`].
+    pub fn lean(self) -> bool {
+        self.technique.lean()
+    }
+
+    /// See [`SssBlurTechnique::bilateral`].
+    pub fn bilateral(self) -> bool {
+        self.technique.bilateral()
+    }
+
+    /// See [`SssBlurTechnique::iterative`].
+    pub fn iterative(self) -> bool {
+        self.technique.iterative()
+    }
+
+    /// See [`SssBlurTechnique::half_resolution`].
+    pub fn half_resolution(self) -> bool {
+        self.technique.half_resolution()
+    }
+}
+
+impl PartialEq for SssBlur {
+    fn eq(&self, other: &Self) -> bool {
+        self.rank == other.rank
+    }
+}
+
+impl Eq for SssBlur {}
+
+impl PartialOrd for SssBlur {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for SssBlur {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.rank.cmp(&other.rank)
+    }
+}
+
+impl std::hash::Hash for SssBlur {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.rank.hash(state);
+    }
+}
+
+impl std::fmt::Debug for SssBlur {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
 
 /// The SSS profiles of a frame: every distinct (profile, blur) of the scene's SSS materials,
 /// each with its ID, and each object's ID.
@@ -65,13 +198,14 @@ pub struct SssProfiles {
 }
 
 impl SssProfiles {
-    /// The profiles `scene`'s SSS materials ask for: each with its own blur, or `forced` on
-    /// all (a named technique); refitted to `gaussians` Gaussians when set. `None` when no
-    /// object scatters.
+    /// The profiles `scene`'s SSS materials ask for: each with its own blur (`blur_of` resolves
+    /// a profile's, [`super::registry::blur_of`]), or `forced` on all (a named technique);
+    /// refitted to `gaussians` Gaussians when set. `None` when no object scatters.
     pub fn new(
         scene: &Scene,
         forced: Option<SssBlur>,
         gaussians: Option<usize>,
+        blur_of: &dyn Fn(&SssProfile) -> Result<SssBlur>,
     ) -> Result<Option<Self>> {
         let mut profiles: Vec<(SssProfile, SssBlur)> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
@@ -80,7 +214,10 @@ impl SssProfiles {
                 object_ids.push(0);
                 continue;
             };
-            let blur = forced.unwrap_or_else(|| p.blur_or_default());
+            let blur = match forced {
+                Some(blur) => blur,
+                None => blur_of(p)?,
+            };
             let profile = match gaussians {
                 Some(n) => crate::scene::profile::fit_profile(p, n)?.0,
                 None => p.clone(),
@@ -109,7 +246,7 @@ impl SssProfiles {
         }))
     }
 
-    /// The blurs in use, one chain each, in [`SssBlur`] order.
+    /// The blurs in use, one chain each, in registry order.
     pub fn chains(&self) -> Vec<SssBlur> {
         let mut chains: Vec<SssBlur> = self.profiles.iter().map(|(_, b)| *b).collect();
         chains.sort();
@@ -142,7 +279,7 @@ impl SssProfiles {
     /// Whether the lighting pass writes linear depth into the lit diffuse's alpha for the
     /// separable blur's taps (a separable chain, and no LEAN chain whose slope x lives there).
     pub fn depth_in_alpha(&self) -> bool {
-        !self.lean() && self.chains().contains(&SssBlur::Separable)
+        !self.lean() && self.chains().iter().any(|b| b.technique().depth_in_alpha())
     }
 
     /// The profile of `object`, if it scatters.
@@ -445,17 +582,21 @@ pub fn sss_passes(
             last: index + 1 == chains.len(),
         };
         let result = if chain.last { output.take() } else { None };
-        base = Some(if blur.iterative() {
-            iterative::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene, result)
-        } else {
-            two_pass::chain_passes(graph, inputs, &chain, base.as_ref(), knobs, scene, result)
-        });
+        base = Some(blur.technique.declare_chain(
+            graph,
+            inputs,
+            &chain,
+            base.as_ref(),
+            knobs,
+            scene,
+            result,
+        ));
     }
     base.expect("SssProfiles is never empty")
 }
 
-/// One chain of a frame.
-struct Chain {
+/// One chain of a frame, as its technique's [`SssBlurTechnique::declare_chain`] declares it.
+pub struct Chain {
     /// Its index in the frame's chains (the profile table's chain number).
     index: usize,
     blur: SssBlur,
@@ -487,12 +628,6 @@ struct BlurConstants {
 }
 
 /// The profile table and frame uniforms every SSS pass binds first (0: frame, 1: profiles).
-/// The pipelines the SSS chains of any frame build (both kinds of chain).
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
-    iterative::shader_permutations(out);
-    two_pass::shader_permutations(out);
-}
-
 fn per_frame_bindings(scene: &SceneGpu) -> Vec<Binding> {
     vec![
         Binding::PerFrame(scene.per_frame.binding(Region::Frame)),

@@ -12,11 +12,12 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::{
-    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur, SssInputs,
-    SssKnobs,
+    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur,
+    SssBlurTechnique, SssInputs, SssKnobs,
 };
 use crate::features::deferred::HDR_FORMAT;
 use crate::features::shipped::PipelineShaders;
+use crate::features::technique::{Shades, TechniqueModule};
 use crate::features::util::{
     check_bindings, clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc,
     PassPipeline,
@@ -45,7 +46,7 @@ pub(super) fn chain_passes(
         format: HDR_FORMAT,
         ..graph.resources()[inputs.diffuse.id()].info
     };
-    let half_res = knobs.half_res && blur == SssBlur::Separable;
+    let half_res = knobs.half_res && blur.half_resolution();
     let blur_info = if half_res {
         ImageInfo {
             width: full.width.div_ceil(2),
@@ -99,10 +100,7 @@ pub(super) fn chain_passes(
         pass.sample(h);
     }
     let texels = 1 + u32::from(lean.is_some());
-    pass.taps(fetches(
-        texels,
-        !depth_in_alpha || blur == SssBlur::Bilateral,
-    ));
+    pass.taps(fetches(texels, !depth_in_alpha || blur.bilateral()));
     pass.color(&mut temp, LoadOp::DontCare);
     if let Some(t) = &mut temp_lean {
         pass.color(t, LoadOp::DontCare);
@@ -150,7 +148,7 @@ pub(super) fn chain_passes(
     if let Some(depth) = shadow_depth {
         pass.sample(depth);
     }
-    pass.taps(fetches(texels, blur == SssBlur::Bilateral));
+    pass.taps(fetches(texels, blur.bilateral()));
     pass.color(&mut vertical_out, LoadOp::DontCare);
     let ids = reads.iter().map(|h| h.id()).collect();
     match scene {
@@ -226,7 +224,7 @@ impl PassSpec {
     /// What its shader permutation depends on.
     fn shape(&self) -> PassShape {
         PassShape {
-            bilateral: self.blur == SssBlur::Bilateral,
+            bilateral: self.blur.bilateral(),
             vertical: self.vertical,
             compose: self.compose,
             half_res: self.half_res,
@@ -332,25 +330,25 @@ impl PassShape {
     }
 }
 
-/// The pipelines the two-pass chains of any frame build. Only the shadowed pass (the
+/// The pipelines a two-pass chain of `blur` builds in any frame. Only the shadowed pass (the
 /// bilateral chain's full-resolution vertical pass with LEAN) numbers bindings after its
 /// inputs: temp, depth, profile IDs, the LEAN temp, diffuse, specular, GB0, GB1 and the
 /// previous chain's result (`base`), as `chain_passes` reads them.
-pub(super) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
-    for flags in 0u32..1 << 8 {
+pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<PipelineShaders>) {
+    for flags in 0u32..1 << 7 {
         let bit = |i: u32| flags & (1 << i) != 0;
         for samples in [11, 17, 25] {
             let shape = PassShape {
-                bilateral: bit(0),
-                vertical: bit(1),
-                compose: bit(2),
-                half_res: bit(3),
-                base: bit(4),
-                edges: bit(5),
-                depth_in_alpha: bit(6),
-                point_taps: bit(7),
+                bilateral: blur.bilateral(),
+                vertical: bit(0),
+                compose: bit(1),
+                half_res: bit(2),
+                base: bit(3),
+                edges: bit(4),
+                depth_in_alpha: bit(5),
+                point_taps: bit(6),
                 samples,
-                inputs: 8 + usize::from(bit(4)),
+                inputs: 8 + usize::from(bit(3)),
             };
             for shadows in [false, true] {
                 let (defines, passthrough) = shape.defines(shadows);
@@ -414,8 +412,9 @@ impl PassExec for TwoPassBlur {
             ));
         }
         for (i, &id) in self.spec.inputs.iter().enumerate() {
-            // The light the separable blur taps between texels: linear; the rest nearest.
-            let sampler = if i == 0 && self.spec.blur == SssBlur::Separable {
+            // The light the separable (non-bilateral) blur taps between texels: linear; the
+            // rest nearest.
+            let sampler = if i == 0 && !self.spec.blur.bilateral() {
                 self.linear
             } else {
                 self.nearest
@@ -512,5 +511,88 @@ impl PassExec for TwoPassBlur {
             gpu.device.destroy_sampler(self.linear, None);
             gpu.device.destroy_sampler(self.nearest, None);
         }
+    }
+}
+
+/// A technique whose chain is two passes (separable, bilateral): what tells them apart. Each
+/// one's module holds its instance; [`crate::features::registry`] lists it.
+pub struct TwoPassChain {
+    /// Its name (`--technique`, `blur = "..."`).
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// It blurs the LEAN G-buffer too and adds LEAN specular in its vertical pass.
+    pub lean: bool,
+    /// Tap weights from the whole profile at each tap's 3D distance (else the kernel's
+    /// weights at the screen offset, following the surface's depth).
+    pub bilateral: bool,
+    /// It can blur at half resolution per side (`--sss-half-res`).
+    pub half_resolution: bool,
+    /// Its taps read linear depth from the lit diffuse's alpha.
+    pub depth_in_alpha: bool,
+    /// The knobs that act on it.
+    pub knobs: &'static [&'static str],
+    /// The built-in scene it is measured on.
+    pub scene: &'static str,
+}
+
+impl TechniqueModule for TwoPassChain {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn summary(&self) -> &'static str {
+        self.summary
+    }
+
+    fn shades(&'static self) -> Shades {
+        Shades::Scattering(self)
+    }
+
+    fn knobs(&self) -> &'static [&'static str] {
+        self.knobs
+    }
+
+    fn scene(&self) -> &'static str {
+        self.scene
+    }
+
+    fn shader_permutations(&self, out: &mut Vec<PipelineShaders>) {
+        shader_permutations(self, out);
+    }
+}
+
+impl SssBlurTechnique for TwoPassChain {
+    fn lean(&self) -> bool {
+        self.lean
+    }
+
+    fn bilateral(&self) -> bool {
+        self.bilateral
+    }
+
+    fn iterative(&self) -> bool {
+        false
+    }
+
+    fn half_resolution(&self) -> bool {
+        self.half_resolution
+    }
+
+    fn depth_in_alpha(&self) -> bool {
+        self.depth_in_alpha
+    }
+
+    fn declare_chain(
+        &self,
+        graph: &mut RenderGraph,
+        inputs: &SssInputs<'_>,
+        chain: &Chain,
+        base: Option<&Handle<Image>>,
+        knobs: &SssKnobs,
+        scene: Option<&Arc<SceneGpu>>,
+        output: Option<Handle<Image>>,
+    ) -> Handle<Image> {
+        chain_passes(graph, inputs, chain, base, knobs, scene, output)
     }
 }

@@ -1,0 +1,35 @@
+//! The contract every technique module implements ([`TechniqueModule`]); the list of them is
+//! [`super::registry`].
+
+use super::shipped::PipelineShaders;
+use super::sss::SssBlurTechnique;
+
+/// What a technique shades: the materials it applies to.
+#[derive(Clone, Copy)]
+pub enum Shades {
+    /// Materials with a `[material.translucency]` table (GDC 2011's term in the lighting pass).
+    Translucent,
+    /// Materials with an SSS profile, diffused by this blur chain.
+    Scattering(&'static dyn SssBlurTechnique),
+    /// Materials with layered media (Li et al.'s scattering passes).
+    Layered,
+}
+
+/// One technique: its module implements this once (see the module docs).
+pub trait TechniqueModule: Sync {
+    /// Its name on the command line and in scene files (`--technique NAME`, `blur = "NAME"`).
+    fn name(&self) -> &'static str;
+    /// One line for help texts and the demo's panel.
+    fn summary(&self) -> &'static str;
+    /// The materials it shades (`'static`: an SSS technique hands out itself as the chain).
+    fn shades(&'static self) -> Shades;
+    /// The command-line knobs (flags, as `--flag`) that act on it: a knob given for a frame
+    /// where no technique of the frame lists it draws a warning that names these techniques.
+    fn knobs(&self) -> &'static [&'static str];
+    /// The built-in scene made to show it, which bench and report measure it on.
+    fn scene(&self) -> &'static str;
+    /// Every pipeline its passes may build, for the shipped SPIR-V ([`super::shipped`]).
+    /// Techniques whose shading is compiled into another feature's pass (GDC 2011's term in
+    /// the lighting pass) add nothing here.
+    fn shader_permutations(&self, out: &mut Vec<PipelineShaders>);
+}

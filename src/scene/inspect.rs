@@ -180,7 +180,7 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
                 p.name,
                 p.gaussians.len(),
                 p.units_per_mm,
-                p.blur_or_default().name()
+                p.blur.as_ref().map_or("default", |b| b.name.as_str())
             ));
         }
         if let Some(l) = &m.layers {

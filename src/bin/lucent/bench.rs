@@ -1,0 +1,253 @@
+//! `lucent bench`: per-pass GPU times of a frame, verified to add up, with the optional
+//! speed-of-light copies, a second technique alternated with the first, and the seeds'
+//! published tables beside ours.
+
+use lucent::frame::{FrameDesc, FrameSettings, Renderer, Technique};
+use lucent::images::output;
+use lucent::measure::bench::{self, BenchOptions, BenchReport, Format};
+use lucent::report::seeds::{self as seed_tables, SeedTable};
+use lucent::{scene, LucentError, Result};
+
+use crate::cli::BenchArgs;
+use crate::session::{check_scene_outputs, with_renderer, Session};
+
+/// The seeds' numbers `--compare-thesis` prints beside ours, as the technique allows.
+struct Seeds {
+    /// The LEAN-mapping thesis's table (control, lcb, lbb).
+    thesis: Option<SeedTable>,
+    /// GDC 2011's cost of translucency.
+    gdc: bool,
+    /// Li et al.'s Table 1 (checked against the scene's materials once it is loaded).
+    li: bool,
+}
+
+impl Seeds {
+    /// What `--compare-thesis` (`wanted`) compares under `technique`; an error when it has
+    /// nothing to compare.
+    fn new(wanted: bool, technique: Technique) -> Result<Self> {
+        let seeds = Self {
+            thesis: seed_tables::thesis_table(technique.name()).filter(|_| wanted),
+            gdc: wanted && technique == Technique::Translucency,
+            // Li et al.'s Table 1: their technique, alone or in `auto`.
+            li: wanted && matches!(technique, Technique::Auto | Technique::Layered),
+        };
+        if wanted && seeds.thesis.is_none() && !seeds.gdc && !seeds.li {
+            return Err(LucentError::InvalidInput(format!(
+                "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
+                 Table 1), translucency (GDC 2011's cost), or auto or layered on a scene with \
+                 layered materials (Li et al.'s Table 1); '{}' has no published table",
+                technique.name()
+            )));
+        }
+        Ok(seeds)
+    }
+}
+
+/// Benchmarks `--scene` and prints the report in `--format`, then what the flags add.
+pub fn run(args: BenchArgs) -> Result<()> {
+    let format = Format::parse(&args.format)?;
+    let against = args.against.as_deref().map(Technique::parse).transpose()?;
+    let technique = Technique::parse(&args.frame.technique)?;
+    let seeds = Seeds::new(args.compare_thesis, technique)?;
+    if format != Format::Markdown && (args.compare_thesis || against.is_some()) {
+        return Err(LucentError::InvalidInput(
+            "--compare-thesis and --against print Markdown tables; use them with --format markdown"
+                .into(),
+        ));
+    }
+    let outputs: Vec<(&str, &std::path::Path)> = [("--json", &args.json), ("--out", &args.out)]
+        .into_iter()
+        .filter_map(|(flag, p)| p.as_deref().map(|p| (flag, p)))
+        .collect();
+    check_scene_outputs(&args.frame.scene, &outputs)?;
+    let options = BenchOptions {
+        frames: args.frames,
+        warmup: args.warmup,
+        isolate: args.isolate,
+    };
+    with_renderer(&args.frame, &args.gpu, false, |session, renderer, scene| {
+        if seeds.li && FrameDesc::new(scene, &renderer.settings)?.layered.is_none() {
+            return Err(LucentError::InvalidInput(format!(
+                "--compare-seeds with --technique {}: scene '{}' has no layered material, so \
+                 Li et al.'s Table 1 has nothing to compare (try --scene scaling:N or layered)",
+                technique.name(),
+                args.frame.scene
+            )));
+        }
+        let report = measure(session, renderer, scene, &args, &options)?;
+        print!("{}", report.format(format));
+        if format != Format::Csv {
+            println!();
+        }
+        print_seeds(session, renderer, scene, &args, &options, &seeds, &report)?;
+        if let Some(technique) = against {
+            compare(session, renderer, scene, technique, &options, &seeds)?;
+        }
+        write_outputs(session, renderer, &args, format, &report)?;
+        trusted(&report, &options)
+    })
+}
+
+/// The benchmark itself, with the speed-of-light copies when `--speed-of-light` asks.
+fn measure(
+    session: &Session,
+    renderer: &Renderer,
+    scene: &scene::Scene,
+    args: &BenchArgs,
+    options: &BenchOptions,
+) -> Result<BenchReport> {
+    let gpu = &session.gpu;
+    if !args.speed_of_light {
+        return bench::run(gpu, renderer, scene, &args.frame.scene, options);
+    }
+    let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
+        gpu,
+        &session.shaders,
+        &session.pipeline_cache,
+        &renderer.executable.plan,
+    )?;
+    let report = bench::run_with_floor(
+        gpu,
+        renderer,
+        Some(&mut copies),
+        scene,
+        &args.frame.scene,
+        options,
+    );
+    let idle = gpu.wait_idle();
+    copies.destroy(gpu);
+    idle?;
+    report
+}
+
+/// Prints the seeds' tables beside `report`: the thesis's, Li et al.'s, GDC 2011's cost.
+fn print_seeds(
+    session: &Session,
+    renderer: &Renderer,
+    scene: &scene::Scene,
+    args: &BenchArgs,
+    options: &BenchOptions,
+    seeds: &Seeds,
+    report: &BenchReport,
+) -> Result<()> {
+    if let Some(table) = &seeds.thesis {
+        println!("{}", seed_tables::beside(report, table));
+    }
+    if seeds.li {
+        let shadows = renderer.settings.shadows;
+        println!(
+            "{}",
+            seed_tables::li_bench_beside(
+                report,
+                lucent::measure::scaling::triangles(scene),
+                shadows.enabled.then_some(shadows.size),
+            )
+        );
+    }
+    if seeds.gdc {
+        let cost = lucent::report::gdc_cost(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            scene,
+            &format!("`{}`", args.frame.scene),
+            (renderer.settings.width, renderer.settings.height),
+            (options.frames, options.warmup),
+        )?;
+        println!("{}", seed_tables::gdc_beside(&cost));
+    }
+    Ok(())
+}
+
+/// `--against`: the same scene under `technique`, alternating frames with the main one, both
+/// printed side by side (with the thesis's ratio when its table is compared).
+fn compare(
+    session: &Session,
+    renderer: &Renderer,
+    scene: &scene::Scene,
+    technique: Technique,
+    options: &BenchOptions,
+    seeds: &Seeds,
+) -> Result<()> {
+    let gpu = &session.gpu;
+    let other = Renderer::new(
+        gpu,
+        &session.shaders,
+        &session.pipeline_cache,
+        scene,
+        FrameSettings {
+            technique,
+            ..renderer.settings
+        },
+    )?;
+    let compared = bench::compare(
+        gpu,
+        [
+            (technique.name(), &other),
+            (renderer.settings.technique.name(), renderer),
+        ],
+        scene,
+        options.frames,
+        options.warmup,
+    );
+    let idle = gpu.wait_idle();
+    other.destroy(gpu);
+    idle?;
+    let compared = compared?;
+    println!("{}", compared.markdown(&gpu.info.describe()));
+    if seeds.thesis.is_some() {
+        if let Some(line) = seed_tables::thesis_ratio_line(&compared) {
+            println!("{line}");
+        }
+    }
+    Ok(())
+}
+
+/// Writes `--json` and `--out`; with CSV or JSON on stdout, the `wrote` lines go to stderr so
+/// stdout stays parseable.
+fn write_outputs(
+    session: &Session,
+    renderer: &Renderer,
+    args: &BenchArgs,
+    format: Format,
+    report: &BenchReport,
+) -> Result<()> {
+    let note = |text: String| {
+        if format == Format::Markdown {
+            println!("{text}");
+        } else {
+            eprintln!("{text}");
+        }
+    };
+    if let Some(json) = &args.json {
+        output::write_file_atomic(json, report.json().as_bytes())?;
+        note(format!("wrote {}", json.display()));
+    }
+    if let Some(out) = &args.out {
+        let (width, height) = (renderer.settings.width, renderer.settings.height);
+        output::write_png_rgba8(out, width, height, &renderer.read_display(&session.gpu)?)?;
+        note(format!("wrote {}", out.display()));
+    }
+    Ok(())
+}
+
+/// Fails when the per-pass times could not be verified, saying when the run was short.
+fn trusted(report: &BenchReport, options: &BenchOptions) -> Result<()> {
+    if report.trusted {
+        return Ok(());
+    }
+    // Tiny runs fail the checks by chance on a shared machine: say so.
+    let short = if options.frames < bench::SHORT_RUN_FRAMES {
+        format!(
+            "; {} measured frames is a short run, and short runs are noisy: try \
+             --frames {} or more",
+            options.frames,
+            bench::SHORT_RUN_FRAMES * 3
+        )
+    } else {
+        String::new()
+    };
+    Err(LucentError::Timing(format!(
+        "the per-pass times could not be verified (see the checks above){short}"
+    )))
+}

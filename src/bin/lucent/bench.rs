@@ -27,9 +27,12 @@ impl Seeds {
     fn new(wanted: bool, technique: Technique) -> Result<Self> {
         let seeds = Self {
             thesis: seed_tables::thesis_table(technique.name()).filter(|_| wanted),
-            gdc: wanted && technique == Technique::Translucency,
+            gdc: wanted
+                && technique == Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
             // Li et al.'s Table 1: their technique, alone or in `auto`.
-            li: wanted && matches!(technique, Technique::Auto | Technique::Layered),
+            li: wanted
+                && (technique == Technique::Auto
+                    || technique == Technique::Only(&lucent::features::layered::LAYERED)),
         };
         if wanted && seeds.thesis.is_none() && !seeds.gdc && !seeds.li {
             return Err(LucentError::InvalidInput(format!(

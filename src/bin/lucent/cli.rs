@@ -14,9 +14,10 @@ use lucent::bake::scene as bake;
 use lucent::features::antialias::Antialias;
 use lucent::features::deferred::GBufferPrecision;
 use lucent::features::layered::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
+use lucent::features::registry;
 use lucent::features::shadows::{ShadowSettings, SHADOW_SIZES};
 use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
-use lucent::features::sss::{SssBlur, SssKnobs, SssPrecision};
+use lucent::features::sss::{SssKnobs, SssPrecision};
 use lucent::frame::{FrameDesc, FrameSettings, Technique};
 use lucent::graph::CompileOptions;
 use lucent::measure::bench;
@@ -564,85 +565,77 @@ impl FrameArgs {
     }
 
     /// The knobs given on the command line that do nothing in this frame (`desc`, of `scene`
-    /// under `settings`), each as a warning naming the technique they need.
+    /// under `settings`), each as a warning naming what they need. A technique's knobs are
+    /// the ones its module lists ([`registry::TechniqueModule::knobs`]): a knob applies when
+    /// some technique of the frame lists it.
     fn inapplicable_knobs(
         &self,
         scene: &scene::Scene,
         settings: &FrameSettings,
         desc: &FrameDesc,
     ) -> Vec<String> {
-        let chains = desc.sss.as_ref().map(|s| s.chains()).unwrap_or_default();
-        let lbb_chain = chains.contains(&SssBlur::LeanBilateral);
-        let separable = chains.contains(&SssBlur::Separable);
-        let two_pass = chains.iter().any(|b| !b.iterative());
-        let iterative = chains.iter().any(|b| b.iterative());
-        let sss = !chains.is_empty();
-        let translucent = desc.translucency.is_some();
-        let lbb = "the bilateral blur: --technique lbb (or SSS materials with blur = \"lbb\")";
-        let blur = "screen-space SSS: --technique control, lcb, lbb, separable or bilateral \
-                    (or auto) on a scene with SSS materials";
-        let per_gaussian = "the per-Gaussian blurs: --technique control, lcb or lbb (or SSS \
-                            materials with one of those blurs)";
-        let two = "the two-pass blurs: --technique separable or bilateral (or SSS materials \
-                   with one of those blurs)";
-        let sep = "the separable blur: --technique separable (or SSS materials with blur = \
-                   \"separable\")";
-        let layered = "Li et al.'s layered media: --technique layered (or auto) on a scene \
-                       with layered materials";
-        let gdc = "GDC 2011 translucency: --technique translucency (or auto) on a scene with \
-                   translucent materials";
-        let knobs = [
-            (self.sss_taps.is_some(), "--sss-taps", lbb, lbb_chain),
-            (self.sss_packed, "--sss-packed", lbb, lbb_chain),
-            (self.sensitivity.is_some(), "--sensitivity", lbb, lbb_chain),
-            (self.sss_gaussians.is_some(), "--sss-gaussians", blur, sss),
-            (
-                self.sss_precision.is_some(),
-                "--sss-precision",
-                per_gaussian,
-                iterative,
-            ),
-            (self.sss_samples.is_some(), "--sss-samples", two, two_pass),
-            (self.sss_kernel.is_some(), "--sss-kernel", two, two_pass),
-            (self.sss_half_res, "--sss-half-res", sep, separable),
-            (self.sss_filter.is_some(), "--sss-filter", sep, separable),
-            (self.no_sss_tiles, "--no-sss-tiles", blur, sss),
-            (self.grayscale, "--grayscale", gdc, translucent),
-            (
-                self.time.is_some(),
-                "--time",
-                "a deforming scene (one with a [deformation] table, e.g. dynamic)",
-                scene.deformation.is_some(),
-            ),
-            (
-                self.shadow_size.is_some(),
-                "--shadow-size",
-                "a light that casts shadows (without --no-shadows; lights with shadows = true)",
-                desc.shadows.is_some(),
-            ),
-        ];
-        let layered_knobs = [
+        let given = [
+            (self.sss_taps.is_some(), "--sss-taps"),
+            (self.sss_packed, "--sss-packed"),
+            (self.sensitivity.is_some(), "--sensitivity"),
+            (self.sss_gaussians.is_some(), "--sss-gaussians"),
+            (self.sss_precision.is_some(), "--sss-precision"),
+            (self.sss_samples.is_some(), "--sss-samples"),
+            (self.sss_kernel.is_some(), "--sss-kernel"),
+            (self.sss_half_res, "--sss-half-res"),
+            (self.sss_filter.is_some(), "--sss-filter"),
+            (self.no_sss_tiles, "--no-sss-tiles"),
+            (self.grayscale, "--grayscale"),
             (self.layered_steps.is_some(), "--layered-steps"),
             (self.pixel_lights.is_some(), "--pixel-lights"),
             (self.phase.is_some(), "--phase"),
             (self.half_irradiance, "--half-irradiance"),
             (self.half_gather, "--half-gather"),
             (self.single_depth.is_some(), "--single-depth"),
-        ]
-        .map(|(given, flag)| (given, flag, layered, desc.layered.is_some()));
-        let technique = settings.technique;
-        knobs
+        ];
+        let mut unused: Vec<(&str, String)> = given
             .iter()
-            .chain(&layered_knobs)
-            .filter(|(given, _, _, applies)| *given && !applies)
-            .map(|(_, flag, needs, _)| {
+            .filter(|(given, flag)| *given && !desc.uses_knob(flag))
+            .map(|(_, flag)| (*flag, technique_knob_needs(flag)))
+            .collect();
+        // Knobs of the scene rather than of a technique.
+        if self.time.is_some() && scene.deformation.is_none() {
+            unused.push((
+                "--time",
+                "a deforming scene (one with a [deformation] table, e.g. dynamic)".into(),
+            ));
+        }
+        if self.shadow_size.is_some() && desc.shadows.is_none() {
+            unused.push((
+                "--shadow-size",
+                "a light that casts shadows (without --no-shadows; lights with shadows = true)"
+                    .into(),
+            ));
+        }
+        unused
+            .into_iter()
+            .map(|(flag, needs)| {
                 format!(
                     "{flag} has no effect with --technique {} on scene '{}': it applies to \
                      {needs}",
-                    technique.name(),
+                    settings.technique.name(),
                     scene.name
                 )
             })
             .collect()
     }
+}
+
+/// What a technique knob needs, from the registry: the techniques that list it, each with its
+/// summary, named as `--technique` choices (or `auto` on a scene whose materials use them).
+fn technique_knob_needs(flag: &str) -> String {
+    let owners: Vec<&'static dyn registry::TechniqueModule> = registry::with_knob(flag).collect();
+    let names: Vec<&str> = owners.iter().map(|t| t.name()).collect();
+    let what: Vec<&str> = owners.iter().map(|t| t.summary()).collect();
+    format!(
+        "--technique {} (or auto on a scene whose materials use {}): {}",
+        names.join(" or "),
+        if owners.len() == 1 { "it" } else { "them" },
+        what.join("; ")
+    )
 }

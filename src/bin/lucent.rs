@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use lucent::backend::shader::{PipelineCache, ShaderCompiler};
 use lucent::backend::{ContextDesc, GpuContext};
 use lucent::bake::scene as bake;
-use lucent::features::deferred::GBufferPrecision;
+use lucent::features::gbuffer::GBufferPrecision;
 use lucent::features::layered::{LayeredKnobs, PhaseForm};
 use lucent::features::shadows::ShadowSettings;
 use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
@@ -769,7 +769,7 @@ fn check_device_fits(
         .sum();
     let heap = info.device_local_bytes;
     if heap > 0 && frame_bytes.saturating_add(texture_bytes) > heap {
-        let size = lucent::files::format_bytes;
+        let size = lucent::error::format_bytes;
         let largest = largest.map_or(String::new(), |r| {
             format!(
                 "; largest image '{}' {}x{} {}, {}",
@@ -986,7 +986,7 @@ fn bench_command(
             }
         }
         if let Some(json) = &json {
-            output::write_file_atomic(json, report.json().as_bytes())?;
+            lucent::files::write_file_atomic(json, report.json().as_bytes())?;
             note(format!("wrote {}", json.display()));
         }
         if let Some(out) = &out {
@@ -1132,7 +1132,7 @@ fn sweep_command(
     let table = lucent::measure::sweep::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
-        output::write_file_atomic(out, table.as_bytes())?;
+        lucent::files::write_file_atomic(out, table.as_bytes())?;
         println!("wrote {}", out.display());
     }
     let bad: usize = rows.iter().map(|r| r.nan + r.inf).sum();
@@ -1185,7 +1185,7 @@ fn sweep_layered_command(
     let table = sweep_layered::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
-        output::write_file_atomic(out, table.as_bytes())?;
+        lucent::files::write_file_atomic(out, table.as_bytes())?;
         println!("wrote {}", out.display());
     }
     let bad: Vec<String> = rows

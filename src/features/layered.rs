@@ -53,8 +53,6 @@ use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-/// The G-buffer's layered material ID per pixel (ID / 255; 0: not layered).
-pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;
 /// The transmitted irradiance image.
 pub const IRRADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Layered materials a frame holds at most (IDs 1 to 16).
@@ -578,7 +576,7 @@ impl LayeredShape {
         if let (true, Some(textures)) = (texdep, self.layer_depths) {
             defines.push((
                 "LUCENT_LAYER_DEPTHS",
-                super::deferred::layer_depths_define(textures),
+                super::layer_depth::layer_depths_define(textures),
             ));
             defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[next]));
             next += 1;
@@ -604,7 +602,7 @@ impl LayeredShape {
 }
 
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for kind in Kind::ALL {
         for flags in 0u32..1 << 6 {
             let bit = |i: u32| flags & (1 << i) != 0;
@@ -619,7 +617,7 @@ pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>
                     entry: bit(4),
                     entry_depths: bit(5),
                 };
-                out.push(super::shipped::PipelineShaders::fullscreen(
+                out.push(crate::backend::shader::PipelineShaders::fullscreen(
                     kind.fragment(),
                     &shape.defines().0,
                 ));

@@ -488,7 +488,7 @@ struct BlurConstants {
 
 /// The profile table and frame uniforms every SSS pass binds first (0: frame, 1: profiles).
 /// The pipelines the SSS chains of any frame build (both kinds of chain).
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     iterative::shader_permutations(out);
     two_pass::shader_permutations(out);
 }

@@ -2,7 +2,8 @@
 //!
 //! Every fallible function returns [`Result`]. Variants carry enough context to print a one-line
 //! reason a user can act on (which file, which pass, which missing feature, which package to
-//! install); nothing in the library panics on bad input or on a missing driver.
+//! install); nothing in the library panics on bad input or on a missing driver. Sizes in
+//! messages are written by [`format_bytes`].
 
 use std::path::PathBuf;
 
@@ -36,7 +37,7 @@ pub enum LucentError {
     #[error(
         "GPU memory allocation '{name}' of {size} failed: {source}; render at a smaller --size \
          (the frame's images grow with it) or use smaller textures",
-        size = crate::files::format_bytes(*.bytes)
+        size = format_bytes(*.bytes)
     )]
     Allocation {
         name: String,
@@ -54,7 +55,7 @@ pub enum LucentError {
         "shader permutation not in the shipped SPIR-V: {permutation}; glsl/permutations.txt is \
          stale (or the permutation is not one lucent's frames build): regenerate it with `{}` \
          and rebuild",
-        crate::backend::shader::MANIFEST_COMMAND
+        MANIFEST_COMMAND
     )]
     ShaderNotShipped { permutation: String },
     /// The render graph is malformed (e.g. a pass reads a resource nothing wrote).
@@ -79,6 +80,10 @@ pub enum LucentError {
     #[error("{path}: {message}")]
     File { path: PathBuf, message: String },
 }
+
+/// The command that regenerates `glsl/permutations.txt`, the shipped SPIR-V's manifest (named
+/// by [`LucentError::ShaderNotShipped`], the manifest's header and its test).
+pub const MANIFEST_COMMAND: &str = "LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders";
 
 /// Result with [`LucentError`].
 pub type Result<T, E = LucentError> = std::result::Result<T, E>;
@@ -139,6 +144,22 @@ pub fn name_of<T: PartialEq>(table: &[(&'static str, T)], value: &T) -> &'static
         .map_or("?", |(n, _)| n)
 }
 
+/// `bytes` for a message: exact below 1 KiB, else in KiB, MiB or GiB with the exact count.
+pub fn format_bytes(bytes: u64) -> String {
+    const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
+    for (unit, size) in UNITS {
+        if bytes >= size {
+            let value = bytes as f64 / size as f64;
+            return if bytes.is_multiple_of(size) {
+                format!("{} {unit}", bytes / size)
+            } else {
+                format!("{value:.1} {unit} ({bytes} bytes)")
+            };
+        }
+    }
+    format!("{bytes} bytes")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -158,5 +179,12 @@ mod tests {
             "{e}"
         );
         assert_eq!(e.lines().count(), 1, "{e}");
+    }
+
+    #[test]
+    fn byte_counts_read_well() {
+        assert_eq!(format_bytes(12), "12 bytes");
+        assert_eq!(format_bytes(4 << 20), "4 MiB");
+        assert_eq!(format_bytes(1536), "1.5 KiB (1536 bytes)");
     }
 }

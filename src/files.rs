@@ -12,14 +12,19 @@
 //! Outputs: [`check_outputs`] refuses, before any work, an output that is one of the command's
 //! inputs (`bake-thickness in.obj --per-vertex in.obj` would overwrite the mesh) and two
 //! outputs that are the same file (`render --out same.png --exr same.png`), whether they are
-//! spelled alike or reached through a symlink, `..` or a hard link. How an output is written
-//! (through symlinks, into devices) is [`crate::images::output::write_file_atomic`]'s.
+//! spelled alike or reached through a symlink, `..` or a hard link. Every file lucent writes
+//! (images, reports, meshes, caches) is written by [`write_file_atomic`]: never half a file,
+//! through symlinks and into devices rather than replacing them.
+//!
+//! Caches: [`default_cache_dir`] is where the SPIR-V, pipeline and thickness caches live when
+//! the caller names no directory (per user, never the source tree).
 
 use std::fs::{File, Metadata};
-use std::io::{Read, Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::{LucentError, Result};
+use crate::error::{format_bytes, LucentError, Result};
 
 /// What a path is, when it is not a regular file: `"a directory"`, `"a FIFO (named pipe)"`.
 pub fn kind_of(metadata: &Metadata) -> &'static str {
@@ -104,22 +109,6 @@ fn too_large(bytes: u64, cap: u64, what: &str) -> String {
         format_bytes(bytes),
         format_bytes(cap)
     )
-}
-
-/// `bytes` for a message: exact below 1 KiB, else in KiB, MiB or GiB with the exact count.
-pub fn format_bytes(bytes: u64) -> String {
-    const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
-    for (unit, size) in UNITS {
-        if bytes >= size {
-            let value = bytes as f64 / size as f64;
-            return if bytes.is_multiple_of(size) {
-                format!("{} {unit}", bytes / size)
-            } else {
-                format!("{value:.1} {unit} ({bytes} bytes)")
-            };
-        }
-    }
-    format!("{bytes} bytes")
 }
 
 /// Reads the whole regular file `path` ([`open_regular`]), at most `cap` bytes: the bytes are
@@ -293,6 +282,129 @@ pub fn check_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Res
     Ok(())
 }
 
+/// Writes `bytes` to `path`, never replacing what `path` is:
+///
+/// - a regular file, or nothing yet: atomically, into a temporary file in the same directory,
+///   then renamed over `path` (a crash or a concurrent reader never sees half a file);
+/// - a symlink: written through it, atomically at its target (the link stays a link, and a
+///   dangling link creates its target);
+/// - a character device, FIFO or socket (`/dev/null`, a pipe to another program): opened and
+///   written into, as a shell redirection would; renaming over it would replace the device with
+///   a file (as root, `/dev/full` became a regular file);
+/// - a directory: an error.
+///
+/// Creates missing parent directories. The error names `path`.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let target = resolve_symlinks(path)?;
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => Err(LucentError::file(
+            path,
+            "is a directory; give a file name to write",
+        )),
+        Ok(m) if !m.is_file() => {
+            // A device or FIFO: written into, never replaced.
+            let mut file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&target)
+                .map_err(|e| LucentError::file(path, format!("cannot open for writing: {e}")))?;
+            file.write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(|e| {
+                    LucentError::file(path, format!("writing into {} failed: {e}", kind_of(&m)))
+                })
+        }
+        _ => write_regular_atomic(path, &target, bytes),
+    }
+}
+
+/// `path` with every symlink of its last component followed (relative links resolved against
+/// their directory); the path itself when it is no symlink. Refuses symlink loops.
+fn resolve_symlinks(path: &Path) -> Result<PathBuf> {
+    let mut target = path.to_path_buf();
+    // The limit Linux puts on symlinks followed in one lookup.
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let next = std::fs::read_link(&target)
+                    .map_err(|e| LucentError::file(path, format!("cannot read symlink: {e}")))?;
+                target = match target.parent() {
+                    Some(parent) if next.is_relative() => parent.join(next),
+                    _ => next,
+                };
+            }
+            _ => return Ok(target),
+        }
+    }
+    Err(LucentError::file(
+        path,
+        "too many levels of symbolic links (a symlink loop?)",
+    ))
+}
+
+/// The temporary-then-rename write of a regular file at `target` (`path` names it in errors).
+fn write_regular_atomic(path: &Path, target: &Path, bytes: &[u8]) -> Result<()> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let file_name = target
+        .file_name()
+        .ok_or_else(|| LucentError::file(path, "not a file path"))?;
+    let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(parent) = parent {
+        std::fs::create_dir_all(parent)
+            .map_err(|e| LucentError::file(path, format!("cannot create directory: {e}")))?;
+    }
+    // Unique per process and call, so concurrent writers of the same file never share a temporary.
+    let tmp_name = format!(
+        "{}.{}-{}.tmp",
+        file_name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    );
+    let tmp: PathBuf = match parent {
+        Some(parent) => parent.join(tmp_name),
+        None => PathBuf::from(tmp_name),
+    };
+    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, target));
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        LucentError::file(path, e)
+    })
+}
+
+/// The cache directory used when the caller names none (the run-time SPIR-V cache, the
+/// thickness bake cache and the pipeline cache live in it): `$LUCENT_CACHE_DIR`, else
+/// `lucent` in the user's cache directory: `$XDG_CACHE_HOME` or `~/.cache` on Linux and
+/// other Unixes, `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's
+/// temporary directory when none of those is known. Per user, so another user's run neither
+/// warns nor writes into someone else's tree, and never the source tree. A host passes its
+/// own directory instead (`ShaderCompiler::new`,
+/// [`PipelineCache::load_for_device`](crate::backend::shader::PipelineCache::load_for_device),
+/// [`crate::bake::scene::load_scene_baked_in`]).
+pub fn default_cache_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("LUCENT_CACHE_DIR").filter(|d| !d.is_empty()) {
+        return PathBuf::from(dir);
+    }
+    user_cache_dir().join("lucent")
+}
+
+/// The platform's per-user cache directory (see [`default_cache_dir`]).
+fn user_cache_dir() -> PathBuf {
+    user_cache_dir_from(|name| std::env::var_os(name))
+}
+
+/// [`user_cache_dir`] with the environment given as a lookup (for tests). Relative values are
+/// ignored, as the XDG base directory specification asks.
+fn user_cache_dir_from(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> PathBuf {
+    let var = |name: &str| env(name).map(PathBuf::from).filter(|p| p.is_absolute());
+    let found = if cfg!(windows) {
+        var("LOCALAPPDATA")
+    } else if cfg!(target_os = "macos") {
+        var("HOME").map(|h| h.join("Library/Caches"))
+    } else {
+        var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")))
+    };
+    found.unwrap_or_else(std::env::temp_dir)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -398,10 +510,62 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    #[cfg(unix)]
     #[test]
-    fn byte_counts_read_well() {
-        assert_eq!(format_bytes(12), "12 bytes");
-        assert_eq!(format_bytes(4 << 20), "4 MiB");
-        assert_eq!(format_bytes(1536), "1.5 KiB (1536 bytes)");
+    fn symlinks_are_written_through_and_devices_into() {
+        let dir = temp_dir("through");
+        let real = dir.join("real.json");
+        std::fs::write(&real, b"old").unwrap();
+        let link = dir.join("link.json");
+        std::os::unix::fs::symlink("real.json", &link).unwrap();
+        write_file_atomic(&link, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        // A dangling link creates its target.
+        let dangling = dir.join("dangling.json");
+        std::os::unix::fs::symlink("made.json", &dangling).unwrap();
+        write_file_atomic(&dangling, b"made").unwrap();
+        assert_eq!(std::fs::read(dir.join("made.json")).unwrap(), b"made");
+        // A device is written into, not replaced.
+        write_file_atomic(Path::new("/dev/null"), b"gone").unwrap();
+        let null = std::fs::metadata("/dev/null").unwrap();
+        assert!(!null.is_file(), "/dev/null was replaced by a file");
+        let e = write_file_atomic(&dir, b"x").unwrap_err().to_string();
+        assert!(e.contains("is a directory"), "{e}");
+        let looped = dir.join("loop");
+        std::os::unix::fs::symlink("loop", &looped).unwrap();
+        let e = write_file_atomic(&looped, b"x").unwrap_err().to_string();
+        assert!(e.contains("symlink loop"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_default_cache_is_per_user() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |name: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map(|(_, v)| std::ffi::OsString::from(v))
+            }
+        };
+        if cfg!(all(unix, not(target_os = "macos"))) {
+            assert_eq!(
+                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "/c"), ("HOME", "/h")])),
+                Path::new("/c")
+            );
+            assert_eq!(
+                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "rel"), ("HOME", "/h")])),
+                Path::new("/h/.cache")
+            );
+        }
+        assert_eq!(user_cache_dir_from(env(&[])), std::env::temp_dir());
+        // Not under the source tree, unless the user's cache is there.
+        if std::env::var_os("LUCENT_CACHE_DIR").is_none() {
+            assert!(default_cache_dir().ends_with("lucent"));
+        }
     }
 }

@@ -20,22 +20,26 @@
 //! Beside them: [`scene`] (the CPU model of what is drawn; no GPU), [`bake`] (the thickness
 //! baker, called explicitly by whoever loads a scene), [`reference`](mod@reference) (CPU f64
 //! versions of every shading equation, used by tests and reports, never by features),
-//! [`images`] (PNG/EXR files and FLIP comparison), [`files`] (every file read is a regular file
-//! read with a cap; a command's outputs are checked against its inputs), [`progress`] (the
-//! bake's and the benchmark's progress). Above the frame: [`measure`] (benchmark, speed of
-//! light, scaling, sweeps) and, with their features, `report` (`lucent report`: the suite, its
-//! sections, the seeds' tables, plots) and `demo` (the interactive window).
+//! [`images`] (PNG/EXR files; FLIP comparison with `measure`). At the bottom, used by every
+//! layer: [`error`] (the one error type), [`files`] (every file read is a regular file read
+//! with a cap, every file written is written atomically, a command's outputs are checked
+//! against its inputs, the default cache directory) and [`progress`] (the bake's and the
+//! benchmark's progress). Above the frame, with their features: `measure` (benchmark, speed
+//! of light, scaling, sweeps), `report` (`lucent report`: the suite, its sections, the seeds'
+//! tables, plots) and `demo` (the interactive window).
 //!
 //! Cargo features, all on by default: `runtime-shaders` (shaderc: GLSL compiled at run time,
 //! `backend::shader::ShaderCompiler::new`; without it pipelines use only the SPIR-V shipped
 //! with the crate, [`backend::shader::ShaderCompiler::shipped`]), `window` (winit, ash-window,
 //! egui, egui-winit, egui-ash-renderer: the `demo` module and `lucent demo`, which needs
-//! `runtime-shaders` for hot reload), `cli` (clap, env_logger: the `lucent` binary's command line) and
-//! `report` (plotters, indicatif: the `report` module and progress bars on stderr). The `lucent`
-//! binary needs `cli` and `report`. With `--no-default-features` the library keeps everything
-//! else (context, graph, scene, bake, renderer, measure, reference, images, shipped shaders)
-//! and depends on none of those crates, nor on shaderc at run time; the bake and the benchmark then report progress through `log` (info level,
-//! every tenth) instead of a bar.
+//! `runtime-shaders` for hot reload), `measure` (nv-flip: the `measure` module and
+//! `images::compare`), `cli` (clap, env_logger: the `lucent` binary's command line; needs
+//! `measure`) and `report` (plotters, indicatif: the `report` module and progress bars on
+//! stderr; needs `measure`). The `lucent` binary needs `cli` and `report`. With
+//! `--no-default-features` the library keeps everything a host renders with (context, graph,
+//! scene, bake, renderer, embed, reference, images, shipped shaders) and depends on none of
+//! those crates, nor on shaderc at run time; the bake and the benchmark then report progress
+//! through `log` (info level, every tenth) instead of a bar.
 
 pub mod backend;
 pub mod bake;
@@ -45,12 +49,11 @@ pub mod embed;
 pub mod error;
 pub mod features;
 pub mod files;
-#[cfg(feature = "report")]
-mod font;
 pub mod frame;
 pub mod gpu_scene;
 pub mod graph;
 pub mod images;
+#[cfg(feature = "measure")]
 pub mod measure;
 pub mod progress;
 pub mod reference;

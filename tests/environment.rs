@@ -31,7 +31,7 @@ fn against_reference(environment: Environment) -> (f64, f64) {
     // albedo's rounding (0.3 stored as 76/255) alone would be 2e-3 of peak.
     let settings = FrameSettings {
         export_hdr: true,
-        gbuffer: lucent::features::deferred::GBufferPrecision::Full,
+        gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
         ..FrameSettings::new(w, h)
     };
     let test = TestGpu::new();

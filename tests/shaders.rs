@@ -21,7 +21,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use ash::vk;
-use lucent::backend::shader::{create_shader_module, PipelineCache, ShaderCompiler, ShaderStage};
+use lucent::backend::shader::{create_shader_module, PipelineCache, ShaderCompiler};
+use lucent::backend::spirv::ShaderStage;
 use lucent::LucentError;
 
 /// A fresh, empty directory under cargo's per-target temporary directory.

@@ -10,7 +10,8 @@
 
 use std::path::Path;
 
-use lucent::backend::shader::{ShaderCompiler, MANIFEST_COMMAND};
+use lucent::backend::shader::ShaderCompiler;
+use lucent::error::MANIFEST_COMMAND;
 use lucent::features::shipped;
 
 fn manifest_path() -> std::path::PathBuf {

@@ -359,7 +359,7 @@ fn lean_final_pass_matches_the_f64_lean_brdf_where_nothing_blurs() {
     for name in ["skin", "teapot"] {
         let scene = scaled_profiles(&lucent::bake::scene::load_scene_baked(name).unwrap(), 1e-6);
         let s = FrameSettings {
-            gbuffer: lucent::features::deferred::GBufferPrecision::Full,
+            gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
             ..settings(Technique::Lbb)
         };
         let frame = render(&test, &scene, s);
@@ -421,7 +421,7 @@ fn lean_projection_matches_its_f64_twin() {
     let test = TestGpu::new();
     let scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let s = FrameSettings {
-        gbuffer: lucent::features::deferred::GBufferPrecision::Full,
+        gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
         ..settings(Technique::Lbb)
     };
     let frame = render(&test, &scene, s);

@@ -3,7 +3,7 @@
 //! only translucent pixels, leaving it out of scenes that do not use it, the stability sweep,
 //! and the error-against-time report.
 
-use lucent::features::deferred::GBufferPrecision;
+use lucent::features::gbuffer::GBufferPrecision;
 use lucent::frame::{FrameDesc, FrameImages, FrameSettings, Renderer, Technique};
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
 use lucent::scene::Scene;

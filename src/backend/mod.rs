@@ -6,6 +6,7 @@
 //! - [`format`](mod@format): the one format table (sizes, channels, encodings, names).
 //! - [`shader`]: SPIR-V shipped with the crate or compiled at run time (feature
 //!   `runtime-shaders`), shader modules, pipeline cache.
+//! - [`spirv`]: what a shader compiles to: its stage and SPIR-V words.
 //! - [`timer`]: GPU timestamp scopes, read without stalling.
 
 pub mod access;
@@ -21,6 +22,7 @@ pub mod shader;
 mod shader_files;
 #[cfg(feature = "runtime-shaders")]
 mod shader_runtime;
+pub mod spirv;
 pub mod timer;
 
 pub use context::*;

@@ -22,7 +22,7 @@
 //! - Both take macro permutations as `defines` through the same [`ShaderCompiler::compile`];
 //!   pipelines (`features/util.rs`) do not know which kind they have.
 //! - The run-time compiler's SPIR-V disk cache (the `cache_dir` of `ShaderCompiler::new`, by
-//!   default [`ShaderCompiler::default_cache_dir`], never the source tree) skips glslang
+//!   default [`crate::files::default_cache_dir`], never the source tree) skips glslang
 //!   entirely when nothing changed; see `shader_runtime.rs`. Pass `None` to always compile
 //!   (tests that must see the compiler run). One case is not detected: a new file that would
 //!   shadow an include previously found elsewhere (e.g. a new `pass/x.glsl` beside a shader
@@ -52,96 +52,15 @@ use super::shader_files::{decode_bundle, define_problem};
 pub(crate) use super::shader_files::{permutation_line, shader_name};
 #[cfg(feature = "runtime-shaders")]
 use super::shader_runtime::RuntimeCompiler;
+use super::spirv::{CompiledShader, ShaderStage, SPIRV_MAGIC};
 use crate::error::{LucentError, Result, VkResultExt};
-use crate::files::read_optional;
-use crate::images::output::write_file_atomic;
+use crate::files::{read_optional, write_file_atomic};
 
 /// The bundle `build.rs` compiled from `glsl/permutations.txt`.
 static SHIPPED_BUNDLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/shaders.bundle"));
 
-/// The command that regenerates `glsl/permutations.txt` (named in errors and docs).
-pub const MANIFEST_COMMAND: &str = "LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders";
-
-/// The platform's per-user cache directory (see [`ShaderCompiler::default_cache_dir`]).
-fn user_cache_dir() -> PathBuf {
-    user_cache_dir_from(|name| std::env::var_os(name))
-}
-
-/// [`user_cache_dir`] with the environment given as a lookup (for tests). Relative values are
-/// ignored, as the XDG base directory specification asks.
-fn user_cache_dir_from(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> PathBuf {
-    let var = |name: &str| env(name).map(PathBuf::from).filter(|p| p.is_absolute());
-    let found = if cfg!(windows) {
-        var("LOCALAPPDATA")
-    } else if cfg!(target_os = "macos") {
-        var("HOME").map(|h| h.join("Library/Caches"))
-    } else {
-        var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|h| h.join(".cache")))
-    };
-    found.unwrap_or_else(std::env::temp_dir)
-}
-
 /// Largest pipeline cache file read.
 const MAX_PIPELINE_CACHE_BYTES: u64 = 1 << 30;
-
-/// The SPIR-V magic number, first word of every module.
-pub(crate) const SPIRV_MAGIC: u32 = 0x0723_0203;
-
-/// A programmable pipeline stage, decided by the file extension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ShaderStage {
-    /// `.vert`
-    Vertex,
-    /// `.frag`
-    Fragment,
-    /// `.comp`
-    Compute,
-}
-
-impl ShaderStage {
-    /// The stage for a file name ending in `.vert`, `.frag` or `.comp`; `None` for anything else.
-    pub fn from_path(path: impl AsRef<Path>) -> Option<Self> {
-        match path.as_ref().extension()?.to_str()? {
-            "vert" => Some(Self::Vertex),
-            "frag" => Some(Self::Fragment),
-            "comp" => Some(Self::Compute),
-            _ => None,
-        }
-    }
-
-    /// The Vulkan stage flag, for pipeline stage create infos and descriptor set layouts.
-    pub fn vk_stage(self) -> vk::ShaderStageFlags {
-        match self {
-            Self::Vertex => vk::ShaderStageFlags::VERTEX,
-            Self::Fragment => vk::ShaderStageFlags::FRAGMENT,
-            Self::Compute => vk::ShaderStageFlags::COMPUTE,
-        }
-    }
-
-    /// The file extension (without dot), also used as the stage's name in cache keys.
-    pub fn extension(self) -> &'static str {
-        match self {
-            Self::Vertex => "vert",
-            Self::Fragment => "frag",
-            Self::Compute => "comp",
-        }
-    }
-}
-
-/// The result of [`ShaderCompiler::compile`].
-#[derive(Debug, Clone)]
-pub struct CompiledShader {
-    /// SPIR-V words, ready for [`create_shader_module`].
-    pub spirv: Vec<u32>,
-    /// The stage, from the file extension.
-    pub stage: ShaderStage,
-    /// Absolute paths of the main file (first) and every file it included, each once (empty
-    /// for shipped SPIR-V: no file is read).
-    pub dependencies: Vec<PathBuf>,
-    /// True when the SPIR-V came from the run-time compiler's disk cache and glslang did not
-    /// run (false for shipped SPIR-V).
-    pub from_cache: bool,
-}
 
 /// The decoded shipped bundle: permutation line -> module, and the modules.
 struct ShippedBundle {
@@ -218,7 +137,7 @@ impl ShaderCompiler {
         if let Some(dir) = std::env::var_os("LUCENT_GLSL_DIR").filter(|d| !d.is_empty()) {
             return PathBuf::from(dir);
         }
-        let is_root = |dir: &Path| dir.join("fullscreen.vert").is_file();
+        let is_root = |dir: &Path| dir.join(FULLSCREEN_VERTEX).is_file();
         let compiled_from = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
         let exe_dir = std::env::current_exe()
             .ok()
@@ -232,21 +151,6 @@ impl ShaderCompiler {
             }
         }
         compiled_from
-    }
-
-    /// The cache directory used when the caller names none (the run-time SPIR-V cache, the
-    /// thickness bake cache and the pipeline cache live in it): `$LUCENT_CACHE_DIR`, else
-    /// `lucent` in the user's cache directory: `$XDG_CACHE_HOME` or `~/.cache` on Linux and
-    /// other Unixes, `~/Library/Caches` on macOS, `%LOCALAPPDATA%` on Windows; the system's
-    /// temporary directory when none of those is known. Per user, so another user's run neither
-    /// warns nor writes into someone else's tree, and never the source tree. A host passes its
-    /// own directory instead (`ShaderCompiler::new`, [`PipelineCache::load_for_device`],
-    /// [`crate::bake::scene::load_scene_baked_in`]).
-    pub fn default_cache_dir() -> PathBuf {
-        if let Some(dir) = std::env::var_os("LUCENT_CACHE_DIR").filter(|d| !d.is_empty()) {
-            return PathBuf::from(dir);
-        }
-        user_cache_dir().join("lucent")
     }
 
     /// Whether this compiler serves the shipped bundle (no GLSL is read).
@@ -343,6 +247,43 @@ pub(crate) fn sorted_defines<'a>(
     Ok(sorted)
 }
 
+/// The vertex shader of every fullscreen pass: one triangle covering the render area, from
+/// `gl_VertexIndex` alone (no vertex buffer). Its presence also marks a GLSL root
+/// (`ShaderCompiler::default_glsl_root`).
+pub const FULLSCREEN_VERTEX: &str = "fullscreen.vert";
+
+/// The shaders one graphics pipeline compiles: its vertex and fragment shader, both with the
+/// same defines (as `features::util::GraphicsPipeline::new` compiles them). What each pass's
+/// `shader_permutations` lists for the shipped SPIR-V (`crate::features::shipped`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PipelineShaders {
+    /// Vertex shader path under `glsl/`.
+    pub vertex: String,
+    /// Fragment shader path under `glsl/`.
+    pub fragment: String,
+    /// The defines, in the order the pass gives them.
+    pub defines: Vec<(String, String)>,
+}
+
+impl PipelineShaders {
+    /// A pipeline of `vertex` and `fragment` with `defines`.
+    pub fn new(vertex: &str, fragment: &str, defines: &[(&str, &str)]) -> Self {
+        Self {
+            vertex: vertex.to_string(),
+            fragment: fragment.to_string(),
+            defines: defines
+                .iter()
+                .map(|(n, v)| (n.to_string(), v.to_string()))
+                .collect(),
+        }
+    }
+
+    /// A fullscreen pass's pipeline: [`FULLSCREEN_VERTEX`] and `fragment`.
+    pub fn fullscreen(fragment: &str, defines: &[(&str, &str)]) -> Self {
+        Self::new(FULLSCREEN_VERTEX, fragment, defines)
+    }
+}
+
 /// Creates a `VkShaderModule` from SPIR-V words (e.g. [`CompiledShader::spirv`]).
 ///
 /// The caller destroys it (`vkDestroyShaderModule`), usually right after creating the pipelines.
@@ -386,7 +327,7 @@ impl PipelineCache {
     }
 
     /// The device's cache in the default cache directory
-    /// ([`ShaderCompiler::default_cache_dir`]`/pipelines.bin`), checked against the device as
+    /// ([`crate::files::default_cache_dir`]`/pipelines.bin`), checked against the device as
     /// [`PipelineCache::load_for_device`] does: what every command and the demo use.
     pub fn load_default(gpu: &crate::backend::GpuContext) -> Result<Self> {
         // SAFETY: the physical device handle belongs to this instance.
@@ -396,7 +337,7 @@ impl PipelineCache {
         };
         Self::load_for_device(
             &gpu.device,
-            Some(ShaderCompiler::default_cache_dir().join("pipelines.bin")),
+            Some(crate::files::default_cache_dir().join("pipelines.bin")),
             &properties,
         )
     }
@@ -522,24 +463,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn stage_from_extension() {
-        assert_eq!(
-            ShaderStage::from_path("a/b.vert"),
-            Some(ShaderStage::Vertex)
-        );
-        assert_eq!(
-            ShaderStage::from_path("b.frag"),
-            Some(ShaderStage::Fragment)
-        );
-        assert_eq!(ShaderStage::from_path("b.comp"), Some(ShaderStage::Compute));
-        assert_eq!(ShaderStage::from_path("common/b.glsl"), None);
-        assert_eq!(
-            ShaderStage::Compute.vk_stage(),
-            vk::ShaderStageFlags::COMPUTE
-        );
-    }
-
-    #[test]
     fn defines_are_validated_and_sorted() {
         let sorted = sorted_defines("x", &[("B", "1"), ("A", "2"), ("B", "3")], false).unwrap();
         assert_eq!(permutation_line("x.frag", sorted), "x.frag A=2 B=3");
@@ -603,34 +526,11 @@ mod tests {
         ));
     }
 
+    #[cfg(feature = "runtime-shaders")]
     #[test]
-    fn default_paths_are_per_user_and_found_from_the_executable() {
-        let env = |pairs: &'static [(&'static str, &'static str)]| {
-            move |name: &str| {
-                pairs
-                    .iter()
-                    .find(|(n, _)| *n == name)
-                    .map(|(_, v)| std::ffi::OsString::from(v))
-            }
-        };
-        if cfg!(all(unix, not(target_os = "macos"))) {
-            assert_eq!(
-                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "/c"), ("HOME", "/h")])),
-                Path::new("/c")
-            );
-            assert_eq!(
-                user_cache_dir_from(env(&[("XDG_CACHE_HOME", "rel"), ("HOME", "/h")])),
-                Path::new("/h/.cache")
-            );
-        }
-        assert_eq!(user_cache_dir_from(env(&[])), std::env::temp_dir());
-        // Not under the source tree, unless the user's cache is there.
-        if std::env::var_os("LUCENT_CACHE_DIR").is_none() {
-            assert!(ShaderCompiler::default_cache_dir().ends_with("lucent"));
-        }
+    fn the_default_glsl_root_is_found_from_the_executable() {
         // This test runs from target/<profile>/deps: the repository's tree is found above it
         // (unless the target directory is elsewhere: then the source tree it was built from).
-        #[cfg(feature = "runtime-shaders")]
         if std::env::var_os("LUCENT_GLSL_DIR").is_none() {
             let found = ShaderCompiler::default_glsl_root().canonicalize().unwrap();
             let repo = Path::new(env!("CARGO_MANIFEST_DIR"))

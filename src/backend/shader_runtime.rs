@@ -14,10 +14,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use xxhash_rust::xxh3::{xxh3_64, Xxh3};
 
 use super::glsl_compile::{compile_glsl, read_source, COMPILER_SETTINGS, MAX_SOURCE_BYTES};
-use super::shader::{CompiledShader, ShaderStage, SPIRV_MAGIC};
+use super::spirv::{CompiledShader, ShaderStage, SPIRV_MAGIC};
 use crate::error::{LucentError, Result};
+use crate::files::write_file_atomic;
 use crate::files::{read_capped, read_optional};
-use crate::images::output::write_file_atomic;
 
 /// First bytes of a SPIR-V cache entry (format version in the last byte).
 const CACHE_MAGIC: &[u8; 8] = b"LUCSPV\0\x01";

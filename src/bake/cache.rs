@@ -105,7 +105,7 @@ pub fn cached_per_vertex_with_status(
     }
     let (values, stats) = bake_per_vertex(mesh, options)?;
     log::info!("{}", bake_report(&stats));
-    if let Err(e) = crate::images::output::write_file_atomic(&path, &encode(key, &values)) {
+    if let Err(e) = crate::files::write_file_atomic(&path, &encode(key, &values)) {
         log::warn!("thickness cache not written ({e}); the bake is used uncached");
     }
     Ok((values, false))

@@ -12,9 +12,9 @@ use glam::Vec3;
 use crate::scene::{self, material, texture, Scene};
 
 /// The thickness bake cache used when the caller names none: `thickness` in
-/// [`crate::backend::shader::ShaderCompiler::default_cache_dir`].
+/// [`crate::files::default_cache_dir`].
 pub fn default_thickness_cache_dir() -> std::path::PathBuf {
-    crate::backend::shader::ShaderCompiler::default_cache_dir().join("thickness")
+    crate::files::default_cache_dir().join("thickness")
 }
 
 /// Loads a scene by built-in name or `.toml` path ([`scene::load_scene`]) and prepares its

@@ -87,7 +87,7 @@ impl ThicknessMap {
                 ExtendedColorType::L8,
             )
             .map_err(|e| LucentError::file(path, format!("PNG encoding failed: {e}")))?;
-        crate::images::output::write_file_atomic(path, &encoded)
+        crate::files::write_file_atomic(path, &encoded)
     }
 }
 

@@ -130,7 +130,7 @@ pub fn run(options: DemoOptions) -> Result<()> {
     })?;
     let shaders = ShaderCompiler::new(
         ShaderCompiler::default_glsl_root(),
-        Some(ShaderCompiler::default_cache_dir()),
+        Some(crate::files::default_cache_dir()),
     )?;
     // Run-time compilation (not the shipped SPIR-V): edited shaders reload while the demo runs.
     let glsl_root = shaders.glsl_root().ok_or_else(|| {

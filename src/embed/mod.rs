@@ -210,7 +210,7 @@ pub struct EmbedOptions {
     /// Where lucent keeps what it caches between runs (the thickness bake; shaders come
     /// compiled with the crate):
     /// a directory the host chooses. `None`: the platform's per-user cache
-    /// ([`ShaderCompiler::default_cache_dir`]: `$LUCENT_CACHE_DIR`, else e.g.
+    /// ([`crate::files::default_cache_dir`]: `$LUCENT_CACHE_DIR`, else e.g.
     /// `~/.cache/lucent`), never the source tree.
     pub cache_dir: Option<PathBuf>,
 }
@@ -269,7 +269,7 @@ impl Lucent {
         gpu.info.storage_image_write_without_format = enabled.storage_image_write_without_format;
         let cache_dir = options
             .cache_dir
-            .unwrap_or_else(ShaderCompiler::default_cache_dir);
+            .unwrap_or_else(crate::files::default_cache_dir);
         // The SPIR-V built with the crate: no `glsl/`, no shaderc at run time.
         let shaders = ShaderCompiler::shipped()?;
         let (pipeline_cache, owns_pipeline_cache) = match options.pipeline_cache {

@@ -561,7 +561,7 @@ fn cleared_image(graph: &mut RenderGraph, width: u32, height: u32) -> Handle<Ima
         ImageInfo {
             width,
             height,
-            format: crate::features::deferred::HDR_FORMAT,
+            format: crate::features::lighting::HDR_FORMAT,
         },
     );
     let mut pass = graph.add_pass("clear specular", PassKind::Raster);

@@ -61,9 +61,9 @@ fn fxaa_defines(linear: bool) -> &'static [(&'static str, &'static str)] {
 }
 
 /// The pipelines the anti-aliasing of any frame builds.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for linear in [false, true] {
-        out.push(super::shipped::PipelineShaders::fullscreen(
+        out.push(crate::backend::shader::PipelineShaders::fullscreen(
             FXAA_FRAGMENT,
             fxaa_defines(linear),
         ));

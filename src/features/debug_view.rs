@@ -15,7 +15,8 @@ use crate::graph::{
 };
 use crate::Result;
 
-use super::deferred::{GBuffer, Lit};
+use super::gbuffer::GBuffer;
+use super::lighting::Lit;
 use super::translucency::ThicknessPacking;
 use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
 use crate::gpu_scene::SceneGpu;
@@ -172,12 +173,12 @@ fn view_defines(
 }
 
 /// The pipelines the debug view of any frame builds.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for &(_, view) in DebugView::ALL {
         for inputs in [ViewInputs::One, ViewInputs::Second, ViewInputs::Term] {
             for colored in [false, true] {
                 for linear in [false, true] {
-                    out.push(super::shipped::PipelineShaders::fullscreen(
+                    out.push(crate::backend::shader::PipelineShaders::fullscreen(
                         VIEW_FRAGMENT,
                         &view_defines(view, inputs, colored, linear),
                     ));

@@ -54,8 +54,6 @@ use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-/// The G-buffer's layered material ID per pixel (ID / 255; 0: not layered).
-pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;
 /// The transmitted irradiance image.
 pub const IRRADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Layered materials a frame holds at most (IDs 1 to 16).
@@ -579,7 +577,7 @@ impl LayeredShape {
         if let (true, Some(textures)) = (texdep, self.layer_depths) {
             defines.push((
                 "LUCENT_LAYER_DEPTHS",
-                super::deferred::layer_depths_define(textures),
+                super::layer_depth::layer_depths_define(textures),
             ));
             defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[next]));
             next += 1;
@@ -605,7 +603,7 @@ impl LayeredShape {
 }
 
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
-fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for kind in Kind::ALL {
         for flags in 0u32..1 << 6 {
             let bit = |i: u32| flags & (1 << i) != 0;
@@ -620,7 +618,7 @@ fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
                     entry: bit(4),
                     entry_depths: bit(5),
                 };
-                out.push(super::shipped::PipelineShaders::fullscreen(
+                out.push(crate::backend::shader::PipelineShaders::fullscreen(
                     kind.fragment(),
                     &shape.defines().0,
                 ));
@@ -778,7 +776,7 @@ impl TechniqueModule for LiLayeredMedia {
         "layered"
     }
 
-    fn shader_permutations(&self, out: &mut Vec<super::shipped::PipelineShaders>) {
+    fn shader_permutations(&self, out: &mut Vec<crate::backend::shader::PipelineShaders>) {
         shader_permutations(out);
     }
 }

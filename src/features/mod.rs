@@ -3,7 +3,9 @@
 //! ([`crate::frame`]) decides which are in a frame; a feature never reads the scene's CPU model
 //! or the f64 reference, only what [`crate::gpu_scene`] put on the GPU.
 //!
-//! - [`deferred`]: the MRT G-buffer and per-light deferred lighting (merged as subpasses).
+//! - [`gbuffer`]: the MRT G-buffer: its targets, their formats, the pass that fills them.
+//! - [`lighting`]: per-light deferred lighting at each G-buffer pixel (merged with the
+//!   G-buffer pass as subpasses).
 //! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
 //!   packing (its shading runs inside the deferred lighting pass).
 //! - [`sss`]: screen-space subsurface scattering, separable blurs of the lit diffuse light.
@@ -11,18 +13,25 @@
 //!   media.
 //! - [`layered`]: Li et al. 2009's layered media: image-space single and dipole multiple
 //!   scattering.
+//! - [`layer_depth`]: the layered media's per-layer depth texels, stored by the G-buffer and
+//!   the light-space maps.
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`antialias`]: FXAA after the tonemap (a knob, off by default).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
+//! - [`copy_pass`]: the copy pass's shader, which the speed-of-light measurement puts in place of
+//!   each pass.
 //! - [`util`]: pipeline and descriptor helpers the passes share.
 //! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 //! - [`technique`] and [`registry`]: the contract a technique module implements and the one
 //!   list of them, which everything that names techniques iterates.
 
 pub mod antialias;
+pub mod copy_pass;
 pub mod debug_view;
-pub mod deferred;
+pub mod gbuffer;
+pub mod layer_depth;
 pub mod layered;
+pub mod lighting;
 pub mod registry;
 pub mod shadows;
 pub mod shipped;

@@ -356,7 +356,7 @@ pub fn shadow_pass(
             .then(|| graph.create_image("light-space.entry", info(ENTRY_FORMAT))),
         layer_depths: desc
             .entry
-            .then(|| super::deferred::layer_depth_format(desc.layer_depth_textures))
+            .then(|| super::layer_depth::layer_depth_format(desc.layer_depth_textures))
             .flatten()
             .map(|f| graph.create_image("light-space.layer-depth", info(f))),
     };
@@ -420,7 +420,7 @@ impl ShadowPass {
         )];
         if let (true, Some(maps)) = (self.layer_depths(), &self.scene.maps) {
             let pair = maps.depth_sets.get(index).copied().unwrap_or([0, 0]);
-            bindings.extend(super::deferred::depth_map_bindings(
+            bindings.extend(super::layer_depth::depth_map_bindings(
                 maps,
                 pair,
                 self.desc.layer_depth_textures,
@@ -588,7 +588,7 @@ pub(crate) fn shadow_map_defines(
     if entry && layer_depth_textures > 0 {
         defines.push((
             "LUCENT_LAYER_DEPTHS",
-            super::deferred::layer_depths_define(layer_depth_textures),
+            super::layer_depth::layer_depths_define(layer_depth_textures),
         ));
         defines.push(("LUCENT_LAYER_DEPTH_LOCATION", if ids { "2" } else { "1" }));
     }
@@ -596,11 +596,11 @@ pub(crate) fn shadow_map_defines(
 }
 
 /// The pipelines the light-space maps pass of any frame builds.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for ids in [false, true] {
         for entry in [false, true] {
             for textures in 0..=2 {
-                out.push(super::shipped::PipelineShaders::new(
+                out.push(crate::backend::shader::PipelineShaders::new(
                     SHADOW_VERTEX,
                     SHADOW_FRAGMENT,
                     &shadow_map_defines(ids, entry, textures),

@@ -29,55 +29,23 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::util::GraphicsPipelineDesc;
-use crate::backend::shader::sorted_defines;
+use crate::backend::shader::{sorted_defines, PipelineShaders};
 use crate::{LucentError, Result};
-
-/// The shaders one pipeline compiles: its vertex and fragment shader, both with the same
-/// defines (as [`super::util::GraphicsPipeline::new`] compiles them).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct PipelineShaders {
-    /// Vertex shader path under `glsl/`.
-    pub vertex: String,
-    /// Fragment shader path under `glsl/`.
-    pub fragment: String,
-    /// The defines, in the order the pass gives them.
-    pub defines: Vec<(String, String)>,
-}
-
-impl PipelineShaders {
-    /// A pipeline of `vertex` and `fragment` with `defines`.
-    pub fn new(vertex: &str, fragment: &str, defines: &[(&str, &str)]) -> Self {
-        Self {
-            vertex: vertex.to_string(),
-            fragment: fragment.to_string(),
-            defines: defines
-                .iter()
-                .map(|(n, v)| (n.to_string(), v.to_string()))
-                .collect(),
-        }
-    }
-
-    /// A fullscreen pass's pipeline ([`GraphicsPipelineDesc::fullscreen`]'s vertex shader).
-    pub fn fullscreen(fragment: &str, defines: &[(&str, &str)]) -> Self {
-        let desc = GraphicsPipelineDesc::fullscreen(fragment, defines, fragment);
-        Self::new(desc.vertex, desc.fragment, defines)
-    }
-}
 
 /// Every pipeline any frame (and the speed-of-light copies of its passes) may build, in the
 /// features' order, repeats included.
 pub fn pipelines() -> Vec<PipelineShaders> {
     let mut out = Vec::new();
     super::shadows::shader_permutations(&mut out);
-    super::deferred::shader_permutations(&mut out);
+    super::gbuffer::shader_permutations(&mut out);
+    super::lighting::shader_permutations(&mut out);
     for technique in super::registry::TECHNIQUES {
         technique.shader_permutations(&mut out);
     }
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
     super::antialias::shader_permutations(&mut out);
-    crate::measure::speed_of_light::shader_permutations(&mut out);
+    super::copy_pass::shader_permutations(&mut out);
     out
 }
 
@@ -110,7 +78,7 @@ pub fn manifest() -> Result<String> {
          (lucent::features::shipped).\n\
          # build.rs compiles each line into the shipped SPIR-V bundle. Do not edit: \
          regenerate with\n#   {}\n",
-        crate::backend::shader::MANIFEST_COMMAND
+        crate::error::MANIFEST_COMMAND
     );
     for line in permutations()? {
         text.push_str(&line);

@@ -1,8 +1,8 @@
 //! The contract every technique module implements ([`TechniqueModule`]); the list of them is
 //! [`super::registry`].
 
-use super::shipped::PipelineShaders;
 use super::sss::SssBlurTechnique;
+use crate::backend::shader::PipelineShaders;
 
 /// What a technique shades: the materials it applies to.
 #[derive(Clone, Copy)]

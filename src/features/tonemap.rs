@@ -103,9 +103,9 @@ fn tonemap_defines(encoding: Encoding) -> &'static [(&'static str, &'static str)
 }
 
 /// The pipelines the tonemap of any frame builds.
-pub(crate) fn shader_permutations(out: &mut Vec<super::shipped::PipelineShaders>) {
+pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for encoding in [Encoding::Srgb, Encoding::Linear, Encoding::SrgbLumaInAlpha] {
-        out.push(super::shipped::PipelineShaders::fullscreen(
+        out.push(crate::backend::shader::PipelineShaders::fullscreen(
             TONEMAP_FRAGMENT,
             tonemap_defines(encoding),
         ));

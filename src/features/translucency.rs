@@ -16,8 +16,8 @@
 
 use glam::Vec3;
 
-use super::shipped::PipelineShaders;
 use super::technique::{Shades, TechniqueModule};
+use crate::backend::shader::PipelineShaders;
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::Scene;
 use crate::{LucentError, Result};

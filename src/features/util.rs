@@ -290,7 +290,7 @@ impl<'a> GraphicsPipelineDesc<'a> {
     /// with struct update syntax.
     pub fn fullscreen(fragment: &'a str, defines: &'a [(&'a str, &'a str)], name: &'a str) -> Self {
         Self {
-            vertex: "fullscreen.vert",
+            vertex: crate::backend::shader::FULLSCREEN_VERTEX,
             fragment,
             defines,
             vertex_input: VertexInput::None,

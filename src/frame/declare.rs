@@ -10,8 +10,8 @@ use super::{FrameDesc, FrameSettings};
 use crate::backend::access::Access;
 use crate::features::antialias::{self, Antialias};
 use crate::features::debug_view;
-use crate::features::deferred::GBufferLayout;
-use crate::features::{deferred, layered, shadows, sss, tonemap};
+use crate::features::gbuffer::{self, GBufferLayout};
+use crate::features::{layered, lighting, shadows, sss, tonemap};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{CompileOptions, ImageInfo, ImportedImage, Plan, RenderGraph, ResourceId};
 use crate::Result;
@@ -67,8 +67,8 @@ pub fn declare_frame(
         .shadows
         .as_ref()
         .map(|s| shadows::shadow_pass(graph, s, scene_gpu));
-    let gb = deferred::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
-    let lit = deferred::lighting_pass(graph, &gb, shadow_maps.as_ref(), scene_gpu);
+    let gb = gbuffer::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
+    let lit = lighting::lighting_pass(graph, &gb, shadow_maps.as_ref(), scene_gpu);
     let display_info = ImageInfo {
         width: settings.width,
         height: settings.height,

@@ -12,7 +12,7 @@
 //! texture or table.
 
 use super::FrameSettings;
-use crate::features::deferred::{GBufferLayout, TranslucencyLayout};
+use crate::features::gbuffer::{GBufferLayout, TranslucencyLayout};
 use crate::features::layered::LayeredDesc;
 use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowDesc;

@@ -4,7 +4,7 @@
 use ash::vk;
 
 use super::FrameTiming;
-use crate::features::deferred::GBufferLayout;
+use crate::features::gbuffer::GBufferLayout;
 use crate::{LucentError, Result};
 
 /// One frame's read-back images.

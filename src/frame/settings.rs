@@ -3,7 +3,7 @@
 use crate::backend::access::Access;
 use crate::features::antialias::Antialias;
 use crate::features::debug_view::DebugView;
-use crate::features::deferred::GBufferPrecision;
+use crate::features::gbuffer::GBufferPrecision;
 use crate::features::layered::LayeredKnobs;
 use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowSettings;

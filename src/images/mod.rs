@@ -2,8 +2,9 @@
 //! it compares two images perceptually (FLIP, with thresholds and difference images).
 //!
 //! - [`output`]: PNG (sRGB RGBA8) and OpenEXR (linear float) writers, fp16 decoding.
-//! - [`compare`]: FLIP between two images, and golden-image comparison that writes the actual
-//!   and difference PNGs on failure.
+//! - `compare` (feature `measure`): FLIP between two images, and golden-image comparison that
+//!   writes the actual and difference PNGs on failure.
 
+#[cfg(feature = "measure")]
 pub mod compare;
 pub mod output;

@@ -5,19 +5,17 @@
 //!   maps, where 8 bits would clip or band. Written with the `image` crate's OpenEXR encoder.
 //! - [`read_png_rgba8`]: load a PNG (golden images) as tightly packed RGBA8.
 //! - [`f16_bytes_to_f32`]: turn an `R16G16B16A16_SFLOAT` readback into `f32`s for EXR or checks.
-//! - [`write_file_atomic`]: the write-to-temporary-then-rename used by every writer here (and by
-//!   the shader caches), so a crash or a concurrent reader never sees half a file; it writes
-//!   through symlinks and into devices and FIFOs rather than replacing them.
 //!
-//! All writers create missing parent directories; every error names the file.
+//! Every writer writes through [`crate::files::write_file_atomic`] (never half a file, missing
+//! parent directories created); every error names the file.
 
-use std::io::{Cursor, Write as _};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::io::Cursor;
+use std::path::Path;
 
 use image::{ExtendedColorType, ImageEncoder, ImageFormat, ImageReader};
 
 use crate::error::{LucentError, Result};
+use crate::files::write_file_atomic;
 
 /// Writes a PNG from tightly packed, row-major (top row first) RGBA8 pixels.
 ///
@@ -49,11 +47,13 @@ pub fn write_exr_rgba32f(path: &Path, width: u32, height: u32, rgba: &[f32]) -> 
     write_file_atomic(path, encoded.get_ref())
 }
 
+/// Largest PNG file read (2 GiB, as for a texture): goldens and screenshots are far smaller.
+const MAX_PNG_FILE_BYTES: u64 = 2 << 30;
+
 /// Reads a PNG file as `(width, height, rgba8)`, converting grey, RGB or 16-bit PNGs to RGBA8.
 pub fn read_png_rgba8(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
-    let (file, _) =
-        crate::files::open_regular(path, crate::scene::texture::MAX_TEXTURE_FILE_BYTES, "PNG")
-            .map_err(|e| LucentError::file(path, e))?;
+    let (file, _) = crate::files::open_regular(path, MAX_PNG_FILE_BYTES, "PNG")
+        .map_err(|e| LucentError::file(path, e))?;
     let image = ImageReader::with_format(std::io::BufReader::new(file), ImageFormat::Png)
         .decode()
         .map_err(|e| LucentError::file(path, format!("not a readable PNG: {e}")))?
@@ -68,97 +68,6 @@ pub fn f16_bytes_to_f32(bytes: &[u8]) -> Vec<f32> {
         .chunks_exact(2)
         .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
         .collect()
-}
-
-/// Writes `bytes` to `path`, never replacing what `path` is:
-///
-/// - a regular file, or nothing yet: atomically, into a temporary file in the same directory,
-///   then renamed over `path` (a crash or a concurrent reader never sees half a file);
-/// - a symlink: written through it, atomically at its target (the link stays a link, and a
-///   dangling link creates its target);
-/// - a character device, FIFO or socket (`/dev/null`, a pipe to another program): opened and
-///   written into, as a shell redirection would; renaming over it would replace the device with
-///   a file (as root, `/dev/full` became a regular file);
-/// - a directory: an error.
-///
-/// Creates missing parent directories. The error names `path`.
-pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let target = resolve_symlinks(path)?;
-    match std::fs::metadata(&target) {
-        Ok(m) if m.is_dir() => Err(LucentError::file(
-            path,
-            "is a directory; give a file name to write",
-        )),
-        Ok(m) if !m.is_file() => {
-            // A device or FIFO: written into, never replaced.
-            let mut file = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&target)
-                .map_err(|e| LucentError::file(path, format!("cannot open for writing: {e}")))?;
-            file.write_all(bytes)
-                .and_then(|()| file.flush())
-                .map_err(|e| {
-                    LucentError::file(
-                        path,
-                        format!("writing into {} failed: {e}", crate::files::kind_of(&m)),
-                    )
-                })
-        }
-        _ => write_regular_atomic(path, &target, bytes),
-    }
-}
-
-/// `path` with every symlink of its last component followed (relative links resolved against
-/// their directory); the path itself when it is no symlink. Refuses symlink loops.
-fn resolve_symlinks(path: &Path) -> Result<PathBuf> {
-    let mut target = path.to_path_buf();
-    // The limit Linux puts on symlinks followed in one lookup.
-    for _ in 0..40 {
-        match std::fs::symlink_metadata(&target) {
-            Ok(m) if m.file_type().is_symlink() => {
-                let next = std::fs::read_link(&target)
-                    .map_err(|e| LucentError::file(path, format!("cannot read symlink: {e}")))?;
-                target = match target.parent() {
-                    Some(parent) if next.is_relative() => parent.join(next),
-                    _ => next,
-                };
-            }
-            _ => return Ok(target),
-        }
-    }
-    Err(LucentError::file(
-        path,
-        "too many levels of symbolic links (a symlink loop?)",
-    ))
-}
-
-/// The temporary-then-rename write of a regular file at `target` (`path` names it in errors).
-fn write_regular_atomic(path: &Path, target: &Path, bytes: &[u8]) -> Result<()> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let file_name = target
-        .file_name()
-        .ok_or_else(|| LucentError::file(path, "not a file path"))?;
-    let parent = target.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(parent) = parent {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| LucentError::file(path, format!("cannot create directory: {e}")))?;
-    }
-    // Unique per process and call, so concurrent writers of the same file never share a temporary.
-    let tmp_name = format!(
-        "{}.{}-{}.tmp",
-        file_name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    );
-    let tmp: PathBuf = match parent {
-        Some(parent) => parent.join(tmp_name),
-        None => PathBuf::from(tmp_name),
-    };
-    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, target));
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        LucentError::file(path, e)
-    })
 }
 
 fn check_len(path: &Path, width: u32, height: u32, channels: u64, len: usize) -> Result<()> {
@@ -180,6 +89,8 @@ fn check_len(path: &Path, width: u32, height: u32, channels: u64, len: usize) ->
 
 #[cfg(test)]
 mod tests {
+    use std::path::PathBuf;
+
     use super::*;
 
     fn temp_dir(name: &str) -> PathBuf {
@@ -229,39 +140,6 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(message.contains("bad.png"), "{message}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[cfg(unix)]
-    #[test]
-    fn symlinks_are_written_through_and_devices_into() {
-        let dir = temp_dir("through");
-        std::fs::create_dir_all(&dir).unwrap();
-        let real = dir.join("real.json");
-        std::fs::write(&real, b"old").unwrap();
-        let link = dir.join("link.json");
-        std::os::unix::fs::symlink("real.json", &link).unwrap();
-        write_file_atomic(&link, b"new").unwrap();
-        assert!(std::fs::symlink_metadata(&link)
-            .unwrap()
-            .file_type()
-            .is_symlink());
-        assert_eq!(std::fs::read(&real).unwrap(), b"new");
-        // A dangling link creates its target.
-        let dangling = dir.join("dangling.json");
-        std::os::unix::fs::symlink("made.json", &dangling).unwrap();
-        write_file_atomic(&dangling, b"made").unwrap();
-        assert_eq!(std::fs::read(dir.join("made.json")).unwrap(), b"made");
-        // A device is written into, not replaced.
-        write_file_atomic(Path::new("/dev/null"), b"gone").unwrap();
-        let null = std::fs::metadata("/dev/null").unwrap();
-        assert!(!null.is_file(), "/dev/null was replaced by a file");
-        let e = write_file_atomic(&dir, b"x").unwrap_err().to_string();
-        assert!(e.contains("is a directory"), "{e}");
-        let looped = dir.join("loop");
-        std::os::unix::fs::symlink("loop", &looped).unwrap();
-        let e = write_file_atomic(&looped, b"x").unwrap_err().to_string();
-        assert!(e.contains("symlink loop"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

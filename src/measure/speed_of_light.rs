@@ -34,6 +34,7 @@ use serde::Serialize;
 use crate::backend::format::{format_info, format_name};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
+use crate::features::copy_pass::{copy_defines, COPY_FRAGMENT, MAX_COPY_IMAGES, MAX_COPY_INPUTS};
 use crate::features::util::{
     clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
 };
@@ -46,12 +47,6 @@ use crate::{LucentError, Result};
 
 /// Passes at more than this many times their copy's time are named as far above their floor.
 pub const FAR_ABOVE_FLOOR: f64 = 4.0;
-
-/// Images one copy pass can read or write (`glsl/bench/copy.frag` declares eight of each, the
-/// colour-attachment count every Vulkan device supports).
-pub const MAX_COPY_IMAGES: usize = 8;
-/// Most images the copy reads (LEAN's final pass reads nine with the light-space maps).
-pub const MAX_COPY_INPUTS: usize = 10;
 
 /// What one physical pass moves, and how many taps it makes.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -486,41 +481,6 @@ fn copy_format(format: vk::Format) -> vk::Format {
             _ => vk::Format::R32G32B32A32_SFLOAT,
         },
         _ => format,
-    }
-}
-
-/// The copy's fragment shader.
-const COPY_FRAGMENT: &str = "bench/copy.frag";
-
-/// Image counts as define strings (at most [`MAX_COPY_INPUTS`]).
-const COUNTS: [&str; MAX_COPY_INPUTS + 1] =
-    ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10"];
-
-/// The copy's defines: images read, colour images written, and whether it writes depth.
-fn copy_defines(inputs: usize, outputs: usize, depth: bool) -> Vec<(&'static str, &'static str)> {
-    let count = |n: usize| COUNTS[n.min(MAX_COPY_INPUTS)];
-    let mut defines = vec![
-        ("LUCENT_COPY_INPUTS", count(inputs)),
-        ("LUCENT_COPY_OUTPUTS", count(outputs)),
-    ];
-    if depth {
-        defines.push(("LUCENT_COPY_DEPTH", "1"));
-    }
-    defines
-}
-
-/// The pipelines the copies of any plan's passes build ([`PassFloor::unsupported`] leaves out
-/// passes with more images than the copy has).
-pub(crate) fn shader_permutations(out: &mut Vec<crate::features::shipped::PipelineShaders>) {
-    for inputs in 0..=MAX_COPY_INPUTS {
-        for outputs in 0..=MAX_COPY_IMAGES {
-            for depth in [false, true] {
-                out.push(crate::features::shipped::PipelineShaders::fullscreen(
-                    COPY_FRAGMENT,
-                    &copy_defines(inputs, outputs, depth),
-                ));
-            }
-        }
     }
 }
 

@@ -33,11 +33,11 @@ use super::sweep::{count_hdr, HdrCounts};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::frame::{render_frame, FrameSettings};
-use crate::reference::dipole::dipole_constants;
 use crate::reference::layered::{
     multiple_scattering, single_scattering, Phase, SingleScatteringOptions, SurfaceSamples,
 };
 use crate::scene::generators::{self, Generator};
+use crate::scene::layered::dipole_constants;
 use crate::scene::layered::{Layer, LayeredMedium, Thickness, MAX_ABS_G, MAX_COEFFICIENT};
 use crate::scene::{Camera, Light, LightKind, Material, Mesh, Object, Scene, Shape};
 use crate::{LucentError, Result};

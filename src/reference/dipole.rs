@@ -1,77 +1,15 @@
 //! Jensen et al.'s dipole diffusion profile (2001) in f64, and fitting a sum of Gaussians to a
 //! radial profile. Used to derive and check the `marble` SSS preset; the multiple-scattering
 //! technique (Li et al.) evaluates the same dipole.
+//!
+//! The dipole's constants are the medium's, derived where the scene derives the GPU's
+//! ([`crate::scene::layered::dipole_constants`]); this module evaluates the profile `Rd(r)`
+//! and its integrals from them.
 
 use std::f64::consts::PI;
 
+use crate::scene::layered::{dipole_constants, Dipole};
 use crate::scene::profile::fit_sum_of_gaussians;
-
-/// Diffuse Fresnel reflectance of a boundary with relative index `eta` (Jensen's fit). The fit
-/// gives 0.0014 at `eta` = 1, where there is no boundary: `eta` = 1 returns 0 exactly (as
-/// Mitsuba forces it), so the dipole's `A` is exactly 1.
-///
-/// Jensen's polynomial is a fit for `eta > 1` (it goes negative below 0.9993: -3.6 at 0.5);
-/// below 1 the fit for a medium less dense than its surroundings is used instead (Egan and
-/// Hilgeman 1979, as in Jensen's dipole literature): `-0.4399 + 0.7099/eta - 0.3319/eta^2 +
-/// 0.0636/eta^3`. Both are clamped to [0, 0.999] (a reflectance; A stays finite).
-pub fn fresnel_diffuse_reflectance(eta: f64) -> f64 {
-    if eta == 1.0 {
-        return 0.0;
-    }
-    let f = if eta > 1.0 {
-        -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
-    } else {
-        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
-    };
-    if f.is_nan() {
-        return 0.0;
-    }
-    f.clamp(0.0, 0.999)
-}
-
-/// Smallest `sigma_t'` used (1/length): `sigma_s' = sigma_a = 0` is a vacuum, where `z_r =
-/// 1/sigma_t'` would be infinite; 1e-12 keeps every constant finite and Rd ~ 0.
-const MIN_SIGMA_T_PRIME: f64 = 1e-12;
-
-/// Jensen's dipole constants for one channel (lengths and coefficients in the caller's unit).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Dipole {
-    /// `sigma_t' = sigma_s' + sigma_a` (clamped to at least 1e-12).
-    pub sigma_t_prime: f64,
-    /// Effective transport coefficient `sqrt(3 sigma_a sigma_t')`.
-    pub sigma_tr: f64,
-    /// Reduced albedo `sigma_s' / sigma_t'`, in [0, 1].
-    pub alpha_prime: f64,
-    /// Depth of the real source, `1 / sigma_t'`.
-    pub z_r: f64,
-    /// Height of the virtual source, `z_r (1 + 4A/3)`.
-    pub z_v: f64,
-    /// Diffuse Fresnel reflectance (0 at `eta` = 1).
-    pub f_dr: f64,
-    /// `A = (1 + F_dr) / (1 - F_dr)`.
-    pub a: f64,
-}
-
-/// The dipole constants for reduced scattering `sigma_s_prime` and absorption `sigma_a` (same
-/// unit, clamped to >= 0) and relative index `eta` (> 0).
-pub fn dipole_constants(sigma_s_prime: f64, sigma_a: f64, eta: f64) -> Dipole {
-    let (sp, sa) = (sigma_s_prime.max(0.0), sigma_a.max(0.0));
-    let sigma_t_prime = (sp + sa).max(MIN_SIGMA_T_PRIME);
-    let f_dr = fresnel_diffuse_reflectance(eta);
-    // F_dr < 1 for every eta > 0.03 or so; clamp so A stays finite for absurd indices.
-    let f_dr_safe = f_dr.min(0.999);
-    let a = (1.0 + f_dr_safe) / (1.0 - f_dr_safe);
-    let z_r = 1.0 / sigma_t_prime;
-    Dipole {
-        sigma_t_prime,
-        sigma_tr: (3.0 * sa * sigma_t_prime).sqrt(),
-        alpha_prime: sp / sigma_t_prime,
-        z_r,
-        z_v: z_r * (1.0 + 4.0 * a / 3.0),
-        f_dr,
-        a,
-    }
-}
 
 impl Dipole {
     /// Jensen's diffuse reflectance Rd(r) at distance `r` from the point of incidence:
@@ -163,23 +101,6 @@ mod tests {
             assert!(v.is_finite() && v > 0.0 && v <= prev, "r={r} v={v}");
             prev = v;
         }
-    }
-
-    #[test]
-    fn eta_one_has_no_boundary() {
-        assert_eq!(fresnel_diffuse_reflectance(1.0), 0.0);
-        // Both fits stay reflectances, and meet near eta = 1.
-        for eta in [1e-3, 0.1, 0.5, 0.9, 0.999, 1.001, 1.3, 2.0, 5.0, 1e3] {
-            let f = fresnel_diffuse_reflectance(eta);
-            assert!((0.0..=0.999).contains(&f), "{eta}: {f}");
-        }
-        assert!(
-            (fresnel_diffuse_reflectance(0.9999) - fresnel_diffuse_reflectance(1.0001)).abs()
-                < 0.01
-        );
-        let d = dipole_constants(1.0, 0.1, 1.0);
-        assert_eq!(d.a, 1.0);
-        assert_eq!(d.z_v, d.z_r * (1.0 + 4.0 / 3.0));
     }
 
     #[test]

@@ -24,11 +24,12 @@
 
 use std::f64::consts::PI;
 
-use super::dipole::{dipole_constants, Dipole};
 use super::lighting::{light_incidence, radiance};
 use super::raytrace::intersect;
 use super::DVec3;
-use crate::scene::layered::{LayeredMedium, Thickness, MAX_ABS_G};
+use crate::scene::layered::{
+    dipole_constants, fresnel_diffuse_reflectance, Dipole, LayeredMedium, Thickness, MAX_ABS_G,
+};
 use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::{LucentError, Result};
 
@@ -577,7 +578,7 @@ fn transmitted_irradiance(scene: &Scene, p: DVec3, n: DVec3, eta: f64) -> DVec3 
     // The environment's irradiance at the normal, E(n) = pi ambient_radiance(n), of which the
     // boundary lets 1 - F_dr through (diffuse light: the hemispherical average of the Fresnel
     // transmittance; unshadowed, as every pass's ambient).
-    let ambient_in = PI * (1.0 - super::dipole::fresnel_diffuse_reflectance(eta));
+    let ambient_in = PI * (1.0 - fresnel_diffuse_reflectance(eta));
     let mut e = scene.environment.ambient_radiance(n) * ambient_in;
     for light in &scene.lights {
         let (to_light, attenuation) = light_incidence(light, p);

@@ -639,7 +639,7 @@ pub fn write_li_report(
     let text = markdown(&results, opts, &gpu.info.describe());
     std::fs::create_dir_all(dir).map_err(|e| LucentError::file(dir, e))?;
     let md = dir.join("li.md");
-    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::files::write_file_atomic(&md, text.as_bytes())?;
     let mut series: Vec<PlotSeries> = Vec::new();
     for r in &results {
         let Some(x) = r.layered_ms() else {

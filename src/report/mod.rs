@@ -34,6 +34,7 @@ use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
 
 pub mod antialias;
+mod font;
 pub mod li;
 pub mod plot;
 pub mod section;
@@ -196,7 +197,7 @@ pub fn run(
     }
     text.push_str(&body);
     let md = dir.join("report.md");
-    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::files::write_file_atomic(&md, text.as_bytes())?;
     files.insert(0, md);
     Ok((text, files))
 }

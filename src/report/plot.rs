@@ -9,7 +9,7 @@
 //! lighting pass time, y = its max abs error against the reference) in one colour per
 //! [`PlotSeries`], with a legend, axis titles and an optional log-scale y axis, into a 960x640
 //! PNG. It is drawn with `plotters` into memory and written with
-//! [`write_file_atomic`](crate::images::output::write_file_atomic), so a reader never sees half a file.
+//! [`write_file_atomic`](crate::files::write_file_atomic), so a reader never sees half a file.
 //!
 //! Text is drawn with a system TrueType font, loaded once at run time (no font is compiled in):
 //! DejaVu Sans (Debian/Ubuntu: `apt-get install fonts-dejavu-core`, listed in `tools/setup.sh`),
@@ -27,8 +27,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::font::{FONT_CANDIDATES, FONT_ENV};
 use crate::error::{LucentError, Result};
-use crate::font::{FONT_CANDIDATES, FONT_ENV};
 
 /// One labelled point of a plot.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +120,7 @@ pub fn write_scatter_png(
     image::codecs::png::PngEncoder::new(&mut encoded)
         .write_image(&rgb, WIDTH, HEIGHT, ExtendedColorType::Rgb8)
         .map_err(|e| LucentError::file(path, format!("PNG encoding failed: {e}")))?;
-    crate::images::output::write_file_atomic(path, &encoded)
+    crate::files::write_file_atomic(path, &encoded)
 }
 
 /// Loads and registers the plot font as plotters' "sans-serif", once per process. The outcome
@@ -541,7 +541,7 @@ fn encode_png(path: &Path, rgb: &[u8]) -> Result<()> {
     image::codecs::png::PngEncoder::new(&mut encoded)
         .write_image(rgb, WIDTH, HEIGHT, ExtendedColorType::Rgb8)
         .map_err(|e| LucentError::file(path, format!("PNG encoding failed: {e}")))?;
-    crate::images::output::write_file_atomic(path, &encoded)
+    crate::files::write_file_atomic(path, &encoded)
 }
 
 fn draw_curves(

@@ -416,7 +416,7 @@ pub fn write_sss_report(
     std::fs::create_dir_all(out)
         .map_err(|e| LucentError::InvalidInput(format!("{}: {e}", out.display())))?;
     let md = out.join("sss.md");
-    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::files::write_file_atomic(&md, text.as_bytes())?;
     let mut series: Vec<PlotSeries> = Vec::new();
     for r in &results {
         let point = PlotPoint {

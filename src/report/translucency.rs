@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::features::deferred::GBufferPrecision;
+use crate::features::gbuffer::GBufferPrecision;
 use crate::frame::{render_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::graph::CompileOptions;
 use crate::images::compare::flip_rgba8;
@@ -448,7 +448,7 @@ pub fn write_translucency_report(
         png.file_name()
             .map_or(String::new(), |n| n.to_string_lossy().into_owned())
     );
-    crate::images::output::write_file_atomic(&md, text.as_bytes())?;
+    crate::files::write_file_atomic(&md, text.as_bytes())?;
     Ok((text, vec![md, png]))
 }
 

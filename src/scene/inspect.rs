@@ -100,7 +100,7 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let _ = writeln!(
                 s,
                 "  host memory when loaded (RGBA f32 with mips): {}",
-                crate::files::format_bytes(host_bytes(t.width, t.height).unwrap_or(u64::MAX))
+                crate::error::format_bytes(host_bytes(t.width, t.height).unwrap_or(u64::MAX))
             );
             let _ = writeln!(s, "  value range (RGBA, as stored): {lo:?} .. {hi:?}");
         }

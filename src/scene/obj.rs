@@ -269,7 +269,7 @@ pub fn write_obj_with_colors(path: &Path, mesh: &Mesh, colors: &[Vec3]) -> Resul
         }
         s.push('\n');
     }
-    crate::images::output::write_file_atomic(path, s.as_bytes())
+    crate::files::write_file_atomic(path, s.as_bytes())
 }
 
 // ---------------------------------------------------------------------------------------------

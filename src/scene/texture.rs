@@ -335,7 +335,7 @@ pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
                  texels (8192x8192) a texture may have: decoded to linear RGBA f32 with mips it \
                  would take {} of host memory (and a normal map twice that again for its LEAN \
                  maps); scale it down to at most 8192x8192",
-                crate::files::format_bytes(cost)
+                crate::error::format_bytes(cost)
             ),
         ));
     }

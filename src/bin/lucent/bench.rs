@@ -223,7 +223,7 @@ fn write_outputs(
         }
     };
     if let Some(json) = &args.json {
-        output::write_file_atomic(json, report.json().as_bytes())?;
+        lucent::files::write_file_atomic(json, report.json().as_bytes())?;
         note(format!("wrote {}", json.display()));
     }
     if let Some(out) = &args.out {

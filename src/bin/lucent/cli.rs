@@ -12,7 +12,7 @@ use clap::{Args, Parser, Subcommand};
 
 use lucent::bake::scene as bake;
 use lucent::features::antialias::Antialias;
-use lucent::features::deferred::GBufferPrecision;
+use lucent::features::gbuffer::GBufferPrecision;
 use lucent::features::layered::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
 use lucent::features::registry;
 use lucent::features::shadows::{ShadowSettings, SHADOW_SIZES};

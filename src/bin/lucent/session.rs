@@ -114,7 +114,7 @@ fn check_device_fits(
         .sum();
     let heap = info.device_local_bytes;
     if heap > 0 && frame_bytes.saturating_add(texture_bytes) > heap {
-        let size = lucent::files::format_bytes;
+        let size = lucent::error::format_bytes;
         let largest = largest.map_or(String::new(), |r| {
             format!(
                 "; largest image '{}' {}x{} {}, {}",

@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 
-use lucent::images::output;
 use lucent::{LucentError, Result};
 
 use crate::cli::{GpuArgs, SweepArgs};
@@ -50,7 +49,7 @@ pub fn run(args: SweepArgs) -> Result<()> {
     let table = lucent::measure::sweep::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
-        output::write_file_atomic(out, table.as_bytes())?;
+        lucent::files::write_file_atomic(out, table.as_bytes())?;
         println!("wrote {}", out.display());
     }
     let bad: usize = rows.iter().map(|r| r.nan + r.inf).sum();
@@ -105,7 +104,7 @@ fn sweep_layered(
     let table = sweep_layered::markdown(&rows, width, height, &device);
     println!("{table}");
     if let Some(out) = &out {
-        output::write_file_atomic(out, table.as_bytes())?;
+        lucent::files::write_file_atomic(out, table.as_bytes())?;
         println!("wrote {}", out.display());
     }
     let bad: Vec<String> = rows

@@ -11,8 +11,8 @@ use super::{
     chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur,
     SssBlurTechnique, SssInputs, SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
-use crate::features::deferred::HDR_FORMAT;
-use crate::features::shipped::PipelineShaders;
+use crate::backend::shader::PipelineShaders;
+use crate::features::lighting::HDR_FORMAT;
 use crate::features::technique::{Shades, TechniqueModule};
 use crate::features::util::{
     check_bindings, clamp_sampler, Binding, Defines, GraphicsPipelineDesc, PassPipeline,

@@ -1,0 +1,53 @@
+//! The copy pass's shader (`glsl/bench/copy.frag`): a fullscreen pass that fetches one texel
+//! from each image it reads and writes every colour image (and depth) it has, nothing else:
+//! the cheapest pass that moves a given pass's bytes. The speed of light
+//! (`crate::measure::speed_of_light`, feature `measure`) puts one in place of each pass of a
+//! plan. Its defines and every permutation of them are here, with the passes, so the shipped
+//! SPIR-V ([`super::shipped`]) holds them whatever features the library is built with.
+
+use crate::backend::shader::PipelineShaders;
+
+/// Images one copy pass can read or write (`glsl/bench/copy.frag` declares eight of each, the
+/// colour-attachment count every Vulkan device supports).
+pub const MAX_COPY_IMAGES: usize = 8;
+/// Most images the copy reads (LEAN's final pass reads nine with the light-space maps).
+pub const MAX_COPY_INPUTS: usize = 10;
+
+/// The copy's fragment shader.
+pub const COPY_FRAGMENT: &str = "bench/copy.frag";
+
+/// Image counts as define strings (at most [`MAX_COPY_INPUTS`]).
+const COUNTS: [&str; MAX_COPY_INPUTS + 1] =
+    ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10"];
+
+/// The copy's defines: images read, colour images written, and whether it writes depth.
+pub fn copy_defines(
+    inputs: usize,
+    outputs: usize,
+    depth: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let count = |n: usize| COUNTS[n.min(MAX_COPY_INPUTS)];
+    let mut defines = vec![
+        ("LUCENT_COPY_INPUTS", count(inputs)),
+        ("LUCENT_COPY_OUTPUTS", count(outputs)),
+    ];
+    if depth {
+        defines.push(("LUCENT_COPY_DEPTH", "1"));
+    }
+    defines
+}
+
+/// The pipelines the copies of any plan's passes build (the speed of light leaves out passes
+/// with more images than the copy has).
+pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
+    for inputs in 0..=MAX_COPY_INPUTS {
+        for outputs in 0..=MAX_COPY_IMAGES {
+            for depth in [false, true] {
+                out.push(PipelineShaders::fullscreen(
+                    COPY_FRAGMENT,
+                    &copy_defines(inputs, outputs, depth),
+                ));
+            }
+        }
+    }
+}

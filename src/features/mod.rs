@@ -14,13 +14,16 @@
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`antialias`]: FXAA after the tonemap (a knob, off by default).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
-//! - [`util`]: pipeline and descriptor helpers the passes share.
+//! - [`pass`]: the fullscreen pass builder: each input stated once, for the graph and the
+//!   shader's bindings.
+//! - [`util`]: pass-level pipeline helpers (a pipeline with its descriptor set, tile draws).
 //! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 
 pub mod antialias;
 pub mod debug_view;
 pub mod deferred;
 pub mod layered;
+pub mod pass;
 pub mod shadows;
 pub mod shipped;
 pub mod sss;

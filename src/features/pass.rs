@@ -274,27 +274,29 @@ struct FullscreenExec {
     variant_pipeline: Option<GraphicsPipeline>,
 }
 
-impl FullscreenExec {
-    /// The clamp sampler with `filter`, made on first use.
-    fn sampler(&mut self, ctx: &PrepareContext<'_>, filter: vk::Filter) -> Result<vk::Sampler> {
-        if let Some(&(_, sampler)) = self.samplers.iter().find(|(f, _)| *f == filter) {
-            return Ok(sampler);
-        }
-        let sampler = clamp_sampler(ctx, filter)?;
-        self.samplers.push((filter, sampler));
-        Ok(sampler)
+/// The clamp sampler with `filter` among `samplers`, made on first use.
+fn sampler(
+    samplers: &mut Vec<(vk::Filter, vk::Sampler)>,
+    ctx: &PrepareContext<'_>,
+    filter: vk::Filter,
+) -> Result<vk::Sampler> {
+    if let Some(&(_, sampler)) = samplers.iter().find(|(f, _)| *f == filter) {
+        return Ok(sampler);
     }
+    let sampler = clamp_sampler(ctx, filter)?;
+    samplers.push((filter, sampler));
+    Ok(sampler)
 }
 
 impl PassExec for FullscreenExec {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         let views = ctx.descriptor_views;
         let mut bindings = Vec::with_capacity(self.slots.len());
-        for i in 0..self.slots.len() {
-            bindings.push(match self.slots[i] {
+        for slot in &self.slots {
+            bindings.push(match *slot {
                 Slot::PerFrame(region) => Binding::PerFrame(self.scene.per_frame.binding(region)),
                 Slot::Sampled(id, filter) => {
-                    Binding::Sampled(views[id], self.sampler(ctx, filter)?)
+                    Binding::Sampled(views[id], sampler(&mut self.samplers, ctx, filter)?)
                 }
                 Slot::Input(id, layout) => Binding::InputAttachment(views[id], layout),
             });

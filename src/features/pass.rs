@@ -11,7 +11,7 @@
 //! (`lucent plan`), it declares the graph accesses only.
 //!
 //! Passes that draw meshes (the G-buffer, the light-space maps) keep their own
-//! [`PassExec`](crate::graph::PassExec).
+//! [`PassExec`].
 //!
 //! ```text
 //! let mut pass = FullscreenPass::new(graph, "tonemap", "post/tonemap.frag", scene);

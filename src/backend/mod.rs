@@ -3,6 +3,8 @@
 //! - [`context`]: the Vulkan context, created by lucent or wrapping a host engine's device.
 //! - [`resources`]: images and buffers with named allocations, readback.
 //! - [`access`]: the one access table every barrier is derived from.
+//! - [`pipeline`]: graphics pipelines, made for the render pass and subpass a caller names.
+//! - [`descriptor`]: descriptor sets (one per pass, with its own pool) and samplers.
 //! - [`format`](mod@format): the one format table (sizes, channels, encodings, names).
 //! - [`shader`]: SPIR-V shipped with the crate or compiled at run time (feature
 //!   `runtime-shaders`), shader modules, pipeline cache.
@@ -12,11 +14,13 @@
 pub mod access;
 pub mod context;
 mod desc;
+pub mod descriptor;
 pub(crate) mod device;
 pub mod format;
 #[cfg(feature = "runtime-shaders")]
 mod glsl_compile;
 mod instance;
+pub mod pipeline;
 pub mod resources;
 pub mod shader;
 mod shader_files;

@@ -16,11 +16,11 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::graph::{Handle, Image, LoadOp, PassKind, RenderGraph};
+use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 use crate::Result;
 
-use super::util::SampleOnePass;
-use crate::gpu_scene::SceneGpu;
+use super::pass::FullscreenPass;
+use crate::gpu_scene::{Region, SceneGpu};
 
 /// The anti-aliasing a frame applies after the tonemap.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -79,19 +79,12 @@ pub fn fxaa_pass(
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
     let linear = super::tonemap::writes_linear(graph.resources()[display.id()].info.format);
-    let mut pass = graph.add_pass("fxaa", PassKind::Raster);
-    pass.sample(ldr).color(&mut display, LoadOp::DontCare);
-    match scene {
-        // Bilinear: the edge search and the final tap sample between texels.
-        Some(scene) => pass.execute(SampleOnePass::new(
-            scene.clone(),
-            ldr.id(),
-            vk::Filter::LINEAR,
-            FXAA_FRAGMENT,
-            fxaa_defines(linear),
-            "fxaa",
-        )),
-        None => pass.finish(),
-    }
+    let mut pass = FullscreenPass::new(graph, "fxaa", FXAA_FRAGMENT, scene);
+    // Bilinear: the edge search and the final tap sample between texels.
+    pass.per_frame(Region::Frame)
+        .sample_with(ldr, vk::Filter::LINEAR)
+        .color(&mut display, LoadOp::DontCare)
+        .defines(fxaa_defines(linear));
+    pass.finish();
     display
 }

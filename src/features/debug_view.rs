@@ -7,19 +7,13 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
-use crate::graph::{
-    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
-    ResourceId,
-};
-use crate::Result;
+use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 
 use super::gbuffer::GBuffer;
 use super::lighting::Lit;
+use super::pass::FullscreenPass;
 use super::translucency::ThicknessPacking;
-use super::util::{clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
-use crate::gpu_scene::SceneGpu;
+use crate::gpu_scene::{Region, SceneGpu};
 
 /// What a debug view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,32 +101,35 @@ pub fn debug_view_pass(
     };
     let mut ldr = display(graph);
     let linear = super::tonemap::writes_linear(graph.resources()[ldr.id()].info.format);
-    let mut pass = graph.add_pass("debug view", PassKind::Raster);
-    pass.sample(source);
-    if let Some(s) = second {
-        pass.sample(s);
-    }
-    if let Some((gb2, depth)) = term_inputs {
-        pass.sample(gb2).sample(depth);
-    }
-    pass.color(&mut ldr, LoadOp::DontCare);
     let colored = gb
         .layout
         .translucency
         .is_some_and(|t| t.packing == ThicknessPacking::Colored);
-    match scene {
-        Some(scene) => pass.execute(DebugViewPass {
-            scene: scene.clone(),
-            view,
-            colored,
-            linear,
-            inputs: (source.id(), second.map(|s| s.id())),
-            term: term_inputs.map(|(g, d)| (g.id(), d.id())),
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-        }),
-        None => pass.finish(),
+    // The term binds its inputs and the material table when the frame has the table; without
+    // it the view shows the second image alone (its other reads still declared).
+    let has_table = scene.is_some_and(|s| s.per_frame.has(Region::Translucency));
+    let inputs = match (second, term_inputs) {
+        (Some(_), Some(_)) if has_table => ViewInputs::Term,
+        (Some(_), _) => ViewInputs::Second,
+        _ => ViewInputs::One,
+    };
+    let mut pass = FullscreenPass::new(graph, "debug view", VIEW_FRAGMENT, scene);
+    pass.per_frame(Region::Frame).sample(source);
+    if let Some(s) = second {
+        pass.sample(s);
     }
+    if let Some((gb2, depth)) = term_inputs {
+        if inputs == ViewInputs::Term {
+            pass.sample(gb2)
+                .sample(depth)
+                .per_frame(Region::Translucency);
+        } else {
+            pass.graph().sample(gb2).sample(depth);
+        }
+    }
+    pass.color(&mut ldr, LoadOp::DontCare)
+        .defines(&view_defines(view, inputs, colored, linear));
+    pass.finish();
     Some(ldr)
 }
 
@@ -140,7 +137,7 @@ pub fn debug_view_pass(
 const VIEW_FRAGMENT: &str = "debug/view.frag";
 
 /// What the debug view samples besides its source.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ViewInputs {
     /// The source alone.
     One,
@@ -185,77 +182,5 @@ pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::Pipeline
                 }
             }
         }
-    }
-}
-
-struct DebugViewPass {
-    scene: Arc<SceneGpu>,
-    view: DebugView,
-    colored: bool,
-    /// Write linear values (sRGB or float targets).
-    linear: bool,
-    inputs: (ResourceId, Option<ResourceId>),
-    /// The translucency term's GB2 and depth.
-    term: Option<(ResourceId, ResourceId)>,
-    sampler: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-}
-
-impl PassExec for DebugViewPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let mut bindings = vec![
-            Binding::PerFrame(
-                self.scene
-                    .per_frame
-                    .binding(crate::gpu_scene::Region::Frame),
-            ),
-            Binding::Sampled(ctx.views[self.inputs.0], self.sampler),
-        ];
-        let has_table = self
-            .scene
-            .per_frame
-            .has(crate::gpu_scene::Region::Translucency);
-        let inputs = match (self.inputs.1, self.term, has_table) {
-            (Some(gb1), Some((gb2, depth)), true) => {
-                for id in [gb1, gb2] {
-                    bindings.push(Binding::Sampled(ctx.views[id], self.sampler));
-                }
-                bindings.push(Binding::Sampled(ctx.descriptor_views[depth], self.sampler));
-                bindings.push(Binding::PerFrame(
-                    self.scene
-                        .per_frame
-                        .binding(crate::gpu_scene::Region::Translucency),
-                ));
-                ViewInputs::Term
-            }
-            (Some(second), _, _) => {
-                bindings.push(Binding::Sampled(ctx.views[second], self.sampler));
-                ViewInputs::Second
-            }
-            _ => ViewInputs::One,
-        };
-        let defines = view_defines(self.view, inputs, self.colored, self.linear);
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc::fullscreen(VIEW_FRAGMENT, &defines, "debug view"),
-        )?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
-            pipeline.draw_fullscreen(ctx);
-        }
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
     }
 }

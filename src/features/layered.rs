@@ -42,14 +42,11 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::pass::FullscreenPass;
 use super::shadows::{self, ShadowMaps};
 use super::technique::{Shades, TechniqueModule};
-use super::util::{check_bindings, clamp_sampler, Binding, GraphicsPipelineDesc, PassPipeline};
-use crate::gpu_scene::{Region, SceneGpu};
-use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
-};
+use crate::gpu_scene::{Region, SceneGpu, TileRect};
+use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -370,71 +367,26 @@ pub fn layered_passes(
             format: IRRADIANCE_FORMAT,
         },
     );
-    // Every pass reads the G-buffer; irradiance the depth atlas (shadows), single scattering
-    // the depth and entry atlases (entry points).
-    let sample = |pass: &mut crate::graph::declare::PassBuilder<'_>, kind: Kind| {
-        pass.sample(inputs.depth)
-            .sample(inputs.gb1)
-            .sample(inputs.ids);
-        if let (Kind::Single, Some(depths)) = (kind, inputs.layer_depths) {
-            pass.sample(depths);
-        }
-        if let (Kind::Irradiance | Kind::Single, Some(maps)) = (kind, inputs.shadows) {
-            pass.sample(&maps.depth);
-            if let (Kind::Single, Some(entry)) = (kind, &maps.entry) {
-                pass.sample(entry);
-                if let Some(depths) = &maps.layer_depths {
-                    pass.sample(depths);
-                }
-            }
-        }
-    };
-    let base = LayeredPassInputs {
-        depth: inputs.depth.id(),
-        gb1: inputs.gb1.id(),
-        ids: inputs.ids.id(),
-        shadow_depth: inputs.shadows.map(|m| m.depth.id()),
-        entry: inputs
-            .shadows
-            .and_then(|m| m.entry.as_ref().map(|h| h.id())),
-        layer_depths: inputs.layer_depths.map(|h| h.id()),
-        entry_depths: inputs
-            .shadows
-            .and_then(|m| m.layer_depths.as_ref().map(|h| h.id())),
-        layer_depth_textures: inputs.layer_depth_textures,
-        irradiance: None,
-        half_term: None,
-    };
-
     // Cleared: pixels outside the rectangles read 0 (the gather rejects them by ID anyway).
-    let mut pass = graph.add_pass("layered irradiance", PassKind::Raster);
-    sample(&mut pass, Kind::Irradiance);
+    let mut pass = layered_pass(graph, Kind::Irradiance, inputs, scale, None, None, scene);
     pass.color(&mut irradiance, LoadOp::Clear([0.0; 4]));
-    match scene {
-        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Irradiance, base, scale)),
-        None => pass.finish(),
-    }
+    pass.finish();
 
-    let gather = LayeredPassInputs {
-        irradiance: Some(irradiance.id()),
-        ..base
-    };
     if !knobs.half_gather {
-        let mut pass = graph.add_pass("single scattering", PassKind::Raster);
-        sample(&mut pass, Kind::Single);
-        pass.color(&mut hdr, LoadOp::Load);
-        match scene {
-            Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Single, base, 1)),
-            None => pass.finish(),
-        }
-        let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
-        sample(&mut pass, Kind::Multiple);
-        pass.sample(&irradiance);
-        pass.color(&mut hdr, LoadOp::Load);
-        match scene {
-            Some(scene) => pass.execute(LayeredPass::new(scene, Kind::Multiple, gather, 1)),
-            None => pass.finish(),
-        }
+        let mut pass = layered_pass(graph, Kind::Single, inputs, 1, None, None, scene);
+        pass.color_add(&mut hdr, LoadOp::Load);
+        pass.finish();
+        let mut pass = layered_pass(
+            graph,
+            Kind::Multiple,
+            inputs,
+            1,
+            Some(&irradiance),
+            None,
+            scene,
+        );
+        pass.color_add(&mut hdr, LoadOp::Load);
+        pass.finish();
         return hdr;
     }
     // Half-resolution gather: the term per 2x2 block (alpha: its material) first, then single
@@ -447,32 +399,133 @@ pub fn layered_passes(
             format: IRRADIANCE_FORMAT,
         },
     );
-    let mut pass = graph.add_pass("multiple scattering", PassKind::Raster);
-    sample(&mut pass, Kind::Multiple);
-    pass.sample(&irradiance);
+    let mut pass = layered_pass(
+        graph,
+        Kind::HalfGather,
+        inputs,
+        2,
+        Some(&irradiance),
+        None,
+        scene,
+    );
     // Cleared: texels outside the rectangles read material 0, which the upsample skips.
     pass.color(&mut half_term, LoadOp::Clear([0.0; 4]));
-    match scene {
-        Some(scene) => pass.execute(LayeredPass::new(scene, Kind::HalfGather, gather, 2)),
-        None => pass.finish(),
-    }
-    let mut pass = graph.add_pass("single scattering", PassKind::Raster);
-    sample(&mut pass, Kind::Single);
-    pass.sample(&half_term);
-    pass.color(&mut hdr, LoadOp::Load);
-    match scene {
-        Some(scene) => pass.execute(LayeredPass::new(
-            scene,
-            Kind::Single,
-            LayeredPassInputs {
-                half_term: Some(half_term.id()),
-                ..base
-            },
-            1,
-        )),
-        None => pass.finish(),
-    }
+    pass.finish();
+    let mut pass = layered_pass(
+        graph,
+        Kind::Single,
+        inputs,
+        1,
+        None,
+        Some(&half_term),
+        scene,
+    );
+    pass.color_add(&mut hdr, LoadOp::Load);
+    pass.finish();
     hdr
+}
+
+/// Starts a layered pass of `kind` at `1 / scale` of the screen per side, reading the gather's
+/// `irradiance` or, in single scattering with `--half-gather`, the half-resolution multiple
+/// scattering term (`half_term`) it upsamples and adds. The graph reads the G-buffer first;
+/// irradiance the depth atlas (shadows), single scattering the depth and entry atlases (entry
+/// points). The shader numbers its bindings as glsl/common/layered.glsl does: 0 frame, 1
+/// layered table, 2 depth, 3 GB1, 4 IDs, then the pass's own (the irradiance image; or the
+/// half-resolution term, the `TexDep` texels, the entry atlas and the shadow bindings), so the
+/// pass's own are bound after all its reads are declared. It draws only the screen rectangles
+/// layered objects may cover.
+fn layered_pass<'g>(
+    graph: &'g mut RenderGraph,
+    kind: Kind,
+    inputs: &LayeredInputs<'_>,
+    scale: u32,
+    irradiance: Option<&Handle<Image>>,
+    half_term: Option<&Handle<Image>>,
+    scene: Option<&Arc<SceneGpu>>,
+) -> FullscreenPass<'g> {
+    let single = kind == Kind::Single;
+    let mut pass = FullscreenPass::new(graph, kind.name(), kind.fragment(), scene);
+    pass.per_frame(Region::Frame)
+        .per_frame(Region::Layered)
+        .sample(inputs.depth)
+        .sample(inputs.gb1)
+        .sample(inputs.ids);
+    // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
+    // first layer's, semi-infinite, as in the paper).
+    let layer_depths = inputs.layer_depths.filter(|_| single);
+    let shadows = inputs
+        .shadows
+        .filter(|_| matches!(kind, Kind::Irradiance | Kind::Single));
+    let entry = shadows
+        .and_then(|maps| maps.entry.as_ref())
+        .filter(|_| single);
+    let entry_depths = entry.and(shadows.and_then(|maps| maps.layer_depths.as_ref()));
+    for h in [layer_depths]
+        .into_iter()
+        .chain([shadows.map(|maps| &maps.depth), entry, entry_depths])
+        .chain([irradiance, half_term])
+        .flatten()
+    {
+        pass.graph().sample(h);
+    }
+    if let Some(irradiance) = irradiance {
+        pass.bind_sampled(irradiance, vk::Filter::NEAREST);
+    }
+    if let (true, Some(half_term)) = (single, half_term) {
+        pass.binding_define("LUCENT_HALF_TERM_BINDING")
+            .bind_sampled(half_term, vk::Filter::NEAREST);
+    }
+    if let Some(depths) = layer_depths {
+        pass.define(
+            "LUCENT_LAYER_DEPTHS",
+            super::layer_depth::layer_depths_define(inputs.layer_depth_textures),
+        )
+        .binding_define("LUCENT_LAYER_DEPTH_BINDING")
+        .bind_sampled(depths, vk::Filter::NEAREST);
+    }
+    if let Some(maps) = shadows {
+        if let Some(entry) = entry {
+            pass.binding_define("LUCENT_ENTRY_BINDING")
+                .bind_sampled(entry, vk::Filter::NEAREST);
+            if let (Some(_), Some(depths)) = (layer_depths, entry_depths) {
+                pass.binding_define("LUCENT_ENTRY_DEPTH_BINDING")
+                    .bind_sampled(depths, vk::Filter::NEAREST);
+            }
+        }
+        pass.bind_shadows(&maps.depth);
+    }
+    match (kind, scale) {
+        (Kind::Irradiance, 2) => {
+            pass.define("LUCENT_HALF_RES", "1");
+        }
+        (Kind::HalfGather, _) => {
+            pass.define("LUCENT_HALF_GATHER", "1");
+        }
+        _ => {}
+    }
+    pass.tiles(move |scene, ctx| {
+        let rects = scene.per_frame.tiles(ctx.frame).layered.clone();
+        Some(
+            rects
+                .iter()
+                .filter(|r| r.translucent)
+                .map(|r| TileRect {
+                    x: r.x / scale,
+                    y: r.y / scale,
+                    width: r
+                        .width
+                        .div_ceil(scale)
+                        .min(ctx.extent.width.saturating_sub(r.x / scale)),
+                    height: r
+                        .height
+                        .div_ceil(scale)
+                        .min(ctx.extent.height.saturating_sub(r.y / scale)),
+                    translucent: true,
+                })
+                .collect(),
+        )
+    });
+    pass
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -484,51 +537,6 @@ enum Kind {
     HalfGather,
 }
 
-#[derive(Clone, Copy)]
-struct LayeredPassInputs {
-    depth: ResourceId,
-    gb1: ResourceId,
-    ids: ResourceId,
-    /// The light-space depth atlas, when some light casts.
-    shadow_depth: Option<ResourceId>,
-    /// Its entry atlas (present with the depth atlas in layered frames).
-    entry: Option<ResourceId>,
-    /// The G-buffer's `TexDep` texels (frames whose media read depth textures).
-    layer_depths: Option<ResourceId>,
-    /// The entry atlas's `TexDep` texels (with `layer_depths` and the atlas).
-    entry_depths: Option<ResourceId>,
-    /// Depth textures per object in `layer_depths` (0, 1 or 2).
-    layer_depth_textures: usize,
-    /// The gather's irradiance image.
-    irradiance: Option<ResourceId>,
-    /// Single scattering with `--half-gather`: the half-resolution multiple-scattering term
-    /// it upsamples and adds.
-    half_term: Option<ResourceId>,
-}
-
-struct LayeredPass {
-    scene: Arc<SceneGpu>,
-    kind: Kind,
-    inputs: LayeredPassInputs,
-    /// The pass's downscale of the screen (the irradiance image at half resolution: 2).
-    scale: u32,
-    pipeline: Option<PassPipeline>,
-    nearest: vk::Sampler,
-}
-
-impl LayeredPass {
-    fn new(scene: &Arc<SceneGpu>, kind: Kind, inputs: LayeredPassInputs, scale: u32) -> Self {
-        Self {
-            scene: scene.clone(),
-            kind,
-            inputs,
-            scale,
-            pipeline: None,
-            nearest: vk::Sampler::null(),
-        }
-    }
-}
-
 impl Kind {
     const ALL: [Kind; 4] = [
         Kind::Irradiance,
@@ -536,6 +544,15 @@ impl Kind {
         Kind::Multiple,
         Kind::HalfGather,
     ];
+
+    /// The pass's name.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Irradiance => "layered irradiance",
+            Kind::Single => "single scattering",
+            Kind::Multiple | Kind::HalfGather => "multiple scattering",
+        }
+    }
 
     fn fragment(self) -> &'static str {
         match self {
@@ -546,7 +563,8 @@ impl Kind {
     }
 }
 
-/// What a layered pass's shader permutation depends on: its kind and which inputs it reads.
+/// What a layered pass's shader permutation depends on: its kind and which inputs it reads
+/// (for the shipped enumeration; a pass itself takes its defines from [`layered_pass`]).
 #[derive(Clone, Copy, Debug)]
 struct LayeredShape {
     kind: Kind,
@@ -562,9 +580,10 @@ struct LayeredShape {
 }
 
 impl LayeredShape {
-    /// The defines, with the bindings number before the shadow bindings (glsl/common/layered.glsl:
-    /// 0 frame, 1 layered table, 2 depth, 3 GB1, 4 IDs, then the pass's own in this order).
-    fn defines(&self) -> (Vec<(&'static str, &'static str)>, usize) {
+    /// The defines [`layered_pass`] gives a pass of this shape, binding numbers counted as it
+    /// appends the bindings (glsl/common/layered.glsl: 0 frame, 1 layered table, 2 depth, 3
+    /// GB1, 4 IDs, then the pass's own in this order).
+    fn defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut defines: Vec<(&str, &str)> = Vec::new();
         let mut next = 5;
         let single = self.kind == Kind::Single;
@@ -598,7 +617,7 @@ impl LayeredShape {
             (Kind::HalfGather, _) => defines.push(("LUCENT_HALF_GATHER", "1")),
             _ => {}
         }
-        (defines, next)
+        defines
     }
 }
 
@@ -620,7 +639,7 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
                 };
                 out.push(crate::backend::shader::PipelineShaders::fullscreen(
                     kind.fragment(),
-                    &shape.defines().0,
+                    &shape.defines(),
                 ));
             }
         }
@@ -629,117 +648,6 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
 
 /// Binding numbers as define strings.
 const NUMBERS: [&str; 12] = ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11"];
-
-impl PassExec for LayeredPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let views = ctx.descriptor_views;
-        let i = &self.inputs;
-        // glsl/common/layered.glsl: 0 frame, 1 layered table, 2 depth, 3 GB1, 4 IDs, then the
-        // pass's own (the irradiance image; or the entry atlas and the shadow bindings).
-        let mut bindings = vec![
-            Binding::PerFrame(self.scene.per_frame.binding(Region::Frame)),
-            Binding::PerFrame(self.scene.per_frame.binding(Region::Layered)),
-            Binding::Sampled(views[i.depth], self.nearest),
-            Binding::Sampled(views[i.gb1], self.nearest),
-            Binding::Sampled(views[i.ids], self.nearest),
-        ];
-        let shape = LayeredShape {
-            kind: self.kind,
-            half_res: self.scale == 2,
-            irradiance: i.irradiance.is_some(),
-            half_term: i.half_term.is_some(),
-            layer_depths: i.layer_depths.map(|_| i.layer_depth_textures),
-            shadows: i.shadow_depth.is_some(),
-            entry: i.entry.is_some(),
-            entry_depths: i.entry_depths.is_some(),
-        };
-        let (defines, before_shadows) = shape.defines();
-        if let Some(irradiance) = i.irradiance {
-            bindings.push(Binding::Sampled(views[irradiance], self.nearest));
-        }
-        if let (Kind::Single, Some(half_term)) = (self.kind, i.half_term) {
-            bindings.push(Binding::Sampled(views[half_term], self.nearest));
-        }
-        // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
-        // first layer's, semi-infinite, as in the paper).
-        let texdep = self.kind == Kind::Single && i.layer_depths.is_some();
-        if let (true, Some(depths)) = (texdep, i.layer_depths) {
-            bindings.push(Binding::Sampled(views[depths], self.nearest));
-        }
-        if let (Some(depth), Kind::Irradiance | Kind::Single) = (i.shadow_depth, self.kind) {
-            if let (Kind::Single, Some(entry)) = (self.kind, i.entry) {
-                bindings.push(Binding::Sampled(views[entry], self.nearest));
-                if let (true, Some(depths)) = (texdep, i.entry_depths) {
-                    bindings.push(Binding::Sampled(views[depths], self.nearest));
-                }
-            }
-            check_bindings("layered", bindings.len(), before_shadows)?;
-            bindings.extend(shadows::lighting_bindings(
-                &self.scene,
-                depth,
-                None,
-                views,
-                self.nearest,
-            ));
-        }
-        let fragment = self.kind.fragment();
-        let name = match self.kind {
-            Kind::Irradiance => "layered irradiance",
-            Kind::Single => "single scattering",
-            Kind::Multiple | Kind::HalfGather => "multiple scattering",
-        };
-        // The irradiance and the half-resolution term are written; the others add.
-        let additive = match self.kind {
-            Kind::Irradiance | Kind::HalfGather => 0,
-            Kind::Single | Kind::Multiple => 1,
-        };
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc {
-                additive_attachments: additive,
-                ..GraphicsPipelineDesc::fullscreen(fragment, &defines, name)
-            },
-        )?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        let Some(pipeline) = &self.pipeline else {
-            return;
-        };
-        pipeline.bind(ctx);
-        let rects = self.scene.per_frame.tiles(ctx.frame).layered.clone();
-        let scaled: Vec<_> = rects
-            .iter()
-            .filter(|r| r.translucent)
-            .map(|r| crate::gpu_scene::TileRect {
-                x: r.x / self.scale,
-                y: r.y / self.scale,
-                width: r
-                    .width
-                    .div_ceil(self.scale)
-                    .min(ctx.extent.width.saturating_sub(r.x / self.scale)),
-                height: r
-                    .height
-                    .div_ceil(self.scale)
-                    .min(ctx.extent.height.saturating_sub(r.y / self.scale)),
-                translucent: true,
-            })
-            .collect();
-        PassPipeline::draw_fullscreen_in(ctx, scaled.iter());
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.nearest, None) };
-        self.nearest = vk::Sampler::null();
-    }
-}
 
 /// Li et al.'s layered media as a registered technique (`--technique layered`).
 pub struct LiLayeredMedia;
@@ -801,6 +709,63 @@ mod tests {
         assert!(LayeredDesc::new(&builtin::builtin("smoke").unwrap())
             .unwrap()
             .is_none());
+    }
+
+    #[test]
+    fn passes_number_their_bindings_as_the_shipped_enumeration_does() {
+        let info = ImageInfo {
+            width: 8,
+            height: 8,
+            format: IRRADIANCE_FORMAT,
+        };
+        for kind in Kind::ALL {
+            for flags in 0u32..1 << 6 {
+                let bit = |i: u32| flags & (1 << i) != 0;
+                for textures in 0..=2 {
+                    let mut graph = RenderGraph::new();
+                    let mut image = |name: &str| graph.create_image(name, info);
+                    let (depth, gb1, ids) = (image("depth"), image("gb1"), image("ids"));
+                    let layer_depths = (textures > 0).then(|| image("layer depths"));
+                    let maps = bit(3).then(|| ShadowMaps {
+                        depth: image("atlas"),
+                        ids: None,
+                        entry: bit(4).then(|| image("entry")),
+                        layer_depths: bit(5).then(|| image("entry depths")),
+                    });
+                    let irradiance = bit(1).then(|| image("irradiance"));
+                    let half_term = bit(2).then(|| image("half term"));
+                    let inputs = LayeredInputs {
+                        depth: &depth,
+                        gb1: &gb1,
+                        ids: &ids,
+                        layer_depths: layer_depths.as_ref(),
+                        layer_depth_textures: textures,
+                        shadows: maps.as_ref(),
+                    };
+                    let scale = if bit(0) { 2 } else { 1 };
+                    let pass = layered_pass(
+                        &mut graph,
+                        kind,
+                        &inputs,
+                        scale,
+                        irradiance.as_ref(),
+                        half_term.as_ref(),
+                        None,
+                    );
+                    let shape = LayeredShape {
+                        kind,
+                        half_res: bit(0),
+                        irradiance: bit(1),
+                        half_term: bit(2),
+                        layer_depths: (textures > 0).then_some(textures),
+                        shadows: bit(3),
+                        entry: bit(4),
+                        entry_depths: bit(5),
+                    };
+                    assert_eq!(pass.shader_defines(), shape.defines(), "{shape:?}");
+                }
+            }
+        }
     }
 
     #[test]

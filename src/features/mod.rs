@@ -18,9 +18,9 @@
 //! - [`tonemap`]: HDR to display (exposure, ACES fit, sRGB).
 //! - [`antialias`]: FXAA after the tonemap (a knob, off by default).
 //! - [`debug_view`]: a G-buffer target or the pre-SSS lit image instead of the frame.
-//! - [`copy_pass`]: the copy pass's shader, which the speed-of-light measurement puts in place of
-//!   each pass.
-//! - [`util`]: pipeline and descriptor helpers the passes share.
+//! - [`pass`]: the fullscreen pass builder: each input stated once, for the graph and the
+//!   shader's bindings.
+//! - [`util`]: pass-level pipeline helpers (a pipeline with its descriptor set, tile draws).
 //! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 //! - [`technique`] and [`registry`]: the contract a technique module implements and the one
 //!   list of them, which everything that names techniques iterates.
@@ -32,6 +32,7 @@ pub mod gbuffer;
 pub mod layer_depth;
 pub mod layered;
 pub mod lighting;
+pub mod pass;
 pub mod registry;
 pub mod shadows;
 pub mod shipped;

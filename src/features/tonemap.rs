@@ -10,10 +10,10 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::graph::{Handle, Image, LoadOp, PassKind, RenderGraph};
+use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 
-use super::util::SampleOnePass;
-use crate::gpu_scene::SceneGpu;
+use super::pass::FullscreenPass;
+use crate::gpu_scene::{Region, SceneGpu};
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
@@ -74,19 +74,12 @@ fn declare(
     encoding: Encoding,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
-    let mut pass = graph.add_pass("tonemap", PassKind::Raster);
-    pass.sample(hdr).color(&mut output, LoadOp::DontCare);
-    match scene {
-        Some(scene) => pass.execute(SampleOnePass::new(
-            scene.clone(),
-            hdr.id(),
-            vk::Filter::NEAREST,
-            TONEMAP_FRAGMENT,
-            tonemap_defines(encoding),
-            "tonemap",
-        )),
-        None => pass.finish(),
-    }
+    let mut pass = FullscreenPass::new(graph, "tonemap", TONEMAP_FRAGMENT, scene);
+    pass.per_frame(Region::Frame)
+        .sample(hdr)
+        .color(&mut output, LoadOp::DontCare)
+        .defines(tonemap_defines(encoding));
+    pass.finish();
     output
 }
 

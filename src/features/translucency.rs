@@ -195,7 +195,7 @@ impl TechniqueModule for Gdc2011Translucency {
     }
 
     /// None of its own: its term is compiled into the lighting pass, whose permutations
-    /// ([`super::deferred`]) walk every translucency layout.
+    /// ([`super::lighting`]) walk every translucency layout.
     fn shader_permutations(&self, _out: &mut Vec<PipelineShaders>) {}
 }
 

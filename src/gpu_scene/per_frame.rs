@@ -154,17 +154,7 @@ pub struct SlotTiles {
 
 /// A binding of one region of the per-frame buffer: a dynamic uniform buffer whose offset the
 /// pass adds at bind time (`slot * stride`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PerFrameBinding {
-    /// The buffer.
-    pub buffer: vk::Buffer,
-    /// The region's offset in slot 0.
-    pub offset: u64,
-    /// The region's size.
-    pub range: u64,
-    /// Bytes from one slot to the next.
-    pub stride: u64,
-}
+pub type PerFrameBinding = crate::backend::descriptor::DynamicUniform;
 
 /// Bytes of each table region of the per-frame buffer (0: the frame has no such table).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -287,17 +287,35 @@ impl PassBuilder<'_> {
     /// Reads the image only at the pixel being shaded (`subpassLoad`); lets the graph merge this
     /// pass with the one that wrote the image. Binding = order of `input` calls.
     pub fn input(&mut self, handle: &Handle<Image>) -> &mut Self {
-        let depth = self.graph.resources[handle.id]
-            .info
+        let access = self.input_access(handle);
+        self.read(handle, access);
+        self
+    }
+
+    /// How [`Self::input`] reads the image: as a depth or a colour input attachment.
+    pub fn input_access(&self, handle: &Handle<Image>) -> Access {
+        if self
+            .info(handle)
             .aspect()
-            .contains(vk::ImageAspectFlags::DEPTH);
-        let access = if depth {
+            .contains(vk::ImageAspectFlags::DEPTH)
+        {
             Access::DepthInputAttachmentRead
         } else {
             Access::InputAttachmentRead
-        };
-        self.read(handle, access);
-        self
+        }
+    }
+
+    /// Size and format of the image.
+    pub fn info(&self, handle: &Handle<Image>) -> ImageInfo {
+        self.graph.resources[handle.id].info
+    }
+
+    /// Whether the pass declared a read of the image's current version so far.
+    pub fn reads(&self, handle: &Handle<Image>) -> bool {
+        self.decl
+            .reads
+            .iter()
+            .any(|u| u.resource == handle.id && u.version == handle.version)
     }
 
     /// Samples the image anywhere (neighbourhood reads, e.g. a blur): never merged with its writer.

@@ -8,21 +8,16 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::{
-    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur,
-    SssBlurTechnique, SssInputs, SssKnobs, LEAN_FINAL_SHADER, PACKED_FORMAT,
+    chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssInputs, SssKnobs,
+    LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
 use crate::backend::shader::PipelineShaders;
 use crate::features::lighting::HDR_FORMAT;
+use crate::features::pass::FullscreenPass;
 use crate::features::technique::{Shades, TechniqueModule};
-use crate::features::util::{
-    check_bindings, clamp_sampler, Binding, Defines, GraphicsPipelineDesc, PassPipeline,
-};
+use crate::features::util::Defines;
 use crate::gpu_scene::SceneGpu;
-use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
-};
-use crate::Result;
+use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 
 /// Declares an iterative chain (see the module docs). Returns the chain's result (`output`
 /// when given).
@@ -100,62 +95,56 @@ pub(super) fn chain_passes(
         } else {
             current.iter().collect()
         };
-        let mut pass = graph.add_pass(
+        let constants = |direction: [f32; 2]| BlurConstants {
+            step: [direction[0], direction[1], step as f32, chain.index as f32],
+        };
+        let mut pass = blur_pass(
+            graph,
             &format!("{}horizontal blur #{n}", chain.prefix),
-            PassKind::Raster,
+            scene,
+            chain,
+            constants([1.0, 0.0]),
+            &source_handles,
+            inputs,
         );
-        for h in &source_handles {
-            pass.sample(h);
-        }
-        pass.sample(inputs.depth)
-            .sample(inputs.profile_ids)
-            .taps(fetches(source_handles.len() as u32));
-        let sources: Vec<ResourceId> = source_handles.iter().map(|h| h.id()).collect();
+        pass.taps(fetches(source_handles.len() as u32))
+            .defines(&blur_defines(
+                blur.technique(),
+                knobs.taps,
+                chain.edges,
+                packed && source_handles.len() == 1,
+                packed,
+                false,
+            ));
         for t in &mut temp {
             pass.color(t, LoadOp::DontCare);
         }
-        let exec = |direction: [f32; 2],
-                    accumulate: bool,
-                    colors: Vec<ResourceId>,
-                    scene: &Arc<SceneGpu>| BlurPass {
-            scene: scene.clone(),
-            packed_in: packed && colors.len() == 1,
-            packed_out: packed,
-            sums: if accumulate { targets } else { 0 },
-            taps: knobs.taps,
-            colors,
-            depth: inputs.depth.id(),
-            profile_ids: inputs.profile_ids.id(),
-            constants: BlurConstants {
-                step: [direction[0], direction[1], step as f32, chain.index as f32],
-            },
-            blur,
-            edges: chain.edges,
-            chain: chain.index,
-            sampler: vk::Sampler::null(),
-            nearest: vk::Sampler::null(),
-            pipeline: None,
-        };
-        match scene {
-            Some(scene) => pass.execute(exec([1.0, 0.0], false, sources, scene)),
-            None => pass.finish(),
-        }
+        pass.finish();
         // Vertical: back into the current result, and its weighted share into the sum.
-        let mut pass = graph.add_pass(
+        let temps: Vec<&Handle<Image>> = temp.iter().collect();
+        let mut pass = blur_pass(
+            graph,
             &format!("{}vertical blur #{n}", chain.prefix),
-            PassKind::Raster,
+            scene,
+            chain,
+            constants([0.0, 1.0]),
+            &temps,
+            inputs,
         );
-        for t in &temp {
-            pass.sample(t);
-        }
-        pass.sample(inputs.depth)
-            .sample(inputs.profile_ids)
-            .taps(fetches(temp.len() as u32));
+        pass.taps(fetches(temps.len() as u32))
+            .defines(&blur_defines(
+                blur.technique(),
+                knobs.taps,
+                chain.edges,
+                packed && temps.len() == 1,
+                packed,
+                true,
+            ));
         for c in &mut current {
             pass.color(c, LoadOp::DontCare);
         }
         for s in &mut sum {
-            pass.color(
+            pass.color_add(
                 s,
                 if step == 0 {
                     LoadOp::Clear([0.0; 4])
@@ -164,11 +153,7 @@ pub(super) fn chain_passes(
                 },
             );
         }
-        let temps = temp.iter().map(|h| h.id()).collect();
-        match scene {
-            Some(scene) => pass.execute(exec([0.0, 1.0], true, temps, scene)),
-            None => pass.finish(),
-        }
+        pass.finish();
     }
     let mut hdr = output.unwrap_or_else(|| {
         graph.create_image(
@@ -184,39 +169,81 @@ pub(super) fn chain_passes(
         None => ("combine", COMBINE_FRAGMENT),
         Some(_) => ("final lighting", LEAN_FINAL_SHADER),
     };
-    let mut pass = graph.add_pass(&format!("{}{name}", chain.prefix), PassKind::Raster);
-    // Inputs in the shader's binding order (after the frame uniforms and the profile table).
+    // The chain's last pass samples every input at its own pixel: on the pixels of its chain's
+    // profiles it writes the blurred light; elsewhere the previous chain's result (`base`), or
+    // the lighting pass's diffuse + specular. Inputs in the shader's binding order (after the
+    // frame uniforms and the profile table).
     let mut reads: Vec<&Handle<Image>> = sum.iter().collect();
     reads.extend([inputs.diffuse, inputs.specular, inputs.profile_ids]);
     if let Some(l) = lean {
         reads.extend([inputs.depth, l.gb0, l.gb1]);
     }
     reads.extend(base);
+    let constants = BlurConstants {
+        step: [0.0, 0.0, 0.0, chain.index as f32],
+    };
+    let mut pass = sss_pass(
+        graph,
+        &format!("{}{name}", chain.prefix),
+        fragment,
+        scene,
+        constants,
+    );
+    let (defines, passthrough) = final_defines(lean.is_some(), base.is_some(), false);
+    pass.defines(&defines);
     for h in &reads {
         pass.sample(h);
     }
     // LEAN specular is direct light: the light-space maps shadow it.
-    let shadow_depth = inputs.shadow_depth.filter(|_| lean.is_some());
-    if let Some(depth) = shadow_depth {
-        pass.sample(depth);
+    if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some()) {
+        pass.shadows(depth);
     }
     pass.color(&mut hdr, LoadOp::DontCare);
-    let ids = reads.iter().map(|h| h.id()).collect();
-    match scene {
-        Some(scene) => pass.execute(FinalPass {
-            shadow_depth: shadow_depth.map(|h| h.id()),
-            scene: scene.clone(),
-            inputs: ids,
-            fragment,
-            chain: chain.index,
-            base: base.is_some(),
-            sampler: vk::Sampler::null(),
-            pipeline: None,
-            passthrough: None,
-        }),
-        None => pass.finish(),
+    // With SSS tiles, `final lighting` evaluates LEAN only on the rectangles its chain may
+    // cover and draws the pass-through variant on the others: lavapipe shades both sides of
+    // the shader's per-pixel branch, rasterisation it does skip.
+    if let Some(extra) = passthrough {
+        let index = chain.index;
+        pass.variant(extra)
+            .tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
     }
+    pass.finish();
     hdr
+}
+
+/// Starts a blur pass of an iterative chain reading `colors` (the light, and with LCB and LBB
+/// the LEAN texel): bindings as glsl/sss/blur.frag declares them, 5 the LEAN texel, though the
+/// graph reads it second. The control's taps fall between texels (linear); depth, profile IDs
+/// and the bilateral blur's whole-texel taps are read nearest (texelFetch; depth formats need
+/// not support linear filtering). It draws only where objects of its chain (and their blur's
+/// reach) can be: every pixel a tap of a scattering pixel reads is written; the rest is never
+/// read.
+fn blur_pass<'g>(
+    graph: &'g mut RenderGraph,
+    name: &str,
+    scene: Option<&Arc<SceneGpu>>,
+    chain: &Chain,
+    constants: BlurConstants,
+    colors: &[&Handle<Image>],
+    inputs: &SssInputs<'_>,
+) -> FullscreenPass<'g> {
+    let filter = if chain.blur.bilateral() {
+        vk::Filter::NEAREST
+    } else {
+        vk::Filter::LINEAR
+    };
+    let mut pass = sss_pass(graph, name, BLUR_FRAGMENT, scene, constants);
+    pass.sample_with(colors[0], filter);
+    for lean in &colors[1..] {
+        pass.graph().sample(lean);
+    }
+    pass.sample(inputs.depth).sample(inputs.profile_ids);
+    for lean in &colors[1..] {
+        pass.bind_sampled(lean, filter);
+    }
+    let index = chain.index;
+    pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
+    pass
 }
 
 /// The iterative blur's fragment shader.
@@ -328,212 +355,6 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
                 }
             }
         }
-    }
-}
-
-struct BlurPass {
-    scene: Arc<SceneGpu>,
-    /// The texels to blur: the light (LCB, LBB: and the LEAN target).
-    colors: Vec<ResourceId>,
-    depth: ResourceId,
-    profile_ids: ResourceId,
-    constants: BlurConstants,
-    blur: SssBlur,
-    /// Reject taps on other profiles' pixels.
-    edges: bool,
-    chain: usize,
-    /// LBB packed: the input is one RGBA32UI texel (after the first pass).
-    packed_in: bool,
-    /// LBB packed: the result is written as one RGBA32UI texel.
-    packed_out: bool,
-    /// Sum-of-Gaussians targets accumulated after the result (vertical passes), else 0.
-    sums: usize,
-    /// Bilateral taps per direction.
-    taps: u32,
-    /// Linear filtering for the control's taps between texels (its offsets are fractional).
-    sampler: vk::Sampler,
-    /// Nearest, for depth and profile IDs and the bilateral blur's whole-texel taps (read with
-    /// texelFetch; depth formats need not support linear filtering).
-    nearest: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-}
-
-impl PassExec for BlurPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.sampler = clamp_sampler(ctx, vk::Filter::LINEAR)?;
-        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let views = ctx.descriptor_views;
-        let color_sampler = if self.blur.bilateral() {
-            self.nearest
-        } else {
-            self.sampler
-        };
-        // Bindings as glsl/sss/blur.frag declares them: 5 is the LEAN texel.
-        let mut bindings = per_frame_bindings(&self.scene);
-        bindings.extend([
-            Binding::Sampled(views[self.colors[0]], color_sampler),
-            Binding::Sampled(views[self.depth], self.nearest),
-            Binding::Sampled(views[self.profile_ids], self.nearest),
-        ]);
-        if let Some(&lean) = self.colors.get(1) {
-            bindings.push(Binding::Sampled(views[lean], color_sampler));
-        }
-        let defines = blur_defines(
-            self.blur.technique(),
-            self.taps,
-            self.edges,
-            self.packed_in,
-            self.packed_out,
-            self.sums > 0,
-        );
-        // The sums follow the results (one packed attachment, or one per blurred texel).
-        let results = match (self.packed_out, self.blur.lean()) {
-            (true, _) | (false, false) => 1,
-            (false, true) => 2,
-        };
-        let additive = ((1u32 << self.sums) - 1) << results;
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &bindings,
-            &GraphicsPipelineDesc {
-                additive_attachments: additive,
-                push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-                ..GraphicsPipelineDesc::fullscreen(BLUR_FRAGMENT, &defines, "sss blur")
-            },
-        )?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        let Some(pipeline) = &self.pipeline else {
-            return;
-        };
-        pipeline.bind(ctx);
-        push_constants(ctx, pipeline, &self.constants);
-        match chain_tiles(&self.scene, ctx, self.chain) {
-            // Only where objects of this chain (and their blur's reach) can be: every pixel a
-            // tap of a scattering pixel reads is written; the rest is never read.
-            Some(rects) => {
-                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
-            }
-            None => {
-                // SAFETY: bound above, inside the pass's subpass.
-                unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
-            }
-        }
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created by `prepare` (or null); the GPU is done with them.
-        unsafe {
-            gpu.device.destroy_sampler(self.sampler, None);
-            gpu.device.destroy_sampler(self.nearest, None);
-        }
-    }
-}
-
-/// A chain's pass after its blurs: `combine` (control) or `final lighting` (LCB, LBB, with
-/// LEAN specular): every input sampled at its own pixel, in the shader's binding order. On
-/// the pixels of its chain's profiles it writes the blurred light; elsewhere the previous
-/// chain's result (`base`), or the lighting pass's diffuse + specular. With SSS tiles,
-/// `final lighting` evaluates LEAN only on the rectangles its chain may cover and draws the
-/// pass-through variant on the others: lavapipe shades both sides of the shader's per-pixel
-/// branch, rasterisation it does skip.
-struct FinalPass {
-    scene: Arc<SceneGpu>,
-    inputs: Vec<ResourceId>,
-    fragment: &'static str,
-    chain: usize,
-    /// The last input is the previous chain's result.
-    base: bool,
-    sampler: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-    /// LCB, LBB: the pass-through variant for rectangles nothing of the chain scatters in.
-    passthrough: Option<crate::features::util::GraphicsPipeline>,
-    /// The light-space maps' depth (LEAN frames where some light casts shadows).
-    shadow_depth: Option<ResourceId>,
-}
-
-impl PassExec for FinalPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let views = ctx.descriptor_views;
-        let mut bindings = per_frame_bindings(&self.scene);
-        bindings.extend(
-            self.inputs
-                .iter()
-                .map(|&id| Binding::Sampled(views[id], self.sampler)),
-        );
-        let lean = self.fragment == LEAN_FINAL_SHADER;
-        let (defines, passthrough) = final_defines(lean, self.base, self.shadow_depth.is_some());
-        if let Some(depth) = self.shadow_depth {
-            check_bindings(
-                self.fragment,
-                bindings.len(),
-                final_bindings(lean, self.base),
-            )?;
-            bindings.extend(crate::features::shadows::lighting_bindings(
-                &self.scene,
-                depth,
-                None,
-                views,
-                self.sampler,
-            ));
-        }
-        let desc = GraphicsPipelineDesc {
-            push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-            ..GraphicsPipelineDesc::fullscreen(self.fragment, &defines, self.fragment)
-        };
-        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
-        if let Some(extra) = passthrough {
-            let (lean, passthrough) =
-                pipeline.with_variant(ctx, &desc, &extra, "final lighting (pass-through)")?;
-            pipeline = lean;
-            self.passthrough = Some(passthrough);
-        }
-        self.pipeline = Some(pipeline);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        let Some(pipeline) = &self.pipeline else {
-            return;
-        };
-        let constants = BlurConstants {
-            step: [0.0, 0.0, 0.0, self.chain as f32],
-        };
-        pipeline.bind(ctx);
-        push_constants(ctx, pipeline, &constants);
-        let tiles = chain_tiles(&self.scene, ctx, self.chain);
-        let (Some(passthrough), Some(rects)) = (&self.passthrough, tiles) else {
-            // SAFETY: bound above, inside the pass's subpass.
-            unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
-            return;
-        };
-        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
-        // SAFETY: made for this subpass with the bound set's layout (same push constants).
-        unsafe {
-            ctx.gpu.device.cmd_bind_pipeline(
-                ctx.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                passthrough.pipeline,
-            );
-        }
-        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        if let Some(mut p) = self.passthrough.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created by `prepare`; the GPU is done with it.
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
     }
 }
 

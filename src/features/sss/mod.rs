@@ -50,7 +50,7 @@ pub mod separable;
 pub mod tables;
 mod two_pass;
 
-use super::util::{Binding, PassPipeline};
+use super::pass::FullscreenPass;
 
 /// Profile IDs are stored in 8 bits and index a uniform table: 0 means "does not scatter", so
 /// a frame holds up to `MAX_SSS_PROFILES - 1` distinct profiles (glsl/common/sss.glsl).
@@ -627,12 +627,20 @@ struct BlurConstants {
     step: [f32; 4],
 }
 
-/// The profile table and frame uniforms every SSS pass binds first (0: frame, 1: profiles).
-fn per_frame_bindings(scene: &SceneGpu) -> Vec<Binding> {
-    vec![
-        Binding::PerFrame(scene.per_frame.binding(Region::Frame)),
-        Binding::PerFrame(scene.per_frame.binding(Region::Profiles)),
-    ]
+/// Starts an SSS pass: the frame uniforms and the profile table bound first (0: frame, 1:
+/// profiles), `constants` pushed before it draws.
+fn sss_pass<'g>(
+    graph: &'g mut RenderGraph,
+    name: &str,
+    fragment: &'static str,
+    scene: Option<&Arc<SceneGpu>>,
+    constants: BlurConstants,
+) -> FullscreenPass<'g> {
+    let mut pass = FullscreenPass::new(graph, name, fragment, scene);
+    pass.per_frame(Region::Frame)
+        .per_frame(Region::Profiles)
+        .push_constants(&constants);
+    pass
 }
 
 /// The tile rectangles of `chain` in the recorded frame (`None`: the whole screen).
@@ -648,19 +656,6 @@ fn chain_tiles(
         .get(chain)
         .cloned()
         .flatten()
-}
-
-fn push_constants(ctx: &RecordContext<'_>, pipeline: &PassPipeline, constants: &BlurConstants) {
-    // SAFETY: the pipeline's layout has this push-constant range; it is bound.
-    unsafe {
-        ctx.gpu.device.cmd_push_constants(
-            ctx.cmd,
-            pipeline.pipeline.layout,
-            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            0,
-            bytemuck::bytes_of(constants),
-        );
-    }
 }
 
 #[cfg(test)]

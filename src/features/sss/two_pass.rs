@@ -11,23 +11,14 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::{
-    chain_tiles, per_frame_bindings, push_constants, BlurConstants, Chain, SssBlur,
-    SssBlurTechnique, SssInputs, SssKnobs,
-};
+use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssInputs, SssKnobs};
 use crate::backend::shader::PipelineShaders;
 use crate::features::lighting::HDR_FORMAT;
+use crate::features::pass::FullscreenPass;
 use crate::features::technique::{Shades, TechniqueModule};
-use crate::features::util::{
-    check_bindings, clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc,
-    PassPipeline,
-};
+use crate::features::util::Defines;
 use crate::gpu_scene::{Region, SceneGpu, TileRect};
-use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
-};
-use crate::Result;
+use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 
 /// Declares a two-pass chain (see the module docs). Returns the chain's result (`output`
 /// when given).
@@ -70,11 +61,8 @@ pub(super) fn chain_passes(
     };
     let mut temp = graph.create_image(&chain.image_name("temp"), blur_info);
     let mut temp_lean = lean.map(|_| graph.create_image(&chain.image_name("temp.lean"), blur_info));
-    let constants = |direction: [f32; 2]| BlurConstants {
-        step: [direction[0], direction[1], 0.0, chain.index as f32],
-    };
-    let spec = |vertical: bool, compose: bool, inputs: Vec<ResourceId>| PassSpec {
-        blur,
+    let shape = |vertical: bool, compose: bool, inputs: usize| PassShape {
+        bilateral: blur.bilateral(),
         vertical,
         compose,
         half_res,
@@ -83,33 +71,28 @@ pub(super) fn chain_passes(
         depth_in_alpha: depth_in_alpha || vertical,
         point_taps: knobs.point_taps,
         samples,
-        chain: chain.index,
-        constants: constants(if vertical { [0.0, 1.0] } else { [1.0, 0.0] }),
         inputs,
-        shadow_depth: None,
     };
 
     // Horizontal: the lit diffuse (and the LEAN target) into the temporaries.
-    let mut pass = graph.add_pass(
-        &format!("{}horizontal blur", chain.prefix),
-        PassKind::Raster,
-    );
     let mut reads: Vec<&Handle<Image>> = vec![inputs.diffuse, inputs.depth, inputs.profile_ids];
     reads.extend(lean.map(|l| l.view_plane));
-    for h in &reads {
-        pass.sample(h);
-    }
+    let mut pass = blur_pass(
+        graph,
+        &format!("{}horizontal blur", chain.prefix),
+        scene,
+        chain,
+        shape(false, false, reads.len()),
+        [1.0, 0.0],
+        &reads,
+    );
     let texels = 1 + u32::from(lean.is_some());
     pass.taps(fetches(texels, !depth_in_alpha || blur.bilateral()));
     pass.color(&mut temp, LoadOp::DontCare);
     if let Some(t) = &mut temp_lean {
         pass.color(t, LoadOp::DontCare);
     }
-    let ids = reads.iter().map(|h| h.id()).collect();
-    match scene {
-        Some(scene) => pass.execute(TwoPassBlur::new(scene, spec(false, false, ids))),
-        None => pass.finish(),
-    }
+    pass.finish();
 
     // Vertical: at full resolution it writes the chain's result; at half resolution a
     // half-resolution blurred image the upsample composes.
@@ -130,7 +113,6 @@ pub(super) fn chain_passes(
     } else {
         result(graph)
     };
-    let mut pass = graph.add_pass(&format!("{}vertical blur", chain.prefix), PassKind::Raster);
     let mut reads: Vec<&Handle<Image>> = vec![&temp, inputs.depth, inputs.profile_ids];
     reads.extend(temp_lean.as_ref());
     if !half_res {
@@ -140,34 +122,28 @@ pub(super) fn chain_passes(
         }
         reads.extend(base);
     }
-    for h in &reads {
-        pass.sample(h);
-    }
+    let mut pass = blur_pass(
+        graph,
+        &format!("{}vertical blur", chain.prefix),
+        scene,
+        chain,
+        shape(true, !half_res, reads.len()),
+        [0.0, 1.0],
+        &reads,
+    );
     // The bilateral chain's LEAN specular is direct light: the light-space maps shadow it.
-    let shadow_depth = inputs.shadow_depth.filter(|_| lean.is_some() && !half_res);
-    if let Some(depth) = shadow_depth {
-        pass.sample(depth);
+    if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some() && !half_res) {
+        pass.shadows(depth);
     }
     pass.taps(fetches(texels, blur.bilateral()));
     pass.color(&mut vertical_out, LoadOp::DontCare);
-    let ids = reads.iter().map(|h| h.id()).collect();
-    match scene {
-        Some(scene) => pass.execute(TwoPassBlur::new(
-            scene,
-            PassSpec {
-                shadow_depth: shadow_depth.map(|h| h.id()),
-                ..spec(true, !half_res, ids)
-            },
-        )),
-        None => pass.finish(),
-    }
+    pass.finish();
     if !half_res {
         return vertical_out;
     }
 
     // Upsample: the half-resolution blur composed at full resolution.
     let mut hdr = result(graph);
-    let mut pass = graph.add_pass(&format!("{}upsample", chain.prefix), PassKind::Raster);
     let mut reads: Vec<&Handle<Image>> = vec![
         &vertical_out,
         inputs.depth,
@@ -176,74 +152,67 @@ pub(super) fn chain_passes(
         inputs.specular,
     ];
     reads.extend(base);
-    for h in &reads {
-        pass.sample(h);
-    }
+    let mut pass = blur_pass(
+        graph,
+        &format!("{}upsample", chain.prefix),
+        scene,
+        chain,
+        shape(true, true, reads.len()),
+        [0.0, 0.0],
+        &reads,
+    );
     pass.color(&mut hdr, LoadOp::DontCare);
-    let ids = reads.iter().map(|h| h.id()).collect();
-    match scene {
-        Some(scene) => pass.execute(TwoPassBlur::new(
-            scene,
-            PassSpec {
-                constants: constants([0.0, 0.0]),
-                ..spec(true, true, ids)
-            },
-        )),
-        None => pass.finish(),
-    }
+    pass.finish();
     hdr
 }
 
-/// What one pass of a two-pass chain is.
-#[derive(Clone, Debug)]
-struct PassSpec {
-    blur: SssBlur,
-    /// The vertical pass (its taps read the temporaries).
-    vertical: bool,
-    /// It writes the chain's result (full-resolution vertical pass, or the upsample).
-    compose: bool,
-    half_res: bool,
-    /// The last input is the previous chain's result.
-    base: bool,
-    edges: bool,
-    /// The taps' depth travels in the light's alpha.
-    depth_in_alpha: bool,
-    /// Separable: nearest-texel taps.
-    point_taps: bool,
-    samples: u32,
-    chain: usize,
-    constants: BlurConstants,
-    /// The images it samples, in the shader's binding order (after the per-frame bindings).
-    inputs: Vec<ResourceId>,
-    /// The light-space maps' depth (the bilateral vertical pass's LEAN specular, when some
-    /// light casts shadows).
-    shadow_depth: Option<ResourceId>,
+/// Starts one pass of a two-pass chain: the kernel table bound after the per-frame pair, then
+/// `reads` in the shader's binding order (the light the separable blur taps between texels
+/// linear, the rest nearest), pushing the blur `direction`. It draws only where objects of its
+/// chain (and their blur's reach) can be, at half resolution in halved rectangles; a composing
+/// pass draws its pass-through variant on the other rectangles.
+fn blur_pass<'g>(
+    graph: &'g mut RenderGraph,
+    name: &str,
+    scene: Option<&Arc<SceneGpu>>,
+    chain: &Chain,
+    shape: PassShape,
+    direction: [f32; 2],
+    reads: &[&Handle<Image>],
+) -> FullscreenPass<'g> {
+    let constants = BlurConstants {
+        step: [direction[0], direction[1], 0.0, chain.index as f32],
+    };
+    let mut pass = sss_pass(graph, name, shape.fragment(), scene, constants);
+    pass.per_frame(Region::Kernels);
+    for (i, h) in reads.iter().enumerate() {
+        let filter = if i == 0 && !chain.blur.bilateral() {
+            vk::Filter::LINEAR
+        } else {
+            vk::Filter::NEAREST
+        };
+        pass.sample_with(h, filter);
+    }
+    let (defines, passthrough) = shape.defines(false);
+    pass.defines(&defines);
+    if let Some(extra) = passthrough {
+        pass.variant(extra);
+    }
+    let index = chain.index;
+    // Half-resolution passes (all but the upsample) draw halved rectangles.
+    let halve = shape.half_res && !shape.upsample();
+    pass.tiles(move |scene, ctx| {
+        let rects = chain_tiles(scene, ctx, index)?;
+        Some(if halve {
+            rects.iter().map(halved).collect()
+        } else {
+            rects
+        })
+    });
+    pass
 }
 
-impl PassSpec {
-    /// What its shader permutation depends on.
-    fn shape(&self) -> PassShape {
-        PassShape {
-            bilateral: self.blur.bilateral(),
-            vertical: self.vertical,
-            compose: self.compose,
-            half_res: self.half_res,
-            base: self.base,
-            edges: self.edges,
-            depth_in_alpha: self.depth_in_alpha,
-            point_taps: self.point_taps,
-            samples: self.samples,
-            inputs: self.inputs.len(),
-        }
-    }
-
-    /// Whether the pass reads the kernel table (binding 2): all of them.
-    fn kernels(&self) -> bool {
-        true
-    }
-}
-
-/// The fields of a [`PassSpec`] its shader permutation depends on.
+/// What the shader permutation of one pass of a two-pass chain depends on.
 #[derive(Clone, Copy, Debug)]
 struct PassShape {
     /// The bilateral blur (else separable).
@@ -363,31 +332,6 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
     }
 }
 
-struct TwoPassBlur {
-    scene: Arc<SceneGpu>,
-    spec: PassSpec,
-    /// Linear filtering for the separable blur's taps between texels.
-    linear: vk::Sampler,
-    /// Nearest, for depth and profile IDs and point taps.
-    nearest: vk::Sampler,
-    pipeline: Option<PassPipeline>,
-    /// Composing passes: the variant for rectangles no object of the chain covers.
-    passthrough: Option<GraphicsPipeline>,
-}
-
-impl TwoPassBlur {
-    fn new(scene: &Arc<SceneGpu>, spec: PassSpec) -> Self {
-        Self {
-            scene: scene.clone(),
-            spec,
-            linear: vk::Sampler::null(),
-            nearest: vk::Sampler::null(),
-            pipeline: None,
-            passthrough: None,
-        }
-    }
-}
-
 /// A tile rectangle at half resolution (every half-resolution pixel the full-resolution one
 /// touches).
 fn halved(r: &TileRect) -> TileRect {
@@ -397,120 +341,6 @@ fn halved(r: &TileRect) -> TileRect {
         width: (r.x + r.width).div_ceil(2) - r.x / 2,
         height: (r.y + r.height).div_ceil(2) - r.y / 2,
         translucent: r.translucent,
-    }
-}
-
-impl PassExec for TwoPassBlur {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        self.linear = clamp_sampler(ctx, vk::Filter::LINEAR)?;
-        self.nearest = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let views = ctx.descriptor_views;
-        let mut bindings = per_frame_bindings(&self.scene);
-        if self.spec.kernels() {
-            bindings.push(Binding::PerFrame(
-                self.scene.per_frame.binding(Region::Kernels),
-            ));
-        }
-        for (i, &id) in self.spec.inputs.iter().enumerate() {
-            // The light the separable (non-bilateral) blur taps between texels: linear; the
-            // rest nearest.
-            let sampler = if i == 0 && !self.spec.blur.bilateral() {
-                self.linear
-            } else {
-                self.nearest
-            };
-            bindings.push(Binding::Sampled(views[id], sampler));
-        }
-        let (defines, passthrough) = self.spec.shape().defines(self.spec.shadow_depth.is_some());
-        if let Some(depth) = self.spec.shadow_depth {
-            check_bindings(
-                "sss two-pass blur",
-                bindings.len(),
-                self.spec.shape().bindings(),
-            )?;
-            bindings.extend(crate::features::shadows::lighting_bindings(
-                &self.scene,
-                depth,
-                None,
-                views,
-                self.nearest,
-            ));
-        }
-        let desc = GraphicsPipelineDesc {
-            push_constant_bytes: std::mem::size_of::<BlurConstants>() as u32,
-            ..GraphicsPipelineDesc::fullscreen(
-                self.spec.shape().fragment(),
-                &defines,
-                "sss two-pass blur",
-            )
-        };
-        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
-        if let Some(extra) = passthrough {
-            let (blur, passthrough) =
-                pipeline.with_variant(ctx, &desc, &extra, "sss two-pass blur (pass-through)")?;
-            pipeline = blur;
-            self.passthrough = Some(passthrough);
-        }
-        self.pipeline = Some(pipeline);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        let Some(pipeline) = &self.pipeline else {
-            return;
-        };
-        pipeline.bind(ctx);
-        push_constants(ctx, pipeline, &self.spec.constants);
-        let tiles = chain_tiles(&self.scene, ctx, self.spec.chain);
-        // Half-resolution passes (all but the upsample) draw halved rectangles.
-        let scaled = |rects: Vec<TileRect>| {
-            if self.spec.half_res && !self.spec.shape().upsample() {
-                rects.iter().map(halved).collect()
-            } else {
-                rects
-            }
-        };
-        let draw_all = || {
-            // SAFETY: bound above, inside the pass's subpass.
-            unsafe { ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
-        };
-        match (tiles, &self.passthrough) {
-            (None, _) => draw_all(),
-            // Blurring only: where objects of this chain (and their blur's reach) can be.
-            (Some(rects), None) => {
-                let rects = scaled(rects);
-                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent))
-            }
-            // Composing: the blur where the chain's objects may be, pass-through elsewhere.
-            (Some(rects), Some(passthrough)) => {
-                let rects = scaled(rects);
-                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
-                // SAFETY: made for this subpass with the bound set's layout (same push
-                // constants).
-                unsafe {
-                    ctx.gpu.device.cmd_bind_pipeline(
-                        ctx.cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        passthrough.pipeline,
-                    );
-                }
-                PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
-            }
-        }
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        if let Some(mut p) = self.passthrough.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created by `prepare` (or null); the GPU is done with them.
-        unsafe {
-            gpu.device.destroy_sampler(self.linear, None);
-            gpu.device.destroy_sampler(self.nearest, None);
-        }
     }
 }
 

@@ -1,0 +1,430 @@
+//! Fullscreen passes that state each input once.
+//!
+//! A [`FullscreenPass`] is declared with one call chain: each [`sample`](FullscreenPass::sample),
+//! [`input`](FullscreenPass::input) or [`color`](FullscreenPass::color) declares the graph access
+//! and appends the shader's next descriptor binding, [`per_frame`](FullscreenPass::per_frame)
+//! appends a region of the per-frame buffer, and binding numbers a shader takes as defines
+//! ([`binding_define`](FullscreenPass::binding_define), [`shadows`](FullscreenPass::shadows))
+//! come from that same order. The pass owns its pipeline (and the variant some passes draw
+//! outside their tiles), its descriptor set and its samplers, and records the fullscreen
+//! triangle over the whole screen or over tile rectangles. Declared without a scene on the GPU
+//! (`lucent plan`), it declares the graph accesses only.
+//!
+//! Passes that draw meshes (the G-buffer, the light-space maps) keep their own
+//! [`PassExec`].
+//!
+//! ```text
+//! let mut pass = FullscreenPass::new(graph, "tonemap", "post/tonemap.frag", scene);
+//! pass.per_frame(Region::Frame)
+//!     .sample(hdr)
+//!     .color(&mut display, LoadOp::DontCare)
+//!     .defines(defines);
+//! pass.finish();
+//! ```
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::util::{
+    clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
+};
+use crate::gpu_scene::{Region, SceneGpu, TileRect};
+use crate::graph::declare::PassBuilder;
+use crate::graph::{
+    Handle, Image, LoadOp, PassExec, PassKind, PrepareContext, RecordContext, RenderGraph,
+    ResourceId,
+};
+use crate::Result;
+
+/// Binding numbers as define strings.
+const NUMBERS: [&str; 24] = [
+    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12", "13", "14", "15", "16",
+    "17", "18", "19", "20", "21", "22", "23",
+];
+
+/// The rectangles a pass draws in the recorded frame (`None`: the whole screen).
+type Tiles = Box<dyn Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>>>;
+
+/// One descriptor binding, as declared.
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    /// A region of the per-frame buffer.
+    PerFrame(Region),
+    /// An image sampled through a clamp sampler with this filter.
+    Sampled(ResourceId, vk::Filter),
+    /// An input attachment in this layout.
+    Input(ResourceId, vk::ImageLayout),
+}
+
+/// A fullscreen raster pass being declared (see the module docs). Finish it with
+/// [`FullscreenPass::finish`].
+pub struct FullscreenPass<'g> {
+    pass: PassBuilder<'g>,
+    /// The scene on the GPU; `None` when only planning.
+    scene: Option<Arc<SceneGpu>>,
+    /// The pass's name (also its pipeline's).
+    name: String,
+    fragment: &'static str,
+    slots: Vec<Slot>,
+    defines: Defines,
+    /// Colour attachments (bit i = location i) that add the shader's output.
+    additive: u32,
+    /// Colour attachments declared so far.
+    colors: u32,
+    push_constants: Vec<u8>,
+    tiles: Option<Tiles>,
+    variant: Option<Defines>,
+}
+
+impl<'g> FullscreenPass<'g> {
+    /// Starts declaring the raster pass `name` drawing `fragment` (a shader under `glsl/`) over
+    /// the fullscreen triangle. `scene` is `None` when only planning.
+    pub fn new(
+        graph: &'g mut RenderGraph,
+        name: &str,
+        fragment: &'static str,
+        scene: Option<&Arc<SceneGpu>>,
+    ) -> Self {
+        Self {
+            pass: graph.add_pass(name, PassKind::Raster),
+            scene: scene.cloned(),
+            name: name.to_string(),
+            fragment,
+            slots: Vec::new(),
+            defines: Vec::new(),
+            additive: 0,
+            colors: 0,
+            push_constants: Vec::new(),
+            tiles: None,
+            variant: None,
+        }
+    }
+
+    /// The graph pass being declared, for accesses that bind nothing (an image only declared
+    /// as read, the taps per pixel).
+    pub fn graph(&mut self) -> &mut PassBuilder<'g> {
+        &mut self.pass
+    }
+
+    /// Binds a region of the per-frame buffer (a dynamic uniform buffer at the recorded
+    /// frame's slot).
+    pub fn per_frame(&mut self, region: Region) -> &mut Self {
+        self.slots.push(Slot::PerFrame(region));
+        self
+    }
+
+    /// Samples the image (nearest texels) and binds it.
+    pub fn sample(&mut self, handle: &Handle<Image>) -> &mut Self {
+        self.sample_with(handle, vk::Filter::NEAREST)
+    }
+
+    /// Samples the image (`LINEAR`: taps between texels) and binds it.
+    pub fn sample_with(&mut self, handle: &Handle<Image>, filter: vk::Filter) -> &mut Self {
+        self.pass.sample(handle);
+        self.slots.push(Slot::Sampled(handle.id(), filter));
+        self
+    }
+
+    /// Binds an image the pass already declared a read of, sampled with `filter` (for shaders
+    /// that number an image after ones the graph reads later).
+    ///
+    /// # Panics
+    /// If the pass does not read the image's current version (a declaration bug).
+    pub fn bind_sampled(&mut self, handle: &Handle<Image>, filter: vk::Filter) -> &mut Self {
+        assert!(
+            self.pass.reads(handle),
+            "pass '{}' binds an image it does not read",
+            self.name
+        );
+        self.slots.push(Slot::Sampled(handle.id(), filter));
+        self
+    }
+
+    /// Reads the image at the pixel being shaded (`subpassLoad`) and binds it as an input
+    /// attachment.
+    pub fn input(&mut self, handle: &Handle<Image>) -> &mut Self {
+        let layout = self.pass.input_access(handle).info().layout;
+        self.pass.input(handle);
+        self.slots.push(Slot::Input(handle.id(), layout));
+        self
+    }
+
+    /// Writes the next colour attachment (location = order of `color` calls).
+    pub fn color(&mut self, handle: &mut Handle<Image>, load: LoadOp) -> &mut Self {
+        self.pass.color(handle, load);
+        self.colors += 1;
+        self
+    }
+
+    /// Writes the next colour attachment by adding the shader's output to it (`Load` keeps
+    /// what is there; a first accumulation clears).
+    pub fn color_add(&mut self, handle: &mut Handle<Image>, load: LoadOp) -> &mut Self {
+        self.additive |= 1 << self.colors;
+        self.color(handle, load)
+    }
+
+    /// Adds a shader define.
+    pub fn define(&mut self, name: &'static str, value: &'static str) -> &mut Self {
+        self.defines.push((name, value));
+        self
+    }
+
+    /// Adds shader defines.
+    pub fn defines(&mut self, defines: &[(&'static str, &'static str)]) -> &mut Self {
+        self.defines.extend_from_slice(defines);
+        self
+    }
+
+    /// Defines `name` as the number of the next binding (a shader whose bindings depend on
+    /// the pass's inputs takes their numbers as defines).
+    pub fn binding_define(&mut self, name: &'static str) -> &mut Self {
+        let number = NUMBERS[self.slots.len().min(NUMBERS.len() - 1)];
+        self.define(name, number)
+    }
+
+    /// Samples the light-space maps' depth atlas: their defines (glsl/common/shadows.glsl,
+    /// numbered from the next binding), the shadow table and the atlas.
+    pub fn shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
+        self.pass.sample(depth);
+        self.bind_shadows(depth)
+    }
+
+    /// [`Self::shadows`] for a depth atlas the pass already declared a read of.
+    pub fn bind_shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
+        self.defines(&super::shadows::lighting_defines(self.slots.len()));
+        self.per_frame(Region::Shadows)
+            .bind_sampled(depth, vk::Filter::NEAREST)
+    }
+
+    /// Push constants the pass pushes before drawing (visible to both stages).
+    pub fn push_constants(&mut self, constants: &impl bytemuck::Pod) -> &mut Self {
+        self.push_constants = bytemuck::bytes_of(constants).to_vec();
+        self
+    }
+
+    /// Declares how many texture taps the shader makes per pixel ([`PassBuilder::taps`]).
+    pub fn taps(&mut self, per_pixel: u32) -> &mut Self {
+        self.pass.taps(per_pixel);
+        self
+    }
+
+    /// Draws only in the rectangles `tiles` gives for the recorded frame (`None`: the whole
+    /// screen): the pass's pipeline in the translucent ones, its [`variant`](Self::variant),
+    /// if any, in the others.
+    pub fn tiles(
+        &mut self,
+        tiles: impl Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>> + 'static,
+    ) -> &mut Self {
+        self.tiles = Some(Box::new(tiles));
+        self
+    }
+
+    /// A second pipeline with `extra` defines added, drawn in the tiles that are not
+    /// translucent (the pass-through variant of a composing pass).
+    pub fn variant(&mut self, extra: Defines) -> &mut Self {
+        self.variant = Some(extra);
+        self
+    }
+
+    /// The shader defines declared so far: what the pipeline is built with once the pass is
+    /// finished.
+    pub fn shader_defines(&self) -> &[(&'static str, &'static str)] {
+        &self.defines
+    }
+
+    /// Finishes the declaration: with a scene on the GPU, the pass with the code that
+    /// records it; when only planning, the graph accesses alone.
+    pub fn finish(self) {
+        let Some(scene) = self.scene else {
+            self.pass.finish();
+            return;
+        };
+        self.pass.execute(FullscreenExec {
+            scene,
+            name: self.name,
+            fragment: self.fragment,
+            slots: self.slots,
+            defines: self.defines,
+            additive: self.additive,
+            push_constants: self.push_constants,
+            tiles: self.tiles,
+            variant: self.variant,
+            samplers: Vec::new(),
+            pipeline: None,
+            variant_pipeline: None,
+        });
+    }
+}
+
+/// The code behind a [`FullscreenPass`].
+struct FullscreenExec {
+    scene: Arc<SceneGpu>,
+    name: String,
+    fragment: &'static str,
+    slots: Vec<Slot>,
+    defines: Defines,
+    additive: u32,
+    push_constants: Vec<u8>,
+    tiles: Option<Tiles>,
+    variant: Option<Defines>,
+    /// One clamp sampler per filter the bindings use.
+    samplers: Vec<(vk::Filter, vk::Sampler)>,
+    pipeline: Option<PassPipeline>,
+    variant_pipeline: Option<GraphicsPipeline>,
+}
+
+/// The clamp sampler with `filter` among `samplers`, made on first use.
+fn sampler(
+    samplers: &mut Vec<(vk::Filter, vk::Sampler)>,
+    ctx: &PrepareContext<'_>,
+    filter: vk::Filter,
+) -> Result<vk::Sampler> {
+    if let Some(&(_, sampler)) = samplers.iter().find(|(f, _)| *f == filter) {
+        return Ok(sampler);
+    }
+    let sampler = clamp_sampler(ctx, filter)?;
+    samplers.push((filter, sampler));
+    Ok(sampler)
+}
+
+impl PassExec for FullscreenExec {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        let views = ctx.descriptor_views;
+        let mut bindings = Vec::with_capacity(self.slots.len());
+        for slot in &self.slots {
+            bindings.push(match *slot {
+                Slot::PerFrame(region) => Binding::PerFrame(self.scene.per_frame.binding(region)),
+                Slot::Sampled(id, filter) => {
+                    Binding::Sampled(views[id], sampler(&mut self.samplers, ctx, filter)?)
+                }
+                Slot::Input(id, layout) => Binding::InputAttachment(views[id], layout),
+            });
+        }
+        let desc = GraphicsPipelineDesc {
+            additive_attachments: self.additive,
+            push_constant_bytes: self.push_constants.len() as u32,
+            ..GraphicsPipelineDesc::fullscreen(self.fragment, &self.defines, &self.name)
+        };
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        if let Some(extra) = &self.variant {
+            let name = format!("{} (pass-through)", self.name);
+            let (main, variant) = pipeline.with_variant(ctx, &desc, extra, &name)?;
+            pipeline = main;
+            self.variant_pipeline = Some(variant);
+        }
+        self.pipeline = Some(pipeline);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        pipeline.bind(ctx);
+        let device = &ctx.gpu.device;
+        if !self.push_constants.is_empty() {
+            // SAFETY: the pipeline's layout has this push-constant range; it is bound.
+            unsafe {
+                device.cmd_push_constants(
+                    ctx.cmd,
+                    pipeline.pipeline.layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    &self.push_constants,
+                );
+            }
+        }
+        let Some(rects) = self.tiles.as_ref().and_then(|t| t(&self.scene, ctx)) else {
+            // SAFETY: bound above, inside the pass's subpass.
+            unsafe { device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
+            return;
+        };
+        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
+        if let Some(variant) = &self.variant_pipeline {
+            // SAFETY: made for this subpass with the bound set's layout (same push constants).
+            unsafe {
+                device.cmd_bind_pipeline(
+                    ctx.cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    variant.pipeline,
+                );
+            }
+            PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.variant_pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        for (_, sampler) in self.samplers.drain(..) {
+            // SAFETY: created in prepare; the GPU is done (caller's contract).
+            unsafe { gpu.device.destroy_sampler(sampler, None) };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::access::Access;
+    use crate::graph::ImageInfo;
+
+    fn image(graph: &mut RenderGraph, name: &str) -> Handle<Image> {
+        let info = ImageInfo {
+            width: 8,
+            height: 8,
+            format: vk::Format::R16G16B16A16_SFLOAT,
+        };
+        graph.create_image(name, info)
+    }
+
+    #[test]
+    fn binding_numbers_follow_the_declaration_order() {
+        let mut graph = RenderGraph::new();
+        let (a, b, depth) = (
+            image(&mut graph, "a"),
+            image(&mut graph, "b"),
+            image(&mut graph, "depth"),
+        );
+        let mut out = image(&mut graph, "out");
+        let mut pass = FullscreenPass::new(&mut graph, "pass", "post/tonemap.frag", None);
+        pass.per_frame(Region::Frame)
+            .sample(&a)
+            .graph()
+            .sample(&depth);
+        pass.binding_define("LUCENT_B_BINDING")
+            .sample_with(&b, vk::Filter::LINEAR)
+            .bind_shadows(&depth)
+            .color(&mut out, LoadOp::DontCare);
+        assert_eq!(
+            pass.shader_defines(),
+            &[
+                ("LUCENT_B_BINDING", "2"),
+                ("LUCENT_SHADOWS", "1"),
+                ("LUCENT_SHADOW_BINDING", "3"),
+            ]
+        );
+        pass.finish();
+        // Planning only: the graph accesses, in declaration order, and no code.
+        let decl = &graph.passes[0];
+        assert!(decl.exec.is_none());
+        let reads: Vec<_> = decl.reads.iter().map(|u| u.resource).collect();
+        assert_eq!(reads, [a.id(), depth.id(), b.id()]);
+        assert_eq!(decl.reads[0].access, Access::FragmentSampledRead);
+        assert_eq!(decl.writes[0].resource, out.id());
+    }
+
+    #[test]
+    #[should_panic(expected = "binds an image it does not read")]
+    fn binding_an_image_the_pass_does_not_read_is_refused() {
+        let mut graph = RenderGraph::new();
+        let a = image(&mut graph, "a");
+        let mut pass = FullscreenPass::new(&mut graph, "pass", "post/tonemap.frag", None);
+        pass.bind_sampled(&a, vk::Filter::NEAREST);
+    }
+}

@@ -1,12 +1,10 @@
 //! The debug views (`FrameSettings::debug_view`, the demo's V key) against the G-buffer read
 //! back from the same frame, validation on.
 
-mod common;
-
-use common::TestGpu;
+use crate::common::TestGpu;
 use lucent::features::debug_view::DebugView;
 use lucent::features::translucency::ThicknessPacking;
-use lucent::frame::{FrameRunner, FrameSettings, GBufferReadback, Renderer, Technique};
+use lucent::frame::{FrameSettings, GBufferReadback, Technique};
 use lucent::scene;
 
 /// The display image of one frame, and its G-buffer.
@@ -15,21 +13,14 @@ fn frame(
     scene: &scene::Scene,
     settings: FrameSettings,
 ) -> (Vec<u8>, GBufferReadback) {
-    let gpu = &test.gpu;
-    let settings = FrameSettings {
-        export_gbuffer: true,
-        ..settings
-    };
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    let display = renderer.read_display(gpu).unwrap();
-    let gbuffer = renderer.read_gbuffer(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    runner.destroy(gpu);
-    renderer.destroy(gpu);
-    (display, gbuffer)
+    let frame = test.render_repeated(
+        scene,
+        FrameSettings {
+            export_gbuffer: true,
+            ..settings
+        },
+    );
+    (frame.display, frame.gbuffer.unwrap())
 }
 
 fn srgb(c: f32) -> f32 {
@@ -189,17 +180,12 @@ fn translucency_term_view_is_the_difference_translucency_makes() {
     let test = TestGpu::new();
     let cubes = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     let hdr = |technique| {
-        let gpu = &test.gpu;
         let settings = FrameSettings {
             technique,
             export_hdr: true,
             ..FrameSettings::new(160, 120)
         };
-        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &cubes, settings).unwrap();
-        let images = renderer.render_once(gpu).unwrap();
-        gpu.wait_idle().unwrap();
-        renderer.destroy(gpu);
-        images.hdr.unwrap()
+        test.render(&cubes, settings).hdr.unwrap()
     };
     let (with, without) = (hdr(Technique::Translucency), hdr(Technique::None));
     let (term, gb) = frame(

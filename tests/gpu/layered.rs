@@ -210,8 +210,8 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     let p = common::plan(&layered, &no_shadows);
     assert!(passes(&p).iter().any(|n| n == "single scattering"));
     assert!(!images(&p).iter().any(|n| n.starts_with("light-space")));
-    // --technique none (and the other single techniques) leave layered media out.
-    for technique in [Technique::None, Technique::Translucency, Technique::Control] {
+    // --technique none (and every other technique but auto and layered) leave layered media out.
+    for technique in common::techniques().into_iter().filter(|t| !t.layered()) {
         let mut t = s;
         t.technique = technique;
         let p = common::plan(&layered, &t);

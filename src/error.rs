@@ -83,7 +83,8 @@ pub enum LucentError {
 
 /// The command that regenerates `glsl/permutations.txt`, the shipped SPIR-V's manifest (named
 /// by [`LucentError::ShaderNotShipped`], the manifest's header and its test).
-pub const MANIFEST_COMMAND: &str = "LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders";
+pub const MANIFEST_COMMAND: &str =
+    "LUCENT_WRITE_MANIFEST=1 cargo test --test cpu shipped_shaders::";
 
 /// Result with [`LucentError`].
 pub type Result<T, E = LucentError> = std::result::Result<T, E>;

@@ -13,7 +13,7 @@
 //!   embedding host use.
 //! - `ShaderCompiler::new` (feature `runtime-shaders`, on by default): compiles a GLSL file
 //!   under the GLSL root (`glsl/` in the repository, or `LUCENT_GLSL_DIR`) at run time. The
-//!   demo uses it so that edited shaders reload while it runs; `tests/shaders.rs` uses it to
+//!   demo uses it so that edited shaders reload while it runs; `tests/gpu/shaders.rs` uses it to
 //!   compile what is not in a frame. The stage comes from the extension (`.vert`, `.frag`,
 //!   `.comp`), the GLSL version from the file's `#version` line. `#include "x.glsl"` is looked
 //!   up next to the including file first, then under the GLSL root, so

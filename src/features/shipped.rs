@@ -4,11 +4,11 @@
 //! A build script cannot call the library, so the set is written down: [`permutations`]
 //! enumerates every (shader, defines) pair any pass of any frame may ask for, and
 //! `glsl/permutations.txt` holds its [`manifest`] text, which `build.rs` compiles. The test
-//! `tests/shipped_shaders.rs` fails when the committed file differs from [`manifest`] and prints
+//! `tests/cpu/shipped_shaders.rs` fails when the committed file differs from [`manifest`] and prints
 //! the command that regenerates it:
 //!
 //! ```text
-//! LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders
+//! LUCENT_WRITE_MANIFEST=1 cargo test --test cpu shipped_shaders::
 //! ```
 //!
 //! Each pass builds its defines with a function of its shape (the G-buffer layout, which inputs

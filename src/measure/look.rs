@@ -1,7 +1,7 @@
 //! The look check, measured: how much of a frame a technique changes against plain lighting
 //! (`--technique none`), and whether it changes anything it should not (halos: pixels of
 //! objects that have none of the frame's techniques). `lucent gallery` prints these numbers
-//! beside its pictures, and `tests/showcase.rs` holds the showcase scenes to them.
+//! beside its pictures, and `tests/gpu/showcase.rs` holds the showcase scenes to them.
 //!
 //! - *Changed*: the share of pixels whose displayed value moved by more than
 //!   [`CHANGED_THRESHOLD`] in some channel: what a viewer comparing the two stills sees.

@@ -34,7 +34,7 @@
 //! shrinks as the target grows, roughly as 1 / sqrt(target / k) with k the constant in the
 //! triangle column; at 1M every generator is within 0.4 %. For Li et al.'s largest row,
 //! 1,084,450, the teapot gets 1,080,560 triangles (resolution 260, -0.36 %).
-//! `tests/generators.rs` checks these bounds. Nothing above [`MAX_TRIANGLES`] is generated.
+//! `tests/cpu/generators.rs` checks these bounds. Nothing above [`MAX_TRIANGLES`] is generated.
 //!
 //! # What every mesh has
 //!

@@ -1,6 +1,6 @@
 //! The showcase scenes: one per technique, each built so the technique is unmistakable in a
 //! still (issue 16's look check: each changes at least 5% of its pixels against `--technique
-//! none`, without halos; `tests/showcase.rs` measures both, `lucent gallery` renders them).
+//! none`, without halos; `tests/gpu/showcase.rs` measures both, `lucent gallery` renders them).
 //!
 //! - `showcase-translucency`: GDC 2011 where it shines: thin objects (an ear, two leaves, a
 //!   wax panel) with baked thickness, a warm light behind them, the camera looking into it.

@@ -1,12 +1,10 @@
 //! The debug views (`FrameSettings::debug_view`, the demo's V key) against the G-buffer read
 //! back from the same frame, validation on.
 
-mod common;
-
-use common::TestGpu;
+use crate::common::TestGpu;
 use lucent::features::debug_view::DebugView;
 use lucent::features::translucency::ThicknessPacking;
-use lucent::frame::{FrameRunner, FrameSettings, GBufferReadback, Renderer, Technique};
+use lucent::frame::{FrameSettings, GBufferReadback, Technique};
 use lucent::scene;
 
 /// The display image of one frame, and its G-buffer.
@@ -15,21 +13,14 @@ fn frame(
     scene: &scene::Scene,
     settings: FrameSettings,
 ) -> (Vec<u8>, GBufferReadback) {
-    let gpu = &test.gpu;
-    let settings = FrameSettings {
-        export_gbuffer: true,
-        ..settings
-    };
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    let display = renderer.read_display(gpu).unwrap();
-    let gbuffer = renderer.read_gbuffer(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    runner.destroy(gpu);
-    renderer.destroy(gpu);
-    (display, gbuffer)
+    let frame = test.render_repeated(
+        scene,
+        FrameSettings {
+            export_gbuffer: true,
+            ..settings
+        },
+    );
+    (frame.display, frame.gbuffer.unwrap())
 }
 
 fn srgb(c: f32) -> f32 {
@@ -56,7 +47,7 @@ fn gbuffer_views_show_what_the_gbuffer_holds() {
     let test = TestGpu::new();
     let cubes = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     let base = FrameSettings {
-        technique: Technique::Translucency,
+        technique: Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
         ..FrameSettings::new(160, 120)
     };
     let view = |v| FrameSettings {
@@ -132,7 +123,7 @@ fn pre_blur_view_is_the_unblurred_lighting_and_the_blur_changes_it() {
     // `edges`: a skin profile four times as wide, so the blur reaches over several pixels.
     let edges = lucent::bake::scene::load_scene_baked("edges").unwrap();
     let base = FrameSettings {
-        technique: Technique::Control,
+        technique: Technique::Only(&lucent::features::sss::control::CONTROL),
         ..FrameSettings::new(320, 240)
     };
     let (after, gb) = frame(&test, &edges, base);
@@ -189,24 +180,24 @@ fn translucency_term_view_is_the_difference_translucency_makes() {
     let test = TestGpu::new();
     let cubes = lucent::bake::scene::load_scene_baked("cubes").unwrap();
     let hdr = |technique| {
-        let gpu = &test.gpu;
         let settings = FrameSettings {
             technique,
             export_hdr: true,
             ..FrameSettings::new(160, 120)
         };
-        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &cubes, settings).unwrap();
-        let images = renderer.render_once(gpu).unwrap();
-        gpu.wait_idle().unwrap();
-        renderer.destroy(gpu);
-        images.hdr.unwrap()
+        test.render(&cubes, settings).hdr.unwrap()
     };
-    let (with, without) = (hdr(Technique::Translucency), hdr(Technique::None));
+    let (with, without) = (
+        hdr(Technique::Only(
+            &lucent::features::translucency::TRANSLUCENCY,
+        )),
+        hdr(Technique::None),
+    );
     let (term, gb) = frame(
         &test,
         &cubes,
         FrameSettings {
-            technique: Technique::Translucency,
+            technique: Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
             debug_view: Some(DebugView::TranslucencyTerm),
             ..FrameSettings::new(160, 120)
         },

@@ -4,32 +4,25 @@
 //! and the error-against-time report.
 
 use lucent::features::gbuffer::GBufferPrecision;
-use lucent::frame::{FrameDesc, FrameImages, FrameSettings, Renderer, Technique};
+use lucent::frame::{FrameDesc, FrameImages, FrameSettings, Technique};
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
 use lucent::scene::Scene;
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 
-/// Renders one frame of `scene` and reads back everything it exports; also returns how many
-/// passes its plan kept.
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> (FrameImages, usize) {
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let images = renderer.render_once(gpu).unwrap();
-    let passes = renderer.executable.plan.passes.len();
-    gpu.wait_idle().unwrap();
-    renderer.destroy(gpu);
-    (images, passes)
+/// How many passes the plan of `scene` under `settings` keeps.
+fn passes(scene: &Scene, settings: &FrameSettings) -> usize {
+    common::plan(scene, settings).passes.len()
 }
 
 fn translucency_settings(w: u32, h: u32) -> FrameSettings {
     FrameSettings {
-        technique: Technique::Translucency,
+        technique: Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
         export_hdr: true,
         export_gbuffer: true,
-        // The f64 reference shades without shadows (tests/shadows.rs checks those).
+        // The f64 reference shades without shadows (tests/gpu/shadows.rs checks those).
         shadows: lucent::features::shadows::ShadowSettings {
             enabled: false,
             ..Default::default()
@@ -79,7 +72,7 @@ fn cubes_match_the_f64_reference_evaluated_from_the_gbuffer() {
             gbuffer: precision,
             ..translucency_settings(320, 240)
         };
-        let (images, _) = render(&gpu, &scene, settings);
+        let images = gpu.render(&scene, settings);
         let (max, peak) = compare_with_reference(&scene, &settings, &images);
         eprintln!(
             "cubes ({}): max |GPU - f64 reference| = {max:.3e} = {:.3e} of peak {peak:.3}",
@@ -104,16 +97,10 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     let half = lucent::bake::scene::load_scene_baked("grid125:50").unwrap();
     let plain = FrameSettings {
         technique: Technique::None,
-        export_hdr: true,
-        export_gbuffer: true,
-        shadows: lucent::features::shadows::ShadowSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..FrameSettings::new(size.0, size.1)
+        ..translucency_settings(size.0, size.1)
     };
-    let (off, _) = render(&gpu, &half, plain);
-    let (on, _) = render(&gpu, &half, translucency_settings(size.0, size.1));
+    let off = gpu.render(&half, plain);
+    let on = gpu.render(&half, translucency_settings(size.0, size.1));
     let gb2 = on.gbuffer.as_ref().unwrap().gb2.as_ref().unwrap();
     let (hdr_off, hdr_on) = (off.hdr.unwrap(), on.hdr.unwrap());
     let (mut translucent, mut changed_opaque, mut brighter) = (0, 0, 0);
@@ -145,34 +132,24 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
         .unwrap()
         .translucency
         .is_none());
-    let (with, passes_with) = render(&gpu, &smoke, settings);
-    let (without, passes_without) = render(
-        &gpu,
-        &smoke,
-        FrameSettings {
-            technique: Technique::None,
-            ..settings
-        },
-    );
+    let plain = FrameSettings {
+        technique: Technique::None,
+        ..settings
+    };
+    let with = gpu.render(&smoke, settings);
+    let without = gpu.render(&smoke, plain);
     assert!(with.gbuffer.unwrap().gb2.is_none());
-    assert_eq!(passes_with, passes_without);
+    assert_eq!(passes(&smoke, &settings), passes(&smoke, &plain));
     assert_eq!(with.display, without.display);
     gpu.finish();
 }
 
 #[test]
 fn stability_sweep_has_no_nan_or_inf_in_any_case() {
-    let gpu = TestGpu::new();
-    let cases = lucent::measure::sweep::translucency_cases();
-    let rows = lucent::measure::sweep::run_translucency(
-        &gpu.gpu,
-        &gpu.shaders,
-        &gpu.cache,
-        32,
-        24,
-        &cases,
-    )
-    .unwrap();
+    use lucent::measure::sweep::{run_translucency, translucency_cases};
+    let test = TestGpu::new();
+    let cases = translucency_cases();
+    let rows = run_translucency(&test.gpu, &test.shaders, &test.cache, 32, 24, &cases).unwrap();
     assert_eq!(rows.len(), cases.len());
     let bad: Vec<String> = rows
         .iter()
@@ -184,7 +161,7 @@ fn stability_sweep_has_no_nan_or_inf_in_any_case() {
     assert!(rows.iter().any(|r| r.max > 1.0));
     // The extreme corner saturates fp16 somewhere, and the clamp holds it finite there.
     assert!(rows.iter().any(|r| r.fp16_overflow > 0));
-    gpu.finish();
+    test.finish();
 }
 
 #[test]

@@ -2,36 +2,26 @@
 //! twin on the very image it read, flat regions untouched, silhouettes smoothed, and frames
 //! without it unchanged.
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 use lucent::features::antialias::Antialias;
-use lucent::frame::{FrameRunner, FrameSettings, Renderer};
+use lucent::frame::{FrameSettings, Renderer};
 use lucent::reference::fxaa::{fxaa_rgba8, LdrImage};
 
 /// Renders `scene_name` at `w x h` with `antialias`; returns (display, the tonemapped image
 /// FXAA read, when it ran).
 fn render(scene_name: &str, w: u32, h: u32, antialias: Antialias) -> (Vec<u8>, Option<Vec<u8>>) {
-    let test = TestGpu::new();
-    let gpu = &test.gpu;
     let scene = lucent::bake::scene::load_scene_baked(scene_name).unwrap();
     let settings = FrameSettings {
         antialias,
         export_ldr: antialias == Antialias::Fxaa,
         ..FrameSettings::new(w, h)
     };
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
-    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
-    // Two frames: the second finds every resource as the first left it.
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    let display = renderer.read_display(gpu).unwrap();
-    let ldr = settings.export_ldr.then(|| renderer.read_ldr(gpu).unwrap());
-    gpu.wait_idle().unwrap();
-    runner.destroy(gpu);
-    renderer.destroy(gpu);
+    let test = TestGpu::new();
+    let frame = test.render_repeated(&scene, settings);
     test.finish();
-    (display, ldr)
+    (frame.display, frame.ldr)
 }
 
 #[test]

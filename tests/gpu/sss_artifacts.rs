@@ -4,28 +4,21 @@
 //! brightness of adjacent columns, in display levels, against the frame without SSS).
 
 use lucent::bake::scene::load_scene_baked;
-use lucent::frame::{FrameImages, FrameSettings, Renderer, Technique};
-use lucent::scene::Scene;
+use lucent::frame::{FrameImages, FrameSettings, Technique};
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 
 const SIZE: (u32, u32) = (320, 240);
 
-fn render(test: &TestGpu, scene: &Scene, technique: Technique) -> FrameImages {
-    let settings = FrameSettings {
+fn settings(technique: Technique) -> FrameSettings {
+    FrameSettings {
         technique,
         export_hdr: true,
         export_gbuffer: true,
         ..FrameSettings::new(SIZE.0, SIZE.1)
-    };
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let images = renderer.render_once(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    renderer.destroy(gpu);
-    images
+    }
 }
 
 fn hdr_max(images: &FrameImages) -> f32 {
@@ -72,20 +65,17 @@ fn lean_specular_stays_bounded_and_draws_no_streaks() {
     let test = TestGpu::new();
     for name in ["edges", "skin"] {
         let scene = load_scene_baked(name).unwrap();
-        let plain = render(&test, &scene, Technique::None);
+        let plain = test.render(&scene, settings(Technique::None));
         let plain_max = hdr_max(&plain);
         // The profile IDs of an SSS frame mark the scattering pixels.
-        let reference = render(&test, &scene, Technique::Control);
+        let reference = test.render(
+            &scene,
+            settings(Technique::Only(&lucent::features::sss::control::CONTROL)),
+        );
         let ids = reference.gbuffer.as_ref().unwrap().sss.clone().unwrap();
         let plain_jump = column_jump(&plain, &ids);
-        for technique in [
-            Technique::Control,
-            Technique::Lcb,
-            Technique::Lbb,
-            Technique::Separable,
-            Technique::Bilateral,
-        ] {
-            let frame = render(&test, &scene, technique);
+        for technique in common::sss_techniques() {
+            let frame = test.render(&scene, settings(technique));
             let max = hdr_max(&frame);
             let jump = column_jump(&frame, &ids);
             eprintln!(

@@ -14,7 +14,7 @@
 //! 256 cases by default (well under a second); more with, for example:
 //!
 //! ```text
-//! PROPTEST_CASES=100000 cargo test --test fuzz_mesh
+//! PROPTEST_CASES=100000 cargo test --test cpu fuzz_mesh::
 //! ```
 //!
 //! (about 3 minutes on 2 cores). Prefer the default test profile over `--release`: it keeps
@@ -23,6 +23,7 @@
 
 use std::path::PathBuf;
 
+use crate::common;
 use lucent::scene::obj::load_obj;
 use proptest::prelude::*;
 use proptest::sample::{select, Index};
@@ -302,8 +303,7 @@ fn cases() -> u32 {
 }
 
 fn work_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lucent-fuzz-mesh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = common::temp_dir("fuzz-mesh");
     // A texture file that exists, for MTL lines naming tex.png.
     std::fs::write(dir.join("tex.png"), b"existence is all that is checked").expect("write");
     dir

@@ -18,8 +18,10 @@
 //! a bad key.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::time::{Duration, Instant};
+
+use crate::common;
 
 /// One row of the README's tables.
 struct Case {
@@ -28,7 +30,7 @@ struct Case {
 }
 
 fn corpus_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad")
+    common::data("bad")
 }
 
 /// The texts between pairs of backticks.
@@ -137,58 +139,54 @@ fn check_message(case: &Case, message: &str) -> Option<String> {
     (!missing.is_empty()).then(|| format!("{}: {missing:?} not in: {message}", case.file))
 }
 
-#[test]
-fn library_reports_each_problem() {
+/// Runs `check` on every file of the README's first table (with its path); fails listing
+/// every problem it reported.
+fn each_corpus_file(check: impl Fn(&Case, &Path) -> Vec<String>) {
     let (cases, _) = read_readme();
-    let mut failures = Vec::new();
-    for case in &cases {
-        let path = corpus_dir().join(&case.file);
-        let result = std::panic::catch_unwind(|| lucent::scene::inspect::inspect_file(&path));
-        match result {
-            Err(_) => failures.push(format!("{}: inspect_file panicked", case.file)),
-            Ok(Ok(summary)) => failures.push(format!("{}: accepted:\n{summary}", case.file)),
-            Ok(Err(e)) => {
-                // The message's first line is what `lucent: error:` prints on its line.
-                let message = e.to_string();
-                let first = message.lines().next().unwrap_or("");
-                failures.extend(check_message(case, first));
-            }
-        }
-    }
+    let failures: Vec<String> = cases
+        .iter()
+        .flat_map(|case| check(case, &corpus_dir().join(&case.file)))
+        .collect();
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }
 
 #[test]
+fn library_reports_each_problem() {
+    each_corpus_file(|case, path| {
+        let result = std::panic::catch_unwind(|| lucent::scene::inspect::inspect_file(path));
+        match result {
+            Err(_) => vec![format!("{}: inspect_file panicked", case.file)],
+            Ok(Ok(summary)) => vec![format!("{}: accepted:\n{summary}", case.file)],
+            Ok(Err(e)) => {
+                // The message's first line is what `lucent: error:` prints on its line.
+                let message = e.to_string();
+                let first = message.lines().next().unwrap_or("");
+                check_message(case, first).into_iter().collect()
+            }
+        }
+    });
+}
+
+#[test]
 fn cli_reports_each_problem() {
-    let (cases, _) = read_readme();
-    let mut failures = Vec::new();
-    for case in &cases {
-        let path = corpus_dir().join(&case.file);
-        let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
-            .arg("inspect")
-            .arg(&path)
-            .output()
-            .expect("the lucent binary runs");
+    each_corpus_file(|case, path| {
+        let out = lucent_in(None, &["inspect", &path.to_string_lossy()]);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        let errors: Vec<&str> = stderr
-            .lines()
-            .filter(|l| l.starts_with("lucent: error:"))
-            .collect();
+        let errors = common::error_lines(&out);
         if out.status.success() {
-            failures.push(format!("{}: exit status 0", case.file));
+            vec![format!("{}: exit status 0", case.file)]
         } else if stderr.contains("panicked") {
-            failures.push(format!("{}: panicked:\n{stderr}", case.file));
+            vec![format!("{}: panicked:\n{stderr}", case.file)]
         } else if errors.len() != 1 {
-            failures.push(format!(
+            vec![format!(
                 "{}: {} 'lucent: error:' lines in stderr:\n{stderr}",
                 case.file,
                 errors.len()
-            ));
+            )]
         } else {
-            failures.extend(check_message(case, errors[0]));
+            check_message(case, &errors[0]).into_iter().collect()
         }
-    }
-    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+    });
 }
 
 #[test]
@@ -224,27 +222,14 @@ fn repaired_files_load_and_say_what_was_repaired() {
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }
 
-/// `lucent ARGS` with a time limit (a test that hangs is a failure, not a stuck CI job).
+/// `lucent ARGS` in `dir` (or here), failing after a minute (a hang is a failure).
 fn lucent_in(dir: Option<&Path>, args: &[&str]) -> Output {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lucent"));
-    command
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
+    let mut command = common::lucent_command();
+    command.args(args);
     if let Some(dir) = dir {
         command.current_dir(dir);
     }
-    let mut child = command.spawn().expect("the lucent binary runs");
-    let start = Instant::now();
-    while child.try_wait().expect("waitable").is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("lucent {args:?} still running after 60 s (hung)");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().expect("output")
+    common::output_within(&mut command, Duration::from_secs(60))
 }
 
 fn lucent(args: &[&str]) -> Output {
@@ -257,24 +242,14 @@ fn one_error_line(args: &[&str], out: &Output) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{args:?} succeeded:\n{stderr}");
     assert!(!stderr.contains("panicked"), "{args:?} panicked:\n{stderr}");
-    let errors: Vec<&str> = stderr
-        .lines()
-        .filter(|l| l.starts_with("lucent: error:"))
-        .collect();
+    let errors = common::error_lines(out);
     assert_eq!(errors.len(), 1, "{args:?}: not one error line:\n{stderr}");
     let lines = stderr.lines().filter(|l| !l.trim().is_empty()).count();
     assert_eq!(
         lines, 1,
         "{args:?}: a command-line error is one line, not:\n{stderr}"
     );
-    errors[0].to_string()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("bad-inputs-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    errors[0].clone()
 }
 
 const SCENE: &str = "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\n[[mesh]]\nname = \"m\"\n\
@@ -288,7 +263,7 @@ fn scene_with(mesh: &str, material: &str) -> String {
 #[cfg(unix)]
 #[test]
 fn devices_fifos_and_directories_are_refused_at_once() {
-    let dir = temp_dir("special");
+    let dir = common::temp_dir("bad-inputs-special");
     let fifo = |name: &str| {
         let path = dir.join(name);
         let made = Command::new("mkfifo")
@@ -325,47 +300,28 @@ fn devices_fifos_and_directories_are_refused_at_once() {
     let d = |name: &str| dir.join(name).to_string_lossy().into_owned();
     let fifo_says = "is a FIFO (named pipe), not a regular file";
     let zero_says = "is a symlink to /dev/zero, which is a character device, not a regular file";
-    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+    let inspect = |file: &str| vec!["inspect".to_string(), d(file)];
+    let mut cases: Vec<(Vec<String>, Vec<&str>)> = Vec::new();
+    for file in ["fifo.obj", "fifo.toml", "fifo.png", "fifo.mtl"] {
+        cases.push((inspect(file), vec![file, fifo_says]));
+    }
+    for file in ["zero.obj", "zero.png"] {
+        cases.push((inspect(file), vec![file, zero_says]));
+    }
+    cases.extend([
         (
-            vec!["inspect".into(), d("fifo.obj")],
-            vec!["fifo.obj", fifo_says],
-        ),
-        (
-            vec!["inspect".into(), d("fifo.toml")],
-            vec!["fifo.toml", fifo_says],
-        ),
-        (
-            vec!["inspect".into(), d("fifo.png")],
-            vec!["fifo.png", fifo_says],
-        ),
-        (
-            vec!["inspect".into(), d("fifo.mtl")],
-            vec!["fifo.mtl", fifo_says],
-        ),
-        (
-            vec!["inspect".into(), d("zero.obj")],
-            vec!["zero.obj", zero_says],
-        ),
-        (
-            vec!["inspect".into(), d("zero.png")],
-            vec!["zero.png", zero_says],
-        ),
-        (
-            vec!["inspect".into(), d("link.toml")],
+            inspect("link.toml"),
             vec!["link.toml", "is a symlink to", "a FIFO (named pipe)"],
         ),
         (
-            vec!["inspect".into(), d("folder.obj")],
+            inspect("folder.obj"),
             vec!["folder.obj", "is a directory, not a regular file"],
         ),
         (
-            vec!["inspect".into(), d("uses_fifo.obj")],
+            inspect("uses_fifo.obj"),
             vec!["fifo.mtl", "mtllib on line 1", fifo_says],
         ),
-        (
-            vec!["inspect".into(), d("fifo_mesh.toml")],
-            vec!["fifo.obj", fifo_says],
-        ),
+        (inspect("fifo_mesh.toml"), vec!["fifo.obj", fifo_says]),
         (
             vec!["render".into(), "--scene".into(), d("fifo.toml")],
             vec!["fifo.toml", fifo_says],
@@ -383,12 +339,11 @@ fn devices_fifos_and_directories_are_refused_at_once() {
             ],
             vec!["zero.obj", zero_says],
         ),
-    ];
+    ]);
     for (args, wanted) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let start = Instant::now();
-        let out = lucent(&args);
-        let line = one_error_line(&args, &out);
+        let line = one_error_line(&args, &lucent(&args));
         for w in wanted {
             assert!(line.contains(w), "{args:?}: '{w}' not in: {line}");
         }
@@ -460,8 +415,7 @@ fn command_line_errors_are_one_line_with_the_fix() {
         (&["bench", "--format", "xml"], &["xml"]),
     ];
     for &(args, wanted) in cases {
-        let out = lucent(args);
-        let line = one_error_line(args, &out);
+        let line = one_error_line(args, &lucent(args));
         for w in wanted {
             assert!(line.contains(w), "{args:?}: '{w}' not in: {line}");
         }
@@ -477,120 +431,70 @@ fn command_line_errors_are_one_line_with_the_fix() {
 
 #[test]
 fn knobs_that_do_not_apply_warn_naming_the_technique_they_need() {
-    let warnings = |args: &[&str]| {
-        let out = lucent(args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stderr)
+    // `lucent LINE` succeeds with one warning per entry of `wanted`, the k-th containing every
+    // substring of `wanted[k]`.
+    let warns = |line: &str, wanted: &[&[&str]]| {
+        let args = common::words(line);
+        let out = lucent(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        let w: Vec<&str> = stderr
             .lines()
             .filter(|l| l.starts_with("lucent: warning:"))
-            .map(str::to_string)
-            .collect::<Vec<_>>()
+            .collect();
+        assert_eq!(w.len(), wanted.len(), "{line}: {w:?}");
+        for (warning, parts) in w.iter().zip(wanted) {
+            for part in *parts {
+                assert!(warning.contains(part), "{line}: '{part}' not in {warning}");
+            }
+        }
     };
-    let w = warnings(&[
-        "plan",
-        "--technique",
-        "none",
-        "--sss-taps",
-        "3",
-        "--sss-packed",
-    ]);
-    assert_eq!(w.len(), 2, "{w:?}");
-    assert!(
-        w[0].contains("--sss-taps has no effect with --technique none")
-            && w[0].contains("--technique lbb"),
-        "{w:?}"
+    warns(
+        "plan --technique none --sss-taps 3 --sss-packed",
+        &[
+            &[
+                "--sss-taps has no effect with --technique none",
+                "--technique lbb",
+            ],
+            &["--sss-packed", "--technique lbb"],
+        ],
     );
-    assert!(
-        w[1].contains("--sss-packed") && w[1].contains("--technique lbb"),
-        "{w:?}"
+    warns(
+        "plan --scene skin --technique control --sss-packed",
+        &[&["--technique control", "lbb"]],
     );
-    let w = warnings(&[
-        "plan",
-        "--scene",
-        "skin",
-        "--technique",
-        "control",
-        "--sss-packed",
-    ]);
-    assert!(
-        w.len() == 1 && w[0].contains("--technique control") && w[0].contains("lbb"),
-        "{w:?}"
-    );
-    let w = warnings(&[
-        "plan",
-        "--technique",
-        "translucency",
-        "--sss-gaussians",
-        "2",
-    ]);
-    assert!(
-        w.len() == 1 && w[0].contains("control, lcb, lbb, separable or bilateral"),
-        "{w:?}"
+    warns(
+        "plan --technique translucency --sss-gaussians 2",
+        &[&["control, lcb, lbb, separable or bilateral"]],
     );
     // The two-pass knobs name the blurs they apply to.
-    let w = warnings(&[
-        "plan",
-        "--scene",
-        "skin",
-        "--technique",
-        "lbb",
-        "--sss-samples",
-        "25",
-        "--sss-half-res",
-    ]);
-    assert!(
-        w.len() == 2
-            && w[0].contains("--sss-samples")
-            && w[0].contains("--technique separable or bilateral")
-            && w[1].contains("--sss-half-res")
-            && w[1].contains("--technique separable"),
-        "{w:?}"
+    warns(
+        "plan --scene skin --technique lbb --sss-samples 25 --sss-half-res",
+        &[
+            &["--sss-samples", "--technique separable or bilateral"],
+            &["--sss-half-res", "--technique separable"],
+        ],
     );
-    let w = warnings(&[
-        "plan",
-        "--scene",
-        "skin",
-        "--technique",
-        "separable",
-        "--sss-samples",
-        "25",
-        "--sss-half-res",
-        "--sss-filter",
-        "bilinear",
-        "--sss-kernel",
-        "line",
-    ]);
-    assert!(w.is_empty(), "{w:?}");
-    let w = warnings(&["plan", "--technique", "none", "--grayscale"]);
-    assert!(
-        w.len() == 1 && w[0].contains("--technique translucency"),
-        "{w:?}"
+    warns(
+        "plan --scene skin --technique separable --sss-samples 25 --sss-half-res \
+         --sss-filter bilinear --sss-kernel line",
+        &[],
+    );
+    warns(
+        "plan --technique none --grayscale",
+        &[&["--technique translucency"]],
     );
     // Under auto the frame decides: skin's profile is blurred with the control, so the
     // bilateral knobs still do nothing.
-    let w = warnings(&["plan", "--scene", "skin", "--sss-packed"]);
-    assert!(
-        w.len() == 1 && w[0].contains("--technique auto on scene 'skin'") && w[0].contains("lbb"),
-        "{w:?}"
+    warns(
+        "plan --scene skin --sss-packed",
+        &[&["--technique auto on scene 'skin'", "lbb"]],
     );
     // Where they apply, no warning.
-    let w = warnings(&[
-        "plan",
-        "--scene",
-        "skin",
-        "--technique",
-        "lbb",
-        "--sss-taps",
-        "3",
-        "--sss-packed",
-        "--sensitivity",
-        "2",
-    ]);
-    assert!(w.is_empty(), "{w:?}");
+    warns(
+        "plan --scene skin --technique lbb --sss-taps 3 --sss-packed --sensitivity 2",
+        &[],
+    );
 }
 
 /// Writes a `size` x `size` RGB8 PNG of the flat normal (128, 128, 255) row by row, so the test
@@ -615,7 +519,7 @@ fn write_flat_normal_map(path: &Path, size: u32) {
 
 #[test]
 fn a_16384_squared_normal_map_is_refused_from_its_header_in_under_a_second() {
-    let dir = temp_dir("huge-normal-map");
+    let dir = common::temp_dir("bad-inputs-huge-normal-map");
     let map = dir.join("normal16k.png");
     write_flat_normal_map(&map, 16384);
     // A real, decodable PNG of that size (not only a header).
@@ -690,7 +594,7 @@ fn a_16384_squared_normal_map_is_refused_from_its_header_in_under_a_second() {
 
 #[test]
 fn a_bake_whose_uvs_cover_no_texel_is_an_error_not_a_black_map() {
-    let dir = temp_dir("bake-no-texel");
+    let dir = common::temp_dir("bad-inputs-bake-no-texel");
     // A tetrahedron whose UVs all sit in a speck smaller than a texel.
     let obj = dir.join("speck.obj");
     std::fs::write(
@@ -700,18 +604,9 @@ fn a_bake_whose_uvs_cover_no_texel_is_an_error_not_a_black_map() {
     )
     .unwrap();
     let out_png = dir.join("t.png");
-    let args = [
-        "bake-thickness",
-        &*obj.to_string_lossy(),
-        "--out",
-        &*out_png.to_string_lossy(),
-        "--rays",
-        "8",
-    ]
-    .map(str::to_string);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let out = lucent(&args);
-    let line = one_error_line(&args, &out);
+    let (obj, out_png_arg) = (obj.to_string_lossy(), out_png.to_string_lossy());
+    let args = ["bake-thickness", &obj, "--out", &out_png_arg, "--rays", "8"];
+    let line = one_error_line(&args, &lucent(&args));
     assert!(
         line.contains("cover no texel of the 512x512 map") && line.contains("--per-vertex"),
         "{line}"
@@ -723,14 +618,12 @@ fn a_bake_whose_uvs_cover_no_texel_is_an_error_not_a_black_map() {
 #[cfg(feature = "window")]
 #[test]
 fn a_bad_demo_script_fails_before_any_window_with_its_line() {
-    let dir = temp_dir("demo-script");
+    let dir = common::temp_dir("bad-inputs-demo-script");
     let script = dir.join("bad.script");
     std::fs::write(&script, "# keys\n1 key F1\n2 key Hyperspace\n3 quit\n").unwrap();
-    let args = ["demo", "--script", &*script.to_string_lossy()].map(str::to_string);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let args = ["demo", "--script", &script.to_string_lossy()];
     // No display: the script is read first, so its error comes before "cannot open a window".
-    let out = lucent(&args);
-    let line = one_error_line(&args, &out);
+    let line = one_error_line(&args, &lucent(&args));
     assert!(
         line.contains("bad.script") && line.contains("line 3: unknown key 'Hyperspace'"),
         "{line}"

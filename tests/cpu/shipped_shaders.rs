@@ -5,7 +5,7 @@
 //! Regenerate the manifest after changing a pass's defines (or adding a shader):
 //!
 //! ```text
-//! LUCENT_WRITE_MANIFEST=1 cargo test --test shipped_shaders
+//! LUCENT_WRITE_MANIFEST=1 cargo test --test cpu shipped_shaders::
 //! ```
 
 use std::path::Path;

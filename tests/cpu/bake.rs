@@ -2,21 +2,35 @@
 //! dilation, and the on-disk cache. Run with `--nocapture` to see the measured errors.
 //!
 //! The bake time of a ~10k-triangle mesh (for the README) is an ignored test:
-//! `cargo test --release --test bake -- --ignored --nocapture bake_time`.
+//! `cargo test --release --test cpu -- --ignored --nocapture bake_time`.
 
-use std::path::PathBuf;
-
+use crate::common;
 use glam::{Vec2, Vec3};
 use lucent::bake::{
     bake_per_vertex, bake_points, bake_report, bake_texture, cache_file, cached_per_vertex,
-    cached_per_vertex_with_status, BakeOptions, SamplePoint, DILATION_RINGS,
+    cached_per_vertex_with_status, BakeOptions, BakeStats, SamplePoint, DILATION_RINGS,
 };
 use lucent::scene::{Mesh, Shape};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lucent-bake-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+/// Prints how the bake of `what` compares with `expected` and checks its mean within 0.02;
+/// returns the largest per-vertex error.
+fn check_mean(what: &str, values: &[f32], expected: f32, stats: &BakeStats) -> f32 {
+    let mean = values.iter().sum::<f32>() / values.len() as f32;
+    let worst = values
+        .iter()
+        .map(|v| (v - expected).abs())
+        .fold(0.0f32, f32::max);
+    println!(
+        "{what}: expected {expected:.4}, mean {mean:.4} (error {:+.4}), worst per-vertex error \
+         {worst:.4}; {}",
+        mean - expected,
+        bake_report(stats)
+    );
+    assert!(
+        (mean - expected).abs() < 0.02,
+        "{what}: mean {mean} vs {expected}"
+    );
+    worst
 }
 
 fn assert_unit_interval(values: &[f32]) {
@@ -122,21 +136,7 @@ fn slab_matches_one_minus_d_over_d_max_squared() {
         let (values, stats) = bake_points(&mesh, &central, &options).unwrap();
         assert_unit_interval(&values);
         let expected = 1.0 - ratio * ratio;
-        let mean = values.iter().sum::<f32>() / values.len() as f32;
-        let worst = values
-            .iter()
-            .map(|v| (v - expected).abs())
-            .fold(0.0f32, f32::max);
-        println!(
-            "slab d/D = {ratio}: expected {expected:.4}, mean {mean:.4} (error {:+.4}), worst \
-             per-vertex error {worst:.4}; {}",
-            mean - expected,
-            bake_report(&stats)
-        );
-        assert!(
-            (mean - expected).abs() < 0.02,
-            "d/D = {ratio}: mean {mean} vs {expected}"
-        );
+        let worst = check_mean(&format!("slab d/D = {ratio}"), &values, expected, &stats);
         // One vertex is a binomial estimate: allow five standard errors.
         assert!(
             worst < 5.0 * stats.std_error as f32,
@@ -167,23 +167,9 @@ fn sphere_matches_d_over_two_r_squared() {
         assert_eq!(values.len(), mesh.vertex_count());
         assert_unit_interval(&values);
         let expected = if d >= 2.0 { 1.0 } else { (d / 2.0).powi(2) };
-        let mean = values.iter().sum::<f32>() / values.len() as f32;
-        let worst = values
-            .iter()
-            .map(|v| (v - expected).abs())
-            .fold(0.0f32, f32::max);
-        println!(
-            "sphere D = {d}: expected {expected:.4}, mean {mean:.4} (error {:+.4}), worst \
-             per-vertex error {worst:.4}; {}",
-            mean - expected,
-            bake_report(&stats)
-        );
         // The 64 x 32 polyhedron is inscribed in the sphere, so its chords are up to ~0.25%
         // shorter; that bias (< 0.002 here) is well inside the tolerance.
-        assert!(
-            (mean - expected).abs() < 0.02,
-            "D = {d}: mean {mean} vs {expected}"
-        );
+        let worst = check_mean(&format!("sphere D = {d}"), &values, expected, &stats);
         assert!(worst < 6.0 * stats.std_error as f32, "D = {d}: {worst}");
     }
 }
@@ -294,7 +280,7 @@ fn texture_bake_fills_charts_and_a_dilated_ring_and_writes_a_png() {
             assert_eq!(map.values[i], 0.0, "texel {x} beyond the dilation");
         }
     }
-    let dir = temp_dir("png");
+    let dir = common::temp_dir("bake-png");
     let path = dir.join("thickness.png");
     map.write_png(&path).unwrap();
     let (w, h, rgba) = lucent::images::output::read_png_rgba8(&path).unwrap();
@@ -335,7 +321,7 @@ fn texture_bake_needs_uvs_and_survives_odd_charts() {
 
 #[test]
 fn cache_hits_misses_and_survives_corruption() {
-    let dir = temp_dir("cache");
+    let dir = common::temp_dir("bake-cache");
     let mesh = Mesh::generate(Shape::Sphere { radius: 1.0 }, 16, 8);
     let options = BakeOptions {
         rays: 32,
@@ -406,7 +392,7 @@ fn cache_hits_misses_and_survives_corruption() {
 }
 
 /// The README's bake-time figure: a 100 x 50 UV sphere (9,800 triangles, 5,151 vertices) at 256
-/// rays per vertex. `cargo test --release --test bake -- --ignored --nocapture bake_time`
+/// rays per vertex. `cargo test --release --test cpu -- --ignored --nocapture bake_time`
 #[test]
 #[ignore]
 fn bake_time_of_a_10k_triangle_mesh() {

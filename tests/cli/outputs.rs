@@ -8,15 +8,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("outputs-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common;
 
 fn lucent(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lucent"))
+    common::lucent_command()
         .args(args)
         .current_dir(dir)
         .output()
@@ -39,7 +34,7 @@ const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 #[cfg(unix)]
 #[test]
 fn symlinked_outputs_are_written_through_and_stay_links() {
-    let dir = temp_dir("symlink");
+    let dir = common::temp_dir("outputs-symlink");
     std::fs::create_dir_all(dir.join("real")).unwrap();
     std::fs::write(dir.join("real/frame.png"), b"old").unwrap();
     std::os::unix::fs::symlink("real/frame.png", dir.join("frame.png")).unwrap();
@@ -67,7 +62,7 @@ fn symlinked_outputs_are_written_through_and_stay_links() {
 #[cfg(unix)]
 #[test]
 fn devices_and_fifos_are_written_into_never_replaced() {
-    let dir = temp_dir("devices");
+    let dir = common::temp_dir("outputs-devices");
     // /dev/null through a symlink and directly, twice in one command (writing into a device
     // twice overwrites nothing).
     std::os::unix::fs::symlink("/dev/null", dir.join("null.png")).unwrap();
@@ -137,10 +132,7 @@ fn refused(dir: &Path, args: &[&str], wanted: &[&str]) {
     let took = start.elapsed();
     let e = stderr(&out);
     assert!(!out.status.success(), "{args:?} succeeded");
-    let lines: Vec<&str> = e
-        .lines()
-        .filter(|l| l.starts_with("lucent: error:"))
-        .collect();
+    let lines = common::error_lines(&out);
     assert_eq!(lines.len(), 1, "{args:?}: {e}");
     for w in wanted {
         assert!(lines[0].contains(w), "{args:?}: '{w}' not in {}", lines[0]);
@@ -162,7 +154,7 @@ fn refused(dir: &Path, args: &[&str], wanted: &[&str]) {
 
 #[test]
 fn outputs_that_are_inputs_or_each_other_are_refused_before_any_work() {
-    let dir = temp_dir("same-file");
+    let dir = common::temp_dir("outputs-same-file");
     let cube = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\n\
                 v -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
     std::fs::write(dir.join("in.obj"), cube).unwrap();

@@ -1,46 +1,29 @@
 //! End-to-end rendering tests on lavapipe with the validation layer (synchronization validation
 //! included) on: any validation error fails the test.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
-use lucent::frame::{FrameRunner, FrameSettings, Renderer, Technique};
+use crate::common::TestGpu;
+use lucent::frame::{FrameSettings, Technique};
 use lucent::graph::CompileOptions;
-use lucent::images::compare::{compare_with_golden, flip_rgba8, FlipThresholds};
+use lucent::images::compare::{flip_rgba8, FlipThresholds};
 use lucent::reference::raytrace;
 use lucent::scene;
-
-fn output_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-output");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Renders one frame of a built-in scene with validation on; returns (display RGBA8, HDR f32).
 fn render(scene_name: &str, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32>>) {
     render_scene(&scene::builtin(scene_name).unwrap(), settings)
 }
 
-/// Renders one frame of `scene` with validation on; returns (display RGBA8, HDR f32).
+/// Renders `scene` on a device of its own ([`TestGpu::render_repeated`]) with validation on;
+/// returns (display RGBA8, HDR f32).
 fn render_scene(scene: &scene::Scene, settings: FrameSettings) -> (Vec<u8>, Option<Vec<f32>>) {
     let test = TestGpu::new();
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
-    // Two frames: the second must find every resource in the state the first left it.
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    runner.run_frame(gpu, &renderer.executable).unwrap();
-    runner.run_isolated(gpu, &renderer.executable).unwrap();
-    let display = renderer.read_display(gpu).unwrap();
-    let hdr = settings.export_hdr.then(|| renderer.read_hdr(gpu).unwrap());
-    gpu.wait_idle().unwrap();
-    runner.destroy(gpu);
-    renderer.destroy(gpu);
+    let frame = test.render_repeated(scene, settings);
     test.finish();
-    (display, hdr)
+    (frame.display, frame.hdr)
 }
 
 #[test]
@@ -78,7 +61,7 @@ fn translucent_cubes_and_grid125_match_their_goldens() {
     // Same settings as tests/golden/LIST's `cubes` and `grid125` lines.
     for name in ["cubes", "grid125"] {
         let settings = FrameSettings {
-            technique: Technique::Translucency,
+            technique: Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
             ..FrameSettings::new(320, 240)
         };
         check_golden(name, name, settings);
@@ -108,13 +91,7 @@ fn dynamic_at_half_a_second_matches_its_golden() {
 fn sss_scenes_match_their_goldens_under_every_sss_technique() {
     // Same settings as tests/golden/LIST's `skin-*` and `teapot-*` lines.
     for scene_name in ["skin", "teapot"] {
-        for technique in [
-            Technique::Control,
-            Technique::Lcb,
-            Technique::Lbb,
-            Technique::Separable,
-            Technique::Bilateral,
-        ] {
+        for technique in common::sss_techniques() {
             let settings = FrameSettings {
                 technique,
                 ..FrameSettings::new(320, 240)
@@ -136,29 +113,10 @@ fn check_golden(name: &str, scene_name: &str, settings: FrameSettings) {
 
 /// [`check_golden`] with the scene shown at `time` seconds (`render --time`).
 fn check_golden_at(name: &str, scene_name: &str, time: f32, settings: FrameSettings) {
-    let (w, h) = (settings.width, settings.height);
     let mut scene = lucent::bake::scene::load_scene_baked(scene_name).unwrap();
     scene.time = time;
     let (display, _) = render_scene(&scene, settings);
-    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
-    let outcome = compare_with_golden(
-        name,
-        &golden,
-        &display,
-        w,
-        h,
-        &FlipThresholds::default(),
-        &output_dir(),
-    )
-    .unwrap();
-    assert!(
-        outcome.passed,
-        "{name} differs from its golden: mean FLIP {:.4}, {:.3}% of pixels above threshold; see {:?} and {:?}",
-        outcome.result.mean,
-        outcome.result.fraction_above * 100.0,
-        outcome.actual_path,
-        outcome.diff_path
-    );
+    common::check_golden(name, &display, settings.width, settings.height);
 }
 
 #[test]
@@ -167,7 +125,7 @@ fn smoke_matches_the_raytraced_f64_reference() {
     let mut settings = FrameSettings::new(w, h);
     settings.export_hdr = true;
     // The ray tracer's lighting has no shadow rays: its twin is the unshadowed frame
-    // (tests/shadows.rs checks the GPU's visibility against rays).
+    // (tests/gpu/shadows.rs checks the GPU's visibility against rays).
     settings.shadows.enabled = false;
     let (display, hdr) = render("smoke", settings);
     let hdr = hdr.unwrap();
@@ -225,7 +183,7 @@ fn smoke_matches_the_raytraced_f64_reference() {
         flip.fraction_above * 100.0
     );
     if !flip.within(&FlipThresholds::default()) {
-        let dir = output_dir();
+        let dir = common::output_dir();
         lucent::images::output::write_png_rgba8(
             &dir.join("smoke-reference.expected.png"),
             w,
@@ -266,29 +224,30 @@ fn merged_and_unmerged_graphs_render_the_same_frame() {
         ..CompileOptions::default()
     };
     let (separate, _) = render("smoke", settings);
-    let max_diff = merged
-        .iter()
-        .zip(&separate)
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap();
+    let max_diff = common::max_difference(&merged, &separate);
     assert!(
         max_diff <= 1,
         "merged and separate passes differ by {max_diff}/255"
     );
 }
 
+/// `lucent` with the validation layer on.
 fn lucent_command() -> Command {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lucent"));
+    let mut cmd = common::lucent_command();
     cmd.env("LUCENT_VALIDATION", "1");
     cmd
+}
+
+/// Runs `lucent ARGS` with the validation layer on.
+fn validated(args: &[&str]) -> Output {
+    lucent_command().args(args).output().unwrap()
 }
 
 #[test]
 fn render_without_a_vulkan_driver_fails_with_one_line() {
     let out = lucent_command()
         .args(["render", "--scene", "smoke", "--out"])
-        .arg(output_dir().join("never-written.png"))
+        .arg(common::output_dir().join("never-written.png"))
         .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
         .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
         .env("RUST_BACKTRACE", "1")
@@ -297,10 +256,7 @@ fn render_without_a_vulkan_driver_fails_with_one_line() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(!stderr.contains("panicked"), "{stderr}");
-    let lines: Vec<&str> = stderr
-        .lines()
-        .filter(|l| l.starts_with("lucent: error:"))
-        .collect();
+    let lines = common::error_lines(&out);
     assert_eq!(lines.len(), 1, "{stderr}");
     assert!(
         lines[0].contains("no Vulkan driver") && lines[0].contains("mesa-vulkan-drivers"),
@@ -310,7 +266,7 @@ fn render_without_a_vulkan_driver_fails_with_one_line() {
 
 #[test]
 fn bench_writes_the_documented_json() {
-    let json_path = output_dir().join("bench.json");
+    let json_path = common::output_dir().join("bench.json");
     let out = lucent_command()
         .args([
             "bench",
@@ -378,10 +334,7 @@ fn bench_writes_the_documented_json() {
 
 #[test]
 fn plan_command_prints_the_merged_group() {
-    let out = lucent_command()
-        .args(["plan", "--scene", "smoke"])
-        .output()
-        .unwrap();
+    let out = validated(&["plan", "--scene", "smoke"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -390,10 +343,7 @@ fn plan_command_prints_the_merged_group() {
         "{text}"
     );
     assert!(text.contains("transient total:"), "{text}");
-    let out = lucent_command()
-        .args(["plan", "--scene", "smoke", "--no-merge"])
-        .output()
-        .unwrap();
+    let out = validated(&["plan", "--scene", "smoke", "--no-merge"]);
     let text = String::from_utf8_lossy(&out.stdout);
     // light-space maps, gbuffer, lighting, tonemap: unmerged, lighting is third.
     assert!(text.contains("[2] \"lighting\""), "{text}");
@@ -401,35 +351,24 @@ fn plan_command_prints_the_merged_group() {
 
 #[test]
 fn unknown_scene_and_bad_size_are_clear_errors() {
-    let out = lucent_command()
-        .args(["plan", "--scene", "nope"])
-        .output()
-        .unwrap();
+    let out = validated(&["plan", "--scene", "nope"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown scene 'nope'"));
-    let out = lucent_command()
-        .args(["plan", "--size", "0x10"])
-        .output()
-        .unwrap();
+    let out = validated(&["plan", "--size", "0x10"]);
     assert!(!out.status.success());
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }
 
 #[test]
 fn render_writes_png_and_linear_exr() {
-    let dir = output_dir();
+    let dir = common::output_dir();
     let (png, exr) = (dir.join("cli-smoke.png"), dir.join("cli-smoke.exr"));
-    let out = lucent_command()
-        .args(["render", "--scene", "smoke", "--size", "96x64", "--out"])
-        .arg(&png)
-        .arg("--exr")
-        .arg(&exr)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::succeeded(
+        lucent_command()
+            .args(["render", "--scene", "smoke", "--size", "96x64", "--out"])
+            .arg(&png)
+            .arg("--exr")
+            .arg(&exr),
     );
     let (w, h, _) = lucent::images::output::read_png_rgba8(&png).unwrap();
     assert_eq!((w, h), (96, 64));
@@ -444,23 +383,10 @@ fn render_writes_png_and_linear_exr() {
 
 #[test]
 fn bench_against_another_technique_prints_both_sides_and_the_ratio() {
-    let stdout = common::run_bench(&[
-        "bench",
-        "--scene",
-        "grid125:50",
-        "--size",
-        "96x72",
-        "--frames",
-        "3",
-        "--warmup",
-        "1",
-        "--technique",
-        "translucency",
-        "--against",
-        "none",
-        "--no-merge",
-        "--validation",
-    ]);
+    let stdout = common::run_bench(
+        "bench --scene grid125:50 --size 96x72 --frames 3 --warmup 1 --technique translucency \
+         --against none --no-merge --validation",
+    );
     assert!(
         stdout.contains("`translucency` against `none`, alternating frames"),
         "{stdout}"

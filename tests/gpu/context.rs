@@ -76,6 +76,16 @@ fn clear_color(ctx: &GpuContext, image: &GpuImage, color: vk::ClearColorValue) {
 }
 
 /// Native-endian `f32`s from raw texel bytes.
+/// Creates an image, clears it to `color` and reads it back from `TRANSFER_DST_OPTIMAL`.
+fn cleared(ctx: &GpuContext, desc: &ImageDesc, name: &str, color: [f32; 4]) -> (GpuImage, Vec<u8>) {
+    let image = ctx.create_image(desc, name).expect("create image");
+    clear_color(ctx, &image, vk::ClearColorValue { float32: color });
+    let bytes = ctx
+        .read_image(&image, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+        .expect("read the image back");
+    (image, bytes)
+}
+
 fn to_f32(bytes: &[u8]) -> Vec<f32> {
     bytes
         .chunks_exact(4)
@@ -239,23 +249,9 @@ fn clear_image_and_read_it_back() {
     let sampled = usage | vk::ImageUsageFlags::SAMPLED;
 
     // RGBA8, non-square so a row-pitch mistake shows.
-    let rgba = ctx
-        .create_image(
-            &ImageDesc::color(37, 19, vk::Format::R8G8B8A8_UNORM, sampled),
-            "test rgba8",
-        )
-        .expect("create image");
+    let rgba_desc = ImageDesc::color(37, 19, vk::Format::R8G8B8A8_UNORM, sampled);
+    let (rgba, bytes) = cleared(&ctx, &rgba_desc, "test rgba8", [1.0, 0.2, 0.0, 1.0]);
     assert_ne!(rgba.view, vk::ImageView::null());
-    clear_color(
-        &ctx,
-        &rgba,
-        vk::ClearColorValue {
-            float32: [1.0, 0.2, 0.0, 1.0],
-        },
-    );
-    let bytes = ctx
-        .read_image(&rgba, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .expect("read rgba8");
     assert_eq!(bytes.len(), 37 * 19 * 4);
     for (i, px) in bytes.chunks_exact(4).enumerate() {
         let expected = [255u8, 51, 0, 255];
@@ -269,23 +265,9 @@ fn clear_image_and_read_it_back() {
     assert_eq!(again, bytes);
 
     // A float format: exact values.
-    let float = ctx
-        .create_image(
-            &ImageDesc::color(8, 4, vk::Format::R32_SFLOAT, usage),
-            "test r32f",
-        )
-        .expect("create r32f");
+    let float_desc = ImageDesc::color(8, 4, vk::Format::R32_SFLOAT, usage);
+    let (float, floats) = cleared(&ctx, &float_desc, "test r32f", [0.25, 0.0, 0.0, 0.0]);
     assert_eq!(float.view, vk::ImageView::null());
-    clear_color(
-        &ctx,
-        &float,
-        vk::ClearColorValue {
-            float32: [0.25, 0.0, 0.0, 0.0],
-        },
-    );
-    let floats = ctx
-        .read_image(&float, vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-        .expect("read r32f");
     let floats: Vec<f32> = to_f32(&floats);
     assert_eq!(floats, vec![0.25f32; 32]);
 
@@ -497,7 +479,12 @@ fn run_child(mode: &str, env: &[(&str, &str)]) -> String {
     let exe = std::env::current_exe().expect("test binary path");
     let mut command = std::process::Command::new(exe);
     command
-        .args(["environment_child", "--exact", "--ignored", "--nocapture"])
+        .args([
+            "context::environment_child",
+            "--exact",
+            "--ignored",
+            "--nocapture",
+        ])
         .env(CHILD_MODE, mode)
         .envs(env.iter().copied());
     let output = command.output().expect("spawn the test binary");

@@ -2,28 +2,12 @@
 //! writes `li.md` and `li-error-vs-time.png`, every variant has a finite error and a finite,
 //! positive time, and the Markdown names every knob of Li et al.'s technique.
 
-use std::path::Path;
-
+use crate::common;
 use lucent::report::li::{li_variants, KNOBS};
 
 #[test]
 fn quick_li_report_times_and_measures_every_knob() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-li-quick");
-    let _ = std::fs::remove_dir_all(&dir);
-    let started = std::time::Instant::now();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .env("LUCENT_VALIDATION", "1")
-        .args(["report", "li", "--quick", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    println!(
-        "report li --quick took {:.1} s",
-        started.elapsed().as_secs_f64()
-    );
+    let dir = common::report(&["li", "--quick"], "report-li-quick");
 
     let text = std::fs::read_to_string(dir.join("li.md")).unwrap();
     println!("{text}");

@@ -4,18 +4,17 @@
 
 use glam::Vec3;
 use lucent::features::layered::{LayeredKnobs, PhaseForm};
-use lucent::frame::{plan_frame, FrameDesc, FrameSettings, Renderer, Technique};
+use lucent::frame::{FrameDesc, FrameSettings, Technique};
 use lucent::graph::Plan;
 use lucent::measure::layered_error::{
     clear_medium, comparison_lights, sphere_scene, term_error, Term,
 };
 use lucent::scene::builtin;
 use lucent::scene::layered::{Layer, LayeredMedium, Thickness};
-use lucent::scene::Scene;
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 
 fn settings(w: u32, h: u32) -> FrameSettings {
     let mut s = FrameSettings::new(w, h);
@@ -148,10 +147,6 @@ fn each_term_agrees_with_its_reference() {
     test.finish();
 }
 
-fn plan(scene: &Scene, s: &FrameSettings) -> Plan {
-    plan_frame(s, &FrameDesc::new(scene, s).unwrap()).unwrap()
-}
-
 fn passes(plan: &Plan) -> Vec<String> {
     plan.passes.iter().map(|p| p.name.clone()).collect()
 }
@@ -175,7 +170,7 @@ const LAYERED_IMAGES: [&str; 3] = ["gbuffer.layered", "layered.irradiance", "lig
 fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     let layered = builtin::builtin("layered").unwrap();
     let s = settings(320, 240);
-    let p = plan(&layered, &s);
+    let p = common::plan(&layered, &s);
     for name in LAYERED_PASSES {
         assert!(
             passes(&p).iter().any(|n| n == name),
@@ -193,25 +188,15 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     // Half-resolution irradiance.
     let mut half = s;
     half.layered.half_irradiance = true;
-    let p = plan(&layered, &half);
-    let irradiance = p
-        .resources
-        .iter()
-        .find(|r| r.name == "layered.irradiance")
-        .unwrap();
-    assert_eq!((irradiance.info.width, irradiance.info.height), (160, 120));
+    let p = common::plan(&layered, &half);
+    assert_eq!(common::image_size(&p, "layered.irradiance"), (160, 120));
     // The half-resolution gather: its half-size term, drawn before single scattering (which
     // upsamples it); the full gather (default) has no such image.
     assert!(!images(&p).iter().any(|n| n == "layered.multiple"));
     let mut half_gather = s;
     half_gather.layered.half_gather = true;
-    let p = plan(&layered, &half_gather);
-    let term = p
-        .resources
-        .iter()
-        .find(|r| r.name == "layered.multiple")
-        .expect("the half-resolution term");
-    assert_eq!((term.info.width, term.info.height), (160, 120));
+    let p = common::plan(&layered, &half_gather);
+    assert_eq!(common::image_size(&p, "layered.multiple"), (160, 120));
     let order = passes(&p);
     let at = |name: &str| order.iter().position(|n| n == name).unwrap();
     assert!(
@@ -222,14 +207,14 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     // but there is no light-space map, so no entry target.
     let mut no_shadows = s;
     no_shadows.shadows.enabled = false;
-    let p = plan(&layered, &no_shadows);
+    let p = common::plan(&layered, &no_shadows);
     assert!(passes(&p).iter().any(|n| n == "single scattering"));
     assert!(!images(&p).iter().any(|n| n.starts_with("light-space")));
-    // --technique none (and the other single techniques) leave layered media out.
-    for technique in [Technique::None, Technique::Translucency, Technique::Control] {
+    // --technique none (and every other technique but auto and layered) leave layered media out.
+    for technique in common::techniques().into_iter().filter(|t| !t.layered()) {
         let mut t = s;
         t.technique = technique;
-        let p = plan(&layered, &t);
+        let p = common::plan(&layered, &t);
         for name in LAYERED_PASSES {
             assert!(
                 !passes(&p).contains(&name.to_string()),
@@ -246,7 +231,7 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     // Scenes without layered materials: no pass, no image, and the maps have no entry target.
     for scene in ["smoke", "cubes", "skin", "teapot", "mixed"] {
         let scene = lucent::scene::load_scene(scene).unwrap();
-        let p = plan(&scene, &s);
+        let p = common::plan(&scene, &s);
         for name in LAYERED_PASSES {
             assert!(
                 !passes(&p).contains(&name.to_string()),
@@ -273,11 +258,7 @@ fn the_layered_scene_differs_from_plain_lighting() {
     let render = |technique| {
         let mut s = settings(160, 120);
         s.technique = technique;
-        let r = Renderer::new(&test.gpu, &test.shaders, &test.cache, &scene, s).unwrap();
-        let images = r.render_once(&test.gpu).unwrap();
-        test.gpu.wait_idle().unwrap();
-        r.destroy(&test.gpu);
-        images.display
+        test.render(&scene, s).display
     };
     let (plain, layered) = (render(Technique::None), render(Technique::Auto));
     let changed = plain
@@ -329,8 +310,7 @@ fn texdep_medium(path: Option<&std::path::Path>, top: f32, middle: f32) -> Layer
 /// Writes a 64 x 64 RGBA32F EXR whose texel at row `y` is `texel(y / 63)`.
 fn depth_exr(name: &str, texel: impl Fn(f32) -> [f32; 4]) -> std::path::PathBuf {
     // One folder per file: the tests run in parallel and each removes its own.
-    let dir = std::env::temp_dir().join(format!("lucent-texdep-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::temp_dir(&format!("layered-texdep-{name}"));
     let path = dir.join(name);
     let image = image::Rgba32FImage::from_fn(64, 64, |_, y| image::Rgba(texel(y as f32 / 63.0)));
     image.save(&path).unwrap();
@@ -417,55 +397,12 @@ fn a_scene_file_with_depth_textures_renders_and_others_have_no_depth_targets() {
     let exr = depth_exr("file.exr", |v| [0.2 + 0.3 * v, 0.1, 0.0, 0.0]);
     let dir = exr.parent().unwrap().to_path_buf();
     let scene_path = dir.join("texdep.toml");
-    std::fs::write(
-        &scene_path,
-        r#"name = "texdep-file"
-[camera]
-eye = [0.0, 0.0, 1.9]
-target = [0.0, 0.0, 0.0]
-fov_y_degrees = 40.0
-
-[[mesh]]
-name = "ball"
-generator = "icosphere"
-level = 4
-
-[[material]]
-name = "stack"
-albedo = [0.8, 0.8, 0.8]
-[material.layered]
-depth_texture = "file.exr"
-[[material.layered.layer]]
-sigma_a = [0.2, 0.4, 0.8]
-sigma_s = [6.0, 7.0, 9.0]
-g = 0.7
-thickness = "texture"
-[[material.layered.layer]]
-sigma_a = [0.9, 0.3, 0.1]
-sigma_s = [3.0, 3.0, 3.0]
-thickness = "texture"
-thickness_scale = 2.0
-[[material.layered.layer]]
-sigma_a = [0.01, 0.03, 0.1]
-sigma_s = [1.5, 2.0, 2.5]
-thickness = "rest"
-
-[[object]]
-mesh = "ball"
-material = "stack"
-scale = 0.5
-
-[[light]]
-type = "point"
-position = [1.2, 0.9, 0.6]
-intensity = 4.0
-"#,
-    )
-    .unwrap();
+    // The scene names its depth texture relative to itself: beside the EXR.
+    std::fs::copy(common::data("texdep.toml"), &scene_path).unwrap();
     let scene =
         lucent::scene::load_scene(scene_path.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"));
     let s = settings(64, 64);
-    let p = plan(&scene, &s);
+    let p = common::plan(&scene, &s);
     for name in ["gbuffer.layer-depth", "light-space.layer-depth"] {
         assert!(
             images(&p).iter().any(|n| n == name),
@@ -474,10 +411,7 @@ intensity = 4.0
         );
     }
     let test = TestGpu::new();
-    let r = Renderer::new(&test.gpu, &test.shaders, &test.cache, &scene, s).unwrap();
-    let frame = r.render_once(&test.gpu).unwrap();
-    test.gpu.wait_idle().unwrap();
-    r.destroy(&test.gpu);
+    let frame = test.render(&scene, s);
     let lit = frame
         .display
         .chunks_exact(4)
@@ -486,7 +420,7 @@ intensity = 4.0
     assert!(lit > 200, "{lit} lit pixels");
     test.finish();
     // Layered media with constant thicknesses (the built-in scene) store no depth texels.
-    let p = plan(&builtin::builtin("layered").unwrap(), &s);
+    let p = common::plan(&builtin::builtin("layered").unwrap(), &s);
     assert!(!images(&p).iter().any(|n| n.contains("layer-depth")));
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -5,15 +5,15 @@
 
 use glam::{Mat4, Vec3};
 use lucent::bake::bvh::Bvh;
-use lucent::frame::{plan_frame, FrameDesc, FrameImages, FrameSettings, Renderer};
+use lucent::frame::{FrameDesc, FrameImages, FrameSettings};
 use lucent::graph::Plan;
 use lucent::scene::generators::{generate, Generator};
 use lucent::scene::material::{ThicknessSource, Translucency};
 use lucent::scene::{builtin, Light, LightKind, Material, Scene};
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -59,15 +59,6 @@ fn occluder_scene(light: Light) -> Scene {
         deformation: None,
         time: 0.0,
     }
-}
-
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> FrameImages {
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let images = renderer.render_once(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    renderer.destroy(gpu);
-    images
 }
 
 fn settings(shadows: bool) -> FrameSettings {
@@ -151,8 +142,8 @@ fn the_floor_under_an_occluder_is_darker_than_open_floor_for_every_light_type() 
         let scene = moved(occluder_scene(light), offset);
         let under = pixel_of(&scene, offset);
         let open = pixel_of(&scene, offset + Vec3::new(0.0, 0.0, 1.6));
-        let lit = render(&test, &scene, settings(false));
-        let shadowed = render(&test, &scene, settings(true));
+        let lit = test.render(&scene, settings(false));
+        let shadowed = test.render(&scene, settings(true));
         let (lit_under, lit_open) = (luminance(&lit, under), luminance(&lit, open));
         let (shadow_under, shadow_open) = (luminance(&shadowed, under), luminance(&shadowed, open));
         println!(
@@ -211,8 +202,8 @@ fn gpu_visibility_matches_rays_against_the_exact_meshes() {
                 (Bvh::new(&m.positions, &m.indices).unwrap(), o.transform)
             })
             .collect();
-        let lit = render(&test, &scene, settings(false));
-        let shadowed = render(&test, &scene, settings(true));
+        let lit = test.render(&scene, settings(false));
+        let shadowed = test.render(&scene, settings(true));
         let gb = lit.gbuffer.as_ref().unwrap();
         let inv = (scene.camera.projection(W as f32 / H as f32) * scene.camera.view()).inverse();
         let (mut compared, mut disagree, mut occluded) = (0usize, 0usize, 0usize);
@@ -256,10 +247,6 @@ fn gpu_visibility_matches_rays_against_the_exact_meshes() {
     test.finish();
 }
 
-fn plan(scene: &Scene, settings: &FrameSettings) -> Plan {
-    plan_frame(settings, &FrameDesc::new(scene, settings).unwrap()).unwrap()
-}
-
 fn has(plan: &Plan, image: &str) -> bool {
     plan.resources
         .iter()
@@ -275,10 +262,10 @@ fn maps_exist_exactly_for_the_lights_that_cast() {
     let s = FrameSettings::new(320, 240);
     // Built-in scenes: every light casts by default; the translucent cubes carry the IDs.
     let cubes = builtin("cubes").unwrap();
-    let p = plan(&cubes, &s);
+    let p = common::plan(&cubes, &s);
     assert!(has_pass(&p) && has(&p, "light-space.depth") && has(&p, "light-space.ids"));
     let layered = builtin("layered").unwrap();
-    let p = plan(&layered, &s);
+    let p = common::plan(&layered, &s);
     assert!(has_pass(&p) && has(&p, "light-space.depth"));
     assert!(!has(&p, "light-space.ids"), "no translucency: no ID target");
     let desc = FrameDesc::new(&layered, &s).unwrap();
@@ -306,7 +293,7 @@ fn maps_exist_exactly_for_the_lights_that_cast() {
             },
         ),
     ] {
-        let p = plan(scene, &settings);
+        let p = common::plan(scene, &settings);
         assert!(!has_pass(&p));
         assert!(!p
             .resources
@@ -322,13 +309,8 @@ fn maps_exist_exactly_for_the_lights_that_cast() {
         },
         ..s
     };
-    let p = plan(&layered, &small);
-    let atlas = p
-        .resources
-        .iter()
-        .find(|r| r.name == "light-space.depth")
-        .unwrap();
-    assert_eq!((atlas.info.width, atlas.info.height), (1536, 1536));
+    let p = common::plan(&layered, &small);
+    assert_eq!(common::image_size(&p, "light-space.depth"), (1536, 1536));
 }
 
 #[test]
@@ -342,8 +324,8 @@ fn translucent_objects_are_not_shadowed_by_their_own_faces() {
     glass.translucency = Some(Translucency::new(ThicknessSource::Constant(1.0)));
     scene.objects[1].material = glass;
     let cube_pixel = pixel_of(&scene, Vec3::new(0.5, 1.5, 0.0));
-    let lit = render(&test, &scene, settings(false));
-    let shadowed = render(&test, &scene, settings(true));
+    let lit = test.render(&scene, settings(false));
+    let shadowed = test.render(&scene, settings(true));
     let (a, b) = (
         luminance(&lit, cube_pixel),
         luminance(&shadowed, cube_pixel),
@@ -365,7 +347,7 @@ fn translucent_objects_are_not_shadowed_by_their_own_faces() {
         ),
         material: Material::opaque("wall", Vec3::splat(0.5), 0.0, 1.0),
     });
-    let walled = render(&test, &scene, settings(true));
+    let walled = test.render(&scene, settings(true));
     let c = luminance(&walled, cube_pixel);
     println!("with a wall between: {c:.4}");
     assert!(

@@ -3,9 +3,7 @@
 //! tables beside ours, the three scaling axes, the error-against-time sections, and every plot
 //! it links decodes as a PNG.
 
-use std::path::Path;
-
-use lucent::frame::Technique;
+use crate::common;
 
 /// One bench table of the report: its title, its pass names, and the (pass, pass / copy) rows
 /// of the speed-of-light table after it.
@@ -47,24 +45,13 @@ fn tables(report: &str) -> Vec<Table> {
 
 #[test]
 fn quick_report_has_every_table_and_plot() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-quick");
-    let _ = std::fs::remove_dir_all(&dir);
-    let started = std::time::Instant::now();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .env("LUCENT_VALIDATION", "1")
-        .args(["report", "--quick", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    println!("quick report took {:.1} s", started.elapsed().as_secs_f64());
+    let dir = common::report(&["--quick"], "report-quick");
 
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let tables = tables(&report);
-    assert_eq!(tables.len(), Technique::ALL.len(), "{report}");
-    for &(name, _) in Technique::ALL {
+    let techniques = common::techniques();
+    assert_eq!(tables.len(), techniques.len(), "{report}");
+    for name in techniques.iter().map(|t| t.name()) {
         assert!(
             tables
                 .iter()
@@ -135,5 +122,5 @@ fn quick_report_has_every_table_and_plot() {
     }
     // Bars per technique, Li et al., three scaling axes, translucency and SSS error against
     // time.
-    assert!(plots >= Technique::ALL.len() + 6, "{plots} plots");
+    assert!(plots >= techniques.len() + 6, "{plots} plots");
 }

@@ -3,13 +3,14 @@
 //! and pipeline cache in use, and mistakes a host can make refused as errors, not as
 //! validation errors.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::common::blur;
+use crate::common::{submit_back_to_back, TestGpu};
 use ash::vk;
-use common::{submit_back_to_back, TestGpu};
 use glam::DVec3;
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -21,14 +22,7 @@ use lucent::features::sss::SssProfiles;
 use lucent::frame::{FrameSettings, Renderer, Technique};
 use lucent::images::compare::{flip_rgba8, FlipThresholds};
 use lucent::images::output::{read_png_rgba8, write_png_rgba8};
-use lucent::scene::material::SssBlur;
 use lucent::LucentError;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lucent-embed-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The example binary `cargo test` built beside this test's (target/<profile>/examples).
 fn example_binary() -> PathBuf {
@@ -38,7 +32,7 @@ fn example_binary() -> PathBuf {
     let path = profile_dir.join("examples").join(name);
     assert!(
         path.is_file(),
-        "{} is missing: `cargo test` builds the examples with the tests (with `--test embed` \
+        "{} is missing: `cargo test` builds the examples with the tests (with `--test gpu` \
          alone, run `cargo build --example host_engine` first)",
         path.display()
     );
@@ -69,7 +63,7 @@ fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
 /// Runs the example and `lucent render` on the same scene and size; both under validation
 /// (the example's own messenger fails it on any error).
 fn example_matches_render(scene: &str, size: &str, frames: &str) {
-    let dir = temp_dir(&format!("example-{scene}"));
+    let dir = common::temp_dir(&format!("embed-example-{scene}"));
     let engine_png = dir.join("engine.png");
     let out = Command::new(example_binary())
         .args([
@@ -86,15 +80,10 @@ fn example_matches_render(scene: &str, size: &str, frames: &str) {
         "the example must run under validation with no errors:\n{stderr}"
     );
     let render_png = dir.join("render.png");
-    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args(["render", "--scene", scene, "--size", size, "--out"])
-        .arg(&render_png)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "lucent render failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::succeeded(
+        common::lucent_command()
+            .args(["render", "--scene", scene, "--size", size, "--out"])
+            .arg(&render_png),
     );
     let (w, h, engine) = read_png_rgba8(&engine_png).unwrap();
     let (rw, rh, render) = read_png_rgba8(&render_png).unwrap();
@@ -171,8 +160,14 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
         }
     }
     for (technique, blur) in [
-        (Technique::Separable, SssBlur::Separable),
-        (Technique::Control, SssBlur::Control),
+        (
+            Technique::Only(&lucent::features::sss::separable::SEPARABLE),
+            blur(&lucent::features::sss::separable::SEPARABLE),
+        ),
+        (
+            Technique::Only(&lucent::features::sss::control::CONTROL),
+            blur(&lucent::features::sss::control::CONTROL),
+        ),
     ] {
         // lucent's own frame, keeping what a host's lighting would have made.
         let settings = FrameSettings {
@@ -244,16 +239,21 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             profile_ids: &ids_host,
         };
         // The scene's profiles in the frame's ID order.
-        let profiles = SssProfiles::new(&scene, Some(blur), None)
-            .unwrap()
-            .unwrap()
-            .profiles
-            .into_iter()
-            .map(|(mut p, b)| {
-                p.blur = Some(b);
-                p
-            })
-            .collect();
+        let profiles = SssProfiles::new(
+            &scene,
+            Some(blur),
+            None,
+            &lucent::features::registry::blur_of,
+        )
+        .unwrap()
+        .unwrap()
+        .profiles
+        .into_iter()
+        .map(|(mut p, b)| {
+            p.blur = Some(b.name().into());
+            p
+        })
+        .collect();
         let desc = PostProcessDesc {
             width: w,
             height: h,
@@ -362,7 +362,7 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             flip.mean
         );
         if !flip.within(&FlipThresholds::default()) || l1 / mean > 0.01 {
-            let dir = temp_dir("post");
+            let dir = common::temp_dir(&format!("embed-post-{}", technique.name()));
             write_png_rgba8(&dir.join("frame.png"), w, h, &want).unwrap();
             write_png_rgba8(&dir.join("post.png"), w, h, &have).unwrap();
             panic!(
@@ -618,7 +618,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() 
         &["'sss mask'", "R8_UNORM"],
     );
     let lean = lucent::scene::material::SssProfile {
-        blur: Some(SssBlur::LeanBilateral),
+        blur: Some(blur(&lucent::features::sss::lbb::LBB).name().into()),
         ..lucent::scene::material::SssProfile::preset("skin").unwrap()
     };
     let good_inputs = PostProcessInputs {
@@ -711,7 +711,7 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
             frames_in_flight: 2,
             pipeline_cache: Some(cache),
             allocator: Some(allocator.clone()),
-            cache_dir: Some(temp_dir("cache")),
+            cache_dir: Some(common::temp_dir("embed-cache")),
         },
     );
     let scene = lucent.load_scene("cubes").unwrap();
@@ -901,12 +901,7 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
         let got = gpu
             .read_image(image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
             .unwrap();
-        let worst = got
-            .iter()
-            .zip(&expected[k])
-            .map(|(a, b)| a.abs_diff(*b))
-            .max()
-            .unwrap();
+        let worst = common::max_difference(&got, &expected[k]);
         assert!(
             worst <= 1,
             "frame {k} differs from its frame alone by {worst}/255"

@@ -4,10 +4,10 @@
 //! non-scattering pixels untouched, scattering pixels blurred with their energy kept, every
 //! output finite, and each against the brute-force f64 reference.
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
-use lucent::frame::{plan_frame, FrameDesc, FrameSettings, Renderer, Technique};
+use crate::common::TestGpu;
+use lucent::frame::{plan_frame, FrameDesc, FrameSettings, GBufferReadback, Technique};
 use lucent::reference::sss::ReferenceSpecular;
 use lucent::scene::Scene;
 
@@ -16,7 +16,7 @@ fn settings(technique: Technique) -> FrameSettings {
         technique,
         export_hdr: true,
         export_gbuffer: true,
-        // The f64 references shade without shadows (tests/shadows.rs checks those).
+        // The f64 references shade without shadows (tests/gpu/shadows.rs checks those).
         shadows: lucent::features::shadows::ShadowSettings {
             enabled: false,
             ..Default::default()
@@ -25,21 +25,62 @@ fn settings(technique: Technique) -> FrameSettings {
     }
 }
 
-/// Every screen-space SSS technique.
-const SSS_TECHNIQUES: [Technique; 5] = [
-    Technique::Control,
-    Technique::Lcb,
-    Technique::Lbb,
-    Technique::Separable,
-    Technique::Bilateral,
-];
+/// The thesis's control technique.
+fn control() -> Technique {
+    Technique::Only(&lucent::features::sss::control::CONTROL)
+}
 
 /// The specular model of a technique's reference.
 fn reference_specular(technique: Technique) -> ReferenceSpecular {
-    match technique {
-        Technique::Control | Technique::Separable => ReferenceSpecular::BlinnPhong,
-        _ => ReferenceSpecular::Lean,
+    // The blurs without LEAN keep the lighting pass's Blinn-Phong specular.
+    if technique.sss_blur().is_some_and(|b| !b.lean()) {
+        ReferenceSpecular::BlinnPhong
+    } else {
+        ReferenceSpecular::Lean
     }
+}
+
+/// `scene` with the specular of its SSS materials off.
+fn without_sss_specular(scene: &Scene) -> Scene {
+    let mut scene = scene.clone();
+    for o in &mut scene.objects {
+        if o.material.sss.is_some() {
+            o.material.specular = 0.0;
+        }
+    }
+    scene
+}
+
+/// LBB's settings with a full-precision G-buffer (the f64 twins read it back).
+fn full_precision_lbb() -> FrameSettings {
+    FrameSettings {
+        gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
+        ..settings(Technique::Only(&lucent::features::sss::lbb::LBB))
+    }
+}
+
+/// The brute-force f64 reference of `scene`'s first profile over the G-buffer read back from
+/// its frame under `s`.
+fn brute_force_reference(
+    scene: &Scene,
+    s: &FrameSettings,
+    gbuffer: &GBufferReadback,
+    specular: ReferenceSpecular,
+) -> Vec<glam::DVec3> {
+    let (profile, _) = FrameDesc::new(scene, s)
+        .unwrap()
+        .sss
+        .unwrap()
+        .profiles
+        .remove(0);
+    lucent::reference::sss::reference_image(scene, gbuffer, &profile, specular)
+}
+
+/// Each SSS scene under each screen-space SSS technique.
+fn cases() -> impl Iterator<Item = (&'static str, Technique)> {
+    ["skin", "teapot"]
+        .into_iter()
+        .flat_map(|n| common::sss_techniques().into_iter().map(move |t| (n, t)))
 }
 
 /// `scene` with every profile scaled by `factor` (its width in world units).
@@ -53,20 +94,11 @@ fn scaled_profiles(scene: &Scene, factor: f32) -> Scene {
     scene
 }
 
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> lucent::frame::FrameImages {
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let images = renderer.render_once(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    renderer.destroy(gpu);
-    images
-}
-
 #[test]
 fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
     let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
-    let s = settings(Technique::Control);
-    let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
+    let s = settings(Technique::Only(&lucent::features::sss::control::CONTROL));
+    let plan = common::plan(&skin, &s);
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
     let mut expected = vec!["gbuffer + lighting".to_string()];
     for i in 1..=6 {
@@ -77,7 +109,7 @@ fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
     assert_eq!(names, expected);
     // No SSS material: no blur passes, no SSS targets.
     let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
-    let plan = plan_frame(&s, &FrameDesc::new(&smoke, &s).unwrap()).unwrap();
+    let plan = common::plan(&smoke, &s);
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["gbuffer + lighting", "tonemap"]);
     assert!(plan.resources.iter().all(|r| !r.name.starts_with("sss.")));
@@ -86,10 +118,7 @@ fn control_declares_one_blur_pair_per_gaussian_and_nothing_without_sss() {
 #[test]
 fn sss_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
     let test = TestGpu::new();
-    for (name, technique) in ["skin", "teapot"]
-        .into_iter()
-        .flat_map(|n| SSS_TECHNIQUES.map(|t| (n, t)))
-    {
+    for (name, technique) in cases() {
         let name = &format!("{name} {}", technique.name());
         // Widened fivefold so every technique's blur spans pixels at 160x120 (the control-style
         // blurs leave Gaussians under a pixel alone).
@@ -100,11 +129,12 @@ fn sss_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
         // Unblurred, same shading: plain lighting for the control; LCB and LBB (whose LEAN
         // specular differs from the lighting pass's Blinn-Phong) with every Gaussian far below a
         // pixel, which their blurs leave as it is.
-        let plain = match technique {
-            Technique::Control => render(&test, &scene, settings(Technique::None)),
-            _ => render(&test, &scaled_profiles(&scene, 1e-6), settings(technique)),
+        let plain = if technique == control() {
+            test.render(&scene, settings(Technique::None))
+        } else {
+            test.render(&scaled_profiles(&scene, 1e-6), settings(technique))
         };
-        let blurred = render(&test, &scene, settings(technique));
+        let blurred = test.render(&scene, settings(technique));
         let (a, b) = (plain.hdr.unwrap(), blurred.hdr.unwrap());
         assert!(b.iter().all(|v| v.is_finite()), "{name}: non-finite output");
         // Which pixels scatter: the G-buffer's SSS strength says.
@@ -148,12 +178,13 @@ fn sss_blurs_only_scattering_pixels_keeps_their_energy_and_stays_finite() {
 fn extreme_profiles_stay_finite_and_bounded() {
     let test = TestGpu::new();
     let base = lucent::bake::scene::load_scene_baked("skin").unwrap();
-    let plain = render(&test, &base, settings(Technique::None)).hdr.unwrap();
+    let plain = test.render(&base, settings(Technique::None)).hdr.unwrap();
     let plain_peak = plain.iter().fold(0.0f32, |m, v| m.max(*v));
-    for technique in SSS_TECHNIQUES {
+    for technique in common::sss_techniques() {
         // LCB and LBB replace the specular with LEAN's, whose Fresnel rises at grazing angles: their
         // bound is the brighter of the plain frame and their own frame without blur.
-        let unblurred = render(&test, &scaled_profiles(&base, 1e-6), settings(technique))
+        let unblurred = test
+            .render(&scaled_profiles(&base, 1e-6), settings(technique))
             .hdr
             .unwrap();
         let peak = unblurred.iter().fold(plain_peak, |m, v| m.max(*v));
@@ -171,16 +202,17 @@ fn extreme_profiles_stay_finite_and_bounded() {
                     }
                 }
             }
-            let hdr = render(&test, &scene, settings(technique)).hdr.unwrap();
+            let hdr = test.render(&scene, settings(technique)).hdr.unwrap();
             let what = format!("{} {what}", technique.name());
             let bad = hdr.iter().filter(|v| !v.is_finite()).count();
             assert_eq!(bad, 0, "{what}: {bad} non-finite values");
             // A blur only averages: nothing brighter than the brightest unblurred pixel. LCB's
             // and LBB's specular is evaluated on blurred slopes and moments, which can tilt a
             // lobe towards a light it missed: not an average, but bounded (no blow-up).
-            let bound = match technique {
-                Technique::Control => peak * 1.01 + 1e-3,
-                _ => peak * 1.5,
+            let bound = if technique == control() {
+                peak * 1.01 + 1e-3
+            } else {
+                peak * 1.5
             };
             let max = hdr.iter().fold(0.0f32, |m, v| m.max(*v));
             assert!(
@@ -194,20 +226,10 @@ fn extreme_profiles_stay_finite_and_bounded() {
 
 #[test]
 fn bench_prints_the_control_beside_the_thesis_table_2() {
-    let stdout = common::run_bench(&[
-        "bench",
-        "--scene",
-        "teapot",
-        "--technique",
-        "control",
-        "--size",
-        "96x72",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-        "--compare-thesis",
-    ]);
+    let stdout = common::run_bench(
+        "bench --scene teapot --technique control --size 96x72 --frames 2 --warmup 1 \
+         --compare-thesis",
+    );
     assert!(
         stdout.contains("Beside LEAN-mapping SSS thesis"),
         "{stdout}"
@@ -225,14 +247,10 @@ fn bench_prints_the_control_beside_the_thesis_table_2() {
 #[test]
 fn blurring_only_the_profiles_rectangles_gives_the_whole_screen_result() {
     let test = TestGpu::new();
-    for (name, technique) in ["skin", "teapot"]
-        .into_iter()
-        .flat_map(|n| SSS_TECHNIQUES.map(|t| (n, t)))
-    {
+    for (name, technique) in cases() {
         let scene = lucent::bake::scene::load_scene_baked(name).unwrap();
-        let tiled = render(&test, &scene, settings(technique));
-        let whole = render(
-            &test,
+        let tiled = test.render(&scene, settings(technique));
+        let whole = test.render(
             &scene,
             FrameSettings {
                 sss_tiles: false,
@@ -278,25 +296,18 @@ fn interior_error(hdr: &[f32], reference: &[glam::DVec3], strength: &[f32], w: i
 #[test]
 fn every_technique_is_closer_to_the_brute_force_reference_than_no_blur() {
     let test = TestGpu::new();
-    for (name, technique) in ["skin", "teapot"]
-        .into_iter()
-        .flat_map(|n| SSS_TECHNIQUES.map(|t| (n, t)))
-    {
+    for (name, technique) in cases() {
         // At 128x96 the presets' scattering is under a pixel wide, and a blur that narrow only
         // adds its bilinear taps' filtering (measured: at 1x and 5x the control is further
         // from the reference than no blur at all). Widened twentyfold it spans many pixels,
         // where the blur must win.
         let mut scene =
             scaled_profiles(&lucent::bake::scene::load_scene_baked(name).unwrap(), 20.0);
-        if technique != Technique::Control {
+        if technique != Technique::Only(&lucent::features::sss::control::CONTROL) {
             // LCB and LBB blur the LEAN moments too, so their highlights spread with the light
             // (the thesis's intent; a physical reference keeps specular at the surface). This
             // test judges the diffusion: without specular both sides shade alike.
-            for o in &mut scene.objects {
-                if o.material.sss.is_some() {
-                    o.material.specular = 0.0;
-                }
-            }
+            scene = without_sss_specular(&scene);
         }
         let s = FrameSettings {
             technique,
@@ -304,34 +315,23 @@ fn every_technique_is_closer_to_the_brute_force_reference_than_no_blur() {
             export_gbuffer: true,
             ..FrameSettings::new(128, 96)
         };
-        let blurred = render(&test, &scene, s);
+        let blurred = test.render(&scene, s);
         // No blur, same shading: the control against plain lighting; LCB and LBB against
         // themselves with every Gaussian narrower than a pixel (their blurs leave such pixels
         // as they are), so the LEAN specular is the same on both sides.
-        let unblurred = match technique {
-            Technique::Control => render(
-                &test,
+        let unblurred = if technique == control() {
+            test.render(
                 &scene,
                 FrameSettings {
                     technique: Technique::None,
                     ..s
                 },
-            ),
-            _ => render(&test, &scaled_profiles(&scene, 1e-6), s),
+            )
+        } else {
+            test.render(&scaled_profiles(&scene, 1e-6), s)
         };
         let gbuffer = blurred.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameDesc::new(&scene, &s)
-            .unwrap()
-            .sss
-            .unwrap()
-            .profiles
-            .remove(0);
-        let reference = lucent::reference::sss::reference_image(
-            &scene,
-            gbuffer,
-            &profile,
-            reference_specular(technique),
-        );
+        let reference = brute_force_reference(&scene, &s, gbuffer, reference_specular(technique));
         let strength = gbuffer.sss.as_ref().unwrap();
         let e_blur = interior_error(blurred.hdr.as_ref().unwrap(), &reference, strength, 128);
         let e_plain = interior_error(unblurred.hdr.as_ref().unwrap(), &reference, strength, 128);
@@ -358,24 +358,10 @@ fn lean_final_pass_matches_the_f64_lean_brdf_where_nothing_blurs() {
     let test = TestGpu::new();
     for name in ["skin", "teapot"] {
         let scene = scaled_profiles(&lucent::bake::scene::load_scene_baked(name).unwrap(), 1e-6);
-        let s = FrameSettings {
-            gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
-            ..settings(Technique::Lbb)
-        };
-        let frame = render(&test, &scene, s);
+        let s = full_precision_lbb();
+        let frame = test.render(&scene, s);
         let gbuffer = frame.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameDesc::new(&scene, &s)
-            .unwrap()
-            .sss
-            .unwrap()
-            .profiles
-            .remove(0);
-        let reference = lucent::reference::sss::reference_image(
-            &scene,
-            gbuffer,
-            &profile,
-            ReferenceSpecular::Lean,
-        );
+        let reference = brute_force_reference(&scene, &s, gbuffer, ReferenceSpecular::Lean);
         let hdr = frame.hdr.as_ref().unwrap();
         let strength = gbuffer.sss.as_ref().unwrap();
         let peak = reference.iter().fold(0.0f64, |m, r| m.max(r.max_element()));
@@ -420,11 +406,8 @@ fn lean_projection_matches_its_f64_twin() {
     use lucent::reference::sss::{roughness_variance, view_plane_lean};
     let test = TestGpu::new();
     let scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
-    let s = FrameSettings {
-        gbuffer: lucent::features::gbuffer::GBufferPrecision::Full,
-        ..settings(Technique::Lbb)
-    };
-    let frame = render(&test, &scene, s);
+    let s = full_precision_lbb();
+    let frame = test.render(&scene, s);
     let gb = frame.gbuffer.unwrap();
     let lean = gb.lean.as_ref().expect("LBB frames export the LEAN target");
     let strength = gb.sss.as_ref().unwrap();
@@ -464,14 +447,14 @@ fn lean_projection_matches_its_f64_twin() {
 fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
     let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
     for (technique, gaussians) in [
-        (Technique::Lbb, None),
-        (Technique::Lcb, None),
-        (Technique::Lbb, Some(4)),
-        (Technique::Lbb, Some(1)),
+        (Technique::Only(&lucent::features::sss::lbb::LBB), None),
+        (Technique::Only(&lucent::features::sss::lcb::LCB), None),
+        (Technique::Only(&lucent::features::sss::lbb::LBB), Some(4)),
+        (Technique::Only(&lucent::features::sss::lbb::LBB), Some(1)),
     ] {
         let mut s = settings(technique);
         s.sss.gaussians = gaussians;
-        let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
+        let plan = common::plan(&skin, &s);
         let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
         let mut expected = vec!["projection + lighting".to_string()];
         for i in 1..=gaussians.unwrap_or(6) {
@@ -483,14 +466,14 @@ fn lcb_and_lbb_declare_the_thesis_passes_and_follow_the_gaussian_count() {
         assert!(plan.resources.iter().any(|r| r.name == "gbuffer.lean"));
     }
     // The control needs no LEAN target.
-    let s = settings(Technique::Control);
-    let plan = plan_frame(&s, &FrameDesc::new(&skin, &s).unwrap()).unwrap();
+    let s = settings(Technique::Only(&lucent::features::sss::control::CONTROL));
+    let plan = common::plan(&skin, &s);
     assert!(plan.resources.iter().all(|r| !r.name.contains("lean")));
     // No SSS material: nothing of any SSS technique.
     let smoke = lucent::bake::scene::load_scene_baked("smoke").unwrap();
-    for technique in SSS_TECHNIQUES {
+    for technique in common::sss_techniques() {
         let s = settings(technique);
-        let plan = plan_frame(&s, &FrameDesc::new(&smoke, &s).unwrap()).unwrap();
+        let plan = common::plan(&smoke, &s);
         let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(
             names,
@@ -518,7 +501,9 @@ fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
         (names, sizes, lean, kernel_bytes)
     };
     // Separable: two blur passes for six Gaussians, no LEAN target, the kernel table.
-    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Separable));
+    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Only(
+        &lucent::features::sss::separable::SEPARABLE,
+    )));
     assert_eq!(
         names,
         [
@@ -531,7 +516,9 @@ fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
     assert!(!lean && kernel_bytes > 0);
     // Bilateral: the LEAN projection, two blur passes that carry the moments, LEAN specular in
     // the vertical pass (no final lighting pass).
-    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Bilateral));
+    let (names, _, lean, kernel_bytes) = passes(&settings(Technique::Only(
+        &lucent::features::sss::bilateral::BILATERAL,
+    )));
     assert_eq!(
         names,
         [
@@ -543,7 +530,9 @@ fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
     );
     assert!(lean && kernel_bytes > 0);
     // Half resolution: both blurs at half size per side (rounded up), then the upsample.
-    let mut half = settings(Technique::Separable);
+    let mut half = settings(Technique::Only(
+        &lucent::features::sss::separable::SEPARABLE,
+    ));
     half.sss.half_res = true;
     let (names, sizes, _, _) = passes(&half);
     assert_eq!(
@@ -560,13 +549,17 @@ fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
     assert_eq!(sizes[2], (80, 60));
     assert_eq!(sizes[3], (160, 120));
     // The per-Gaussian chains need no kernel table: the frame's buffer has no such region.
-    for technique in [Technique::Control, Technique::Lcb, Technique::Lbb] {
+    let per_gaussian = |t: &Technique| t.sss_blur().is_some_and(|b| b.iterative());
+    for technique in common::sss_techniques().into_iter().filter(per_gaussian) {
         let (_, _, _, kernel_bytes) = passes(&settings(technique));
         assert_eq!(kernel_bytes, 0, "{}", technique.name());
     }
     // Every sample count the knob offers compiles to the same two passes.
     for samples in [11, 17, 25] {
-        for technique in [Technique::Separable, Technique::Bilateral] {
+        for technique in common::sss_techniques()
+            .into_iter()
+            .filter(|t| !per_gaussian(t))
+        {
             let mut s = settings(technique);
             s.sss.samples = samples;
             assert_eq!(passes(&s).0.len(), 4, "{} {samples}", technique.name());
@@ -579,8 +572,8 @@ fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
     use lucent::frame::Fault;
     let test = TestGpu::new();
     let scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
-    for technique in SSS_TECHNIQUES {
-        let clean = render(&test, &scene, settings(technique));
+    for technique in common::sss_techniques() {
+        let clean = test.render(&scene, settings(technique));
         let clean_hdr = clean.hdr.unwrap();
         let strength = clean.gbuffer.unwrap().sss.unwrap();
         // A scattering pixel in the middle of a sphere, so the blur's taps all around read it.
@@ -603,7 +596,7 @@ fn a_nan_or_inf_in_one_lit_pixel_does_not_spread() {
                 ..settings(technique)
             };
             let what = format!("{} {fault:?}", technique.name());
-            let hdr = render(&test, &scene, s).hdr.unwrap();
+            let hdr = test.render(&scene, s).hdr.unwrap();
             let bad = hdr.iter().filter(|v| !v.is_finite()).count();
             assert_eq!(bad, 0, "{what}: {bad} non-finite values in the output");
             // Only the blur's reach around the pixel may differ from the clean frame.
@@ -637,27 +630,20 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
     let scene = lucent::bake::scene::load_scene_baked("edges").unwrap();
     // The same scene with the SSS objects' specular off: LCB and LBB blur their highlights
     // (the thesis's intent) and the control does not, so bleed is compared on diffusion alone.
-    let mut diffuse_only = scene.clone();
-    for o in &mut diffuse_only.objects {
-        if o.material.sss.is_some() {
-            o.material.specular = 0.0;
-        }
-    }
+    let diffuse_only = without_sss_specular(&scene);
     let base = FrameSettings {
         export_hdr: true,
         export_gbuffer: true,
         ..FrameSettings::new(128, 96)
     };
-    let plain = render(
-        &test,
+    let plain = test.render(
         &scene,
         FrameSettings {
             technique: Technique::None,
             ..base
         },
     );
-    let plain_diffuse = render(
-        &test,
+    let plain_diffuse = test.render(
         &diffuse_only,
         FrameSettings {
             technique: Technique::None,
@@ -665,23 +651,12 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
         },
     );
     let mut metrics = Vec::new();
-    for technique in SSS_TECHNIQUES {
+    for technique in common::sss_techniques() {
         let s = FrameSettings { technique, ..base };
-        let frame = render(&test, &scene, s);
-        let diffusion_only = render(&test, &diffuse_only, s);
+        let frame = test.render(&scene, s);
+        let diffusion_only = test.render(&diffuse_only, s);
         let gbuffer = frame.gbuffer.as_ref().unwrap();
-        let (profile, _) = FrameDesc::new(&scene, &s)
-            .unwrap()
-            .sss
-            .unwrap()
-            .profiles
-            .remove(0);
-        let reference = lucent::reference::sss::reference_image(
-            &scene,
-            gbuffer,
-            &profile,
-            reference_specular(technique),
-        );
+        let reference = brute_force_reference(&scene, &s, gbuffer, reference_specular(technique));
         let strength = gbuffer.sss.as_ref().unwrap();
         let m = lucent::reference::sss::edge_metrics(
             128,
@@ -697,12 +672,8 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
         assert_eq!(m.halo_pixels, 0, "{}: {m:?}", technique.name());
         assert!(m.edge_error.is_finite() && m.interior_error.is_finite());
         let gbuffer = diffusion_only.gbuffer.as_ref().unwrap();
-        let reference = lucent::reference::sss::reference_image(
-            &diffuse_only,
-            gbuffer,
-            &profile,
-            reference_specular(technique),
-        );
+        let reference =
+            brute_force_reference(&diffuse_only, &s, gbuffer, reference_specular(technique));
         let d = lucent::reference::sss::edge_metrics(
             128,
             gbuffer.sss.as_ref().unwrap(),
@@ -732,19 +703,10 @@ fn edge_quality_of_every_technique_is_measured_on_the_edges_scene() {
 
 #[test]
 fn sss_report_writes_its_table_and_plot() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("sss-report");
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args([
-            "report", "sss", "--size", "128x96", "--rounds", "1", "--warmup", "0",
-        ])
-        .arg("--out")
-        .arg(&dir)
-        .arg("--validation")
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let dir = common::report(
+        &["sss", "--size", "128x96", "--rounds", "1", "--warmup", "0"],
+        "sss-report",
+    );
     let md = std::fs::read_to_string(dir.join("sss.md")).unwrap();
     for variant in lucent::report::sss::sss_variants() {
         let row = md

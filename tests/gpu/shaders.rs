@@ -16,23 +16,17 @@
 // Run-time compilation only exists with the feature (on by default).
 #![cfg(feature = "runtime-shaders")]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
+use crate::common;
 use ash::vk;
 use lucent::backend::shader::{create_shader_module, PipelineCache, ShaderCompiler};
 use lucent::backend::spirv::ShaderStage;
 use lucent::LucentError;
 
 /// A fresh, empty directory under cargo's per-target temporary directory.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("shaders-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn write(root: &Path, name: &str, text: &str) {
     let path = root.join(name);
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -158,7 +152,7 @@ fn every_shader_in_glsl_compiles() {
 
 #[test]
 fn error_in_an_include_names_the_included_file_and_line() {
-    let root = temp_dir("include-error");
+    let root = common::temp_dir("shaders-include-error");
     write(
         &root,
         "common/broken.glsl",
@@ -225,7 +219,7 @@ fn error_in_an_include_names_the_included_file_and_line() {
 
 #[test]
 fn includes_resolve_next_to_the_includer_first_then_from_the_root() {
-    let root = temp_dir("include-order");
+    let root = common::temp_dir("shaders-include-order");
     write(
         &root,
         "value.glsl",
@@ -258,7 +252,7 @@ fn includes_resolve_next_to_the_includer_first_then_from_the_root() {
 
 #[test]
 fn cache_hits_and_is_invalidated_by_an_include_change() {
-    let root = temp_dir("cache");
+    let root = common::temp_dir("shaders-cache");
     let cache = root.join("cache");
     write(&root, "common/k.glsl", "const float K = 1.0;\n");
     write(
@@ -425,7 +419,7 @@ impl Drop for TestDevice {
 
 #[test]
 fn shader_module_and_pipeline_cache_on_a_device() {
-    let root = temp_dir("device");
+    let root = common::temp_dir("shaders-device");
     write(
         &root,
         "fill.comp",

@@ -12,6 +12,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::common;
 use lucent::images::compare::{flip_rgba8, FlipThresholds};
 use lucent::images::output::read_png_rgba8;
 
@@ -87,15 +88,9 @@ fn which(name: &str) -> Option<PathBuf> {
     })
 }
 
-fn out_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("demo");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// `lucent ARGS` against `display` (X11 only: a Wayland session of the host must not be used).
 fn lucent(display: &str) -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_lucent"));
+    let mut command = common::lucent_command();
     command
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
@@ -104,31 +99,37 @@ fn lucent(display: &str) -> Command {
     command
 }
 
-#[test]
-fn scripted_demo_exits_cleanly_and_its_last_frame_matches_render() {
-    let xvfb = Xvfb::start();
-    let dir = out_dir();
-    let shot = dir.join("demo-cubes.png");
-    let _ = std::fs::remove_file(&shot);
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/demo.script");
-    let out = lucent(&xvfb.display)
-        .args([
-            "demo", "--scene", "cubes", "--size", "320x240", "--frames", "90",
-        ])
-        .arg("--script")
-        .arg(&script)
-        .arg("--screenshot")
-        .arg(&shot)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
+/// Runs a scripted demo to the end: it must exit 0 without a validation error; returns its
+/// stdout and stderr.
+fn run_demo(command: &mut Command) -> (String, String) {
+    let out = command.output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(
         out.status.success(),
         "demo failed ({}):\n{stdout}\n{stderr}",
         out.status
     );
     assert!(!stderr.contains("Validation Error"), "{stderr}");
+    (stdout, stderr)
+}
+
+#[test]
+fn scripted_demo_exits_cleanly_and_its_last_frame_matches_render() {
+    let xvfb = Xvfb::start();
+    let dir = common::temp_dir("demo-cubes");
+    let shot = dir.join("demo-cubes.png");
+    let script = common::data("demo.script");
+    let (stdout, stderr) = run_demo(
+        lucent(&xvfb.display)
+            .args([
+                "demo", "--scene", "cubes", "--size", "320x240", "--frames", "90",
+            ])
+            .arg("--script")
+            .arg(&script)
+            .arg("--screenshot")
+            .arg(&shot),
+    );
     // The summary line: all frames presented, time spent minimized, the swapchain recreated
     // for every resize that changed its size (at least: to 0x0, and back).
     let summary = stdout
@@ -161,17 +162,12 @@ fn scripted_demo_exits_cleanly_and_its_last_frame_matches_render() {
         eprintln!("note: the X server kept the window at {w}x{h} instead of 320x240");
     }
     let reference = dir.join("render-cubes.png");
-    let rendered = lucent(&xvfb.display)
-        .args(["render", "--scene", "cubes", "--technique", "translucency"])
-        .args(["--size", &format!("{w}x{h}")])
-        .arg("--out")
-        .arg(&reference)
-        .output()
-        .unwrap();
-    assert!(
-        rendered.status.success(),
-        "{}",
-        String::from_utf8_lossy(&rendered.stderr)
+    common::succeeded(
+        lucent(&xvfb.display)
+            .args(["render", "--scene", "cubes", "--technique", "translucency"])
+            .args(["--size", &format!("{w}x{h}")])
+            .arg("--out")
+            .arg(&reference),
     );
     let (_, _, expected) = read_png_rgba8(&reference).unwrap();
     let flip = flip_rgba8(&expected, &demo, w, h).unwrap();
@@ -226,8 +222,7 @@ fn wait_for(
 fn shader_edits_rebuild_the_frame_and_a_broken_shader_keeps_the_old_one() {
     let xvfb = Xvfb::start();
     // A private copy of the shaders, so the edits below touch nothing another test compiles.
-    let glsl = out_dir().join(format!("glsl-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&glsl);
+    let glsl = common::temp_dir("demo-glsl");
     copy_tree(&Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"), &glsl);
     let tonemap = glsl.join("post/tonemap.frag");
     let original = std::fs::read_to_string(&tonemap).unwrap();
@@ -299,55 +294,13 @@ fn shader_edits_rebuild_the_frame_and_a_broken_shader_keeps_the_old_one() {
 /// (casting shadows) over a floor, so that the technique (translucency) differs from plain
 /// lighting and a moved light moves both the lit areas and the shadow.
 fn light_scene(light: [f32; 3], intensity: f32) -> String {
-    format!(
-        r#"name = "demo-lights"
-ambient = [0.03, 0.035, 0.04]
-sky = [0.15, 0.2, 0.3]
-[camera]
-eye = [0.0, 2.0, 6.0]
-target = [0.0, 0.8, 0.0]
-[[mesh]]
-name = "block"
-generator = "cube"
-level = 2
-[[mesh]]
-name = "ground"
-generator = "plane"
-level = 0
-[[material]]
-name = "jade"
-albedo = [0.35, 0.75, 0.45]
-roughness = 0.3
-[material.translucency]
-thickness = 0.3
-color = [0.4, 1.0, 0.5]
-power = 4.0
-distortion = 0.2
-ambient = 0.1
-[[material]]
-name = "floor"
-albedo = [0.55, 0.55, 0.5]
-specular = 0.1
-roughness = 0.8
-[[object]]
-mesh = "block"
-material = "jade"
-translate = [0.0, 0.8, 0.0]
-rotate_degrees = [0.0, 30.0, 0.0]
-scale = 0.8
-[[object]]
-mesh = "ground"
-material = "floor"
-scale = [8.0, 1.0, 8.0]
-[[light]]
-type = "point"
-position = [{}, {}, {}]
-color = [1.0, 0.95, 0.9]
-intensity = {intensity}
-range = 20.0
-"#,
-        light[0], light[1], light[2]
-    )
+    std::fs::read_to_string(common::data("demo-lights.toml"))
+        .unwrap()
+        .replace(
+            "POSITION",
+            &format!("[{}, {}, {}]", light[0], light[1], light[2]),
+        )
+        .replace("INTENSITY", &intensity.to_string())
 }
 
 /// Columns `from..to` of a `w`-wide RGBA8 image.
@@ -384,9 +337,7 @@ fn assert_flip(what: &str, expected: &[u8], got: &[u8], w: u32, h: u32) {
 #[test]
 fn scripted_light_move_split_and_difference_views_match_render() {
     let xvfb = Xvfb::start();
-    let dir = out_dir().join(format!("lights-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::temp_dir("demo-lights");
     let start = [1.0, 2.2, -2.0];
     let scene = dir.join("lights.toml");
     std::fs::write(&scene, light_scene(start, 20.0)).unwrap();
@@ -407,23 +358,15 @@ fn scripted_light_move_split_and_difference_views_match_render() {
         ),
     )
     .unwrap();
-    let out = lucent(&xvfb.display)
-        .args(["demo", "--technique", "translucency", "--size", "240x180"])
-        .arg("--scene")
-        .arg(&scene)
-        .args(["--frames", "20"])
-        .arg("--script")
-        .arg(&script)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success(),
-        "demo failed ({}):\n{stdout}\n{stderr}",
-        out.status
+    let (stdout, _) = run_demo(
+        lucent(&xvfb.display)
+            .args(["demo", "--technique", "translucency", "--size", "240x180"])
+            .arg("--scene")
+            .arg(&scene)
+            .args(["--frames", "20"])
+            .arg("--script")
+            .arg(&script),
     );
-    assert!(!stderr.contains("Validation Error"), "{stderr}");
     // Where the keys put the light: the demo prints every light at exit.
     let line = stdout
         .lines()
@@ -446,19 +389,14 @@ fn scripted_light_move_split_and_difference_views_match_render() {
             "render-{}-{technique}.png",
             scene.file_stem().unwrap().to_string_lossy()
         ));
-        let rendered = lucent(&xvfb.display)
-            .args(["render", "--technique", technique])
-            .args(["--size", &format!("{w}x{h}")])
-            .arg("--scene")
-            .arg(scene)
-            .arg("--out")
-            .arg(&file)
-            .output()
-            .unwrap();
-        assert!(
-            rendered.status.success(),
-            "{}",
-            String::from_utf8_lossy(&rendered.stderr)
+        common::succeeded(
+            lucent(&xvfb.display)
+                .args(["render", "--technique", technique])
+                .args(["--size", &format!("{w}x{h}")])
+                .arg("--scene")
+                .arg(scene)
+                .arg("--out")
+                .arg(&file),
         );
         let (rw, rh, pixels) = read_png_rgba8(&file).unwrap();
         assert_eq!((rw, rh), (w, h));

@@ -7,9 +7,7 @@ use lucent::bake::scene::load_scene_baked;
 use lucent::frame::{FrameSettings, Renderer};
 use lucent::scene::Scene;
 
-mod common;
-
-use common::{run_bench, submit_back_to_back, TestGpu};
+use crate::common::{run_bench, submit_back_to_back, TestGpu};
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -18,14 +16,6 @@ fn dynamic_at(time: f32) -> Scene {
     let mut scene = load_scene_baked("dynamic").unwrap();
     scene.time = time;
     scene
-}
-
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> Vec<u8> {
-    let renderer = Renderer::new(&test.gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let display = renderer.render_once(&test.gpu).unwrap().display;
-    test.gpu.wait_idle().unwrap();
-    renderer.destroy(&test.gpu);
-    display
 }
 
 fn changed_pixels(a: &[u8], b: &[u8]) -> usize {
@@ -40,8 +30,8 @@ fn dynamic_deforms_and_an_updated_renderer_draws_the_new_instant() {
     let test = TestGpu::new();
     let settings = FrameSettings::new(W, H);
     let (t0, t1) = (dynamic_at(0.0), dynamic_at(0.5));
-    let at_0 = render(&test, &t0, settings);
-    let at_half = render(&test, &t1, settings);
+    let at_0 = test.render(&t0, settings).display;
+    let at_half = test.render(&t1, settings).display;
     let changed = changed_pixels(&at_0, &at_half);
     println!(
         "dynamic: {changed} of {} pixels change from t = 0 to t = 0.5",
@@ -61,9 +51,9 @@ fn dynamic_deforms_and_an_updated_renderer_draws_the_new_instant() {
 
     // A static scene's time changes nothing.
     let mut smoke = load_scene_baked("smoke").unwrap();
-    let a = render(&test, &smoke, settings);
+    let a = test.render(&smoke, settings).display;
     smoke.time = 3.0;
-    assert_eq!(render(&test, &smoke, settings), a);
+    assert_eq!(test.render(&smoke, settings).display, a);
     test.finish();
 }
 
@@ -82,7 +72,10 @@ fn each_frame_in_flight_draws_its_own_instant() {
         frames_in_flight: 2,
         ..FrameSettings::new(W, H)
     };
-    let reference = |t: f32| render(&test, &dynamic_at(t), FrameSettings::new(W, H));
+    let reference = |t: f32| {
+        test.render(&dynamic_at(t), FrameSettings::new(W, H))
+            .display
+    };
     let (want_0, want_half) = (reference(0.0), reference(0.5));
     let renderer =
         Renderer::new(gpu, &test.shaders, &test.cache, &dynamic_at(0.0), settings).unwrap();
@@ -102,10 +95,9 @@ fn each_frame_in_flight_draws_its_own_instant() {
 #[test]
 fn the_benchmark_times_the_deformation_of_deforming_scenes_only() {
     let json = |scene: &str| {
-        let out = run_bench(&[
-            "bench", "--scene", scene, "--size", "96x64", "--frames", "3", "--warmup", "1",
-            "--format", "json",
-        ]);
+        let out = run_bench(&format!(
+            "bench --scene {scene} --size 96x64 --frames 3 --warmup 1 --format json"
+        ));
         serde_json::from_str::<serde_json::Value>(&out).unwrap()
     };
     let dynamic = json("dynamic");

@@ -2,14 +2,10 @@
 //! showcase scene changes at least 5% of its pixels against plain lighting, without halos,
 //! matches its golden, and `lucent gallery` writes its pictures and page.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use crate::common;
 
-mod common;
-
-use common::TestGpu;
+use crate::common::TestGpu;
 use lucent::frame::FrameSettings;
-use lucent::images::compare::{compare_with_golden, FlipThresholds};
 use lucent::measure::look;
 
 const SHOWCASES: [&str; 4] = [
@@ -18,12 +14,6 @@ const SHOWCASES: [&str; 4] = [
     "showcase-marble",
     "showcase-layered",
 ];
-
-fn output_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-output");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 #[test]
 fn each_showcase_scene_changes_five_percent_of_its_pixels_without_halos() {
@@ -67,39 +57,17 @@ fn showcase_scenes_match_their_goldens() {
     let test = TestGpu::new();
     for name in SHOWCASES {
         let scene = lucent::bake::scene::load_scene_baked(name).unwrap();
-        let frame = lucent::frame::render_frame(
-            &test.gpu,
-            &test.shaders,
-            &test.cache,
-            &scene,
-            FrameSettings::new(320, 240),
-        )
-        .unwrap();
-        let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
-        let outcome = compare_with_golden(
-            name,
-            &golden,
-            &frame.display,
-            320,
-            240,
-            &FlipThresholds::default(),
-            &output_dir(),
-        )
-        .unwrap();
-        assert!(
-            outcome.passed,
-            "{name} differs from its golden: mean FLIP {:.4}; see {:?} and {:?}",
-            outcome.result.mean, outcome.actual_path, outcome.diff_path
-        );
+        let frame = test.render(&scene, FrameSettings::new(320, 240));
+        common::check_golden(name, &frame.display, 320, 240);
     }
     test.finish();
 }
 
 #[test]
 fn gallery_writes_every_scene_and_its_page() {
-    let out = output_dir().join("gallery");
+    let out = common::output_dir().join("gallery");
     let _ = std::fs::remove_dir_all(&out);
-    let run = Command::new(env!("CARGO_BIN_EXE_lucent"))
+    let run = common::lucent_command()
         .args(["gallery", "--size", "96x72", "--out"])
         .arg(&out)
         .output()
@@ -125,13 +93,13 @@ fn gallery_writes_every_scene_and_its_page() {
 
 #[test]
 fn gallery_refuses_an_unknown_scene_and_a_bad_size() {
-    let out = output_dir().join("gallery-bad");
+    let out = common::output_dir().join("gallery-bad");
     for args in [
         vec!["--scene", "no-such-scene", "--size", "32x24"],
         vec!["--size", "0x24"],
         vec!["--aa", "msaa", "--size", "32x24"],
     ] {
-        let run = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        let run = common::lucent_command()
             .arg("gallery")
             .args(&args)
             .arg("--out")

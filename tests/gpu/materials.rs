@@ -4,29 +4,31 @@
 //! and MTL `map_Kd`, knobs that change only values, rendering into a caller's image, and
 //! frames in flight.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use crate::common::blur;
 use ash::vk;
 use glam::Vec3;
 use lucent::backend::access::Access;
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::bake::scene::load_scene_baked;
+use lucent::features::sss::SssBlur;
 use lucent::frame::{
-    plan_frame, FrameDesc, FrameImages, FrameRunner, FrameSettings, Renderer, TargetDesc, Technique,
+    FrameDesc, FrameImages, FrameRunner, FrameSettings, Renderer, TargetDesc, Technique,
 };
 use lucent::graph::Plan;
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
-use lucent::scene::material::SssBlur;
+use lucent::scene::material::TechniqueName;
 use lucent::scene::Scene;
 
-mod common;
+use crate::common;
 
-use common::{submit_back_to_back, TestGpu};
+use crate::common::{submit_back_to_back, TestGpu};
 
 fn settings(technique: Technique, w: u32, h: u32) -> FrameSettings {
     FrameSettings {
         technique,
-        // The f64 references shade without shadows (tests/shadows.rs checks those).
+        // The f64 references shade without shadows (tests/gpu/shadows.rs checks those).
         shadows: lucent::features::shadows::ShadowSettings {
             enabled: false,
             ..Default::default()
@@ -36,8 +38,7 @@ fn settings(technique: Technique, w: u32, h: u32) -> FrameSettings {
 }
 
 fn plan(scene: &Scene, technique: Technique) -> Plan {
-    let s = settings(technique, 320, 240);
-    plan_frame(&s, &FrameDesc::new(scene, &s).unwrap()).unwrap()
+    common::plan(scene, &settings(technique, 320, 240))
 }
 
 fn pass_names(plan: &Plan) -> Vec<String> {
@@ -62,11 +63,11 @@ fn mixed_two_chains(other: SssBlur) -> Scene {
     let mut scene = load_scene_baked("mixed").unwrap();
     for o in &mut scene.objects {
         if let Some(sss) = o.material.sss.as_mut() {
-            sss.blur = Some(if o.material.name == "marble" {
-                SssBlur::LeanBilateral
+            sss.blur = Some(TechniqueName::new(if o.material.name == "marble" {
+                blur(&lucent::features::sss::lbb::LBB).name()
             } else {
-                other
-            });
+                other.name()
+            }));
         }
     }
     scene
@@ -85,14 +86,31 @@ fn auto_puts_in_the_frame_exactly_what_the_materials_ask_for() {
     let cubes = load_scene_baked("cubes").unwrap();
     let p = plan(&cubes, Technique::Auto);
     assert!(has_image(&p, "gbuffer.translucency") && !has_sss_image(&p));
-    assert_eq!(p.dump(), plan(&cubes, Technique::Translucency).dump());
+    assert_eq!(
+        p.dump(),
+        plan(
+            &cubes,
+            Technique::Only(&lucent::features::translucency::TRANSLUCENCY)
+        )
+        .dump()
+    );
 
     // Skin: its blur (the default, the separable blur), no GB2.
     let skin = load_scene_baked("skin").unwrap();
     let p = plan(&skin, Technique::Auto);
     assert!(!has_image(&p, "gbuffer.translucency") && has_sss_image(&p));
-    assert_eq!(SssBlur::DEFAULT, SssBlur::Separable);
-    assert_eq!(p.dump(), plan(&skin, Technique::Separable).dump());
+    assert_eq!(
+        lucent::features::registry::default_sss_blur(),
+        blur(&lucent::features::sss::separable::SEPARABLE)
+    );
+    assert_eq!(
+        p.dump(),
+        plan(
+            &skin,
+            Technique::Only(&lucent::features::sss::separable::SEPARABLE)
+        )
+        .dump()
+    );
 
     // Mixed: translucency and SSS in one frame, both G-buffer targets, one blur pair for both
     // profiles, the vertical pass composing the frame.
@@ -113,16 +131,22 @@ fn auto_puts_in_the_frame_exactly_what_the_materials_ask_for() {
         ]
     );
     // Named techniques restrict the frame to theirs.
-    let p = plan(&mixed, Technique::Translucency);
+    let p = plan(
+        &mixed,
+        Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
+    );
     assert!(has_image(&p, "gbuffer.translucency") && !has_sss_image(&p));
-    let p = plan(&mixed, Technique::Control);
+    let p = plan(
+        &mixed,
+        Technique::Only(&lucent::features::sss::control::CONTROL),
+    );
     assert!(!has_image(&p, "gbuffer.translucency") && has_sss_image(&p));
     let p = plan(&mixed, Technique::None);
     assert_eq!(pass_names(&p), ["gbuffer + lighting", "tonemap"]);
 
     // Two blurs: one chain each, told apart by name, the LEAN target for the LBB chain only
     // once; the LBB chain's final pass keeps the control chain's result elsewhere.
-    let two = mixed_two_chains(SssBlur::Control);
+    let two = mixed_two_chains(blur(&lucent::features::sss::control::CONTROL));
     let p = plan(&two, Technique::Auto);
     let names = pass_names(&p);
     assert_eq!(names[0], "projection + lighting");
@@ -168,7 +192,7 @@ fn frames_in_flight_wait_for_the_previous_frames_last_use_of_each_transient() {
         ..one
     };
     let first_barrier = |s: &FrameSettings| {
-        let plan = plan_frame(s, &FrameDesc::new(&mixed, s).unwrap()).unwrap();
+        let plan = common::plan(&mixed, s);
         let gb0 = plan.resource_by_name("gbuffer.albedo").unwrap();
         plan.physical[0]
             .barriers
@@ -193,9 +217,9 @@ fn frames_in_flight_wait_for_the_previous_frames_last_use_of_each_transient() {
 
 #[test]
 fn cubes_render_translucent_without_a_flag() {
-    let dir = temp_dir("cubes-cli");
+    let dir = common::temp_dir("materials-cubes-cli");
     let run = |extra: &[&str], out: &Path| {
-        let status = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+        let status = common::lucent_command()
             .args(["render", "--scene", "cubes", "--size", "96x72", "--out"])
             .arg(out)
             .args(extra)
@@ -212,22 +236,6 @@ fn cubes_render_translucent_without_a_flag() {
         "auto renders cubes as --technique translucency"
     );
     assert_ne!(default, plain, "and that is not plain lighting");
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("materials-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn render(test: &TestGpu, scene: &Scene, settings: FrameSettings) -> FrameImages {
-    let gpu = &test.gpu;
-    let renderer = Renderer::new(gpu, &test.shaders, &test.cache, scene, settings).unwrap();
-    let images = renderer.render_once(gpu).unwrap();
-    gpu.wait_idle().unwrap();
-    renderer.destroy(gpu);
-    images
 }
 
 fn exported(technique: Technique, w: u32, h: u32) -> FrameSettings {
@@ -292,12 +300,19 @@ fn each_sss_material_is_diffused_with_its_own_profile_without_bleeding() {
     assert!(skin > 0.0 && marble > 0.0 && skin != marble);
 
     // Against the same frame without SSS (translucency kept: the disc is both).
-    let plain = render(&test, &mixed, exported(Technique::Translucency, w, h));
-    let together = render(&test, &mixed, s);
+    let plain = test.render(
+        &mixed,
+        exported(
+            Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
+            w,
+            h,
+        ),
+    );
+    let together = test.render(&mixed, s);
     // The skin sphere and the disc share the skin profile (one ID); the marble has its own.
     for (names, id) in [(&["skin", "ear"][..], skin), (&["marble"][..], marble)] {
         let alone_scene = only_scattering(&mixed, names);
-        let alone = render(&test, &alone_scene, s);
+        let alone = test.render(&alone_scene, s);
         let alone_id = {
             let d = FrameDesc::new(&alone_scene, &s).unwrap();
             let i = alone_scene
@@ -372,17 +387,26 @@ fn two_blur_chains_compose_in_one_frame() {
     // The marble's LBB chain beside the thesis's control chain (LBB last), and beside the
     // default separable chain (LBB first, the separable chain's vertical pass composing).
     for (other, chains) in [
-        (SssBlur::Control, [SssBlur::Control, SssBlur::LeanBilateral]),
         (
-            SssBlur::Separable,
-            [SssBlur::LeanBilateral, SssBlur::Separable],
+            blur(&lucent::features::sss::control::CONTROL),
+            [
+                blur(&lucent::features::sss::control::CONTROL),
+                blur(&lucent::features::sss::lbb::LBB),
+            ],
+        ),
+        (
+            blur(&lucent::features::sss::separable::SEPARABLE),
+            [
+                blur(&lucent::features::sss::lbb::LBB),
+                blur(&lucent::features::sss::separable::SEPARABLE),
+            ],
         ),
     ] {
         let two = mixed_two_chains(other);
         let s = exported(Technique::Auto, w, h);
-        let both = render(&test, &two, s);
+        let both = test.render(&two, s);
         // The same frame without the LBB chain: the other chain alone.
-        let other_only = render(&test, &only_scattering(&two, &["skin", "ear"]), s);
+        let other_only = test.render(&only_scattering(&two, &["skin", "ear"]), s);
         let hdr = both.hdr.as_ref().unwrap();
         assert!(hdr.iter().all(|v| v.is_finite()), "non-finite output");
         let ids = both.gbuffer.as_ref().unwrap().sss.as_ref().unwrap();
@@ -429,7 +453,7 @@ fn mixed_translucent_pixels_match_the_f64_reference() {
     let test = TestGpu::new();
     let mixed = load_scene_baked("mixed").unwrap();
     let s = exported(Technique::Auto, 320, 200);
-    let images = render(&test, &mixed, s);
+    let images = test.render(&mixed, s);
     let desc = FrameDesc::new(&mixed, &s).unwrap();
     let t = desc.translucency.as_ref().unwrap();
     let gbuffer = images.gbuffer.as_ref().unwrap();
@@ -495,34 +519,10 @@ fn albedo_left_right(images: &FrameImages, w: u32, h: u32) -> (Vec3, Vec3) {
     (at(w / 4), at(3 * w / 4))
 }
 
-const QUAD_SCENE: &str = r#"
-[camera]
-eye = [0.0, 3.0, 2.0]
-target = [0.0, 0.0, 0.0]
-fov_y_degrees = 40.0
-
-[[mesh]]
-name = "quad"
-MESH
-
-[[material]]
-name = "m"
-MATERIAL
-
-[[object]]
-mesh = "quad"
-material = "m"
-
-[[light]]
-type = "directional"
-direction = [0.0, -1.0, 0.0]
-intensity = 1.0
-"#;
-
 #[test]
 fn albedo_textures_and_mtl_map_kd_are_applied() {
     let test = TestGpu::new();
-    let dir = temp_dir("albedo");
+    let dir = common::temp_dir("materials-albedo");
     let (w, h) = (64, 48);
     solid_png(&dir.join("orange.png"), [230, 120, 40]);
     let orange = Vec3::new(srgb_to_linear(230), srgb_to_linear(120), srgb_to_linear(40));
@@ -530,7 +530,8 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
         let path = dir.join(name);
         std::fs::write(
             &path,
-            QUAD_SCENE
+            std::fs::read_to_string(common::data("quad.toml"))
+                .unwrap()
                 .replace("MESH", mesh)
                 .replace("MATERIAL", material),
         )
@@ -547,7 +548,7 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
     );
     let s = exported(Technique::Auto, w, h);
     assert!(FrameDesc::new(&textured, &s).unwrap().albedo_maps);
-    let images = render(&test, &textured, s);
+    let images = test.render(&textured, s);
     let (left, right) = albedo_left_right(&images, w, h);
     let expected = orange * Vec3::new(1.0, 0.5, 1.0);
     assert!(
@@ -559,7 +560,7 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
         "generator = \"plane\"",
         "albedo = [1.0, 0.5, 1.0]",
     );
-    let (left, _) = albedo_left_right(&render(&test, &untextured, s), w, h);
+    let (left, _) = albedo_left_right(&test.render(&untextured, s), w, h);
     assert!(close(left, Vec3::new(1.0, 0.5, 1.0)), "{left}");
 
     // MTL: one face's material has Kd, the other's map_Kd; both are rendered.
@@ -578,7 +579,7 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
     .unwrap();
     let obj = write_scene("obj.toml", "obj = \"quad.obj\"", "specular = 0.2");
     assert_eq!(obj.objects.len(), 2, "one object per MTL material");
-    let images = render(&test, &obj, s);
+    let images = test.render(&obj, s);
     let (left, right) = albedo_left_right(&images, w, h);
     assert!(close(left, Vec3::new(0.2, 0.6, 0.3)), "Kd: {left}");
     assert!(close(right, orange), "map_Kd: {right} vs {orange}");
@@ -618,8 +619,8 @@ fn knobs_that_change_values_update_the_frame_without_rebuilding_it() {
     let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len()).unwrap();
     runner.run_frame(gpu, &renderer.executable).unwrap();
     let updated = renderer.read_display(gpu).unwrap();
-    let fresh = render(&test, &tuned, s).display;
-    let before = render(&test, &mixed, s).display;
+    let fresh = test.render(&tuned, s).display;
+    let before = test.render(&mixed, s).display;
     assert_eq!(
         updated, fresh,
         "an updated frame is the frame built for the values"
@@ -757,12 +758,7 @@ fn frames_in_flight_into_given_images_match_frames_one_at_a_time() {
                     .collect(),
                 _ => bytes,
             };
-            let worst = got
-                .iter()
-                .zip(&expected[k])
-                .map(|(a, b)| a.abs_diff(*b))
-                .max()
-                .unwrap();
+            let worst = common::max_difference(&got, &expected[k]);
             eprintln!("{name} target, frame {k}: largest difference {worst}/255");
             let allowed = if format == vk::Format::R8G8B8A8_UNORM {
                 0

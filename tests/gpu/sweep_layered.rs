@@ -2,28 +2,18 @@
 //! synchronization validation on: every case's frame and f64 references free of NaN and Inf,
 //! and `lucent sweep layered` writing its table and exiting 0.
 
-use std::process::Command;
-
 use lucent::measure::sweep_layered::{layered_cases, run_layered, LayeredGeometry};
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 
 #[test]
 fn layered_sweep_has_no_nan_or_inf_in_any_case() {
-    let gpu = TestGpu::new();
+    let test = TestGpu::new();
+    let (gpu, shaders, cache) = (&test.gpu, &test.shaders, &test.cache);
     let cases = layered_cases().unwrap();
-    let rows = run_layered(
-        &gpu.gpu,
-        &gpu.shaders,
-        &gpu.cache,
-        32,
-        24,
-        &cases,
-        |_, _| {},
-    )
-    .unwrap();
+    let rows = run_layered(gpu, shaders, cache, 32, 24, &cases, |_, _| {}).unwrap();
     assert_eq!(rows.len(), cases.len());
     let bad: Vec<String> = rows
         .iter()
@@ -56,30 +46,20 @@ fn layered_sweep_has_no_nan_or_inf_in_any_case() {
         .filter(|r| r.case.geometry == LayeredGeometry::Front)
         .any(|r| r.reference.max_radiance > 0.1));
     assert!(rows.iter().all(|r| r.reference.samples > 0));
-    gpu.finish();
+    test.finish();
 }
 
 #[test]
 fn sweep_layered_command_writes_the_table_and_exits_zero() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweep-layered");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let table = dir.join("sweep.md");
-    let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args([
-            "sweep",
-            "layered",
-            "--quick",
-            "--validation",
-            "--size",
-            "24x16",
-        ])
-        .arg("--out")
-        .arg(&table)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let table = common::temp_dir("sweep-layered").join("sweep.md");
+    let out = common::succeeded(
+        common::lucent_command()
+            .args(common::words(
+                "sweep layered --quick --validation --size 24x16",
+            ))
+            .arg("--out")
+            .arg(&table),
+    );
     let written = std::fs::read_to_string(&table).unwrap();
     assert!(
         written.contains("## lucent sweep layered, 24x16"),
@@ -102,10 +82,7 @@ fn sweep_layered_command_writes_the_table_and_exits_zero() {
             "available: translucency, layered",
         ),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_lucent"))
-            .args(args)
-            .output()
-            .unwrap();
+        let out = common::lucent(args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && stderr.contains(want), "{stderr}");
     }

@@ -1,34 +1,23 @@
 //! `lucent bench` output formats and the speed-of-light table, through the command line (with
 //! the validation layer on: any validation error fails the command and so the test).
 
-mod common;
+use crate::common;
 
-use common::{run_bench, TestGpu};
+use crate::common::{run_bench, TestGpu};
 use lucent::frame::{FrameSettings, Renderer, Technique};
 use lucent::measure::speed_of_light::{floors, CopyFrame};
 
-fn bench_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
-    let mut args = vec![
-        "bench",
-        "--validation",
-        "--scene",
-        "cubes",
-        "--technique",
-        "translucency",
-        "--size",
-        "128x96",
-        "--frames",
-        "3",
-        "--warmup",
-        "1",
-    ];
-    args.extend_from_slice(extra);
-    args
+/// A validated bench of `cubes` under translucency, with `extra` arguments.
+fn bench_args(extra: &str) -> String {
+    format!(
+        "bench --validation --scene cubes --technique translucency --size 128x96 --frames 3 \
+         --warmup 1 {extra}"
+    )
 }
 
 #[test]
 fn csv_has_a_row_per_pass_with_its_speed_of_light_ratio() {
-    let csv = run_bench(&bench_args(&["--speed-of-light", "--format", "csv"]));
+    let csv = run_bench(&bench_args("--speed-of-light --format csv"));
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().expect("a header line").split(',').collect();
     let column = |name: &str| {
@@ -78,7 +67,7 @@ fn csv_has_a_row_per_pass_with_its_speed_of_light_ratio() {
 
 #[test]
 fn json_on_stdout_carries_the_speed_of_light_rows() {
-    let json = run_bench(&bench_args(&["--speed-of-light", "--format", "json"]));
+    let json = run_bench(&bench_args("--speed-of-light --format json"));
     let v: serde_json::Value =
         serde_json::from_str(&json).unwrap_or_else(|e| panic!("{e}: {json}"));
     let passes = v["passes"].as_array().unwrap();
@@ -105,22 +94,10 @@ fn json_on_stdout_carries_the_speed_of_light_rows() {
 
 #[test]
 fn markdown_names_the_passes_far_above_their_floor_and_the_seeds_alias_works() {
-    let text = run_bench(&[
-        "bench",
-        "--validation",
-        "--scene",
-        "skin",
-        "--technique",
-        "control",
-        "--size",
-        "96x64",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-        "--speed-of-light",
-        "--compare-seeds",
-    ]);
+    let text = run_bench(
+        "bench --validation --scene skin --technique control --size 96x64 --frames 2 --warmup 1 \
+         --speed-of-light --compare-seeds",
+    );
     assert!(text.contains("### Speed of light"), "{text}");
     assert!(
         text.contains("Far above their floor") || text.contains("No pass is more than"),
@@ -132,23 +109,10 @@ fn markdown_names_the_passes_far_above_their_floor_and_the_seeds_alias_works() {
 #[test]
 fn a_layered_bench_prints_li_et_al_s_nearest_row_and_other_scenes_refuse() {
     let bench = |scene: &str, technique: &str, maps: &str| {
-        run_bench(&[
-            "bench",
-            "--validation",
-            "--scene",
-            scene,
-            "--technique",
-            technique,
-            "--size",
-            "96x64",
-            "--shadow-size",
-            maps,
-            "--frames",
-            "2",
-            "--warmup",
-            "1",
-            "--compare-seeds",
-        ])
+        run_bench(&format!(
+            "bench --validation --scene {scene} --technique {technique} --size 96x64 \
+             --shadow-size {maps} --frames 2 --warmup 1 --compare-seeds"
+        ))
     };
     for (technique, maps) in [("auto", "512"), ("layered", "1024")] {
         let text = bench("scaling:2900", technique, maps);
@@ -181,19 +145,9 @@ fn a_layered_bench_prints_li_et_al_s_nearest_row_and_other_scenes_refuse() {
         assert!(text.contains("`single scattering"), "{text}");
     }
     // auto on a scene without layered materials: one clear error line.
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args([
-            "bench",
-            "--scene",
-            "smoke",
-            "--size",
-            "64x48",
-            "--frames",
-            "1",
-            "--compare-seeds",
-        ])
-        .output()
-        .unwrap();
+    let out = common::lucent(&common::words(
+        "bench --scene smoke --size 64x48 --frames 1 --compare-seeds",
+    ));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{stderr}");
     assert!(stderr.contains("has no layered material"), "{stderr}");
@@ -203,22 +157,10 @@ fn a_layered_bench_prints_li_et_al_s_nearest_row_and_other_scenes_refuse() {
 #[test]
 fn packed_lbb_bench_with_its_copies_is_validation_clean() {
     // The issue-12 case: the packed RGBA32UI target's copy read it as float (88 errors).
-    let text = run_bench(&[
-        "bench",
-        "--validation",
-        "--scene",
-        "skin",
-        "--technique",
-        "lbb",
-        "--sss-packed",
-        "--speed-of-light",
-        "--size",
-        "64x48",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-    ]);
+    let text = run_bench(
+        "bench --validation --scene skin --technique lbb --sss-packed --speed-of-light \
+         --size 64x48 --frames 2 --warmup 1",
+    );
     assert!(
         text.is_empty() || text.contains("RGBA32UI"),
         "the packed target is not in the table:\n{text}"
@@ -238,16 +180,10 @@ fn bad_formats_and_format_conflicts_are_one_line_errors() {
             "--compare-thesis",
         ],
     ] {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
-            .args(&args)
-            .output()
-            .unwrap();
+        let out = common::lucent(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{args:?}");
-        let lines: Vec<&str> = stderr
-            .lines()
-            .filter(|l| l.starts_with("lucent: error:"))
-            .collect();
+        let lines = common::error_lines(&out);
         assert_eq!(lines.len(), 1, "{stderr}");
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
@@ -259,10 +195,14 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
     let gpu = &test.gpu;
     // Every technique, and LBB once more with its packed RGBA32UI ping-pong target (whose copy
     // must read and write integers: a float read of it is a validation error).
-    let cases = Technique::ALL
-        .iter()
-        .map(|&(name, technique)| (name, technique, false))
-        .chain([("lbb --sss-packed", Technique::Lbb, true)]);
+    let cases = common::techniques()
+        .into_iter()
+        .map(|technique| (technique.name(), technique, false))
+        .chain([(
+            "lbb --sss-packed",
+            Technique::Only(&lucent::features::sss::lbb::LBB),
+            true,
+        )]);
     for (name, technique, packed) in cases {
         let scene_name = lucent::report::scene_for(technique).unwrap();
         let scene = lucent::bake::scene::load_scene_baked(&scene_name).unwrap();
@@ -281,19 +221,15 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
         gpu.wait_idle().unwrap();
         copies.destroy(gpu);
         renderer.destroy(gpu);
-        assert_eq!(medians.len(), plan_len(&scene, settings), "{name}");
+        assert_eq!(
+            medians.len(),
+            common::plan(&scene, &settings).physical.len(),
+            "{name}"
+        );
         for (i, m) in medians.iter().enumerate() {
             let m = m.unwrap_or_else(|| panic!("{name} on {scene_name}: floor {i} has no copy"));
             assert!(m.median > 0.0, "{name}: floor {i} took {m:?}");
         }
     }
     test.finish();
-}
-
-fn plan_len(scene: &lucent::scene::Scene, settings: FrameSettings) -> usize {
-    let features = lucent::frame::FrameDesc::new(scene, &settings).unwrap();
-    lucent::frame::plan_frame(&settings, &features)
-        .unwrap()
-        .physical
-        .len()
 }

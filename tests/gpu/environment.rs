@@ -5,19 +5,13 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 
-use common::TestGpu;
+use crate::common::TestGpu;
 use glam::Vec3;
 use lucent::frame::{render_frame, FrameSettings, Technique};
 use lucent::reference::raytrace;
 use lucent::scene::{self, Environment};
-
-fn output_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("test-output/environment");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The `smoke` scene lit by `environment` alone (no lights: the environment is the whole
 /// image), rendered on the GPU and ray-traced in f64; returns (99th percentile, max) of
@@ -111,7 +105,7 @@ fn write_hdr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 
 
 #[test]
 fn a_radiance_map_from_a_scene_file_lights_the_top_and_not_the_bottom() {
-    let dir = output_dir();
+    let dir = common::temp_dir("environment-radiance-map");
     // Bright red above the horizon, black below.
     let map = dir.join("red-sky.hdr");
     write_hdr(&map, 64, 32, |_, y| {
@@ -156,10 +150,22 @@ fn every_technique_receives_the_environment() {
     // (the SSS passes blur it as incident light, layered media take it in through the surface).
     let test = TestGpu::new();
     for (scene_name, technique) in [
-        ("cubes", Technique::Translucency),
-        ("skin", Technique::Separable),
-        ("skin", Technique::Control),
-        ("layered", Technique::Layered),
+        (
+            "cubes",
+            Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
+        ),
+        (
+            "skin",
+            Technique::Only(&lucent::features::sss::separable::SEPARABLE),
+        ),
+        (
+            "skin",
+            Technique::Only(&lucent::features::sss::control::CONTROL),
+        ),
+        (
+            "layered",
+            Technique::Only(&lucent::features::layered::LAYERED),
+        ),
         ("smoke", Technique::None),
     ] {
         let mut scene = lucent::bake::scene::load_scene_baked(scene_name).unwrap();
@@ -186,7 +192,7 @@ fn every_technique_receives_the_environment() {
 
 #[test]
 fn hostile_maps_and_keys_are_errors_naming_the_file() {
-    let dir = output_dir();
+    let dir = common::temp_dir("environment-hostile-maps");
     // A NaN texel (EXR stores floats as given).
     let nan_map = dir.join("nan.exr");
     let mut rgba = vec![0.5f32; 8 * 4 * 4];
@@ -271,7 +277,7 @@ fn hostile_maps_and_keys_are_errors_naming_the_file() {
     let ok = scene::load_scene(dir.join("ok.toml").to_str().unwrap()).unwrap();
     assert_eq!(ok.environment.mean_radiance(), Vec3::splat(0.1));
     // The command line's --environment: unknown words and missing files are errors.
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_lucent"))
+    let run = common::lucent_command()
         .args([
             "render",
             "--scene",

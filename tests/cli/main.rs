@@ -1,0 +1,14 @@
+//! The tests that run the `lucent` binary (`CARGO_BIN_EXE_lucent`, validation on): bad inputs,
+//! the benchmark, the interactive demo under Xvfb, outputs, the reports. One binary, each former
+//! test file a module; `cargo test --test cli bench::` runs one of them.
+
+#[path = "../common/mod.rs"]
+#[allow(dead_code)] // the harness serves three binaries; this one does not use all of it
+mod common;
+
+mod bad_inputs;
+mod bench;
+mod demo;
+mod outputs;
+mod report;
+mod report_li;

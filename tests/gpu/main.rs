@@ -1,0 +1,26 @@
+//! The tests that render in-process on a Vulkan device (lavapipe on CI) with the validation
+//! layer and synchronization validation on: the context, shaders, the graph executor, every
+//! technique against its goldens and f64 references, embedding. One binary, each former test
+//! file a module; `cargo test --test gpu sss::` runs one of them.
+
+#[path = "../common/mod.rs"]
+#[allow(dead_code)] // the harness serves three binaries; this one does not use all of it
+mod common;
+
+mod antialias;
+mod context;
+mod debug_view;
+mod deformation;
+mod embed;
+mod environment;
+mod graph_gpu;
+mod layered;
+mod materials;
+mod render;
+mod shaders;
+mod shadows;
+mod showcase;
+mod sss;
+mod sss_artifacts;
+mod sweep_layered;
+mod translucency;

@@ -1,8 +1,8 @@
 //! The two-pass chains (separable, bilateral): one horizontal and one vertical pass blur every
-//! profile of the chain with a kernel made from the whole profile (glsl/sss/separable.frag),
-//! the vertical pass writing the chain's result itself. The separable blur can run at half
-//! resolution per side, then a full-resolution `upsample` pass composes it depth-aware
-//! (glsl/sss/upsample.frag).
+//! profile of the chain with a kernel made from the whole profile (glsl/sss/separable.frag and
+//! glsl/sss/bilateral.frag over glsl/sss/two_pass_kernel.glsl), the vertical pass writing the
+//! chain's result itself. The separable blur can run at half resolution per side, then a
+//! full-resolution `upsample` pass composes it depth-aware (glsl/sss/upsample.frag).
 //!
 //! Pass names: `horizontal blur`, `vertical blur` (and `upsample`), prefixed by the blur in
 //! frames with several chains.
@@ -238,6 +238,8 @@ impl PassShape {
     fn fragment(&self) -> &'static str {
         if self.upsample() {
             "sss/upsample.frag"
+        } else if self.bilateral {
+            "sss/bilateral.frag"
         } else {
             "sss/separable.frag"
         }
@@ -258,7 +260,6 @@ impl PassShape {
             }
         } else {
             if self.bilateral {
-                defines.push(("LUCENT_SSS_BILATERAL2", "1"));
                 defines.push((
                     "LUCENT_SSS_SAMPLES",
                     match self.samples {
@@ -268,19 +269,20 @@ impl PassShape {
                     },
                 ));
             } else {
-                defines.push(("LUCENT_SSS_SEPARABLE", "1"));
+                // Only the separable blur runs at half resolution, passes depth on in alpha
+                // and takes point taps.
                 if self.point_taps {
                     defines.push(("LUCENT_SSS_POINT_TAPS", "1"));
+                }
+                if self.half_res {
+                    defines.push(("LUCENT_SSS_HALF_RES", "1"));
+                }
+                if self.depth_in_alpha && !self.vertical {
+                    defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
                 }
             }
             if self.vertical {
                 defines.push(("LUCENT_SSS_VERTICAL", "1"));
-            }
-            if self.half_res {
-                defines.push(("LUCENT_SSS_HALF_RES", "1"));
-            }
-            if self.depth_in_alpha && !self.vertical {
-                defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
             }
             if self.edges {
                 defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));

@@ -1,0 +1,675 @@
+//! Scene files: TOML, read through serde, validated, and turned into a [`Scene`].
+//!
+//! The format is documented by `docs/scene-format.toml`, a commented example that the tests load.
+//! Every error names the file, the line and the key: syntax errors, unknown keys and wrong types
+//! come from the TOML parser (which knows the position); missing files and out-of-range values
+//! are checked here, and the line is that of the value at fault, from the span the TOML parser
+//! kept for it.
+//!
+//! `schema` is the format as serde reads it, `build` turns its tables into the scene's parts (one
+//! function per table) and `materials` its `[[material]]` tables.
+
+mod build;
+mod materials;
+mod schema;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use toml::Spanned;
+
+use super::Scene;
+use crate::{LucentError, Result};
+use schema::SceneToml;
+
+/// Largest file a scene may be (a scene file is a few kilobytes; this refuses binary garbage).
+const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
+
+/// The scene file being read: its name and text, for errors, and its directory, which relative
+/// paths inside it are resolved against.
+struct SceneFile<'a> {
+    path: &'a Path,
+    source: &'a str,
+    base: PathBuf,
+}
+
+impl<'a> SceneFile<'a> {
+    fn new(path: &'a Path, source: &'a str) -> Self {
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        SceneFile { path, source, base }
+    }
+
+    /// `p` as the file names it: relative paths are relative to the file's directory.
+    fn resolve(&self, p: &Path) -> PathBuf {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.base.join(p)
+        }
+    }
+
+    /// The table errors name keys of: `section` (`""` for the top level) and, for an array of
+    /// tables, the entry's `index`.
+    fn table(&self, section: &'a str, index: Option<usize>) -> Table<'_> {
+        Table {
+            file: self,
+            section,
+            index,
+        }
+    }
+}
+
+/// The 1-based line of `source` that `span` starts on. A table's span may start at the blank
+/// line before it: that is skipped to its text.
+fn line_of(source: &str, span: &Range<usize>) -> Option<usize> {
+    let text = source.get(span.clone())?;
+    let start = span.start + (text.len() - text.trim_start().len());
+    Some(source.get(..start)?.matches('\n').count() + 1)
+}
+
+/// Where an error is: the span of a value the file gives, or `None` for a key it leaves out.
+fn span<T>(value: &Option<Spanned<T>>) -> Option<Range<usize>> {
+    value.as_ref().map(Spanned::span)
+}
+
+/// A value the file may give, without its span.
+fn value<T: Copy>(value: &Option<Spanned<T>>) -> Option<T> {
+    value.as_ref().map(|v| *v.get_ref())
+}
+
+/// One table of the scene file (the top level, `[camera]`, or `[[material]]` number `index`):
+/// what errors about its keys are named after.
+#[derive(Clone, Copy)]
+struct Table<'a> {
+    file: &'a SceneFile<'a>,
+    section: &'a str,
+    index: Option<usize>,
+}
+
+impl Table<'_> {
+    /// Where a key is: `line N, key `material[0].roughness`` (the line of `span`, when the
+    /// key is in the file; `camera.near`, `exposure` for other tables).
+    fn location(&self, key: &str, span: Option<Range<usize>>) -> String {
+        let full_key = match (self.section.is_empty(), self.index) {
+            (true, _) => key.to_string(),
+            (false, Some(i)) => format!("{}[{i}].{key}", self.section),
+            (false, None) => format!("{}.{key}", self.section),
+        };
+        match span.and_then(|span| line_of(self.file.source, &span)) {
+            Some(line) => format!("line {line}, key `{full_key}`"),
+            None => format!("key `{full_key}`"),
+        }
+    }
+
+    /// An error naming the file, the line of `span` (when the key is in the file) and the key
+    /// (`material[0].roughness`, `camera.near`, `exposure`).
+    fn error(
+        &self,
+        key: &str,
+        span: Option<Range<usize>>,
+        message: impl std::fmt::Display,
+    ) -> LucentError {
+        let location = self.location(key, span);
+        LucentError::file(self.file.path, format!("{location}: {message}"))
+    }
+
+    /// Checks that the three numbers at `key`, if given, are finite and (for a finite `min`)
+    /// at least `min`.
+    fn check3(&self, key: &str, v: Option<&Spanned<[f32; 3]>>, min: f32) -> Result<()> {
+        let Some(v) = v else { return Ok(()) };
+        let numbers = *v.get_ref();
+        if numbers.iter().all(|c| c.is_finite() && *c >= min) {
+            return Ok(());
+        }
+        let bound = if min.is_finite() {
+            format!(" and >= {min}")
+        } else {
+            String::new()
+        };
+        Err(self.error(
+            key,
+            Some(v.span()),
+            format!("{numbers:?} must be finite{bound}"),
+        ))
+    }
+}
+
+/// Largest `far / near` a scene may have without a warning: the 32-bit float depth buffer
+/// (standard, not reversed, depth) then resolves 0.6% of the distance at the far plane.
+pub const MAX_DEPTH_RATIO: f32 = 1e5;
+
+/// The warning for a depth range the depth buffer cannot resolve, with the numbers, or `None`.
+///
+/// With depth `d = f/(f-n) (1 - n/z)` stored as f32 (spacing `2^-24` just below 1), two
+/// surfaces at distance `z` are told apart when they are `z^2 2^-24 / n` apart, and a surface
+/// beyond `n 2^25` gets the depth the buffer is cleared to (1) and fails the depth test: it
+/// vanishes. `distance` is the camera's distance to its target, where the step is reported.
+pub fn depth_range_warning(near: f32, far: f32, distance: f32) -> Option<String> {
+    let ratio = far / near;
+    if ratio <= MAX_DEPTH_RATIO {
+        return None;
+    }
+    // f64: near 1e-7 squared and divided must not round to 0 or overflow.
+    let (n, f, d) = (
+        f64::from(near),
+        f64::from(far),
+        f64::from(distance).min(f64::from(far)),
+    );
+    let step = d * d * 2f64.powi(-24) / n;
+    let lost = n * 2f64.powi(25);
+    let vanish = if lost < f {
+        format!(
+            "; surfaces farther than {lost:.3} from the camera get the far plane's depth and \
+             vanish"
+        )
+    } else {
+        String::new()
+    };
+    // Tiny and huge numbers in exponent form (`1e-7`, not `0.0000001`).
+    let num = |x: f64| {
+        if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+            format!("{x:.3e}")
+        } else {
+            format!("{x:.3}")
+        }
+    };
+    Some(format!(
+        "near = {near:e} and far = {far} (far/near = {ratio:.1e}) is more than the 32-bit depth \
+         buffer resolves: at the target's distance ({}) its step is {}, so surfaces closer \
+         together than that are not told apart{vanish}; raise `near` or lower `far` to keep \
+         far/near under {MAX_DEPTH_RATIO:.0e}",
+        num(d),
+        num(step)
+    ))
+}
+
+/// Loads a scene file. Relative paths inside it (OBJ files, textures) are resolved against the
+/// file's directory.
+pub fn load_scene_file(path: &Path) -> Result<Scene> {
+    // A regular file, read with the cap counted as it is read (not the size the filesystem
+    // reports): a device or FIFO named as a scene is an error, never an endless read.
+    let bytes = crate::files::read_capped(path, MAX_SCENE_FILE_BYTES, "scene file")
+        .map_err(|e| LucentError::file(path, e))?;
+    let source = String::from_utf8(bytes).map_err(|e| {
+        LucentError::file(
+            path,
+            format!(
+                "not UTF-8 text (byte {}): scene files are UTF-8 TOML",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })?;
+    parse_scene(path, &source)
+}
+
+/// A TOML parse or type error as one line: `FILE: line L, column C: MESSAGE`. toml's own
+/// `Display` spreads over several lines (a source excerpt with a caret), which would break the
+/// one-line `lucent: error:` contract; its message already names the key or value at fault.
+fn toml_error(path: &Path, source: &str, error: &toml::de::Error) -> LucentError {
+    let message = error
+        .message()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    // A missing key is reported at the table it is missing from: the text of that table's
+    // first line is not the key at fault. A missing [camera] is at the top of the file.
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.strip_suffix('`'))
+    {
+        if field == "camera" {
+            return LucentError::file(
+                path,
+                "invalid scene: no [camera] table; every scene needs one, with `eye` and \
+                 `target` (see docs/scene-format.toml)",
+            );
+        }
+        let table = error
+            .span()
+            .and_then(|span| line_of(source, &span))
+            .map(|line| format!("line {line}: "));
+        return LucentError::file(
+            path,
+            format!(
+                "invalid scene: {}missing key `{field}` in this table",
+                table.unwrap_or_default()
+            ),
+        );
+    }
+    let location = error.span().and_then(|span| {
+        let before = source.get(..span.start)?;
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        // A type error's message names the expected type but not the key: take the key from
+        // the text before `=` on the offending line.
+        let text = source.lines().nth(line - 1).unwrap_or_default();
+        let key = text
+            .split_once('=')
+            .map(|(k, _)| format!(", key `{}`", k.trim()))
+            .unwrap_or_default();
+        Some(format!("line {line}, column {column}{key}: "))
+    });
+    LucentError::file(
+        path,
+        format!("invalid scene: {}{message}", location.unwrap_or_default()),
+    )
+}
+
+/// Parses scene TOML `source`; `path` names it in errors and anchors relative paths.
+pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
+    let raw: SceneToml = toml::from_str(source).map_err(|e| toml_error(path, source, &e))?;
+    let file = SceneFile::new(path, source);
+    let top = file.table("", None);
+    if let Some(technique) = &raw.technique {
+        return Err(top.error(
+            "technique",
+            Some(technique.span()),
+            "the scene-level `technique` key is gone: each material's parts decide what the \
+             frame shades (translucency, [material.sss] with its `blur`); remove the key, and \
+             use `--technique` on the command line for A/B comparisons",
+        ));
+    }
+    let camera = build::camera(&file, &raw.camera)?;
+    let meshes = build::meshes(&file, &raw.mesh)?;
+    let materials = materials::materials(&file, &raw.material)?;
+    let objects = build::objects(&file, &raw.object, &meshes, &materials, &raw.material)?;
+    let lights = build::lights(&file, &raw.light)?;
+    let deformation = build::deformation(&file, raw.deformation.as_ref())?;
+    top.check3("ambient", raw.ambient.as_ref(), 0.0)?;
+    top.check3("sky", raw.sky.as_ref(), 0.0)?;
+    let environment = build::environment(&file, raw.environment.as_ref(), &raw.ambient)?;
+    let exposure = value(&raw.exposure).unwrap_or(1.0);
+    if !(exposure.is_finite() && exposure > 0.0) {
+        return Err(top.error(
+            "exposure",
+            span(&raw.exposure),
+            format!("{exposure} must be finite and > 0"),
+        ));
+    }
+    let name = raw.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into())
+    });
+    Ok(Scene {
+        name,
+        meshes: meshes.meshes,
+        objects,
+        lights,
+        camera,
+        environment,
+        sky: glam::Vec3::from(value(&raw.sky).unwrap_or([0.15, 0.2, 0.3])),
+        exposure,
+        deformation,
+        time: 0.0,
+    })
+}
+
+/// Loads a scene by built-in name, or from a `.toml` file when `name_or_path` ends in `.toml`
+/// or names an existing file. Only parses and checks: thickness the materials ask to bake or
+/// sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
+pub fn load_scene(name_or_path: &str) -> Result<Scene> {
+    let path = Path::new(name_or_path);
+    // Anything at that path but a directory is the user's file (a FIFO or device named as a
+    // scene gets the loader's "not a regular file" error, not "unknown scene").
+    if name_or_path.ends_with(".toml") || (path.exists() && !path.is_dir()) {
+        load_scene_file(path)
+    } else {
+        super::builtin(name_or_path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::scene::material::{LightKind, Thickness, ThicknessSource};
+
+    fn parse(source: &str) -> Result<Scene> {
+        parse_scene(Path::new("test.toml"), source)
+    }
+
+    const MINIMAL: &str = r#"
+[camera]
+eye = [0, 1, 5]
+target = [0, 0, 0]
+
+[[mesh]]
+name = "ball"
+generator = "icosphere"
+level = 1
+
+[[material]]
+name = "red"
+albedo = [0.8, 0.1, 0.1]
+
+[[object]]
+mesh = "ball"
+material = "red"
+"#;
+
+    #[test]
+    fn minimal_scene_loads() {
+        let s = parse(MINIMAL).unwrap();
+        assert_eq!(s.objects.len(), 1);
+        assert_eq!(s.name, "test");
+    }
+
+    /// The 1-based line of the first line of `source` starting with `prefix`.
+    fn line_of(source: &str, prefix: &str) -> usize {
+        source.lines().position(|l| l.starts_with(prefix)).unwrap() + 1
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let bad = MINIMAL.replace(
+            "albedo = [0.8, 0.1, 0.1]",
+            "albedo = [0.8, 0.1, 0.1]\nroughness = 3.0",
+        );
+        let e = parse(&bad).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&bad, "roughness"));
+        assert!(
+            e.contains("test.toml") && e.contains(&line) && e.contains("material[0].roughness"),
+            "{e}"
+        );
+
+        let unknown = MINIMAL.replace("level = 1", "level = 1\ncolour = 3");
+        let e = parse(&unknown).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&unknown, "colour"));
+        assert!(
+            e.contains("test.toml") && e.contains(&line) && e.contains("colour"),
+            "{e}"
+        );
+
+        let wrong_type = MINIMAL.replace("level = 1", "level = \"high\"");
+        let e = parse(&wrong_type).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&wrong_type, "level"));
+        assert!(e.contains(&line) && e.contains("level"), "{e}");
+
+        let missing = MINIMAL.replace(
+            "generator = \"icosphere\"\nlevel = 1",
+            "obj = \"nowhere.obj\"",
+        );
+        let e = parse(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("mesh[0].obj") && e.contains("nowhere.obj") && e.contains("not found"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn lights_are_checked() {
+        let with_light = format!(
+            "{MINIMAL}\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = -5\n"
+        );
+        let e = parse(&with_light).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&with_light, "intensity"));
+        assert!(e.contains("light[0].intensity") && e.contains(&line), "{e}");
+        let spot = format!("{MINIMAL}\n[[light]]\ntype = \"spot\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\nintensity = 5\n");
+        assert!(matches!(
+            parse(&spot).unwrap().lights[0].kind,
+            LightKind::Spot { .. }
+        ));
+    }
+
+    #[test]
+    fn scene_messages_name_the_key_and_line() {
+        let scale = MINIMAL.replace("material = \"red\"", "material = \"red\"\nscale = [8, 1]");
+        let e = parse(&scale).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&scale, "scale"));
+        assert!(
+            e.contains(&line) && e.contains("[x, y, z]") && e.contains("array of 2"),
+            "{e}"
+        );
+        assert!(!e.contains("untagged"), "{e}");
+        let range = format!(
+            "{MINIMAL}\n[[light]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 5\nrange = -1\n"
+        );
+        let e = parse(&range).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&range, "range"));
+        assert!(e.contains("light[0].range") && e.contains(&line), "{e}");
+        assert!(!e.contains("position"), "{e}");
+        let upm = MINIMAL.replace(
+            "albedo = [0.8, 0.1, 0.1]",
+            "albedo = [0.8, 0.1, 0.1]\nsss = { preset = \"skin\", units_per_mm = 0 }",
+        );
+        let e = parse(&upm).unwrap_err().to_string();
+        let line = format!("line {}", line_of(&upm, "sss"));
+        assert!(
+            e.contains("material[0].sss.units_per_mm") && e.contains(&line),
+            "{e}"
+        );
+        let no_camera = format!(
+            "name = \"x\"\n{}",
+            MINIMAL.replace("[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n", "")
+        );
+        let e = parse(&no_camera).unwrap_err().to_string();
+        assert!(
+            e.contains("no [camera] table") && !e.contains("`name`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn depth_ranges_beyond_the_depth_buffer_warn_with_the_numbers() {
+        assert_eq!(depth_range_warning(0.1, 100.0, 5.0), None);
+        let w = depth_range_warning(1e-7, 100.0, 5.0).unwrap();
+        assert!(
+            w.contains("near = 1e-7")
+                && w.contains("far/near = 1.0e9")
+                && w.contains("vanish")
+                && w.contains("3.355")
+                && w.contains("step is 14.901"),
+            "{w}"
+        );
+        // Beyond the limit but nothing vanishes: the step is reported, not a vanishing distance.
+        let w = depth_range_warning(1e-3, 200.0, 10.0).unwrap();
+        assert!(w.contains("2.0e5") && !w.contains("vanish"), "{w}");
+        // The scene still loads.
+        let s = MINIMAL.replace("target = [0, 0, 0]", "target = [0, 0, 0]\nnear = 1e-7");
+        assert_eq!(parse(&s).unwrap().camera.near, 1e-7);
+    }
+
+    #[test]
+    fn the_documented_example_loads() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/scene-format.toml");
+        let scene = load_scene_file(&path).unwrap();
+        assert_eq!(scene.objects.len(), 3);
+        assert_eq!(scene.lights.len(), 3);
+        let jade = &scene.objects[0].material;
+        assert_eq!(
+            jade.translucency.as_ref().unwrap().thickness,
+            ThicknessSource::Bake
+        );
+        assert!(scene.objects[1].material.sss.is_some());
+    }
+
+    /// MINIMAL with a second material `skin` (the object's) whose body is `layered`.
+    fn with_layered(layered: &str) -> String {
+        MINIMAL.replace(
+            "[[object]]\nmesh = \"ball\"\nmaterial = \"red\"",
+            &format!(
+                "[[material]]\nname = \"skin\"\n\n{layered}\n[[object]]\nmesh = \"ball\"\n\
+                 material = \"skin\""
+            ),
+        )
+    }
+
+    const TWO_LAYERS: &str = r#"[material.layered]
+eta = 1.4
+weights = [0.2, 0.3, 0.1, 0.1, 0.3]
+units_per_mm = 0.1
+
+[[material.layered.layer]]
+sigma_a = [0.2, 0.37, 0.82]
+sigma_s_prime = [4.7, 5.9, 8.7]
+g = 0.9
+thickness = 0.25
+
+[[material.layered.layer]]
+sigma_a = [0.03, 0.26, 0.46]
+sigma_s = [2.3, 2.9, 4.4]
+g = -0.5
+thickness = "rest"
+"#;
+
+    #[test]
+    fn layered_media_load_from_presets_and_layer_tables() {
+        let s = parse(&with_layered("[material.layered]\npreset = \"skimmilk\"\n")).unwrap();
+        let m = s.objects[0].material.layers.as_ref().unwrap();
+        assert_eq!(m.name, "skimmilk");
+        assert_eq!(m.weights, crate::scene::layered::DEFAULT_WEIGHTS);
+
+        let s = parse(&with_layered(TWO_LAYERS)).unwrap();
+        let m = s.objects[0].material.layers.as_ref().unwrap();
+        assert_eq!(m.layers.len(), 2);
+        assert_eq!((m.eta, m.units_per_mm), (1.4, 0.1));
+        assert_eq!(m.weights, [0.2, 0.3, 0.1, 0.1, 0.3]);
+        // sigma_s' / (1 - g) is stored; sigma_s as given.
+        assert!(
+            (m.layers[0].sigma_s.x - 47.0).abs() < 1e-3,
+            "{}",
+            m.layers[0].sigma_s
+        );
+        assert_eq!(m.layers[1].sigma_s, Vec3::new(2.3, 2.9, 4.4));
+        assert_eq!(m.layers[0].thickness, Thickness::Mm(0.25));
+        assert_eq!(m.layers[1].thickness, Thickness::Rest);
+    }
+
+    #[test]
+    fn layered_errors_name_file_line_and_key() {
+        let base = with_layered(TWO_LAYERS);
+        // (replace, with, key, message part); the line is that of the replacement.
+        let cases = [
+            (
+                "g = -0.5",
+                "g = -1",
+                "material[1].layered.layer[1].g",
+                "[-0.999, 0.999]",
+            ),
+            (
+                "g = 0.9",
+                "g = nan",
+                "material[1].layered.layer[0].g",
+                "NaN",
+            ),
+            (
+                "sigma_s = [2.3, 2.9, 4.4]",
+                "sigma_s = [2.3, inf, 4.4]",
+                "material[1].layered.layer[1].sigma_s",
+                "finite",
+            ),
+            (
+                "sigma_a = [0.03, 0.26, 0.46]",
+                "sigma_a = [0.03, -0.26, 0.46]",
+                "material[1].layered.layer[1].sigma_a",
+                "[0, 1e6]",
+            ),
+            (
+                "sigma_s_prime = [4.7, 5.9, 8.7]",
+                "sigma_s_prime = [4.7, 5.9, 8.7]\nsigma_s = [1, 1, 1]",
+                "material[1].layered.layer[0].sigma_s_prime",
+                "not both",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = -0.25",
+                "material[1].layered.layer[0].thickness",
+                "rest",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = \"thick\"",
+                "material[1].layered.layer[0].thickness",
+                "texture",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = 0.25\nthickness_scale = 2",
+                "material[1].layered.layer[0].thickness_scale",
+                "only a layer",
+            ),
+            (
+                "thickness = 0.25",
+                "thickness = \"texture\"",
+                "material[1].layered.depth_texture",
+                "missing",
+            ),
+            ("eta = 1.4", "eta = 0", "material[1].layered.eta", "> 0"),
+            (
+                "weights = [0.2, 0.3, 0.1, 0.1, 0.3]",
+                "weights = [0.2, 0.3, -0.1, 0.1, 0.3]",
+                "material[1].layered.weights",
+                "-0.1",
+            ),
+            (
+                "units_per_mm = 0.1",
+                "units_per_mm = inf",
+                "material[1].layered.units_per_mm",
+                "must be in",
+            ),
+            (
+                "units_per_mm = 0.1",
+                "units_per_mm = 1e-33",
+                "material[1].layered.units_per_mm",
+                "must be in [1e-6",
+            ),
+            (
+                "eta = 1.4",
+                "eta = 1.4\npreset = \"apple\"",
+                "material[1].layered.preset",
+                "not both",
+            ),
+            (
+                "eta = 1.4",
+                "eta = 1.4\ndepth_texture = [\"a.exr\", 3]",
+                "material[1].layered.depth_texture",
+                "array of paths",
+            ),
+        ];
+        for (from, to, key, part) in cases {
+            let src = base.replacen(from, to, 1);
+            assert_ne!(src, base, "{from}");
+            let e = parse(&src).unwrap_err().to_string();
+            let leaf = key.rsplit('.').next().unwrap();
+            let first = to.lines().find(|l| l.starts_with(leaf)).unwrap_or(to);
+            let line = format!("line {}", src.lines().position(|l| l == first).unwrap() + 1);
+            let line_ok = key.ends_with("depth_texture") && part == "missing" || e.contains(&line);
+            assert!(
+                e.contains("test.toml") && line_ok && e.contains(key) && e.contains(part),
+                "{to}: {e}"
+            );
+        }
+        // No body, an unknown preset, an unknown key, too many layers.
+        let e = parse(&with_layered("[material.layered]\neta = 1.3\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("material[1].layered") && e.contains("preset"),
+            "{e}"
+        );
+        let e = parse(&with_layered("[material.layered]\npreset = \"frog\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("material[1].layered.preset") && e.contains("apple"),
+            "{e}"
+        );
+        let e = parse(&with_layered(
+            "[material.layered]\npreset = \"apple\"\ncolour = 1\n",
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("colour"), "{e}");
+        let layer =
+            "[[material.layered.layer]]\nsigma_a = [0, 0, 0]\nsigma_s = [1, 1, 1]\nthickness = 1\n";
+        let e = parse(&with_layered(&format!(
+            "[material.layered]\n{}",
+            layer.repeat(9)
+        )))
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("9 layers"), "{e}");
+    }
+}

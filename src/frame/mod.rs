@@ -7,12 +7,14 @@
 //! - [`declare`]: [`declare_frame`], the one place that decides which passes a frame has;
 //!   `lucent plan` calls it without a GPU, [`Renderer`] with one.
 //! - [`renderer`]: a scene compiled into an executable frame on a device.
+//! - [`inspect`]: `lucent inspect FILE`, any input loaded with every check and summarised.
 //! - [`readback`]: images and G-buffers read back and decoded.
 //! - [`runner`]: [`FrameRunner`] submits frames either as one command buffer (in-frame
 //!   timestamps) or one submission per physical pass (isolated timing).
 
 pub mod declare;
 pub mod desc;
+pub mod inspect;
 pub mod readback;
 pub mod renderer;
 pub mod runner;

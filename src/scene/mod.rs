@@ -10,7 +10,6 @@ pub mod environment;
 pub mod file;
 pub mod generators;
 pub mod inputs;
-pub mod inspect;
 pub mod layered;
 pub mod lean;
 pub mod material;

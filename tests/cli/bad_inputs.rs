@@ -6,7 +6,7 @@
 //!
 //! - the real one: `lucent inspect FILE` exits non-zero with exactly one `lucent: error:` line
 //!   on stderr that names the file and contains the substrings, and nothing panicked;
-//! - in-process: `lucent::scene::inspect::inspect_file` returns the same error (and does not
+//! - in-process: `lucent::frame::inspect::inspect_file` returns the same error (and does not
 //!   panic), so a failure points at the loader rather than the command line.
 //!
 //! The README's second table lists files that load with a repair or a warning: `inspect` must
@@ -153,7 +153,7 @@ fn each_corpus_file(check: impl Fn(&Case, &Path) -> Vec<String>) {
 #[test]
 fn library_reports_each_problem() {
     each_corpus_file(|case, path| {
-        let result = std::panic::catch_unwind(|| lucent::scene::inspect::inspect_file(path));
+        let result = std::panic::catch_unwind(|| lucent::frame::inspect::inspect_file(path));
         match result {
             Err(_) => vec![format!("{}: inspect_file panicked", case.file)],
             Ok(Ok(summary)) => vec![format!("{}: accepted:\n{summary}", case.file)],
@@ -194,7 +194,7 @@ fn repaired_files_load_and_say_what_was_repaired() {
     let mut failures = Vec::new();
     for case in &read_corpus().loaded {
         let path = corpus_dir().join(&case.file);
-        if let Err(e) = lucent::scene::inspect::inspect_file(&path) {
+        if let Err(e) = lucent::frame::inspect::inspect_file(&path) {
             failures.push(format!("{}: inspect_file failed: {e}", case.file));
         }
         let out = lucent(&["inspect", &path.to_string_lossy()]);

@@ -626,16 +626,21 @@ impl FrameArgs {
     }
 }
 
-/// What a technique knob needs, from the registry: the techniques that list it, each with its
-/// summary, named as `--technique` choices (or `auto` on a scene whose materials use them).
+/// What a technique knob needs, from the registry: the techniques that list it, as
+/// `--technique` choices (`a, b or c`), or `auto` on a scene whose materials use them.
 fn technique_knob_needs(flag: &str) -> String {
-    let owners: Vec<&'static dyn registry::TechniqueModule> = registry::with_knob(flag).collect();
-    let names: Vec<&str> = owners.iter().map(|t| t.name()).collect();
-    let what: Vec<&str> = owners.iter().map(|t| t.summary()).collect();
+    let names: Vec<&str> = registry::with_knob(flag).map(|t| t.name()).collect();
+    let listed = match names.split_last() {
+        Some((last, [])) => last.to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => "no technique".to_string(),
+    };
     format!(
-        "--technique {} (or auto on a scene whose materials use {}): {}",
-        names.join(" or "),
-        if owners.len() == 1 { "it" } else { "them" },
-        what.join("; ")
+        "--technique {listed} (or auto on a scene whose materials use {})",
+        if names.len() == 1 {
+            "it"
+        } else {
+            "one of them"
+        }
     )
 }

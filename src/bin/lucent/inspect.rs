@@ -1,12 +1,12 @@
 //! `lucent inspect`: a mesh, texture, MTL or scene file loaded and summarised (or what is wrong
 //! with it).
 
-use lucent::{scene, Result};
+use lucent::{frame, Result};
 
 use crate::cli::InspectArgs;
 
 /// Prints the summary of `args.file`.
 pub fn run(args: InspectArgs) -> Result<()> {
-    print!("{}", scene::inspect::inspect_file(&args.file)?);
+    print!("{}", frame::inspect::inspect_file(&args.file)?);
     Ok(())
 }

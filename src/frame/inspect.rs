@@ -1,5 +1,6 @@
 //! `lucent inspect FILE`: load any input lucent reads, with every check it would get in a real
-//! run, and summarise it, or fail with the error a render would fail with.
+//! run (a scene's technique names resolved by the registry too), and summarise it, or fail with
+//! the error a render would fail with.
 //!
 //! Use it to find out whether an asset is usable before building a scene around it. The file
 //! type is chosen by extension (case-insensitive):
@@ -16,9 +17,9 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::file::load_scene_file;
-use super::obj::{load_mtl, load_obj, ObjMaterial};
-use super::texture::{decode_texture, host_bytes, mip_levels, TextureUsage};
+use crate::scene::file::load_scene_file;
+use crate::scene::obj::{load_mtl, load_obj, ObjMaterial};
+use crate::scene::texture::{decode_texture, host_bytes, mip_levels, TextureUsage};
 use crate::{LucentError, Result};
 use rayon::prelude::*;
 
@@ -106,6 +107,8 @@ pub fn inspect_file(path: &Path) -> Result<String> {
         }
         "toml" => {
             let scene = load_scene_file(path)?;
+            // Every technique the materials name must be registered, as a frame checks.
+            crate::features::registry::check_names(&scene)?;
             let triangles: usize = scene.meshes.iter().map(|m| m.triangle_count()).sum();
             let _ = writeln!(s, "{}: scene '{}'", path.display(), scene.name);
             let _ = writeln!(
@@ -119,7 +122,7 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let _ = writeln!(s, "  environment: {}", scene.environment.describe());
             if matches!(
                 scene.environment.kind,
-                super::environment::EnvironmentKind::Map { .. }
+                crate::scene::environment::EnvironmentKind::Map { .. }
             ) {
                 // What the nine coefficients cost in accuracy for this map.
                 let (max, mean) = scene.environment.max_error(200);
@@ -156,7 +159,7 @@ pub fn inspect_file(path: &Path) -> Result<String> {
 
 /// Appends one line per material the scene's objects use, with the parts that decide what a
 /// frame of the scene shades under `--technique auto`.
-fn write_scene_materials(s: &mut String, scene: &super::Scene) {
+fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
     let mut seen: Vec<&str> = Vec::new();
     for o in &scene.objects {
         let m = &o.material;
@@ -180,14 +183,16 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
                 p.name,
                 p.gaussians.len(),
                 p.units_per_mm,
-                p.blur.as_ref().map_or("default", |b| b.name.as_str())
+                crate::features::registry::blur_of(p).map_or("?", |b| b.name())
             ));
         }
         if let Some(l) = &m.layers {
-            let textured = l
-                .layers
-                .iter()
-                .any(|x| matches!(x.thickness, super::layered::Thickness::Texture { .. }));
+            let textured = l.layers.iter().any(|x| {
+                matches!(
+                    x.thickness,
+                    crate::scene::layered::Thickness::Texture { .. }
+                )
+            });
             parts.push(format!(
                 "layered {} ({} layer{}{})",
                 l.name,
@@ -213,8 +218,8 @@ fn write_scene_materials(s: &mut String, scene: &super::Scene) {
 }
 
 /// A layered medium's numbers, one indented line for the medium and one per layer.
-fn layered_lines(l: &super::layered::LayeredMedium) -> String {
-    use super::layered::Thickness;
+fn layered_lines(l: &crate::scene::layered::LayeredMedium) -> String {
+    use crate::scene::layered::Thickness;
     let mut s = String::new();
     let w = l.weights;
     let _ = writeln!(
@@ -247,10 +252,10 @@ fn layered_lines(l: &super::layered::LayeredMedium) -> String {
     s
 }
 
-fn texture_name(t: &super::material::TextureSource) -> String {
+fn texture_name(t: &crate::scene::material::TextureSource) -> String {
     match t {
-        super::material::TextureSource::File(p) => p.display().to_string(),
-        super::material::TextureSource::Procedural(p) => format!("{p:?}"),
+        crate::scene::material::TextureSource::File(p) => p.display().to_string(),
+        crate::scene::material::TextureSource::Procedural(p) => format!("{p:?}"),
     }
 }
 

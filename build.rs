@@ -44,7 +44,7 @@ fn main() {
     if std::env::var_os("CARGO_FEATURE_RUNTIME_SHADERS").is_some() {
         link_shaderc();
     }
-    // Regenerating the manifest (tests/shipped_shaders.rs) must work while the committed one is
+    // Regenerating the manifest (tests/cpu/shipped_shaders.rs) must work while the committed one is
     // stale, even when some of its lines no longer compile: that run ships nothing.
     println!("cargo:rerun-if-env-changed=LUCENT_WRITE_MANIFEST");
     let result = if std::env::var_os("LUCENT_WRITE_MANIFEST").is_some() {

@@ -156,7 +156,7 @@ pub struct SssProfile {
 pub struct TechniqueName {
     /// The name as written.
     pub name: String,
-    /// Where it was written: the scene file and `line N, key `...``.
+    /// Where it was written: the scene file and ``line N, key `...` ``.
     origin: Option<(PathBuf, String)>,
 }
 
@@ -169,7 +169,7 @@ impl TechniqueName {
         }
     }
 
-    /// A name read from `path` at `location` (`line N, key `material[i].blur``).
+    /// A name read from `path` at `location` (``line N, key `material[i].blur` ``).
     pub fn written_at(name: impl Into<String>, path: &std::path::Path, location: String) -> Self {
         Self {
             name: name.into(),

@@ -60,8 +60,8 @@ pub const MAX_SSS_STEPS: usize = 8;
 
 /// A screen-space SSS technique's chain of passes: what its module implements besides
 /// [`super::technique::TechniqueModule`] (whose [`Shades::Scattering`](super::technique::Shades)
-/// returns it). The two kinds of chain are built by shared code ([`iterative`]: one blur pair
-/// per Gaussian; [`two_pass`]: one pair for the whole profile), parametrised by the
+/// returns it). The two kinds of chain are built by shared code (`iterative.rs`: one blur pair
+/// per Gaussian; `two_pass.rs`: one pair for the whole profile), parametrised by the
 /// properties below, never by a technique's name.
 pub trait SssBlurTechnique: Sync {
     /// Whether it blurs the LEAN G-buffer (view-plane slopes and moments) with the light.

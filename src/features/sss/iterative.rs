@@ -14,7 +14,6 @@ use super::{
 use crate::backend::shader::PipelineShaders;
 use crate::features::lighting::HDR_FORMAT;
 use crate::features::pass::FullscreenPass;
-use crate::features::technique::{Shades, TechniqueModule};
 use crate::features::util::Defines;
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
@@ -375,31 +374,7 @@ pub struct IterativeChain {
     pub scene: &'static str,
 }
 
-impl TechniqueModule for IterativeChain {
-    fn name(&self) -> &'static str {
-        self.name
-    }
-
-    fn summary(&self) -> &'static str {
-        self.summary
-    }
-
-    fn shades(&'static self) -> Shades {
-        Shades::Scattering(self)
-    }
-
-    fn knobs(&self) -> &'static [&'static str] {
-        self.knobs
-    }
-
-    fn scene(&self) -> &'static str {
-        self.scene
-    }
-
-    fn shader_permutations(&self, out: &mut Vec<PipelineShaders>) {
-        shader_permutations(self, out);
-    }
-}
+super::chain_technique_module!(IterativeChain);
 
 impl SssBlurTechnique for IterativeChain {
     fn lean(&self) -> bool {

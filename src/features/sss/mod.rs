@@ -40,6 +40,41 @@ use crate::scene::material::SssProfile;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
+/// Implements [`TechniqueModule`](super::technique::TechniqueModule) for a chain technique
+/// struct (its `name`, `summary`, `knobs` and `scene` fields; itself as the chain; the
+/// `shader_permutations(chain, out)` of the module that invokes it), written once for the
+/// iterative and the two-pass chains.
+macro_rules! chain_technique_module {
+    ($chain:ty) => {
+        impl $crate::features::technique::TechniqueModule for $chain {
+            fn name(&self) -> &'static str {
+                self.name
+            }
+
+            fn summary(&self) -> &'static str {
+                self.summary
+            }
+
+            fn shades(&'static self) -> $crate::features::technique::Shades {
+                $crate::features::technique::Shades::Scattering(self)
+            }
+
+            fn knobs(&self) -> &'static [&'static str] {
+                self.knobs
+            }
+
+            fn scene(&self) -> &'static str {
+                self.scene
+            }
+
+            fn shader_permutations(&self, out: &mut Vec<$crate::backend::shader::PipelineShaders>) {
+                shader_permutations(self, out);
+            }
+        }
+    };
+}
+use chain_technique_module;
+
 pub mod bilateral;
 pub mod control;
 mod iterative;

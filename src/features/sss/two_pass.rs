@@ -15,7 +15,6 @@ use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssIn
 use crate::backend::shader::PipelineShaders;
 use crate::features::lighting::HDR_FORMAT;
 use crate::features::pass::FullscreenPass;
-use crate::features::technique::{Shades, TechniqueModule};
 use crate::features::util::Defines;
 use crate::gpu_scene::{Region, SceneGpu, TileRect};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
@@ -368,31 +367,7 @@ pub struct TwoPassChain {
     pub scene: &'static str,
 }
 
-impl TechniqueModule for TwoPassChain {
-    fn name(&self) -> &'static str {
-        self.name
-    }
-
-    fn summary(&self) -> &'static str {
-        self.summary
-    }
-
-    fn shades(&'static self) -> Shades {
-        Shades::Scattering(self)
-    }
-
-    fn knobs(&self) -> &'static [&'static str] {
-        self.knobs
-    }
-
-    fn scene(&self) -> &'static str {
-        self.scene
-    }
-
-    fn shader_permutations(&self, out: &mut Vec<PipelineShaders>) {
-        shader_permutations(self, out);
-    }
-}
+super::chain_technique_module!(TwoPassChain);
 
 impl SssBlurTechnique for TwoPassChain {
     fn lean(&self) -> bool {

@@ -36,11 +36,6 @@ pub static TECHNIQUES: &[&dyn TechniqueModule] = &[
     &super::layered::LAYERED,
 ];
 
-/// The technique called `name`, if one is registered.
-pub fn find(name: &str) -> Option<&'static dyn TechniqueModule> {
-    TECHNIQUES.iter().copied().find(|t| t.name() == name)
-}
-
 /// The position of the technique called `name` in [`TECHNIQUES`] (chain order), or `None`.
 pub fn position(name: &str) -> Option<usize> {
     TECHNIQUES.iter().position(|t| t.name() == name)
@@ -122,19 +117,6 @@ pub fn with_knob(flag: &str) -> impl Iterator<Item = &'static dyn TechniqueModul
         .iter()
         .copied()
         .filter(move |t| t.knobs().contains(&flag))
-}
-
-/// Every knob some technique lists, each once, in registry order.
-pub fn knobs() -> Vec<&'static str> {
-    let mut flags: Vec<&'static str> = Vec::new();
-    for t in TECHNIQUES {
-        for flag in t.knobs() {
-            if !flags.contains(flag) {
-                flags.push(flag);
-            }
-        }
-    }
-    flags
 }
 
 #[cfg(test)]

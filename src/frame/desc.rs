@@ -231,12 +231,6 @@ impl FrameDesc {
             .collect()
     }
 
-    /// Whether some technique of the frame acts on the knob `flag` (a registry knob, see
-    /// [`TechniqueModule::knobs`]).
-    pub fn uses_knob(&self, flag: &str) -> bool {
-        self.techniques().iter().any(|t| t.knobs().contains(&flag))
-    }
-
     /// The features in the frame, for messages and the plan dump's header.
     pub fn names(&self) -> Vec<String> {
         let mut names = Vec::new();

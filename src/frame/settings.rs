@@ -42,12 +42,6 @@ impl std::fmt::Debug for Technique {
     }
 }
 
-impl From<&'static dyn TechniqueModule> for Technique {
-    fn from(technique: &'static dyn TechniqueModule) -> Self {
-        Technique::Only(technique)
-    }
-}
-
 impl Technique {
     /// Every choice with its command-line name: `auto`, `none`, then the registry's techniques
     /// in registry order.

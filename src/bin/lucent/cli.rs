@@ -593,9 +593,10 @@ impl FrameArgs {
             (self.half_gather, "--half-gather"),
             (self.single_depth.is_some(), "--single-depth"),
         ];
+        let techniques = desc.techniques();
         let mut unused: Vec<(&str, String)> = given
             .iter()
-            .filter(|(given, flag)| *given && !desc.uses_knob(flag))
+            .filter(|(given, flag)| *given && !techniques.iter().any(|t| t.knobs().contains(flag)))
             .map(|(_, flag)| (*flag, technique_knob_needs(flag)))
             .collect();
         // Knobs of the scene rather than of a technique.

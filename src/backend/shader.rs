@@ -253,7 +253,7 @@ pub(crate) fn sorted_defines<'a>(
 pub const FULLSCREEN_VERTEX: &str = "fullscreen.vert";
 
 /// The shaders one graphics pipeline compiles: its vertex and fragment shader, both with the
-/// same defines (as `features::util::GraphicsPipeline::new` compiles them). What each pass's
+/// same defines (as `backend::pipeline::GraphicsPipeline::new` compiles them). What each pass's
 /// `shader_permutations` lists for the shipped SPIR-V (`crate::features::shipped`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PipelineShaders {

@@ -36,10 +36,9 @@ use crate::backend::access::Access;
 use crate::backend::format::{format_info, FormatKind};
 use crate::features::registry;
 use crate::features::sss::{self, SssKnobs, SssProfiles};
-use crate::gpu_scene::{FrameUniforms, Region, SceneGpu, SceneUpload, SlotTiles};
+use crate::gpu_scene::{FrameUniforms, SceneGpu, SceneUpload, SlotTiles, FRAME};
 use crate::graph::{
-    Executable, Handle, Image, ImageInfo, ImportedImage, LoadOp, PassExec, PassKind,
-    PrepareContext, RecordContext, RenderGraph, ResourceId,
+    Executable, Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
 use crate::scene::material::SssProfile;
 use crate::scene::{Camera, Scene};
@@ -194,7 +193,6 @@ impl PostProcessSss {
             profiles,
             object_ids: Vec::new(),
         };
-        let two_pass = profiles.two_pass();
         let no_objects = frame_scene(PLACEHOLDER_CAMERA);
         let upload = SceneUpload {
             translucency_ids: None,
@@ -203,16 +201,8 @@ impl PostProcessSss {
             lean: false,
             albedo_maps: false,
             frames_in_flight: lucent.frames_in_flight(),
-            translucency_table_bytes: 0,
-            profile_table_bytes: sss::PROFILE_TABLE_BYTES,
-            kernel_table_bytes: if two_pass {
-                sss::kernel::KERNEL_TABLE_BYTES
-            } else {
-                0
-            },
-            shadow_table_bytes: 0,
+            tables: sss::tables::regions(&profiles),
             layered_ids: None,
-            layered_table_bytes: 0,
             layer_depth_textures: 0,
         };
         let scene_gpu = Arc::new(SceneGpu::new(lucent.gpu(), &no_objects, &upload)?);
@@ -457,7 +447,7 @@ impl PostProcessSss {
         let uniforms = FrameUniforms::new(&scene, self.desc.width, self.desc.height);
         self.scene_gpu()
             .per_frame
-            .write(slot, Region::Frame, bytemuck::bytes_of(&uniforms))?;
+            .write(slot, &FRAME, bytemuck::bytes_of(&uniforms))?;
         let set = &mut self.sets[index];
         let gpu = lucent.gpu();
         set.executable
@@ -566,19 +556,8 @@ fn cleared_image(graph: &mut RenderGraph, width: u32, height: u32) -> Handle<Ima
     );
     let mut pass = graph.add_pass("clear specular", PassKind::Raster);
     pass.color(&mut image, LoadOp::Clear([0.0; 4]));
-    pass.execute(ClearOnly);
+    pass.clears_only();
     image
-}
-
-/// A raster pass whose work is its attachment's clear.
-struct ClearOnly;
-
-impl PassExec for ClearOnly {
-    fn prepare(&mut self, _: &PrepareContext<'_>) -> Result<()> {
-        Ok(())
-    }
-    fn record(&self, _: &RecordContext<'_>) {}
-    fn destroy(&mut self, _: &crate::backend::GpuContext) {}
 }
 
 #[cfg(test)]

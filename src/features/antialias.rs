@@ -20,7 +20,7 @@ use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 use crate::Result;
 
 use super::pass::FullscreenPass;
-use crate::gpu_scene::{Region, SceneGpu};
+use crate::gpu_scene::{SceneGpu, FRAME};
 
 /// The anti-aliasing a frame applies after the tonemap.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -81,7 +81,7 @@ pub fn fxaa_pass(
     let linear = super::tonemap::writes_linear(graph.resources()[display.id()].info.format);
     let mut pass = FullscreenPass::new(graph, "fxaa", FXAA_FRAGMENT, scene);
     // Bilinear: the edge search and the final tap sample between texels.
-    pass.per_frame(Region::Frame)
+    pass.per_frame(&FRAME)
         .sample_with(ldr, vk::Filter::LINEAR)
         .color(&mut display, LoadOp::DontCare)
         .defines(fxaa_defines(linear));

@@ -13,7 +13,7 @@ use super::gbuffer::GBuffer;
 use super::lighting::Lit;
 use super::pass::FullscreenPass;
 use super::translucency::ThicknessPacking;
-use crate::gpu_scene::{Region, SceneGpu};
+use crate::gpu_scene::{SceneGpu, FRAME};
 
 /// What a debug view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,14 +107,14 @@ pub fn debug_view_pass(
         .is_some_and(|t| t.packing == ThicknessPacking::Colored);
     // The term binds its inputs and the material table when the frame has the table; without
     // it the view shows the second image alone (its other reads still declared).
-    let has_table = scene.is_some_and(|s| s.per_frame.has(Region::Translucency));
+    let has_table = scene.is_some_and(|s| s.per_frame.has(&super::translucency::TABLE_REGION));
     let inputs = match (second, term_inputs) {
         (Some(_), Some(_)) if has_table => ViewInputs::Term,
         (Some(_), _) => ViewInputs::Second,
         _ => ViewInputs::One,
     };
     let mut pass = FullscreenPass::new(graph, "debug view", VIEW_FRAGMENT, scene);
-    pass.per_frame(Region::Frame).sample(source);
+    pass.per_frame(&FRAME).sample(source);
     if let Some(s) = second {
         pass.sample(s);
     }
@@ -122,7 +122,7 @@ pub fn debug_view_pass(
         if inputs == ViewInputs::Term {
             pass.sample(gb2)
                 .sample(depth)
-                .per_frame(Region::Translucency);
+                .per_frame(&super::translucency::TABLE_REGION);
         } else {
             pass.graph().sample(gb2).sample(depth);
         }

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::backend::shader::PipelineShaders;
-use crate::gpu_scene::{Region, SceneGpu};
+use crate::gpu_scene::{SceneGpu, FRAME};
 use crate::graph::{
     Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
     RenderGraph,
@@ -20,7 +20,9 @@ use crate::Result;
 
 use super::layer_depth::{depth_map_bindings, layer_depth_format, layer_depths_define};
 use super::translucency::ThicknessPacking;
-use super::util::{Binding, DescriptorSet, GraphicsPipelineDesc, PassPipeline, VertexInput};
+use super::util::PassPipeline;
+use crate::backend::descriptor::{Binding, DescriptorSet};
+use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
 
 /// Depth.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -445,9 +447,7 @@ impl GBufferPass {
     /// (glsl/deferred/gbuffer.frag): the frame uniforms, then the normal (or LEAN 1) map, LEAN
     /// map 2, the albedo map and the depth maps, those the frame has.
     fn bindings(&self, index: usize) -> Vec<Binding> {
-        let mut bindings = vec![Binding::PerFrame(
-            self.scene.per_frame.binding(Region::Frame),
-        )];
+        let mut bindings = vec![Binding::PerFrame(self.scene.per_frame.binding(&FRAME))];
         if let Some(maps) = &self.scene.maps {
             let set = maps.sets.get(index).copied().unwrap_or_default();
             let (normal, albedo) = (set.normal, set.albedo);

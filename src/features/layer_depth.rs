@@ -5,7 +5,7 @@
 
 use ash::vk;
 
-use super::util::Binding;
+use crate::backend::descriptor::Binding;
 
 /// The `TexDep` texels of a G-buffer or light-space map texel for `textures` depth textures
 /// (glsl/common/layer_depths.glsl: two fp16 texels per 32-bit component): RG32UI holds four

@@ -15,21 +15,14 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
-use crate::gpu_scene::{Region, SceneGpu};
-use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph, ResourceId,
-};
-use crate::Result;
+use crate::gpu_scene::{SceneGpu, FRAME};
+use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 
 use super::gbuffer::{all_layouts, GBuffer, GBufferLayout};
+use super::pass::FullscreenPass;
 use super::shadows::{self, ShadowMaps};
-use super::util::{
-    check_bindings, clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc,
-    PassPipeline,
-};
+use super::util::Defines;
 
 /// Lit HDR colour.
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -68,13 +61,27 @@ pub fn lighting_pass(
         .layout
         .sss
         .then(|| graph.create_image("lighting.specular", hdr_info));
-    let mut pass = graph.add_pass("lighting", PassKind::Raster);
-    pass.input(&gb.gb0).input(&gb.gb1).input(&gb.depth);
+    let shadow_ids = shadows.map(|maps| maps.ids.is_some());
+    let (plain, translucent) = lighting_defines(&gb.layout, shadow_ids);
+    let mut pass = FullscreenPass::new(graph, "lighting", LIGHTING_FRAGMENT, scene);
+    // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency; then the
+    // shadow table and atlases (glsl/deferred/lighting.frag, glsl/common/shadows.glsl).
+    pass.defines(&plain)
+        .per_frame(&FRAME)
+        .input(&gb.gb0)
+        .input(&gb.gb1)
+        .input(&gb.depth);
     if let Some(gb2) = &gb.gb2 {
-        pass.input(gb2);
+        pass.input(gb2)
+            .per_frame(&super::translucency::TABLE_REGION);
     }
     if let Some(maps) = shadows {
-        pass.sample(&maps.depth);
+        // `lighting_defines` numbered the shadow bindings from here.
+        debug_assert_eq!(
+            pass.next_binding(),
+            lighting_bindings_before_shadows(&gb.layout)
+        );
+        pass.per_frame(&shadows::TABLE_REGION).sample(&maps.depth);
         if let Some(ids) = &maps.ids {
             pass.sample(ids);
         }
@@ -83,25 +90,13 @@ pub fn lighting_pass(
     if let Some(specular) = &mut specular {
         pass.color(specular, LoadOp::DontCare);
     }
-    let inputs = LightingInputs {
-        gb0: gb.gb0.id(),
-        gb1: gb.gb1.id(),
-        depth: gb.depth.id(),
-        gb2: gb.gb2.as_ref().map(|h| h.id()),
-        shadow_depth: shadows.map(|m| m.depth.id()),
-        shadow_ids: shadows.and_then(|m| m.ids.as_ref().map(|h| h.id())),
-    };
-    match scene {
-        Some(scene) => pass.execute(LightingPass {
-            scene: scene.clone(),
-            inputs,
-            layout: gb.layout,
-            pipeline: None,
-            translucent: None,
-            sampler: vk::Sampler::null(),
-        }),
-        None => pass.finish(),
+    if let Some(extra) = translucent {
+        // The translucent shader on the tiles translucent objects may cover, the plain one on
+        // the others.
+        pass.marked_variant(extra)
+            .tiles(|scene, ctx| Some(scene.per_frame.tiles(ctx.frame).lighting.clone()));
     }
+    pass.finish();
     Lit {
         color: hdr,
         specular,
@@ -166,114 +161,5 @@ pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
                 out.push(fullscreen(&all));
             }
         }
-    }
-}
-
-/// The G-buffer images the lighting pass reads.
-struct LightingInputs {
-    gb0: ResourceId,
-    gb1: ResourceId,
-    depth: ResourceId,
-    gb2: Option<ResourceId>,
-    /// The light-space maps' depth and ID atlases, when some light casts shadows.
-    shadow_depth: Option<ResourceId>,
-    shadow_ids: Option<ResourceId>,
-}
-
-struct LightingPass {
-    scene: Arc<SceneGpu>,
-    inputs: LightingInputs,
-    layout: GBufferLayout,
-    /// The plain shader: every pixel, or with translucency the tiles no translucent object
-    /// touches.
-    pipeline: Option<PassPipeline>,
-    /// With translucency: the translucency shader for the other tiles (same set).
-    translucent: Option<GraphicsPipeline>,
-    /// Nearest clamp sampler for the light-space maps (null without shadows).
-    sampler: vk::Sampler,
-}
-
-impl PassExec for LightingPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let inputs = &self.inputs;
-        let color_layout = Access::InputAttachmentRead.info().layout;
-        let depth_layout = Access::DepthInputAttachmentRead.info().layout;
-        let views = ctx.descriptor_views;
-        // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency
-        // (glsl/deferred/lighting.frag).
-        let mut bindings = vec![
-            Binding::PerFrame(self.scene.per_frame.binding(Region::Frame)),
-            Binding::InputAttachment(views[inputs.gb0], color_layout),
-            Binding::InputAttachment(views[inputs.gb1], color_layout),
-            Binding::InputAttachment(views[inputs.depth], depth_layout),
-        ];
-        if let Some(gb2) = inputs.gb2 {
-            bindings.push(Binding::InputAttachment(views[gb2], color_layout));
-            bindings.push(Binding::PerFrame(
-                self.scene.per_frame.binding(Region::Translucency),
-            ));
-        }
-        let shadow_ids = inputs.shadow_depth.map(|_| inputs.shadow_ids.is_some());
-        let (plain_defines, translucent_defines) = lighting_defines(&self.layout, shadow_ids);
-        if let Some(depth) = inputs.shadow_depth {
-            self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-            // The shadow table, then the atlases (glsl/common/shadows.glsl).
-            check_bindings(
-                "lighting",
-                bindings.len(),
-                lighting_bindings_before_shadows(&self.layout),
-            )?;
-            bindings.extend(shadows::lighting_bindings(
-                &self.scene,
-                depth,
-                inputs.shadow_ids,
-                views,
-                self.sampler,
-            ));
-        }
-        let plain = GraphicsPipelineDesc::fullscreen(LIGHTING_FRAGMENT, &plain_defines, "lighting");
-        let mut pipeline = PassPipeline::new(ctx, &bindings, &plain)?;
-        if let Some(extra) = translucent_defines {
-            let (plain_pipeline, translucent) =
-                pipeline.with_variant(ctx, &plain, &extra, "lighting (translucent)")?;
-            pipeline = plain_pipeline;
-            self.translucent = Some(translucent);
-        }
-        self.pipeline = Some(pipeline);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        let Some(pipeline) = &self.pipeline else {
-            return;
-        };
-        let Some(translucent) = &self.translucent else {
-            pipeline.draw_fullscreen(ctx);
-            return;
-        };
-        let rects = self.scene.per_frame.tiles(ctx.frame).lighting.clone();
-        pipeline.bind(ctx);
-        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
-        // SAFETY: made for this subpass with the bound set's layout.
-        unsafe {
-            ctx.gpu.device.cmd_bind_pipeline(
-                ctx.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                translucent.pipeline,
-            );
-        }
-        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
-    }
-
-    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        if let Some(mut p) = self.translucent.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
     }
 }

@@ -29,6 +29,7 @@ pub mod antialias;
 pub mod copy_pass;
 pub mod debug_view;
 pub mod gbuffer;
+pub mod knob;
 pub mod layer_depth;
 pub mod layered;
 pub mod lighting;

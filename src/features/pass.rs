@@ -15,7 +15,7 @@
 //!
 //! ```text
 //! let mut pass = FullscreenPass::new(graph, "tonemap", "post/tonemap.frag", scene);
-//! pass.per_frame(Region::Frame)
+//! pass.per_frame(&FRAME)
 //!     .sample(hdr)
 //!     .color(&mut display, LoadOp::DontCare)
 //!     .defines(defines);
@@ -26,9 +26,9 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::util::{
-    clamp_sampler, Binding, Defines, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
-};
+use super::util::{Defines, PassPipeline};
+use crate::backend::descriptor::{clamp_sampler, Binding};
+use crate::backend::pipeline::{GraphicsPipeline, GraphicsPipelineDesc};
 use crate::gpu_scene::{Region, SceneGpu, TileRect};
 use crate::graph::declare::PassBuilder;
 use crate::graph::{
@@ -50,7 +50,7 @@ type Tiles = Box<dyn Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>>>
 #[derive(Clone, Copy, Debug)]
 enum Slot {
     /// A region of the per-frame buffer.
-    PerFrame(Region),
+    PerFrame(&'static Region),
     /// An image sampled through a clamp sampler with this filter.
     Sampled(ResourceId, vk::Filter),
     /// An input attachment in this layout.
@@ -61,8 +61,12 @@ enum Slot {
 /// [`FullscreenPass::finish`].
 pub struct FullscreenPass<'g> {
     pass: PassBuilder<'g>,
-    /// The scene on the GPU; `None` when only planning.
+    /// The scene on the GPU, which per-frame bindings and tiles read.
     scene: Option<Arc<SceneGpu>>,
+    /// Whether the pass runs on a GPU (false: only planning, the graph accesses alone).
+    runs: bool,
+    /// The pass writes depth and its pipeline tests it ([`Self::depth`]).
+    depth_test: bool,
     /// The pass's name (also its pipeline's).
     name: String,
     fragment: &'static str,
@@ -74,7 +78,18 @@ pub struct FullscreenPass<'g> {
     colors: u32,
     push_constants: Vec<u8>,
     tiles: Option<Tiles>,
-    variant: Option<Defines>,
+    variant: Option<Variant>,
+}
+
+/// A second pipeline of a tiled pass: the pass's defines plus `extra`, drawn in the tiles the
+/// pass's own pipeline does not draw.
+struct Variant {
+    extra: Defines,
+    /// Drawn in the marked (`translucent`) tiles, the pass's own pipeline in the others;
+    /// otherwise the reverse.
+    in_marked: bool,
+    /// Its pipeline's name after the pass's (`pass-through`, `translucent`).
+    label: &'static str,
 }
 
 impl<'g> FullscreenPass<'g> {
@@ -89,6 +104,8 @@ impl<'g> FullscreenPass<'g> {
         Self {
             pass: graph.add_pass(name, PassKind::Raster),
             scene: scene.cloned(),
+            runs: scene.is_some(),
+            depth_test: false,
             name: name.to_string(),
             fragment,
             slots: Vec::new(),
@@ -101,6 +118,22 @@ impl<'g> FullscreenPass<'g> {
         }
     }
 
+    /// A pass that runs without a scene on the GPU (the benchmark's speed-of-light copies): it
+    /// may sample images, but binds no per-frame region and draws no tiles.
+    pub fn standalone(graph: &'g mut RenderGraph, name: &str, fragment: &'static str) -> Self {
+        Self {
+            runs: true,
+            ..Self::new(graph, name, fragment, None)
+        }
+    }
+
+    /// Writes the depth attachment, the pipeline testing (and writing) depth.
+    pub fn depth(&mut self, handle: &mut Handle<Image>, load: LoadOp) -> &mut Self {
+        self.pass.depth(handle, load);
+        self.depth_test = true;
+        self
+    }
+
     /// The graph pass being declared, for accesses that bind nothing (an image only declared
     /// as read, the taps per pixel).
     pub fn graph(&mut self) -> &mut PassBuilder<'g> {
@@ -109,7 +142,7 @@ impl<'g> FullscreenPass<'g> {
 
     /// Binds a region of the per-frame buffer (a dynamic uniform buffer at the recorded
     /// frame's slot).
-    pub fn per_frame(&mut self, region: Region) -> &mut Self {
+    pub fn per_frame(&mut self, region: &'static Region) -> &mut Self {
         self.slots.push(Slot::PerFrame(region));
         self
     }
@@ -193,7 +226,7 @@ impl<'g> FullscreenPass<'g> {
     /// [`Self::shadows`] for a depth atlas the pass already declared a read of.
     pub fn bind_shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
         self.defines(&super::shadows::lighting_defines(self.slots.len()));
-        self.per_frame(Region::Shadows)
+        self.per_frame(&super::shadows::TABLE_REGION)
             .bind_sampled(depth, vk::Filter::NEAREST)
     }
 
@@ -223,8 +256,28 @@ impl<'g> FullscreenPass<'g> {
     /// A second pipeline with `extra` defines added, drawn in the tiles that are not
     /// translucent (the pass-through variant of a composing pass).
     pub fn variant(&mut self, extra: Defines) -> &mut Self {
-        self.variant = Some(extra);
+        self.variant = Some(Variant {
+            extra,
+            in_marked: false,
+            label: "pass-through",
+        });
         self
+    }
+
+    /// A second pipeline with `extra` defines added, drawn in the marked (`translucent`)
+    /// tiles, the pass's own pipeline in the others (the lighting pass's translucent shader).
+    pub fn marked_variant(&mut self, extra: Defines) -> &mut Self {
+        self.variant = Some(Variant {
+            extra,
+            in_marked: true,
+            label: "translucent",
+        });
+        self
+    }
+
+    /// The number the next binding gets.
+    pub fn next_binding(&self) -> usize {
+        self.slots.len()
     }
 
     /// The shader defines declared so far: what the pipeline is built with once the pass is
@@ -236,12 +289,13 @@ impl<'g> FullscreenPass<'g> {
     /// Finishes the declaration: with a scene on the GPU, the pass with the code that
     /// records it; when only planning, the graph accesses alone.
     pub fn finish(self) {
-        let Some(scene) = self.scene else {
+        if !self.runs {
             self.pass.finish();
             return;
-        };
+        }
         self.pass.execute(FullscreenExec {
-            scene,
+            scene: self.scene,
+            depth_test: self.depth_test,
             name: self.name,
             fragment: self.fragment,
             slots: self.slots,
@@ -252,6 +306,7 @@ impl<'g> FullscreenPass<'g> {
             variant: self.variant,
             samplers: Vec::new(),
             pipeline: None,
+            bare: None,
             variant_pipeline: None,
         });
     }
@@ -259,7 +314,8 @@ impl<'g> FullscreenPass<'g> {
 
 /// The code behind a [`FullscreenPass`].
 struct FullscreenExec {
-    scene: Arc<SceneGpu>,
+    scene: Option<Arc<SceneGpu>>,
+    depth_test: bool,
     name: String,
     fragment: &'static str,
     slots: Vec<Slot>,
@@ -267,10 +323,12 @@ struct FullscreenExec {
     additive: u32,
     push_constants: Vec<u8>,
     tiles: Option<Tiles>,
-    variant: Option<Defines>,
+    variant: Option<Variant>,
     /// One clamp sampler per filter the bindings use.
     samplers: Vec<(vk::Filter, vk::Sampler)>,
     pipeline: Option<PassPipeline>,
+    /// A pass without bindings: its pipeline, without a descriptor set.
+    bare: Option<GraphicsPipeline>,
     variant_pipeline: Option<GraphicsPipeline>,
 }
 
@@ -294,7 +352,15 @@ impl PassExec for FullscreenExec {
         let mut bindings = Vec::with_capacity(self.slots.len());
         for slot in &self.slots {
             bindings.push(match *slot {
-                Slot::PerFrame(region) => Binding::PerFrame(self.scene.per_frame.binding(region)),
+                Slot::PerFrame(region) => {
+                    let scene = self.scene.as_ref().ok_or_else(|| {
+                        crate::LucentError::Graph(format!(
+                            "pass '{}' binds the per-frame region '{}' without a scene",
+                            self.name, region.name
+                        ))
+                    })?;
+                    Binding::PerFrame(scene.per_frame.binding(region))
+                }
                 Slot::Sampled(id, filter) => {
                     Binding::Sampled(views[id], sampler(&mut self.samplers, ctx, filter)?)
                 }
@@ -304,12 +370,19 @@ impl PassExec for FullscreenExec {
         let desc = GraphicsPipelineDesc {
             additive_attachments: self.additive,
             push_constant_bytes: self.push_constants.len() as u32,
+            depth_test: self.depth_test,
             ..GraphicsPipelineDesc::fullscreen(self.fragment, &self.defines, &self.name)
         };
+        // Nothing to bind, push or tile: a pipeline without a descriptor set.
+        let bare = bindings.is_empty() && self.push_constants.is_empty();
+        if bare && self.variant.is_none() && self.tiles.is_none() {
+            self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);
+            return Ok(());
+        }
         let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
-        if let Some(extra) = &self.variant {
-            let name = format!("{} (pass-through)", self.name);
-            let (main, variant) = pipeline.with_variant(ctx, &desc, extra, &name)?;
+        if let Some(variant) = &self.variant {
+            let name = format!("{} ({})", self.name, variant.label);
+            let (main, variant) = pipeline.with_variant(ctx, &desc, &variant.extra, &name)?;
             pipeline = main;
             self.variant_pipeline = Some(variant);
         }
@@ -318,11 +391,19 @@ impl PassExec for FullscreenExec {
     }
 
     fn record(&self, ctx: &RecordContext<'_>) {
+        let device = &ctx.gpu.device;
+        if let Some(bare) = &self.bare {
+            // SAFETY: the pipeline is alive; the executor began this pass's subpass.
+            unsafe {
+                device.cmd_bind_pipeline(ctx.cmd, vk::PipelineBindPoint::GRAPHICS, bare.pipeline);
+                device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
+            }
+            return;
+        }
         let Some(pipeline) = &self.pipeline else {
             return;
         };
         pipeline.bind(ctx);
-        let device = &ctx.gpu.device;
         if !self.push_constants.is_empty() {
             // SAFETY: the pipeline's layout has this push-constant range; it is bound.
             unsafe {
@@ -335,12 +416,18 @@ impl PassExec for FullscreenExec {
                 );
             }
         }
-        let Some(rects) = self.tiles.as_ref().and_then(|t| t(&self.scene, ctx)) else {
+        let tiles = self.tiles.as_ref().zip(self.scene.as_ref());
+        let Some(rects) = tiles.and_then(|(tiles, scene)| tiles(scene, ctx)) else {
             // SAFETY: bound above, inside the pass's subpass.
             unsafe { device.cmd_draw(ctx.cmd, 3, 1, 0, 0) };
             return;
         };
-        PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| r.translucent));
+        // The pass's own pipeline draws the marked tiles, or with a marked variant the others.
+        let own_in_marked = !self.variant.as_ref().is_some_and(|v| v.in_marked);
+        PassPipeline::draw_fullscreen_in(
+            ctx,
+            rects.iter().filter(|r| r.translucent == own_in_marked),
+        );
         if let Some(variant) = &self.variant_pipeline {
             // SAFETY: made for this subpass with the bound set's layout (same push constants).
             unsafe {
@@ -350,7 +437,10 @@ impl PassExec for FullscreenExec {
                     variant.pipeline,
                 );
             }
-            PassPipeline::draw_fullscreen_in(ctx, rects.iter().filter(|r| !r.translucent));
+            PassPipeline::draw_fullscreen_in(
+                ctx,
+                rects.iter().filter(|r| r.translucent != own_in_marked),
+            );
         }
     }
 
@@ -359,6 +449,9 @@ impl PassExec for FullscreenExec {
             p.destroy(&gpu.device);
         }
         if let Some(mut p) = self.variant_pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+        if let Some(mut p) = self.bare.take() {
             p.destroy(&gpu.device);
         }
         for (_, sampler) in self.samplers.drain(..) {
@@ -372,6 +465,7 @@ impl PassExec for FullscreenExec {
 mod tests {
     use super::*;
     use crate::backend::access::Access;
+    use crate::gpu_scene::FRAME;
     use crate::graph::ImageInfo;
 
     fn image(graph: &mut RenderGraph, name: &str) -> Handle<Image> {
@@ -393,10 +487,7 @@ mod tests {
         );
         let mut out = image(&mut graph, "out");
         let mut pass = FullscreenPass::new(&mut graph, "pass", "post/tonemap.frag", None);
-        pass.per_frame(Region::Frame)
-            .sample(&a)
-            .graph()
-            .sample(&depth);
+        pass.per_frame(&FRAME).sample(&a).graph().sample(&depth);
         pass.binding_define("LUCENT_B_BINDING")
             .sample_with(&b, vk::Filter::LINEAR)
             .bind_shadows(&depth)

@@ -20,6 +20,7 @@
 //! Adding a technique is its module, its shader, one line here and its goldens:
 //! `docs/architecture.md` walks through it.
 
+use super::knob::Knob;
 use super::sss::SssBlur;
 pub use super::technique::{Shades, TechniqueModule};
 use crate::scene::material::SssProfile;
@@ -111,12 +112,23 @@ pub fn check_names(scene: &crate::scene::Scene) -> Result<()> {
     Ok(())
 }
 
-/// The techniques that list `flag` among their knobs.
-pub fn with_knob(flag: &str) -> impl Iterator<Item = &'static dyn TechniqueModule> + '_ {
+/// The techniques that list `knob` among their knobs.
+pub fn with_knob(knob: &Knob) -> impl Iterator<Item = &'static dyn TechniqueModule> + '_ {
     TECHNIQUES
         .iter()
         .copied()
-        .filter(move |t| t.knobs().contains(&flag))
+        .filter(move |t| t.knobs().iter().any(|k| std::ptr::eq(*k, knob)))
+}
+
+/// Every technique knob once, in registry order (the order of the command line's flags).
+pub fn knobs() -> Vec<&'static Knob> {
+    let mut all: Vec<&'static Knob> = Vec::new();
+    for knob in TECHNIQUES.iter().flat_map(|t| t.knobs().iter().copied()) {
+        if !all.iter().any(|k| std::ptr::eq(*k, knob)) {
+            all.push(knob);
+        }
+    }
+    all
 }
 
 #[cfg(test)]
@@ -130,7 +142,16 @@ mod tests {
             // `auto` and `none` are what `--technique` says besides the registered names.
             assert!(!["auto", "none"].contains(&t.name()));
             assert!(!t.summary().is_empty());
-            assert!(t.knobs().iter().all(|k| k.starts_with("--")));
+            assert!(t.knobs().iter().all(|k| k.flag.starts_with("--")));
+        }
+    }
+
+    /// Two knobs never share a flag (the command line would refuse to build).
+    #[test]
+    fn knob_flags_are_unique() {
+        let knobs = knobs();
+        for (i, k) in knobs.iter().enumerate() {
+            assert!(knobs[..i].iter().all(|o| o.flag != k.flag), "{k:?} twice");
         }
     }
 

@@ -30,8 +30,10 @@ use crate::graph::{
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::Result;
 
-use super::util::{Binding, GraphicsPipelineDesc, PassPipeline, VertexInput};
-use crate::gpu_scene::{Region, SceneGpu};
+use super::util::PassPipeline;
+use crate::backend::descriptor::{Binding, DescriptorSet};
+use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
+use crate::gpu_scene::{Region, SceneGpu, TableRegion};
 
 /// Depth of the light-space maps.
 pub const SHADOW_DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -223,6 +225,17 @@ impl ShadowUniforms {
 /// Bytes of the per-frame shadow region.
 pub const SHADOW_TABLE_BYTES: u64 = std::mem::size_of::<ShadowUniforms>() as u64;
 
+/// The light-space maps' table in the per-frame buffer.
+pub static TABLE_REGION: Region = Region::new("light-space maps' table");
+
+/// The per-frame region a frame with shadows writes its table into.
+pub fn table_region() -> TableRegion {
+    TableRegion {
+        region: &TABLE_REGION,
+        bytes: SHADOW_TABLE_BYTES,
+    }
+}
+
 /// A sphere around every object in world space (the directional lights' maps cover it).
 fn world_sphere(scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> (Vec3, f32) {
     let mut lo = Vec3::splat(f32::MAX);
@@ -403,7 +416,7 @@ struct ShadowPass {
     pipeline: Option<PassPipeline>,
     /// Frames with `TexDep` media: one set per depth-texture pair after the first (the
     /// pipeline's own), each `maps table + the pair`, bound per draw.
-    depth_sets: Vec<super::util::DescriptorSet>,
+    depth_sets: Vec<DescriptorSet>,
 }
 
 impl ShadowPass {
@@ -416,7 +429,7 @@ impl ShadowPass {
     /// in frames with `TexDep` media the pair's textures.
     fn bindings(&self, index: usize) -> Vec<Binding> {
         let mut bindings = vec![Binding::PerFrame(
-            self.scene.per_frame.binding(Region::Shadows),
+            self.scene.per_frame.binding(&TABLE_REGION),
         )];
         if let (true, Some(maps)) = (self.layer_depths(), &self.scene.maps) {
             let pair = maps.depth_sets.get(index).copied().unwrap_or([0, 0]);
@@ -470,7 +483,7 @@ impl PassExec for ShadowPass {
         };
         for index in 1..pairs {
             // Identically defined layouts are compatible: these sets bind to the pipeline's.
-            let set = super::util::DescriptorSet::new(
+            let set = DescriptorSet::new(
                 ctx,
                 &self.bindings(index),
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
@@ -625,26 +638,6 @@ pub fn lighting_defines(first: usize) -> [(&'static str, &'static str); 2] {
             BINDINGS[first.min(BINDINGS.len() - 1)],
         ),
     ]
-}
-
-/// The bindings a lighting pass appends for the maps (after its own): the shadow table, the
-/// depth atlas and, with transmission IDs, the ID atlas; `views` are the graph's descriptor
-/// views and `sampler` a nearest clamp sampler.
-pub fn lighting_bindings(
-    scene: &SceneGpu,
-    depth: crate::graph::ResourceId,
-    ids: Option<crate::graph::ResourceId>,
-    views: &[vk::ImageView],
-    sampler: vk::Sampler,
-) -> Vec<Binding> {
-    let mut bindings = vec![
-        Binding::PerFrame(scene.per_frame.binding(Region::Shadows)),
-        Binding::Sampled(views[depth], sampler),
-    ];
-    if let Some(ids) = ids {
-        bindings.push(Binding::Sampled(views[ids], sampler));
-    }
-    bindings
 }
 
 #[cfg(test)]

@@ -14,8 +14,8 @@
 //! Each pass builds its defines with a function of its shape (the G-buffer layout, which inputs
 //! it reads, its knobs), and that same function is what its module's `shader_permutations`
 //! calls over every shape the pass can have, so the two cannot drift apart. Binding numbers in
-//! defines are derived from the shape too; the pass checks, when it builds its descriptor set,
-//! that it made as many bindings as the defines number ([`super::util::check_bindings`]). The
+//! defines are derived from the shape too, and a pass declared with
+//! [`super::pass::FullscreenPass`] numbers them from the bindings it has declared. The
 //! shapes enumerated are the whole input space of each function (every G-buffer layout flag,
 //! every knob value the defines distinguish), not only the scenes in the tests. Combinations
 //! one frame can never hold (LEAN without SSS, say) are included when the shader compiles them:

@@ -13,7 +13,7 @@ use ash::vk;
 use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 
 use super::pass::FullscreenPass;
-use crate::gpu_scene::{Region, SceneGpu};
+use crate::gpu_scene::{SceneGpu, FRAME};
 
 /// Display target format: sRGB-encoded by the shader, stored as UNORM.
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
@@ -75,7 +75,7 @@ fn declare(
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
     let mut pass = FullscreenPass::new(graph, "tonemap", TONEMAP_FRAGMENT, scene);
-    pass.per_frame(Region::Frame)
+    pass.per_frame(&FRAME)
         .sample(hdr)
         .color(&mut output, LoadOp::DontCare)
         .defines(tonemap_defines(encoding));

@@ -16,8 +16,10 @@
 
 use glam::Vec3;
 
+use super::knob::{Knob, Takes};
 use super::technique::{Shades, TechniqueModule};
 use crate::backend::shader::PipelineShaders;
+use crate::gpu_scene::{Region, TableRegion};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -166,11 +168,32 @@ pub struct MaterialTableGpu {
     pub rows: [MaterialRow; MAX_TRANSLUCENT_MATERIALS + 1],
 }
 
+/// The GDC 2011 material table in the per-frame buffer.
+pub static TABLE_REGION: Region = Region::new("GDC 2011 material table");
+
+/// The per-frame region a frame with translucency writes its material table into.
+pub fn table_region() -> TableRegion {
+    TableRegion {
+        region: &TABLE_REGION,
+        bytes: std::mem::size_of::<MaterialTableGpu>() as u64,
+    }
+}
+
 /// GDC 2011 translucency as a registered technique (`--technique translucency`).
 pub struct Gdc2011Translucency;
 
 /// The technique's instance, listed in [`super::registry`].
 pub static TRANSLUCENCY: Gdc2011Translucency = Gdc2011Translucency;
+
+/// `--grayscale`: thickness stored as its luminance, the talk's one-channel G-buffer.
+pub static GRAYSCALE_KNOB: Knob = Knob {
+    flag: "--grayscale",
+    help: "Store coloured thickness as grayscale (its luminance), the talk's one-channel \
+           G-buffer.",
+    takes: Takes::Switch,
+    default: None,
+    apply: |k, _| *k.force_grayscale = true,
+};
 
 impl TechniqueModule for Gdc2011Translucency {
     fn name(&self) -> &'static str {
@@ -186,8 +209,9 @@ impl TechniqueModule for Gdc2011Translucency {
         Shades::Translucent
     }
 
-    fn knobs(&self) -> &'static [&'static str] {
-        &["--grayscale"]
+    fn knobs(&self) -> &'static [&'static Knob] {
+        static KNOBS: &[&Knob] = &[&GRAYSCALE_KNOB];
+        KNOBS
     }
 
     fn scene(&self) -> &'static str {

@@ -1,14 +1,12 @@
 //! Pass-level helpers: a pass's pipeline with its descriptor set ([`PassPipeline`]) and its
-//! fullscreen draws over tile rectangles, the render graph's contexts as the backend's pipeline
-//! targets, and the binding check of passes that number their own bindings. The ash-level
-//! pipeline and descriptor code is [`crate::backend::pipeline`] and
-//! [`crate::backend::descriptor`]; its types are re-exported here for the passes that build
-//! their pipelines by hand.
+//! fullscreen draws over tile rectangles, and the render graph's contexts as the backend's
+//! pipeline targets. The ash-level pipeline and descriptor code is [`crate::backend::pipeline`]
+//! and [`crate::backend::descriptor`]; passes that draw meshes use it from there.
 
 use ash::vk;
 
-pub use crate::backend::descriptor::{clamp_sampler, Binding, DescriptorSet};
-pub use crate::backend::pipeline::{GraphicsPipeline, GraphicsPipelineDesc, VertexInput};
+use crate::backend::descriptor::{Binding, DescriptorSet};
+use crate::backend::pipeline::{GraphicsPipeline, GraphicsPipelineDesc};
 use crate::backend::pipeline::{PipelineTarget, Recording};
 use crate::backend::shader::ShaderCompiler;
 use crate::backend::GpuContext;
@@ -56,19 +54,6 @@ impl Recording for RecordContext<'_> {
 
 /// A pass's shader defines, `("NAME", "VALUE")` (see [`crate::features::shipped`]).
 pub type Defines = Vec<(&'static str, &'static str)>;
-
-/// Checks that a pass built the descriptor bindings its shader permutation numbers from:
-/// binding numbers in defines come from the pass's shape ([`crate::features::shipped`] lists
-/// every permutation), so `built` (the bindings made) must be `expected` (what the defines say).
-pub fn check_bindings(pass: &str, built: usize, expected: usize) -> Result<()> {
-    if built == expected {
-        return Ok(());
-    }
-    Err(crate::LucentError::Graph(format!(
-        "pass '{pass}': {built} descriptor bindings before the next group, but its shader \
-         permutation numbers them from {expected} (the pass's bindings and its defines disagree)"
-    )))
-}
 
 /// A pass's pipeline together with its descriptor set: what most passes hold after `prepare`.
 pub struct PassPipeline {

@@ -17,8 +17,8 @@ use crate::features::layered::LayeredDesc;
 use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
-use crate::features::translucency::{MaterialTable, MaterialTableGpu, ThicknessPacking};
-use crate::gpu_scene::SceneUpload;
+use crate::features::translucency::{MaterialTable, ThicknessPacking};
+use crate::gpu_scene::{SceneUpload, TableRegion};
 use crate::scene::Scene;
 use crate::Result;
 
@@ -144,6 +144,24 @@ impl FrameDesc {
         }
     }
 
+    /// The per-frame tables of this frame's features, each registered by its feature.
+    pub fn tables(&self) -> Vec<TableRegion> {
+        let mut tables = Vec::new();
+        if self.translucency.is_some() {
+            tables.push(crate::features::translucency::table_region());
+        }
+        if let Some(profiles) = &self.sss {
+            tables.extend(crate::features::sss::tables::regions(profiles));
+        }
+        if self.shadows.is_some() {
+            tables.push(crate::features::shadows::table_region());
+        }
+        if self.layered.is_some() {
+            tables.push(crate::features::layered::table_region());
+        }
+        tables
+    }
+
     /// What the scene's GPU data must hold for this frame.
     pub fn upload(&self, frames_in_flight: usize) -> SceneUpload<'_> {
         SceneUpload {
@@ -153,33 +171,9 @@ impl FrameDesc {
             lean: self.lean(),
             albedo_maps: self.albedo_maps,
             frames_in_flight,
-            translucency_table_bytes: if self.translucency.is_some() {
-                std::mem::size_of::<MaterialTableGpu>() as u64
-            } else {
-                0
-            },
-            profile_table_bytes: if self.sss.is_some() {
-                crate::features::sss::PROFILE_TABLE_BYTES
-            } else {
-                0
-            },
-            kernel_table_bytes: if self.two_pass() {
-                crate::features::sss::kernel::KERNEL_TABLE_BYTES
-            } else {
-                0
-            },
-            shadow_table_bytes: if self.shadows.is_some() {
-                crate::features::shadows::SHADOW_TABLE_BYTES
-            } else {
-                0
-            },
+            tables: self.tables(),
             layered_ids: self.layered.as_ref().map(|l| &l.object_ids[..]),
             layer_depth_textures: self.layer_depth_textures(),
-            layered_table_bytes: if self.layered.is_some() {
-                crate::features::layered::LAYERED_TABLE_BYTES
-            } else {
-                0
-            },
         }
     }
 

@@ -16,7 +16,7 @@ use crate::features::sss;
 use crate::gpu_scene::tiles::{
     bounds_of, mesh_bounds, object_tiles, tile_rects, translucent_tiles,
 };
-use crate::gpu_scene::{FrameUniforms, Region, SceneGpu, SlotTiles};
+use crate::gpu_scene::{FrameUniforms, SceneGpu, SlotTiles, FRAME};
 use crate::graph::{Executable, RenderGraph, ResourceId};
 use crate::scene::{Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
@@ -192,16 +192,20 @@ impl Renderer {
         if let Some(f) = self.settings.fault {
             uniforms.fault = [f.x as i32, f.y as i32, if f.nan { 1 } else { 2 }, 0];
         }
-        per_frame.write(slot, Region::Frame, bytemuck::bytes_of(&uniforms))?;
+        per_frame.write(slot, &FRAME, bytemuck::bytes_of(&uniforms))?;
         if let Some(shadows) = &desc.shadows {
             let table = shadows.uniforms(scene, mesh_bounds);
-            per_frame.write(slot, Region::Shadows, bytemuck::bytes_of(&table))?;
+            per_frame.write(
+                slot,
+                &crate::features::shadows::TABLE_REGION,
+                bytemuck::bytes_of(&table),
+            )?;
         }
         let mut tiles = SlotTiles::default();
         if let Some(t) = &desc.translucency {
             per_frame.write(
                 slot,
-                Region::Translucency,
+                &crate::features::translucency::TABLE_REGION,
                 bytemuck::bytes_of(&t.table.gpu()),
             )?;
             let (columns, _, marked) = translucent_tiles(scene, mesh_bounds, width, height);
@@ -226,7 +230,11 @@ impl Renderer {
         }
         if let Some(layered) = &desc.layered {
             let table = layered.table(&self.settings.layered);
-            per_frame.write(slot, Region::Layered, bytemuck::bytes_of(&table))?;
+            per_frame.write(
+                slot,
+                &crate::features::layered::TABLE_REGION,
+                bytemuck::bytes_of(&table),
+            )?;
             // The scattering passes stay on the object (the gather rejects other materials).
             let (columns, _, marked) = object_tiles(scene, mesh_bounds, width, height, |i, _| {
                 (layered.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)

@@ -4,6 +4,7 @@ use crate::backend::access::Access;
 use crate::features::antialias::Antialias;
 use crate::features::debug_view::DebugView;
 use crate::features::gbuffer::GBufferPrecision;
+use crate::features::knob::{Given, Knob, KnobTargets};
 use crate::features::layered::LayeredKnobs;
 use crate::features::registry::{self, Shades, TechniqueModule};
 use crate::features::shadows::ShadowSettings;
@@ -223,5 +224,22 @@ impl FrameSettings {
             antialias: Antialias::Off,
             export_ldr: false,
         }
+    }
+
+    /// The settings technique knobs set, for a knob's `apply`
+    /// ([`crate::features::knob::Knob`]).
+    pub fn knob_targets(&mut self) -> KnobTargets<'_> {
+        KnobTargets {
+            sss: &mut self.sss,
+            layered: &mut self.layered,
+            force_grayscale: &mut self.force_grayscale,
+            sss_tiles: &mut self.sss_tiles,
+        }
+    }
+
+    /// Sets technique knob `knob` to `value` (a value [`crate::features::knob::Takes::parse`]
+    /// accepted).
+    pub fn set_knob(&mut self, knob: &Knob, value: Given) {
+        (knob.apply)(&mut self.knob_targets(), value);
     }
 }

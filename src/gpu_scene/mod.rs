@@ -24,7 +24,9 @@ use crate::scene::texture::{load_texture, procedural_texture, Texture, TextureUs
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-pub use per_frame::{FrameUniforms, PerFrame, PerFrameBinding, Region, SlotTiles};
+pub use per_frame::{
+    FrameUniforms, PerFrame, PerFrameBinding, Region, SlotTiles, TableRegion, FRAME,
+};
 pub use tiles::TileRect;
 
 /// One draw: which mesh, with which material textures and per-object constants.
@@ -202,7 +204,7 @@ pub struct MaterialMaps {
 }
 
 /// What the frame needs of the scene on the GPU (the frame description decides it).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SceneUpload<'a> {
     /// Frames with translucency: each object's translucency material ID (0: opaque); the
     /// meshes get their thickness streams.
@@ -217,19 +219,12 @@ pub struct SceneUpload<'a> {
     pub albedo_maps: bool,
     /// Frames in flight (slots of the per-frame buffer).
     pub frames_in_flight: usize,
-    /// Bytes of the translucency material table (0 without translucency).
-    pub translucency_table_bytes: u64,
-    /// Bytes of the SSS profile table (0 without SSS).
-    pub profile_table_bytes: u64,
-    /// Bytes of the separable kernel table (0 without a separable chain).
-    pub kernel_table_bytes: u64,
-    /// Bytes of the light-space maps' table (0: no light casts shadows).
-    pub shadow_table_bytes: u64,
+    /// The per-frame tables the frame's features write (besides the frame uniforms), in the
+    /// order the per-frame buffer lays them out.
+    pub tables: Vec<TableRegion>,
     /// Frames with layered materials: each object's layered material ID (0: not layered);
     /// a layered object's albedo is weighted by its eq. 3 `λ1` and its specular by `λ2`.
     pub layered_ids: Option<&'a [u8]>,
-    /// Bytes of the layered media's table (0 without layered materials).
-    pub layered_table_bytes: u64,
     /// `TexDep` depth textures the frame's layered media read per object (0: none; 1 or 2:
     /// [`crate::features::layered::LayeredDesc::depth_textures`]).
     pub layer_depth_textures: usize,
@@ -337,18 +332,7 @@ fn load_source(source: &TextureSource, usage: TextureUsage) -> Result<Texture> {
 impl SceneGpu {
     /// Uploads what `upload` asks for of `scene` and creates the per-frame buffer.
     pub fn new(gpu: &GpuContext, scene: &Scene, upload: &SceneUpload<'_>) -> Result<Self> {
-        let per_frame = PerFrame::new(
-            gpu,
-            upload.frames_in_flight,
-            &per_frame::TableBytes {
-                translucency: upload.translucency_table_bytes,
-                profiles: upload.profile_table_bytes,
-                kernels: upload.kernel_table_bytes,
-                shadows: upload.shadow_table_bytes,
-                layered: upload.layered_table_bytes,
-            },
-            &scene.name,
-        )?;
+        let per_frame = PerFrame::new(gpu, upload.frames_in_flight, &upload.tables, &scene.name)?;
         let mut out = Self {
             meshes: Vec::with_capacity(scene.meshes.len()),
             draws: Vec::with_capacity(scene.objects.len()),

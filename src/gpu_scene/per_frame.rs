@@ -106,36 +106,42 @@ impl FrameUniforms {
     }
 }
 
-/// A region of every slot of the per-frame buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Region {
-    /// [`FrameUniforms`]: every pass's binding 0.
-    Frame,
-    /// The GDC 2011 material table (frames with translucency).
-    Translucency,
-    /// The SSS profile table (frames with SSS).
-    Profiles,
-    /// The separable SSS kernel table (frames with a separable chain).
-    Kernels,
-    /// The light-space maps' table (frames where some light casts shadows).
-    Shadows,
-    /// The layered media's table (frames with layered materials).
-    Layered,
+/// A region of every slot of the per-frame buffer: one table, declared as a `static` by the
+/// feature that writes it (`features::translucency::TABLE_REGION`, ...) and known by its
+/// address, so a new feature's table is a new static, not an edit here. [`FRAME`] (the frame
+/// uniforms) is in every frame; a table is in a frame when its feature lists it among the
+/// frame's [`TableRegion`]s.
+#[derive(Debug)]
+pub struct Region {
+    /// What it holds, for errors (never empty: two statics never share an address).
+    pub name: &'static str,
 }
 
-const REGIONS: usize = 6;
-
 impl Region {
-    fn index(self) -> usize {
-        match self {
-            Region::Frame => 0,
-            Region::Translucency => 1,
-            Region::Profiles => 2,
-            Region::Kernels => 3,
-            Region::Shadows => 4,
-            Region::Layered => 5,
-        }
+    /// A region holding `name`.
+    pub const fn new(name: &'static str) -> Self {
+        Self { name }
     }
+}
+
+impl PartialEq for Region {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+impl Eq for Region {}
+
+/// The frame uniforms ([`FrameUniforms`]): every pass's binding 0.
+pub static FRAME: Region = Region::new("frame uniforms");
+
+/// A table region of a frame and its size in bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableRegion {
+    /// The region.
+    pub region: &'static Region,
+    /// Its bytes (> 0).
+    pub bytes: u64,
 }
 
 /// The rectangles the passes draw in this slot's frame.
@@ -156,28 +162,14 @@ pub struct SlotTiles {
 /// pass adds at bind time (`slot * stride`).
 pub type PerFrameBinding = crate::backend::descriptor::DynamicUniform;
 
-/// Bytes of each table region of the per-frame buffer (0: the frame has no such table).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct TableBytes {
-    /// The GDC 2011 material table.
-    pub translucency: u64,
-    /// The SSS profile table.
-    pub profiles: u64,
-    /// The separable kernel table.
-    pub kernels: u64,
-    /// The light-space maps' table.
-    pub shadows: u64,
-    /// The layered media's table.
-    pub layered: u64,
-}
-
 /// The per-frame buffer and tiles, one slot per frame in flight (see the module docs).
 pub struct PerFrame {
     /// Locked only while the CPU writes a slot (passes bind `handle`).
     buffer: Mutex<GpuBuffer>,
     handle: vk::Buffer,
-    offsets: [u64; REGIONS],
-    sizes: [u64; REGIONS],
+    /// Each region of a slot: the region, its offset in the slot, its bytes (the frame
+    /// uniforms first).
+    regions: Vec<(&'static Region, u64, u64)>,
     stride: u64,
     slots: usize,
     tiles: Vec<Mutex<SlotTiles>>,
@@ -185,13 +177,8 @@ pub struct PerFrame {
 
 impl PerFrame {
     /// Creates the buffer for `slots` frames in flight (1 to [`MAX_FRAMES_IN_FLIGHT`]), with
-    /// the tables' regions `table_bytes` long (0: the frame has none).
-    pub fn new(
-        gpu: &GpuContext,
-        slots: usize,
-        table_bytes: &TableBytes,
-        name: &str,
-    ) -> Result<Self> {
+    /// the frame uniforms and `tables` in each slot.
+    pub fn new(gpu: &GpuContext, slots: usize, tables: &[TableRegion], name: &str) -> Result<Self> {
         if !(1..=MAX_FRAMES_IN_FLIGHT).contains(&slots) {
             return Err(LucentError::InvalidInput(format!(
                 "{slots} frames in flight: 1 to {MAX_FRAMES_IN_FLIGHT} are supported"
@@ -199,19 +186,21 @@ impl PerFrame {
         }
         let align = gpu.info.uniform_offset_alignment.max(16);
         let round = |v: u64| v.div_ceil(align) * align;
-        let sizes = [
-            std::mem::size_of::<FrameUniforms>() as u64,
-            table_bytes.translucency,
-            table_bytes.profiles,
-            table_bytes.kernels,
-            table_bytes.shadows,
-            table_bytes.layered,
-        ];
-        let mut offsets = [0u64; REGIONS];
+        let frame = TableRegion {
+            region: &FRAME,
+            bytes: std::mem::size_of::<FrameUniforms>() as u64,
+        };
+        let mut regions: Vec<(&'static Region, u64, u64)> = Vec::new();
         let mut end = 0u64;
-        for (offset, &size) in offsets.iter_mut().zip(&sizes) {
-            *offset = end;
-            end = round(end + size);
+        for table in std::iter::once(&frame).chain(tables) {
+            if table.bytes == 0 || regions.iter().any(|(r, _, _)| *r == table.region) {
+                return Err(LucentError::InvalidInput(format!(
+                    "per-frame region '{}' listed twice or empty",
+                    table.region.name
+                )));
+            }
+            regions.push((table.region, end, table.bytes));
+            end = round(end + table.bytes);
         }
         let stride = end;
         let buffer = gpu.create_buffer(
@@ -223,8 +212,7 @@ impl PerFrame {
         Ok(Self {
             handle: buffer.buffer,
             buffer: Mutex::new(buffer),
-            offsets,
-            sizes,
+            regions,
             stride,
             slots,
             tiles: (0..slots)
@@ -239,16 +227,27 @@ impl PerFrame {
     }
 
     /// Whether the frame has `region`.
-    pub fn has(&self, region: Region) -> bool {
-        self.sizes[region.index()] > 0
+    pub fn has(&self, region: &Region) -> bool {
+        self.find(region).is_some()
+    }
+
+    /// `region`'s offset in a slot and bytes.
+    fn find(&self, region: &Region) -> Option<(u64, u64)> {
+        self.regions
+            .iter()
+            .find(|(r, _, _)| *r == region)
+            .map(|&(_, offset, bytes)| (offset, bytes))
     }
 
     /// The descriptor binding of `region` (bound with the slot's offset, see [`Self::offset`]).
-    pub fn binding(&self, region: Region) -> PerFrameBinding {
+    /// A region the frame lacks binds the slot's first 16 bytes: a pass may declare a table it
+    /// only reads behind a specialization its frame never takes.
+    pub fn binding(&self, region: &Region) -> PerFrameBinding {
+        let (offset, bytes) = self.find(region).unwrap_or((0, 16));
         PerFrameBinding {
             buffer: self.handle,
-            offset: self.offsets[region.index()],
-            range: self.sizes[region.index()].max(16),
+            offset,
+            range: bytes.max(16),
             stride: self.stride,
         }
     }
@@ -261,17 +260,17 @@ impl PerFrame {
 
     /// Writes `bytes` into `region` of `slot`. The GPU must not be reading that slot (its
     /// last frame has completed).
-    pub fn write(&self, slot: usize, region: Region, bytes: &[u8]) -> Result<()> {
-        let r = region.index();
-        if slot >= self.slots || bytes.len() as u64 > self.sizes[r] {
+    pub fn write(&self, slot: usize, region: &Region, bytes: &[u8]) -> Result<()> {
+        let (offset, size) = self.find(region).unwrap_or((0, 0));
+        if slot >= self.slots || bytes.len() as u64 > size {
             return Err(LucentError::InvalidInput(format!(
-                "per-frame write of {} bytes into slot {slot} region {region:?} (slots {}, size {})",
+                "per-frame write of {} bytes into slot {slot} region '{}' (slots {}, size {size})",
                 bytes.len(),
+                region.name,
                 self.slots,
-                self.sizes[r]
             )));
         }
-        let start = (self.stride * slot as u64 + self.offsets[r]) as usize;
+        let start = (self.stride * slot as u64 + offset) as usize;
         // A poisoned lock only means a writer panicked mid-copy; the bytes are plain data.
         let mut buffer = self.buffer.lock().unwrap_or_else(|e| e.into_inner());
         let mapped = buffer.mapped_mut().ok_or_else(|| {

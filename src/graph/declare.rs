@@ -378,6 +378,23 @@ impl PassBuilder<'_> {
     pub fn finish(self) {
         self.graph.passes.push(self.decl);
     }
+
+    /// Finishes a raster pass whose work is its attachments' load ops (a clear): it records no
+    /// draw, but runs on a GPU.
+    pub fn clears_only(self) {
+        self.execute(ClearsOnly);
+    }
+}
+
+/// The code behind [`PassBuilder::clears_only`]: nothing beyond the render pass's clears.
+struct ClearsOnly;
+
+impl PassExec for ClearsOnly {
+    fn prepare(&mut self, _: &super::PrepareContext<'_>) -> crate::Result<()> {
+        Ok(())
+    }
+    fn record(&self, _: &super::RecordContext<'_>) {}
+    fn destroy(&mut self, _: &crate::backend::GpuContext) {}
 }
 
 /// Two images a multi-pass blur alternates between: each step reads one and writes the other.

@@ -35,13 +35,10 @@ use crate::backend::format::{format_info, format_name};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::copy_pass::{copy_defines, COPY_FRAGMENT, MAX_COPY_IMAGES, MAX_COPY_INPUTS};
-use crate::features::util::{
-    clamp_sampler, Binding, GraphicsPipeline, GraphicsPipelineDesc, PassPipeline,
-};
+use crate::features::pass::FullscreenPass;
 use crate::frame::FrameRunner;
 use crate::graph::{
-    CompileOptions, Executable, ImageInfo, LoadOp, PassExec, PassKind, Plan, PrepareContext,
-    RecordContext, RenderGraph, ResourceId,
+    CompileOptions, Executable, ImageInfo, LoadOp, PassKind, Plan, RenderGraph, ResourceId,
 };
 use crate::{LucentError, Result};
 
@@ -204,7 +201,7 @@ impl CopyFrame {
                 } else {
                     fill.color(&mut image, LoadOp::Clear([0.25, 0.5, 0.75, 1.0]));
                 }
-                fill.execute(FillPass);
+                fill.clears_only();
                 inputs.push(image);
             }
             let name = copy_name(&floor.pass);
@@ -233,7 +230,9 @@ impl CopyFrame {
                     },
                 )
             });
-            let mut pass = graph.add_pass(&name, PassKind::Raster);
+            let defines = copy_defines(inputs.len(), floor.colour_writes.len(), depth.is_some());
+            let mut pass = FullscreenPass::standalone(&mut graph, &name, COPY_FRAGMENT);
+            pass.defines(&defines);
             for input in &inputs {
                 pass.sample(input);
             }
@@ -243,15 +242,8 @@ impl CopyFrame {
             if let Some(depth) = &mut depth {
                 pass.depth(depth, LoadOp::Clear([1.0, 0.0, 0.0, 0.0]));
             }
-            pass.taps(inputs.len() as u32).side_effects();
-            pass.execute(CopyPass {
-                inputs: inputs.iter().map(|h| h.id()).collect(),
-                outputs: floor.colour_writes.len(),
-                depth: depth.is_some(),
-                sampler: vk::Sampler::null(),
-                pipeline: None,
-                bare: None,
-            });
+            pass.taps(inputs.len() as u32).graph().side_effects();
+            pass.finish();
             names.push(Some(name));
         }
         // Unmerged: each copy is its own render pass with its own timestamp pair.
@@ -455,17 +447,6 @@ pub fn markdown(rows: &[FloorRow]) -> String {
     out
 }
 
-/// Clears its attachments (the render pass's load op); draws nothing.
-struct FillPass;
-
-impl PassExec for FillPass {
-    fn prepare(&mut self, _ctx: &PrepareContext<'_>) -> Result<()> {
-        Ok(())
-    }
-    fn record(&self, _ctx: &RecordContext<'_>) {}
-    fn destroy(&mut self, _gpu: &GpuContext) {}
-}
-
 /// The format the copy frame gives an image that the pass reads or writes as `format`: the
 /// format itself, or for an integer format the float format of the same texel size. A texel
 /// fetch moves the same bytes, and `glsl/bench/copy.frag` then reads and writes floats only, so
@@ -481,69 +462,6 @@ fn copy_format(format: vk::Format) -> vk::Format {
             _ => vk::Format::R32G32B32A32_SFLOAT,
         },
         _ => format,
-    }
-}
-
-/// `glsl/bench/copy.frag` over the whole render area.
-struct CopyPass {
-    inputs: Vec<ResourceId>,
-    /// Colour images written.
-    outputs: usize,
-    depth: bool,
-    sampler: vk::Sampler,
-    /// With inputs: pipeline and descriptor set.
-    pipeline: Option<PassPipeline>,
-    /// Without inputs: a pipeline without descriptor sets.
-    bare: Option<GraphicsPipeline>,
-}
-
-impl PassExec for CopyPass {
-    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let defines = copy_defines(self.inputs.len(), self.outputs, self.depth);
-        let desc = GraphicsPipelineDesc {
-            depth_test: self.depth,
-            ..GraphicsPipelineDesc::fullscreen(COPY_FRAGMENT, &defines, "speed-of-light copy")
-        };
-        if self.inputs.is_empty() {
-            self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);
-            return Ok(());
-        }
-        self.sampler = clamp_sampler(ctx, vk::Filter::NEAREST)?;
-        let bindings: Vec<Binding> = self
-            .inputs
-            .iter()
-            .map(|&id| Binding::Sampled(ctx.descriptor_views[id], self.sampler))
-            .collect();
-        self.pipeline = Some(PassPipeline::new(ctx, &bindings, &desc)?);
-        Ok(())
-    }
-
-    fn record(&self, ctx: &RecordContext<'_>) {
-        if let Some(pipeline) = &self.pipeline {
-            pipeline.draw_fullscreen(ctx);
-        } else if let Some(bare) = &self.bare {
-            // SAFETY: the pipeline is alive; the executor began this pass's render pass.
-            unsafe {
-                ctx.gpu.device.cmd_bind_pipeline(
-                    ctx.cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    bare.pipeline,
-                );
-                ctx.gpu.device.cmd_draw(ctx.cmd, 3, 1, 0, 0);
-            }
-        }
-    }
-
-    fn destroy(&mut self, gpu: &GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
-        }
-        if let Some(mut p) = self.bare.take() {
-            p.destroy(&gpu.device);
-        }
-        // SAFETY: created in prepare (or null); the GPU is done (caller's contract).
-        unsafe { gpu.device.destroy_sampler(self.sampler, None) };
-        self.sampler = vk::Sampler::null();
     }
 }
 

@@ -57,6 +57,25 @@ pub const ERROR_SECTIONS: &[(&str, SectionFn)] = &[
     ),
 ];
 
+/// Writes one error-against-time report into a directory: its Markdown and the files written.
+pub type WriteReportFn = fn(
+    &crate::backend::GpuContext,
+    &crate::backend::shader::ShaderCompiler,
+    &crate::backend::shader::PipelineCache,
+    &std::path::Path,
+    &section::ReportOptions,
+) -> Result<(String, Vec<std::path::PathBuf>)>;
+
+/// The sections `lucent report NAME` writes on their own (besides `li`, which has its own
+/// options), by name.
+pub const STANDALONE_REPORTS: &[(&str, WriteReportFn)] = &[
+    (
+        "translucency",
+        crate::report::translucency::write_translucency_report as WriteReportFn,
+    ),
+    ("sss", crate::report::sss::write_sss_report as WriteReportFn),
+];
+
 /// The SSS error-against-time report ([`crate::report::sss`]) as a section, written beside
 /// `report.md`. Full run: the suite's size, 5 rounds after 1 warm-up (as `docs/report/sss.md`
 /// was first measured); quick: 128x96, 1 round, no warm-up.
@@ -322,9 +341,9 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
         )?;
         let _ = writeln!(out.markdown, "\n![passes of {name}]({})\n", file_name(&png));
         out.files.push(png);
-        if let Some(table) = crate::report::seeds::thesis_table(name) {
+        if let Some(table) = technique.module().and_then(|m| m.published_timing()) {
             out.markdown.push_str(
-                &crate::report::seeds::beside(&report, &table).replacen("## ", "#### ", 1),
+                &crate::report::seeds::beside(&report, table).replacen("## ", "#### ", 1),
             );
             out.markdown.push('\n');
         }

@@ -15,96 +15,30 @@ use std::fmt::Write as _;
 
 use crate::measure::bench::BenchReport;
 
-/// One row of a published per-pass table.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SeedRow {
-    /// The row's name as printed.
-    pub name: &'static str,
-    /// Milliseconds.
-    pub ms: f64,
-}
-
-/// A published per-pass table.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SeedTable {
-    /// Where it comes from.
-    pub source: &'static str,
-    /// The machine it was measured on.
-    pub device: &'static str,
-    /// Its rows in order.
-    pub rows: &'static [SeedRow],
-}
-
-impl SeedTable {
-    /// Sum of the rows, ms.
-    pub fn total(&self) -> f64 {
-        self.rows.iter().map(|r| r.ms).sum()
-    }
-}
-
-const fn row(name: &'static str, ms: f64) -> SeedRow {
-    SeedRow { name, ms }
-}
-
-const THESIS_DEVICE: &str =
-    "NVIDIA GTX 770, 1024x768 (Visual Studio Graphics Debugger, average of ten runs)";
-
-/// The LEAN-mapping SSS thesis, section 5.1.2, Table 1: "Performance figures for bilateral
-/// blur" (LBB, marble, four blurs).
-pub const THESIS_TABLE_1_LBB: SeedTable = SeedTable {
-    source: "LEAN-mapping SSS thesis, section 5.1.2, Table 1 (LBB)",
-    device: THESIS_DEVICE,
-    rows: &[
-        row("Projection", 0.20),
-        row("Horizontal Blur #1", 0.24),
-        row("Vertical Blur #1", 0.63),
-        row("Horizontal Blur #2", 0.36),
-        row("Vertical Blur #2", 0.63),
-        row("Horizontal Blur #3", 0.36),
-        row("Vertical Blur #3", 0.63),
-        row("Horizontal Blur #4", 0.35),
-        row("Vertical Blur #4", 0.63),
-        row("Final Lighting Pass", 0.09862),
-    ],
-};
-
-/// The thesis, section 5.1.2, Table 2: "Performance figures for the control screen space
-/// shader" (Jimenez's blur, marble, four blurs; "Vertical Blur #3" is printed without a unit).
-pub const THESIS_TABLE_2_CONTROL: SeedTable = SeedTable {
-    source: "LEAN-mapping SSS thesis, section 5.1.2, Table 2 (control)",
-    device: THESIS_DEVICE,
-    rows: &[
-        row("Lighting calculations", 0.05174),
-        row("Horizontal Blur #1", 0.10),
-        row("Vertical Blur #1", 0.16),
-        row("Horizontal Blur #2", 0.11),
-        row("Vertical Blur #2", 0.16),
-        row("Horizontal Blur #3", 0.14),
-        row("Vertical Blur #3", 0.15),
-        row("Horizontal Blur #4", 0.14),
-        row("Vertical Blur #4", 0.21),
-    ],
-};
-
-/// The thesis's table for a technique, by command-line name: Table 2 for `control`, Table 1
-/// for `lbb` and `lcb` (the thesis times only LBB; LCB runs the same pipeline with the
-/// control's blur).
-pub fn thesis_table(technique: &str) -> Option<SeedTable> {
-    match technique {
-        "control" => Some(THESIS_TABLE_2_CONTROL),
-        "lbb" | "lcb" => Some(THESIS_TABLE_1_LBB),
-        _ => None,
-    }
-}
+pub use crate::features::sss::control::THESIS_TABLE_2_CONTROL;
+pub use crate::features::sss::lbb::THESIS_TABLE_1_LBB;
+pub use crate::features::technique::{SeedRow, SeedTable};
 
 /// The thesis's LBB / control cost ratio beside ours, when `compared` measured a LEAN technique
 /// (`lbb` or `lcb`) against `control` in one run (alternating frames).
 pub fn thesis_ratio_line(compared: &crate::measure::bench::Comparison) -> Option<String> {
+    // Which side the thesis timed as LBB (Table 1: LBB, or LCB, which runs its pipeline) and
+    // which as the control (Table 2), by the tables the techniques' modules publish.
+    let published = |name: &str| {
+        crate::frame::Technique::parse(name)
+            .ok()
+            .and_then(|t| t.module())
+            .and_then(|m| m.published_timing())
+    };
+    let is =
+        |name: &str, table: &SeedTable| published(name).is_some_and(|t| std::ptr::eq(t, table));
     let [a, b] = &compared.names;
-    let (lean, control) = match (a.as_str(), b.as_str()) {
-        ("control", "lbb" | "lcb") => (1, 0),
-        ("lbb" | "lcb", "control") => (0, 1),
-        _ => return None,
+    let (lean, control) = if is(a, &THESIS_TABLE_1_LBB) && is(b, &THESIS_TABLE_2_CONTROL) {
+        (0, 1)
+    } else if is(b, &THESIS_TABLE_1_LBB) && is(a, &THESIS_TABLE_2_CONTROL) {
+        (1, 0)
+    } else {
+        return None;
     };
     let theirs = THESIS_TABLE_1_LBB.total() / THESIS_TABLE_2_CONTROL.total();
     let ours = compared.frame[lean].median / compared.frame[control].median.max(1e-9);

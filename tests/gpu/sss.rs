@@ -497,7 +497,12 @@ fn two_pass_blurs_declare_two_passes_and_only_what_they_use() {
         let names: Vec<String> = plan.physical.iter().map(|p| p.name.clone()).collect();
         let sizes: Vec<(u32, u32)> = plan.physical.iter().map(|p| p.extent).collect();
         let lean = plan.resources.iter().any(|r| r.name.contains("lean"));
-        let kernel_bytes = desc.upload(1).kernel_table_bytes;
+        let kernel_bytes: u64 = desc
+            .tables()
+            .iter()
+            .filter(|t| t.region == &lucent::features::sss::tables::KERNELS)
+            .map(|t| t.bytes)
+            .sum();
         (names, sizes, lean, kernel_bytes)
     };
     // Separable: two blur passes for six Gaussians, no LEAN target, the kernel table.

@@ -2,6 +2,7 @@
 //! speed-of-light copies, a second technique alternated with the first, and the seeds'
 //! published tables beside ours.
 
+use lucent::features::technique::TechniqueModule;
 use lucent::frame::{FrameDesc, FrameSettings, Renderer, Technique};
 use lucent::images::output;
 use lucent::measure::bench::{self, BenchOptions, BenchReport, Format};
@@ -14,7 +15,7 @@ use crate::session::{check_scene_outputs, with_renderer, Session};
 /// The seeds' numbers `--compare-thesis` prints beside ours, as the technique allows.
 struct Seeds {
     /// The LEAN-mapping thesis's table (control, lcb, lbb).
-    thesis: Option<SeedTable>,
+    thesis: Option<&'static SeedTable>,
     /// GDC 2011's cost of translucency.
     gdc: bool,
     /// Li et al.'s Table 1 (checked against the scene's materials once it is loaded).
@@ -26,7 +27,10 @@ impl Seeds {
     /// nothing to compare.
     fn new(wanted: bool, technique: Technique) -> Result<Self> {
         let seeds = Self {
-            thesis: seed_tables::thesis_table(technique.name()).filter(|_| wanted),
+            thesis: technique
+                .module()
+                .and_then(|m| m.published_timing())
+                .filter(|_| wanted),
             gdc: wanted
                 && technique == Technique::Only(&lucent::features::translucency::TRANSLUCENCY),
             // Li et al.'s Table 1: their technique, alone or in `auto`.
@@ -35,10 +39,20 @@ impl Seeds {
                     || technique == Technique::Only(&lucent::features::layered::LAYERED)),
         };
         if wanted && seeds.thesis.is_none() && !seeds.gdc && !seeds.li {
+            // The techniques with a published per-pass table, from the registry.
+            let per_pass: Vec<String> = lucent::features::registry::TECHNIQUES
+                .iter()
+                .filter_map(|t| {
+                    let table = t.published_timing()?;
+                    Some(format!("{} ({})", t.name(), table.source))
+                })
+                .collect();
             return Err(LucentError::InvalidInput(format!(
-                "--compare-seeds needs --technique control (the thesis's Table 2), lcb or lbb (its \
-                 Table 1), translucency (GDC 2011's cost), or auto or layered on a scene with \
-                 layered materials (Li et al.'s Table 1); '{}' has no published table",
+                "--compare-seeds needs --technique {}, {} (GDC 2011's cost), or auto or {} on a \
+                 scene with layered materials (Li et al.'s Table 1); '{}' has no published table",
+                per_pass.join(", "),
+                lucent::features::translucency::TRANSLUCENCY.name(),
+                lucent::features::layered::LAYERED.name(),
                 technique.name()
             )));
         }

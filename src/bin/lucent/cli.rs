@@ -13,11 +13,11 @@ use clap::{Args, Parser, Subcommand};
 use lucent::bake::scene as bake;
 use lucent::features::antialias::Antialias;
 use lucent::features::gbuffer::GBufferPrecision;
-use lucent::features::layered::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
+use lucent::features::knob::{Given, Knob, Takes};
+use lucent::features::layered::LayeredKnobs;
 use lucent::features::registry;
 use lucent::features::shadows::{ShadowSettings, SHADOW_SIZES};
-use lucent::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
-use lucent::features::sss::{SssKnobs, SssPrecision};
+use lucent::features::sss::SssKnobs;
 use lucent::frame::{FrameDesc, FrameSettings, Technique};
 use lucent::graph::CompileOptions;
 use lucent::measure::bench;
@@ -285,48 +285,9 @@ pub struct FrameArgs {
     /// fp16 normal), half (all RGBA16F) or full (all RGBA32F).
     #[arg(long, default_value = "compact", value_parser = one_of(GBufferPrecision::ALL.iter().copied()))]
     gbuffer: GBufferPrecision,
-    /// Store coloured thickness as grayscale (its luminance), the talk's one-channel G-buffer.
-    #[arg(long)]
-    grayscale: bool,
-    /// Run the SSS blurs over the whole screen instead of only the rectangles of objects with
-    /// a profile (A/B comparison).
-    #[arg(long)]
-    no_sss_tiles: bool,
-    /// SSS (control, lcb, lbb): refit the profile with this many Gaussians (1-8): fewer blur
-    /// pairs, at the fit error `lucent plan` and the report print.
-    #[arg(long, allow_negative_numbers = true, value_parser = whole(1..=8usize))]
-    sss_gaussians: Option<usize>,
-    /// SSS (control, lcb, lbb): precision of the sum-of-Gaussians targets: half (RGBA16F) or
-    /// full (RGBA32F, the default).
-    #[arg(long, value_parser = one_of(SssPrecision::ALL.iter().copied()))]
-    sss_precision: Option<SssPrecision>,
-    /// LBB: the bilateral blur's sensitivity to depth differences, relative to each profile
-    /// Gaussian's width (a finite number >= 0; 1: weights follow the taps' 3D distance;
-    /// default 1).
-    #[arg(long, allow_negative_numbers = true, value_parser = finite(|v| v >= 0.0, "a finite number >= 0"))]
-    sensitivity: Option<f32>,
-    /// LBB: blur the light and the LEAN moments as one packed RGBA32UI target (eight fp16
-    /// halves) instead of two RGBA16F targets (A/B comparison; slower on lavapipe).
-    #[arg(long)]
-    sss_packed: bool,
-    /// LBB: bilateral taps per direction (3, 5 or 7; default 5; the thesis's shader has 7).
-    #[arg(long, allow_negative_numbers = true, value_parser = one_of([3, 5, 7].map(|n: u32| (n, n))))]
-    sss_taps: Option<u32>,
-    /// The two-pass blurs (separable, bilateral): samples per direction (11, 17 or 25;
-    /// default 17).
-    #[arg(long, allow_negative_numbers = true, value_parser = one_of(SAMPLE_COUNTS.map(|n| (n, n))))]
-    sss_samples: Option<u32>,
-    /// The two-pass blurs' 1-D kernel: marginal (each Gaussian's 1-D marginal, the default)
-    /// or line (the profile along a line, Jimenez 2015).
-    #[arg(long, value_parser = one_of([("marginal", KernelShape::Marginal), ("line", KernelShape::Line)]))]
-    sss_kernel: Option<KernelShape>,
-    /// The separable blur at half resolution per side, upsampled depth-aware.
-    #[arg(long)]
-    sss_half_res: bool,
-    /// The separable blur's taps: bilinear (between texels, Jimenez's) or point (the nearest
-    /// texel: one fetch instead of four on a CPU driver).
-    #[arg(long, value_parser = one_of([("point", true), ("bilinear", false)]))]
-    sss_filter: Option<bool>,
+    /// The technique knobs, as their modules declare them (`registry::knobs`).
+    #[command(flatten)]
+    pub knobs: TechniqueKnobArgs,
     /// No light casts shadows (no light-space maps pass; each light's own `shadows = false`
     /// turns off just that light's).
     #[arg(long)]
@@ -335,30 +296,6 @@ pub struct FrameArgs {
     /// Table 1 uses 512 and 1024). Halved until every face fits an 8192x8192 atlas.
     #[arg(long, allow_negative_numbers = true, value_parser = ranged(SHADOW_SIZES))]
     shadow_size: Option<u32>,
-    /// Layered media (Li et al.): single scattering's march steps along the refracted view
-    /// ray (1 to 64; default 4).
-    #[arg(long, allow_negative_numbers = true, value_parser = ranged(STEP_RANGE))]
-    layered_steps: Option<u32>,
-    /// Layered media: multiple scattering's pixel lights per pixel (4 to 64; default 12, Li
-    /// et al.'s).
-    #[arg(long, allow_negative_numbers = true, value_parser = ranged(PIXEL_LIGHT_RANGE))]
-    pixel_lights: Option<u32>,
-    /// Layered media: single scattering's phase function: hg (true Henyey-Greenstein, the
-    /// default) or schlick (Li et al.'s eq. 9 form with Schlick's k).
-    #[arg(long, value_parser = one_of(PhaseForm::ALL.iter().copied()))]
-    phase: Option<PhaseForm>,
-    /// Layered media: the irradiance image multiple scattering gathers from at half
-    /// resolution per side.
-    #[arg(long)]
-    half_irradiance: bool,
-    /// Layered media: multiple scattering gathered once per 2x2 block and upsampled by
-    /// material and depth (cheaper; a coarser mottling than the full gather's grain).
-    #[arg(long)]
-    half_gather: bool,
-    /// Layered media: single scattering's depth D_max in mean free paths of the first layer
-    /// (a finite number > 0; default 4).
-    #[arg(long, allow_negative_numbers = true, value_parser = finite(|v| v > 0.0 && v <= 1e3, "a number of mean free paths in (0, 1000]"))]
-    single_depth: Option<f32>,
     /// The instant shown, in seconds (a finite number; default 0): a deforming scene
     /// (`dynamic`) is deformed at it; `bench` starts its animation there.
     #[arg(long, allow_negative_numbers = true, value_parser = finite(|_| true, "a finite number of seconds"))]
@@ -492,7 +429,7 @@ impl FrameArgs {
 
     /// The frame's settings; `export_hdr` keeps the linear HDR frame for reading back.
     pub fn settings(&self, export_hdr: bool) -> Result<FrameSettings> {
-        Ok(FrameSettings {
+        let mut settings = FrameSettings {
             width: self.size.0,
             height: self.size.1,
             technique: Technique::parse(&self.technique)?,
@@ -505,10 +442,10 @@ impl FrameArgs {
             export_gbuffer: false,
             export_lit: false,
             gbuffer: self.gbuffer,
-            force_grayscale: self.grayscale,
-            sss_tiles: !self.no_sss_tiles,
+            force_grayscale: false,
+            sss_tiles: true,
             fault: None,
-            sss: self.sss_knobs(),
+            sss: SssKnobs::default(),
             debug_view: None,
             frames_in_flight: 1,
             target: None,
@@ -518,38 +455,12 @@ impl FrameArgs {
             },
             antialias: Antialias::parse(&self.aa)?,
             export_ldr: false,
-            layered: self.layered_knobs(),
-        })
-    }
-
-    /// The SSS knobs given, the defaults for the rest.
-    fn sss_knobs(&self) -> SssKnobs {
-        let defaults = SssKnobs::default();
-        SssKnobs {
-            gaussians: self.sss_gaussians,
-            precision: self.sss_precision.unwrap_or(defaults.precision),
-            packed: self.sss_packed,
-            taps: self.sss_taps.unwrap_or(defaults.taps),
-            // Range-checked by the parser (finite, >= 0).
-            sensitivity: self.sensitivity.unwrap_or(defaults.sensitivity),
-            samples: self.sss_samples.unwrap_or(defaults.samples),
-            shape: self.sss_kernel.unwrap_or(defaults.shape),
-            half_res: self.sss_half_res,
-            point_taps: self.sss_filter.unwrap_or(defaults.point_taps),
+            layered: LayeredKnobs::default(),
+        };
+        for &(knob, value) in &self.knobs.given {
+            settings.set_knob(knob, value);
         }
-    }
-
-    /// The layered-media knobs given, the defaults for the rest.
-    fn layered_knobs(&self) -> LayeredKnobs {
-        let defaults = LayeredKnobs::default();
-        LayeredKnobs {
-            steps: self.layered_steps.unwrap_or(defaults.steps),
-            pixel_lights: self.pixel_lights.unwrap_or(defaults.pixel_lights),
-            phase: self.phase.unwrap_or(defaults.phase),
-            half_irradiance: self.half_irradiance,
-            half_gather: self.half_gather,
-            max_depth_mfp: self.single_depth.unwrap_or(defaults.max_depth_mfp),
-        }
+        Ok(settings)
     }
 
     /// Prints a warning (on stderr) for every knob that does nothing in this frame.
@@ -574,30 +485,17 @@ impl FrameArgs {
         settings: &FrameSettings,
         desc: &FrameDesc,
     ) -> Vec<String> {
-        let given = [
-            (self.sss_taps.is_some(), "--sss-taps"),
-            (self.sss_packed, "--sss-packed"),
-            (self.sensitivity.is_some(), "--sensitivity"),
-            (self.sss_gaussians.is_some(), "--sss-gaussians"),
-            (self.sss_precision.is_some(), "--sss-precision"),
-            (self.sss_samples.is_some(), "--sss-samples"),
-            (self.sss_kernel.is_some(), "--sss-kernel"),
-            (self.sss_half_res, "--sss-half-res"),
-            (self.sss_filter.is_some(), "--sss-filter"),
-            (self.no_sss_tiles, "--no-sss-tiles"),
-            (self.grayscale, "--grayscale"),
-            (self.layered_steps.is_some(), "--layered-steps"),
-            (self.pixel_lights.is_some(), "--pixel-lights"),
-            (self.phase.is_some(), "--phase"),
-            (self.half_irradiance, "--half-irradiance"),
-            (self.half_gather, "--half-gather"),
-            (self.single_depth.is_some(), "--single-depth"),
-        ];
         let techniques = desc.techniques();
-        let mut unused: Vec<(&str, String)> = given
+        let mut unused: Vec<(&str, String)> = self
+            .knobs
+            .given
             .iter()
-            .filter(|(given, flag)| *given && !techniques.iter().any(|t| t.knobs().contains(flag)))
-            .map(|(_, flag)| (*flag, technique_knob_needs(flag)))
+            .filter(|(knob, _)| {
+                !techniques
+                    .iter()
+                    .any(|t| t.knobs().iter().any(|k| std::ptr::eq(*k, *knob)))
+            })
+            .map(|(knob, _)| (knob.flag, technique_knob_needs(knob)))
             .collect();
         // Knobs of the scene rather than of a technique.
         if self.time.is_some() && scene.deformation.is_none() {
@@ -629,8 +527,8 @@ impl FrameArgs {
 
 /// What a technique knob needs, from the registry: the techniques that list it, as
 /// `--technique` choices (`a, b or c`), or `auto` on a scene whose materials use them.
-fn technique_knob_needs(flag: &str) -> String {
-    let names: Vec<&str> = registry::with_knob(flag).map(|t| t.name()).collect();
+fn technique_knob_needs(knob: &Knob) -> String {
+    let names: Vec<&str> = registry::with_knob(knob).map(|t| t.name()).collect();
     let listed = match names.split_last() {
         Some((last, [])) => last.to_string(),
         Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
@@ -644,4 +542,61 @@ fn technique_knob_needs(flag: &str) -> String {
             "one of them"
         }
     )
+}
+
+/// The technique knobs given on the command line. Its flags are not written here: clap's
+/// arguments are built from the registry's knobs ([`registry::knobs`]), each with the flag,
+/// help and range check its technique's module declares.
+#[derive(Clone, Default)]
+pub struct TechniqueKnobArgs {
+    /// Each knob given, with its checked value, in registry order.
+    pub given: Vec<(&'static Knob, Given)>,
+}
+
+impl clap::FromArgMatches for TechniqueKnobArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> std::result::Result<Self, clap::Error> {
+        let given = registry::knobs()
+            .into_iter()
+            .filter_map(|knob| {
+                let value = match knob.takes {
+                    Takes::Switch => matches.get_flag(knob.long()).then_some(Given::Switch),
+                    _ => matches.get_one::<Given>(knob.long()).copied(),
+                };
+                value.map(|value| (knob, value))
+            })
+            .collect();
+        Ok(Self { given })
+    }
+
+    fn update_from_arg_matches(
+        &mut self,
+        matches: &clap::ArgMatches,
+    ) -> std::result::Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+impl Args for TechniqueKnobArgs {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        registry::knobs()
+            .into_iter()
+            .fold(command, |command, knob| {
+                let arg = clap::Arg::new(knob.long())
+                    .long(knob.long())
+                    .help(knob.help);
+                let arg = match knob.takes.placeholder() {
+                    None => arg.action(clap::ArgAction::SetTrue),
+                    Some(placeholder) => arg
+                        .value_name(placeholder)
+                        .allow_negative_numbers(true)
+                        .value_parser(move |text: &str| knob.takes.parse(text)),
+                };
+                command.arg(arg)
+            })
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        Self::augment_args(command)
+    }
 }

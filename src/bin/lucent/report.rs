@@ -33,15 +33,14 @@ pub fn run(args: ReportArgs) -> Result<()> {
             })?
         }
         Some(technique) => {
-            let write = match technique.as_str() {
-                "translucency" => lucent::report::translucency::write_translucency_report,
-                "sss" => lucent::report::sss::write_sss_report,
-                _ => {
-                    return Err(LucentError::InvalidInput(format!(
-                        "report: unknown section '{technique}'; available: translucency, sss, li \
-                         (or no section: the whole suite)"
-                    )))
-                }
+            let reports = lucent::report::STANDALONE_REPORTS;
+            let Some(&(_, write)) = reports.iter().find(|(name, _)| name == technique) else {
+                let names: Vec<&str> = reports.iter().map(|(name, _)| *name).collect();
+                return Err(LucentError::InvalidInput(format!(
+                    "report: unknown section '{technique}'; available: {}, li (or no section: \
+                     the whole suite)",
+                    names.join(", ")
+                )));
             };
             let (width, height) = args.size.unwrap_or((1024, 768));
             let options = lucent::report::section::ReportOptions {

@@ -3,6 +3,9 @@
 
 use std::path::PathBuf;
 
+use lucent::features::layered::LAYERED;
+use lucent::features::technique::TechniqueModule;
+use lucent::features::translucency::TRANSLUCENCY;
 use lucent::{LucentError, Result};
 
 use crate::cli::{GpuArgs, SweepArgs};
@@ -17,21 +20,23 @@ pub fn run(args: SweepArgs) -> Result<()> {
         quick,
         gpu: gpu_args,
     } = args;
+    // The techniques with a sweep: their cases live in `lucent::measure::sweep`.
+    let (translucency, layered) = (TRANSLUCENCY.name(), LAYERED.name());
     let technique = technique.as_str();
-    if !matches!(technique, "translucency" | "layered") {
+    if technique != translucency && technique != layered {
         return Err(LucentError::InvalidInput(format!(
-            "sweep: unknown technique '{technique}'; available: translucency, layered"
+            "sweep: unknown technique '{technique}'; available: {translucency}, {layered}"
         )));
     }
-    if quick && technique != "layered" {
-        return Err(LucentError::InvalidInput(
-            "sweep: --quick applies to `sweep layered` only".into(),
-        ));
+    if quick && technique != layered {
+        return Err(LucentError::InvalidInput(format!(
+            "sweep: --quick applies to `sweep {layered}` only"
+        )));
     }
     if let Some(out) = &out {
         lucent::files::check_outputs(&[], &[("--out", out)])?;
     }
-    if technique == "layered" {
+    if technique == layered {
         return sweep_layered((width, height), out, quick, &gpu_args);
     }
     let cases = lucent::measure::sweep::translucency_cases();

@@ -2,6 +2,7 @@
 //! blurred by a kernel whose tap weights are the whole profile at each tap's 3D distance (a
 //! tabulated falloff in the kernel table), then LEAN specular in the vertical pass.
 
+use super::knobs;
 use super::two_pass::TwoPassChain;
 
 /// The two-pass bilateral blur (`--technique bilateral`, `blur = "bilateral"`).
@@ -14,10 +15,11 @@ pub static BILATERAL: TwoPassChain = TwoPassChain {
     half_resolution: false,
     depth_in_alpha: false,
     knobs: &[
-        "--sss-gaussians",
-        "--sss-samples",
-        "--sss-kernel",
-        "--no-sss-tiles",
+        &knobs::GAUSSIANS,
+        &knobs::SAMPLES,
+        &knobs::KERNEL,
+        &knobs::NO_TILES,
     ],
     scene: "teapot",
+    published_timing: None,
 };

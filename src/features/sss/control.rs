@@ -5,6 +5,9 @@
 //! (glsl/sss/blur.frag, glsl/sss/combine.frag).
 
 use super::iterative::IterativeChain;
+use super::iterative::THESIS_DEVICE;
+use super::knobs;
+use crate::features::technique::{seed_row, SeedTable};
 
 /// The control technique (`--technique control`, `blur = "control"`).
 pub static CONTROL: IterativeChain = IterativeChain {
@@ -13,6 +16,25 @@ pub static CONTROL: IterativeChain = IterativeChain {
               diffuse light, one blur pair per Gaussian",
     lean: false,
     bilateral: false,
-    knobs: &["--sss-gaussians", "--sss-precision", "--no-sss-tiles"],
+    knobs: &[&knobs::GAUSSIANS, &knobs::PRECISION, &knobs::NO_TILES],
     scene: "skin",
+    published_timing: Some(&THESIS_TABLE_2_CONTROL),
+};
+
+/// The thesis, section 5.1.2, Table 2: "Performance figures for the control screen space
+/// shader" (Jimenez's blur, marble, four blurs; "Vertical Blur #3" is printed without a unit).
+pub static THESIS_TABLE_2_CONTROL: SeedTable = SeedTable {
+    source: "LEAN-mapping SSS thesis, section 5.1.2, Table 2 (control)",
+    device: THESIS_DEVICE,
+    rows: &[
+        seed_row("Lighting calculations", 0.05174),
+        seed_row("Horizontal Blur #1", 0.10),
+        seed_row("Vertical Blur #1", 0.16),
+        seed_row("Horizontal Blur #2", 0.11),
+        seed_row("Vertical Blur #2", 0.16),
+        seed_row("Horizontal Blur #3", 0.14),
+        seed_row("Vertical Blur #3", 0.15),
+        seed_row("Horizontal Blur #4", 0.14),
+        seed_row("Vertical Blur #4", 0.21),
+    ],
 };

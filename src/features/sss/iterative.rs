@@ -369,7 +369,9 @@ pub struct IterativeChain {
     /// Point taps weighted by a depth Gaussian (else bilinear taps lerped across edges).
     pub bilateral: bool,
     /// The knobs that act on it.
-    pub knobs: &'static [&'static str],
+    pub knobs: &'static [&'static crate::features::knob::Knob],
+    /// The per-pass timings the thesis published for it (Tables 1 and 2).
+    pub published_timing: Option<&'static crate::features::technique::SeedTable>,
     /// The built-in scene it is measured on.
     pub scene: &'static str,
 }
@@ -402,3 +404,7 @@ impl SssBlurTechnique for IterativeChain {
         chain_passes(graph, inputs, chain, base, knobs, scene, output)
     }
 }
+
+/// The machine the thesis's tables were measured on.
+pub(super) const THESIS_DEVICE: &str =
+    "NVIDIA GTX 770, 1024x768 (Visual Studio Graphics Debugger, average of ten runs)";

@@ -4,6 +4,7 @@
 //! specular with Fresnel on the blurred moments (glsl/sss/lean_brdf.frag).
 
 use super::iterative::IterativeChain;
+use super::knobs;
 
 /// LCB (`--technique lcb`, `blur = "lcb"`).
 pub static LCB: IterativeChain = IterativeChain {
@@ -12,6 +13,7 @@ pub static LCB: IterativeChain = IterativeChain {
               moments blurred together, LEAN specular on the blurred moments",
     lean: true,
     bilateral: false,
-    knobs: &["--sss-gaussians", "--sss-precision", "--no-sss-tiles"],
+    knobs: &[&knobs::GAUSSIANS, &knobs::PRECISION, &knobs::NO_TILES],
     scene: "teapot",
+    published_timing: Some(&super::lbb::THESIS_TABLE_1_LBB),
 };

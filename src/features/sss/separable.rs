@@ -4,6 +4,7 @@
 //! bilinear (`--sss-filter`), optionally at half resolution with a depth-aware upsample
 //! (`--sss-half-res`). The default blur of SSS materials ([`crate::features::registry`]).
 
+use super::knobs;
 use super::two_pass::TwoPassChain;
 
 /// The separable blur (`--technique separable`, `blur = "separable"`).
@@ -16,12 +17,13 @@ pub static SEPARABLE: TwoPassChain = TwoPassChain {
     half_resolution: true,
     depth_in_alpha: true,
     knobs: &[
-        "--sss-gaussians",
-        "--sss-samples",
-        "--sss-kernel",
-        "--sss-half-res",
-        "--sss-filter",
-        "--no-sss-tiles",
+        &knobs::GAUSSIANS,
+        &knobs::SAMPLES,
+        &knobs::KERNEL,
+        &knobs::HALF_RES,
+        &knobs::FILTER,
+        &knobs::NO_TILES,
     ],
     scene: "teapot",
+    published_timing: None,
 };

@@ -16,7 +16,7 @@ use crate::backend::shader::PipelineShaders;
 use crate::features::lighting::HDR_FORMAT;
 use crate::features::pass::FullscreenPass;
 use crate::features::util::Defines;
-use crate::gpu_scene::{Region, SceneGpu, TileRect};
+use crate::gpu_scene::{SceneGpu, TableRegion, TileRect};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 
 /// Declares a two-pass chain (see the module docs). Returns the chain's result (`output`
@@ -183,7 +183,7 @@ fn blur_pass<'g>(
         step: [direction[0], direction[1], 0.0, chain.index as f32],
     };
     let mut pass = sss_pass(graph, name, shape.fragment(), scene, constants);
-    pass.per_frame(Region::Kernels);
+    pass.per_frame(&super::tables::KERNELS);
     for (i, h) in reads.iter().enumerate() {
         let filter = if i == 0 && !chain.blur.bilateral() {
             vk::Filter::LINEAR
@@ -362,7 +362,9 @@ pub struct TwoPassChain {
     /// Its taps read linear depth from the lit diffuse's alpha.
     pub depth_in_alpha: bool,
     /// The knobs that act on it.
-    pub knobs: &'static [&'static str],
+    pub knobs: &'static [&'static crate::features::knob::Knob],
+    /// The per-pass timings its seed published for it.
+    pub published_timing: Option<&'static crate::features::technique::SeedTable>,
     /// The built-in scene it is measured on.
     pub scene: &'static str,
 }
@@ -388,6 +390,18 @@ impl SssBlurTechnique for TwoPassChain {
 
     fn depth_in_alpha(&self) -> bool {
         self.depth_in_alpha
+    }
+
+    fn table(&self) -> Option<TableRegion> {
+        Some(TableRegion {
+            region: &super::tables::KERNELS,
+            bytes: super::kernel::KERNEL_TABLE_BYTES,
+        })
+    }
+
+    fn table_bytes(&self, profiles: &super::SssProfiles, knobs: &SssKnobs) -> Vec<u8> {
+        let kernels = super::kernel::kernel_table(profiles, knobs.samples, knobs.shape);
+        bytemuck::bytes_of(&kernels).to_vec()
     }
 
     fn declare_chain(

@@ -42,86 +42,29 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::knob::Knob;
 use super::pass::FullscreenPass;
 use super::shadows::{self, ShadowMaps};
 use super::technique::{Shades, TechniqueModule};
-use crate::gpu_scene::{Region, SceneGpu, TileRect};
+use crate::gpu_scene::{Region, SceneGpu, TableRegion, TileRect, FRAME};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
+pub mod knobs;
+pub mod settings;
+
+pub use knobs::{
+    HALF_GATHER_KNOB, HALF_IRRADIANCE_KNOB, PHASE_KNOB, PIXEL_LIGHTS_KNOB, SINGLE_DEPTH_KNOB,
+    STEPS_KNOB,
+};
+pub use settings::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
+
 /// The transmitted irradiance image.
 pub const IRRADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// Layered materials a frame holds at most (IDs 1 to 16).
 pub const MAX_LAYERED_MATERIALS: usize = 16;
-
-/// March steps the knob takes (Li et al. do not say; the default 4 is within 4% of the
-/// 256-step reference on the test spheres, docs/layered.md).
-pub const STEP_RANGE: std::ops::RangeInclusive<u32> = 1..=64;
-/// Pixel lights the knob takes (Li et al. use 12).
-pub const PIXEL_LIGHT_RANGE: std::ops::RangeInclusive<u32> = 4..=64;
-
-/// Which phase function single scattering evaluates.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum PhaseForm {
-    /// True Henyey-Greenstein.
-    #[default]
-    HenyeyGreenstein,
-    /// Schlick's approximation (`k = 1.55 g - 0.55 g^3`; Li et al.'s eq. 9).
-    Schlick,
-}
-
-impl PhaseForm {
-    /// Every form with its command-line name.
-    pub const ALL: &'static [(&'static str, PhaseForm)] = &[
-        ("hg", PhaseForm::HenyeyGreenstein),
-        ("schlick", PhaseForm::Schlick),
-    ];
-
-    /// Command-line name.
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, p)| *p == self)
-            .map_or("?", |(n, _)| n)
-    }
-}
-
-/// The layered passes' knobs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LayeredKnobs {
-    /// Single scattering's march steps `K` ([`STEP_RANGE`]).
-    pub steps: u32,
-    /// Multiple scattering's pixel lights `M` ([`PIXEL_LIGHT_RANGE`]).
-    pub pixel_lights: u32,
-    /// The phase function.
-    pub phase: PhaseForm,
-    /// The irradiance image at half resolution per side.
-    pub half_irradiance: bool,
-    /// Multiple scattering gathered at half resolution per side (one gather per 2x2 block),
-    /// brought back by a material- and depth-aware upsample in the single scattering pass.
-    /// Cheaper and, by the error metric, closer to the reference (the upsample averages four
-    /// differently rotated gathers), but the gather's noise becomes a coarser mottling than
-    /// the full-resolution gather's fine grain (docs/layered.md): off by default.
-    pub half_gather: bool,
-    /// Single scattering's depth `D_max` in mean free paths of the first layer's clearest
-    /// channel (> 0; default 4: beyond, `e^-4` of the light is left to multiple scattering).
-    pub max_depth_mfp: f32,
-}
-
-impl Default for LayeredKnobs {
-    fn default() -> Self {
-        Self {
-            steps: 4,
-            pixel_lights: 12,
-            phase: PhaseForm::HenyeyGreenstein,
-            half_irradiance: false,
-            half_gather: false,
-            max_depth_mfp: 4.0,
-        }
-    }
-}
 
 /// The layered part of a frame: its materials (ID = index + 1) and each object's ID.
 #[derive(Clone, Debug, PartialEq)]
@@ -332,6 +275,17 @@ pub struct LayeredTableGpu {
 /// Bytes of the per-frame layered region.
 pub const LAYERED_TABLE_BYTES: u64 = std::mem::size_of::<LayeredTableGpu>() as u64;
 
+/// The layered media's table in the per-frame buffer.
+pub static TABLE_REGION: Region = Region::new("layered media table");
+
+/// The per-frame region a frame with layered materials writes its table into.
+pub fn table_region() -> TableRegion {
+    TableRegion {
+        region: &TABLE_REGION,
+        bytes: LAYERED_TABLE_BYTES,
+    }
+}
+
 /// The G-buffer images the layered passes read.
 pub struct LayeredInputs<'a> {
     /// Depth.
@@ -445,8 +399,8 @@ fn layered_pass<'g>(
 ) -> FullscreenPass<'g> {
     let single = kind == Kind::Single;
     let mut pass = FullscreenPass::new(graph, kind.name(), kind.fragment(), scene);
-    pass.per_frame(Region::Frame)
-        .per_frame(Region::Layered)
+    pass.per_frame(&FRAME)
+        .per_frame(&TABLE_REGION)
         .sample(inputs.depth)
         .sample(inputs.gb1)
         .sample(inputs.ids);
@@ -669,15 +623,16 @@ impl TechniqueModule for LiLayeredMedia {
         Shades::Layered
     }
 
-    fn knobs(&self) -> &'static [&'static str] {
-        &[
-            "--layered-steps",
-            "--pixel-lights",
-            "--phase",
-            "--half-irradiance",
-            "--half-gather",
-            "--single-depth",
-        ]
+    fn knobs(&self) -> &'static [&'static Knob] {
+        static KNOBS: &[&Knob] = &[
+            &STEPS_KNOB,
+            &PIXEL_LIGHTS_KNOB,
+            &PHASE_KNOB,
+            &HALF_IRRADIANCE_KNOB,
+            &HALF_GATHER_KNOB,
+            &SINGLE_DEPTH_KNOB,
+        ];
+        KNOBS
     }
 
     fn scene(&self) -> &'static str {

@@ -34,6 +34,7 @@ pub static TECHNIQUES: &[&dyn TechniqueModule] = &[
     &super::sss::lbb::LBB,
     &super::sss::separable::SEPARABLE,
     &super::sss::bilateral::BILATERAL,
+    &super::sss::burley::BURLEY,
     &super::layered::LAYERED,
 ];
 

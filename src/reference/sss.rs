@@ -17,7 +17,7 @@ use super::{gbuffer_pixels, DVec3};
 use crate::frame::GBufferReadback;
 use crate::scene::lean::covariance_of;
 use crate::scene::material::SssProfile;
-use crate::scene::profile::normalized_weights;
+use crate::scene::profile::{burley_cdf, burley_profile, normalized_weights};
 use crate::scene::Scene;
 
 /// One pixel of the read-back frame, in world space.
@@ -182,12 +182,14 @@ pub enum ReferenceSpecular {
 /// The reference HDR image (RGB per pixel, rows top first) of the SSS frame whose G-buffer is
 /// `gbuffer` (it must carry the SSS profile IDs), blurring with `profile`; scattering pixels get
 /// `specular`'s model, unblurred (specular reflection happens at the surface).
-pub fn reference_image(
+/// Every pixel's shading as the lighting pass computes it: the non-scattering pixels' whole
+/// light and the scattering pixels' specular in the image, their diffuse apart (in world
+/// space) for a profile to convolve.
+fn shaded(
     scene: &Scene,
     gbuffer: &GBufferReadback,
-    profile: &SssProfile,
     specular: ReferenceSpecular,
-) -> Vec<DVec3> {
+) -> (Vec<DVec3>, Vec<SurfacePixel>) {
     let view = DMat3::from_mat4(scene.camera.view().as_dmat4());
     let eye = scene.camera.eye.as_dvec3();
     let focal = f64::from(scene.camera.focal_px(gbuffer.height));
@@ -241,6 +243,16 @@ pub fn reference_image(
             out[i] += diffuse;
         }
     }
+    (out, scattering)
+}
+
+pub fn reference_image(
+    scene: &Scene,
+    gbuffer: &GBufferReadback,
+    profile: &SssProfile,
+    specular: ReferenceSpecular,
+) -> Vec<DVec3> {
+    let (mut out, scattering) = shaded(scene, gbuffer, specular);
     let mm_per_unit = 1.0 / f64::from(profile.units_per_mm).max(1e-12);
     // Each Gaussian is convolved and normalised on its own, then weighted: a Gaussian narrower
     // than a pixel then keeps its light in the pixel (point-sampling it at its peak and
@@ -270,6 +282,49 @@ pub fn reference_image(
                 acc + *w * (*sum / k.max(1e-300))
             });
         out[p.index] += blurred;
+    }
+    out
+}
+
+/// The reference HDR image of the SSS frame whose G-buffer is `gbuffer` under Christensen and
+/// Burley's normalized diffusion with shape `d_mm` per channel (mm; `units_per_mm` scene units
+/// per mm): per scattering pixel `p` and channel, `sum_q K(p, q) E_q / sum_q K(p, q)` over the
+/// scattering pixels, with `K = R(|x_p - x_q|) A_q` for `q != p` and, for the pixel itself
+/// (where `R` is infinite but integrable), the profile's energy within a disc of the pixel's
+/// area, `P(sqrt(A_p / pi))`. Specular is added unblurred; other pixels keep their lighting.
+pub fn burley_reference_image(
+    scene: &Scene,
+    gbuffer: &GBufferReadback,
+    d_mm: DVec3,
+    units_per_mm: f64,
+    specular: ReferenceSpecular,
+) -> Vec<DVec3> {
+    let (mut out, scattering) = shaded(scene, gbuffer, specular);
+    let mm_per_unit = 1.0 / units_per_mm.max(1e-12);
+    let area_mm2 = mm_per_unit * mm_per_unit;
+    for p in &scattering {
+        let (mut sum, mut weights) = (DVec3::ZERO, DVec3::ZERO);
+        for q in &scattering {
+            let k = if q.index == p.index {
+                let rho = (q.area * area_mm2 / std::f64::consts::PI).sqrt();
+                DVec3::new(
+                    burley_cdf(d_mm.x, rho),
+                    burley_cdf(d_mm.y, rho),
+                    burley_cdf(d_mm.z, rho),
+                )
+            } else {
+                let r = (p.position - q.position).length() * mm_per_unit;
+                DVec3::new(
+                    burley_profile(d_mm.x, r),
+                    burley_profile(d_mm.y, r),
+                    burley_profile(d_mm.z, r),
+                ) * (q.area * area_mm2)
+            };
+            sum += k * q.diffuse;
+            weights += k;
+        }
+        // The pixel's own term is > 0 (its area is), so no weight sum is 0.
+        out[p.index] += sum / weights.max(DVec3::splat(1e-300));
     }
     out
 }

@@ -175,6 +175,23 @@ pub fn sss_variants() -> Vec<SssVariant> {
         name: "separable half resolution".into(),
         settings: half_res,
     });
+    let burley = Technique::Only(&crate::features::sss::burley::BURLEY);
+    for budget in [8, 40, 80] {
+        let mut s = base(burley);
+        s.sss.burley_budget = budget;
+        v.push(SssVariant {
+            knob: "Burley sample budget",
+            name: format!("burley budget {budget}"),
+            settings: s,
+        });
+    }
+    let mut fixed = base(burley);
+    fixed.sss.burley_rotation = false;
+    v.push(SssVariant {
+        knob: "Burley rotation",
+        name: "burley without rotation".into(),
+        settings: fixed,
+    });
     v
 }
 

@@ -146,6 +146,26 @@ pub struct SssProfile {
     /// The screen-space blur the material asks for (`[material.sss] blur`, a registered SSS
     /// technique's name); `None`: the registry's default blur.
     pub blur: Option<TechniqueName>,
+    /// Christensen and Burley's normalized diffusion, for the 2-D Burley blur
+    /// (`[material.sss] scattering_distance` or `mean_free_path`); `None`: the Burley blur
+    /// matches the Gaussians' second moment (the other blurs always read the Gaussians).
+    pub burley: Option<BurleyDistance>,
+}
+
+/// How a material gives Burley's per-channel shape parameter `d` (mm): directly, as HDRP's
+/// "scattering distance", or as a diffuse mean free path `l` with the surface albedo `A`,
+/// `d = l / s(A)` by one of Christensen and Burley's fits (chosen per frame: `--burley-fit`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BurleyDistance {
+    /// `d` per channel, mm.
+    Scattering(Vec3),
+    /// The diffuse mean free path per channel (mm) and the albedo the fit reads.
+    MeanFreePath {
+        /// `l` per channel, mm.
+        mfp: Vec3,
+        /// Surface albedo `A` per channel, in [0, 1].
+        albedo: Vec3,
+    },
 }
 
 /// A technique a scene names (`[material.sss] blur`), kept as written. The scene knows no
@@ -245,6 +265,7 @@ impl SssProfile {
                 .collect(),
             units_per_mm: 0.01,
             blur: None,
+            burley: None,
         })
     }
 

@@ -1,14 +1,15 @@
 //! Diffusion profiles as sums of Gaussians (d'Eon and Luebke): evaluating one at a radius,
 //! normalising its weights, and fitting a sum of Gaussians to any radial profile (how the
 //! `marble` preset was made from Jensen's dipole, and how `--sss-gaussians N` refits a profile
-//! with fewer blur steps). CPU math of the materials; the f64 reference and the frame both use
-//! it.
+//! with fewer blur steps); and Christensen and Burley's normalized diffusion (the 2-D Burley
+//! blur's profile, its exact radial CDF inverse, the albedo fits and a sum of Gaussians fitted
+//! to it). CPU math of the materials; the f64 reference and the frame both use it.
 
 use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::material::{Gaussian, SssProfile};
+use super::material::{BurleyDistance, Gaussian, SssProfile};
 use crate::Result;
 
 /// Each Gaussian's weight, normalised per channel so the weights sum to 1 (as the blurs
@@ -160,8 +161,147 @@ pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 
             .collect(),
         units_per_mm: profile.units_per_mm,
         blur: profile.blur.clone(),
+        burley: profile.burley,
     };
     Ok((refit, errors))
+}
+
+/// Christensen and Burley's (2015) fits of the scaling `s` of the normalized diffusion profile
+/// from the surface albedo `A`, for a shape given as a mean free path `l` (`d = l / s`). Their
+/// relative errors against Monte Carlo are a few percent; which one is right for a material
+/// is what the path-traced truth decides, so all three stay one knob away (`--burley-fit`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BurleyFit {
+    /// Searchlight configuration (their eq. 6, with the diffuse mean free path): `s = 3.5 +
+    /// 100 (A - 0.33)^4`, Unreal's choice.
+    #[default]
+    Searchlight,
+    /// Diffuse surface transmission (eq. 5): `s = 1.9 - A + 3.5 (A - 0.8)^2`, EEVEE's.
+    Diffuse,
+    /// Perpendicular incidence (eq. 3): `s = 1.85 - A + 7 |A - 0.8|^3`.
+    Perpendicular,
+}
+
+impl BurleyFit {
+    /// Every fit with its command-line name.
+    pub const ALL: &'static [(&'static str, BurleyFit)] = &[
+        ("searchlight", BurleyFit::Searchlight),
+        ("diffuse", BurleyFit::Diffuse),
+        ("perpendicular", BurleyFit::Perpendicular),
+    ];
+
+    /// `s` for albedo `a` (clamped to [0, 1]: every fit is positive there).
+    pub fn scale(self, a: f64) -> f64 {
+        let a = a.clamp(0.0, 1.0);
+        match self {
+            BurleyFit::Searchlight => 3.5 + 100.0 * (a - 0.33).powi(4),
+            BurleyFit::Diffuse => 1.9 - a + 3.5 * (a - 0.8).powi(2),
+            BurleyFit::Perpendicular => 1.85 - a + 7.0 * (a - 0.8).abs().powi(3),
+        }
+    }
+}
+
+/// Smallest and largest Burley `d` (mm) lucent accepts: below, the profile is far narrower
+/// than any pixel; above, wider than any scene (the blur clamps its reach on screen anyway).
+pub const BURLEY_D_RANGE: (f32, f32) = (1e-4, 1e3);
+
+/// Burley's 2-D profile with shape `d` (mm) at radius `r` (mm), normalised to integrate to 1
+/// over the plane: `(e^(-r/d) + e^(-r/3d)) / (8 pi d r)`. Infinite at `r = 0` (integrable).
+pub fn burley_profile(d: f64, r: f64) -> f64 {
+    let d = d.max(1e-12);
+    ((-r / d).exp() + (-r / (3.0 * d)).exp()) / (8.0 * PI * d * r)
+}
+
+/// The fraction of Burley's profile within radius `r` (mm) of its centre:
+/// `1 - e^(-r/d) / 4 - 3 e^(-r/3d) / 4`.
+pub fn burley_cdf(d: f64, r: f64) -> f64 {
+    let d = d.max(1e-12);
+    1.0 - 0.25 * (-r / d).exp() - 0.75 * (-r / (3.0 * d)).exp()
+}
+
+/// The radius (in units of `d`) within which a fraction `xi` in [0, 1) of Burley's profile
+/// lies: the exact inverse of [`burley_cdf`] (Golubev): with `u = 1 - xi` and
+/// `G = 1 + 4 u (2 u + sqrt(1 + 4 u^2))`, `r / d = 3 ln((1 + G^(-1/3) + G^(1/3)) / (4 u))`.
+pub fn burley_radius(xi: f64) -> f64 {
+    // Guarded: u -> 0 sends the radius to infinity; 1e-7 is past any reach the blur uses.
+    let u = (1.0 - xi).clamp(1e-7, 1.0);
+    let g = 1.0 + 4.0 * u * (2.0 * u + (1.0 + 4.0 * u * u).sqrt());
+    let third = g.cbrt();
+    3.0 * ((1.0 + 1.0 / third + third) / (4.0 * u)).ln()
+}
+
+/// The fraction of the profile the blur gathers: out to [`BURLEY_REACH`] `d` (HDRP's cut,
+/// 99.7% of the energy).
+pub const BURLEY_REACH: f64 = 16.56;
+
+impl SssProfile {
+    /// Burley's `d` per channel (mm) for this profile: as its material gives it
+    /// ([`BurleyDistance`], a mean free path through `fit`), or matched to its Gaussians'
+    /// second moment (`E[r^2] = 14 d^2` for Burley's profile, `2 v` for a 2-D Gaussian), so a
+    /// preset renders with Burley at the width the other blurs give it.
+    pub fn burley_d(&self, fit: BurleyFit) -> DVec3 {
+        let (lo, hi) = (f64::from(BURLEY_D_RANGE.0), f64::from(BURLEY_D_RANGE.1));
+        let d = match self.burley {
+            Some(BurleyDistance::Scattering(d)) => d.as_dvec3(),
+            Some(BurleyDistance::MeanFreePath { mfp, albedo }) => {
+                let a = albedo.as_dvec3();
+                mfp.as_dvec3() / DVec3::new(fit.scale(a.x), fit.scale(a.y), fit.scale(a.z))
+            }
+            None => {
+                let weights = normalized_weights(self);
+                let moment = self
+                    .gaussians
+                    .iter()
+                    .zip(&weights)
+                    .fold(DVec3::ZERO, |m, (g, w)| {
+                        m + *w * 2.0 * f64::from(g.variance)
+                    });
+                (moment / 14.0).max(DVec3::ZERO).map(f64::sqrt)
+            }
+        };
+        // Guarded: a NaN or out-of-range d (only reachable from code, the scene file checks
+        // its keys) is held to the range the blur's table is built for.
+        DVec3::new(d.x, d.y, d.z).map(|v| if v.is_finite() { v.clamp(lo, hi) } else { lo })
+    }
+}
+
+/// Six Gaussians fitted to Burley's profile of `d` per channel (mm), weights per channel by
+/// non-negative least squares (area-weighted, out to [`BURLEY_REACH`] `d`), normalised: what
+/// the Gaussian blurs render a material that gives only Burley's distances with.
+pub fn burley_gaussians(d: DVec3) -> Vec<Gaussian> {
+    let (lo, hi) = (d.min_element().max(1e-6), d.max_element().max(1e-6));
+    // From a fifth of the narrowest d to eight times the widest, geometrically: the
+    // e^(-r/3d) tail carries most of the second moment, and narrower Gaussians drop it.
+    let (v_lo, v_hi) = ((0.2 * lo).powi(2), (8.0 * hi).powi(2));
+    let n = 6;
+    let variances: Vec<f64> = (0..n)
+        .map(|k| (v_lo.ln() + (v_hi.ln() - v_lo.ln()) * k as f64 / (n - 1) as f64).exp())
+        .collect();
+    let mut weights = vec![glam::Vec3::ZERO; n];
+    for c in 0..3 {
+        let dc = d[c].max(1e-6);
+        let (w, _) = fit_sum_of_gaussians(
+            &variances,
+            |r| burley_profile(dc, r.max(1e-9)),
+            BURLEY_REACH * dc,
+        );
+        let total: f64 = w.iter().sum();
+        for (i, wi) in w.iter().enumerate() {
+            weights[i][c] = if total > 0.0 {
+                (wi / total) as f32
+            } else {
+                1.0 / n as f32
+            };
+        }
+    }
+    variances
+        .iter()
+        .zip(weights)
+        .map(|(&v, weight)| Gaussian {
+            variance: v as f32,
+            weight,
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -191,5 +331,72 @@ mod tests {
         let (_, e4) = fit_profile(&skin, 4).unwrap();
         assert!(e4.iter().all(|&e| e < 0.05), "{e4:?}");
         assert!(fit_profile(&skin, 0).is_err() && fit_profile(&skin, 9).is_err());
+    }
+
+    #[test]
+    fn burley_cdf_inverse_is_exact_and_the_profile_integrates_to_one() {
+        for xi in [0.0, 0.1, 0.5, 0.9, 0.99, 0.997] {
+            let r = burley_radius(xi);
+            assert!((burley_cdf(1.0, r) - xi).abs() < 1e-9, "{xi}: {r}");
+        }
+        // HDRP's cut: 16.56 d holds 99.7% of the profile.
+        assert!((burley_cdf(1.0, BURLEY_REACH) - 0.997).abs() < 1e-3);
+        // Midpoint quadrature of 2 pi r R(r) against the closed-form CDF.
+        let (d, r_max, steps) = (0.7, 5.0, 200_000);
+        let dr = r_max / steps as f64;
+        let total: f64 = (0..steps)
+            .map(|k| {
+                let r = (k as f64 + 0.5) * dr;
+                2.0 * PI * r * burley_profile(d, r) * dr
+            })
+            .sum();
+        assert!((total - burley_cdf(d, r_max)).abs() < 1e-6, "{total}");
+        // Extreme xi stays finite.
+        assert!(burley_radius(1.0).is_finite() && burley_radius(-1.0).is_finite());
+    }
+
+    #[test]
+    fn burley_d_matches_the_gaussians_second_moment_and_the_fits() {
+        // One Gaussian of variance v: E[r^2] = 2 v = 14 d^2.
+        let one = SssProfile {
+            gaussians: vec![Gaussian {
+                variance: 7.0,
+                weight: glam::Vec3::ONE,
+            }],
+            ..SssProfile::preset("skin").unwrap()
+        };
+        let d = one.burley_d(BurleyFit::Searchlight);
+        assert!((d - DVec3::ONE).abs().max_element() < 1e-6, "{d}");
+        // Skin: red scatters farthest.
+        let skin = SssProfile::preset("skin")
+            .unwrap()
+            .burley_d(BurleyFit::Searchlight);
+        assert!(skin.x > skin.y && skin.y > skin.z, "{skin}");
+        let mfp = SssProfile {
+            burley: Some(BurleyDistance::MeanFreePath {
+                mfp: glam::Vec3::splat(2.0),
+                albedo: glam::Vec3::new(0.0, 0.5, 1.0),
+            }),
+            ..one.clone()
+        };
+        for (_, fit) in BurleyFit::ALL {
+            let d = mfp.burley_d(*fit);
+            assert!(d.is_finite() && d.min_element() > 0.0, "{fit:?}: {d}");
+        }
+        // Searchlight at A = 0.33: s = 3.5.
+        assert!((BurleyFit::Searchlight.scale(0.33) - 3.5).abs() < 1e-12);
+        // The fitted Gaussians carry the profile's width.
+        let gaussians = burley_gaussians(DVec3::new(1.0, 0.5, 0.25));
+        let fitted = SssProfile {
+            gaussians,
+            burley: None,
+            ..one
+        };
+        fitted.validate().unwrap();
+        let back = fitted.burley_d(BurleyFit::Searchlight);
+        assert!(
+            (back.x - 1.0).abs() < 0.25 && back.z < back.y && back.y < back.x,
+            "{back}"
+        );
     }
 }

@@ -8,6 +8,7 @@
 mod common;
 
 mod antialias;
+mod burley;
 mod context;
 mod debug_view;
 mod deformation;

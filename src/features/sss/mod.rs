@@ -80,6 +80,7 @@ macro_rules! chain_technique_module {
 use chain_technique_module;
 
 pub mod bilateral;
+pub mod burley;
 pub mod control;
 mod iterative;
 pub mod kernel;

@@ -45,6 +45,12 @@ impl SssPrecision {
 /// curving away is blurred by its true distance, a background a few sigma behind gets nothing.
 pub const DEFAULT_SENSITIVITY: f32 = 1.0;
 
+/// The Burley blur's default sample budget (measured in docs/sss.md, "Burley").
+pub const DEFAULT_BURLEY_BUDGET: u32 = 20;
+
+/// The Burley blur's budgets `--burley-budget` takes.
+pub const BURLEY_BUDGET_RANGE: (u32, u32) = (4, 256);
+
 /// The screen-space SSS knobs a frame is built with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SssKnobs {
@@ -78,6 +84,14 @@ pub struct SssKnobs {
     /// a CPU driver, measured as close to the brute-force reference as bilinear taps,
     /// docs/sss.md), or bilinear between texels (Jimenez's).
     pub point_taps: bool,
+    /// The Burley blur's most samples per pixel (HDRP's budget; fewer where the kernel covers
+    /// fewer pixels: `pi R^2 / 4`).
+    pub burley_budget: u32,
+    /// The Burley blur's golden-angle spiral rotated per pixel (interleaved gradient noise);
+    /// off: every pixel samples the same directions.
+    pub burley_rotation: bool,
+    /// The fit of Burley's `s` from the albedo, for materials that give a mean free path.
+    pub burley_fit: crate::scene::profile::BurleyFit,
 }
 
 impl Default for SssKnobs {
@@ -92,6 +106,9 @@ impl Default for SssKnobs {
             shape: kernel::KernelShape::Marginal,
             half_res: false,
             point_taps: true,
+            burley_budget: DEFAULT_BURLEY_BUDGET,
+            burley_rotation: true,
+            burley_fit: crate::scene::profile::BurleyFit::Searchlight,
         }
     }
 }

@@ -14,8 +14,8 @@ use super::schema::{
 use super::{span, value, SceneFile, Table};
 use crate::scene::layered::{self, sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS};
 use crate::scene::material::{
-    Gaussian, Layer, LayeredMedium, Material, PowMode, SssProfile, TechniqueName, TextureSource,
-    Thickness, ThicknessSource, Translucency,
+    BurleyDistance, Gaussian, Layer, LayeredMedium, Material, PowMode, SssProfile, TechniqueName,
+    TextureSource, Thickness, ThicknessSource, Translucency,
 };
 use crate::scene::obj::ObjMaterial;
 use crate::Result;
@@ -69,7 +69,7 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         material.translucency = Some(translucency(file, at, t)?);
     }
     if let Some(s) = &m.sss {
-        material.sss = Some(sss(at, s)?);
+        material.sss = Some(sss(at, s, material.albedo)?);
     }
     if m.layers.is_some() {
         return Err(at.error(
@@ -148,27 +148,49 @@ fn translucency(file: &SceneFile<'_>, at: Table<'_>, t: &TranslucencyToml) -> Re
     Ok(translucency)
 }
 
-/// `[material.sss]`: a preset or Gaussians, their scale, and the blur that renders them.
-fn sss(at: Table<'_>, s: &SssToml) -> Result<SssProfile> {
-    let mut profile = match (&s.preset, &s.gaussians) {
-        (Some(p), None) => {
-            SssProfile::preset(p.get_ref()).map_err(|e| at.error("preset", Some(p.span()), e))?
-        }
-        (None, Some(rows)) => SssProfile {
-            name: "custom".into(),
-            gaussians: rows
-                .get_ref()
-                .iter()
-                .map(|r| Gaussian {
-                    variance: r[0],
-                    weight: Vec3::new(r[1], r[2], r[3]),
-                })
-                .collect(),
-            units_per_mm: 0.01,
-            blur: None,
-        },
-        _ => return Err(at.error("sss", None, "give exactly one of `preset` or `gaussians`")),
-    };
+/// `[material.sss]`: a preset or Gaussians, their scale, Burley's distances, and the blur that
+/// renders them. `albedo` is the material's, which a `mean_free_path` is scaled by.
+fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
+    let burley = burley_distance(at, s, albedo)?;
+    let mut profile =
+        match (&s.preset, &s.gaussians) {
+            (Some(p), None) => SssProfile::preset(p.get_ref())
+                .map_err(|e| at.error("preset", Some(p.span()), e))?,
+            (None, Some(rows)) => SssProfile {
+                name: "custom".into(),
+                gaussians: rows
+                    .get_ref()
+                    .iter()
+                    .map(|r| Gaussian {
+                        variance: r[0],
+                        weight: Vec3::new(r[1], r[2], r[3]),
+                    })
+                    .collect(),
+                units_per_mm: 0.01,
+                blur: None,
+                burley: None,
+            },
+            // Burley's distances alone: the Gaussian blurs get six Gaussians fitted to the profile
+            // (a mean free path through the default fit).
+            (None, None) if burley.is_some() => SssProfile {
+                name: "burley".into(),
+                gaussians: Vec::new(),
+                units_per_mm: 0.01,
+                blur: None,
+                burley,
+            },
+            _ => return Err(at.error(
+                "sss",
+                None,
+                "give exactly one of `preset` or `gaussians` (or only `scattering_distance` or \
+                 `mean_free_path`)",
+            )),
+        };
+    profile.burley = burley;
+    if profile.gaussians.is_empty() {
+        profile.gaussians =
+            crate::scene::profile::burley_gaussians(profile.burley_d(Default::default()));
+    }
     if let Some(u) = &s.units_per_mm {
         let u_value = *u.get_ref();
         if !(u_value.is_finite() && u_value > 0.0) {
@@ -191,6 +213,39 @@ fn sss(at: Table<'_>, s: &SssToml) -> Result<SssProfile> {
         None => at.error("units_per_mm", span(&s.units_per_mm), e),
     })?;
     Ok(profile)
+}
+
+/// `[material.sss] scattering_distance` or `mean_free_path`: Burley's shape per channel, mm,
+/// each component finite and within [`crate::scene::profile::BURLEY_D_RANGE`].
+fn burley_distance(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<Option<BurleyDistance>> {
+    let (lo, hi) = crate::scene::profile::BURLEY_D_RANGE;
+    let checked = |key: &str, v: &Spanned<[f32; 3]>| -> Result<Vec3> {
+        let d = Vec3::from(*v.get_ref());
+        if d.is_finite() && d.min_element() >= lo && d.max_element() <= hi {
+            return Ok(d);
+        }
+        Err(at.error(
+            key,
+            Some(v.span()),
+            format!("{d} must be three finite millimetres from {lo} to {hi}"),
+        ))
+    };
+    match (&s.scattering_distance, &s.mean_free_path) {
+        (Some(_), Some(m)) => Err(at.error(
+            "sss.mean_free_path",
+            Some(m.span()),
+            "give at most one of `scattering_distance` (Burley's d) and `mean_free_path`",
+        )),
+        (Some(d), None) => Ok(Some(BurleyDistance::Scattering(checked(
+            "sss.scattering_distance",
+            d,
+        )?))),
+        (None, Some(m)) => Ok(Some(BurleyDistance::MeanFreePath {
+            mfp: checked("sss.mean_free_path", m)?,
+            albedo: albedo.clamp(Vec3::ZERO, Vec3::ONE),
+        })),
+        (None, None) => Ok(None),
+    }
 }
 
 /// `[material.sss] blur`: the blur that renders the profile, by name.

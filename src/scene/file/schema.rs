@@ -99,6 +99,10 @@ pub(super) struct SssToml {
     pub(super) gaussians: Option<Spanned<Vec<[f32; 4]>>>,
     pub(super) units_per_mm: Option<Spanned<f32>>,
     pub(super) blur: Option<Spanned<String>>,
+    /// Burley's `d` per channel, mm.
+    pub(super) scattering_distance: Option<Spanned<[f32; 3]>>,
+    /// Burley's diffuse mean free path per channel, mm.
+    pub(super) mean_free_path: Option<Spanned<[f32; 3]>>,
 }
 
 /// One `[[material.layered.layer]]` table.

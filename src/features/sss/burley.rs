@@ -1,0 +1,321 @@
+//! 2-D Burley SSS (Christensen and Burley 2015, as HDRP, Unreal and EEVEE ship it): one
+//! fullscreen pass that importance-samples the normalized diffusion profile
+//! `R(r) = (e^(-r/d) + e^(-r/3d)) / (8 pi d r)` around each pixel (glsl/sss/burley.frag).
+//!
+//! Per pixel of a Burley profile: radii from the exact inverse of the widest channel's radial
+//! CDF at stratified `xi_i = (i + 1/2) / n`, angles on a golden-angle spiral rotated per pixel
+//! by interleaved gradient noise (`--burley-rotation off`: not rotated), `n` from the kernel's
+//! area on screen (`pi R^2 / 4` pixels for a reach `R` of 16.56 `d`, HDRP's cut) under a budget
+//! (`--burley-budget`), pixels whose reach is under one pixel left as they are. Each sample
+//! weighs `R_c(r_3d) / pdf(r)` per channel with the depth difference inside the distance; taps
+//! on pixels of another profile or that do not scatter are rejected (no halo: those pixels keep
+//! their light); the sum is divided by the weights' sum. `d` per channel comes from the
+//! material ([`crate::scene::material::BurleyDistance`]; a mean free path through
+//! `--burley-fit`) or from its Gaussians' second moment.
+//!
+//! Its table (`burley` per frame: [`BurleyTableGpu`]) holds each profile's `d` in world units
+//! and the budget; the pass reads the per-frame pair, that table, the lit diffuse (linear depth
+//! in alpha), depth, profile IDs, specular and the previous chain's result, and composes the
+//! chain's result itself (no separate combine pass).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::settings::BURLEY_BUDGET_RANGE;
+use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssInputs, SssKnobs};
+use super::{SssProfiles, MAX_SSS_PROFILES};
+use crate::backend::shader::PipelineShaders;
+use crate::features::knob::{Given, Knob, Takes};
+use crate::features::lighting::HDR_FORMAT;
+use crate::features::util::Defines;
+use crate::gpu_scene::{Region, SceneGpu, TableRegion};
+use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
+use crate::scene::profile::{burley_cdf, burley_radius, BurleyFit, BURLEY_REACH};
+
+/// The Burley blur (`--technique burley`, `blur = "burley"`).
+pub static BURLEY: BurleyChain = BurleyChain {
+    name: "burley",
+    summary: "2-D Burley SSS (HDRP, Unreal, EEVEE): the normalized diffusion profile \
+              importance-sampled around each pixel in one pass",
+    knobs: &[&BUDGET, &ROTATION, &FIT, &super::knobs::NO_TILES],
+    scene: "skin",
+    published_timing: None,
+};
+
+/// The Burley chain's module data (one instance, [`BURLEY`]).
+pub struct BurleyChain {
+    /// Its name.
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// The knobs that act on it.
+    pub knobs: &'static [&'static Knob],
+    /// The built-in scene it is measured on.
+    pub scene: &'static str,
+    /// No published per-pass table.
+    pub published_timing: Option<&'static crate::features::technique::SeedTable>,
+}
+
+super::chain_technique_module!(BurleyChain);
+
+/// `--burley-budget N`: the most samples per pixel.
+pub static BUDGET: Knob = Knob {
+    flag: "--burley-budget",
+    help: "Burley SSS: the most samples per pixel (4 to 256; default 20; fewer where the \
+           kernel covers fewer pixels, pi R^2 / 4; HDRP's budgets are 20, 40 and 80).",
+    takes: Takes::Whole {
+        min: BURLEY_BUDGET_RANGE.0,
+        max: BURLEY_BUDGET_RANGE.1,
+    },
+    default: Some(Given::Whole(super::settings::DEFAULT_BURLEY_BUDGET)),
+    apply: |k, v| k.sss.burley_budget = v.whole(),
+};
+
+/// `--burley-rotation on|off`: the per-pixel rotation of the sample spiral.
+pub static ROTATION: Knob = Knob {
+    flag: "--burley-rotation",
+    help: "Burley SSS: rotate the golden-angle sample spiral per pixel (on, the default: \
+           interleaved gradient noise) or not (off: every pixel samples the same directions).",
+    takes: Takes::Choice(&["on", "off"]),
+    default: Some(Given::Choice("on")),
+    apply: |k, v| k.sss.burley_rotation = v.choice() == "on",
+};
+
+/// `--burley-fit`: the albedo fit of materials that give a mean free path.
+pub static FIT: Knob = Knob {
+    flag: "--burley-fit",
+    help: "Burley SSS: Christensen and Burley's fit of s from the albedo for materials that \
+           give a mean_free_path: searchlight (the default, Unreal's), diffuse (EEVEE's) or \
+           perpendicular.",
+    takes: Takes::Choice(&["searchlight", "diffuse", "perpendicular"]),
+    default: Some(Given::Choice("searchlight")),
+    apply: |k, v| {
+        if let Some((_, fit)) = BurleyFit::ALL.iter().find(|(n, _)| *n == v.choice()) {
+            k.sss.burley_fit = *fit;
+        }
+    },
+};
+
+/// The Burley table in the per-frame buffer.
+pub static TABLE_REGION: Region = Region::new("SSS Burley table");
+
+/// The Burley table, std140 (glsl/sss/burley.frag `SssBurley`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BurleyTableGpu {
+    /// Per profile ID: rgb `d` per channel in world units, a the widest `d`.
+    pub distance: [[f32; 4]; MAX_SSS_PROFILES],
+    /// x: the sample budget; y: 1 to rotate the spiral per pixel; z: the reach in units of `d`.
+    pub knobs: [f32; 4],
+    /// The inverse CDF `r / d` at [`BURLEY_RADII`]` + 1` evenly spaced fractions of the profile
+    /// within the reach, four a row: the shader interpolates it.
+    pub radii: [[f32; 4]; BURLEY_RADII / 4 + 1],
+    /// At the same fractions, `t / (e^(-t) + e^(-t/3))` for the radius `t` in units of `d`:
+    /// the sample's `1 / pdf` up to constants.
+    pub inverse_pdf: [[f32; 4]; BURLEY_RADII / 4 + 1],
+}
+
+/// Entries of the tabulated inverse CDF (glsl/sss/burley.frag `BURLEY_RADII`).
+pub const BURLEY_RADII: usize = 128;
+
+/// The inverse CDF of Burley's profile at `BURLEY_RADII + 1` fractions of the energy within
+/// [`BURLEY_REACH`] `d`, in units of `d`, and each radius's `1 / pdf` up to constants.
+type RadiusTable = [[f32; 4]; BURLEY_RADII / 4 + 1];
+
+fn radii_tables() -> (RadiusTable, RadiusTable) {
+    let within = burley_cdf(1.0, BURLEY_REACH);
+    let (mut radii, mut inverse_pdf) = (
+        [[0.0; 4]; BURLEY_RADII / 4 + 1],
+        [[0.0; 4]; BURLEY_RADII / 4 + 1],
+    );
+    for k in 0..=BURLEY_RADII {
+        let t = burley_radius(within * k as f64 / BURLEY_RADII as f64).min(BURLEY_REACH);
+        radii[k / 4][k % 4] = t as f32;
+        // (e^(-t) + e^(-t/3)) >= 2 e^(-t/3) > 0 within the reach: no division by zero.
+        inverse_pdf[k / 4][k % 4] = (t / ((-t).exp() + (-t / 3.0).exp())) as f32;
+    }
+    (radii, inverse_pdf)
+}
+
+/// The Burley table of `profiles` under `knobs`: every profile's `d` (a profile another chain
+/// blurs gets one too; the pass only reads its own chain's).
+pub fn burley_table(profiles: &SssProfiles, knobs: &SssKnobs) -> BurleyTableGpu {
+    let mut table = BurleyTableGpu {
+        distance: [[0.0; 4]; MAX_SSS_PROFILES],
+        knobs: [
+            knobs
+                .burley_budget
+                .clamp(BURLEY_BUDGET_RANGE.0, BURLEY_BUDGET_RANGE.1) as f32,
+            if knobs.burley_rotation { 1.0 } else { 0.0 },
+            BURLEY_REACH as f32,
+            0.0,
+        ],
+        radii: [[0.0; 4]; BURLEY_RADII / 4 + 1],
+        inverse_pdf: [[0.0; 4]; BURLEY_RADII / 4 + 1],
+    };
+    (table.radii, table.inverse_pdf) = radii_tables();
+    for (i, (profile, _)) in profiles
+        .profiles
+        .iter()
+        .enumerate()
+        .take(MAX_SSS_PROFILES - 1)
+    {
+        let units = f64::from(profile.units_per_mm);
+        // `burley_d` holds d within the accepted range, so the world-unit d is finite.
+        let d = profile.burley_d(knobs.burley_fit) * units;
+        table.distance[i + 1] = [d.x as f32, d.y as f32, d.z as f32, d.max_element() as f32];
+    }
+    table
+}
+
+/// The pass's shape: what its defines depend on.
+#[derive(Clone, Copy)]
+struct PassShape {
+    /// The previous chain's result is kept where the chain does not scatter.
+    base: bool,
+    /// The lit diffuse's alpha holds linear depth.
+    depth_in_alpha: bool,
+}
+
+impl PassShape {
+    /// The defines, and the pass-through variant's extra one.
+    fn defines(self) -> (Defines, Defines) {
+        let mut defines: Defines = Vec::new();
+        if self.base {
+            defines.push(("LUCENT_SSS_BASE", "1"));
+        }
+        if self.depth_in_alpha {
+            defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
+        }
+        (defines, vec![("LUCENT_SSS_PASSTHROUGH", "1")])
+    }
+}
+
+const BURLEY_FRAGMENT: &str = "sss/burley.frag";
+
+/// Every pipeline the pass may build.
+fn shader_permutations(_: &BurleyChain, out: &mut Vec<PipelineShaders>) {
+    for base in [false, true] {
+        for depth_in_alpha in [false, true] {
+            let (defines, passthrough) = PassShape {
+                base,
+                depth_in_alpha,
+            }
+            .defines();
+            out.push(PipelineShaders::fullscreen(BURLEY_FRAGMENT, &defines));
+            let mut all = defines.clone();
+            all.extend(passthrough);
+            out.push(PipelineShaders::fullscreen(BURLEY_FRAGMENT, &all));
+        }
+    }
+}
+
+impl SssBlurTechnique for BurleyChain {
+    fn lean(&self) -> bool {
+        false
+    }
+
+    fn bilateral(&self) -> bool {
+        false
+    }
+
+    fn iterative(&self) -> bool {
+        false
+    }
+
+    fn depth_in_alpha(&self) -> bool {
+        true
+    }
+
+    fn table(&self) -> Option<TableRegion> {
+        Some(TableRegion {
+            region: &TABLE_REGION,
+            bytes: std::mem::size_of::<BurleyTableGpu>() as u64,
+        })
+    }
+
+    fn table_bytes(&self, profiles: &SssProfiles, knobs: &SssKnobs) -> Vec<u8> {
+        bytemuck::bytes_of(&burley_table(profiles, knobs)).to_vec()
+    }
+
+    fn declare_chain(
+        &self,
+        graph: &mut RenderGraph,
+        inputs: &SssInputs<'_>,
+        chain: &Chain,
+        base: Option<&Handle<Image>>,
+        knobs: &SssKnobs,
+        scene: Option<&Arc<SceneGpu>>,
+        output: Option<Handle<Image>>,
+    ) -> Handle<Image> {
+        let full = ImageInfo {
+            format: HDR_FORMAT,
+            ..graph.resources()[inputs.diffuse.id()].info
+        };
+        let mut result = output.unwrap_or_else(|| {
+            let name = if chain.last {
+                "hdr".to_string()
+            } else {
+                chain.image_name("result")
+            };
+            graph.create_image(&name, full)
+        });
+        let shape = PassShape {
+            base: base.is_some(),
+            depth_in_alpha: inputs.depth_in_alpha,
+        };
+        let constants = BlurConstants {
+            step: [0.0, 0.0, 0.0, chain.index as f32],
+        };
+        let name = format!("{}burley", chain.prefix);
+        let mut pass = sss_pass(graph, &name, BURLEY_FRAGMENT, scene, constants);
+        pass.per_frame(&TABLE_REGION);
+        // Binding order of glsl/sss/burley.frag: light (depth in alpha), depth, profile IDs,
+        // specular, the previous chain's result.
+        let mut reads = vec![
+            inputs.diffuse,
+            inputs.depth,
+            inputs.profile_ids,
+            inputs.specular,
+        ];
+        reads.extend(base);
+        for image in reads {
+            pass.sample_with(image, vk::Filter::NEAREST);
+        }
+        // Per pixel: the centre's light, depth and profile, then per sample its light and
+        // profile ID (depth travels in the light's alpha), up to the budget.
+        pass.taps(3 + 2 * knobs.burley_budget);
+        let (defines, passthrough) = shape.defines();
+        pass.defines(&defines).variant(passthrough);
+        let index = chain.index;
+        pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
+        pass.color(&mut result, LoadOp::DontCare);
+        pass.finish();
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::registry;
+
+    #[test]
+    fn table_holds_each_profile_d_in_world_units() {
+        let scene = crate::scene::builtin::builtin("skin").unwrap();
+        let blur = registry::blur_of_technique(&BURLEY).unwrap();
+        let profiles = SssProfiles::new(&scene, Some(blur), None, &registry::blur_of)
+            .unwrap()
+            .unwrap();
+        let knobs = SssKnobs::default();
+        let table = burley_table(&profiles, &knobs);
+        let (profile, _) = &profiles.profiles[0];
+        let d = profile.burley_d(knobs.burley_fit) * f64::from(profile.units_per_mm);
+        let row = table.distance[1];
+        assert!((f64::from(row[0]) - d.x).abs() < 1e-6 * d.x.max(1.0));
+        assert_eq!(row[3], row[0].max(row[1]).max(row[2]));
+        assert_eq!(table.distance[0], [0.0; 4]);
+        assert_eq!(table.knobs[0], knobs.burley_budget as f32);
+    }
+}

@@ -1,14 +1,12 @@
 #version 450
 // permutation: LUCENT_SSS_DEPTH_IN_ALPHA
-// permutation: LUCENT_SSS_DEPTH_IN_ALPHA LUCENT_SSS_PASSTHROUGH
-// permutation: LUCENT_SSS_BASE LUCENT_SSS_DEPTH_IN_ALPHA
-// permutation: LUCENT_SSS_BASE
-// 2-D Burley SSS (src/features/sss/burley.rs): Christensen and Burley's normalized diffusion
-// profile importance-sampled around each pixel in one pass, the chain's result composed here.
+// permutation:
+// The gather pass of 2-D Burley SSS (src/features/sss/burley.rs): Christensen and Burley's
+// normalized diffusion profile importance-sampled around each pixel; writes the diffused light
+// and the pixel's linear depth in alpha (negative where it does not scatter), which
+// glsl/sss/burley_resolve.frag averages over 3x3 pixels and composes.
 //
 // - LUCENT_SSS_DEPTH_IN_ALPHA: the lit diffuse's alpha holds linear depth (else read depth).
-// - LUCENT_SSS_BASE: pixels the chain does not scatter keep the previous chain's result.
-// - LUCENT_SSS_PASSTHROUGH: the variant for rectangles no object of the chain covers.
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 
@@ -28,10 +26,6 @@ layout(std140, set = 0, binding = 2) uniform SssBurley {
 layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;   // lit diffuse (+ depth)
 layout(set = 0, binding = 4) uniform sampler2D depth_tex;     // device depth
 layout(set = 0, binding = 5) uniform sampler2D profile_tex;   // profile IDs
-layout(set = 0, binding = 6) uniform sampler2D specular_tex;  // lit specular
-#ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 7) uniform sampler2D base_tex;      // the previous chain's result
-#endif
 
 layout(push_constant) uniform Blur {
     vec4 step;  // w: the chain
@@ -59,10 +53,15 @@ vec2 burley_sample(float t) {
 }
 
 
-// Interleaved gradient noise (Jimenez 2014): a per-pixel value in [0, 1) whose neighbours
-// differ by large steps, so a rotation drawn from it forms no visible low-frequency pattern.
-float interleaved_gradient_noise(vec2 px) {
-    return fract(52.9829189 * fract(dot(px, vec2(0.06711056, 0.00583715))));
+// The spiral's rotation at a pixel: one of nine, 2 pi k / 9, with k from the pixel's place in
+// its 3x3 block. Every 3x3 window holds all nine, so the resolve's 3x3 average sees each
+// radius stratum at nine evenly spaced angles: a polar grid of 9 n samples, with no noise and
+// no repeating pattern left (a per-pixel random rotation leaves grain a still cannot average
+// away, measured in docs/sss.md).
+float spiral_rotation(ivec2 px) {
+    int k = (px.x % 3) * 3 + (px.y % 3);
+    // Neighbours in a row differ by three ninths, in a column by one.
+    return 2.0 * PI * (float(k) + 0.5) / 9.0;
 }
 
 vec4 finite_or(vec4 c, vec4 fallback) {
@@ -82,11 +81,7 @@ void main() {
     ivec2 size = textureSize(diffuse_tex, 0);
     vec4 center = finite_or(texelFetch(diffuse_tex, px, 0), vec4(0.0));
     int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
-#ifdef LUCENT_SSS_PASSTHROUGH
-    bool scatters = false;
-#else
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
-#endif
     vec3 blurred = center.rgb;
     if (scatters) {
         float depth_m = depth_at(px, center);
@@ -106,9 +101,7 @@ void main() {
         int budget = clamp(int(burley.knobs.x + 0.5), 1, 256);
         int samples = clamp(int(PI * reach_px * reach_px * 0.25 + 0.5), 0, budget);
         if (reach_px >= 1.0 && samples > 0) {
-            float rotation = burley.knobs.y > 0.5
-                ? 2.0 * PI * interleaved_gradient_noise(vec2(px))
-                : 0.0;
+            float rotation = burley.knobs.y > 0.5 ? spiral_rotation(px) : 0.0;
             // The spiral's direction turns by the golden angle per sample: one rotation
             // matrix instead of a cos and a sin per sample.
             vec2 direction = vec2(cos(rotation), sin(rotation));
@@ -148,17 +141,9 @@ void main() {
             blurred = any(isnan(result)) || any(isinf(result)) ? center.rgb : result;
         }
     }
-    vec3 color;
-    if (scatters) {
-        color = blurred + texelFetch(specular_tex, px, 0).rgb;
-    } else {
-#ifdef LUCENT_SSS_BASE
-        color = texelFetch(base_tex, px, 0).rgb;
-#else
-        color = center.rgb + texelFetch(specular_tex, px, 0).rgb;
-#endif
-    }
-    // fp16 targets: in range, and a NaN becomes black.
-    color = any(isnan(color)) ? vec3(0.0) : clamp(color, vec3(0.0), vec3(65504.0));
-    out_color = vec4(color, 1.0);
+    // fp16 target: in range; the depth travels in alpha, negative where the pixel does not
+    // scatter (the resolve averages only its own profile's pixels).
+    blurred = clamp(blurred, vec3(0.0), vec3(65504.0));
+    float depth_m = depth_at(px, center);
+    out_color = vec4(blurred, scatters ? depth_m : -depth_m);
 }

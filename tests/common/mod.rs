@@ -362,3 +362,34 @@ pub fn interior(
         })
     })
 }
+
+/// An SSS test frame of `technique` at `width` x `height`: the HDR image and the G-buffer read
+/// back, no shadows (the f64 references shade without; tests/gpu/shadows.rs checks those).
+pub fn sss_frame(technique: Technique, width: u32, height: u32) -> FrameSettings {
+    FrameSettings {
+        technique,
+        export_hdr: true,
+        export_gbuffer: true,
+        shadows: lucent::features::shadows::ShadowSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..FrameSettings::new(width, height)
+    }
+}
+
+/// Whether pixel `i` of a frame `w` pixels wide scatters with its whole 9x9 neighbourhood
+/// (`strength`: the G-buffer's SSS profile per pixel): away from the silhouettes, which the
+/// edge tests judge.
+pub fn interior_scattering(strength: &[f32], w: usize, i: usize) -> bool {
+    let h = strength.len() / w.max(1);
+    let (x, y) = ((i % w) as i64, (i / w) as i64);
+    (-4..=4).all(|dy| {
+        (-4..=4).all(|dx| {
+            let (nx, ny) = (x + dx, y + dy);
+            (0..w as i64).contains(&nx)
+                && (0..h as i64).contains(&ny)
+                && strength[ny as usize * w + nx as usize] > 0.0
+        })
+    })
+}

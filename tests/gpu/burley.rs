@@ -18,17 +18,7 @@ use lucent::scene::Scene;
 const SIZE: (u32, u32) = (128, 96);
 
 fn settings(technique: Technique) -> FrameSettings {
-    FrameSettings {
-        technique,
-        export_hdr: true,
-        export_gbuffer: true,
-        // The f64 references shade without shadows.
-        shadows: lucent::features::shadows::ShadowSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..FrameSettings::new(SIZE.0, SIZE.1)
-    }
+    common::sss_frame(technique, SIZE.0, SIZE.1)
 }
 
 /// `name` with its profiles widened `factor` times (so the blurs span many pixels at this
@@ -47,21 +37,9 @@ fn scene(name: &str, factor: f32) -> Scene {
 /// Mean |GPU - reference| per channel over scattering pixels whose 9x9 neighbourhood all
 /// scatters (the edges are the edge test's), relative to the reference's mean there.
 fn interior_error(hdr: &[f32], reference: &[DVec3], strength: &[f32]) -> f64 {
-    let (w, h) = (SIZE.0 as i64, SIZE.1 as i64);
-    let interior = |i: usize| {
-        let (x, y) = (i as i64 % w, i as i64 / w);
-        (-4..=4).all(|dy| {
-            (-4..=4).all(|dx| {
-                let (nx, ny) = (x + dx, y + dy);
-                (0..w).contains(&nx)
-                    && (0..h).contains(&ny)
-                    && strength[(ny * w + nx) as usize] > 0.0
-            })
-        })
-    };
     let (mut error, mut level, mut n) = (0.0f64, 0.0f64, 0usize);
     for (i, r) in reference.iter().enumerate() {
-        if interior(i) {
+        if common::interior_scattering(strength, SIZE.0 as usize, i) {
             for c in 0..3 {
                 error += (f64::from(hdr[i * 4 + c]) - r[c]).abs();
                 level += r[c].abs();
@@ -135,7 +113,7 @@ fn burley_matches_its_f64_reference_as_closely_as_the_separable_blur_matches_its
         );
     }
     // More samples, less error: the budget is the knob that trades one for the other.
-    let curve: Vec<(u32, f64)> = [8, 16, 24, 32, 64, 128]
+    let curve: Vec<(u32, f64)> = [4, 8, 12, 20, 32, 64]
         .into_iter()
         .map(|b| (b, errors(&test, "teapot", Some(b)).0))
         .collect();
@@ -143,7 +121,7 @@ fn burley_matches_its_f64_reference_as_closely_as_the_separable_blur_matches_its
     let (low, high) = (curve[0].1, curve[curve.len() - 1].1);
     assert!(
         high < low,
-        "budget 128 ({high:.4e}) not closer than 8 ({low:.4e})"
+        "budget 64 ({high:.4e}) not closer than 4 ({low:.4e})"
     );
     test.finish();
 }
@@ -195,11 +173,14 @@ fn extreme_burley_distances_stay_finite() {
 }
 
 #[test]
-fn burley_is_one_pass_with_its_table_only_when_used() {
+fn burley_is_a_gather_and_a_resolve_with_its_table_only_when_used() {
     let skin = lucent::bake::scene::load_scene_baked("skin").unwrap();
     let plan = common::plan(&skin, &settings(Technique::Only(&BURLEY)));
     let names: Vec<&str> = plan.physical.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names, ["gbuffer + lighting", "burley", "tonemap"]);
+    assert_eq!(
+        names,
+        ["gbuffer + lighting", "burley", "burley resolve", "tonemap"]
+    );
     let desc = |t| FrameDesc::new(&skin, &settings(t)).unwrap();
     let has_table = |d: &FrameDesc| {
         d.tables()
@@ -231,5 +212,60 @@ fn burley_composes_with_the_other_techniques_in_mixed() {
     let test = TestGpu::new();
     let hdr = test.render(&scene, s).hdr.unwrap();
     assert!(hdr.iter().all(|v| v.is_finite()));
+    test.finish();
+}
+
+/// Mean |L - median of its 5x5 neighbourhood| of the luminance of `hdr` over the pixels whose
+/// 9x9 neighbourhood all scatters (`strength`): the grain a still shows.
+fn grain(hdr: &[f32], strength: &[f32], w: usize, h: usize) -> f64 {
+    let lum = |i: usize| {
+        0.2126 * f64::from(hdr[i * 4])
+            + 0.7152 * f64::from(hdr[i * 4 + 1])
+            + 0.0722 * f64::from(hdr[i * 4 + 2])
+    };
+    let (mut sum, mut n) = (0.0, 0usize);
+    for y in 4..h - 4 {
+        for x in 4..w - 4 {
+            if !common::interior_scattering(strength, w, y * w + x) {
+                continue;
+            }
+            let mut around: Vec<f64> = (0..25)
+                .map(|k| lum((y + k / 5 - 2) * w + x + k % 5 - 2))
+                .collect();
+            around.sort_by(f64::total_cmp);
+            sum += (lum(y * w + x) - around[12]).abs();
+            n += 1;
+        }
+    }
+    assert!(n > 1000, "{n} interior pixels");
+    sum / n as f64
+}
+
+#[test]
+fn burley_leaves_no_grain_in_a_still() {
+    // showcase-skin at 640x480, the measurement: Burley's grain at most 1.2x plain
+    // lighting's on the same pixels (a per-pixel random rotation measured 4.7x).
+    let test = TestGpu::new();
+    let scene = lucent::bake::scene::load_scene_baked("showcase-skin").unwrap();
+    let (w, h) = (640usize, 480usize);
+    let s = |technique| FrameSettings {
+        technique,
+        export_hdr: true,
+        export_gbuffer: true,
+        ..FrameSettings::new(w as u32, h as u32)
+    };
+    let burley = test.render(&scene, s(Technique::Only(&BURLEY)));
+    let strength = burley.gbuffer.as_ref().unwrap().sss.clone().unwrap();
+    let plain = test.render(&scene, s(Technique::None));
+    let g_burley = grain(burley.hdr.as_ref().unwrap(), &strength, w, h);
+    let g_plain = grain(plain.hdr.as_ref().unwrap(), &strength, w, h);
+    eprintln!(
+        "showcase-skin grain: burley {g_burley:.4e}, plain {g_plain:.4e} ({:.2}x)",
+        g_burley / g_plain
+    );
+    assert!(
+        g_burley <= 1.2 * g_plain,
+        "burley {g_burley:.4e}, plain {g_plain:.4e}"
+    );
     test.finish();
 }

@@ -12,17 +12,7 @@ use lucent::reference::sss::ReferenceSpecular;
 use lucent::scene::Scene;
 
 fn settings(technique: Technique) -> FrameSettings {
-    FrameSettings {
-        technique,
-        export_hdr: true,
-        export_gbuffer: true,
-        // The f64 references shade without shadows (tests/gpu/shadows.rs checks those).
-        shadows: lucent::features::shadows::ShadowSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..FrameSettings::new(160, 120)
-    }
+    common::sss_frame(technique, 160, 120)
 }
 
 /// The thesis's control technique.
@@ -269,21 +259,9 @@ fn blurring_only_the_profiles_rectangles_gives_the_whole_screen_result() {
 /// Mean |image - reference| per channel over the interior of the scattering pixels (the pixel
 /// and every pixel within 4 of it scatter: away from silhouettes, which the edge metrics judge).
 fn interior_error(hdr: &[f32], reference: &[glam::DVec3], strength: &[f32], w: i64) -> f64 {
-    let h = strength.len() as i64 / w;
-    let interior = |i: usize| {
-        let (x, y) = (i as i64 % w, i as i64 / w);
-        (-4..=4).all(|dy| {
-            (-4..=4).all(|dx| {
-                let (nx, ny) = (x + dx, y + dy);
-                (0..w).contains(&nx)
-                    && (0..h).contains(&ny)
-                    && strength[(ny * w + nx) as usize] > 0.0
-            })
-        })
-    };
     let (mut sum, mut n) = (0.0f64, 0usize);
     for (i, r) in reference.iter().enumerate() {
-        if interior(i) {
+        if common::interior_scattering(strength, w as usize, i) {
             for c in 0..3 {
                 sum += (f64::from(hdr[i * 4 + c]) - r[c]).abs();
             }

@@ -1,10 +1,11 @@
-//! 2-D Burley SSS (Christensen and Burley 2015, as HDRP, Unreal and EEVEE ship it): one
-//! fullscreen pass that importance-samples the normalized diffusion profile
-//! `R(r) = (e^(-r/d) + e^(-r/3d)) / (8 pi d r)` around each pixel (glsl/sss/burley.frag).
+//! 2-D Burley SSS (Christensen and Burley 2015, as HDRP, Unreal and EEVEE ship it): a
+//! fullscreen gather pass that importance-samples the normalized diffusion profile
+//! `R(r) = (e^(-r/d) + e^(-r/3d)) / (8 pi d r)` around each pixel (glsl/sss/burley.frag), and a
+//! resolve pass (glsl/sss/burley_resolve.frag).
 //!
 //! Per pixel of a Burley profile: radii from the exact inverse of the widest channel's radial
-//! CDF at stratified `xi_i = (i + 1/2) / n`, angles on a golden-angle spiral rotated per pixel
-//! by interleaved gradient noise (`--burley-rotation off`: not rotated), `n` from the kernel's
+//! CDF at stratified `xi_i = (i + 1/2) / n`, angles on a golden-angle spiral rotated by one of
+//! nine angles per 3x3 block (`--burley-rotation off`: not rotated), `n` from the kernel's
 //! area on screen (`pi R^2 / 4` pixels for a reach `R` of 16.56 `d`, HDRP's cut) under a budget
 //! (`--burley-budget`), pixels whose reach is under one pixel left as they are. Each sample
 //! weighs `R_c(r_3d) / pdf(r)` per channel with the depth difference inside the distance; taps
@@ -14,9 +15,12 @@
 //! `--burley-fit`) or from its Gaussians' second moment.
 //!
 //! Its table (`burley` per frame: [`BurleyTableGpu`]) holds each profile's `d` in world units
-//! and the budget; the pass reads the per-frame pair, that table, the lit diffuse (linear depth
-//! in alpha), depth, profile IDs, specular and the previous chain's result, and composes the
-//! chain's result itself (no separate combine pass).
+//! and the budget. Two passes: `burley` gathers (the per-frame pair, that table, the lit
+//! diffuse with linear depth in alpha, depth, profile IDs), `burley resolve` averages each
+//! scattering pixel with its 3x3 neighbours of the same profile and depth (the nine spiral
+//! rotations of a 3x3 block together: every radius at nine evenly spaced angles, so a still
+//! shows neither grain nor the unrotated spiral's striations) and composes the chain's result
+//! (plus specular; the previous chain's result or the lit light elsewhere).
 
 use std::sync::Arc;
 
@@ -62,7 +66,7 @@ super::chain_technique_module!(BurleyChain);
 /// `--burley-budget N`: the most samples per pixel.
 pub static BUDGET: Knob = Knob {
     flag: "--burley-budget",
-    help: "Burley SSS: the most samples per pixel (4 to 256; default 20; fewer where the \
+    help: "Burley SSS: the most samples per pixel (4 to 256; default 8; fewer where the \
            kernel covers fewer pixels, pi R^2 / 4; HDRP's budgets are 20, 40 and 80).",
     takes: Takes::Whole {
         min: BURLEY_BUDGET_RANGE.0,
@@ -75,8 +79,9 @@ pub static BUDGET: Knob = Knob {
 /// `--burley-rotation on|off`: the per-pixel rotation of the sample spiral.
 pub static ROTATION: Knob = Knob {
     flag: "--burley-rotation",
-    help: "Burley SSS: rotate the golden-angle sample spiral per pixel (on, the default: \
-           interleaved gradient noise) or not (off: every pixel samples the same directions).",
+    help: "Burley SSS: rotate the golden-angle sample spiral by one of nine angles per 3x3 \
+           block, which the resolve averages (on, the default), or not (off: every pixel \
+           samples the same directions, striations along them).",
     takes: Takes::Choice(&["on", "off"]),
     default: Some(Given::Choice("on")),
     apply: |k, v| k.sss.burley_rotation = v.choice() == "on",
@@ -169,45 +174,45 @@ pub fn burley_table(profiles: &SssProfiles, knobs: &SssKnobs) -> BurleyTableGpu 
     table
 }
 
-/// The pass's shape: what its defines depend on.
-#[derive(Clone, Copy)]
-struct PassShape {
-    /// The previous chain's result is kept where the chain does not scatter.
-    base: bool,
-    /// The lit diffuse's alpha holds linear depth.
-    depth_in_alpha: bool,
-}
+const GATHER_FRAGMENT: &str = "sss/burley.frag";
+const RESOLVE_FRAGMENT: &str = "sss/burley_resolve.frag";
 
-impl PassShape {
-    /// The defines, and the pass-through variant's extra one.
-    fn defines(self) -> (Defines, Defines) {
-        let mut defines: Defines = Vec::new();
-        if self.base {
-            defines.push(("LUCENT_SSS_BASE", "1"));
-        }
-        if self.depth_in_alpha {
-            defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
-        }
-        (defines, vec![("LUCENT_SSS_PASSTHROUGH", "1")])
+/// The gather pass's defines.
+fn gather_defines(depth_in_alpha: bool) -> Defines {
+    if depth_in_alpha {
+        vec![("LUCENT_SSS_DEPTH_IN_ALPHA", "1")]
+    } else {
+        Vec::new()
     }
 }
 
-const BURLEY_FRAGMENT: &str = "sss/burley.frag";
+/// The resolve pass's defines (`base`: it keeps the previous chain's result; `edges`: the
+/// frame has several profiles), and its pass-through variant's extra one.
+fn resolve_defines(base: bool, edges: bool) -> (Defines, Defines) {
+    let mut defines = Vec::new();
+    if base {
+        defines.push(("LUCENT_SSS_BASE", "1"));
+    }
+    if edges {
+        defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
+    }
+    (defines, vec![("LUCENT_SSS_PASSTHROUGH", "1")])
+}
 
-/// Every pipeline the pass may build.
+/// Every pipeline the passes may build.
 fn shader_permutations(_: &BurleyChain, out: &mut Vec<PipelineShaders>) {
-    for base in [false, true] {
-        for depth_in_alpha in [false, true] {
-            let (defines, passthrough) = PassShape {
-                base,
-                depth_in_alpha,
-            }
-            .defines();
-            out.push(PipelineShaders::fullscreen(BURLEY_FRAGMENT, &defines));
-            let mut all = defines.clone();
-            all.extend(passthrough);
-            out.push(PipelineShaders::fullscreen(BURLEY_FRAGMENT, &all));
-        }
+    for depth_in_alpha in [false, true] {
+        out.push(PipelineShaders::fullscreen(
+            GATHER_FRAGMENT,
+            &gather_defines(depth_in_alpha),
+        ));
+    }
+    for (base, edges) in [(false, false), (false, true), (true, false), (true, true)] {
+        let (defines, passthrough) = resolve_defines(base, edges);
+        out.push(PipelineShaders::fullscreen(RESOLVE_FRAGMENT, &defines));
+        let mut all = defines.clone();
+        all.extend(passthrough);
+        out.push(PipelineShaders::fullscreen(RESOLVE_FRAGMENT, &all));
     }
 }
 
@@ -261,34 +266,46 @@ impl SssBlurTechnique for BurleyChain {
             };
             graph.create_image(&name, full)
         });
-        let shape = PassShape {
-            base: base.is_some(),
-            depth_in_alpha: inputs.depth_in_alpha,
-        };
         let constants = BlurConstants {
             step: [0.0, 0.0, 0.0, chain.index as f32],
         };
+        let index = chain.index;
+
+        // Gather: the profile importance-sampled around each of the chain's pixels.
+        let mut gathered = graph.create_image(&chain.image_name("gathered"), full);
         let name = format!("{}burley", chain.prefix);
-        let mut pass = sss_pass(graph, &name, BURLEY_FRAGMENT, scene, constants);
+        let mut pass = sss_pass(graph, &name, GATHER_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
-        // Binding order of glsl/sss/burley.frag: light (depth in alpha), depth, profile IDs,
-        // specular, the previous chain's result.
+        for image in [inputs.diffuse, inputs.depth, inputs.profile_ids] {
+            pass.sample_with(image, vk::Filter::NEAREST);
+        }
+        // Per pixel: the centre's light and profile, then per sample its light and profile ID
+        // (depth travels in the light's alpha), up to the budget.
+        pass.taps(2 + 2 * knobs.burley_budget);
+        pass.defines(&gather_defines(inputs.depth_in_alpha));
+        pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
+        pass.color(&mut gathered, LoadOp::DontCare);
+        pass.finish();
+
+        // Resolve: the 3x3 average of the nine spiral rotations, composed.
+        let name = format!("{}burley resolve", chain.prefix);
+        let mut pass = sss_pass(graph, &name, RESOLVE_FRAGMENT, scene, constants);
+        pass.per_frame(&TABLE_REGION);
         let mut reads = vec![
-            inputs.diffuse,
-            inputs.depth,
+            &gathered,
             inputs.profile_ids,
+            inputs.diffuse,
             inputs.specular,
         ];
         reads.extend(base);
         for image in reads {
             pass.sample_with(image, vk::Filter::NEAREST);
         }
-        // Per pixel: the centre's light, depth and profile, then per sample its light and
-        // profile ID (depth travels in the light's alpha), up to the budget.
-        pass.taps(3 + 2 * knobs.burley_budget);
-        let (defines, passthrough) = shape.defines();
+        // The centre's profile, then nine gathered texels (and their profile IDs with several
+        // profiles), the lit diffuse and specular.
+        pass.taps(1 + 9 * (1 + u32::from(chain.edges)) + 2);
+        let (defines, passthrough) = resolve_defines(base.is_some(), chain.edges);
         pass.defines(&defines).variant(passthrough);
-        let index = chain.index;
         pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
         pass.color(&mut result, LoadOp::DontCare);
         pass.finish();

@@ -46,7 +46,7 @@ impl SssPrecision {
 pub const DEFAULT_SENSITIVITY: f32 = 1.0;
 
 /// The Burley blur's default sample budget (measured in docs/sss.md, "Burley").
-pub const DEFAULT_BURLEY_BUDGET: u32 = 20;
+pub const DEFAULT_BURLEY_BUDGET: u32 = 8;
 
 /// The Burley blur's budgets `--burley-budget` takes.
 pub const BURLEY_BUDGET_RANGE: (u32, u32) = (4, 256);
@@ -87,8 +87,8 @@ pub struct SssKnobs {
     /// The Burley blur's most samples per pixel (HDRP's budget; fewer where the kernel covers
     /// fewer pixels: `pi R^2 / 4`).
     pub burley_budget: u32,
-    /// The Burley blur's golden-angle spiral rotated per pixel (interleaved gradient noise);
-    /// off: every pixel samples the same directions.
+    /// The Burley blur's golden-angle spiral rotated by one of nine angles per 3x3 block (the
+    /// resolve averages the nine); off: every pixel samples the same directions.
     pub burley_rotation: bool,
     /// The fit of Burley's `s` from the albedo, for materials that give a mean free path.
     pub burley_fit: crate::scene::profile::BurleyFit,

@@ -10,6 +10,7 @@
 //! - [`layered_error`]: Li et al.'s layered terms against their f64 references.
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
 //! - [`sweep_layered`]: the layered media's sweep, the GPU frames and the f64 references.
+//! - [`sweep_burley`]: 2-D Burley SSS at extreme distances, albedos and views.
 
 pub mod bench;
 pub mod gallery;
@@ -19,4 +20,5 @@ pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;
 pub mod sweep;
+pub mod sweep_burley;
 pub mod sweep_layered;

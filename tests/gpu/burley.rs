@@ -269,3 +269,13 @@ fn burley_leaves_no_grain_in_a_still() {
     );
     test.finish();
 }
+
+#[test]
+fn sweep_burley_finds_no_nan_or_inf() {
+    // Every distance from 1e-4 to 1e3 mm, albedo 0 to 1 under each fit, front, grazing and
+    // close views (src/measure/sweep_burley.rs), under validation.
+    let out = common::succeeded(common::lucent_command().args(["sweep", "burley", "--validation"]));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("0 NaN/Inf values: stable"), "{text}");
+    assert!(text.contains("| grazing | d = 1e3 mm |"), "{text}");
+}

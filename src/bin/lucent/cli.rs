@@ -181,7 +181,7 @@ pub struct PlanArgs {
 /// `lucent sweep`.
 #[derive(Args)]
 pub struct SweepArgs {
-    /// The technique to sweep (`translucency` or `layered`).
+    /// The technique to sweep (`translucency`, `layered` or `burley`).
     pub technique: String,
     /// Resolution of each case as WIDTHxHEIGHT.
     #[arg(long, default_value = "64x48", value_parser = parse_size)]

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use lucent::features::layered::LAYERED;
+use lucent::features::sss::burley::BURLEY;
 use lucent::features::technique::TechniqueModule;
 use lucent::features::translucency::TRANSLUCENCY;
 use lucent::{LucentError, Result};
@@ -21,11 +22,12 @@ pub fn run(args: SweepArgs) -> Result<()> {
         gpu: gpu_args,
     } = args;
     // The techniques with a sweep: their cases live in `lucent::measure::sweep`.
-    let (translucency, layered) = (TRANSLUCENCY.name(), LAYERED.name());
+    let (translucency, layered, burley) = (TRANSLUCENCY.name(), LAYERED.name(), BURLEY.name());
     let technique = technique.as_str();
-    if technique != translucency && technique != layered {
+    if ![translucency, layered, burley].contains(&technique) {
         return Err(LucentError::InvalidInput(format!(
-            "sweep: unknown technique '{technique}'; available: {translucency}, {layered}"
+            "sweep: unknown technique '{technique}'; available: {translucency}, {layered}, \
+             {burley}"
         )));
     }
     if quick && technique != layered {
@@ -38,6 +40,9 @@ pub fn run(args: SweepArgs) -> Result<()> {
     }
     if technique == layered {
         return sweep_layered((width, height), out, quick, &gpu_args);
+    }
+    if technique == burley {
+        return sweep_burley((width, height), out, &gpu_args);
     }
     let cases = lucent::measure::sweep::translucency_cases();
     let (rows, device) = with_session(&gpu_args, |session| {
@@ -123,6 +128,40 @@ fn sweep_layered(
             "sweep layered: {values} NaN/Inf values in {} cases (see the table): {}",
             bad.len(),
             bad.join(", ")
+        )));
+    }
+    Ok(())
+}
+
+/// `sweep burley`: Burley's extreme distances, albedos and views.
+fn sweep_burley(
+    (width, height): (u32, u32),
+    out: Option<PathBuf>,
+    gpu_args: &GpuArgs,
+) -> Result<()> {
+    use lucent::measure::sweep_burley;
+    let cases = sweep_burley::burley_cases();
+    let (rows, device) = with_session(gpu_args, |session| {
+        let rows = sweep_burley::run_burley(
+            &session.gpu,
+            &session.shaders,
+            &session.pipeline_cache,
+            width,
+            height,
+            &cases,
+        )?;
+        Ok((rows, session.gpu.info.describe()))
+    })?;
+    let table = sweep_burley::markdown(&rows, width, height, &device);
+    println!("{table}");
+    if let Some(out) = &out {
+        lucent::files::write_file_atomic(out, table.as_bytes())?;
+        println!("wrote {}", out.display());
+    }
+    let bad: usize = rows.iter().map(|r| r.nan + r.inf).sum();
+    if bad > 0 {
+        return Err(LucentError::InvalidInput(format!(
+            "sweep burley: {bad} NaN/Inf values (see the table)"
         )));
     }
     Ok(())

@@ -1,7 +1,10 @@
-// Multiple scattering gathered at half resolution (src/features/layered.rs, `--half-gather`),
-// brought back to full resolution by the single scattering pass, which adds it with its own
-// terms (one full-screen pass fewer: on lavapipe a pass over the screen costs ~15 ms at
-// 1024^2 whatever it does). Each pixel takes the four half-resolution texels around it,
+// Multiple scattering read back by the single scattering pass, which adds it with its own
+// terms. At full resolution (LUCENT_FULL_RES_TERM) each pixel averages its 3x3 neighbours of
+// its own material and depth: the gather rotated its spiral by one of nine angles per 3x3
+// block (glsl/common/sampling.glsl), so the average sees every radius at nine angles and no
+// grain is left. Gathered at half resolution (src/features/layered.rs, `--half-gather`), it is
+// brought back to full resolution here (one full-screen pass fewer: on lavapipe a pass over
+// the screen costs ~15 ms at 1024^2 whatever it does). Each pixel takes the four half-resolution texels around it,
 // bilinearly weighted, keeping only those of its own material and at its own depth (a texel
 // holds its 2x2 block's top-left pixel), so no term leaks across silhouettes or between
 // objects. Include after layered.glsl with LUCENT_HALF_TERM_BINDING defined.
@@ -11,6 +14,27 @@
 // rgb: the weighted multiple-scattering term; alpha: the texel's layered material ID.
 layout(set = 0, binding = LUCENT_HALF_TERM_BINDING) uniform sampler2D half_term;
 
+#ifdef LUCENT_FULL_RES_TERM
+// The full-resolution term at pixel `px` of material `id`: the mean over its 3x3 neighbours of
+// that material within ~1% of its depth (the pixel itself always counts).
+vec3 upsampled_multiple(ivec2 px, int id) {
+    ivec2 size = textureSize(half_term, 0);
+    float here = linear_depth(texelFetch(gbuffer_depth, px, 0).r);
+    vec3 sum = vec3(0.0);
+    float count = 0.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = clamp(px + ivec2(dx, dy), ivec2(0), size - 1);
+            vec4 texel = texelFetch(half_term, q, 0);
+            float d = linear_depth(texelFetch(gbuffer_depth, q, 0).r);
+            float keep = int(texel.a + 0.5) == id && abs(d - here) <= 0.01 * here ? 1.0 : 0.0;
+            sum += keep * texel.rgb;
+            count += keep;
+        }
+    }
+    return count > 0.0 ? sum / count : vec3(0.0);
+}
+#else
 // The half-resolution term at full-resolution pixel `px` of material `id` (0 where no texel
 // around it is of that material at that depth: a sliver thinner than a texel).
 vec3 upsampled_multiple(ivec2 px, int id) {
@@ -41,5 +65,6 @@ vec3 upsampled_multiple(ivec2 px, int id) {
     }
     return total > 0.0 ? sum / total : vec3(0.0);
 }
+#endif
 
 #endif

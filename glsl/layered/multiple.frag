@@ -3,18 +3,22 @@
 // Li et al.'s multiple scattering (eqs. 12-13), added into the lit image weighted by eq. 3's
 // λ5 (src/features/layered.rs, `multiple scattering`): Jensen's dipole of the first layer
 // gathered over M pixel lights of the irradiance image. Set 0 as glsl/common/layered.glsl,
-// then the irradiance image (binding 5). With LUCENT_HALF_GATHER each texel of a
-// half-resolution target gathers for its 2x2 block's top-left pixel and stores the weighted
-// term with the material ID in alpha, for glsl/layered/upsample.frag.
+// then the irradiance image (binding 5). It stores the weighted term with the material ID in
+// alpha, which single scattering reads back (glsl/common/layered_upsample.glsl): at full
+// resolution the spiral is rotated by one of nine angles per 3x3 block
+// (glsl/common/sampling.glsl) and single scattering averages each pixel's 3x3 neighbours; with
+// LUCENT_HALF_GATHER each texel of a half-resolution target gathers for its 2x2 block's
+// top-left pixel, rotated per pixel, and single scattering upsamples it.
 #include "../common/layered.glsl"
+#include "../common/sampling.glsl"
 
 layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
 
-// Per-pixel rotation of the sample spiral (Jimenez's interleaved gradient noise): banding
-// becomes noise, deterministic per pixel.
+// Per-pixel rotation of the half-resolution gather's spiral (Jimenez's interleaved gradient
+// noise): banding becomes noise, deterministic per pixel.
 float pixel_noise(vec2 p) {
     return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715))));
 }
@@ -51,8 +55,13 @@ void main() {
     int count = clamp(layered.knobs.y, 4, 64);
     int scale = max(layered.knobs.w, 1);
     ivec2 size = ivec2(frame.viewport.xy);
-    // Noise of the full-resolution pixel gathered for (at half resolution, its block's).
+#ifdef LUCENT_HALF_GATHER
+    // Noise of the full-resolution pixel gathered for (its block's): the upsample averages
+    // four differently rotated gathers.
     float rotation = 6.28318530718 * pixel_noise(vec2(px) + 0.5);
+#else
+    float rotation = spiral_rotation(px);
+#endif
     vec3 gathered = vec3(0.0), weight = vec3(0.0);
     for (int i = 0; i < count; ++i) {
         float u = (float(i) + 0.5) / float(count);
@@ -60,7 +69,7 @@ void main() {
         // The area a sample stands for: 1 / (count x its density on the tangent plane).
         float pdf_r = sigma * exp(-sigma * r_plane) / span;
         float area = 6.28318530718 * r_plane / (float(count) * max(pdf_r, 1e-30));
-        float phi = float(i) * 2.39996323 + rotation; // golden-angle spiral
+        float phi = float(i) * GOLDEN_ANGLE + rotation;
         vec3 y = x_o + r_plane * (cos(phi) * t + sin(phi) * b);
         vec4 clip = frame.view_proj * vec4(y, 1.0);
         if (!(clip.w > 0.0)) {
@@ -90,9 +99,5 @@ void main() {
     // (No accepted sample: both sums are 0, and so is the term.)
     vec3 l_ms = fresnel_transmittance(cos_o, eta) / PI * MAT.total.rgb * gathered /
                 max(weight, vec3(1e-30));
-#ifdef LUCENT_HALF_GATHER
     out_color = vec4(finite_term(MAT.weights.z * l_ms), float(id));
-#else
-    out_color = vec4(finite_term(MAT.weights.z * l_ms), 0.0);
-#endif
 }

@@ -2,13 +2,15 @@
 // permutation: LUCENT_ENTRY_BINDING=5 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6
 // permutation: LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_BINDING=5
 // permutation: LUCENT_HALF_TERM_BINDING=5
+// permutation: LUCENT_HALF_TERM_BINDING=5 LUCENT_FULL_RES_TERM
 // permutation: LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_BINDING=5 LUCENT_ENTRY_BINDING=6 LUCENT_ENTRY_DEPTH_BINDING=7 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=8
 // Li et al.'s single scattering (eqs. 4-11) and the transmitted term L_t, added into the lit
 // image (src/features/layered.rs, `single scattering`), weighted by eq. 3's λ4 and λ3.
 // Set 0 as glsl/common/layered.glsl, then (media with TexDep layers) the G-buffer's layer
 // depth texels, then (lights with maps) the entry atlas, its layer depth texels (with TexDep)
-// and the shadow bindings; with `--half-gather` the half-resolution multiple-scattering term
-// (LUCENT_HALF_TERM_BINDING), which this pass upsamples and adds.
+// and the shadow bindings; the multiple-scattering term (LUCENT_HALF_TERM_BINDING), which this
+// pass resolves over 3x3 pixels (LUCENT_FULL_RES_TERM) or, with `--half-gather`, upsamples,
+// and adds.
 #include "../common/layered.glsl"
 #ifdef LUCENT_HALF_TERM_BINDING
 #include "../common/layered_upsample.glsl"

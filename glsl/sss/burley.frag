@@ -9,6 +9,7 @@
 // - LUCENT_SSS_DEPTH_IN_ALPHA: the lit diffuse's alpha holds linear depth (else read depth).
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
+#include "../common/sampling.glsl"
 
 #define BURLEY_RADII 128
 // Per profile ID: rgb d per channel (world units), a the widest; knobs: x the sample budget,
@@ -35,8 +36,6 @@ layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
 
 const float PI = 3.14159265358979;
-// The golden angle, radians: consecutive samples turn by it (a Fibonacci spiral).
-const float GOLDEN_ANGLE = 2.39996322972865;
 
 // The radius (in units of d) within which a fraction t in [0, 1] of the profile's reach lies:
 // the exact inverse CDF (src/scene/profile.rs `burley_radius`), tabulated on the CPU and
@@ -52,17 +51,6 @@ vec2 burley_sample(float t) {
     return mix(a, b, x - float(k));
 }
 
-
-// The spiral's rotation at a pixel: one of nine, 2 pi k / 9, with k from the pixel's place in
-// its 3x3 block. Every 3x3 window holds all nine, so the resolve's 3x3 average sees each
-// radius stratum at nine evenly spaced angles: a polar grid of 9 n samples, with no noise and
-// no repeating pattern left (a per-pixel random rotation leaves grain a still cannot average
-// away, measured in docs/sss.md).
-float spiral_rotation(ivec2 px) {
-    int k = (px.x % 3) * 3 + (px.y % 3);
-    // Neighbours in a row differ by three ninths, in a column by one.
-    return 2.0 * PI * (float(k) + 0.5) / 9.0;
-}
 
 vec4 finite_or(vec4 c, vec4 fallback) {
     return any(isnan(c)) || any(isinf(c)) ? fallback : c;

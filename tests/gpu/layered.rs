@@ -190,9 +190,16 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     half.layered.half_irradiance = true;
     let p = common::plan(&layered, &half);
     assert_eq!(common::image_size(&p, "layered.irradiance"), (160, 120));
-    // The half-resolution gather: its half-size term, drawn before single scattering (which
-    // upsamples it); the full gather (default) has no such image.
-    assert!(!images(&p).iter().any(|n| n == "layered.multiple"));
+    // The term multiple scattering writes for single scattering to resolve: full size by
+    // default (single scattering averages it over 3x3 pixels), half size with the half gather
+    // (single scattering upsamples it); drawn before single scattering either way.
+    assert_eq!(common::image_size(&p, "layered.multiple"), (320, 240));
+    let order = passes(&p);
+    let at = |name: &str| order.iter().position(|n| n == name).unwrap();
+    assert!(
+        at("multiple scattering") < at("single scattering"),
+        "{order:?}"
+    );
     let mut half_gather = s;
     half_gather.layered.half_gather = true;
     let p = common::plan(&layered, &half_gather);

@@ -58,7 +58,8 @@ pub static HALF_IRRADIANCE_KNOB: Knob = Knob {
 pub static HALF_GATHER_KNOB: Knob = Knob {
     flag: "--half-gather",
     help: "Layered media: multiple scattering gathered once per 2x2 block and upsampled by \
-           material and depth (cheaper; a coarser mottling than the full gather's grain).",
+           material and depth (cheaper; a coarse mottling where the full gather, resolved over \
+           3x3 pixels, shows no grain).",
     takes: Takes::Switch,
     default: None,
     apply: |k, _| k.layered.half_gather = true,

@@ -327,9 +327,16 @@ pub fn layered_passes(
     pass.finish();
 
     if !knobs.half_gather {
-        let mut pass = layered_pass(graph, Kind::Single, inputs, 1, None, None, scene);
-        pass.color_add(&mut hdr, LoadOp::Load);
-        pass.finish();
+        // Full-resolution gather: the term per pixel (alpha: its material), rotated by one of
+        // nine angles per 3x3 block; single scattering then adds its own terms and the term
+        // averaged over 3x3 pixels (glsl/common/layered_upsample.glsl): no grain in a still.
+        let mut term = graph.create_image(
+            "layered.multiple",
+            ImageInfo {
+                format: IRRADIANCE_FORMAT,
+                ..info
+            },
+        );
         let mut pass = layered_pass(
             graph,
             Kind::Multiple,
@@ -339,6 +346,10 @@ pub fn layered_passes(
             None,
             scene,
         );
+        // Cleared: pixels outside the rectangles read material 0, which the resolve skips.
+        pass.color(&mut term, LoadOp::Clear([0.0; 4]));
+        pass.finish();
+        let mut pass = layered_pass(graph, Kind::Single, inputs, 1, None, Some(&term), scene);
         pass.color_add(&mut hdr, LoadOp::Load);
         pass.finish();
         return hdr;
@@ -398,6 +409,11 @@ fn layered_pass<'g>(
     scene: Option<&Arc<SceneGpu>>,
 ) -> FullscreenPass<'g> {
     let single = kind == Kind::Single;
+    // The multiple-scattering term single scattering reads is at full resolution unless it
+    // was gathered at half (its image is then half the depth's width).
+    let half_gather = half_term.is_some_and(|h| {
+        graph.resources()[h.id()].info.width != graph.resources()[inputs.depth.id()].info.width
+    });
     let mut pass = FullscreenPass::new(graph, kind.name(), kind.fragment(), scene);
     pass.per_frame(&FRAME)
         .per_frame(&TABLE_REGION)
@@ -428,6 +444,9 @@ fn layered_pass<'g>(
     if let (true, Some(half_term)) = (single, half_term) {
         pass.binding_define("LUCENT_HALF_TERM_BINDING")
             .bind_sampled(half_term, vk::Filter::NEAREST);
+        if scale == 1 && !half_gather {
+            pass.define("LUCENT_FULL_RES_TERM", "1");
+        }
     }
     if let Some(depths) = layer_depths {
         pass.define(
@@ -526,6 +545,8 @@ struct LayeredShape {
     half_res: bool,
     irradiance: bool,
     half_term: bool,
+    /// The term single scattering reads is at full resolution (resolved over 3x3 pixels).
+    full_res_term: bool,
     /// The G-buffer's `TexDep` texels, of this many depth textures.
     layer_depths: Option<usize>,
     shadows: bool,
@@ -545,6 +566,9 @@ impl LayeredShape {
         if single && self.half_term {
             defines.push(("LUCENT_HALF_TERM_BINDING", NUMBERS[next]));
             next += 1;
+            if self.full_res_term && !self.half_res {
+                defines.push(("LUCENT_FULL_RES_TERM", "1"));
+            }
         }
         let texdep = single && self.layer_depths.is_some();
         if let (true, Some(textures)) = (texdep, self.layer_depths) {
@@ -578,14 +602,19 @@ impl LayeredShape {
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
 fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for kind in Kind::ALL {
-        for flags in 0u32..1 << 6 {
+        for flags in 0u32..1 << 7 {
             let bit = |i: u32| flags & (1 << i) != 0;
+            // The full-resolution term only tells a single scattering pass that reads one apart.
+            if bit(6) && !(kind == Kind::Single && bit(2) && !bit(0)) {
+                continue;
+            }
             for layer_depths in [None, Some(1), Some(2)] {
                 let shape = LayeredShape {
                     kind,
                     half_res: bit(0),
                     irradiance: bit(1),
                     half_term: bit(2),
+                    full_res_term: bit(6),
                     layer_depths,
                     shadows: bit(3),
                     entry: bit(4),
@@ -674,7 +703,7 @@ mod tests {
             format: IRRADIANCE_FORMAT,
         };
         for kind in Kind::ALL {
-            for flags in 0u32..1 << 6 {
+            for flags in 0u32..1 << 7 {
                 let bit = |i: u32| flags & (1 << i) != 0;
                 for textures in 0..=2 {
                     let mut graph = RenderGraph::new();
@@ -688,7 +717,12 @@ mod tests {
                         layer_depths: bit(5).then(|| image("entry depths")),
                     });
                     let irradiance = bit(1).then(|| image("irradiance"));
-                    let half_term = bit(2).then(|| image("half term"));
+                    // Bit 6: the term at full resolution (else half the depth's width).
+                    let term_info = ImageInfo {
+                        width: if bit(6) { 8 } else { 4 },
+                        ..info
+                    };
+                    let half_term = bit(2).then(|| graph.create_image("term", term_info));
                     let inputs = LayeredInputs {
                         depth: &depth,
                         gb1: &gb1,
@@ -712,6 +746,7 @@ mod tests {
                         half_res: bit(0),
                         irradiance: bit(1),
                         half_term: bit(2),
+                        full_res_term: bit(6),
                         layer_depths: (textures > 0).then_some(textures),
                         shadows: bit(3),
                         entry: bit(4),

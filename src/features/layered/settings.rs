@@ -47,8 +47,9 @@ pub struct LayeredKnobs {
     /// Multiple scattering gathered at half resolution per side (one gather per 2x2 block),
     /// brought back by a material- and depth-aware upsample in the single scattering pass.
     /// Cheaper and, by the error metric, closer to the reference (the upsample averages four
-    /// differently rotated gathers), but the gather's noise becomes a coarser mottling than
-    /// the full-resolution gather's fine grain (docs/layered.md): off by default.
+    /// differently rotated gathers), but the gather's noise becomes a coarse mottling, where
+    /// the full-resolution gather (nine rotations per 3x3 block, resolved by single
+    /// scattering) shows no grain (docs/layered.md): off by default.
     pub half_gather: bool,
     /// Single scattering's depth `D_max` in mean free paths of the first layer's clearest
     /// channel (> 0; default 4: beyond, `e^-4` of the light is left to multiple scattering).

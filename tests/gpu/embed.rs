@@ -168,6 +168,10 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             Technique::Only(&lucent::features::sss::control::CONTROL),
             blur(&lucent::features::sss::control::CONTROL),
         ),
+        (
+            Technique::Only(&lucent::features::sss::burley::BURLEY),
+            blur(&lucent::features::sss::burley::BURLEY),
+        ),
     ] {
         // lucent's own frame, keeping what a host's lighting would have made.
         let settings = FrameSettings {

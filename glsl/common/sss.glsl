@@ -14,8 +14,13 @@ struct SssStep {
     vec4 weight;  // rgb: the completed Gaussian's weight in the sum; a: their mean
 };
 
-layout(std140, set = 0, binding = 1) uniform SssProfiles {
-    vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count; z: Gaussian count
+// The lighting pass reads the table at a binding of its own (LUCENT_SSS_PROFILES_BINDING).
+#ifndef LUCENT_SSS_PROFILES_BINDING
+#define LUCENT_SSS_PROFILES_BINDING 1
+#endif
+layout(std140, set = 0, binding = LUCENT_SSS_PROFILES_BINDING) uniform SssProfiles {
+    vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count; z: Gaussian count;
+                                  // w: texturing (sss_albedo_before)
     SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
     // The whole profile's 1-D form in world units: rgb = weight / sqrt(2 pi v), a = 1 / (2 v).
     vec4 gaussians[MAX_SSS_PROFILES * MAX_SSS_STEPS];
@@ -29,6 +34,25 @@ int sss_profile_id(float stored) {
 // Whether profile `id` is blurred by chain `chain` (0 never is).
 bool sss_in_chain(int id, int chain) {
     return id > 0 && int(sss_profiles.info[id].x + 0.5) == chain;
+}
+
+// Where profile `id`'s albedo meets the blur (src/scene/material.rs `Texturing`, info.w):
+// 0 pre (in the blurred light), 1 post (after the blur), 2 pre-post (its square root before
+// and after). ID 0's row is zero: a pixel that does not scatter keeps its albedo in its light.
+int sss_texturing(int id) {
+    return int(sss_profiles.info[id].w + 0.5);
+}
+
+// The albedo's factor in the light the lighting pass writes for the blur to diffuse.
+vec3 sss_albedo_before(int id, vec3 albedo) {
+    int mode = sss_texturing(id);
+    return mode == 1 ? vec3(1.0) : (mode == 2 ? sqrt(max(albedo, vec3(0.0))) : albedo);
+}
+
+// The albedo's factor that multiplies the diffused light when the chain composes it.
+vec3 sss_albedo_after(int id, vec3 albedo) {
+    int mode = sss_texturing(id);
+    return mode == 1 ? albedo : (mode == 2 ? sqrt(max(albedo, vec3(0.0))) : vec3(1.0));
 }
 
 SssStep sss_step(int id, int step) {

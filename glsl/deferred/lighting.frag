@@ -9,6 +9,8 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_FAULT_INJECTION
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_SSS_TEXTURING=4
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=6 LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
 // permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
@@ -31,6 +33,13 @@
 #ifdef LUCENT_SHADOWS
 #include "../common/shadows.glsl"
 #endif
+#ifdef LUCENT_SSS_TEXTURING
+// SSS materials whose albedo is applied after the blur (`Texturing`): the pixel's profile ID
+// (binding LUCENT_SSS_TEXTURING, an input attachment after GB2's) and the profile table
+// (the next binding) say how much of the albedo goes into the diffuse light.
+#define LUCENT_SSS_PROFILES_BINDING (LUCENT_SSS_TEXTURING + 1)
+#include "../common/sss.glsl"
+#endif
 
 // How much of light `i` reaches the pixel: x reflected, y transmitted through `material`.
 vec2 light_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, int material) {
@@ -46,6 +55,15 @@ layout(input_attachment_index = 1, set = 0, binding = 2) uniform subpassInput gb
 layout(input_attachment_index = 2, set = 0, binding = 3) uniform subpassInput depth;
 #ifdef LUCENT_TRANSLUCENCY
 layout(input_attachment_index = 3, set = 0, binding = 4) uniform subpassInput gb2;
+#endif
+#ifdef LUCENT_SSS_TEXTURING
+#ifdef LUCENT_TRANSLUCENCY
+layout(input_attachment_index = 4, set = 0, binding = LUCENT_SSS_TEXTURING)
+    uniform subpassInput profile_ids;
+#else
+layout(input_attachment_index = 3, set = 0, binding = LUCENT_SSS_TEXTURING)
+    uniform subpassInput profile_ids;
+#endif
 #endif
 
 layout(location = 0) in vec2 in_uv;
@@ -71,6 +89,11 @@ void main() {
         return;
     }
     Surface s = unpack_gbuffer(subpassLoad(gb0), subpassLoad(gb1));
+#ifdef LUCENT_SSS_TEXTURING
+    // The diffuse light carries only the part of the albedo the profile applies before the
+    // blur; the chain's last pass multiplies in the rest (glsl/common/sss.glsl).
+    s.albedo = sss_albedo_before(sss_profile_id(subpassLoad(profile_ids).r), s.albedo);
+#endif
     vec3 pos = world_position(gl_FragCoord.xy, d);
     vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
     vec3 color = ambient_radiance(s.normal) * s.albedo;

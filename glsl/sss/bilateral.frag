@@ -4,6 +4,7 @@
 // permutation: LUCENT_SSS_SAMPLES=11 LUCENT_SSS_VERTICAL
 // permutation: LUCENT_SSS_SAMPLES=25 LUCENT_SSS_VERTICAL LUCENT_SSS_PASSTHROUGH LUCENT_SSS_BASE
 // permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SSS_PROFILE_EDGES
+// permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
 // The bilateral SSS blur (the LEAN-mapping SSS thesis's idea in two passes), one direction per
 // pass (see two_pass_kernel.glsl): LUCENT_SSS_SAMPLES point taps at whole texels evenly over
@@ -103,6 +104,10 @@ void main() {
     if (scatters) {
         vec4 gb0 = texelFetch(albedo_tex, px, 0);
         vec4 gb1 = texelFetch(normal_tex, px, 0);
+#ifdef LUCENT_SSS_ALBEDO
+        // The albedo the lighting pass left out of the light (glsl/common/sss.glsl).
+        blurred *= sss_albedo_after(id, gb0.rgb);
+#endif
         color = blurred + lean_final_specular(gl_FragCoord.xy, device_depth,
                                               vec2(blurred_slope_x, blurred_lean.x),
                                               blurred_lean.yzw, gb1.a, gb0.a);

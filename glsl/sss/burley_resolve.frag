@@ -2,6 +2,7 @@
 // permutation:
 // permutation: LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES
+// permutation: LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_PASSTHROUGH
 // The resolve pass of 2-D Burley SSS (src/features/sss/burley.rs): each scattering pixel's
 // diffused light averaged with its 3x3 neighbours of the same profile at a similar depth
@@ -28,6 +29,14 @@ layout(set = 0, binding = 5) uniform sampler2D diffuse_tex;   // lit diffuse
 layout(set = 0, binding = 6) uniform sampler2D specular_tex;  // lit specular
 #ifdef LUCENT_SSS_BASE
 layout(set = 0, binding = 7) uniform sampler2D base_tex;      // the previous chain's result
+#endif
+#ifdef LUCENT_SSS_ALBEDO
+// GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = 8) uniform sampler2D albedo_tex;
+#else
+layout(set = 0, binding = 7) uniform sampler2D albedo_tex;
+#endif
 #endif
 
 layout(push_constant) uniform Blur {
@@ -72,6 +81,9 @@ void main() {
         }
         // The pixel itself always counts (a scattering pixel's gathered depth is positive).
         vec3 diffused = count > 0.0 ? sum / count : texelFetch(diffuse_tex, px, 0).rgb;
+#ifdef LUCENT_SSS_ALBEDO
+        diffused *= sss_albedo_after(id, texelFetch(albedo_tex, px, 0).rgb);
+#endif
         color = diffused + texelFetch(specular_tex, px, 0).rgb;
     } else {
 #ifdef LUCENT_SSS_BASE

@@ -1,5 +1,6 @@
 #version 450
 // permutation: LUCENT_SSS_BASE
+// permutation: LUCENT_SSS_BASE LUCENT_SSS_ALBEDO
 // Screen-space SSS, the control chain's final composite: on the pixels of this chain's
 // profiles the sum of Gaussians plus the specular the blur kept out; elsewhere the previous
 // chain's result (LUCENT_SSS_BASE, frames with several chains) or the lit diffuse + specular.
@@ -12,6 +13,14 @@ layout(set = 0, binding = 4) uniform sampler2D specular_tex;
 layout(set = 0, binding = 5) uniform sampler2D profile_tex;
 #ifdef LUCENT_SSS_BASE
 layout(set = 0, binding = 6) uniform sampler2D base_tex;
+#endif
+#ifdef LUCENT_SSS_ALBEDO
+// GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = 7) uniform sampler2D albedo_tex;
+#else
+layout(set = 0, binding = 6) uniform sampler2D albedo_tex;
+#endif
 #endif
 
 layout(push_constant) uniform Chain {
@@ -26,7 +35,11 @@ void main() {
     int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
     vec3 color;
     if (sss_in_chain(id, int(chain.step.w + 0.5))) {
-        color = texelFetch(sum_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb;
+        vec3 diffused = texelFetch(sum_tex, px, 0).rgb;
+#ifdef LUCENT_SSS_ALBEDO
+        diffused *= sss_albedo_after(id, texelFetch(albedo_tex, px, 0).rgb);
+#endif
+        color = diffused + texelFetch(specular_tex, px, 0).rgb;
     } else {
 #ifdef LUCENT_SSS_BASE
         color = texelFetch(base_tex, px, 0).rgb;

@@ -1,6 +1,7 @@
 #version 450
 // permutation: LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SSS_BASE
+// permutation: LUCENT_SSS_BASE LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
 // LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): on the pixels
@@ -36,9 +37,10 @@ void main() {
 #ifdef LUCENT_SSS_PASSTHROUGH
     // Drawn on the screen rectangles no object of this chain can touch.
     bool scatters = false;
+    int id = 0;
 #else
-    bool scatters = sss_in_chain(sss_profile_id(texelFetch(profile_tex, px, 0).r),
-                                 int(chain.step.w + 0.5));
+    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    bool scatters = sss_in_chain(id, int(chain.step.w + 0.5));
 #endif
     vec3 color;
     if (scatters) {
@@ -49,7 +51,12 @@ void main() {
         float d = texelFetch(depth_tex, px, 0).r;
         vec3 specular =
             lean_final_specular(gl_FragCoord.xy, d, vec2(s0.a, s1.x), s1.yzw, gb1.a, gb0.a);
-        color = s0.rgb + specular;
+        vec3 diffused = s0.rgb;
+#ifdef LUCENT_SSS_ALBEDO
+        // The albedo the lighting pass left out of the light (glsl/common/sss.glsl).
+        diffused *= sss_albedo_after(id, gb0.rgb);
+#endif
+        color = diffused + specular;
     } else {
 #ifdef LUCENT_SSS_BASE
         color = texelFetch(base_tex, px, 0).rgb;

@@ -3,6 +3,8 @@
 // permutation: LUCENT_SSS_VERTICAL
 // permutation: LUCENT_SSS_VERTICAL LUCENT_SSS_PASSTHROUGH
 // permutation: LUCENT_SSS_VERTICAL LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES
+// permutation: LUCENT_SSS_VERTICAL LUCENT_SSS_BASE LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ALBEDO
+// permutation: LUCENT_SSS_VERTICAL LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_HALF_RES
 // permutation: LUCENT_SSS_POINT_TAPS LUCENT_SSS_DEPTH_IN_ALPHA
 // permutation: LUCENT_SSS_POINT_TAPS LUCENT_SSS_VERTICAL
@@ -25,6 +27,14 @@ layout(set = 0, binding = IMAGE0 + 3) uniform sampler2D diffuse_tex;  // unblurr
 layout(set = 0, binding = IMAGE0 + 4) uniform sampler2D specular_tex;
 #ifdef LUCENT_SSS_BASE
 layout(set = 0, binding = IMAGE0 + 5) uniform sampler2D base_tex;     // the previous chain's
+#endif
+#ifdef LUCENT_SSS_ALBEDO
+// GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = IMAGE0 + 6) uniform sampler2D albedo_tex;
+#else
+layout(set = 0, binding = IMAGE0 + 5) uniform sampler2D albedo_tex;
+#endif
 #endif
 #endif
 
@@ -124,6 +134,9 @@ void main() {
 #ifdef LUCENT_SSS_COMPOSE
     vec3 color;
     if (scatters) {
+#ifdef LUCENT_SSS_ALBEDO
+        blurred *= sss_albedo_after(id, texelFetch(albedo_tex, px, 0).rgb);
+#endif
         color = blurred + texelFetch(specular_tex, px, 0).rgb;
     } else {
 #ifdef LUCENT_SSS_BASE

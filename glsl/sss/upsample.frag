@@ -1,5 +1,6 @@
 #version 450
 // permutation: LUCENT_SSS_BASE
+// permutation: LUCENT_SSS_BASE LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_PASSTHROUGH
 // The separable blur at half resolution, composed at full resolution (src/features/sss/
 // two_pass.rs): on the chain's pixels the blurred light from the four nearest half-resolution
@@ -18,6 +19,14 @@ layout(set = 0, binding = 6) uniform sampler2D diffuse_tex;
 layout(set = 0, binding = 7) uniform sampler2D specular_tex;
 #ifdef LUCENT_SSS_BASE
 layout(set = 0, binding = 8) uniform sampler2D base_tex;
+#endif
+#ifdef LUCENT_SSS_ALBEDO
+// GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
+#ifdef LUCENT_SSS_BASE
+layout(set = 0, binding = 9) uniform sampler2D albedo_tex;
+#else
+layout(set = 0, binding = 8) uniform sampler2D albedo_tex;
+#endif
 #endif
 
 layout(push_constant) uniform Chain {
@@ -70,6 +79,9 @@ void main() {
         }
         // Every neighbour across an edge (a one-pixel sliver): the nearest in depth.
         vec3 blurred = total > 1e-4 ? sum / total : nearest;
+#ifdef LUCENT_SSS_ALBEDO
+        blurred *= sss_albedo_after(id, texelFetch(albedo_tex, px, 0).rgb);
+#endif
         color = blurred + texelFetch(specular_tex, px, 0).rgb;
     } else {
 #ifdef LUCENT_SSS_BASE

@@ -40,7 +40,7 @@ use crate::gpu_scene::{FrameUniforms, SceneGpu, SceneUpload, SlotTiles, FRAME};
 use crate::graph::{
     Executable, Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
-use crate::scene::material::SssProfile;
+use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::{Camera, Scene};
 use crate::{LucentError, Result};
 
@@ -53,7 +53,9 @@ pub struct PostProcessDesc {
     pub height: u32,
     /// The profiles, by ID: pixels with ID `k` are blurred with `profiles[k - 1]` and its
     /// blur ([`SssProfile::blur`]: the control, separable or bilateral; LCB and LBB blur the
-    /// G-buffer's LEAN data, which a host's lit image does not carry). 1 to 31 profiles.
+    /// G-buffer's LEAN data, which a host's lit image does not carry). 1 to 31 profiles. Their
+    /// [`SssProfile::texturing`] must be [`Texturing::Pre`]: the host's diffuse light already
+    /// holds its albedo, so the blur diffuses it with the light.
     pub profiles: Vec<SssProfile>,
     /// The blurs' knobs (samples, kernel shape, precision, half resolution...).
     pub knobs: SssKnobs,
@@ -176,6 +178,15 @@ impl PostProcessSss {
                     p.name,
                     blur.name(),
                     usable.join(", ")
+                )));
+            }
+            if p.texturing != Texturing::Pre {
+                return Err(LucentError::InvalidInput(format!(
+                    "post-process SSS: profile '{}' asks for texturing '{}', but a host's lit \
+                     diffuse already carries its albedo, so only 'pre' (the albedo blurred with \
+                     the light) can be honoured here; set `texturing: Texturing::Pre`",
+                    p.name,
+                    p.texturing.name()
                 )));
             }
             profiles.push((p.clone(), blur));
@@ -340,6 +351,8 @@ impl PostProcessSss {
             profile_ids: &profile_ids,
             lean: None,
             shadow_depth: None,
+            // The host's diffuse light carries its albedo (every profile is `Texturing::Pre`).
+            albedo: None,
             // The host's alpha is its own: the taps read the depth buffer.
             depth_in_alpha: false,
         };

@@ -29,7 +29,9 @@ pub enum DebugView {
     /// Material ID (GB2) as a colour, frames with translucency only.
     MaterialId,
     /// The lit frame before the SSS blurs (diffuse + specular, tonemapped), frames with SSS
-    /// only; the ordinary frame is the one after.
+    /// only; the ordinary frame is the one after. It shows what the blurs read: a profile that
+    /// applies its albedo after the blur (`Texturing::Post`, the default) shows its light
+    /// without that albedo.
     LitBeforeSss,
     /// The GDC 2011 translucency term alone (every light, tonemapped), frames with
     /// translucency only.

@@ -75,6 +75,10 @@ pub struct GBufferLayout {
     /// lighting pass writes diffuse and specular to separate targets, so the blur sees diffuse
     /// only.
     pub sss: bool,
+    /// Some SSS profile applies its albedo after the blur (`Texturing::Post` or `PrePost`): the
+    /// lighting pass reads the profile IDs (an input attachment) and the profile table, and
+    /// the SSS chains' last passes multiply the albedo (GB0) back in.
+    pub sss_texturing: bool,
     /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
     /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
     pub lean: bool,
@@ -395,11 +399,11 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
     }
     let mut layouts = Vec::new();
     for &translucency in &translucency {
-        for flags in 0u32..1 << 7 {
+        for flags in 0u32..1 << 8 {
             let bit = |i: u32| flags & (1 << i) != 0;
-            // LEAN and depth-in-alpha are properties of SSS chains
-            // (`FrameDesc::gbuffer_layout`): a frame without SSS has neither.
-            if !bit(0) && (bit(1) || bit(4)) {
+            // LEAN, depth-in-alpha and texturing are properties of SSS chains
+            // (`FrameDesc::gbuffer_layout`): a frame without SSS has none of them.
+            if !bit(0) && (bit(1) || bit(4) || bit(7)) {
                 continue;
             }
             for layer_depth_textures in 0..=2 {
@@ -407,6 +411,7 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
                     precision: GBufferPrecision::Compact,
                     translucency,
                     sss: bit(0),
+                    sss_texturing: bit(7),
                     lean: bit(1),
                     lean_clear: false,
                     normal_maps: bit(2),

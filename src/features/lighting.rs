@@ -16,7 +16,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::backend::shader::PipelineShaders;
-use crate::gpu_scene::{SceneGpu, FRAME};
+use crate::gpu_scene::{Region, SceneGpu, FRAME};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 
 use super::gbuffer::{all_layouts, GBuffer, GBufferLayout};
@@ -37,11 +37,15 @@ pub struct Lit {
 
 /// Declares the lighting pass: reads the G-buffer at the same pixel (and the light-space maps,
 /// when some light casts shadows), writes lit HDR colour (with SSS: diffuse and specular
-/// apart).
+/// apart). When some SSS profile applies its albedo after the blur
+/// (`GBufferLayout::sss_texturing`), it also reads the profile IDs and `sss_profiles`, the
+/// SSS profile table's region (the SSS feature owns it), to leave that albedo out of the
+/// diffuse light.
 pub fn lighting_pass(
     graph: &mut RenderGraph,
     gb: &GBuffer,
     shadows: Option<&ShadowMaps>,
+    sss_profiles: Option<&'static Region>,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Lit {
     let info = graph.resources()[gb.gb0.id()].info;
@@ -75,6 +79,13 @@ pub fn lighting_pass(
         pass.input(gb2)
             .per_frame(&super::translucency::TABLE_REGION);
     }
+    if gb.layout.sss_texturing {
+        // `lighting_defines` numbered these two bindings (LUCENT_SSS_TEXTURING).
+        let (Some(ids), Some(table)) = (&gb.sss, sss_profiles) else {
+            panic!("a frame with SSS texturing has profile IDs and a profile table");
+        };
+        pass.input(ids).per_frame(table);
+    }
     if let Some(maps) = shadows {
         // `lighting_defines` numbered the shadow bindings from here.
         debug_assert_eq!(
@@ -106,10 +117,16 @@ pub fn lighting_pass(
 /// The lighting pass's fragment shader.
 const LIGHTING_FRAGMENT: &str = "deferred/lighting.frag";
 
-/// The lighting pass's descriptor bindings before the shadow bindings
+/// The lighting pass's descriptor bindings before the SSS texturing pair
 /// (glsl/deferred/lighting.frag): 0-3 always, 4 (GB2) and 5 (material table) with translucency.
-fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
+fn lighting_bindings_before_texturing(layout: &GBufferLayout) -> usize {
     4 + 2 * usize::from(layout.translucency.is_some())
+}
+
+/// The lighting pass's descriptor bindings before the shadow bindings: then the profile IDs and
+/// the SSS profile table when some profile applies its albedo after the blur.
+fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
+    lighting_bindings_before_texturing(layout) + 2 * usize::from(layout.sss_texturing)
 }
 
 /// The lighting pass's defines: the plain shader's, and with translucency the extra ones of the
@@ -124,6 +141,15 @@ fn lighting_defines(layout: &GBufferLayout, shadows: Option<bool>) -> (Defines, 
     }
     if layout.sss {
         plain.push(("LUCENT_SPLIT_SPECULAR", "1"));
+    }
+    if layout.sss_texturing {
+        plain.push((
+            "LUCENT_SSS_TEXTURING",
+            match lighting_bindings_before_texturing(layout) {
+                4 => "4",
+                _ => "6",
+            },
+        ));
     }
     if layout.lean {
         plain.push(("LUCENT_LEAN", "1"));

@@ -68,7 +68,13 @@ pub fn declare_frame(
         .as_ref()
         .map(|s| shadows::shadow_pass(graph, s, scene_gpu));
     let gb = gbuffer::gbuffer_pass(graph, settings.width, settings.height, layout, scene_gpu);
-    let lit = lighting::lighting_pass(graph, &gb, shadow_maps.as_ref(), scene_gpu);
+    let lit = lighting::lighting_pass(
+        graph,
+        &gb,
+        shadow_maps.as_ref(),
+        layout.sss_texturing.then_some(&sss::tables::PROFILES),
+        scene_gpu,
+    );
     let display_info = ImageInfo {
         width: settings.width,
         height: settings.height,
@@ -118,6 +124,7 @@ pub fn declare_frame(
                     gb1: &gb.gb1,
                 }),
                 shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
+                albedo: layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: profiles.depth_in_alpha(),
             },
             profiles,

@@ -19,6 +19,7 @@ use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
 use crate::features::translucency::{MaterialTable, ThicknessPacking};
 use crate::gpu_scene::{SceneUpload, TableRegion};
+use crate::scene::material::Texturing;
 use crate::scene::Scene;
 use crate::Result;
 
@@ -60,6 +61,7 @@ impl FrameDesc {
                 scene,
                 technique.sss_blur(),
                 settings.sss.gaussians,
+                settings.sss.texturing,
                 &registry::blur_of,
             )?
         } else {
@@ -132,6 +134,11 @@ impl FrameDesc {
                 single_material: t.table.rows.len() == 1,
             }),
             sss: self.sss.is_some(),
+            sss_texturing: self.sss.as_ref().is_some_and(|p| {
+                p.profiles
+                    .iter()
+                    .any(|(profile, _)| profile.texturing != Texturing::Pre)
+            }),
             lean: self.lean(),
             // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
             lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),

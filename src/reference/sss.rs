@@ -8,7 +8,9 @@
 //! `E_q` its lit diffuse (ambient + Lambert, as the lighting pass computes it) and
 //! `R(r) = sum_i w_i G(v_i, r)` the profile with `r` in millimetres. The normalisation keeps
 //! energy, as the blurs' normalised weights do; specular is added unblurred. Non-scattering
-//! pixels keep their lighting. Cost is quadratic in scattering pixels: use small frames.
+//! pixels keep their lighting. The albedo `a` enters as the profile's texturing says
+//! ([`Texturing`]): `E_q` carries `before(a_q)` and the result is multiplied by `after(a_p)`.
+//! Cost is quadratic in scattering pixels: use small frames.
 
 use glam::{DMat3, DVec2};
 
@@ -16,7 +18,7 @@ use super::lighting::{light_incidence, radiance, shade_direct_split, shininess};
 use super::{gbuffer_pixels, DVec3};
 use crate::frame::GBufferReadback;
 use crate::scene::lean::covariance_of;
-use crate::scene::material::SssProfile;
+use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::profile::{burley_cdf, burley_profile, normalized_weights};
 use crate::scene::Scene;
 
@@ -25,7 +27,10 @@ struct SurfacePixel {
     index: usize,
     position: DVec3,
     area: f64,
+    /// Lit diffuse with the part of the albedo applied before the blur.
     diffuse: DVec3,
+    /// The part applied after it.
+    albedo_after: DVec3,
 }
 
 /// Smallest view-space n.z (relative to |n|) a slope is taken from (glsl/common/lean.glsl).
@@ -185,10 +190,12 @@ pub enum ReferenceSpecular {
 /// Every pixel's shading as the lighting pass computes it: the non-scattering pixels' whole
 /// light and the scattering pixels' specular in the image, their diffuse apart (in world
 /// space) for a profile to convolve.
+/// The scattering pixels' albedo enters as `texturing` says.
 fn shaded(
     scene: &Scene,
     gbuffer: &GBufferReadback,
     specular: ReferenceSpecular,
+    texturing: Texturing,
 ) -> (Vec<DVec3>, Vec<SurfacePixel>) {
     let view = DMat3::from_mat4(scene.camera.view().as_dmat4());
     let eye = scene.camera.eye.as_dvec3();
@@ -203,15 +210,25 @@ fn shaded(
             continue;
         };
         let to_eye = (eye - p.position).normalize();
+        let scatters = strength.get(i).is_some_and(|&s| s > 0.0);
+        // A scattering pixel's light carries only the albedo's part before the blur.
+        let albedo = p.material.albedo.as_dvec3();
+        let mut material = p.material.clone();
+        let apply = |f: fn(Texturing, f64) -> f64| albedo.to_array().map(|a| f(texturing, a));
+        let albedo_after = if scatters {
+            material.albedo = DVec3::from(apply(Texturing::before)).as_vec3();
+            DVec3::from(apply(Texturing::after))
+        } else {
+            DVec3::ONE
+        };
         let mut diffuse =
-            scene.environment.ambient_radiance(p.normal) * p.material.albedo.as_dvec3();
+            scene.environment.ambient_radiance(p.normal) * material.albedo.as_dvec3();
         let mut blinn_phong = DVec3::ZERO;
         for light in &scene.lights {
-            let (d, s) = shade_direct_split(&p.material, p.normal, p.position, to_eye, light);
+            let (d, s) = shade_direct_split(&material, p.normal, p.position, to_eye, light);
             diffuse += d;
             blinn_phong += s;
         }
-        let scatters = strength.get(i).is_some_and(|&s| s > 0.0);
         out[i] += match (specular, gbuffer.lean.as_ref()) {
             (ReferenceSpecular::Lean, Some(lean)) if scatters => {
                 let [by, mxx, myy, mxy] = lean[i].map(f64::from);
@@ -238,6 +255,7 @@ fn shaded(
                 position: p.position,
                 area: (distance / focal).powi(2) / cos,
                 diffuse,
+                albedo_after,
             });
         } else {
             out[i] += diffuse;
@@ -252,7 +270,7 @@ pub fn reference_image(
     profile: &SssProfile,
     specular: ReferenceSpecular,
 ) -> Vec<DVec3> {
-    let (mut out, scattering) = shaded(scene, gbuffer, specular);
+    let (mut out, scattering) = shaded(scene, gbuffer, specular, profile.texturing);
     let mm_per_unit = 1.0 / f64::from(profile.units_per_mm).max(1e-12);
     // Each Gaussian is convolved and normalised on its own, then weighted: a Gaussian narrower
     // than a pixel then keeps its light in the pixel (point-sampling it at its peak and
@@ -281,7 +299,7 @@ pub fn reference_image(
             .fold(DVec3::ZERO, |acc, ((sum, k), w)| {
                 acc + *w * (*sum / k.max(1e-300))
             });
-        out[p.index] += blurred;
+        out[p.index] += p.albedo_after * blurred;
     }
     out
 }
@@ -292,14 +310,16 @@ pub fn reference_image(
 /// scattering pixels, with `K = R(|x_p - x_q|) A_q` for `q != p` and, for the pixel itself
 /// (where `R` is infinite but integrable), the profile's energy within a disc of the pixel's
 /// area, `P(sqrt(A_p / pi))`. Specular is added unblurred; other pixels keep their lighting.
+/// The albedo enters as `texturing` says.
 pub fn burley_reference_image(
     scene: &Scene,
     gbuffer: &GBufferReadback,
     d_mm: DVec3,
     units_per_mm: f64,
     specular: ReferenceSpecular,
+    texturing: Texturing,
 ) -> Vec<DVec3> {
-    let (mut out, scattering) = shaded(scene, gbuffer, specular);
+    let (mut out, scattering) = shaded(scene, gbuffer, specular, texturing);
     let mm_per_unit = 1.0 / units_per_mm.max(1e-12);
     let area_mm2 = mm_per_unit * mm_per_unit;
     for p in &scattering {
@@ -324,7 +344,7 @@ pub fn burley_reference_image(
             weights += k;
         }
         // The pixel's own term is > 0 (its area is), so no weight sum is 0.
-        out[p.index] += sum / weights.max(DVec3::splat(1e-300));
+        out[p.index] += p.albedo_after * (sum / weights.max(DVec3::splat(1e-300)));
     }
     out
 }

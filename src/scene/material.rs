@@ -150,6 +150,79 @@ pub struct SssProfile {
     /// (`[material.sss] scattering_distance` or `mean_free_path`); `None`: the Burley blur
     /// matches the Gaussians' second moment (the other blurs always read the Gaussians).
     pub burley: Option<BurleyDistance>,
+    /// Where the surface albedo meets the scattered light (`[material.sss] texturing`).
+    pub texturing: Texturing,
+}
+
+/// Where a screen-space SSS material's albedo (its texture included) is applied relative to
+/// the blur. Light that scatters under a surface crosses it on the way in and on the way out,
+/// so a texture's detail belongs outside the blur, not smeared by it (HDRP's "post-scatter"
+/// and "pre- and post-scatter" texturing modes; UE and EEVEE multiply after).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Texturing {
+    /// The albedo is in the light the blur diffuses (lucent's behaviour before this mode
+    /// existed; kept to measure what the other two change): textures are blurred away.
+    Pre,
+    /// The blur diffuses light without albedo; the pixel's own albedo multiplies the result:
+    /// textures stay as sharp as under plain lighting. The default: the only mode that keeps
+    /// `showcase-marble`'s veins at the contrast plain lighting gives them (docs/sss.md,
+    /// "Albedo after the scatter", has the measurements).
+    #[default]
+    Post,
+    /// The square root of the albedo before the blur and after it (HDRP's default): some of
+    /// the neighbours' colour bleeds in (light entered through them), half the pixel's own
+    /// detail stays.
+    PrePost,
+}
+
+impl Texturing {
+    /// Every mode with its scene-file and command-line name.
+    pub const ALL: [(&'static str, Texturing); 3] = [
+        ("pre", Texturing::Pre),
+        ("post", Texturing::Post),
+        ("pre-post", Texturing::PrePost),
+    ];
+
+    /// The mode named `name` (scene files, `--sss-texturing`).
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    }
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, t)| *t == self)
+            .map_or("post", |(n, _)| n)
+    }
+
+    /// The shaders' code for it (glsl/common/sss.glsl `sss_albedo_*`): 0 pre, 1 post,
+    /// 2 pre-post.
+    pub fn code(self) -> f32 {
+        match self {
+            Texturing::Pre => 0.0,
+            Texturing::Post => 1.0,
+            Texturing::PrePost => 2.0,
+        }
+    }
+
+    /// The factor of the albedo `a` in the light the blur diffuses.
+    pub fn before(self, a: f64) -> f64 {
+        match self {
+            Texturing::Pre => a,
+            Texturing::Post => 1.0,
+            Texturing::PrePost => a.max(0.0).sqrt(),
+        }
+    }
+
+    /// The factor of the albedo `a` that multiplies the blurred light.
+    pub fn after(self, a: f64) -> f64 {
+        match self {
+            Texturing::Pre => 1.0,
+            Texturing::Post => a,
+            Texturing::PrePost => a.max(0.0).sqrt(),
+        }
+    }
 }
 
 /// How a material gives Burley's per-channel shape parameter `d` (mm): directly, as HDRP's
@@ -266,6 +339,7 @@ impl SssProfile {
             units_per_mm: 0.01,
             blur: None,
             burley: None,
+            texturing: Texturing::default(),
         })
     }
 

@@ -162,6 +162,7 @@ pub fn fit_profile(profile: &SssProfile, n: usize) -> Result<(SssProfile, [f64; 
         units_per_mm: profile.units_per_mm,
         blur: profile.blur.clone(),
         burley: profile.burley,
+        texturing: profile.texturing,
     };
     Ok((refit, errors))
 }

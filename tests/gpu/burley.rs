@@ -73,6 +73,7 @@ fn errors(test: &TestGpu, name: &str, budget: Option<u32>) -> (f64, f64) {
         d,
         f64::from(profile.units_per_mm),
         ReferenceSpecular::BlinnPhong,
+        profile.texturing,
     );
     let strength = gbuffer.sss.as_ref().unwrap();
     let e_burley = interior_error(frame.hdr.as_ref().unwrap(), &reference, strength);

@@ -122,10 +122,12 @@ fn pre_blur_view_is_the_unblurred_lighting_and_the_blur_changes_it() {
     let test = TestGpu::new();
     // `edges`: a skin profile four times as wide, so the blur reaches over several pixels.
     let edges = lucent::bake::scene::load_scene_baked("edges").unwrap();
-    let base = FrameSettings {
+    let mut base = FrameSettings {
         technique: Technique::Only(&lucent::features::sss::control::CONTROL),
         ..FrameSettings::new(320, 240)
     };
+    // The view shows the light the blur reads: with the albedo in it, that is the plain frame.
+    base.sss.texturing = Some(lucent::scene::material::Texturing::Pre);
     let (after, gb) = frame(&test, &edges, base);
     let (before, _) = frame(
         &test,

@@ -22,6 +22,7 @@ use lucent::features::sss::SssProfiles;
 use lucent::frame::{FrameSettings, Renderer, Technique};
 use lucent::images::compare::{flip_rgba8, FlipThresholds};
 use lucent::images::output::{read_png_rgba8, write_png_rgba8};
+use lucent::scene::material::Texturing;
 use lucent::LucentError;
 
 /// The example binary `cargo test` built beside this test's (target/<profile>/examples).
@@ -181,6 +182,9 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             export_lit: true,
             ..FrameSettings::new(w, h)
         };
+        // A host's lit diffuse carries its albedo: the post-process blurs it with the light.
+        let mut settings = settings;
+        settings.sss.texturing = Some(Texturing::Pre);
         let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
         let images = renderer.render_once(gpu).unwrap();
         let lit = renderer.read_lit(gpu).unwrap();
@@ -247,6 +251,7 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             &scene,
             Some(blur),
             None,
+            Some(Texturing::Pre),
             &lucent::features::registry::blur_of,
         )
         .unwrap()
@@ -570,7 +575,10 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() 
     let diffuse_host = described(&colour, "lit diffuse", usage);
     let depth_host = described(&depth, "scene depth", usage);
     let ids_host = described(&ids, "sss mask", usage);
-    let skin = lucent::scene::material::SssProfile::preset("skin").unwrap();
+    let skin = lucent::scene::material::SssProfile {
+        texturing: Texturing::Pre,
+        ..lucent::scene::material::SssProfile::preset("skin").unwrap()
+    };
     let desc = PostProcessDesc {
         width: w,
         height: h,

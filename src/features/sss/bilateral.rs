@@ -18,6 +18,7 @@ pub static BILATERAL: TwoPassChain = TwoPassChain {
         &knobs::GAUSSIANS,
         &knobs::SAMPLES,
         &knobs::KERNEL,
+        &knobs::TEXTURING,
         &knobs::NO_TILES,
     ],
     scene: "teapot",

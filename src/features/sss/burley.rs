@@ -42,7 +42,13 @@ pub static BURLEY: BurleyChain = BurleyChain {
     name: "burley",
     summary: "2-D Burley SSS (HDRP, Unreal, EEVEE): the normalized diffusion profile \
               importance-sampled around each pixel in one pass",
-    knobs: &[&BUDGET, &ROTATION, &FIT, &super::knobs::NO_TILES],
+    knobs: &[
+        &BUDGET,
+        &ROTATION,
+        &FIT,
+        &super::knobs::TEXTURING,
+        &super::knobs::NO_TILES,
+    ],
     scene: "skin",
     published_timing: None,
 };
@@ -188,10 +194,13 @@ fn gather_defines(depth_in_alpha: bool) -> Defines {
 
 /// The resolve pass's defines (`base`: it keeps the previous chain's result; `edges`: the
 /// frame has several profiles), and its pass-through variant's extra one.
-fn resolve_defines(base: bool, edges: bool) -> (Defines, Defines) {
+fn resolve_defines(base: bool, edges: bool, albedo: bool) -> (Defines, Defines) {
     let mut defines = Vec::new();
     if base {
         defines.push(("LUCENT_SSS_BASE", "1"));
+    }
+    if albedo {
+        defines.push(("LUCENT_SSS_ALBEDO", "1"));
     }
     if edges {
         defines.push(("LUCENT_SSS_PROFILE_EDGES", "1"));
@@ -207,8 +216,9 @@ fn shader_permutations(_: &BurleyChain, out: &mut Vec<PipelineShaders>) {
             &gather_defines(depth_in_alpha),
         ));
     }
-    for (base, edges) in [(false, false), (false, true), (true, false), (true, true)] {
-        let (defines, passthrough) = resolve_defines(base, edges);
+    for flags in 0u32..1 << 3 {
+        let bit = |i: u32| flags & (1 << i) != 0;
+        let (defines, passthrough) = resolve_defines(bit(0), bit(1), bit(2));
         out.push(PipelineShaders::fullscreen(RESOLVE_FRAGMENT, &defines));
         let mut all = defines.clone();
         all.extend(passthrough);
@@ -298,13 +308,16 @@ impl SssBlurTechnique for BurleyChain {
             inputs.specular,
         ];
         reads.extend(base);
+        // The albedo the lighting pass left out of the light, last.
+        reads.extend(inputs.albedo);
         for image in reads {
             pass.sample_with(image, vk::Filter::NEAREST);
         }
         // The centre's profile, then nine gathered texels (and their profile IDs with several
         // profiles), the lit diffuse and specular.
-        pass.taps(1 + 9 * (1 + u32::from(chain.edges)) + 2);
-        let (defines, passthrough) = resolve_defines(base.is_some(), chain.edges);
+        pass.taps(1 + 9 * (1 + u32::from(chain.edges)) + 2 + u32::from(inputs.albedo.is_some()));
+        let (defines, passthrough) =
+            resolve_defines(base.is_some(), chain.edges, inputs.albedo.is_some());
         pass.defines(&defines).variant(passthrough);
         pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
         pass.color(&mut result, LoadOp::DontCare);
@@ -322,7 +335,7 @@ mod tests {
     fn table_holds_each_profile_d_in_world_units() {
         let scene = crate::scene::builtin::builtin("skin").unwrap();
         let blur = registry::blur_of_technique(&BURLEY).unwrap();
-        let profiles = SssProfiles::new(&scene, Some(blur), None, &registry::blur_of)
+        let profiles = SssProfiles::new(&scene, Some(blur), None, None, &registry::blur_of)
             .unwrap()
             .unwrap();
         let knobs = SssKnobs::default();

@@ -16,7 +16,12 @@ pub static CONTROL: IterativeChain = IterativeChain {
               diffuse light, one blur pair per Gaussian",
     lean: false,
     bilateral: false,
-    knobs: &[&knobs::GAUSSIANS, &knobs::PRECISION, &knobs::NO_TILES],
+    knobs: &[
+        &knobs::GAUSSIANS,
+        &knobs::PRECISION,
+        &knobs::TEXTURING,
+        &knobs::NO_TILES,
+    ],
     scene: "skin",
     published_timing: Some(&THESIS_TABLE_2_CONTROL),
 };

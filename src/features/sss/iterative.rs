@@ -178,6 +178,11 @@ pub(super) fn chain_passes(
         reads.extend([inputs.depth, l.gb0, l.gb1]);
     }
     reads.extend(base);
+    // The albedo left out of the light: LCB's and LBB's pass reads GB0 already; the control's
+    // combine reads it last.
+    if let (Some(albedo), None) = (inputs.albedo, lean) {
+        reads.push(albedo);
+    }
     let constants = BlurConstants {
         step: [0.0, 0.0, 0.0, chain.index as f32],
     };
@@ -188,7 +193,12 @@ pub(super) fn chain_passes(
         scene,
         constants,
     );
-    let (defines, passthrough) = final_defines(lean.is_some(), base.is_some(), false);
+    let (defines, passthrough) = final_defines(
+        lean.is_some(),
+        base.is_some(),
+        inputs.albedo.is_some(),
+        false,
+    );
     pass.defines(&defines);
     for h in &reads {
         pass.sample(h);
@@ -308,10 +318,18 @@ fn final_bindings(lean: bool, base: bool) -> usize {
 
 /// The final pass's defines (`lean`: LEAN `final lighting`, else `combine`), and with LEAN the
 /// pass-through variant's extra define. `shadows`: LEAN specular reads the light-space maps.
-fn final_defines(lean: bool, base: bool, shadows: bool) -> (Defines, Option<Defines>) {
+fn final_defines(
+    lean: bool,
+    base: bool,
+    albedo: bool,
+    shadows: bool,
+) -> (Defines, Option<Defines>) {
     let mut defines: Vec<(&str, &str)> = Vec::new();
     if base {
         defines.push(("LUCENT_SSS_BASE", "1"));
+    }
+    if albedo {
+        defines.push(("LUCENT_SSS_ALBEDO", "1"));
     }
     if shadows {
         defines.extend(crate::features::shadows::lighting_defines(final_bindings(
@@ -343,9 +361,9 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
         } else {
             COMBINE_FRAGMENT
         };
-        for base in [false, true] {
+        for (base, albedo) in [(false, false), (false, true), (true, false), (true, true)] {
             for shadows in [false, true] {
-                let (defines, passthrough) = final_defines(lean, base, shadows);
+                let (defines, passthrough) = final_defines(lean, base, albedo, shadows);
                 out.push(PipelineShaders::fullscreen(fragment, &defines));
                 if let Some(extra) = passthrough {
                     let mut all = defines.clone();

@@ -4,6 +4,7 @@
 use super::kernel;
 use super::settings::{SssPrecision, DEFAULT_SENSITIVITY};
 use crate::features::knob::{Given, Knob, Takes};
+use crate::scene::material::Texturing;
 
 /// `--sss-gaussians N`: refit the profile with fewer Gaussians.
 pub static GAUSSIANS: Knob = Knob {
@@ -106,6 +107,18 @@ pub static FILTER: Knob = Knob {
     takes: Takes::Choice(&["point", "bilinear"]),
     default: Some(Given::Choice("point")),
     apply: |k, v| k.sss.point_taps = v.choice() == "point",
+};
+
+/// `--sss-texturing pre|post|pre-post`: where every SSS material's albedo meets the blur.
+pub static TEXTURING: Knob = Knob {
+    flag: "--sss-texturing",
+    help: "Every screen-space SSS material: where its albedo (texture included) is applied: \
+           post (after the blur), pre-post (its square root before and after) or pre (blurred \
+           with the light: textures smear). Default: each material's `texturing` (pre-post \
+           unless it says otherwise).",
+    takes: Takes::Choice(&["pre", "post", "pre-post"]),
+    default: None,
+    apply: |k, v| k.sss.texturing = Texturing::named(v.choice()),
 };
 
 /// `--no-sss-tiles`: every SSS chain over the whole screen.

@@ -21,6 +21,7 @@ pub static LBB: IterativeChain = IterativeChain {
         &knobs::SENSITIVITY,
         &knobs::GAUSSIANS,
         &knobs::PRECISION,
+        &knobs::TEXTURING,
         &knobs::NO_TILES,
     ],
     scene: "teapot",

@@ -13,7 +13,12 @@ pub static LCB: IterativeChain = IterativeChain {
               moments blurred together, LEAN specular on the blurred moments",
     lean: true,
     bilateral: false,
-    knobs: &[&knobs::GAUSSIANS, &knobs::PRECISION, &knobs::NO_TILES],
+    knobs: &[
+        &knobs::GAUSSIANS,
+        &knobs::PRECISION,
+        &knobs::TEXTURING,
+        &knobs::NO_TILES,
+    ],
     scene: "teapot",
     published_timing: Some(&super::lbb::THESIS_TABLE_1_LBB),
 };

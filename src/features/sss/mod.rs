@@ -36,7 +36,7 @@ use ash::vk;
 
 use crate::gpu_scene::{SceneGpu, TableRegion, FRAME};
 use crate::graph::{Handle, Image, RecordContext, RenderGraph};
-use crate::scene::material::SssProfile;
+use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
@@ -254,11 +254,13 @@ pub struct SssProfiles {
 impl SssProfiles {
     /// The profiles `scene`'s SSS materials ask for: each with its own blur (`blur_of` resolves
     /// a profile's, [`super::registry::blur_of`]), or `forced` on all (a named technique);
-    /// refitted to `gaussians` Gaussians when set. `None` when no object scatters.
+    /// refitted to `gaussians` Gaussians when set, and with `texturing` instead of each
+    /// material's own when set (`--sss-texturing`). `None` when no object scatters.
     pub fn new(
         scene: &Scene,
         forced: Option<SssBlur>,
         gaussians: Option<usize>,
+        texturing: Option<Texturing>,
         blur_of: &dyn Fn(&SssProfile) -> Result<SssBlur>,
     ) -> Result<Option<Self>> {
         let mut profiles: Vec<(SssProfile, SssBlur)> = Vec::new();
@@ -272,10 +274,13 @@ impl SssProfiles {
                 Some(blur) => blur,
                 None => blur_of(p)?,
             };
-            let profile = match gaussians {
+            let mut profile = match gaussians {
                 Some(n) => crate::scene::profile::fit_profile(p, n)?.0,
                 None => p.clone(),
             };
+            if let Some(texturing) = texturing {
+                profile.texturing = texturing;
+            }
             let entry = (profile, blur);
             let index = match profiles.iter().position(|e| *e == entry) {
                 Some(i) => i,
@@ -358,7 +363,7 @@ impl SssProfiles {
                 chain as f32,
                 steps.len() as f32,
                 profile.gaussians.len().min(MAX_SSS_STEPS) as f32,
-                0.0,
+                profile.texturing.code(),
             ];
             // The whole profile in world units, for the two-pass bilateral blur's weights: its
             // 1-D form at the tap's distance d, sum_i w_i exp(-d^2 / 2 v_i) / sqrt(2 pi v_i)
@@ -404,7 +409,8 @@ impl SssProfiles {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ProfileTableGpu {
-    /// Per ID: x the chain (index into [`SssProfiles::chains`]), y its step count.
+    /// Per ID: x the chain (index into [`SssProfiles::chains`]), y its step count, z its
+    /// Gaussian count, w its texturing ([`Texturing::code`]).
     pub info: [[f32; 4]; MAX_SSS_PROFILES],
     /// Per ID and step (`id * MAX_SSS_STEPS + step`): `[sigma in world units, depth term, 0,
     /// 0]` and `[weight r, g, b, their mean]`.
@@ -496,6 +502,11 @@ pub struct SssInputs<'a> {
     pub lean: Option<LeanInputs<'a>>,
     /// The light-space maps' depth, when some light casts shadows (LEAN specular is shadowed).
     pub shadow_depth: Option<&'a Handle<Image>>,
+    /// G-buffer albedo (GB0), when some profile applies its albedo after the blur
+    /// ([`Texturing`]): the lighting pass left it out of `diffuse`, and each chain's last pass
+    /// multiplies it back in (define `LUCENT_SSS_ALBEDO`). `None`: the light carries its
+    /// albedo (every profile `Texturing::Pre`, or a host's lit image).
+    pub albedo: Option<&'a Handle<Image>>,
     /// The lit diffuse's alpha holds linear depth for the separable chain's taps (the lighting
     /// pass wrote it: [`SssProfiles::depth_in_alpha`]); otherwise the taps read `depth`.
     pub depth_in_alpha: bool,

@@ -22,6 +22,7 @@ pub static SEPARABLE: TwoPassChain = TwoPassChain {
         &knobs::KERNEL,
         &knobs::HALF_RES,
         &knobs::FILTER,
+        &knobs::TEXTURING,
         &knobs::NO_TILES,
     ],
     scene: "teapot",

@@ -92,6 +92,8 @@ pub struct SssKnobs {
     pub burley_rotation: bool,
     /// The fit of Burley's `s` from the albedo, for materials that give a mean free path.
     pub burley_fit: crate::scene::profile::BurleyFit,
+    /// Every SSS material's texturing mode instead of its own (`--sss-texturing`).
+    pub texturing: Option<crate::scene::material::Texturing>,
 }
 
 impl Default for SssKnobs {
@@ -109,6 +111,7 @@ impl Default for SssKnobs {
             burley_budget: DEFAULT_BURLEY_BUDGET,
             burley_rotation: true,
             burley_fit: crate::scene::profile::BurleyFit::Searchlight,
+            texturing: None,
         }
     }
 }

@@ -51,6 +51,7 @@ pub(super) fn chain_passes(
         _ => None,
     };
     let samples = knobs.samples;
+    let albedo_after = inputs.albedo.is_some();
     // Fetches per pixel of a blur pass, for the benchmark's cost per tap: the centre texels,
     // depth and profile ID, then each sample's texels (and its depth where it does not travel
     // in alpha, and its profile ID with several profiles).
@@ -69,6 +70,7 @@ pub(super) fn chain_passes(
         edges: chain.edges,
         depth_in_alpha: depth_in_alpha || vertical,
         point_taps: knobs.point_taps,
+        albedo: compose && albedo_after,
         samples,
         inputs,
     };
@@ -120,6 +122,10 @@ pub(super) fn chain_passes(
             reads.extend([l.gb0, l.gb1]);
         }
         reads.extend(base);
+        // The albedo left out of the light, read last (the LEAN pass reads GB0 already).
+        if lean.is_none() {
+            reads.extend(inputs.albedo);
+        }
     }
     let mut pass = blur_pass(
         graph,
@@ -151,6 +157,7 @@ pub(super) fn chain_passes(
         inputs.specular,
     ];
     reads.extend(base);
+    reads.extend(inputs.albedo);
     let mut pass = blur_pass(
         graph,
         &format!("{}upsample", chain.prefix),
@@ -223,6 +230,9 @@ struct PassShape {
     edges: bool,
     depth_in_alpha: bool,
     point_taps: bool,
+    /// A composing pass multiplies the albedo the lighting pass left out back in
+    /// (`SssInputs::albedo`).
+    albedo: bool,
     samples: u32,
     /// Images sampled (after the per-frame bindings and the kernel table).
     inputs: usize,
@@ -253,6 +263,9 @@ impl PassShape {
     /// light-space maps), and for composing passes the pass-through variant's extra define.
     fn defines(&self, shadows: bool) -> (Defines, Option<Defines>) {
         let mut defines: Vec<(&str, &str)> = Vec::new();
+        if self.albedo {
+            defines.push(("LUCENT_SSS_ALBEDO", "1"));
+        }
         if self.upsample() {
             if self.base {
                 defines.push(("LUCENT_SSS_BASE", "1"));
@@ -305,8 +318,12 @@ impl PassShape {
 /// inputs: temp, depth, profile IDs, the LEAN temp, diffuse, specular, GB0, GB1 and the
 /// previous chain's result (`base`), as `chain_passes` reads them.
 pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<PipelineShaders>) {
-    for flags in 0u32..1 << 7 {
+    for flags in 0u32..1 << 8 {
         let bit = |i: u32| flags & (1 << i) != 0;
+        // Only a composing pass multiplies the albedo in.
+        if bit(7) && !bit(1) {
+            continue;
+        }
         for samples in [11, 17, 25] {
             let shape = PassShape {
                 bilateral: blur.bilateral(),
@@ -317,6 +334,7 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
                 edges: bit(4),
                 depth_in_alpha: bit(5),
                 point_taps: bit(6),
+                albedo: bit(7),
                 samples,
                 inputs: 8 + usize::from(bit(3)),
             };

@@ -15,7 +15,7 @@ use super::{span, value, SceneFile, Table};
 use crate::scene::layered::{self, sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS};
 use crate::scene::material::{
     BurleyDistance, Gaussian, Layer, LayeredMedium, Material, PowMode, SssProfile, TechniqueName,
-    TextureSource, Thickness, ThicknessSource, Translucency,
+    TextureSource, Texturing, Thickness, ThicknessSource, Translucency,
 };
 use crate::scene::obj::ObjMaterial;
 use crate::Result;
@@ -169,6 +169,7 @@ fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
                 units_per_mm: 0.01,
                 blur: None,
                 burley: None,
+                texturing: Texturing::default(),
             },
             // Burley's distances alone: the Gaussian blurs get six Gaussians fitted to the profile
             // (a mean free path through the default fit).
@@ -178,6 +179,7 @@ fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
                 units_per_mm: 0.01,
                 blur: None,
                 burley,
+                texturing: Texturing::default(),
             },
             _ => return Err(at.error(
                 "sss",
@@ -207,6 +209,19 @@ fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
     }
     if let Some(b) = &s.blur {
         profile.blur = Some(sss_blur(at, b));
+    }
+    if let Some(t) = &s.texturing {
+        profile.texturing = Texturing::named(t.get_ref()).ok_or_else(|| {
+            at.error(
+                "sss.texturing",
+                Some(t.span()),
+                format!(
+                    "unknown texturing '{}'; use post (albedo after the blur), pre-post (its \
+                     square root before and after) or pre (albedo blurred with the light)",
+                    t.get_ref()
+                ),
+            )
+        })?;
     }
     profile.validate().map_err(|e| match &s.gaussians {
         Some(g) => at.error("gaussians", Some(g.span()), e),

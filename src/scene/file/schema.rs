@@ -103,6 +103,8 @@ pub(super) struct SssToml {
     pub(super) scattering_distance: Option<Spanned<[f32; 3]>>,
     /// Burley's diffuse mean free path per channel, mm.
     pub(super) mean_free_path: Option<Spanned<[f32; 3]>>,
+    /// `post`, `pre-post` or `pre` (`Texturing`).
+    pub(super) texturing: Option<Spanned<String>>,
 }
 
 /// One `[[material.layered.layer]]` table.

@@ -221,8 +221,7 @@ fn shaded(
         } else {
             DVec3::ONE
         };
-        let mut diffuse =
-            scene.environment.ambient_radiance(p.normal) * material.albedo.as_dvec3();
+        let mut diffuse = scene.environment.ambient_radiance(p.normal) * material.albedo.as_dvec3();
         let mut blinn_phong = DVec3::ZERO;
         for light in &scene.lights {
             let (d, s) = shade_direct_split(&material, p.normal, p.position, to_eye, light);

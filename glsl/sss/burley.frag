@@ -1,12 +1,16 @@
 #version 450
 // permutation: LUCENT_SSS_DEPTH_IN_ALPHA
 // permutation:
+// permutation: LUCENT_SSS_DEPTH_IN_ALPHA LUCENT_SSS_HALF_RES
 // The gather pass of 2-D Burley SSS (src/features/sss/burley.rs): Christensen and Burley's
 // normalized diffusion profile importance-sampled around each pixel; writes the diffused light
 // and the pixel's linear depth in alpha (negative where it does not scatter), which
 // glsl/sss/burley_resolve.frag averages over 3x3 pixels and composes.
 //
 // - LUCENT_SSS_DEPTH_IN_ALPHA: the lit diffuse's alpha holds linear depth (else read depth).
+// - LUCENT_SSS_HALF_RES: the target is half the size per side; each texel gathers around the
+//   top-left pixel of its 2x2 block, its spiral rotated by the texel's place in its own 3x3
+//   block (the resolve averages 3x3 texels).
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 #include "../common/sampling.glsl"
@@ -65,8 +69,14 @@ float depth_at(ivec2 px, vec4 light) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(diffuse_tex, 0);
+#ifdef LUCENT_SSS_HALF_RES
+    ivec2 texel = ivec2(gl_FragCoord.xy);
+    ivec2 px = min(texel * 2, size - 1);
+#else
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    ivec2 texel = px;
+#endif
     vec4 center = finite_or(texelFetch(diffuse_tex, px, 0), vec4(0.0));
     int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
@@ -89,7 +99,7 @@ void main() {
         int budget = clamp(int(burley.knobs.x + 0.5), 1, 256);
         int samples = clamp(int(PI * reach_px * reach_px * 0.25 + 0.5), 0, budget);
         if (reach_px >= 1.0 && samples > 0) {
-            float rotation = burley.knobs.y > 0.5 ? spiral_rotation(px) : 0.0;
+            float rotation = burley.knobs.y > 0.5 ? spiral_rotation(texel) : 0.0;
             // The spiral's direction turns by the golden angle per sample: one rotation
             // matrix instead of a cos and a sin per sample.
             vec2 direction = vec2(cos(rotation), sin(rotation));

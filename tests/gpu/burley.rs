@@ -51,13 +51,15 @@ fn interior_error(hdr: &[f32], reference: &[DVec3], strength: &[f32]) -> f64 {
     error / level.max(1e-12)
 }
 
-/// Burley's and the separable blur's relative errors against their own references on `name`.
-fn errors(test: &TestGpu, name: &str, budget: Option<u32>) -> (f64, f64) {
+/// Burley's (at `budget`, at half resolution when `half_res`) and the separable blur's
+/// relative errors against their own references on `name`.
+fn errors(test: &TestGpu, name: &str, budget: Option<u32>, half_res: bool) -> (f64, f64) {
     let scene = scene(name, 20.0);
     let mut burley = settings(Technique::Only(&BURLEY));
     if let Some(b) = budget {
         burley.sss.burley_budget = b;
     }
+    burley.sss.burley_half_res = half_res;
     let frame = test.render(&scene, burley);
     let gbuffer = frame.gbuffer.as_ref().unwrap();
     let (profile, _) = FrameDesc::new(&scene, &burley)
@@ -99,7 +101,7 @@ fn errors(test: &TestGpu, name: &str, budget: Option<u32>) -> (f64, f64) {
 fn burley_matches_its_f64_reference_as_closely_as_the_separable_blur_matches_its_own() {
     let test = TestGpu::new();
     for name in ["skin", "teapot"] {
-        let (burley, separable) = errors(&test, name, None);
+        let (burley, separable) = errors(&test, name, None, false);
         eprintln!(
             "{name}: mean relative |GPU - own f64 reference| on interior scattering pixels: \
              burley {burley:.4e}, separable {separable:.4e}"
@@ -116,7 +118,7 @@ fn burley_matches_its_f64_reference_as_closely_as_the_separable_blur_matches_its
     // More samples, less error: the budget is the knob that trades one for the other.
     let curve: Vec<(u32, f64)> = [4, 8, 12, 20, 32, 64]
         .into_iter()
-        .map(|b| (b, errors(&test, "teapot", Some(b)).0))
+        .map(|b| (b, errors(&test, "teapot", Some(b), false).0))
         .collect();
     eprintln!("teapot: burley's error by budget {curve:?}");
     let (low, high) = (curve[0].1, curve[curve.len() - 1].1);
@@ -124,6 +126,23 @@ fn burley_matches_its_f64_reference_as_closely_as_the_separable_blur_matches_its
         high < low,
         "budget 64 ({high:.4e}) not closer than 4 ({low:.4e})"
     );
+    test.finish();
+}
+
+#[test]
+fn half_resolution_burley_stays_near_its_reference() {
+    // `--burley-half-res`: a quarter of the gathers, resolved at full resolution; its error
+    // against the full-resolution reference stays within 1.5x the full-resolution gather's.
+    let test = TestGpu::new();
+    for name in ["skin", "teapot"] {
+        let full = errors(&test, name, None, false).0;
+        let half = errors(&test, name, None, true).0;
+        eprintln!("{name}: burley {full:.4e} at full resolution, {half:.4e} at half");
+        assert!(
+            half <= 1.5 * full,
+            "{name}: half resolution {half:.4e} against full {full:.4e}"
+        );
+    }
     test.finish();
 }
 
@@ -190,6 +209,14 @@ fn burley_is_a_gather_and_a_resolve_with_its_table_only_when_used() {
     };
     assert!(has_table(&desc(Technique::Only(&BURLEY))));
     assert!(!has_table(&desc(Technique::Only(&SEPARABLE))));
+    // `--burley-half-res`: the same passes, the gathered image a quarter the size.
+    let full = settings(Technique::Only(&BURLEY));
+    let mut half = full;
+    half.sss.burley_half_res = true;
+    let (w, h) = common::image_size(&common::plan(&skin, &full), "sss.gathered");
+    assert_eq!((w, h), (SIZE.0, SIZE.1));
+    let (w, h) = common::image_size(&common::plan(&skin, &half), "sss.gathered");
+    assert_eq!((w, h), (SIZE.0.div_ceil(2), SIZE.1.div_ceil(2)));
 }
 
 #[test]

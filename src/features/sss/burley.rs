@@ -46,6 +46,7 @@ pub static BURLEY: BurleyChain = BurleyChain {
         &BUDGET,
         &ROTATION,
         &FIT,
+        &HALF_RES,
         &super::knobs::TEXTURING,
         &super::knobs::NO_TILES,
     ],
@@ -91,6 +92,18 @@ pub static ROTATION: Knob = Knob {
     takes: Takes::Choice(&["on", "off"]),
     default: Some(Given::Choice("on")),
     apply: |k, v| k.sss.burley_rotation = v.choice() == "on",
+};
+
+/// `--burley-half-res`: the gather at half resolution per side.
+pub static HALF_RES: Knob = Knob {
+    flag: "--burley-half-res",
+    help: "Burley SSS: gather at half resolution per side (a quarter of the gathers) and \
+           resolve at full resolution over the 3x3 half-resolution texels around each pixel, \
+           by depth and profile; pixels whose profile reaches under two pixels keep their own \
+           light.",
+    takes: Takes::Switch,
+    default: None,
+    apply: |k, _| k.sss.burley_half_res = true,
 };
 
 /// `--burley-fit`: the albedo fit of materials that give a mean free path.
@@ -183,19 +196,25 @@ pub fn burley_table(profiles: &SssProfiles, knobs: &SssKnobs) -> BurleyTableGpu 
 const GATHER_FRAGMENT: &str = "sss/burley.frag";
 const RESOLVE_FRAGMENT: &str = "sss/burley_resolve.frag";
 
-/// The gather pass's defines.
-fn gather_defines(depth_in_alpha: bool) -> Defines {
+/// The gather pass's defines (`half_res`: one gather per 2x2 block).
+fn gather_defines(depth_in_alpha: bool, half_res: bool) -> Defines {
+    let mut defines = Vec::new();
     if depth_in_alpha {
-        vec![("LUCENT_SSS_DEPTH_IN_ALPHA", "1")]
-    } else {
-        Vec::new()
+        defines.push(("LUCENT_SSS_DEPTH_IN_ALPHA", "1"));
     }
+    if half_res {
+        defines.push(("LUCENT_SSS_HALF_RES", "1"));
+    }
+    defines
 }
 
 /// The resolve pass's defines (`base`: it keeps the previous chain's result; `edges`: the
 /// frame has several profiles), and its pass-through variant's extra one.
-fn resolve_defines(base: bool, edges: bool, albedo: bool) -> (Defines, Defines) {
+fn resolve_defines(base: bool, edges: bool, albedo: bool, half_res: bool) -> (Defines, Defines) {
     let mut defines = Vec::new();
+    if half_res {
+        defines.push(("LUCENT_SSS_HALF_RES", "1"));
+    }
     if base {
         defines.push(("LUCENT_SSS_BASE", "1"));
     }
@@ -210,15 +229,16 @@ fn resolve_defines(base: bool, edges: bool, albedo: bool) -> (Defines, Defines) 
 
 /// Every pipeline the passes may build.
 fn shader_permutations(_: &BurleyChain, out: &mut Vec<PipelineShaders>) {
-    for depth_in_alpha in [false, true] {
+    for flags in 0u32..1 << 2 {
+        let bit = |i: u32| flags & (1 << i) != 0;
         out.push(PipelineShaders::fullscreen(
             GATHER_FRAGMENT,
-            &gather_defines(depth_in_alpha),
+            &gather_defines(bit(0), bit(1)),
         ));
     }
-    for flags in 0u32..1 << 3 {
+    for flags in 0u32..1 << 4 {
         let bit = |i: u32| flags & (1 << i) != 0;
-        let (defines, passthrough) = resolve_defines(bit(0), bit(1), bit(2));
+        let (defines, passthrough) = resolve_defines(bit(0), bit(1), bit(2), bit(3));
         out.push(PipelineShaders::fullscreen(RESOLVE_FRAGMENT, &defines));
         let mut all = defines.clone();
         all.extend(passthrough);
@@ -281,8 +301,19 @@ impl SssBlurTechnique for BurleyChain {
         };
         let index = chain.index;
 
-        // Gather: the profile importance-sampled around each of the chain's pixels.
-        let mut gathered = graph.create_image(&chain.image_name("gathered"), full);
+        // Gather: the profile importance-sampled around each of the chain's pixels (with
+        // `--burley-half-res`, around the top-left pixel of each 2x2 block).
+        let half_res = knobs.burley_half_res;
+        let gathered_info = if half_res {
+            ImageInfo {
+                width: full.width.div_ceil(2),
+                height: full.height.div_ceil(2),
+                ..full
+            }
+        } else {
+            full
+        };
+        let mut gathered = graph.create_image(&chain.image_name("gathered"), gathered_info);
         let name = format!("{}burley", chain.prefix);
         let mut pass = sss_pass(graph, &name, GATHER_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
@@ -292,8 +323,15 @@ impl SssBlurTechnique for BurleyChain {
         // Per pixel: the centre's light and profile, then per sample its light and profile ID
         // (depth travels in the light's alpha), up to the budget.
         pass.taps(2 + 2 * knobs.burley_budget);
-        pass.defines(&gather_defines(inputs.depth_in_alpha));
-        pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
+        pass.defines(&gather_defines(inputs.depth_in_alpha, half_res));
+        pass.tiles(move |scene, ctx| {
+            let rects = chain_tiles(scene, ctx, index)?;
+            Some(if half_res {
+                rects.iter().map(super::two_pass::halved).collect()
+            } else {
+                rects
+            })
+        });
         pass.color(&mut gathered, LoadOp::DontCare);
         pass.finish();
 
@@ -308,16 +346,29 @@ impl SssBlurTechnique for BurleyChain {
             inputs.specular,
         ];
         reads.extend(base);
-        // The albedo the lighting pass left out of the light, last.
+        // The albedo the lighting pass left out of the light; at half resolution the depth
+        // (each pixel's own, against the gathered texels').
         reads.extend(inputs.albedo);
+        if half_res {
+            reads.push(inputs.depth);
+        }
         for image in reads {
             pass.sample_with(image, vk::Filter::NEAREST);
         }
         // The centre's profile, then nine gathered texels (and their profile IDs with several
         // profiles), the lit diffuse and specular.
-        pass.taps(1 + 9 * (1 + u32::from(chain.edges)) + 2 + u32::from(inputs.albedo.is_some()));
-        let (defines, passthrough) =
-            resolve_defines(base.is_some(), chain.edges, inputs.albedo.is_some());
+        pass.taps(
+            1 + 9 * (1 + u32::from(chain.edges))
+                + 2
+                + u32::from(inputs.albedo.is_some())
+                + u32::from(half_res),
+        );
+        let (defines, passthrough) = resolve_defines(
+            base.is_some(),
+            chain.edges,
+            inputs.albedo.is_some(),
+            half_res,
+        );
         pass.defines(&defines).variant(passthrough);
         pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
         pass.color(&mut result, LoadOp::DontCare);

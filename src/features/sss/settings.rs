@@ -92,6 +92,9 @@ pub struct SssKnobs {
     pub burley_rotation: bool,
     /// The fit of Burley's `s` from the albedo, for materials that give a mean free path.
     pub burley_fit: crate::scene::profile::BurleyFit,
+    /// The Burley gather at half resolution per side (a quarter of the gathers), resolved at
+    /// full resolution over the 3x3 half-resolution texels around each pixel.
+    pub burley_half_res: bool,
     /// Every SSS material's texturing mode instead of its own (`--sss-texturing`).
     pub texturing: Option<crate::scene::material::Texturing>,
 }
@@ -111,6 +114,7 @@ impl Default for SssKnobs {
             burley_budget: DEFAULT_BURLEY_BUDGET,
             burley_rotation: true,
             burley_fit: crate::scene::profile::BurleyFit::Searchlight,
+            burley_half_res: false,
             texturing: None,
         }
     }

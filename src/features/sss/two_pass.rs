@@ -353,7 +353,7 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
 
 /// A tile rectangle at half resolution (every half-resolution pixel the full-resolution one
 /// touches).
-fn halved(r: &TileRect) -> TileRect {
+pub(super) fn halved(r: &TileRect) -> TileRect {
     TileRect {
         x: r.x / 2,
         y: r.y / 2,

@@ -65,11 +65,27 @@ float shadow_distance(vec4 params, float d) {
     return near * far / max(far - d * (far - near), 1e-12);
 }
 
+// The device depth of a distance `z` from the face's eye along its axis (the inverse of
+// `shadow_distance`, both increasing): a tap compares its stored depth with the point's
+// converted once, instead of converting every tap's depth to a distance. A distance before
+// the near plane maps below 0 (every occluder lies beyond it: lit), as it compared before.
+float shadow_device_depth(vec4 params, float z) {
+    float near = abs(params.z), far = params.w;
+    float range = max(far - near, 1e-12);
+    if (params.z < 0.0) {
+        return (z - near) / range; // orthographic: linear
+    }
+    // Perspective: d = far (z - near) / (z (far - near)); z is held positive (a point on the
+    // eye would divide by zero; it lies before the near plane anyway).
+    return far * (z - near) / (max(z, 1e-12) * range);
+}
+
 // How much of `light` reaches `pos` (normal `normal`, towards the light `to_light`): x for light
 // reflected at the surface, y for light transmitted through translucency material `material`
 // (GDC 2011: occluders of the pixel's own material do not shadow it; material 0 = not
 // translucent). A 4x4-texel tent (a 3x3 box, bilinearly placed) read with four gathers, the
-// taps compared in world distance from the light: the point is first moved one map texel
+// taps compared as device depths with the point's distance from the light converted once
+// (distance and depth grow together, so the comparison is the same): the point is first moved one map texel
 // along its normal, and a tap counts as lit when its occluder lies no nearer than the point's
 // distance minus a bias that grows with the slope (a tap two texels away on a surface at angle
 // theta to the light lies 2 tan(theta) texels nearer; capped at 8 texels, grazing light).
@@ -92,7 +108,8 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
     float cos_theta = clamp(abs(dot(normal, to_light)), 0.05, 1.0);
     float tan_theta = sqrt(1.0 - cos_theta * cos_theta) / cos_theta;
     float bias = texel * (1.0 + min(2.0 * tan_theta, 8.0));
-    float reference = shadow_distance(face.params, ndc.z) - bias;
+    // The point's distance less the bias, as a device depth the taps compare with directly.
+    float reference = shadow_device_depth(face.params, shadow_distance(face.params, ndc.z) - bias);
     // Texel-centre coordinates in the atlas; the 4x4 block starts one texel before the
     // bilinear footprint and is kept inside the tile (a neighbour's tile is another face).
     vec2 t = face.rect.xy + (ndc.xy * 0.5 + 0.5) * face.rect.z - 0.5;
@@ -107,11 +124,7 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
             // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
             // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
             vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadows.atlas.zw;
-            vec4 d = textureGather(shadow_depth, corner, 0);
-            vec4 occluder = vec4(shadow_distance(face.params, d.x),
-                                 shadow_distance(face.params, d.y),
-                                 shadow_distance(face.params, d.z),
-                                 shadow_distance(face.params, d.w));
+            vec4 occluder = textureGather(shadow_depth, corner, 0);
             vec4 lit = step(vec4(reference), occluder);
             float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];
             float y0 = wy[2 * by], y1 = wy[2 * by + 1];

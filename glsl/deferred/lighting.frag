@@ -155,7 +155,10 @@ void main() {
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
-        float visible = light_visibility(i, pos, s.normal, to_light, 0).x;
+        // Light that cannot reach the surface (outside the range, behind it) reflects
+        // nothing: no shadow lookup for it.
+        bool lit_side = attenuation > 0.0 && dot(s.normal, to_light) > 0.0;
+        float visible = lit_side ? light_visibility(i, pos, s.normal, to_light, 0).x : 0.0;
         color += shade_incident(s, to_eye, to_light, attenuation * visible, light);
     }
 #endif

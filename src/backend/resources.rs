@@ -436,6 +436,29 @@ impl GpuContext {
         name: &str,
         mut fill: impl FnMut(usize, &mut [u8]) -> Result<()>,
     ) -> Result<GpuImage> {
+        self.upload_image_chain(desc, level_bytes, name, |mapped| {
+            let mut start = 0usize;
+            for (level, &bytes) in level_bytes.iter().enumerate() {
+                let end = start + bytes as usize;
+                fill(level, &mut mapped[start..end])?;
+                start = end;
+            }
+            Ok(())
+        })
+    }
+
+    /// [`Self::upload_image_with`] with the whole staging buffer at once: `fill(bytes)` gets
+    /// every level, level 0 first, tightly packed (`level_bytes` each), so it can make each
+    /// level from the one before it in place. `fill` runs, and whatever it owns is dropped,
+    /// before the image is created: a loader that moves its decoded file into `fill` never
+    /// holds the file, the staging buffer and the image at once.
+    pub fn upload_image_chain(
+        &self,
+        desc: &ImageDesc,
+        level_bytes: &[u64],
+        name: &str,
+        fill: impl FnOnce(&mut [u8]) -> Result<()>,
+    ) -> Result<GpuImage> {
         if level_bytes.len() != desc.mip_levels.max(1) as usize {
             return Err(LucentError::InvalidInput(format!(
                 "upload '{name}': {} levels of data for {} mip levels",
@@ -461,19 +484,7 @@ impl GpuContext {
             &format!("{name} (staging)"),
         )?;
         let filled = match staging.mapped_mut() {
-            Some(mapped) => {
-                let mut start = 0usize;
-                let mut result = Ok(());
-                for (level, &bytes) in level_bytes.iter().enumerate() {
-                    let end = start + bytes as usize;
-                    result = fill(level, &mut mapped[start..end]);
-                    if result.is_err() {
-                        break;
-                    }
-                    start = end;
-                }
-                result
-            }
+            Some(mapped) => fill(&mut mapped[..total as usize]),
             None => Err(LucentError::InvalidInput(format!(
                 "staging memory for '{name}' is not host-visible"
             ))),

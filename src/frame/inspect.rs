@@ -20,6 +20,7 @@ use glam::Vec3;
 use crate::scene::file::load_scene_file;
 use crate::scene::obj::{load_mtl, load_obj, ObjMaterial};
 use crate::scene::texture::{decode_texture, host_bytes, mip_levels, TextureUsage};
+use crate::scene::upload::level_bytes;
 use crate::{LucentError, Result};
 use rayon::prelude::*;
 
@@ -98,9 +99,17 @@ pub fn inspect_file(path: &Path) -> Result<String> {
             let _ = writeln!(s, "{}: {} image", path.display(), ext.to_uppercase());
             let _ = writeln!(s, "  size: {}x{}", t.width, t.height);
             let _ = writeln!(s, "  mip levels: {}", mip_levels(t.width, t.height));
+            let layout = t.upload_layout();
+            let gpu: u64 = level_bytes(t.width, t.height, layout).iter().sum();
             let _ = writeln!(
                 s,
-                "  host memory when loaded (RGBA f32 with mips): {}",
+                "  on the GPU ({layout:?} with mips): {}, about twice that in host memory while \
+                 loading",
+                crate::error::format_bytes(gpu)
+            );
+            let _ = writeln!(
+                s,
+                "  host memory where the CPU computes with it (RGBA f32 with mips): {}",
                 crate::error::format_bytes(host_bytes(t.width, t.height).unwrap_or(u64::MAX))
             );
             let _ = writeln!(s, "  value range (RGBA, as stored): {lo:?} .. {hi:?}");

@@ -20,7 +20,8 @@ use ash::vk;
 use crate::backend::{GpuBuffer, GpuContext, GpuImage};
 use crate::error::VkResultExt;
 use crate::scene::material::TextureSource;
-use crate::scene::texture::{load_texture, procedural_texture, Texture, TextureUsage};
+use crate::scene::texture::{decode_texture, procedural_texture, Texture, TextureUsage};
+use crate::scene::upload::{self, UploadLayout};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
@@ -322,10 +323,81 @@ fn index_of_or_push<T: PartialEq + Copy>(list: &mut Vec<T>, value: T) -> usize {
     }
 }
 
-fn load_source(source: &TextureSource, usage: TextureUsage) -> Result<Texture> {
+/// The Vulkan format of an upload layout.
+fn upload_format(layout: UploadLayout) -> vk::Format {
+    match layout {
+        UploadLayout::Unorm8 => vk::Format::R8G8B8A8_UNORM,
+        UploadLayout::Srgb8 => vk::Format::R8G8B8A8_SRGB,
+        UploadLayout::Half => vk::Format::R16G16B16A16_SFLOAT,
+        UploadLayout::HalfRed => vk::Format::R16_SFLOAT,
+    }
+}
+
+/// Creates a sampled `width x height` image in `layout` with its whole mip chain, which
+/// `fill` writes into the staging buffer ([`upload::write_chain`] or
+/// [`upload::write_texture_chain`]).
+fn upload_chain(
+    gpu: &GpuContext,
+    width: u32,
+    height: u32,
+    layout: UploadLayout,
+    name: &str,
+    fill: impl FnOnce(&mut [u8]) -> Result<()>,
+) -> Result<GpuImage> {
+    let desc = crate::backend::ImageDesc {
+        mip_levels: crate::scene::texture::mip_levels(width, height),
+        ..crate::backend::ImageDesc::color(
+            width,
+            height,
+            upload_format(layout),
+            vk::ImageUsageFlags::SAMPLED,
+        )
+    };
+    let sizes = upload::level_bytes(width, height, layout);
+    gpu.upload_image_chain(&desc, &sizes, name, fill)
+}
+
+/// Loads a texture file onto the GPU in the layout [`crate::scene::upload`] picks for it: the
+/// file is decoded as stored, written into the staging buffer and dropped, and the mips are
+/// made there, so loading costs about twice the texture's decoded size plus mips in host
+/// memory. Errors name the file.
+pub fn upload_texture_file(
+    gpu: &GpuContext,
+    path: &std::path::Path,
+    usage: TextureUsage,
+    name: &str,
+) -> Result<GpuImage> {
+    let decoded = decode_texture(path, usage)?;
+    warn_non_finite(path, &decoded);
+    let (width, height, layout) = (decoded.width, decoded.height, decoded.upload_layout());
+    upload_chain(gpu, width, height, layout, name, move |out| {
+        upload::write_texture_chain(decoded, out)
+    })
+}
+
+fn warn_non_finite(path: &std::path::Path, decoded: &crate::scene::texture::DecodedImage) {
+    let replaced = decoded.non_finite();
+    if replaced > 0 {
+        log::warn!(
+            "{}: replaced {replaced} NaN or infinite texel values with 0",
+            path.display()
+        );
+    }
+}
+
+/// Uploads a map of `usage` from `source`: a file through [`upload_texture_file`], a
+/// procedural texture through [`upload_texture`].
+fn upload_source(
+    gpu: &GpuContext,
+    source: &TextureSource,
+    usage: TextureUsage,
+    name: &str,
+) -> Result<GpuImage> {
     match source {
-        TextureSource::File(path) => load_texture(path, usage),
-        TextureSource::Procedural(p) => procedural_texture(p, PROCEDURAL_TEXTURE_SIZE),
+        TextureSource::File(path) => upload_texture_file(gpu, path, usage, name),
+        TextureSource::Procedural(p) => {
+            upload_texture(gpu, &procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?, name)
+        }
     }
 }
 
@@ -567,8 +639,43 @@ impl SceneGpu {
             push(maps, &flat, "flat normal map")?;
             let sources = distinct_sources(scene, |o| o.material.normal_texture.as_ref());
             for (i, source) in sources.iter().enumerate() {
-                let texture = load_source(source, TextureUsage::Data)?;
-                push(maps, &texture, &format!("{} normal map {i}", scene.name))?;
+                let name = format!("{} normal map {i}", scene.name);
+                match source {
+                    TextureSource::File(path) if lean => {
+                        // The LEAN maps straight from the decoded file into their staging
+                        // buffers: no f32 copy of the normal map or of either LEAN map. Map 2
+                        // holds one value (M.xy), so it is one fp16 channel (sampled as
+                        // (r, 0, 0, 1), what the four-channel map stored).
+                        let normals = decode_texture(path, TextureUsage::Data)?;
+                        warn_non_finite(path, &normals);
+                        let (w, h) = (normals.width, normals.height);
+                        for (which, layout) in [(1, UploadLayout::Half), (2, UploadLayout::HalfRed)]
+                        {
+                            let label = format!("{name} LEAN {which}");
+                            let image = upload_chain(gpu, w, h, layout, &label, |out| {
+                                upload::write_chain(w, h, layout, out, |x, y| {
+                                    crate::scene::lean::lean_texel(normals.texel(x, y), which)
+                                })
+                            })?;
+                            if which == 1 {
+                                maps.normal.push(image);
+                            } else {
+                                maps.lean2.push(image);
+                            }
+                        }
+                    }
+                    TextureSource::File(_) => {
+                        maps.normal
+                            .push(upload_source(gpu, source, TextureUsage::Data, &name)?);
+                    }
+                    TextureSource::Procedural(p) => {
+                        push(
+                            maps,
+                            &procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?,
+                            &name,
+                        )?;
+                    }
+                }
             }
         }
         if albedo_maps {
@@ -577,9 +684,9 @@ impl SceneGpu {
                 .push(upload_texture(gpu, &white, "white albedo map")?);
             let sources = distinct_sources(scene, |o| o.material.albedo_texture.as_ref());
             for (i, source) in sources.iter().enumerate() {
-                let texture = load_source(source, TextureUsage::Color)?;
                 let name = format!("{} albedo map {i}", scene.name);
-                maps.albedo.push(upload_texture(gpu, &texture, &name)?);
+                maps.albedo
+                    .push(upload_source(gpu, source, TextureUsage::Color, &name)?);
             }
         }
         if !depth_sources.is_empty() {
@@ -590,11 +697,11 @@ impl SceneGpu {
             maps.depth
                 .push(upload_texture(gpu, &zero, "zero depth map")?);
             for (i, source) in depth_sources.iter().enumerate() {
-                // Linear data: the loader keeps float and 16-bit precision and replaces NaN
-                // and infinite texels with 0 (fp16 on the GPU: 3 significant digits).
-                let texture = load_source(source, TextureUsage::Data)?;
+                // Linear data: 8-bit files stay 8-bit, float and 16-bit ones become fp16 on
+                // the GPU (3 significant digits), NaN and infinite texels 0.
                 let name = format!("{} layer depth map {i}", scene.name);
-                maps.depth.push(upload_texture(gpu, &texture, &name)?);
+                maps.depth
+                    .push(upload_source(gpu, source, TextureUsage::Data, &name)?);
             }
         }
         Ok(())

@@ -34,14 +34,7 @@ pub fn lean_maps(normal_map: &Texture) -> Result<(Texture, Texture)> {
 pub fn lean_map(normal_map: &Texture, which: u8) -> Result<Texture> {
     let texels: Vec<[f32; 4]> = normal_map.mips[0]
         .iter()
-        .map(|t| {
-            let (b, m) = slope_and_moments(Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE);
-            if which == 1 {
-                [b[0], b[1], m[0], m[1]]
-            } else {
-                [m[2], 0.0, 0.0, 1.0]
-            }
-        })
+        .map(|&t| lean_texel(t, which))
         .collect();
     let name = if which == 1 {
         "LEAN map 1"
@@ -50,6 +43,18 @@ pub fn lean_map(normal_map: &Texture, which: u8) -> Result<Texture> {
     };
     let (w, h) = (normal_map.width, normal_map.height);
     Texture::from_texels(name, w, h, TextureUsage::Data, texels)
+}
+
+/// Texel of LEAN map `which` (1 or 2) for a normal-map texel stored as `n * 0.5 + 0.5`
+/// (the layout in the module docs).
+pub fn lean_texel(normal_map_texel: [f32; 4], which: u8) -> [f32; 4] {
+    let t = normal_map_texel;
+    let (b, m) = slope_and_moments(Vec3::new(t[0], t[1], t[2]) * 2.0 - Vec3::ONE);
+    if which == 1 {
+        [b[0], b[1], m[0], m[1]]
+    } else {
+        [m[2], 0.0, 0.0, 1.0]
+    }
 }
 
 /// Slope `B` and second moments `(B.x^2, B.y^2, B.x B.y)` of a tangent-space normal.

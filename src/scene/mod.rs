@@ -20,6 +20,7 @@ pub mod polygon;
 pub mod profile;
 pub mod showcase;
 pub mod texture;
+pub mod upload;
 
 use glam::{Mat4, Vec3};
 

@@ -18,8 +18,11 @@
 //!
 //! Memory: a loaded texture costs its linear `f32` texels and mips ([`host_bytes`], about 21
 //! bytes per texel); while loading, the decoded file is held beside its `f32` level 0 and
-//! nothing else of the image's size. [`decode_texture`] keeps the image as stored (its decoded
-//! size, no `f32` copy) for what samples it on the CPU: thickness maps, `lucent inspect`.
+//! nothing else of the image's size. That is for what computes with texels on the CPU (the
+//! f64 references, layer depth textures); the renderer uploads texture files without any
+//! `f32` copy ([`super::upload`]: the file's own precision, about twice its decoded size plus
+//! mips while loading). [`decode_texture`] keeps the image as stored (its decoded size, no
+//! `f32` copy) for what samples it on the CPU: thickness maps, `lucent inspect`, the upload.
 
 use std::path::Path;
 
@@ -328,13 +331,19 @@ pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
     let texels = u64::from(width) * u64::from(height);
     if texels > MAX_TEXTURE_TEXELS {
         let cost = host_bytes(width, height).unwrap_or(u64::MAX);
+        let gpu: u64 =
+            super::upload::level_bytes(width, height, super::upload::UploadLayout::Unorm8)
+                .iter()
+                .sum();
         return Err(LucentError::file(
             path,
             format!(
                 "image is {width}x{height} ({texels} texels), more than the {MAX_TEXTURE_TEXELS} \
-                 texels (8192x8192) a texture may have: decoded to linear RGBA f32 with mips it \
-                 would take {} of host memory (and a normal map twice that again for its LEAN \
-                 maps); scale it down to at most 8192x8192",
+                 texels (8192x8192) a texture may have: it would take {} on the GPU as 8-bit \
+                 RGBA with mips (twice that while loading; a 16-bit or float file twice that \
+                 again) and {} of host memory as linear RGBA f32 where the CPU computes with \
+                 it; scale it down to at most 8192x8192",
+                crate::error::format_bytes(gpu),
                 crate::error::format_bytes(cost)
             ),
         ));
@@ -502,6 +511,59 @@ impl DecodedImage {
         bilinear(self.width, self.height, uv, |x, y| self.texel(x, y))
     }
 
+    /// The layout the GPU stores this image in ([`super::upload`]): 8-bit files stay 8-bit
+    /// (sRGB-encoded for colour usage, the sampler decodes), everything else is linear binary16.
+    pub fn upload_layout(&self) -> super::upload::UploadLayout {
+        use super::upload::UploadLayout;
+        match self.image {
+            DynamicImage::ImageLuma8(_)
+            | DynamicImage::ImageLumaA8(_)
+            | DynamicImage::ImageRgb8(_)
+            | DynamicImage::ImageRgba8(_) => {
+                if self.srgb {
+                    UploadLayout::Srgb8
+                } else {
+                    UploadLayout::Unorm8
+                }
+            }
+            _ => UploadLayout::Half,
+        }
+    }
+
+    /// Writes row `y` of an 8-bit image into `out` as RGBA8, values as stored (grey
+    /// replicated, missing alpha 255), and returns true; returns false, writing nothing, for
+    /// any other layout.
+    pub(super) fn write_rgba8_row(&self, y: usize, out: &mut [u8]) -> bool {
+        let w = self.width as usize;
+        match &self.image {
+            DynamicImage::ImageLuma8(im) => {
+                for (o, &v) in out
+                    .chunks_exact_mut(4)
+                    .zip(&im.as_raw()[y * w..(y + 1) * w])
+                {
+                    o.copy_from_slice(&[v, v, v, 255]);
+                }
+            }
+            DynamicImage::ImageLumaA8(im) => {
+                let row = &im.as_raw()[y * w * 2..(y + 1) * w * 2];
+                for (o, p) in out.chunks_exact_mut(4).zip(row.chunks_exact(2)) {
+                    o.copy_from_slice(&[p[0], p[0], p[0], p[1]]);
+                }
+            }
+            DynamicImage::ImageRgb8(im) => {
+                let row = &im.as_raw()[y * w * 3..(y + 1) * w * 3];
+                for (o, p) in out.chunks_exact_mut(4).zip(row.chunks_exact(3)) {
+                    o.copy_from_slice(&[p[0], p[1], p[2], 255]);
+                }
+            }
+            DynamicImage::ImageRgba8(im) => {
+                out.copy_from_slice(&im.as_raw()[y * w * 4..(y + 1) * w * 4]);
+            }
+            _ => return false,
+        }
+        true
+    }
+
     /// Every texel in row order as linear RGBA `f32` (level 0 of a [`Texture`]), converted in
     /// parallel; non-finite values counted.
     fn texels(&self) -> (Vec<[f32; 4]>, usize) {
@@ -602,7 +664,7 @@ fn sanitize(texels: &mut [[f32; 4]]) -> usize {
 
 /// For each texel of a `m`-texel axis downsampled from `n` texels: the source texels it covers
 /// and their weights (overlap / footprint), summing to 1.
-fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
+pub(super) fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
     (0..m)
         .map(|i| {
             let start = i as f64 * n as f64 / m as f64;

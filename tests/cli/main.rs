@@ -1,5 +1,6 @@
 //! The tests that run the `lucent` binary (`CARGO_BIN_EXE_lucent`, validation on): bad inputs,
-//! the benchmark, the interactive demo under Xvfb, outputs, the reports. One binary, each former
+//! the benchmark, the interactive demo under Xvfb, host memory while loading a texture, outputs,
+//! the reports. One binary, each former
 //! test file a module; `cargo test --test cli bench::` runs one of them.
 
 #[path = "../common/mod.rs"]
@@ -9,6 +10,7 @@ mod common;
 mod bad_inputs;
 mod bench;
 mod demo;
+mod memory;
 mod outputs;
 mod report;
 mod report_li;

@@ -7,14 +7,21 @@
 // (below the thresholds the pixel is copied unchanged, so flat regions are bit-exact); the
 // 3x3 second differences decide whether the edge runs horizontally or vertically; the edge is
 // followed both ways along its length until the luma leaves the edge's mean (up to
-// FXAA_STEPS probes, growing strides); the pixel then samples, bilinearly, across the edge by
-// how near it sits to the edge's nearer end (a stair step becomes a ramp), or by the
-// sub-pixel amount when that is larger (isolated single-pixel features). With
-// LUCENT_OUTPUT_LINEAR the result is decoded back to linear for sRGB and float targets.
+// FXAA_STEPS probes, growing strides); the pixel then moves across the edge by how near it
+// sits to the edge's nearer end (a stair step becomes a ramp), or by the sub-pixel amount when
+// that is larger (isolated single-pixel features). With LUCENT_OUTPUT_LINEAR the result is
+// decoded back to linear for sRGB and float targets.
+//
+// Cost on lavapipe (docs/antialias.md): every read is a texel fetch, never a filtered tap (a
+// bilinear tap costs about four fetches there, and the first in a shader several more);
+// the values FXAA 3.11 reads between texels are means of two texels, computed here. llvmpipe
+// runs both sides of every branch and each loop as long as any of its 8 lanes needs it, so
+// the search's first probe comes from the 3x3 already read, and each loop trip probes one
+// direction (two fetches) rather than both (four).
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D ldr;  // bilinear, clamped to the edge
+layout(set = 0, binding = 1) uniform sampler2D ldr;  // read with texelFetch only
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
@@ -27,24 +34,42 @@ const float EDGE_THRESHOLD = 0.125;
 const float EDGE_THRESHOLD_MIN = 0.0625;
 // How much of the sub-pixel aliasing is removed (0 none, 1 all; 0.75 the preset's default).
 const float SUBPIXEL = 0.75;
-// Search probes along the edge and their strides in pixels (12 probes reach 27 pixels).
+// Search probes each way along the edge (12 probes reach 27 pixels).
 const int FXAA_STEPS = 12;
-const float STRIDES[FXAA_STEPS] = float[](1.0, 1.0, 1.0, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.0, 4.0, 8.0);
 
-float luma_at(vec2 uv) {
-    return textureLod(ldr, uv, 0.0).a;
+// The stride of probe i in whole pixels: 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 4, 8. Whole strides keep
+// every probe on a pixel pair (FXAA 3.11's 1.5 would put the later ones between four texels);
+// computed rather than read from a constant array, which lavapipe indexes per lane (7.9 -> 7.1
+// ms at 1024x768).
+int stride(int i) {
+    return i < 5 ? 1 : (i < 10 ? 2 : (i == 10 ? 4 : 8));
+}
+
+// The last texel of the image: every fetch is clamped to it, as a clamp-to-edge sampler would.
+ivec2 last_texel;
+
+vec4 texel_at(ivec2 p) {
+    return texelFetch(ldr, clamp(p, ivec2(0), last_texel), 0);
+}
+
+float luma_at(ivec2 p) {
+    return texel_at(p).a;
 }
 
 void main() {
-    vec2 texel = frame.viewport.zw;
-    vec2 uv = gl_FragCoord.xy * texel;  // this pixel's centre
-    vec4 centre = textureLod(ldr, uv, 0.0);
+    last_texel = textureSize(ldr, 0) - 1;
+    ivec2 p = ivec2(gl_FragCoord.xy);  // this pixel, inside the image
+    vec4 centre = texelFetch(ldr, p, 0);
     float l_m = centre.a;
     // North is the row above: smaller y in Vulkan's image coordinates.
-    float l_n = textureLodOffset(ldr, uv, 0.0, ivec2(0, -1)).a;
-    float l_s = textureLodOffset(ldr, uv, 0.0, ivec2(0, 1)).a;
-    float l_w = textureLodOffset(ldr, uv, 0.0, ivec2(-1, 0)).a;
-    float l_e = textureLodOffset(ldr, uv, 0.0, ivec2(1, 0)).a;
+    vec4 t_n = texel_at(p + ivec2(0, -1));
+    vec4 t_s = texel_at(p + ivec2(0, 1));
+    vec4 t_w = texel_at(p + ivec2(-1, 0));
+    vec4 t_e = texel_at(p + ivec2(1, 0));
+    float l_n = t_n.a;
+    float l_s = t_s.a;
+    float l_w = t_w.a;
+    float l_e = t_e.a;
     float lo = min(l_m, min(min(l_n, l_s), min(l_w, l_e)));
     float hi = max(l_m, max(max(l_n, l_s), max(l_w, l_e)));
     float range = hi - lo;
@@ -56,10 +81,10 @@ void main() {
         out_color.a = 1.0;
         return;
     }
-    float l_nw = textureLodOffset(ldr, uv, 0.0, ivec2(-1, -1)).a;
-    float l_ne = textureLodOffset(ldr, uv, 0.0, ivec2(1, -1)).a;
-    float l_sw = textureLodOffset(ldr, uv, 0.0, ivec2(-1, 1)).a;
-    float l_se = textureLodOffset(ldr, uv, 0.0, ivec2(1, 1)).a;
+    float l_nw = luma_at(p + ivec2(-1, -1));
+    float l_ne = luma_at(p + ivec2(1, -1));
+    float l_sw = luma_at(p + ivec2(-1, 1));
+    float l_se = luma_at(p + ivec2(1, 1));
 
     // Sub-pixel aliasing: how far the centre stands out of its 3x3 low-pass, relative to the
     // local contrast (range > 0 here: the threshold above is at least EDGE_THRESHOLD_MIN).
@@ -81,58 +106,61 @@ void main() {
     float grad_before = abs(l_before - l_m);
     float grad_after = abs(l_after - l_m);
     bool toward_before = grad_before >= grad_after;
-    float step_across = horizontal ? texel.y : texel.x;
+    // One pixel across the edge (toward the steeper neighbour), and one along it.
+    ivec2 across = horizontal ? ivec2(0, 1) : ivec2(1, 0);
     if (toward_before) {
-        step_across = -step_across;
+        across = -across;
     }
+    ivec2 along = horizontal ? ivec2(1, 0) : ivec2(0, 1);
     float edge_mean = 0.5 * (l_m + (toward_before ? l_before : l_after));
     float gradient_scaled = 0.25 * max(grad_before, grad_after);
 
-    // Walk along the edge, on the boundary between this pixel and its neighbour across it.
-    vec2 on_edge = uv;
-    vec2 along = horizontal ? vec2(texel.x, 0.0) : vec2(0.0, texel.y);
-    if (horizontal) {
-        on_edge.y += 0.5 * step_across;
-    } else {
-        on_edge.x += 0.5 * step_across;
-    }
-    vec2 p_neg = on_edge - along;
-    vec2 p_pos = on_edge + along;
-    float end_neg = luma_at(p_neg) - edge_mean;
-    float end_pos = luma_at(p_pos) - edge_mean;
+    // Walk along the edge both ways. A probe d pixels away reads the mean luma of the pixel
+    // pair that straddles the edge there (this pixel's row or column and the one across),
+    // what a bilinear tap on the boundary between them would read. The first probe each way
+    // (d = 1) is a pair of the 3x3 neighbourhood.
+    float l_neg_pair = horizontal ? (toward_before ? l_nw : l_sw) : (toward_before ? l_nw : l_ne);
+    float l_pos_pair = horizontal ? (toward_before ? l_ne : l_se) : (toward_before ? l_sw : l_se);
+    int d_neg = 1;
+    int d_pos = 1;
+    float end_neg = 0.5 * ((horizontal ? l_w : l_n) + l_neg_pair) - edge_mean;
+    float end_pos = 0.5 * ((horizontal ? l_e : l_s) + l_pos_pair) - edge_mean;
     bool done_neg = abs(end_neg) >= gradient_scaled;
     bool done_pos = abs(end_pos) >= gradient_scaled;
-    for (int i = 1; i < FXAA_STEPS && !(done_neg && done_pos); ++i) {
-        if (!done_neg) {
-            p_neg -= along * STRIDES[i];
-            end_neg = luma_at(p_neg) - edge_mean;
-            done_neg = abs(end_neg) >= gradient_scaled;
-        }
-        if (!done_pos) {
-            p_pos += along * STRIDES[i];
-            end_pos = luma_at(p_pos) - edge_mean;
-            done_pos = abs(end_pos) >= gradient_scaled;
+    // Trip k probes step k / 2 of the negative (even k) or positive (odd k) direction.
+    for (int k = 2; k < 2 * FXAA_STEPS && !(done_neg && done_pos); ++k) {
+        bool neg = (k & 1) == 0;
+        if (neg ? !done_neg : !done_pos) {
+            int d = (neg ? d_neg : d_pos) + stride(k >> 1);
+            ivec2 q = p + (neg ? -d : d) * along;
+            float e = 0.5 * (luma_at(q) + luma_at(q + across)) - edge_mean;
+            bool done = abs(e) >= gradient_scaled;
+            if (neg) {
+                d_neg = d;
+                end_neg = e;
+                done_neg = done;
+            } else {
+                d_pos = d;
+                end_pos = e;
+                done_pos = done;
+            }
         }
     }
-    float dist_neg = horizontal ? uv.x - p_neg.x : uv.y - p_neg.y;
-    float dist_pos = horizontal ? p_pos.x - uv.x : p_pos.y - uv.y;
-    bool nearer_neg = dist_neg < dist_pos;
-    float dist = min(dist_neg, dist_pos);
-    // > 0: the probes move at least one texel each way.
-    float span = max(dist_neg + dist_pos, 1e-6);
+    bool nearer_neg = d_neg < d_pos;
+    // >= 2: the probes move at least one pixel each way.
+    float span = float(d_neg + d_pos);
+    float dist = float(min(d_neg, d_pos));
     // Blend only at the end of the span where the luma crosses to the other side: the edge's
     // step belongs to that end.
     bool centre_below = l_m - edge_mean < 0.0;
     bool good_end = ((nearer_neg ? end_neg : end_pos) < 0.0) != centre_below;
     float offset = good_end ? 0.5 - dist / span : 0.0;
     offset = max(offset, sub);
-    vec2 sample_uv = uv;
-    if (horizontal) {
-        sample_uv.y += offset * step_across;
-    } else {
-        sample_uv.x += offset * step_across;
-    }
-    vec3 c = textureLod(ldr, sample_uv, 0.0).rgb;
+    // Move the pixel by `offset` toward the pixel across the edge (a 4-neighbour already
+    // read): the blend a bilinear tap there would return.
+    vec3 across_rgb = horizontal ? (toward_before ? t_n.rgb : t_s.rgb)
+                                 : (toward_before ? t_w.rgb : t_e.rgb);
+    vec3 c = mix(centre.rgb, across_rgb, offset);
 #ifdef LUCENT_OUTPUT_LINEAR
     c = srgb_to_linear(c);
 #endif

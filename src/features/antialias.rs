@@ -2,19 +2,19 @@
 //!
 //! A frame with anti-aliasing tonemaps into an intermediate RGBA8 image (sRGB-encoded colour,
 //! the luma of each pixel in alpha: [`super::tonemap::tonemap_with_luma_pass`]) and the `fxaa`
-//! pass samples it bilinearly into the display image, encoded for the display's format
+//! pass reads it, texel by texel, into the display image, encoded for the display's format
 //! (`glsl/post/fxaa.frag`; its f64 twin is [`crate::reference::fxaa`]). Pixels below the
 //! contrast thresholds are copied unchanged, so flat regions keep their exact values and the
 //! goldens of frames without anti-aliasing stay what they were: a frame without it has neither
 //! the pass nor the intermediate image.
 //!
-//! Why off by default: on lavapipe the pass costs 12.6-13.8% of the frame at 1024x768
-//! (docs/antialias.md, `lucent bench --aa fxaa`), more than "cheap"; on a GPU a full-screen
-//! pass of this kind is far cheaper and a host may well turn it on.
+//! Cost: 1.4-1.5x the tonemap pass on lavapipe at 1024x768 (it was 4-5x with bilinear taps;
+//! docs/antialias.md has the table and where the time went). Why still off by default: it is
+//! 4-8% of the frame there, and lucent's frames are measurements (ratios to the plain frame,
+//! goldens, f64 references of the display) that a default post pass would shift; a host
+//! brings its own anti-aliasing, and on a GPU may well turn this on.
 
 use std::sync::Arc;
-
-use ash::vk;
 
 use crate::graph::{Handle, Image, LoadOp, RenderGraph};
 use crate::Result;
@@ -80,9 +80,9 @@ pub fn fxaa_pass(
 ) -> Handle<Image> {
     let linear = super::tonemap::writes_linear(graph.resources()[display.id()].info.format);
     let mut pass = FullscreenPass::new(graph, "fxaa", FXAA_FRAGMENT, scene);
-    // Bilinear: the edge search and the final tap sample between texels.
+    // Read with texel fetches only (the shader averages the texels it needs between).
     pass.per_frame(&FRAME)
-        .sample_with(ldr, vk::Filter::LINEAR)
+        .sample(ldr)
         .color(&mut display, LoadOp::DontCare)
         .defines(fxaa_defines(linear));
     pass.finish();

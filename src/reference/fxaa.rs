@@ -1,6 +1,10 @@
 //! FXAA in f64: the twin of `glsl/post/fxaa.frag`, run on the same 8-bit intermediate image
-//! (sRGB-encoded RGB, luma in alpha) with the same bilinear, clamp-to-edge sampling, so a test
-//! can hold the GPU's anti-aliased frame against it pixel by pixel.
+//! (sRGB-encoded RGB, luma in alpha) with bilinear, clamp-to-edge sampling, so a test can hold
+//! the GPU's anti-aliased frame against it pixel by pixel. The shader fetches texels and
+//! computes the few bilinear values FXAA needs itself (the mean of a pixel pair at an edge
+//! probe, a blend of two pixels along one axis at the end): the same numbers as the bilinear
+//! samples here, since every probe lies on a pixel pair (whole strides) and the final tap
+//! moves along one axis only.
 
 /// The intermediate image FXAA reads: RGBA8 rows top first, alpha the luma of the encoded RGB.
 pub struct LdrImage<'a> {
@@ -16,7 +20,7 @@ pub struct LdrImage<'a> {
 const EDGE_THRESHOLD: f64 = 0.125;
 const EDGE_THRESHOLD_MIN: f64 = 0.0625;
 const SUBPIXEL: f64 = 0.75;
-const STRIDES: [f64; 12] = [1.0, 1.0, 1.0, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.0, 4.0, 8.0];
+const STRIDES: [f64; 12] = [1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 2.0, 2.0, 4.0, 8.0];
 
 /// The luma the tonemap writes into alpha for sRGB-encoded `rgb` in [0, 1] (Rec. 601 weights).
 pub fn luma(rgb: [f64; 3]) -> f64 {

@@ -92,6 +92,9 @@ pub struct DemoOptions {
     pub validation: bool,
     /// Device name filter.
     pub device: Option<String>,
+    /// The GLSL tree to compile and watch (`--shaders`); `None`:
+    /// [`ShaderCompiler::default_glsl_root`].
+    pub glsl_root: Option<PathBuf>,
     /// Frame settings besides size and technique (G-buffer precision, merging, ...).
     pub base: FrameSettings,
 }
@@ -129,7 +132,10 @@ pub fn run(options: DemoOptions) -> Result<()> {
         ..ContextDesc::from_env(options.validation, options.device.clone())
     })?;
     let shaders = ShaderCompiler::new(
-        ShaderCompiler::default_glsl_root(),
+        options
+            .glsl_root
+            .clone()
+            .unwrap_or_else(ShaderCompiler::default_glsl_root),
         Some(crate::files::default_cache_dir()),
     )?;
     // Run-time compilation (not the shipped SPIR-V): edited shaders reload while the demo runs.

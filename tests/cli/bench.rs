@@ -233,3 +233,81 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
     }
     test.finish();
 }
+
+/// Copies the repository's `glsl/` into `to`, file by file.
+fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+#[test]
+fn shaders_dir_compiles_an_edited_tree_at_run_time_and_a_bad_one_is_refused() {
+    use lucent::images::output::read_png_rgba8;
+    let dir = common::temp_dir("shaders-flag");
+    let tree = dir.join("glsl");
+    copy_tree(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl"),
+        &tree,
+    );
+    // The edit: the tonemap reads no light, so every pixel of the picture is black.
+    let tonemap = tree.join("post/tonemap.frag");
+    let source = std::fs::read_to_string(&tonemap).unwrap();
+    let light = "vec3 c = texelFetch(hdr, ivec2(gl_FragCoord.xy), 0).rgb * frame.exposure.x;";
+    assert!(
+        source.contains(light),
+        "the tonemap's first line changed: update this test"
+    );
+    std::fs::write(&tonemap, source.replace(light, "vec3 c = vec3(0.0);")).unwrap();
+    let brightest = |png: &std::path::Path| {
+        let (_, _, rgba) = read_png_rgba8(png).unwrap();
+        rgba.chunks(4)
+            .map(|p| p[0].max(p[1]).max(p[2]))
+            .max()
+            .unwrap()
+    };
+    let render = |png: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--validation",
+            "--scene",
+            "smoke",
+            "--size",
+            "64x48",
+        ];
+        args.extend_from_slice(&["--out", png.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let out = common::lucent(&args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let shipped = dir.join("shipped.png");
+    render(&shipped, &[]);
+    assert!(brightest(&shipped) > 64, "the shipped frame is lit");
+    let edited = dir.join("edited.png");
+    render(&edited, &["--shaders", tree.to_str().unwrap()]);
+    assert_eq!(brightest(&edited), 0, "the edited tonemap's frame is black");
+
+    let out = common::lucent(&[
+        "render",
+        "--scene",
+        "smoke",
+        "--shaders",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("not a shader tree"),
+        "{stderr}"
+    );
+}

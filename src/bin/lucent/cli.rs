@@ -323,6 +323,10 @@ pub struct GpuArgs {
     /// LUCENT_VALIDATION=1); any validation error makes the command fail.
     #[arg(long)]
     pub validation: bool,
+    /// Compile the GLSL under this directory at run time instead of using the SPIR-V built into
+    /// the binary: measure an edited copy of `glsl/` without rebuilding (docs/performance.md).
+    #[arg(long, value_name = "DIR")]
+    pub shaders: Option<std::path::PathBuf>,
 }
 
 /// A whole number in `range`, for the count flags whose messages the tests and docs quote:

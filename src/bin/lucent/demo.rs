@@ -28,6 +28,7 @@ pub fn run(args: DemoArgs) -> Result<()> {
         screenshot,
         validation: gpu.validation,
         device: gpu.device,
+        glsl_root: gpu.shaders,
         base: FrameSettings::new(size.0, size.1),
     })
 }

@@ -18,12 +18,38 @@ pub struct Session {
     pub pipeline_cache: PipelineCache,
 }
 
+/// A run-time compiler for the GLSL tree `dir` (`--shaders`), refused with the reason when
+/// `dir` is no shader tree or this build has no compiler.
+fn runtime_shaders(dir: &Path) -> Result<ShaderCompiler> {
+    if !dir.join("common").is_dir() {
+        return Err(LucentError::InvalidInput(format!(
+            "--shaders {}: not a shader tree (a copy of the repository's glsl/, with common/)",
+            dir.display()
+        )));
+    }
+    #[cfg(feature = "runtime-shaders")]
+    {
+        ShaderCompiler::new(dir, None)
+    }
+    #[cfg(not(feature = "runtime-shaders"))]
+    {
+        Err(LucentError::InvalidInput(format!(
+            "--shaders {}: this build has no run-time shader compiler (feature runtime-shaders)",
+            dir.display()
+        )))
+    }
+}
+
 impl Session {
     fn new(args: &GpuArgs) -> Result<Self> {
         let gpu = GpuContext::new(&ContextDesc::from_env(args.validation, args.device.clone()))?;
         log::info!("device: {} ({})", gpu.info.describe(), gpu.info.driver());
-        // The SPIR-V compiled with the crate (the demo compiles at run time, for hot reload).
-        let shaders = ShaderCompiler::shipped()?;
+        // The SPIR-V compiled with the crate (the demo compiles at run time, for hot reload),
+        // or the GLSL of `--shaders DIR` compiled as the passes ask for it.
+        let shaders = match &args.shaders {
+            None => ShaderCompiler::shipped()?,
+            Some(dir) => runtime_shaders(dir)?,
+        };
         let pipeline_cache = PipelineCache::load_default(&gpu)?;
         Ok(Self {
             gpu,

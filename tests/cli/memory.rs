@@ -1,6 +1,6 @@
 //! Host memory a texture costs while loading, measured on the `lucent` process itself: its
-//! peak resident set (`ru_maxrss` from `wait4` on that one child, so tests running beside it
-//! do not count), rendering a scene with a large normal map against the same scene without it.
+//! peak resident set (its own `VmHWM`, so tests running beside it do not count), rendering a
+//! scene with a large normal map against the same scene without it.
 //!
 //! The loader's promise (src/scene/upload.rs): about twice the texture's decoded size plus
 //! mips. On lavapipe the GPU image is host memory too, so the difference is the whole cost: the
@@ -16,29 +16,47 @@ use crate::common;
 
 /// Runs `command` to the end and returns its peak resident set in bytes; fails the test,
 /// showing its stderr, unless it succeeded.
+///
+/// The peak is the child's own `VmHWM` (`/proc/PID/status`), read every millisecond while it
+/// runs: a high-water mark, so any read after the peak sees it. Not `ru_maxrss` from `wait4`:
+/// Linux carries the forking process's high-water mark across `exec` into it, and this test
+/// binary, with the other CLI tests running in it, can be larger than the child.
 fn peak_resident_bytes(command: &mut Command, stderr_file: &Path) -> u64 {
-    let child = command
+    let mut child = command
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(std::fs::File::create(stderr_file).unwrap())
         .spawn()
         .expect("lucent runs");
-    let pid = libc::pid_t::try_from(child.id()).expect("a pid fits pid_t");
-    let mut status = 0;
-    // SAFETY: rusage is plain data (all-zero is a valid value); wait4 writes it and the status
-    // for this child, which nothing else waits for (the `Child` is dropped without waiting).
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(waited, pid, "wait4: {}", std::io::Error::last_os_error());
-    drop(child);
-    let succeeded = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
+    let status_file = format!("/proc/{}/status", child.id());
+    let mut peak_kib = 0u64;
+    let status = loop {
+        // A zombie's status has no VmHWM line: nothing read then, the peak was read before.
+        if let Ok(text) = std::fs::read_to_string(&status_file) {
+            let hwm = text
+                .lines()
+                .find_map(|line| line.strip_prefix("VmHWM:"))
+                .and_then(|rest| {
+                    rest.trim()
+                        .trim_end_matches("kB")
+                        .trim()
+                        .parse::<u64>()
+                        .ok()
+                });
+            peak_kib = peak_kib.max(hwm.unwrap_or(0));
+        }
+        if let Some(status) = child.try_wait().expect("waitable") {
+            break status;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    };
     assert!(
-        succeeded,
-        "{command:?} failed (status {status}): {}",
+        status.success(),
+        "{command:?} failed ({status}): {}",
         std::fs::read_to_string(stderr_file).unwrap_or_default()
     );
-    // Linux reports ru_maxrss in KiB.
-    u64::try_from(usage.ru_maxrss).expect("a size") * 1024
+    assert!(peak_kib > 0, "no VmHWM read from {status_file}");
+    peak_kib * 1024
 }
 
 /// A `size x size` RGB8 PNG normal map with some relief (so nothing about it is special),

@@ -4,9 +4,13 @@
 // block (glsl/common/sampling.glsl), so the average sees every radius at nine angles and no
 // grain is left. Gathered at half resolution (src/features/layered.rs, `--half-gather`), it is
 // brought back to full resolution here (one full-screen pass fewer: on lavapipe a pass over
-// the screen costs ~15 ms at 1024^2 whatever it does). Each pixel takes the four half-resolution texels around it,
-// bilinearly weighted, keeping only those of its own material and at its own depth (a texel
-// holds its 2x2 block's top-left pixel), so no term leaks across silhouettes or between
+// the screen costs ~15 ms at 1024^2 whatever it does). The half-resolution gather rotated its
+// spiral by one of nine angles per 3x3 block of texels, so the resolve weighs the 4x4 texels
+// around each pixel with a tent of per-axis weights (1 - f, 1, 1, f): a 3x3 box placed at the
+// pixel's own position, in which every rotation has the same total weight (the two outer
+// texels of an axis hold the same rotation, 1 - f + f = 1). It keeps only texels of the
+// pixel's material and at its depth (a texel holds its 2x2 block's top-left pixel), so no
+// term leaks across silhouettes or between
 // objects. Include after layered.glsl with LUCENT_HALF_TERM_BINDING defined.
 #ifndef LUCENT_LAYERED_UPSAMPLE_GLSL
 #define LUCENT_LAYERED_UPSAMPLE_GLSL
@@ -45,11 +49,13 @@ vec3 upsampled_multiple(ivec2 px, int id) {
     vec2 t = vec2(px) * 0.5;
     ivec2 base = ivec2(floor(t));
     vec2 f = t - vec2(base);
+    vec4 wx = vec4(1.0 - f.x, 1.0, 1.0, f.x);
+    vec4 wy = vec4(1.0 - f.y, 1.0, 1.0, f.y);
     vec3 sum = vec3(0.0);
     float total = 0.0;
-    for (int k = 0; k < 4; ++k) {
-        ivec2 o = ivec2(k & 1, k >> 1);
-        ivec2 q = min(base + o, half_size - 1);
+    for (int k = 0; k < 16; ++k) {
+        ivec2 o = ivec2(k & 3, k >> 2);
+        ivec2 q = clamp(base + o - 1, ivec2(0), half_size - 1);
         vec4 texel = texelFetch(half_term, q, 0);
         if (int(texel.a + 0.5) != id) {
             continue;
@@ -58,8 +64,7 @@ vec3 upsampled_multiple(ivec2 px, int id) {
         // Depth agreement within ~1% of the depth: a texel across a fold of the same object
         // (or behind it) gets no say.
         float rel = abs(d - here) / max(0.01 * here, 1e-6);
-        float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y) + 1e-4;
-        w /= 1.0 + rel * rel;
+        float w = (wx[o.x] * wy[o.y] + 1e-4) / (1.0 + rel * rel);
         sum += texel.rgb * w;
         total += w;
     }

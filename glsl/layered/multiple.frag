@@ -8,7 +8,8 @@
 // resolution the spiral is rotated by one of nine angles per 3x3 block
 // (glsl/common/sampling.glsl) and single scattering averages each pixel's 3x3 neighbours; with
 // LUCENT_HALF_GATHER each texel of a half-resolution target gathers for its 2x2 block's
-// top-left pixel, rotated per pixel, and single scattering upsamples it.
+// top-left pixel, its spiral rotated by one of nine angles per 3x3 block of texels, and single
+// scattering resolves it over the texels around each pixel (every rotation an equal share).
 #include "../common/layered.glsl"
 #include "../common/sampling.glsl"
 
@@ -16,12 +17,6 @@ layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
-
-// Per-pixel rotation of the half-resolution gather's spiral (Jimenez's interleaved gradient
-// noise): banding becomes noise, deterministic per pixel.
-float pixel_noise(vec2 p) {
-    return fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715))));
-}
 
 void main() {
 #ifdef LUCENT_HALF_GATHER
@@ -55,13 +50,9 @@ void main() {
     int count = clamp(layered.knobs.y, 4, 64);
     int scale = max(layered.knobs.w, 1);
     ivec2 size = ivec2(frame.viewport.xy);
-#ifdef LUCENT_HALF_GATHER
-    // Noise of the full-resolution pixel gathered for (its block's): the upsample averages
-    // four differently rotated gathers.
-    float rotation = 6.28318530718 * pixel_noise(vec2(px) + 0.5);
-#else
-    float rotation = spiral_rotation(px);
-#endif
+    // One of nine rotations per 3x3 block of this pass's texels (half-resolution texels with
+    // LUCENT_HALF_GATHER): the resolve in single scattering gives each an equal share.
+    float rotation = spiral_rotation(ivec2(gl_FragCoord.xy));
     vec3 gathered = vec3(0.0), weight = vec3(0.0);
     for (int i = 0; i < count; ++i) {
         float u = (float(i) + 0.5) / float(count);

@@ -84,21 +84,21 @@ fn cases() -> Vec<(&'static str, LayeredMedium, Term, LayeredKnobs, f64)> {
             0.15,
         ),
         (
-            "apple half gather",
+            "apple full gather",
             preset("apple"),
             Term::Multiple,
             LayeredKnobs {
-                half_gather: true,
+                half_gather: false,
                 ..default
             },
             0.08,
         ),
         (
-            "skin1 half gather",
+            "skin1 full gather",
             preset("skin1"),
             Term::Multiple,
             LayeredKnobs {
-                half_gather: true,
+                half_gather: false,
                 ..default
             },
             0.15,
@@ -123,9 +123,10 @@ fn each_term_agrees_with_its_reference() {
             knobs.pixel_lights,
             knobs.phase.name(),
             match (knobs.half_irradiance, knobs.half_gather) {
-                (true, _) => ", half irradiance",
-                (_, true) => ", half gather",
-                _ => "",
+                (true, true) => ", half irradiance, half gather",
+                (true, false) => ", half irradiance, full gather",
+                (false, true) => ", half gather",
+                (false, false) => ", full gather",
             },
             e.pixels,
             e.relative_l1,
@@ -190,20 +191,21 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     half.layered.half_irradiance = true;
     let p = common::plan(&layered, &half);
     assert_eq!(common::image_size(&p, "layered.irradiance"), (160, 120));
-    // The term multiple scattering writes for single scattering to resolve: full size by
-    // default (single scattering averages it over 3x3 pixels), half size with the half gather
-    // (single scattering upsamples it); drawn before single scattering either way.
-    assert_eq!(common::image_size(&p, "layered.multiple"), (320, 240));
+    // The term multiple scattering writes for single scattering to resolve: half size by
+    // default (the half gather; single scattering resolves it over 4x4 texels), full size with
+    // the full gather (single scattering averages it over 3x3 pixels); drawn before single
+    // scattering either way.
+    assert_eq!(common::image_size(&p, "layered.multiple"), (160, 120));
     let order = passes(&p);
     let at = |name: &str| order.iter().position(|n| n == name).unwrap();
     assert!(
         at("multiple scattering") < at("single scattering"),
         "{order:?}"
     );
-    let mut half_gather = s;
-    half_gather.layered.half_gather = true;
-    let p = common::plan(&layered, &half_gather);
-    assert_eq!(common::image_size(&p, "layered.multiple"), (160, 120));
+    let mut full_gather = s;
+    full_gather.layered.half_gather = false;
+    let p = common::plan(&layered, &full_gather);
+    assert_eq!(common::image_size(&p, "layered.multiple"), (320, 240));
     let order = passes(&p);
     let at = |name: &str| order.iter().position(|n| n == name).unwrap();
     assert!(
@@ -460,34 +462,38 @@ fn grain(hdr: &[f32], mask: &[bool], w: usize) -> f64 {
 
 /// Issue 25: Li et al.'s pixel-light gather leaves no grain a still can see. On
 /// `showcase-layered` at 640x480, over the pixels the technique changes (4 px in from any
-/// other), the default gather (12 pixel lights, nine rotations averaged over 3x3 pixels) has
-/// at most 1.2x the grain of the same frame converged with 64 pixel lights (measured 1.04x);
-/// plain lighting's grain is printed
-/// beside it (the media's own structure, which the converged frame has too, is most of the
-/// difference to plain lighting; docs/layered.md, "Grain").
+/// other), each gather with 12 pixel lights has at most 1.2x the grain of the same frame
+/// converged with 64 pixel lights gathered per pixel: the default half gather (one gather per
+/// 2x2 block, nine rotations per 3x3 block of texels, resolved over 4x4 texels; measured
+/// 1.01x) and the full gather (nine rotations per 3x3 pixels, averaged over 3x3 pixels;
+/// 1.04x). Plain lighting's grain is printed beside them (the media's own structure, which
+/// the converged frame has too, is most of the difference to plain lighting; docs/layered.md,
+/// "Grain").
 #[test]
 fn the_pixel_light_gather_leaves_no_grain_in_a_still() {
     let test = TestGpu::new();
     let scene = lucent::bake::scene::load_scene_baked("showcase-layered").unwrap();
     let (w, h) = (640usize, 480usize);
-    let frame = |technique, pixel_lights: u32| {
+    let frame = |technique, pixel_lights: u32, half_gather: bool| {
         let mut s = FrameSettings {
             technique,
             export_hdr: true,
             ..FrameSettings::new(w as u32, h as u32)
         };
         s.layered.pixel_lights = pixel_lights;
+        s.layered.half_gather = half_gather;
         test.render(&scene, s).hdr.unwrap()
     };
-    let plain = frame(Technique::None, 12);
-    let default = frame(Technique::Auto, 12);
-    let converged = frame(Technique::Auto, 64);
+    let plain = frame(Technique::None, 12, true);
+    let half = frame(Technique::Auto, 12, true);
+    let full = frame(Technique::Auto, 12, false);
+    let converged = frame(Technique::Auto, 64, false);
     // The technique's pixels: changed by more than 2% of the plain frame's luminance, with
     // every pixel 4 px around changed too (silhouettes are not grain).
     let changed: Vec<bool> = (0..w * h)
         .map(|i| {
             (0..3).any(|c| {
-                let (a, b) = (plain[i * 4 + c], default[i * 4 + c]);
+                let (a, b) = (plain[i * 4 + c], full[i * 4 + c]);
                 (a - b).abs() > 0.02 * a.abs().max(0.05)
             })
         })
@@ -500,22 +506,27 @@ fn the_pixel_light_gather_leaves_no_grain_in_a_still() {
                 && (0..81).all(|k| changed[(y + k / 9 - 4) * w + x + k % 9 - 4])
         })
         .collect();
-    let (g_plain, g_default, g_converged) = (
+    let (g_plain, g_half, g_full, g_converged) = (
         grain(&plain, &mask, w),
-        grain(&default, &mask, w),
+        grain(&half, &mask, w),
+        grain(&full, &mask, w),
         grain(&converged, &mask, w),
     );
     eprintln!(
-        "showcase-layered grain over {} px: 12 pixel lights {g_default:.4e}, 64 pixel lights \
-         {g_converged:.4e} ({:.2}x), plain lighting {g_plain:.4e} ({:.2}x)",
+        "showcase-layered grain over {} px: half gather {g_half:.4e} ({:.2}x), full gather \
+         {g_full:.4e} ({:.2}x), 64 pixel lights per pixel {g_converged:.4e}, plain lighting \
+         {g_plain:.4e}",
         mask.iter().filter(|&&m| m).count(),
-        g_default / g_converged,
-        g_default / g_plain
+        g_half / g_converged,
+        g_full / g_converged,
     );
-    assert!(
-        g_default <= 1.2 * g_converged,
-        "12 pixel lights {g_default:.4e} against 64 {g_converged:.4e}: visible grain"
-    );
+    for (name, g) in [("half", g_half), ("full", g_full)] {
+        assert!(
+            g <= 1.2 * g_converged,
+            "the {name} gather with 12 pixel lights {g:.4e} against 64 per pixel \
+             {g_converged:.4e}: visible grain"
+        );
+    }
     test.finish();
 }
 

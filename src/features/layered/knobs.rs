@@ -54,15 +54,16 @@ pub static HALF_IRRADIANCE_KNOB: Knob = Knob {
     apply: |k, _| k.layered.half_irradiance = true,
 };
 
-/// `--half-gather`: multiple scattering gathered per 2x2 block.
-pub static HALF_GATHER_KNOB: Knob = Knob {
-    flag: "--half-gather",
-    help: "Layered media: multiple scattering gathered once per 2x2 block and upsampled by \
-           material and depth (cheaper; a coarse mottling where the full gather, resolved over \
-           3x3 pixels, shows no grain).",
-    takes: Takes::Switch,
-    default: None,
-    apply: |k, _| k.layered.half_gather = true,
+/// `--gather half|full`: multiple scattering gathered per 2x2 block (the default) or per pixel.
+pub static GATHER_KNOB: Knob = Knob {
+    flag: "--gather",
+    help: "Layered media: multiple scattering's pixel-light gather, half (the default: once per \
+           2x2 block, resolved at full resolution over the 4x4 half-resolution texels around \
+           each pixel, by material and depth) or full (once per pixel, resolved over 3x3 \
+           pixels; the same error and grain for about 3x the gather's time).",
+    takes: Takes::Choice(&["half", "full"]),
+    default: Some(Given::Choice("half")),
+    apply: |k, v| k.layered.half_gather = v.choice() == "half",
 };
 
 /// `--single-depth X`: single scattering's depth in mean free paths.

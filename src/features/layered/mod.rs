@@ -56,8 +56,7 @@ pub mod knobs;
 pub mod settings;
 
 pub use knobs::{
-    HALF_GATHER_KNOB, HALF_IRRADIANCE_KNOB, PHASE_KNOB, PIXEL_LIGHTS_KNOB, SINGLE_DEPTH_KNOB,
-    STEPS_KNOB,
+    GATHER_KNOB, HALF_IRRADIANCE_KNOB, PHASE_KNOB, PIXEL_LIGHTS_KNOB, SINGLE_DEPTH_KNOB, STEPS_KNOB,
 };
 pub use settings::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
 
@@ -658,7 +657,7 @@ impl TechniqueModule for LiLayeredMedia {
             &PIXEL_LIGHTS_KNOB,
             &PHASE_KNOB,
             &HALF_IRRADIANCE_KNOB,
-            &HALF_GATHER_KNOB,
+            &GATHER_KNOB,
             &SINGLE_DEPTH_KNOB,
         ];
         KNOBS

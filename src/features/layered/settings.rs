@@ -44,12 +44,12 @@ pub struct LayeredKnobs {
     pub phase: PhaseForm,
     /// The irradiance image at half resolution per side.
     pub half_irradiance: bool,
-    /// Multiple scattering gathered at half resolution per side (one gather per 2x2 block),
-    /// brought back by a material- and depth-aware upsample in the single scattering pass.
-    /// Cheaper and, by the error metric, closer to the reference (the upsample averages four
-    /// differently rotated gathers), but the gather's noise becomes a coarse mottling, where
-    /// the full-resolution gather (nine rotations per 3x3 block, resolved by single
-    /// scattering) shows no grain (docs/layered.md): off by default.
+    /// Multiple scattering gathered at half resolution per side (one gather per 2x2 block,
+    /// the default), resolved at full resolution in the single scattering pass over the 4x4
+    /// texels around each pixel; or per pixel (`false`), resolved over 3x3 pixels. Both
+    /// rotate the gather's spiral by one of nine angles per 3x3 block of the gather's own
+    /// texels and give every rotation an equal share in the resolve: the same error against
+    /// the reference and the same grain, for a quarter of the gathers (docs/layered.md).
     pub half_gather: bool,
     /// Single scattering's depth `D_max` in mean free paths of the first layer's clearest
     /// channel (> 0; default 4: beyond, `e^-4` of the light is left to multiple scattering).
@@ -63,7 +63,7 @@ impl Default for LayeredKnobs {
             pixel_lights: 12,
             phase: PhaseForm::HenyeyGreenstein,
             half_irradiance: false,
-            half_gather: false,
+            half_gather: true,
             max_depth_mfp: 4.0,
         }
     }

@@ -269,10 +269,16 @@ fn world_sphere(scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> (Vec3, f32) {
 /// The view-projection and texel-size parameters of each face of a light.
 fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Mat4, Vec4)> {
     let tile = tile as f32;
-    // Perspective faces: near at 1/200 of the range keeps fp32 depth resolution at the far end
-    // of a 20-unit range near 1e-4 units (the normal offset covers that).
+    // Perspective faces: far at the light's range or the scene's farthest point from the
+    // light, whichever is nearer, and near at 1/200 of that, which keeps fp32 depth resolution
+    // at the far end of a 20-unit span near 1e-4 units (the normal offset covers that). Far
+    // must not be the range alone: a light with a range of 1000 units put its near plane 5
+    // units out, and a slab 0.9 units from it was missing from its map (no shadow, and a
+    // layered medium that took its entry points from the map rendered black).
     let perspective = |position: Vec3, forward: Vec3, up: Vec3, fov: f32, range: f32| {
-        let far = range.max(1e-3);
+        // (A tenth more: deforming meshes move a little beyond their rest bounds.)
+        let reach = ((position - center).length() + radius) * 1.1;
+        let far = range.min(reach).max(1e-3);
         let near = far / 200.0;
         let view = Mat4::look_to_rh(position, forward, up);
         let proj = Mat4::perspective_rh(fov, 1.0, near, far);
@@ -714,6 +720,33 @@ mod tests {
             assert!(clip.w > 0.0, "{d}");
             assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{d}: {ndc}");
             assert!((0.0..=1.0).contains(&ndc.z), "{d}: {ndc}");
+        }
+    }
+
+    #[test]
+    fn a_long_range_light_keeps_the_geometry_near_it_in_its_map() {
+        // Issue 26's back-lit slab: 2 x 2 x 0.2 units at the origin, a point light 1 unit
+        // behind it with a range of 1000. The slab's back face (0.9 units from the light)
+        // must lie between the -Z face's planes, as must the far corners of the slab.
+        let position = Vec3::new(0.0, 0.0, -1.0);
+        let (center, radius) = (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1).length());
+        for range in [10.0, 1000.0, 1e7] {
+            let faces = light_faces(LightKind::Point { position, range }, center, radius, 512);
+            let plus_z = faces[4].0; // +Z: from the light towards the slab
+            for p in [Vec3::new(0.0, 0.0, -0.1), Vec3::new(0.0, 0.0, 0.1)] {
+                let clip = plus_z * p.extend(1.0);
+                let ndc = clip.truncate() / clip.w;
+                assert!(
+                    clip.w > 0.0 && (0.0..=1.0).contains(&ndc.z),
+                    "range {range}: {p}: {ndc}"
+                );
+            }
+            // Far follows the scene, not the range: depth precision is spent on what is there.
+            assert!(
+                faces[4].1.w <= 1.1 * (1.0 + radius) + 1e-4,
+                "range {range}: {}",
+                faces[4].1
+            );
         }
     }
 

@@ -530,9 +530,11 @@ fn the_pixel_light_gather_leaves_no_grain_in_a_still() {
     test.finish();
 }
 
-/// Issue 26: a thin layered slab lit only from behind glows through (it once rendered black).
-/// `tests/data/backlit-slab.toml`: 40 x 40 x 4 mm of skin1 at eta 1, a point light 20 mm
-/// behind it. Plain lighting leaves the front face black (no light reaches it); the layered
+/// Issue 26: a thin layered slab lit only from behind glows through. It rendered black: the
+/// light's range (1000 units) put its shadow map's near plane 5 units out, past the slab, so
+/// the map held no entry points for it (src/features/shadows.rs now ends a face's depth range
+/// at the scene). `tests/data/backlit-slab.toml`: 40 x 40 x 4 mm of skin1 at eta 1, a point
+/// light 20 mm behind it. Plain lighting leaves the front face black (no light reaches it); the layered
 /// frame must show light through it, finite, reddest where skin1 absorbs least. The bar is a
 /// floor, not the truth: 1-D diffusion through 4 mm of skin1 lets through of the order of
 /// e^(-sigma_tr 4 mm) = 0.34 of the red (sigma_tr = sqrt(3 sigma_a sigma_t') = 0.27 / mm), so

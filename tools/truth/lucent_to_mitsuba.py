@@ -488,9 +488,13 @@ def material_parts(sc, index, m, notes):
     sigma_s = np.array(sigma_s, dtype=float) / units_per_mm
     sigma_t = sigma_a + sigma_s
     albedo = np.divide(sigma_s, sigma_t, out=np.zeros(3), where=sigma_t > 0)
+    # Mitsuba reads an RGB sigma_t as a reflectance (each channel <= 1): give it sigma_t over
+    # its largest channel and that largest channel as `scale` (exact: scale x rgb).
+    sigma_t_scale = float(sigma_t.max()) if sigma_t.max() > 0 else 1.0
     medium = {
         "type": "homogeneous",
-        "sigma_t": _rgb(sigma_t),
+        "sigma_t": _rgb(sigma_t / sigma_t_scale),
+        "scale": sigma_t_scale,
         "albedo": _rgb(albedo),
         "phase": {"type": "hg", "g": g},
     }

@@ -256,6 +256,7 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
     materials = {m.get("name"): (i, m) for i, m in enumerate(t.get("material", []))}
     corners = []  # world-space bounding-box corners of every object
     has_dielectric = False
+    dielectric_key = None  # the first material with eta != 1, for the refusal below
     for k, obj in enumerate(t.get("object", [])):
         okey = f"object[{k}]"
         if obj.get("mesh") not in meshes:
@@ -273,6 +274,8 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
                 raise sc.refuse(f"{okey}.mesh", f"mesh {mesh['name']!r} is not a closed surface; "
                                 "a medium needs one to be inside of")
             shape["interior"] = medium
+            if eta != 1.0 and dielectric_key is None:
+                dielectric_key = f"material[{ma_index}].layered.eta"
             has_dielectric |= eta != 1.0
         shape["bsdf"] = bsdf
         scene[f"object{k}"] = shape
@@ -284,7 +287,7 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
         scene[f"light{k}"] = light_emitter(sc, k, light, corners, notes)
     if has_dielectric and t.get("light") and not allow_dielectric_delta_lights:
         raise sc.refuse(
-            "material.layered.eta",
+            dielectric_key,
             "a medium behind a dielectric boundary (eta != 1) cannot be lit by point, spot or "
             "directional lights in Mitsuba's volpath: its shadow rays do not cross a smooth "
             "dielectric, so only paths that hit an emitter by chance carry light, and a delta "
@@ -348,7 +351,7 @@ def environment_emitter(sc: _Scene, t: dict) -> dict | None:
         image = np.empty((rows, 2 * rows, 3), dtype=np.float32)
         image[: rows // 2] = env["sky"]
         image[rows // 2:] = env["ground"]
-        return {"type": "envmap", "bitmap": mi.Bitmap(image), "filter_type": "bilinear"}
+        return {"type": "envmap", "bitmap": mi.Bitmap(image)}
     raise sc.refuse(
         "environment.kind",
         "kind = \"map\" is not converted: lucent lights with the map's nine spherical-harmonic "

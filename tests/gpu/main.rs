@@ -25,3 +25,4 @@ mod sss;
 mod sss_artifacts;
 mod sweep_layered;
 mod translucency;
+mod truth;

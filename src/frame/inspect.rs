@@ -215,6 +215,31 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 }
             ));
         }
+        if let Some(medium) = &m.medium {
+            // What each technique took from the medium, and what the material wrote itself.
+            let rd = medium.total_diffuse_reflectance();
+            let layer = &medium.layers[0];
+            parts.push(format!(
+                "medium {} (sigma_a {:?}, sigma_s {:?} mm^-1, g {}, eta {}, {} units/mm): albedo \
+                 {}, layered {}",
+                medium.name,
+                layer.sigma_a.to_array(),
+                layer.sigma_s.to_array(),
+                layer.g,
+                medium.eta,
+                medium.units_per_mm,
+                if m.albedo == rd {
+                    format!("{:?} = its total diffuse reflectance R_d", rd.to_array())
+                } else {
+                    format!("written (its R_d would be {:?})", rd.to_array())
+                },
+                if m.layers.as_ref() == Some(medium) {
+                    "= the medium, one semi-infinite layer"
+                } else {
+                    "written ([material.layered])"
+                }
+            ));
+        }
         let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
         let parts = if parts.is_empty() {
             "opaque".to_string()

@@ -307,6 +307,25 @@ impl LayeredMedium {
         }
     }
 
+    /// Jensen et al.'s total diffuse reflectance `R_d` of the first layer, taken as
+    /// semi-infinite, at the medium's `eta`, per channel: the fraction of the light falling on a
+    /// flat surface of it that leaves again, everywhere, diffusely (the dipole integrated over
+    /// the plane, `crate::reference::dipole`). The albedo a Lambertian surface of this medium
+    /// has: what `[material.medium]` gives a material that writes none.
+    pub fn total_diffuse_reflectance(&self) -> Vec3 {
+        let r = self.first_layer_reduced();
+        let channel = |c: usize| {
+            let dipole = dipole_constants(
+                f64::from(r.sigma_s_prime[c]),
+                f64::from(r.sigma_a[c]),
+                f64::from(self.eta),
+            );
+            // In [0, 1] for every medium validate() accepts; clamped so an albedo stays one.
+            dipole.total_reflectance().clamp(0.0, 1.0) as f32
+        };
+        Vec3::new(channel(0), channel(1), channel(2))
+    }
+
     /// A preset by name (see the module docs): the Jensen 2001 media, `li-teapot` and
     /// `skin-layered`.
     pub fn preset(name: &str) -> Result<Self> {

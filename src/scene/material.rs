@@ -398,6 +398,10 @@ pub struct Material {
     pub sss: Option<SssProfile>,
     /// Li et al.'s layered medium, if the material is layered.
     pub layers: Option<LayeredMedium>,
+    /// The one homogeneous medium the material is made of (`[material.medium]`, one
+    /// semi-infinite layer), if it gives one: its albedo (when not written) is the medium's
+    /// total diffuse reflectance and its `layers` (when not written) the medium itself.
+    pub medium: Option<LayeredMedium>,
 }
 
 impl Material {
@@ -413,6 +417,7 @@ impl Material {
             translucency: None,
             sss: None,
             layers: None,
+            medium: None,
         }
     }
 
@@ -459,6 +464,12 @@ impl Material {
         }
         if let Some(l) = &self.layers {
             l.validate()?;
+        }
+        if let Some(m) = &self.medium {
+            m.validate()?;
+            if m.layers.len() != 1 || m.layers[0].thickness != Thickness::Rest {
+                return bad("a medium is one semi-infinite layer".into());
+            }
         }
         Ok(())
     }

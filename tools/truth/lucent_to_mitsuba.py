@@ -275,7 +275,8 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
                                 "a medium needs one to be inside of")
             shape["interior"] = medium
             if eta != 1.0 and dielectric_key is None:
-                dielectric_key = f"material[{ma_index}].layered.eta"
+                table = "medium" if "medium" in material else "layered"
+                dielectric_key = f"material[{ma_index}].{table}.eta"
             has_dielectric |= eta != 1.0
         shape["bsdf"] = bsdf
         scene[f"object{k}"] = shape
@@ -413,7 +414,7 @@ def material_parts(sc, index, m, notes):
     """(bsdf, medium or None, eta) of `[[material]]` number `index`."""
     key = f"material[{index}]"
     known = {"name", "albedo", "specular", "roughness", "albedo_texture", "normal_texture",
-             "translucency", "sss", "layered", "layers"}
+             "translucency", "sss", "layered", "layers", "medium"}
     for k in m:
         if k not in known:
             raise sc.refuse(f"{key}.{k}", "unknown key")
@@ -423,6 +424,8 @@ def material_parts(sc, index, m, notes):
     if "layers" in m:
         raise sc.refuse(f"{key}.layers", "gone from lucent: use [material.layered]")
     layered = m.get("layered")
+    if "medium" in m:
+        return _medium_parts(sc, key, m, notes)
     if layered is None:
         for part in ("sss", "translucency"):
             if part in m:
@@ -483,6 +486,51 @@ def material_parts(sc, index, m, notes):
     knobs = [k for k in ("albedo", "specular", "roughness") if k in m]
     knobs += [f"layered.{k}" for k in ("weights",) if k in layered]
     knobs += [k for k in ("sss", "translucency") if k in m]
+    return _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes)
+
+
+def _medium_parts(sc, key, m, notes):
+    """(bsdf, medium, eta) of a material with `[material.medium]`: the one medium lucent's
+    techniques derive their parameters from (src/scene/file/materials.rs `medium`), so the
+    truth renders it; a `[material.layered]` beside it is one of lucent's approximations."""
+    medium = m["medium"]
+    mkey = f"{key}.medium"
+    for k in medium:
+        if k not in {"preset", "sigma_a", "sigma_s", "sigma_s_prime", "g", "eta", "units_per_mm"}:
+            raise sc.refuse(f"{mkey}.{k}", "unknown key")
+    preset = medium.get("preset")
+    coefficients = [k for k in ("sigma_a", "sigma_s", "sigma_s_prime", "g") if k in medium]
+    if preset is not None:
+        if coefficients:
+            raise sc.refuse(f"{mkey}.preset", "give a preset or the coefficients, not both")
+        if preset not in JENSEN_2001:
+            raise sc.refuse(f"{mkey}.preset", f"{preset!r} is not one of Jensen 2001's media "
+                            f"({', '.join(sorted(JENSEN_2001))})")
+        sigma_s_prime, sigma_a = JENSEN_2001[preset]
+        sigma_s, g = list(sigma_s_prime), 0.0
+    else:
+        if "sigma_a" not in medium:
+            raise sc.refuse(mkey, "missing sigma_a")
+        g = float(medium.get("g", 0.0))
+        sigma_a = medium["sigma_a"]
+        if ("sigma_s" in medium) == ("sigma_s_prime" in medium):
+            raise sc.refuse(mkey, "give sigma_s or sigma_s_prime (one of them)")
+        if "sigma_s" in medium:
+            sigma_s = medium["sigma_s"]
+        else:
+            one_minus_g = max(1.0 - max(-MAX_ABS_G, min(MAX_ABS_G, g)), 1.0 - MAX_ABS_G)
+            sigma_s = [s / one_minus_g for s in medium["sigma_s_prime"]]
+    # lucent's defaults for a medium: eta 1.3 (presets and coefficients alike), 0.04 units/mm.
+    eta = float(medium.get("eta", PRESET_ETA if preset is not None else 1.3))
+    units_per_mm = float(medium.get("units_per_mm", DEFAULT_UNITS_PER_MM))
+    knobs = [k for k in ("albedo", "specular", "roughness", "layered", "sss", "translucency")
+             if k in m]
+    return _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes)
+
+
+def _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes):
+    """(bsdf, medium, eta) of a homogeneous interior in mm^-1 at `units_per_mm`; `knobs`:
+    the material's keys that tune lucent's techniques only (noted, not rendered)."""
     if knobs:
         notes.append(f"{key} ({m.get('name')}): {', '.join(knobs)} tune lucent's techniques, "
                      "not the medium: not rendered by the truth")

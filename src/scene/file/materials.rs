@@ -9,10 +9,12 @@ use glam::Vec3;
 use toml::Spanned;
 
 use super::schema::{
-    LayerToml, LayeredToml, MaterialToml, SssToml, ThicknessToml, TranslucencyToml,
+    LayerToml, LayeredToml, MaterialToml, MediumToml, SssToml, ThicknessToml, TranslucencyToml,
 };
 use super::{span, value, SceneFile, Table};
-use crate::scene::layered::{self, sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS};
+use crate::scene::layered::{
+    self, sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS, PHYSICAL_WEIGHTS,
+};
 use crate::scene::material::{
     BurleyDistance, Gaussian, Layer, LayeredMedium, Material, PowMode, SssProfile, TechniqueName,
     TextureSource, Texturing, Thickness, ThicknessSource, Translucency,
@@ -57,9 +59,17 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         }
         Ok(Some(TextureSource::File(full)))
     };
+    let medium = m.medium.as_ref().map(|t| medium(at, t)).transpose()?;
+    // The albedo a technique shades with: as written, else the medium's total diffuse
+    // reflectance (what a Lambertian surface of it reflects), else a light grey.
+    let albedo = match (value(&m.albedo), &medium) {
+        (Some(written), _) => Vec3::from(written),
+        (None, Some(medium)) => medium.total_diffuse_reflectance(),
+        (None, None) => Vec3::splat(0.8),
+    };
     let mut material = Material::opaque(
         m.name.get_ref(),
-        Vec3::from(value(&m.albedo).unwrap_or([0.8; 3])),
+        albedo,
         value(&m.specular).unwrap_or(0.5),
         value(&m.roughness).unwrap_or(0.5),
     );
@@ -79,9 +89,13 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
              skin1, ...) or `[[material.layered.layer]]` tables (see docs/scene-format.toml)",
         ));
     }
-    if let Some(l) = &m.layered {
-        material.layers = Some(layered_medium(file, at, l)?);
-    }
+    // Li et al.'s layers: the material's own table, else the medium as one semi-infinite layer.
+    material.layers = match (&m.layered, &medium) {
+        (Some(l), _) => Some(layered_medium(file, at, l)?),
+        (None, Some(medium)) => Some(medium.clone()),
+        (None, None) => None,
+    };
+    material.medium = medium;
     // Map a range failure to the key it names.
     material.validate().map_err(|e| {
         let message = e.to_string();
@@ -316,15 +330,7 @@ fn layered_medium(file: &SceneFile<'_>, at: Table<'_>, l: &LayeredToml) -> Resul
         }
     };
     if let Some(eta) = &l.eta {
-        let eta_value = *eta.get_ref();
-        if !(eta_value.is_finite() && eta_value > 0.0) {
-            return Err(at.error(
-                "layered.eta",
-                Some(eta.span()),
-                format!("{eta_value} must be finite and > 0 (relative index; 1 = no boundary)"),
-            ));
-        }
-        medium.eta = eta_value;
+        medium.eta = checked_eta(at, "layered.eta", eta)?;
     }
     if let Some(weights) = &l.weights {
         let w = *weights.get_ref();
@@ -341,21 +347,7 @@ fn layered_medium(file: &SceneFile<'_>, at: Table<'_>, l: &LayeredToml) -> Resul
         medium.weights = w;
     }
     if let Some(units) = &l.units_per_mm {
-        let u = *units.get_ref();
-        let range = layered::UNITS_PER_MM_RANGE;
-        if !(u.is_finite() && range.contains(&u)) {
-            return Err(at.error(
-                "layered.units_per_mm",
-                Some(units.span()),
-                format!(
-                    "{u} must be in [{:e}, {:e}] (scene units per millimetre: 1 when a unit is \
-                     a millimetre, 0.001 when it is a metre)",
-                    range.start(),
-                    range.end()
-                ),
-            ));
-        }
-        medium.units_per_mm = u;
+        medium.units_per_mm = checked_units_per_mm(at, "layered.units_per_mm", units)?;
     }
     medium.depth_textures = depth_textures(file, at, l, medium.depth_textures_needed())?;
     // Everything was checked above; this names what a future field would miss.
@@ -367,8 +359,35 @@ fn layered_medium(file: &SceneFile<'_>, at: Table<'_>, l: &LayeredToml) -> Resul
 
 /// `[[material.layered.layer]]` number `k` of `count`.
 fn layer(at: Table<'_>, k: usize, count: usize, t: &LayerToml) -> Result<Layer> {
-    let key = |leaf: &str| format!("layered.layer[{k}].{leaf}");
-    let missing = |what: &str| at.error(&format!("layered.layer[{k}]"), None, what);
+    let prefix = format!("layered.layer[{k}]");
+    let missing = |what: &str| at.error(&prefix, None, what);
+    let (sigma_a, sigma_s, g) = coefficients(
+        at,
+        &prefix,
+        [&t.sigma_a, &t.sigma_s, &t.sigma_s_prime],
+        &t.g,
+    )?;
+    let thickness = layer_thickness(at, k, count, t, &missing)?;
+    Ok(Layer {
+        sigma_a,
+        sigma_s,
+        g,
+        thickness,
+    })
+}
+
+/// A medium's absorption, scattering (`sigma_s`, or the reduced `sigma_s_prime` stored as
+/// `sigma_s' / (1 - g)`) and Henyey-Greenstein `g`, written as `[sigma_a, sigma_s,
+/// sigma_s_prime]` in the table `prefix` (a layer's or `[material.medium]`): each error names
+/// its key. Returns (sigma_a, sigma_s, g), mm^-1.
+fn coefficients(
+    at: Table<'_>,
+    prefix: &str,
+    [sigma_a, sigma_s, sigma_s_prime]: [&Option<Spanned<[f32; 3]>>; 3],
+    g: &Option<Spanned<f32>>,
+) -> Result<(Vec3, Vec3, f32)> {
+    let key = |leaf: &str| format!("{prefix}.{leaf}");
+    let missing = |what: &str| at.error(prefix, None, what);
     let coefficient = |leaf: &str, v: &Spanned<[f32; 3]>| -> Result<Vec3> {
         let numbers = *v.get_ref();
         if numbers
@@ -384,25 +403,25 @@ fn layer(at: Table<'_>, k: usize, count: usize, t: &LayerToml) -> Result<Layer> 
             ))
         }
     };
-    let sigma_a = match &t.sigma_a {
+    let sigma_a = match sigma_a {
         Some(v) => coefficient("sigma_a", v)?,
         None => return Err(missing("missing `sigma_a` (absorption, RGB, mm^-1)")),
     };
-    let g = value(&t.g).unwrap_or(0.0);
-    if !(g.is_finite() && g.abs() <= MAX_ABS_G) {
+    let g_value = value(g).unwrap_or(0.0);
+    if !(g_value.is_finite() && g_value.abs() <= MAX_ABS_G) {
         return Err(at.error(
             &key("g"),
-            span(&t.g),
+            span(g),
             format!(
-                "{g} must be in [-{MAX_ABS_G}, {MAX_ABS_G}] (Henyey-Greenstein anisotropy; \
+                "{g_value} must be in [-{MAX_ABS_G}, {MAX_ABS_G}] (Henyey-Greenstein anisotropy; \
                  |g| = 1 is a delta)"
             ),
         ));
     }
-    let sigma_s = match (&t.sigma_s, &t.sigma_s_prime) {
+    let sigma_s = match (sigma_s, sigma_s_prime) {
         (Some(v), None) => coefficient("sigma_s", v)?,
         (None, Some(v)) => {
-            let s = sigma_s_from_reduced(coefficient("sigma_s_prime", v)?, g);
+            let s = sigma_s_from_reduced(coefficient("sigma_s_prime", v)?, g_value);
             if s.max_element() > MAX_COEFFICIENT {
                 return Err(at.error(
                     &key("sigma_s_prime"),
@@ -428,13 +447,93 @@ fn layer(at: Table<'_>, k: usize, count: usize, t: &LayerToml) -> Result<Layer> 
             ))
         }
     };
-    let thickness = layer_thickness(at, k, count, t, &missing)?;
-    Ok(Layer {
-        sigma_a,
-        sigma_s,
-        g,
-        thickness,
-    })
+    Ok((sigma_a, sigma_s, g_value))
+}
+
+/// A relative index of refraction (`key`): finite and > 0.
+fn checked_eta(at: Table<'_>, key: &str, eta: &Spanned<f32>) -> Result<f32> {
+    let eta_value = *eta.get_ref();
+    if eta_value.is_finite() && eta_value > 0.0 {
+        Ok(eta_value)
+    } else {
+        Err(at.error(
+            key,
+            Some(eta.span()),
+            format!("{eta_value} must be finite and > 0 (relative index; 1 = no boundary)"),
+        ))
+    }
+}
+
+/// Scene units per millimetre (`key`), in [`layered::UNITS_PER_MM_RANGE`].
+fn checked_units_per_mm(at: Table<'_>, key: &str, units: &Spanned<f32>) -> Result<f32> {
+    let u = *units.get_ref();
+    let range = layered::UNITS_PER_MM_RANGE;
+    if u.is_finite() && range.contains(&u) {
+        Ok(u)
+    } else {
+        Err(at.error(
+            key,
+            Some(units.span()),
+            format!(
+                "{u} must be in [{:e}, {:e}] (scene units per millimetre: 1 when a unit is a \
+                 millimetre, 0.001 when it is a metre)",
+                range.start(),
+                range.end()
+            ),
+        ))
+    }
+}
+
+/// `[material.medium]`: the one homogeneous medium the material is made of, a Jensen 2001
+/// `preset` or its coefficients (mm^-1), its `eta` and `units_per_mm`, as one semi-infinite
+/// layer weighted physically (eq. 3's lambdas (0, 1, 1, 1, 1): the medium's light, nothing
+/// added). The material's albedo and Li et al.'s layers derive from it where the material
+/// does not write its own (`material`).
+fn medium(at: Table<'_>, t: &MediumToml) -> Result<LayeredMedium> {
+    let written = [&t.sigma_a, &t.sigma_s, &t.sigma_s_prime];
+    let coefficients_written = written.iter().any(|c| c.is_some()) || t.g.is_some();
+    let mut medium =
+        match &t.preset {
+            Some(p) if coefficients_written => return Err(at.error(
+                "medium.preset",
+                Some(p.span()),
+                "give a `preset` or the coefficients (`sigma_a`, `sigma_s` or `sigma_s_prime`, \
+                 `g`), not both",
+            )),
+            Some(p) => {
+                let preset = LayeredMedium::preset(p.get_ref())
+                    .map_err(|e| at.error("medium.preset", Some(p.span()), e))?;
+                if preset.layers.len() != 1 {
+                    return Err(at.error(
+                        "medium.preset",
+                        Some(p.span()),
+                        format!(
+                            "`{}` is a stack of {} layers, not one medium: give it as \
+                         `[material.layered] preset = \"{}\"`",
+                            p.get_ref(),
+                            preset.layers.len(),
+                            p.get_ref()
+                        ),
+                    ));
+                }
+                preset
+            }
+            None => {
+                let (sigma_a, sigma_s, g) = coefficients(at, "medium", written, &t.g)?;
+                let mut medium = LayeredMedium::homogeneous("custom", Vec3::ZERO, sigma_a, g, 1.3);
+                medium.layers[0].sigma_s = sigma_s;
+                medium
+            }
+        };
+    medium.weights = PHYSICAL_WEIGHTS;
+    if let Some(eta) = &t.eta {
+        medium.eta = checked_eta(at, "medium.eta", eta)?;
+    }
+    if let Some(units) = &t.units_per_mm {
+        medium.units_per_mm = checked_units_per_mm(at, "medium.units_per_mm", units)?;
+    }
+    medium.validate().map_err(|e| at.error("medium", None, e))?;
+    Ok(medium)
 }
 
 /// What a layer's `thickness` may be.

@@ -537,6 +537,130 @@ thickness = "rest"
         assert_eq!(m.layers[1].thickness, Thickness::Rest);
     }
 
+    const MEDIUM: &str = r#"[material.medium]
+sigma_a = [0.032, 0.17, 0.48]
+sigma_s = [0.74, 0.88, 1.01]
+eta = 1.0
+units_per_mm = 0.05
+"#;
+
+    #[test]
+    fn a_medium_gives_the_albedo_and_the_layers_unless_they_are_written() {
+        // Skin1 (Jensen 2001) at eta 1: its total diffuse reflectance, as the truth tool's
+        // scenes write it by hand (tools/truth/scenes/skin1-slab-backlit.toml, computed there
+        // from Jensen's formula in Python): (0.5473, 0.2912, 0.161).
+        let s = parse(&with_layered(MEDIUM)).unwrap();
+        let m = &s.objects[0].material;
+        let expected = Vec3::new(0.5473, 0.2912, 0.161);
+        assert!(
+            (m.albedo - expected).abs().max_element() < 5e-4,
+            "{}",
+            m.albedo
+        );
+        // The f64 twin: the dipole's closed form, channel by channel.
+        for c in 0..3 {
+            let d = crate::scene::layered::dipole_constants(
+                [0.74, 0.88, 1.01][c],
+                [0.032, 0.17, 0.48][c],
+                1.0,
+            );
+            assert!((f64::from(m.albedo[c]) - d.total_reflectance()).abs() < 1e-6);
+        }
+        let layers = m.layers.as_ref().unwrap();
+        assert_eq!(layers, m.medium.as_ref().unwrap());
+        assert_eq!(layers.layers.len(), 1);
+        assert_eq!(layers.layers[0].thickness, Thickness::Rest);
+        assert_eq!(layers.layers[0].sigma_s, Vec3::new(0.74, 0.88, 1.01));
+        assert_eq!((layers.eta, layers.units_per_mm), (1.0, 0.05));
+        assert_eq!(layers.weights, crate::scene::layered::PHYSICAL_WEIGHTS);
+        // A preset, its eta (1.3) kept: marble's R_d is higher than skin1's in every channel.
+        let s = parse(&with_layered("[material.medium]\npreset = \"marble\"\n")).unwrap();
+        let marble = &s.objects[0].material;
+        assert!(marble.albedo.cmpgt(expected).all(), "{}", marble.albedo);
+        assert_eq!(marble.layers.as_ref().unwrap().eta, 1.3);
+        // Written keys override what the medium derives.
+        let s = parse(&with_layered(&format!(
+            "albedo = [0.1, 0.2, 0.3]\n{MEDIUM}"
+        )))
+        .unwrap();
+        assert_eq!(s.objects[0].material.albedo, Vec3::new(0.1, 0.2, 0.3));
+        let s = parse(&with_layered(&format!(
+            "{MEDIUM}\n[material.layered]\npreset = \"apple\"\n"
+        )))
+        .unwrap();
+        let m = &s.objects[0].material;
+        assert_eq!(m.layers.as_ref().unwrap().name, "apple");
+        assert!((m.albedo - expected).abs().max_element() < 5e-4);
+    }
+
+    #[test]
+    fn medium_errors_name_file_line_and_key() {
+        let base = with_layered(MEDIUM);
+        let cases = [
+            ("eta = 1.0", "eta = -1", "material[1].medium.eta", "> 0"),
+            (
+                "units_per_mm = 0.05",
+                "units_per_mm = 1e9",
+                "material[1].medium.units_per_mm",
+                "must be in",
+            ),
+            (
+                "sigma_a = [0.032, 0.17, 0.48]",
+                "sigma_a = [0.032, nan, 0.48]",
+                "material[1].medium.sigma_a",
+                "finite",
+            ),
+            (
+                "sigma_s = [0.74, 0.88, 1.01]",
+                "sigma_s = [0.74, 0.88, 1.01]\ng = 1.5",
+                "material[1].medium.g",
+                "[-0.999, 0.999]",
+            ),
+            (
+                "sigma_s = [0.74, 0.88, 1.01]",
+                "sigma_s = [0.74, 0.88, 1.01]\nsigma_s_prime = [1, 1, 1]",
+                "material[1].medium.sigma_s_prime",
+                "not both",
+            ),
+            (
+                "eta = 1.0",
+                "eta = 1.0\npreset = \"marble\"",
+                "material[1].medium.preset",
+                "not both",
+            ),
+            (
+                "eta = 1.0",
+                "eta = 1.0\nthickness = 2.0",
+                "key `thickness`",
+                "unknown field `thickness`",
+            ),
+        ];
+        for (from, to, key, part) in cases {
+            let src = base.replacen(from, to, 1);
+            assert_ne!(src, base, "{from}");
+            let e = parse(&src).unwrap_err().to_string();
+            assert!(
+                e.contains("test.toml") && e.contains(key) && e.contains(part),
+                "{to}: {e}"
+            );
+        }
+        // A stack is not one medium; an unknown preset names the ones there are.
+        let stack = with_layered("[material.medium]\npreset = \"skin-layered\"\n");
+        let e = parse(&stack).unwrap_err().to_string();
+        assert!(
+            e.contains("medium.preset") && e.contains("[material.layered]"),
+            "{e}"
+        );
+        let e = parse(&with_layered("[material.medium]\npreset = \"jade\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("medium.preset") && e.contains("skin1"), "{e}");
+        let e = parse(&with_layered("[material.medium]\neta = 1.2\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("medium") && e.contains("sigma_a"), "{e}");
+    }
+
     #[test]
     fn layered_errors_name_file_line_and_key() {
         let base = with_layered(TWO_LAYERS);

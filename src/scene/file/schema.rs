@@ -133,6 +133,19 @@ pub(super) struct LayeredToml {
     pub(super) depth_texture: Option<Spanned<toml::Value>>,
 }
 
+/// `[material.medium]`: one homogeneous medium the material is made of.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MediumToml {
+    pub(super) preset: Option<Spanned<String>>,
+    pub(super) sigma_a: Option<Spanned<[f32; 3]>>,
+    pub(super) sigma_s: Option<Spanned<[f32; 3]>>,
+    pub(super) sigma_s_prime: Option<Spanned<[f32; 3]>>,
+    pub(super) g: Option<Spanned<f32>>,
+    pub(super) eta: Option<Spanned<f32>>,
+    pub(super) units_per_mm: Option<Spanned<f32>>,
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct MaterialToml {
@@ -145,6 +158,7 @@ pub(super) struct MaterialToml {
     pub(super) translucency: Option<TranslucencyToml>,
     pub(super) sss: Option<SssToml>,
     pub(super) layered: Option<LayeredToml>,
+    pub(super) medium: Option<MediumToml>,
     /// Gone: `[material.layered]` replaced it. Kept only to say so.
     pub(super) layers: Option<toml::Value>,
 }

@@ -544,6 +544,39 @@ mod tests {
     use super::*;
 
     #[test]
+    fn total_diffuse_reflectance_stays_an_albedo_at_extreme_media() {
+        // A medium's R_d becomes a material's albedo: finite and in [0, 1] for every medium
+        // validate() accepts (coefficients 0 to 1e6 mm^-1, g to +-0.999, eta 1 to 2.5 and
+        // beyond), 0 without scattering and near 1 without absorption.
+        for sp in [0.0, 1e-6, 1.0, 1e6] {
+            for sa in [0.0, 1e-6, 1.0, 1e6] {
+                for g in [-0.999, 0.0, 0.999] {
+                    for eta in [0.5, 1.0, 1.3, 2.5, 10.0] {
+                        let m = LayeredMedium::homogeneous(
+                            "x",
+                            Vec3::splat(sp),
+                            Vec3::splat(sa),
+                            g,
+                            eta,
+                        );
+                        let rd = m.total_diffuse_reflectance();
+                        assert!(
+                            rd.is_finite() && rd.min_element() >= 0.0 && rd.max_element() <= 1.0,
+                            "sigma_s' {sp}, sigma_a {sa}, g {g}, eta {eta}: {rd}"
+                        );
+                        if sp == 0.0 {
+                            assert_eq!(rd, Vec3::ZERO);
+                        }
+                        if sa == 0.0 && sp > 0.0 && eta == 1.0 {
+                            assert!(rd.min_element() > 0.99, "{sp} {g}: {rd}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn eta_one_has_no_boundary() {
         assert_eq!(fresnel_diffuse_reflectance(1.0), 0.0);
         // Both fits stay reflectances, and meet near eta = 1.

@@ -235,10 +235,30 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 },
                 if m.layers.as_ref() == Some(medium) {
                     "= the medium, one semi-infinite layer"
-                } else {
+                } else if m.layers.is_some() {
                     "written ([material.layered])"
+                } else {
+                    "none (the material names another technique)"
                 }
             ));
+            if m.sss.is_none() {
+                // What a forced screen-space technique (`--technique separable`, ...) blurs with.
+                let (profile, errors) = crate::scene::profile::medium_profile(medium);
+                let burley = match profile.burley {
+                    Some(crate::scene::material::BurleyDistance::MeanFreePath { mfp, .. }) => {
+                        format!(", Burley: mean free path {:?} mm", mfp.to_array())
+                    }
+                    _ => String::new(),
+                };
+                parts.push(format!(
+                    "under a forced SSS technique: {} Gaussians fitted to its dipole (relative \
+                     L2 error {:.3} / {:.3} / {:.3}){burley}",
+                    profile.gaussians.len(),
+                    errors[0],
+                    errors[1],
+                    errors[2]
+                ));
+            }
         }
         let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
         let parts = if parts.is_empty() {

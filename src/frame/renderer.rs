@@ -216,10 +216,11 @@ impl Renderer {
             for chain in profiles.chains() {
                 let rects = self.settings.sss_tiles.then(|| {
                     let (columns, _, marked) =
-                        object_tiles(scene, mesh_bounds, width, height, |i, o| {
-                            let (_, blur) = profiles.of_object(i)?;
-                            let own = o.material.sss.as_ref()?;
-                            (*blur == chain).then(|| sss::profile_reach(own))
+                        object_tiles(scene, mesh_bounds, width, height, |i, _| {
+                            // The frame's profile: the material's own, refitted, or the
+                            // one fitted to its medium.
+                            let (profile, blur) = profiles.of_object(i)?;
+                            (*blur == chain).then(|| sss::profile_reach(profile))
                         });
                     // All rectangles: the blurs draw the marked ones, LCB's and LBB's final
                     // pass its LEAN variant there and the pass-through variant elsewhere.

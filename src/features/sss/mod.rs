@@ -255,7 +255,10 @@ impl SssProfiles {
     /// The profiles `scene`'s SSS materials ask for: each with its own blur (`blur_of` resolves
     /// a profile's, [`super::registry::blur_of`]), or `forced` on all (a named technique);
     /// refitted to `gaussians` Gaussians when set, and with `texturing` instead of each
-    /// material's own when set (`--sss-texturing`). `None` when no object scatters.
+    /// material's own when set (`--sss-texturing`). `None` when no object scatters. Under a
+    /// `forced` blur, a material without a profile of its own but with a medium
+    /// (`[material.medium]`) scatters with the profile fitted to its medium
+    /// ([`crate::scene::profile::medium_profile`]).
     pub fn new(
         scene: &Scene,
         forced: Option<SssBlur>,
@@ -266,7 +269,14 @@ impl SssProfiles {
         let mut profiles: Vec<(SssProfile, SssBlur)> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
-            let Some(p) = &object.material.sss else {
+            let material = &object.material;
+            let derived = match (&material.sss, forced, &material.medium) {
+                (None, Some(_), Some(medium)) => {
+                    Some(crate::scene::profile::medium_profile(medium).0)
+                }
+                _ => None,
+            };
+            let Some(p) = material.sss.as_ref().or(derived.as_ref()) else {
                 object_ids.push(0);
                 continue;
             };

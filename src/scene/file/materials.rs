@@ -89,11 +89,15 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
              skin1, ...) or `[[material.layered.layer]]` tables (see docs/scene-format.toml)",
         ));
     }
-    // Li et al.'s layers: the material's own table, else the medium as one semi-infinite layer.
+    // Li et al.'s layers: the material's own table, else the medium as one semi-infinite layer
+    // when the material names no other technique: a medium with a [material.sss] or
+    // [material.translucency] is rendered by that technique under `auto` (one technique per
+    // material; a forced SSS technique fits a profile to the medium, `SssProfiles::new`).
+    let other_technique = m.sss.is_some() || m.translucency.is_some();
     material.layers = match (&m.layered, &medium) {
         (Some(l), _) => Some(layered_medium(file, at, l)?),
-        (None, Some(medium)) => Some(medium.clone()),
-        (None, None) => None,
+        (None, Some(medium)) if !other_technique => Some(medium.clone()),
+        (None, _) => None,
     };
     material.medium = medium;
     // Map a range failure to the key it names.

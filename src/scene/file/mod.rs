@@ -594,6 +594,40 @@ units_per_mm = 0.05
     }
 
     #[test]
+    fn a_medium_is_layered_under_auto_and_fitted_under_a_forced_sss_technique() {
+        use crate::frame::{FrameDesc, FrameSettings, Technique};
+        let scene = parse(&with_layered(MEDIUM)).unwrap();
+        let settings = |t: &str| FrameSettings {
+            technique: Technique::parse(t).unwrap(),
+            ..FrameSettings::new(64, 64)
+        };
+        let auto = FrameDesc::new(&scene, &settings("auto")).unwrap();
+        assert!(auto.layered.is_some() && auto.sss.is_none());
+        for blur in ["separable", "bilateral", "burley", "control"] {
+            let d = FrameDesc::new(&scene, &settings(blur)).unwrap();
+            let sss = d.sss.as_ref().unwrap_or_else(|| panic!("{blur}: no SSS"));
+            assert!(d.layered.is_none(), "{blur}");
+            let (profile, _) = sss.of_object(0).unwrap();
+            assert!(
+                profile.name.contains("fitted to its dipole"),
+                "{}",
+                profile.name
+            );
+        }
+        // A medium beside a technique's own table: that technique renders it under `auto`, and
+        // no layered medium is derived as well.
+        let with_sss = parse(&with_layered(&format!(
+            "{MEDIUM}\n[material.sss]\npreset = \"skin\"\n"
+        )))
+        .unwrap();
+        let m = &with_sss.objects[0].material;
+        assert!(m.layers.is_none() && m.sss.is_some() && m.medium.is_some());
+        let auto = FrameDesc::new(&with_sss, &settings("auto")).unwrap();
+        assert!(auto.layered.is_none());
+        assert_eq!(auto.sss.unwrap().of_object(0).unwrap().0.name, "skin");
+    }
+
+    #[test]
     fn medium_errors_name_file_line_and_key() {
         let base = with_layered(MEDIUM);
         let cases = [

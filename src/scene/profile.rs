@@ -387,6 +387,40 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_medium_s_profile_stays_valid_at_extreme_media() {
+        // The stability sweep's extremes: coefficients 0 to 1e6 mm^-1, albedo -> 1 (no
+        // absorption), g +-0.999, eta 1 and 2.5: a profile that validates (finite, positive
+        // variances, weights summing to 1) and a finite fit error, never NaN.
+        for sp in [0.0f32, 1e-6, 1.0, 1e6] {
+            for sa in [0.0f32, 1e-6, 1.0, 1e6] {
+                for g in [-0.999f32, 0.0, 0.999] {
+                    for eta in [1.0f32, 2.5] {
+                        let medium = LayeredMedium::homogeneous(
+                            "x",
+                            glam::Vec3::splat(sp),
+                            glam::Vec3::splat(sa),
+                            g,
+                            eta,
+                        );
+                        let (profile, errors) = medium_profile(&medium);
+                        let case = format!("sigma_s' {sp}, sigma_a {sa}, g {g}, eta {eta}");
+                        profile.validate().unwrap_or_else(|e| panic!("{case}: {e}"));
+                        assert!(errors.iter().all(|e| e.is_finite()), "{case}: {errors:?}");
+                        let sum = profile
+                            .gaussians
+                            .iter()
+                            .fold(glam::Vec3::ZERO, |s, g| s + g.weight);
+                        assert!(
+                            (sum - glam::Vec3::ONE).abs().max_element() < 1e-4,
+                            "{case}: {sum}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_medium_s_profile_is_its_dipole_in_six_gaussians() {
         // Every single-layer preset at eta 1 and 1.3: a valid profile, weights summing to 1 per
         // channel, the fit within 20% (relative L2, area-weighted) of the dipole it stands for

@@ -390,8 +390,8 @@ pub fn layered_passes(
 }
 
 /// Starts a layered pass of `kind` at `1 / scale` of the screen per side, reading the gather's
-/// `irradiance` or, in single scattering with `--half-gather`, the half-resolution multiple
-/// scattering term (`half_term`) it upsamples and adds. The graph reads the G-buffer first;
+/// `irradiance` or, in single scattering, the multiple scattering term (`half_term`: half
+/// resolution under the default `--gather half`) it resolves and adds. The graph reads the G-buffer first;
 /// irradiance the depth atlas (shadows), single scattering the depth and entry atlases (entry
 /// points). The shader numbers its bindings as glsl/common/layered.glsl does: 0 frame, 1
 /// layered table, 2 depth, 3 GB1, 4 IDs, then the pass's own (the irradiance image; or the

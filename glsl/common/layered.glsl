@@ -199,6 +199,20 @@ vec3 dipole_rd(int mat, float r) {
     return MAT.alpha_prime.rgb / (4.0 * PI) * (real + virt);
 }
 
+// The first layer's diffuse transmission through a thickness a (scene units): the part of
+// the light that entered which diffuses out farther than a from its entry,
+// 2 pi ∫_a^inf Rd(r) r dr = (alpha'/2) sum over z_r, z_v of z e^(-sigma_tr d) / d with
+// d = sqrt(a^2 + z^2) (Dipole::transmitted_beyond; HDRP's thick transmission reads its profile
+// at the thickness the same way). d >= z > 0: finite; e^-x of a large x is 0.
+vec3 dipole_beyond(int mat, float a) {
+    float a2 = a * a;
+    vec3 dr = sqrt(a2 + MAT.z_r.rgb * MAT.z_r.rgb);
+    vec3 dv = sqrt(a2 + MAT.z_v.rgb * MAT.z_v.rgb);
+    vec3 real = MAT.z_r.rgb / dr * exp(-MAT.sigma_tr.rgb * dr);
+    vec3 virt = MAT.z_v.rgb / dv * exp(-MAT.sigma_tr.rgb * dv);
+    return 0.5 * MAT.alpha_prime.rgb * (real + virt);
+}
+
 // The light transmitted into the surface at p (outward normal n): radiance x falloff x cos x
 // Fresnel transmittance of every light, shadowed where the light casts, and the ambient's
 // (transmitted_irradiance).

@@ -144,8 +144,22 @@ vec3 entering(int i, vec3 p_in, vec3 n_in, vec3 to_light, float eta) {
            (max(attenuation, 0.0) * fresnel_transmittance(cos_in, eta));
 }
 
-// L_t's light from light `i` at x_o (facing away from it): the transmittance from the entry
-// point on the light's side, filtered like a shadow lookup (each of the four texels around
+// How much of the light that entered at `p` (outward normal `n`) the view does not hold
+// already: the multiple-scattering gather carries the irradiance of the surface the camera
+// sees, so the diffusion through the thickness adds only light that entered on the far side
+// (a back-lit object's back), 1 where the entry faces away from the eye, 0 where it faces it,
+// with a smooth ramp between (a hard test toggled across the facets of the entry map and drew
+// a hatching at the boundary). A side-lit sphere's entry points face the eye: it is unchanged.
+float unseen_entry(vec3 p, vec3 n) {
+    vec3 from_eye = p - frame.camera_pos.xyz;
+    float len2 = dot(from_eye, from_eye);
+    return len2 > 1e-20 ? smoothstep(0.0, 0.3, dot(n, from_eye * inversesqrt(len2))) : 0.0;
+}
+
+// L_t's light from light `i` at x_o (facing away from it): the light that entered on the
+// light's side and crossed the object, unscattered (its transmittance) and by diffusion
+// (dipole_beyond, issue 26: a back-lit thin slab glows as the path-traced truth does), from the
+// entry point, filtered like a shadow lookup (each of the four texels around
 // x_o's map position gives its own entry distance and transmittance, bilinearly weighted;
 // texels of another material block): filtering the distance instead would leave a staircase
 // where the first surface along the light changes (the object's rim and its self-occlusion
@@ -197,9 +211,15 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
         float d_map = shadow_distance(FACE.params, d[k]);
         vec3 p_in = FACE.params.z < 0.0 ? inner + to_light * max(d_x - d_map, 0.0)
                                         : l + (inner - l) * min(d_map / max(d_x, 1e-12), 1.0);
-        float fade = smoothstep(0.0, 3.0 * texel_size, length(p_in - x_o));
+        float thickness = length(p_in - x_o);
+        float fade = smoothstep(0.0, 3.0 * texel_size, thickness);
         vec3 e = entering(i, p_in, n_in, to_light, eta);
-        sum += (w[k] * fade) * e * exp(-optical_depth(mat, p_in, n_in, p_in, x_o, texels_in));
+        // Unscattered, and diffused through the thickness by the first layer's dipole (the
+        // light that entered: the irradiance, so the cosine at the entry).
+        vec3 crossed = exp(-optical_depth(mat, p_in, n_in, p_in, x_o, texels_in)) +
+                       (unseen_entry(p_in, n_in) * max(dot(to_light, n_in), 0.0)) *
+                           dipole_beyond(mat, thickness);
+        sum += (w[k] * fade) * e * crossed;
     }
     return sum;
 #undef FACE

@@ -46,6 +46,24 @@ impl Dipole {
         0.5 * self.alpha_prime * (part(self.z_r) + part(self.z_v))
     }
 
+    /// The part of the light that entered which diffuses out farther than `a` from where it
+    /// entered, `2 pi ∫_a^∞ Rd(r) r dr = (alpha'/2) Σ_{z = z_r, z_v} z e^(-sigma_tr d(a)) /
+    /// d(a)` (`R_d` less [`Dipole::reflectance_within`] `a`): lucent's diffuse transmission
+    /// through a thickness `a` (the light that entered on an object's far side and crossed it
+    /// by diffusion; HDRP reads its profile at the thickness the same way). `R_d` at `a = 0`.
+    pub fn transmitted_beyond(&self, a: f64) -> f64 {
+        let part = |z: f64| {
+            let d = (a * a + z * z).sqrt();
+            // z / d <= 1 and e^-x of a large x is 0: finite for every finite a.
+            if d.is_finite() {
+                z / d * (-self.sigma_tr * d).exp()
+            } else {
+                0.0
+            }
+        };
+        0.5 * self.alpha_prime * (part(self.z_r) + part(self.z_v))
+    }
+
     /// Total diffuse reflectance `R_d = 2 pi ∫ Rd(r) r dr` in closed form:
     /// `(alpha'/2) (1 + e^(-4/3 A sqrt(3(1 - alpha')))) e^(-sqrt(3(1 - alpha')))`.
     pub fn total_reflectance(&self) -> f64 {
@@ -100,6 +118,25 @@ mod tests {
             let v = dipole_rd(r, 2.19, 0.0021, 1.5);
             assert!(v.is_finite() && v > 0.0 && v <= prev, "r={r} v={v}");
             prev = v;
+        }
+    }
+
+    #[test]
+    fn what_diffuses_beyond_a_is_the_total_less_what_stays_within_a() {
+        for &(sp, sa, eta) in &[(2.19, 0.0021, 1.5), (0.74, 0.032, 1.0), (1.0, 1.0, 1.3)] {
+            let d = dipole_constants(sp, sa, eta);
+            assert!((d.transmitted_beyond(0.0) - d.total_reflectance()).abs() < 1e-12);
+            let mut previous = f64::INFINITY;
+            for a in [0.0, 0.01, 0.1, 1.0, 4.0, 40.0, 1e6] {
+                let beyond = d.transmitted_beyond(a);
+                let sum = beyond + d.reflectance_within(a);
+                assert!(
+                    (sum - d.total_reflectance()).abs() < 1e-9,
+                    "{sp} {sa} {eta} {a}"
+                );
+                assert!(beyond.is_finite() && beyond >= 0.0 && beyond <= previous);
+                previous = beyond;
+            }
         }
     }
 

@@ -505,14 +505,20 @@ pub fn single_scattering(
 }
 
 /// Li et al.'s refraction light `L_t` as lucent reads it (see [`crate::features::layered`]):
-/// light that crossed the object unscattered from where it entered on the light's side to
-/// `x_o` on the far side, leaving diffusely towards `-view_dir`:
+/// light that crossed the object from where it entered on the light's side to `x_o` on the
+/// far side, leaving diffusely towards `-view_dir`: unscattered, and (issue 26) diffused
+/// through the thickness `a = |P' - x_o|` by the first layer's dipole
+/// ([`crate::scene::layered::Dipole::transmitted_beyond`]):
 ///
-/// `L_t = T(x_o) / pi Σ_lights V(P') T(P') E(P') exp(-tau(P' -> x_o))`
+/// `L_t = T(x_o) / pi Σ_lights V(P') T(P') E(P') [exp(-tau(P' -> x_o)) + cos(P') Tb(a)]`
 ///
 /// for each light `x_o` faces away from (`dot(to_light, n) < 0`); `P'` = where the segment from
 /// `x_o` towards the light leaves the object (exact), `tau` the planar-layer optical depth
-/// relative to `P'`. Needs a sphere.
+/// relative to `P'`, `cos(P')` the light's cosine to the normal there (the diffusing light is
+/// the irradiance that entered). The diffused part is weighted by `smoothstep(0, 0.3, n(P') .
+/// (P' - eye) / |P' - eye|)`: 1 where `P'` faces away from the eye, 0 where the camera sees it
+/// (light that entered in view is multiple scattering's, which gathers it from the visible
+/// surface). Needs a sphere.
 pub fn transmitted(
     scene: &Scene,
     object: usize,
@@ -529,6 +535,17 @@ pub fn transmitted(
     if cos_o <= 0.0 {
         return Ok(DVec3::ZERO);
     }
+    // The first layer's dipole in scene units, per channel, as the GPU's table holds it.
+    let reduced = medium.first_layer_reduced();
+    let dipoles: Vec<_> = (0..3)
+        .map(|c| {
+            crate::scene::layered::dipole_constants(
+                f64::from(reduced.sigma_s_prime[c]),
+                f64::from(reduced.sigma_a[c]),
+                eta,
+            )
+        })
+        .collect();
     let mut sum = DVec3::ZERO;
     for light in &scene.lights {
         let (to_light, _) = light_incidence(light, x_o);
@@ -539,9 +556,21 @@ pub fn transmitted(
             continue;
         };
         let tau = stack.optical_depth(entry.point, entry.normal, entry.point, x_o);
-        sum += entry.radiance * DVec3::new((-tau.x).exp(), (-tau.y).exp(), (-tau.z).exp());
+        let thickness = (entry.point - x_o).length();
+        let from_eye = (entry.point - scene.camera.eye.as_dvec3()).normalize_or_zero();
+        let unseen = smoothstep(0.0, 0.3, entry.normal.dot(from_eye));
+        let cos_in = unseen * entry.to_light.dot(entry.normal).max(0.0);
+        let crossed =
+            |c: usize| (-tau[c]).exp() + cos_in * dipoles[c].transmitted_beyond(thickness);
+        sum += entry.radiance * DVec3::new(crossed(0), crossed(1), crossed(2));
     }
     Ok(sum * (fresnel_transmittance(cos_o, eta) / PI))
+}
+
+/// GLSL's `smoothstep(edge0, edge1, x)`: 0 below edge0, 1 above edge1, a cubic between.
+fn smoothstep(edge0: f64, edge1: f64, x: f64) -> f64 {
+    let t = ((x - edge0) / (edge1 - edge0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
 }
 
 /// One area sample of an object's surface.

@@ -536,11 +536,11 @@ fn the_pixel_light_gather_leaves_no_grain_in_a_still() {
 /// at the scene). `tests/data/backlit-slab.toml`: 40 x 40 x 4 mm of skin1 at eta 1, a point
 /// light 20 mm behind it. Plain lighting leaves the front face black (no light reaches it); the layered
 /// frame must show light through it, finite, reddest where skin1 absorbs least. The bar is a
-/// floor, not the truth: 1-D diffusion through 4 mm of skin1 lets through of the order of
-/// e^(-sigma_tr 4 mm) = 0.34 of the red (sigma_tr = sqrt(3 sigma_a sigma_t') = 0.27 / mm), so
-/// the red radiance of the front face should be near 0.34 E / pi; at least 2% of E / pi says
-/// "not black" with a wide margin. How close it comes to the path-traced truth is the truth
-/// comparison's business (tools/truth).
+/// floor, not the truth: the path-traced truth of the same slab (tools/truth, its light 2.5x
+/// brighter) has a red radiance of 0.23 E / pi at the centre; the layered frame gives 0.19 E /
+/// pi with the dipole's diffusion through the thickness (0.06 with unscattered light alone, 0
+/// before the shadow map's depth range was fixed). At least 10% says "lit through" with a
+/// margin; how close it comes to the truth is `tests/gpu/truth.rs`'s business.
 #[test]
 fn a_thin_slab_lit_from_behind_glows_through() {
     let test = TestGpu::new();
@@ -584,8 +584,8 @@ fn a_thin_slab_lit_from_behind_glows_through() {
         "plain lighting lit the front face: {plain:?}"
     );
     assert!(
-        layered[0] >= 0.02 * e / std::f64::consts::PI,
-        "the layered slab lets through {layered:?}: black (at least 2% of E / pi in red)"
+        layered[0] >= 0.1 * e / std::f64::consts::PI,
+        "the layered slab lets through {layered:?}: too little (at least 10% of E / pi in red)"
     );
     assert!(
         layered[0] > layered[1] && layered[1] > layered[2],

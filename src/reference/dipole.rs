@@ -33,17 +33,21 @@ impl Dipole {
     /// sqrt(a^2 + z^2)`, since `(sigma_tr d + 1) e^(-sigma_tr d) / d^2` is the derivative of
     /// `-e^(-sigma_tr d) / d`. Used for the peak of Rd that a surface sample cannot resolve.
     pub fn reflectance_within(&self, a: f64) -> f64 {
-        let part = |z: f64| {
-            let d = (a * a + z * z).sqrt();
-            // z / d <= 1, and both exponentials only shrink: never NaN for finite inputs.
-            let tail = if d.is_finite() {
-                z / d * (-self.sigma_tr * d).exp()
-            } else {
-                0.0
-            };
-            ((-self.sigma_tr * z).exp() - tail).max(0.0)
-        };
+        // Both exponentials only shrink: never NaN for finite inputs.
+        let part = |z: f64| ((-self.sigma_tr * z).exp() - self.beyond(z, a)).max(0.0);
         0.5 * self.alpha_prime * (part(self.z_r) + part(self.z_v))
+    }
+
+    /// One source's share (depth `z`) of the light that leaves farther than `a` from its
+    /// entry, before the `alpha'/2`: `z e^(-sigma_tr d) / d` with `d = sqrt(a^2 + z^2)`.
+    fn beyond(&self, z: f64, a: f64) -> f64 {
+        let d = (a * a + z * z).sqrt();
+        // z / d <= 1 and e^-x of a large x is 0: finite for every finite a.
+        if d.is_finite() {
+            z / d * (-self.sigma_tr * d).exp()
+        } else {
+            0.0
+        }
     }
 
     /// The part of the light that entered which diffuses out farther than `a` from where it
@@ -52,16 +56,7 @@ impl Dipole {
     /// through a thickness `a` (the light that entered on an object's far side and crossed it
     /// by diffusion; HDRP reads its profile at the thickness the same way). `R_d` at `a = 0`.
     pub fn transmitted_beyond(&self, a: f64) -> f64 {
-        let part = |z: f64| {
-            let d = (a * a + z * z).sqrt();
-            // z / d <= 1 and e^-x of a large x is 0: finite for every finite a.
-            if d.is_finite() {
-                z / d * (-self.sigma_tr * d).exp()
-            } else {
-                0.0
-            }
-        };
-        0.5 * self.alpha_prime * (part(self.z_r) + part(self.z_v))
+        0.5 * self.alpha_prime * (self.beyond(self.z_r, a) + self.beyond(self.z_v, a))
     }
 
     /// Total diffuse reflectance `R_d = 2 pi ∫ Rd(r) r dr` in closed form:

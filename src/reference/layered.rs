@@ -536,16 +536,7 @@ pub fn transmitted(
         return Ok(DVec3::ZERO);
     }
     // The first layer's dipole in scene units, per channel, as the GPU's table holds it.
-    let reduced = medium.first_layer_reduced();
-    let dipoles: Vec<_> = (0..3)
-        .map(|c| {
-            crate::scene::layered::dipole_constants(
-                f64::from(reduced.sigma_s_prime[c]),
-                f64::from(reduced.sigma_a[c]),
-                eta,
-            )
-        })
-        .collect();
+    let dipoles = medium.first_layer_dipoles();
     let mut sum = DVec3::ZERO;
     for light in &scene.lights {
         let (to_light, _) = light_incidence(light, x_o);

@@ -313,17 +313,11 @@ impl LayeredMedium {
     /// the plane, `crate::reference::dipole`). The albedo a Lambertian surface of this medium
     /// has: what `[material.medium]` gives a material that writes none.
     pub fn total_diffuse_reflectance(&self) -> Vec3 {
-        let r = self.first_layer_reduced();
-        let channel = |c: usize| {
-            let dipole = dipole_constants(
-                f64::from(r.sigma_s_prime[c]),
-                f64::from(r.sigma_a[c]),
-                f64::from(self.eta),
-            );
-            // In [0, 1] for every medium validate() accepts; clamped so an albedo stays one.
-            dipole.total_reflectance().clamp(0.0, 1.0) as f32
-        };
-        Vec3::new(channel(0), channel(1), channel(2))
+        // In [0, 1] for every medium validate() accepts; clamped so an albedo stays one.
+        Vec3::from(
+            self.first_layer_dipoles()
+                .map(|dipole| dipole.total_reflectance().clamp(0.0, 1.0) as f32),
+        )
     }
 
     /// A preset by name (see the module docs): the Jensen 2001 media, `li-teapot` and
@@ -392,18 +386,23 @@ impl LayeredMedium {
         }
     }
 
-    /// Jensen's dipole constants of the first layer per channel, in scene units (computed in
-    /// f64 by [`dipole_constants`], which the reference's dipole profile evaluates too).
-    pub fn dipole_constants(&self) -> DipoleConstants {
+    /// The first layer's dipole per channel (R, G, B), in f64 and scene units: what
+    /// [`LayeredMedium::dipole_constants`] rounds for the GPU, and what the references evaluate.
+    pub fn first_layer_dipoles(&self) -> [Dipole; 3] {
         let r = self.first_layer_reduced();
-        let per = |c: usize| {
+        [0, 1, 2].map(|c| {
             dipole_constants(
                 f64::from(r.sigma_s_prime[c]),
                 f64::from(r.sigma_a[c]),
                 f64::from(self.eta),
             )
-        };
-        let (x, y, z) = (per(0), per(1), per(2));
+        })
+    }
+
+    /// Jensen's dipole constants of the first layer per channel, in scene units (computed in
+    /// f64 by [`dipole_constants`], which the reference's dipole profile evaluates too).
+    pub fn dipole_constants(&self) -> DipoleConstants {
+        let [x, y, z] = self.first_layer_dipoles();
         let v = |f: fn(&Dipole) -> f64| Vec3::new(f(&x) as f32, f(&y) as f32, f(&z) as f32);
         DipoleConstants {
             sigma_tr: v(|d| d.sigma_tr),

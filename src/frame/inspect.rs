@@ -215,7 +215,12 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 }
             ));
         }
-        if let Some(medium) = &m.medium {
+        if let Some(crate::scene::material::Medium {
+            layered: medium,
+            profile,
+            fit_error: errors,
+        }) = &m.medium
+        {
             // What each technique took from the medium, and what the material wrote itself.
             let rd = medium.total_diffuse_reflectance();
             let layer = &medium.layers[0];
@@ -243,7 +248,6 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
             ));
             if m.sss.is_none() {
                 // What a forced screen-space technique (`--technique separable`, ...) blurs with.
-                let (profile, errors) = crate::scene::profile::medium_profile(medium);
                 let burley = match profile.burley {
                     Some(crate::scene::material::BurleyDistance::MeanFreePath { mfp, .. }) => {
                         format!(", Burley: mean free path {:?} mm", mfp.to_array())

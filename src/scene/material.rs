@@ -398,10 +398,37 @@ pub struct Material {
     pub sss: Option<SssProfile>,
     /// Li et al.'s layered medium, if the material is layered.
     pub layers: Option<LayeredMedium>,
-    /// The one homogeneous medium the material is made of (`[material.medium]`, one
-    /// semi-infinite layer), if it gives one: its albedo (when not written) is the medium's
-    /// total diffuse reflectance and its `layers` (when not written) the medium itself.
-    pub medium: Option<LayeredMedium>,
+    /// The one homogeneous medium the material is made of (`[material.medium]`), if it gives
+    /// one: its albedo (when not written) is the medium's total diffuse reflectance and its
+    /// `layers` (when not written) the medium itself.
+    pub medium: Option<Medium>,
+}
+
+/// The one homogeneous medium a material is made of (`[material.medium]`) with what a
+/// technique derives from it that takes work to derive, done once when the material is made
+/// (a frame reads it every frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Medium {
+    /// The medium as one semi-infinite layer with physical weights: Li et al.'s layers.
+    pub layered: LayeredMedium,
+    /// The screen-space profile fitted to its dipole
+    /// ([`crate::scene::profile::medium_profile`]): what a forced SSS technique blurs a
+    /// material without a `[material.sss]` of its own with.
+    pub profile: SssProfile,
+    /// That fit's relative L2 error per channel.
+    pub fit_error: [f64; 3],
+}
+
+impl Medium {
+    /// `layered` (one semi-infinite layer) with its SSS profile fitted.
+    pub fn new(layered: LayeredMedium) -> Self {
+        let (profile, fit_error) = crate::scene::profile::medium_profile(&layered);
+        Self {
+            layered,
+            profile,
+            fit_error,
+        }
+    }
 }
 
 impl Material {
@@ -465,7 +492,7 @@ impl Material {
         if let Some(l) = &self.layers {
             l.validate()?;
         }
-        if let Some(m) = &self.medium {
+        if let Some(Medium { layered: m, .. }) = &self.medium {
             m.validate()?;
             if m.layers.len() != 1 || m.layers[0].thickness != Thickness::Rest {
                 return bad("a medium is one semi-infinite layer".into());

@@ -257,8 +257,8 @@ impl SssProfiles {
     /// refitted to `gaussians` Gaussians when set, and with `texturing` instead of each
     /// material's own when set (`--sss-texturing`). `None` when no object scatters. Under a
     /// `forced` blur, a material without a profile of its own but with a medium
-    /// (`[material.medium]`) scatters with the profile fitted to its medium
-    /// ([`crate::scene::profile::medium_profile`]).
+    /// (`[material.medium]`) scatters with the profile fitted to its medium when it was made
+    /// ([`crate::scene::material::Medium::profile`]).
     pub fn new(
         scene: &Scene,
         forced: Option<SssBlur>,
@@ -270,13 +270,11 @@ impl SssProfiles {
         let mut object_ids = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let material = &object.material;
-            let derived = match (&material.sss, forced, &material.medium) {
-                (None, Some(_), Some(medium)) => {
-                    Some(crate::scene::profile::medium_profile(medium).0)
-                }
+            let derived = match (forced, &material.medium) {
+                (Some(_), Some(medium)) => Some(&medium.profile),
                 _ => None,
             };
-            let Some(p) = material.sss.as_ref().or(derived.as_ref()) else {
+            let Some(p) = material.sss.as_ref().or(derived) else {
                 object_ids.push(0);
                 continue;
             };

@@ -16,8 +16,8 @@ use crate::scene::layered::{
     self, sigma_s_from_reduced, MAX_ABS_G, MAX_COEFFICIENT, MAX_LAYERS, PHYSICAL_WEIGHTS,
 };
 use crate::scene::material::{
-    BurleyDistance, Gaussian, Layer, LayeredMedium, Material, PowMode, SssProfile, TechniqueName,
-    TextureSource, Texturing, Thickness, ThicknessSource, Translucency,
+    BurleyDistance, Gaussian, Layer, LayeredMedium, Material, Medium, PowMode, SssProfile,
+    TechniqueName, TextureSource, Texturing, Thickness, ThicknessSource, Translucency,
 };
 use crate::scene::obj::ObjMaterial;
 use crate::Result;
@@ -99,7 +99,7 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         (None, Some(medium)) if !other_technique => Some(medium.clone()),
         (None, _) => None,
     };
-    material.medium = medium;
+    material.medium = medium.map(Medium::new);
     // Map a range failure to the key it names.
     material.validate().map_err(|e| {
         let message = e.to_string();

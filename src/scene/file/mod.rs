@@ -567,7 +567,7 @@ units_per_mm = 0.05
             assert!((f64::from(m.albedo[c]) - d.total_reflectance()).abs() < 1e-6);
         }
         let layers = m.layers.as_ref().unwrap();
-        assert_eq!(layers, m.medium.as_ref().unwrap());
+        assert_eq!(layers, &m.medium.as_ref().unwrap().layered);
         assert_eq!(layers.layers.len(), 1);
         assert_eq!(layers.layers[0].thickness, Thickness::Rest);
         assert_eq!(layers.layers[0].sigma_s, Vec3::new(0.74, 0.88, 1.01));

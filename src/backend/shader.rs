@@ -137,7 +137,6 @@ impl ShaderCompiler {
         if let Some(dir) = std::env::var_os("LUCENT_GLSL_DIR").filter(|d| !d.is_empty()) {
             return PathBuf::from(dir);
         }
-        let is_root = |dir: &Path| dir.join(FULLSCREEN_VERTEX).is_file();
         let compiled_from = Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl");
         let exe_dir = std::env::current_exe()
             .ok()
@@ -146,11 +145,21 @@ impl ShaderCompiler {
         if let Some(dir) = exe_dir {
             let beside = [dir.join("glsl"), dir.join("../share/lucent/glsl")];
             let above = dir.ancestors().skip(1).map(|a| a.join("glsl"));
-            if let Some(found) = beside.into_iter().chain(above).find(|d| is_root(d)) {
+            if let Some(found) = beside
+                .into_iter()
+                .chain(above)
+                .find(|d| Self::is_glsl_root(d))
+            {
                 return found;
             }
         }
         compiled_from
+    }
+
+    /// Whether `dir` is a GLSL tree (a copy of the repository's `glsl/`), recognised by its
+    /// [`FULLSCREEN_VERTEX`].
+    pub fn is_glsl_root(dir: &Path) -> bool {
+        dir.join(FULLSCREEN_VERTEX).is_file()
     }
 
     /// Whether this compiler serves the shipped bundle (no GLSL is read).

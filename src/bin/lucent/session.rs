@@ -21,10 +21,11 @@ pub struct Session {
 /// A run-time compiler for the GLSL tree `dir` (`--shaders`), refused with the reason when
 /// `dir` is no shader tree or this build has no compiler.
 fn runtime_shaders(dir: &Path) -> Result<ShaderCompiler> {
-    if !dir.join("common").is_dir() {
+    if !ShaderCompiler::is_glsl_root(dir) {
         return Err(LucentError::InvalidInput(format!(
-            "--shaders {}: not a shader tree (a copy of the repository's glsl/, with common/)",
-            dir.display()
+            "--shaders {}: not a shader tree (a copy of the repository's glsl/, with {})",
+            dir.display(),
+            lucent::backend::shader::FULLSCREEN_VERTEX
         )));
     }
     #[cfg(feature = "runtime-shaders")]

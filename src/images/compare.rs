@@ -95,24 +95,8 @@ pub fn flip_rgba8_with_threshold(
     height: u32,
     pixel_threshold: f32,
 ) -> Result<FlipResult> {
-    let expected = u64::from(width) * u64::from(height) * 4;
-    if width == 0 || height == 0 {
-        return Err(LucentError::InvalidInput(format!(
-            "FLIP comparison of an empty {width}x{height} image"
-        )));
-    }
-    for (what, image) in [("reference", reference), ("test", test)] {
-        if image.len() as u64 != expected {
-            return Err(LucentError::InvalidInput(format!(
-                "FLIP comparison: {what} image has {} bytes, {width}x{height} RGBA8 needs {expected}",
-                image.len()
-            )));
-        }
-    }
-    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgba_to_rgb(reference));
-    let test = nv_flip::FlipImageRgb8::with_data(width, height, &rgba_to_rgb(test));
-    let error_map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
-
+    check_rgba8_pair(reference, test, width, height)?;
+    let error_map = flip_map(reference, test, width, height);
     let pool = nv_flip::FlipPool::from_image(&error_map);
     let errors = error_map.to_vec();
     let above = errors.iter().filter(|&&e| e > pixel_threshold).count();
@@ -128,6 +112,43 @@ pub fn flip_rgba8_with_threshold(
         fraction_above: above as f32 / errors.len() as f32,
         error_map_rgba,
     })
+}
+
+/// The per-pixel FLIP errors of two sRGB RGBA8 images (alpha ignored), rows top first, as
+/// [`flip_rgba8`] computes them: for a mean over some of the pixels (an object's, say).
+pub fn flip_errors_rgba8(
+    reference: &[u8],
+    test: &[u8],
+    width: u32,
+    height: u32,
+) -> Result<Vec<f32>> {
+    check_rgba8_pair(reference, test, width, height)?;
+    Ok(flip_map(reference, test, width, height).to_vec())
+}
+
+/// Both images are `width x height` RGBA8, and not empty.
+fn check_rgba8_pair(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<()> {
+    let expected = u64::from(width) * u64::from(height) * 4;
+    if width == 0 || height == 0 {
+        return Err(LucentError::InvalidInput(format!(
+            "FLIP comparison of an empty {width}x{height} image"
+        )));
+    }
+    for (what, image) in [("reference", reference), ("test", test)] {
+        if image.len() as u64 != expected {
+            return Err(LucentError::InvalidInput(format!(
+                "FLIP comparison: {what} image has {} bytes, {width}x{height} RGBA8 needs {expected}",
+                image.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+fn flip_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> nv_flip::FlipImageFloat {
+    let reference = nv_flip::FlipImageRgb8::with_data(width, height, &rgba_to_rgb(reference));
+    let test = nv_flip::FlipImageRgb8::with_data(width, height, &rgba_to_rgb(test));
+    nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE)
 }
 
 fn rgba_to_rgb(rgba: &[u8]) -> Vec<u8> {

@@ -11,6 +11,7 @@
 //! - [`sweep`]: stability sweeps at extreme parameters (NaN, Inf, overflow counts).
 //! - [`sweep_layered`]: the layered media's sweep, the GPU frames and the f64 references.
 //! - [`sweep_burley`]: 2-D Burley SSS at extreme distances, albedos and views.
+//! - [`truth`]: a frame against the path-traced truth (error, energy per channel, FLIP).
 
 pub mod bench;
 pub mod gallery;
@@ -22,3 +23,4 @@ pub mod stats;
 pub mod sweep;
 pub mod sweep_burley;
 pub mod sweep_layered;
+pub mod truth;

@@ -41,6 +41,7 @@ pub mod section;
 pub mod seeds;
 pub mod sss;
 pub mod translucency;
+pub mod truth;
 
 pub use section::{embed, SectionFn, SectionOutput, SuiteContext, SuiteOptions};
 

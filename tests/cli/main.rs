@@ -14,3 +14,4 @@ mod memory;
 mod outputs;
 mod report;
 mod report_li;
+mod report_truth;

@@ -1,10 +1,9 @@
 //! lucent against the path-traced truth: the truths committed in `tools/truth/truths/` (Mitsuba
-//! 3 `volpath` renders of the scenes in `tools/truth/scenes/`, 160x120, their sample counts and
-//! noise in each truth's JSON; `tools/truth/README.md`) compared with lucent's linear HDR frame
-//! of the same scene, as `tools/truth/compare.py` compares them, so no Mitsuba is needed here:
-//! the relative mean absolute error `sum |L - T| / sum T` over the pixels every camera ray of
-//! the truth's coverage render hit (eroded one pixel: silhouettes of a tessellated mesh and an
-//! analytic shape differ by a fraction of a pixel), and the energy `sum L / sum T` per channel.
+//! 3 `volpath` renders of the scenes in `tools/truth/scenes/`, their sample counts and noise in
+//! each truth's JSON; `tools/truth/README.md`) compared with lucent's linear HDR frame of the
+//! same scene by [`lucent::measure::truth`], as `tools/truth/compare.py` compares them, so no
+//! Mitsuba is needed here: the relative mean absolute error `sum |L - T| / sum T` over the
+//! object's pixels, and the energy `sum L / sum T` per channel.
 //!
 //! Each case holds lucent at most a little above today's error (a change that moves a frame
 //! away from the truth fails here) and its energy inside the range that says what the
@@ -14,11 +13,9 @@
 use std::path::{Path, PathBuf};
 
 use lucent::frame::{FrameSettings, Technique};
+use lucent::measure::truth::{load_truth, measure};
 
 use crate::common::TestGpu;
-
-/// The truths' frame size (`tools/truth/validate.sh`'s default).
-const SIZE: (usize, usize) = (160, 120);
 
 /// How much above its recorded error a case may go: a tenth of the truths' per-pixel noise
 /// (0.07) in the mean over thousands of pixels is far less; this is for lucent's own drift
@@ -27,34 +24,6 @@ const ERROR_SLACK: f64 = 0.01;
 
 fn truth_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/truth")
-}
-
-/// A linear RGB(A) EXR as RGBA f32 rows, with its size.
-fn read_exr(path: &Path) -> (usize, usize, Vec<f32>) {
-    let image = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let (w, h) = (image.width() as usize, image.height() as usize);
-    (w, h, image.to_rgba32f().into_raw())
-}
-
-/// The truth's object pixels: fully covered (every ray hit), less `erode` pixels at the edge.
-fn object_mask(coverage: &[f32], w: usize, h: usize, erode: usize) -> Vec<bool> {
-    let mut mask: Vec<bool> = (0..w * h).map(|i| coverage[i * 4] >= 0.999).collect();
-    for _ in 0..erode {
-        let inside = |x: i64, y: i64, m: &[bool]| {
-            x >= 0
-                && y >= 0
-                && (x as usize) < w
-                && (y as usize) < h
-                && m[y as usize * w + x as usize]
-        };
-        mask = (0..w * h)
-            .map(|i| {
-                let (x, y) = ((i % w) as i64, (i / w) as i64);
-                (-1..=1).all(|dy| (-1..=1).all(|dx| inside(x + dx, y + dy, &mask)))
-            })
-            .collect();
-    }
-    mask
 }
 
 /// One comparison: a truth scene under a technique, and what lucent must hold against it.
@@ -170,37 +139,17 @@ fn lucent_stays_within_its_recorded_distance_of_the_path_traced_truth() {
     let test = TestGpu::new();
     let mut failures = Vec::new();
     for case in cases() {
-        let dir = truth_dir();
-        let scene_path = dir.join(format!("scenes/{}.toml", case.scene));
-        let scene = lucent::scene::load_scene(scene_path.to_str().unwrap())
-            .unwrap_or_else(|e| panic!("{e}"));
-        let (tw, th, truth) = read_exr(&dir.join(format!("truths/{}.exr", case.scene)));
-        let (cw, ch, coverage) = read_exr(&dir.join(format!("truths/{}.coverage.exr", case.scene)));
-        assert_eq!((tw, th), SIZE, "{}: the truth's size", case.scene);
-        assert_eq!((cw, ch), SIZE, "{}: the coverage's size", case.scene);
-        let mask = object_mask(&coverage, tw, th, 1);
-        let pixels = mask.iter().filter(|&&m| m).count();
+        let truth = load_truth(&truth_dir(), case.scene).unwrap_or_else(|e| panic!("{e}"));
+        let pixels = truth.object_pixels();
         assert!(pixels > 1000, "{}: {pixels} object pixels", case.scene);
         let settings = FrameSettings {
             technique: case.technique,
             export_hdr: true,
-            ..FrameSettings::new(tw as u32, th as u32)
+            ..FrameSettings::new(truth.width, truth.height)
         };
-        let frame = test.render(&scene, settings).hdr.unwrap();
-        let (mut diff, mut total) = (0.0f64, 0.0f64);
-        let (mut lucent_sum, mut truth_sum) = ([0.0f64; 3], [0.0f64; 3]);
-        for i in (0..tw * th).filter(|&i| mask[i]) {
-            for c in 0..3 {
-                let (l, t) = (f64::from(frame[i * 4 + c]), f64::from(truth[i * 4 + c]));
-                assert!(l.is_finite(), "{}: lucent pixel {i}: {l}", case.scene);
-                diff += (l - t).abs();
-                total += t;
-                lucent_sum[c] += l;
-                truth_sum[c] += t;
-            }
-        }
-        let error = diff / total;
-        let energy: Vec<f64> = (0..3).map(|c| lucent_sum[c] / truth_sum[c]).collect();
+        let frame = test.render(&truth.scene, settings).hdr.unwrap();
+        let measured = measure(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
+        let (error, energy) = (measured.error, measured.energy);
         println!(
             "{} under {:?}: error {error:.4} (recorded {}), energy {energy:.4?} over {pixels} px",
             case.scene, case.technique, case.error

@@ -200,8 +200,9 @@ pub struct SweepArgs {
 /// `lucent report`.
 #[derive(Args)]
 pub struct ReportArgs {
-    /// Only this error-against-time section (`translucency`, `sss` or `li`: Li et al.'s
-    /// layered passes, every knob); default: the whole suite.
+    /// Only this error-against-time section (`translucency`, `sss`, `li`: Li et al.'s
+    /// layered passes, every knob, or `truth`: every technique and knob against the
+    /// path-traced truths); default: the whole suite.
     pub technique: Option<String>,
     /// Output directory.
     #[arg(long, default_value = "report")]
@@ -223,6 +224,13 @@ pub struct ReportArgs {
     /// --quick 1).
     #[arg(long, value_parser = whole(0..=bench::MAX_WARMUP))]
     pub warmup: Option<usize>,
+    /// `truth` only: the truth directory, with `scenes/NAME.toml` and `truths/NAME.exr`
+    /// (default `tools/truth`, tools/truth/README.md).
+    #[arg(long)]
+    pub truths: Option<PathBuf>,
+    /// `truth` only: these scenes, comma-separated (default: every scene with a truth).
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Option<Vec<String>>,
     #[command(flatten)]
     pub gpu: GpuArgs,
 }

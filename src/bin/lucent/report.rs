@@ -10,7 +10,38 @@ use crate::session::with_session;
 /// Writes the suite (or the section `args.technique`) into `--out` and prints its text.
 pub fn run(args: ReportArgs) -> Result<()> {
     let gpu_args = &args.gpu;
+    if args.technique.as_deref() != Some("truth")
+        && (args.truths.is_some() || args.scenes.is_some())
+    {
+        return Err(LucentError::InvalidInput(
+            "report: --truths and --scenes are options of `lucent report truth` only".into(),
+        ));
+    }
     let (text, files) = match &args.technique {
+        Some(technique) if technique == "truth" => {
+            let truths = args
+                .truths
+                .clone()
+                .unwrap_or_else(|| std::path::PathBuf::from("tools/truth"));
+            let mut options = if args.quick {
+                lucent::report::truth::TruthOptions::quick(truths)
+            } else {
+                lucent::report::truth::TruthOptions::full(truths)
+            };
+            options.scenes = args.scenes.clone();
+            options.size = args.size;
+            options.rounds = args.rounds.unwrap_or(options.rounds);
+            options.warmup = args.warmup.unwrap_or(options.warmup);
+            with_session(gpu_args, |session| {
+                lucent::report::truth::write_truth_report(
+                    &session.gpu,
+                    &session.shaders,
+                    &session.pipeline_cache,
+                    &args.out,
+                    &options,
+                )
+            })?
+        }
         Some(technique) if technique == "li" => {
             let mut options = if args.quick {
                 lucent::report::li::LiOptions::quick()
@@ -37,8 +68,8 @@ pub fn run(args: ReportArgs) -> Result<()> {
             let Some(&(_, write)) = reports.iter().find(|(name, _)| name == technique) else {
                 let names: Vec<&str> = reports.iter().map(|(name, _)| *name).collect();
                 return Err(LucentError::InvalidInput(format!(
-                    "report: unknown section '{technique}'; available: {}, li (or no section: \
-                     the whole suite)",
+                    "report: unknown section '{technique}'; available: {}, li, truth (or no \
+                     section: the whole suite)",
                     names.join(", ")
                 )));
             };

@@ -1,0 +1,587 @@
+//! `lucent report truth`: every technique, and each of its knobs, on every path-traced truth
+//! scene, as (error against the truth, milliseconds); which technique comes closest to the
+//! light transport it imitates under a few cost budgets.
+//!
+//! For each truth of the truth directory (`tools/truth`, [`crate::measure::truth`]):
+//! - **error**: every variant renders the scene once at the truth's size; its linear HDR frame
+//!   is measured against the truth over the object's pixels: relative mean absolute error,
+//!   energy per channel, and FLIP after the scene's tonemap.
+//! - **time**: every variant's frames at the report's size (default: the truth's), taken
+//!   round-robin (one frame of each variant per round, after warm-up rounds), so a shared, noisy
+//!   machine slows every variant alike; the median frame (submit to fence) and its ratio to
+//!   plain lighting's (`none`) in the same run.
+//!
+//! The variants ([`truth_variants`]) come from the technique registry: `auto`, `none`, every
+//! registered technique at its defaults, then (without `--quick`) each knob a technique lists
+//! turned to each of its values (both ends of a whole-number range; continuous knobs are left at
+//! their defaults and named in the report). A new technique is in this report by registering.
+//!
+//! Writes `truth.md` and one `truth-NAME.png` plot per scene.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::backend::shader::{PipelineCache, ShaderCompiler};
+use crate::backend::GpuContext;
+use crate::features::knob::{Given, Takes};
+use crate::frame::{render_frame, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::measure::stats::Stats;
+use crate::measure::truth::{load_truth, measure, truth_names, Truth, TruthError};
+use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
+use crate::{LucentError, Result};
+
+/// The cost budgets of the summary table, as multiples of plain lighting's frame.
+pub const BUDGETS: &[f64] = &[1.25, 1.5, 2.0, 4.0];
+
+/// What `lucent report truth` measures.
+#[derive(Clone, Debug)]
+pub struct TruthOptions {
+    /// The truth directory (`scenes/` and `truths/`).
+    pub truths: PathBuf,
+    /// Only these scenes (by name); `None`: every scene with a truth.
+    pub scenes: Option<Vec<String>>,
+    /// Techniques at their defaults only (no knob variants).
+    pub quick: bool,
+    /// The timed frames' size; `None`: each truth's own.
+    pub size: Option<(u32, u32)>,
+    /// Measured rounds (one frame of each variant per round).
+    pub rounds: usize,
+    /// Discarded rounds first.
+    pub warmup: usize,
+}
+
+impl TruthOptions {
+    /// The full report: every knob, 9 rounds after 2 warm-up rounds.
+    pub fn full(truths: PathBuf) -> Self {
+        Self {
+            truths,
+            scenes: None,
+            quick: false,
+            size: None,
+            rounds: 9,
+            warmup: 2,
+        }
+    }
+
+    /// `--quick`: techniques at their defaults, 2 rounds after 1 warm-up round.
+    pub fn quick(truths: PathBuf) -> Self {
+        Self {
+            quick: true,
+            rounds: 2,
+            warmup: 1,
+            ..Self::full(truths)
+        }
+    }
+}
+
+/// One configuration to measure.
+#[derive(Clone, Debug)]
+pub struct TruthVariant {
+    /// The technique (the plot's series).
+    pub technique: Technique,
+    /// The knob turned and its value, as on the command line; `None`: the defaults.
+    pub knob: Option<String>,
+    /// The frame's settings (size set per measurement).
+    pub settings: FrameSettings,
+}
+
+impl TruthVariant {
+    /// The variant as the command line says it: `burley`, `burley --burley-budget 4`.
+    pub fn name(&self) -> String {
+        match &self.knob {
+            Some(knob) => format!("{} {knob}", self.technique.name()),
+            None => self.technique.name().to_string(),
+        }
+    }
+}
+
+/// The values a knob is measured at: a switch given, both ends of a whole range, every listed
+/// whole number or choice; `None` for a continuous knob (no finite set of values to try).
+fn knob_values(takes: &Takes) -> Option<Vec<Given>> {
+    Some(match *takes {
+        Takes::Switch => vec![Given::Switch],
+        Takes::Whole { min, max } => vec![Given::Whole(min), Given::Whole(max)],
+        Takes::WholeOf(values) => values.iter().map(|&n| Given::Whole(n)).collect(),
+        Takes::Choice(names) => names.iter().map(|&n| Given::Choice(n)).collect(),
+        Takes::Number { .. } => return None,
+    })
+}
+
+fn given_text(value: Given) -> String {
+    match value {
+        Given::Switch => String::new(),
+        Given::Whole(n) => format!(" {n}"),
+        Given::Number(x) => format!(" {x}"),
+        Given::Choice(name) => format!(" {name}"),
+    }
+}
+
+/// Every variant: `auto`, `none` and each registered technique at its defaults, then (unless
+/// `quick`) each knob of each technique at each of its values other than its default. Returns
+/// the variants and the continuous knobs left at their defaults (`--flag`).
+pub fn truth_variants(quick: bool) -> (Vec<TruthVariant>, Vec<&'static str>) {
+    let base = |technique| FrameSettings {
+        technique,
+        export_hdr: true,
+        ..FrameSettings::new(1, 1)
+    };
+    let mut variants: Vec<TruthVariant> = Technique::all()
+        .into_iter()
+        .map(|(_, technique)| TruthVariant {
+            technique,
+            knob: None,
+            settings: base(technique),
+        })
+        .collect();
+    let mut continuous = Vec::new();
+    if quick {
+        return (variants, continuous);
+    }
+    for &module in crate::features::registry::TECHNIQUES {
+        let technique = Technique::Only(module);
+        for &knob in module.knobs() {
+            let Some(values) = knob_values(&knob.takes) else {
+                if !continuous.contains(&knob.flag) {
+                    continuous.push(knob.flag);
+                }
+                continue;
+            };
+            for value in values.into_iter().filter(|&v| Some(v) != knob.default) {
+                let mut settings = base(technique);
+                settings.set_knob(knob, value);
+                variants.push(TruthVariant {
+                    technique,
+                    knob: Some(format!("{}{}", knob.flag, given_text(value))),
+                    settings,
+                });
+            }
+        }
+    }
+    (variants, continuous)
+}
+
+/// What one variant measured on one truth.
+#[derive(Clone, Debug)]
+pub struct TruthResult {
+    /// The variant.
+    pub variant: TruthVariant,
+    /// Its frame against the truth, or why it could not render the scene.
+    pub error: std::result::Result<TruthError, String>,
+    /// Whole frame (submit to fence), ms, at the timed size.
+    pub frame: Stats,
+}
+
+/// One truth scene's results.
+pub struct SceneResults {
+    /// The truth (scene, size, samples, noise).
+    pub truth: Truth,
+    /// What the scene file's leading comment says it is.
+    pub description: String,
+    /// The timed frames' size.
+    pub timed_size: (u32, u32),
+    /// Every variant, in [`truth_variants`] order.
+    pub results: Vec<TruthResult>,
+}
+
+impl SceneResults {
+    /// Plain lighting's median frame in this run.
+    pub fn none_ms(&self) -> f64 {
+        self.results
+            .iter()
+            .find(|r| r.variant.technique == Technique::None && r.variant.knob.is_none())
+            .map_or(f64::NAN, |r| r.frame.median)
+    }
+
+    /// The variant with the least error whose frame is at most `budget` times plain
+    /// lighting's (`None`: no limit).
+    pub fn best_within(&self, budget: Option<f64>) -> Option<&TruthResult> {
+        let limit = budget.map_or(f64::INFINITY, |b| b * self.none_ms());
+        self.results
+            .iter()
+            .filter(|r| r.frame.median <= limit)
+            .filter_map(|r| r.error.as_ref().ok().map(|e| (r, e.error)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(r, _)| r)
+    }
+}
+
+/// The leading `#` comment of a scene file, as one paragraph.
+fn scene_description(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    text.lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(|l| l.trim_start_matches('#').trim())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Measures every variant on every truth of `opts.truths`.
+pub fn run(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    opts: &TruthOptions,
+) -> Result<Vec<SceneResults>> {
+    if opts.rounds == 0 {
+        return Err(LucentError::InvalidInput(
+            "report truth: --rounds must be at least 1".into(),
+        ));
+    }
+    let available = truth_names(&opts.truths)?;
+    let names = match &opts.scenes {
+        None => available.clone(),
+        Some(wanted) => {
+            if let Some(unknown) = wanted.iter().find(|w| !available.contains(w)) {
+                return Err(LucentError::InvalidInput(format!(
+                    "report truth: no truth '{unknown}' in {}; available: {}",
+                    opts.truths.display(),
+                    available.join(", ")
+                )));
+            }
+            wanted.clone()
+        }
+    };
+    if names.is_empty() {
+        return Err(LucentError::InvalidInput(format!(
+            "report truth: {} holds no scene with a truth (tools/truth/README.md says how to \
+             render one)",
+            opts.truths.display()
+        )));
+    }
+    let (variants, _) = truth_variants(opts.quick);
+    let mut out = Vec::with_capacity(names.len());
+    for name in &names {
+        let truth = load_truth(&opts.truths, name)?;
+        let description = scene_description(&truth.scene_path);
+        let errors: Vec<std::result::Result<TruthError, String>> = variants
+            .iter()
+            .map(|v| {
+                let settings = FrameSettings {
+                    width: truth.width,
+                    height: truth.height,
+                    ..v.settings
+                };
+                let hdr = render_frame(gpu, shaders, cache, &truth.scene, settings)
+                    .map_err(|e| e.to_string())?
+                    .hdr
+                    .ok_or_else(|| "no HDR frame exported".to_string())?;
+                measure(&truth, &hdr).map_err(|e| e.to_string())
+            })
+            .collect();
+        let timed_size = opts.size.unwrap_or((truth.width, truth.height));
+        let frames = time_round_robin(gpu, shaders, cache, &truth, &variants, timed_size, opts)?;
+        let results = variants
+            .iter()
+            .zip(errors)
+            .zip(frames)
+            .map(|((variant, error), frame)| TruthResult {
+                variant: variant.clone(),
+                error,
+                frame,
+            })
+            .collect();
+        out.push(SceneResults {
+            truth,
+            description,
+            timed_size,
+            results,
+        });
+    }
+    Ok(out)
+}
+
+/// Every variant's frames of the truth's scene at `size`, round-robin; a variant that cannot
+/// build its frame gets NaN times (its error says why).
+fn time_round_robin(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    truth: &Truth,
+    variants: &[TruthVariant],
+    (width, height): (u32, u32),
+    opts: &TruthOptions,
+) -> Result<Vec<Stats>> {
+    let mut renderers: Vec<Option<Renderer>> = Vec::with_capacity(variants.len());
+    let mut runners = Vec::with_capacity(variants.len());
+    let timed = (|| -> Result<Vec<Stats>> {
+        for v in variants {
+            let settings = FrameSettings {
+                width,
+                height,
+                export_hdr: false,
+                ..v.settings
+            };
+            let renderer = Renderer::new(gpu, shaders, cache, &truth.scene, settings).ok();
+            if let Some(r) = &renderer {
+                runners.push(Some(FrameRunner::new(
+                    gpu,
+                    r.executable.plan.physical.len(),
+                )?));
+            } else {
+                runners.push(None);
+            }
+            renderers.push(renderer);
+        }
+        let mut samples = vec![Vec::new(); variants.len()];
+        for round in 0..opts.warmup + opts.rounds {
+            for (i, (renderer, runner)) in renderers.iter().zip(&mut runners).enumerate() {
+                if let (Some(renderer), Some(runner)) = (renderer, runner) {
+                    let t = runner.run_frame(gpu, &renderer.executable)?;
+                    if round >= opts.warmup {
+                        samples[i].push(t.wall_ms);
+                    }
+                }
+            }
+        }
+        Ok(samples
+            .iter()
+            .map(|s| {
+                if s.is_empty() {
+                    Stats {
+                        median: f64::NAN,
+                        min: f64::NAN,
+                        max: f64::NAN,
+                    }
+                } else {
+                    Stats::of(s)
+                }
+            })
+            .collect())
+    })();
+    crate::frame::destroy_after_idle(
+        gpu,
+        renderers.into_iter().flatten().collect(),
+        runners.into_iter().flatten().collect(),
+    )?;
+    timed
+}
+
+/// The report as Markdown.
+pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> String {
+    let mut out = String::new();
+    let (_, continuous) = truth_variants(opts.quick);
+    let size = opts
+        .size
+        .map_or("each truth's size".to_string(), |(w, h)| format!("{w}x{h}"));
+    let _ = writeln!(
+        out,
+        "# lucent against the path-traced truth\n\n\
+         - device: {device}\n\
+         - truths: `{}` (Mitsuba 3 `volpath`, tools/truth/README.md); each scene's samples and \
+         noise below\n\
+         - error: relative mean absolute error `sum |L - T| / sum T` over the object's pixels \
+         (wholly covered, eroded one pixel), at the truth's size; energy: `sum L / sum T` per \
+         channel; FLIP: mean over the same pixels after the scene's tonemap (exposure, ACES, \
+         sRGB)\n\
+         - time: frames at {size}, {} rounds round-robin after {} warm-up rounds, submit to \
+         fence; `/ none` is the ratio to plain lighting's frame in the same run\n\
+         - variants: `auto`, `none`, every registered technique at its defaults{}\n\
+         - generated by `lucent report truth --out DIR{}{}`\n",
+        opts.truths.display(),
+        opts.rounds,
+        opts.warmup,
+        if opts.quick {
+            " (`--quick`: no knob variants)".to_string()
+        } else if continuous.is_empty() {
+            ", then each knob of each technique at each of its values".to_string()
+        } else {
+            format!(
+                ", then each knob of each technique at each of its values (both ends of a \
+                 whole-number range); continuous knobs stay at their defaults: {}",
+                continuous
+                    .iter()
+                    .map(|k| format!("`{k}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        },
+        if opts.quick { " --quick" } else { "" },
+        opts.size
+            .map_or(String::new(), |(w, h)| format!(" --size {w}x{h}")),
+    );
+    let _ = writeln!(out, "## The best technique under a cost budget\n");
+    let _ = writeln!(
+        out,
+        "The variant with the least error whose frame costs at most the budget times plain \
+         lighting's (same run), per scene: its error, and its cost as a multiple of plain \
+         lighting's.\n"
+    );
+    let mut header = "| scene | none |".to_string();
+    let mut rule = "|---|---|".to_string();
+    for b in BUDGETS {
+        let _ = write!(header, " <= {b}x none |");
+        rule.push_str("---|");
+    }
+    header.push_str(" any cost |");
+    rule.push_str("---|");
+    let _ = writeln!(out, "{header}\n{rule}");
+    for s in scenes {
+        let none = s
+            .results
+            .iter()
+            .find(|r| r.variant.technique == Technique::None && r.variant.knob.is_none());
+        let cell = |r: Option<&TruthResult>| match r {
+            Some(r) => match &r.error {
+                Ok(e) => format!(
+                    "`{}` {:.3} ({:.2}x)",
+                    r.variant.name(),
+                    e.error,
+                    r.frame.median / s.none_ms()
+                ),
+                Err(_) => "-".into(),
+            },
+            None => "-".into(),
+        };
+        let mut row = format!(
+            "| {} | {} |",
+            s.truth.name,
+            none.and_then(|r| r.error.as_ref().ok())
+                .map_or("-".into(), |e| format!("{:.3}", e.error))
+        );
+        for &b in BUDGETS {
+            let _ = write!(row, " {} |", cell(s.best_within(Some(b))));
+        }
+        let _ = write!(row, " {} |", cell(s.best_within(None)));
+        let _ = writeln!(out, "{row}");
+    }
+    for s in scenes {
+        let _ = writeln!(
+            out,
+            "\n## {}\n\n{}\n\n- truth: {}x{}, {} samples per pixel, noise {} (half the \
+             relative difference of two seeds' 4x4-pixel block means); {} object pixels\n\
+             - timed at {}x{}; plain lighting {:.2} ms\n\n\
+             ![error against time](truth-{}.png)\n",
+            s.truth.name,
+            s.description,
+            s.truth.width,
+            s.truth.height,
+            s.truth.spp.map_or("?".into(), |n| n.to_string()),
+            s.truth.noise.map_or("?".into(), |n| format!("{n:.4}")),
+            s.truth.object_pixels(),
+            s.timed_size.0,
+            s.timed_size.1,
+            s.none_ms(),
+            s.truth.name,
+        );
+        let _ = writeln!(
+            out,
+            "| variant | frame ms | / none | error | FLIP | energy R | energy G | energy B |\n\
+             |---|---:|---:|---:|---:|---:|---:|---:|"
+        );
+        for r in &s.results {
+            let (ms, ratio) = (r.frame.median, r.frame.median / s.none_ms());
+            match &r.error {
+                Ok(e) => {
+                    let _ = writeln!(
+                        out,
+                        "| `{}` | {ms:.2} | {ratio:.2}x | {:.4} | {:.4} | {:.3} | {:.3} | {:.3} |",
+                        r.variant.name(),
+                        e.error,
+                        e.flip,
+                        e.energy[0],
+                        e.energy[1],
+                        e.energy[2]
+                    );
+                }
+                Err(why) => {
+                    let _ = writeln!(
+                        out,
+                        "| `{}` | {ms:.2} | {ratio:.2}x | not rendered: {} | | | | |",
+                        r.variant.name(),
+                        why.replace('|', "/").replace('\n', " ")
+                    );
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs the truth report and writes `truth.md` and a `truth-NAME.png` plot per scene into
+/// `out`. Returns the Markdown and the files written.
+pub fn write_truth_report(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    cache: &PipelineCache,
+    out: &Path,
+    opts: &TruthOptions,
+) -> Result<(String, Vec<PathBuf>)> {
+    let scenes = run(gpu, shaders, cache, opts)?;
+    let text = markdown(&scenes, opts, &gpu.info.describe());
+    std::fs::create_dir_all(out)
+        .map_err(|e| LucentError::InvalidInput(format!("{}: {e}", out.display())))?;
+    let md = out.join("truth.md");
+    crate::files::write_file_atomic(&md, text.as_bytes())?;
+    let mut files = vec![md];
+    for s in &scenes {
+        let mut series: Vec<PlotSeries> = Vec::new();
+        for r in &s.results {
+            let Ok(e) = &r.error else { continue };
+            if !r.frame.median.is_finite() {
+                continue;
+            }
+            let point = PlotPoint {
+                label: r.variant.knob.clone().unwrap_or_default(),
+                x: r.frame.median,
+                y: e.error,
+            };
+            let name = r.variant.technique.name();
+            match series.iter_mut().find(|p| p.name == name) {
+                Some(p) => p.points.push(point),
+                None => series.push(PlotSeries {
+                    name: name.into(),
+                    points: vec![point],
+                }),
+            }
+        }
+        let png = out.join(format!("truth-{}.png", s.truth.name));
+        write_scatter_png(
+            &png,
+            &format!("{}: error against the path-traced truth", s.truth.name),
+            &format!("frame ms ({}x{})", s.timed_size.0, s.timed_size.1),
+            "sum |lucent - truth| / sum truth (object pixels)",
+            &series,
+            false,
+        )?;
+        files.push(png);
+    }
+    Ok((text, files))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn variants_cover_every_technique_and_turn_each_knob() {
+        let (quick, _) = truth_variants(true);
+        assert_eq!(quick.len(), Technique::all().len());
+        let (full, continuous) = truth_variants(false);
+        for &module in crate::features::registry::TECHNIQUES {
+            for knob in module.knobs() {
+                let turned = full.iter().any(|v| {
+                    v.technique == Technique::Only(module)
+                        && v.knob.as_deref().is_some_and(|k| k.starts_with(knob.flag))
+                });
+                assert!(
+                    turned || continuous.contains(&knob.flag),
+                    "{} {}: neither measured nor named as continuous",
+                    module.name(),
+                    knob.flag
+                );
+            }
+        }
+        // Every knob variant differs from its technique's defaults.
+        for v in full.iter().filter(|v| v.knob.is_some()) {
+            let defaults = full
+                .iter()
+                .find(|d| d.technique == v.technique && d.knob.is_none())
+                .unwrap();
+            assert!(
+                v.settings != defaults.settings,
+                "{} changes nothing",
+                v.name()
+            );
+        }
+    }
+}

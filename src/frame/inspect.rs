@@ -222,7 +222,10 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
         }) = &m.medium
         {
             // What each technique took from the medium, and what the material wrote itself.
-            let rd = medium.total_diffuse_reflectance();
+            let (albedo, rd) = (
+                medium.white_sky_albedo(),
+                medium.total_diffuse_reflectance(),
+            );
             let layer = &medium.layers[0];
             parts.push(format!(
                 "medium {} (sigma_a {:?}, sigma_s {:?} mm^-1, g {}, eta {}, {} units/mm): albedo \
@@ -233,10 +236,17 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 layer.g,
                 medium.eta,
                 medium.units_per_mm,
-                if m.albedo == rd {
-                    format!("{:?} = its total diffuse reflectance R_d", rd.to_array())
+                if m.albedo == albedo {
+                    format!(
+                        "{:?} = its white-sky albedo (the dipole's R_d: {:?})",
+                        albedo.to_array(),
+                        rd.to_array()
+                    )
                 } else {
-                    format!("written (its R_d would be {:?})", rd.to_array())
+                    format!(
+                        "written (its white-sky albedo would be {:?})",
+                        albedo.to_array()
+                    )
                 },
                 if m.layers.as_ref() == Some(medium) {
                     "= the medium, one semi-infinite layer"

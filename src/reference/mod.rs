@@ -4,6 +4,7 @@
 //! changes, so does its twin. [`raytrace`] renders a whole scene from the analytic shapes its
 //! meshes approximate, as an independent end-to-end reference.
 
+pub mod albedo;
 pub mod dipole;
 pub mod fxaa;
 pub mod layered;

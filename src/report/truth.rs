@@ -33,6 +33,10 @@ use crate::{LucentError, Result};
 /// The cost budgets of the summary table, as multiples of plain lighting's frame.
 pub const BUDGETS: &[f64] = &[1.25, 1.5, 2.0, 4.0];
 
+/// Errors within this fraction of each other count as equal when the budget table picks the
+/// best variant (the cheaper wins): far below any difference a viewer sees.
+pub const TIE: f64 = 0.005;
+
 /// What `lucent report truth` measures.
 #[derive(Clone, Debug)]
 pub struct TruthOptions {
@@ -193,14 +197,21 @@ impl SceneResults {
     }
 
     /// The variant with the least error whose frame is at most `budget` times plain
-    /// lighting's (`None`: no limit).
+    /// lighting's (`None`: no limit); of variants within [`TIE`] of that error, the cheapest
+    /// (`auto` and `none` on a plain sphere differ in rounding, not in what they show).
     pub fn best_within(&self, budget: Option<f64>) -> Option<&TruthResult> {
         let limit = budget.map_or(f64::INFINITY, |b| b * self.none_ms());
-        self.results
+        let within: Vec<(&TruthResult, f64)> = self
+            .results
             .iter()
             .filter(|r| r.frame.median <= limit)
             .filter_map(|r| r.error.as_ref().ok().map(|e| (r, e.error)))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .collect();
+        let least = within.iter().map(|&(_, e)| e).fold(f64::INFINITY, f64::min);
+        within
+            .into_iter()
+            .filter(|&(_, e)| e <= least * (1.0 + TIE))
+            .min_by(|a, b| a.0.frame.median.total_cmp(&b.0.frame.median))
             .map(|(r, _)| r)
     }
 }
@@ -404,7 +415,8 @@ pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> S
         out,
         "The variant with the least error whose frame costs at most the budget times plain \
          lighting's (same run), per scene: its error, and its cost as a multiple of plain \
-         lighting's.\n"
+         lighting's. Errors within {:.1}% of each other count as equal; the cheaper wins.\n",
+        TIE * 100.0
     );
     let mut header = "| scene | none |".to_string();
     let mut rule = "|---|---|".to_string();

@@ -310,14 +310,34 @@ impl LayeredMedium {
     /// Jensen et al.'s total diffuse reflectance `R_d` of the first layer, taken as
     /// semi-infinite, at the medium's `eta`, per channel: the fraction of the light falling on a
     /// flat surface of it that leaves again, everywhere, diffusely (the dipole integrated over
-    /// the plane, `crate::reference::dipole`). The albedo a Lambertian surface of this medium
-    /// has: what `[material.medium]` gives a material that writes none.
+    /// the plane, `crate::reference::dipole`): multiple scattering alone, in the diffusion
+    /// approximation. What the layered passes' dipole integrates to; a Lambertian surface of
+    /// the medium takes [`LayeredMedium::white_sky_albedo`] instead.
     pub fn total_diffuse_reflectance(&self) -> Vec3 {
         // In [0, 1] for every medium validate() accepts; clamped so an albedo stays one.
         Vec3::from(
             self.first_layer_dipoles()
                 .map(|dipole| dipole.total_reflectance().clamp(0.0, 1.0) as f32),
         )
+    }
+
+    /// The white-sky albedo of the first layer, taken as semi-infinite, at the medium's `eta`,
+    /// per channel: the fraction of the light falling on a flat surface of it from every
+    /// direction that leaves again, single and multiple scattering together
+    /// ([`crate::reference::albedo`]; exact for isotropic scattering behind an index-matched
+    /// boundary). The albedo a Lambertian surface of this medium has: what `[material.medium]`
+    /// gives a material that writes none. Above [`LayeredMedium::total_diffuse_reflectance`]
+    /// (the dipole's, which misses single scattering and underestimates diffusion at moderate
+    /// albedo): skin1 (0.625, 0.385, 0.241) against R_d (0.547, 0.291, 0.161).
+    pub fn white_sky_albedo(&self) -> Vec3 {
+        let r = self.first_layer_reduced();
+        Vec3::from_array(std::array::from_fn(|c| {
+            crate::reference::albedo::white_sky_albedo(
+                f64::from(r.sigma_s_prime[c]),
+                f64::from(r.sigma_a[c]),
+                f64::from(self.eta),
+            ) as f32
+        }))
     }
 
     /// A preset by name (see the module docs): the Jensen 2001 media, `li-teapot` and

@@ -399,7 +399,7 @@ pub struct Material {
     /// Li et al.'s layered medium, if the material is layered.
     pub layers: Option<LayeredMedium>,
     /// The one homogeneous medium the material is made of (`[material.medium]`), if it gives
-    /// one: its albedo (when not written) is the medium's total diffuse reflectance and its
+    /// one: its albedo (when not written) is the medium's white-sky albedo and its
     /// `layers` (when not written) the medium itself.
     pub medium: Option<Medium>,
 }

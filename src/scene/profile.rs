@@ -180,7 +180,8 @@ pub const MEDIUM_GAUSSIANS: usize = 6;
 /// `z_r = 1 / sigma_t'` to three diffusion lengths `1 / sigma_tr` of the widest channel (at
 /// most 300 transport mean free paths: a medium that absorbs nothing diffuses without end);
 /// and Burley's normalized diffusion from the medium's diffuse mean free path `1 / sigma_t'`
-/// with `R_d` as its surface albedo. Returns the profile and the fit's relative L2 error per
+/// with its white-sky albedo ([`LayeredMedium::white_sky_albedo`], Christensen and Burley's
+/// surface albedo is a Monte Carlo total reflectance too). Returns the profile and the fit's relative L2 error per
 /// channel (`inspect` prints it).
 pub fn medium_profile(medium: &LayeredMedium) -> (SssProfile, [f64; 3]) {
     let layer = &medium.layers[0];
@@ -237,7 +238,7 @@ pub fn medium_profile(medium: &LayeredMedium) -> (SssProfile, [f64; 3]) {
         blur: None,
         burley: Some(BurleyDistance::MeanFreePath {
             mfp,
-            albedo: medium.total_diffuse_reflectance(),
+            albedo: medium.white_sky_albedo(),
         }),
         texturing: Texturing::default(),
     };
@@ -454,7 +455,7 @@ mod tests {
                 let Some(BurleyDistance::MeanFreePath { mfp, albedo }) = profile.burley else {
                     panic!("{name}: no Burley distance");
                 };
-                assert_eq!(albedo, medium.total_diffuse_reflectance());
+                assert_eq!(albedo, medium.white_sky_albedo());
                 let expected = 1.0 / (medium.layers[0].sigma_s_prime() + medium.layers[0].sigma_a);
                 assert!((mfp - expected).abs().max_element() < 1e-4 * expected.max_element());
             }

@@ -60,11 +60,11 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         Ok(Some(TextureSource::File(full)))
     };
     let medium = m.medium.as_ref().map(|t| medium(at, t)).transpose()?;
-    // The albedo a technique shades with: as written, else the medium's total diffuse
-    // reflectance (what a Lambertian surface of it reflects), else a light grey.
+    // The albedo a technique shades with: as written, else the medium's white-sky albedo
+    // (what a Lambertian surface of it reflects), else a light grey.
     let albedo = match (value(&m.albedo), &medium) {
         (Some(written), _) => Vec3::from(written),
-        (None, Some(medium)) => medium.total_diffuse_reflectance(),
+        (None, Some(medium)) => medium.white_sky_albedo(),
         (None, None) => Vec3::splat(0.8),
     };
     let mut material = Material::opaque(

@@ -214,9 +214,13 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
         float thickness = length(p_in - x_o);
         float fade = smoothstep(0.0, 3.0 * texel_size, thickness);
         vec3 e = entering(i, p_in, n_in, to_light, eta);
-        // Unscattered, and diffused through the thickness by the first layer's dipole (the
-        // light that entered: the irradiance, so the cosine at the entry).
-        vec3 crossed = exp(-optical_depth(mat, p_in, n_in, p_in, x_o, texels_in)) +
+        // Unscattered: the beam's flux through x_o's surface, so the cosine at the exit (the
+        // beam spreads over 1 / |cos| of it; without it the rim just past a side light's
+        // terminator, where the chord is short and the exit grazing, drew a bright band). And
+        // diffused through the thickness by the first layer's dipole: the light that entered,
+        // the irradiance, so the cosine at the entry.
+        vec3 crossed = max(-dot(to_light, n_o), 0.0) *
+                           exp(-optical_depth(mat, p_in, n_in, p_in, x_o, texels_in)) +
                        (unseen_entry(p_in, n_in) * max(dot(to_light, n_in), 0.0)) *
                            dipole_beyond(mat, thickness);
         sum += (w[k] * fade) * e * crossed;

@@ -510,12 +510,13 @@ pub fn single_scattering(
 /// through the thickness `a = |P' - x_o|` by the first layer's dipole
 /// ([`crate::scene::layered::Dipole::transmitted_beyond`]):
 ///
-/// `L_t = T(x_o) / pi Σ_lights V(P') T(P') E(P') [exp(-tau(P' -> x_o)) + cos(P') Tb(a)]`
+/// `L_t = T(x_o) / pi Σ_lights V(P') T(P') E(P') [cos(x_o) exp(-tau(P' -> x_o)) + cos(P') Tb(a)]`
 ///
 /// for each light `x_o` faces away from (`dot(to_light, n) < 0`); `P'` = where the segment from
 /// `x_o` towards the light leaves the object (exact), `tau` the planar-layer optical depth
-/// relative to `P'`, `cos(P')` the light's cosine to the normal there (the diffusing light is
-/// the irradiance that entered). The diffused part is weighted by `smoothstep(0, 0.3, n(P') .
+/// relative to `P'`, `cos(x_o)` the light's cosine to the normal at `x_o` (the unscattered
+/// beam's flux through the surface it leaves by), `cos(P')` the light's cosine to the normal
+/// there (the diffusing light is the irradiance that entered). The diffused part is weighted by `smoothstep(0, 0.3, n(P') .
 /// (P' - eye) / |P' - eye|)`: 1 where `P'` faces away from the eye, 0 where the camera sees it
 /// (light that entered in view is multiple scattering's, which gathers it from the visible
 /// surface). Needs a sphere.
@@ -551,8 +552,11 @@ pub fn transmitted(
         let from_eye = (entry.point - scene.camera.eye.as_dvec3()).normalize_or_zero();
         let unseen = smoothstep(0.0, 0.3, entry.normal.dot(from_eye));
         let cos_in = unseen * entry.to_light.dot(entry.normal).max(0.0);
-        let crossed =
-            |c: usize| (-tau[c]).exp() + cos_in * dipoles[c].transmitted_beyond(thickness);
+        // The unscattered beam's flux through x_o's surface: the cosine at the exit.
+        let cos_exit = (-to_light.dot(n_o)).max(0.0);
+        let crossed = |c: usize| {
+            cos_exit * (-tau[c]).exp() + cos_in * dipoles[c].transmitted_beyond(thickness)
+        };
         sum += entry.radiance * DVec3::new(crossed(0), crossed(1), crossed(2));
     }
     Ok(sum * (fresnel_transmittance(cos_o, eta) / PI))

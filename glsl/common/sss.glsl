@@ -24,6 +24,13 @@ layout(std140, set = 0, binding = LUCENT_SSS_PROFILES_BINDING) uniform SssProfil
     SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
     // The whole profile's 1-D form in world units: rgb = weight / sqrt(2 pi v), a = 1 / (2 v).
     vec4 gaussians[MAX_SSS_PROFILES * MAX_SSS_STEPS];
+    // Diffuse transmission through thickness from the material's medium (src/features/sss/
+    // transmission.rs `SssTransmission::rows`), 4 rows per ID: the medium's dipole in mm,
+    // sigma_tr (a: mm per scene unit, 0 = the profile has no medium: no transmission), z_r,
+    // z_v, and (alpha' / 2) / A (A: the medium's albedo); the alphas of the last three the
+    // largest transmittance per channel, min(1 / A, 1000). Read by the lighting pass
+    // (sss_transmission.glsl).
+    vec4 transmission[MAX_SSS_PROFILES * 4];
 } sss_profiles;
 
 // The profile ID stored at a texel (exact for UNORM8: rounding recovers the integer).

@@ -17,6 +17,7 @@
 // permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SSS_TRANSMISSION
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
@@ -39,6 +40,11 @@
 // (the next binding) say how much of the albedo goes into the diffuse light.
 #define LUCENT_SSS_PROFILES_BINDING (LUCENT_SSS_TEXTURING + 1)
 #include "../common/sss.glsl"
+#endif
+#ifdef LUCENT_SSS_TRANSMISSION
+// SSS materials with a medium: diffuse transmission through the thickness the light-space
+// maps measure (needs LUCENT_SHADOWS and LUCENT_SSS_TEXTURING's profile IDs and table).
+#include "../common/sss_transmission.glsl"
 #endif
 
 // How much of light `i` reaches the pixel: x reflected, y transmitted through `material`.
@@ -92,7 +98,13 @@ void main() {
 #ifdef LUCENT_SSS_TEXTURING
     // The diffuse light carries only the part of the albedo the profile applies before the
     // blur; the chain's last pass multiplies in the rest (glsl/common/sss.glsl).
-    s.albedo = sss_albedo_before(sss_profile_id(subpassLoad(profile_ids).r), s.albedo);
+    int sss_id = sss_profile_id(subpassLoad(profile_ids).r);
+    s.albedo = sss_albedo_before(sss_id, s.albedo);
+#endif
+#ifdef LUCENT_SSS_TRANSMISSION
+    // Only pixels whose profile has a medium look up thicknesses (a branch the pixels of one
+    // object take alike; the rest of the frame skips it).
+    bool transmits = sss_transmits(sss_id);
 #endif
     vec3 pos = world_position(gl_FragCoord.xy, d);
     vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
@@ -137,6 +149,13 @@ void main() {
         vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation * visible.x);
         color += s.albedo / PI * incident;
         specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
+#ifdef LUCENT_SSS_TRANSMISSION
+        // Light diffused through the object from its far side joins the diffuse before the
+        // blur, which spreads it, with the albedo's part the diffuse light carries.
+        if (transmits) {
+            color += s.albedo / PI * sss_transmitted(sss_id, i, pos, s.normal, to_light);
+        }
+#endif
 #ifdef LUCENT_TRANSLUCENCY
         // Transmitted light joins the diffuse: the SSS blur diffuses it too.
         color += translucency_transmitted(s, to_eye, v_dot_n, to_light, attenuation * visible.y,

@@ -200,7 +200,9 @@ impl PostProcessSss {
         }
         check_output_format(desc.output_format)?;
         // Each pixel's ID picks its profile; there are no objects (`object_ids` is empty).
+        // A host's lit light has no lighting pass here to add transmission in: no media.
         let profiles = SssProfiles {
+            transmission: vec![None; profiles.len()],
             profiles,
             object_ids: Vec::new(),
         };

@@ -79,6 +79,11 @@ pub struct GBufferLayout {
     /// lighting pass reads the profile IDs (an input attachment) and the profile table, and
     /// the SSS chains' last passes multiply the albedo (GB0) back in.
     pub sss_texturing: bool,
+    /// Some SSS profile's material has a medium and some light casts shadows: the lighting
+    /// pass reads the profile IDs and table (as for texturing) and adds the light the medium
+    /// diffuses through the object's thickness, which the light-space maps measure
+    /// ([`super::sss::transmission`]).
+    pub sss_transmission: bool,
     /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
     /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
     pub lean: bool,
@@ -399,11 +404,11 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
     }
     let mut layouts = Vec::new();
     for &translucency in &translucency {
-        for flags in 0u32..1 << 8 {
+        for flags in 0u32..1 << 9 {
             let bit = |i: u32| flags & (1 << i) != 0;
-            // LEAN, depth-in-alpha and texturing are properties of SSS chains
+            // LEAN, depth-in-alpha, texturing and transmission are properties of SSS chains
             // (`FrameDesc::gbuffer_layout`): a frame without SSS has none of them.
-            if !bit(0) && (bit(1) || bit(4) || bit(7)) {
+            if !bit(0) && (bit(1) || bit(4) || bit(7) || bit(8)) {
                 continue;
             }
             for layer_depth_textures in 0..=2 {
@@ -412,6 +417,7 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
                     translucency,
                     sss: bit(0),
                     sss_texturing: bit(7),
+                    sss_transmission: bit(8),
                     lean: bit(1),
                     lean_clear: false,
                     normal_maps: bit(2),

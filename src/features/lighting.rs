@@ -38,7 +38,8 @@ pub struct Lit {
 /// Declares the lighting pass: reads the G-buffer at the same pixel (and the light-space maps,
 /// when some light casts shadows), writes lit HDR colour (with SSS: diffuse and specular
 /// apart). When some SSS profile applies its albedo after the blur
-/// (`GBufferLayout::sss_texturing`), it also reads the profile IDs and `sss_profiles`, the
+/// (`GBufferLayout::sss_texturing`) or transmits light through its medium
+/// (`GBufferLayout::sss_transmission`), it also reads the profile IDs and `sss_profiles`, the
 /// SSS profile table's region (the SSS feature owns it), to leave that albedo out of the
 /// diffuse light.
 pub fn lighting_pass(
@@ -79,10 +80,10 @@ pub fn lighting_pass(
         pass.input(gb2)
             .per_frame(&super::translucency::TABLE_REGION);
     }
-    if gb.layout.sss_texturing {
+    if reads_profiles(&gb.layout) {
         // `lighting_defines` numbered these two bindings (LUCENT_SSS_TEXTURING).
         let (Some(ids), Some(table)) = (&gb.sss, sss_profiles) else {
-            panic!("a frame with SSS texturing has profile IDs and a profile table");
+            panic!("a frame with SSS texturing or transmission has profile IDs and a table");
         };
         pass.input(ids).per_frame(table);
     }
@@ -123,10 +124,16 @@ fn lighting_bindings_before_texturing(layout: &GBufferLayout) -> usize {
     4 + 2 * usize::from(layout.translucency.is_some())
 }
 
+/// Whether the lighting pass reads the SSS profile IDs and table: some profile applies its
+/// albedo after the blur, or transmits light through its medium.
+fn reads_profiles(layout: &GBufferLayout) -> bool {
+    layout.sss_texturing || layout.sss_transmission
+}
+
 /// The lighting pass's descriptor bindings before the shadow bindings: then the profile IDs and
-/// the SSS profile table when some profile applies its albedo after the blur.
+/// the SSS profile table when it reads them ([`reads_profiles`]).
 fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
-    lighting_bindings_before_texturing(layout) + 2 * usize::from(layout.sss_texturing)
+    lighting_bindings_before_texturing(layout) + 2 * usize::from(reads_profiles(layout))
 }
 
 /// The lighting pass's defines: the plain shader's, and with translucency the extra ones of the
@@ -142,7 +149,9 @@ fn lighting_defines(layout: &GBufferLayout, shadows: Option<bool>) -> (Defines, 
     if layout.sss {
         plain.push(("LUCENT_SPLIT_SPECULAR", "1"));
     }
-    if layout.sss_texturing {
+    if reads_profiles(layout) {
+        // The profile IDs' binding (named for its first use: profiles in `pre` mode keep
+        // their albedo in the light, sss_albedo_before).
         plain.push((
             "LUCENT_SSS_TEXTURING",
             match lighting_bindings_before_texturing(layout) {
@@ -150,6 +159,10 @@ fn lighting_defines(layout: &GBufferLayout, shadows: Option<bool>) -> (Defines, 
                 _ => "6",
             },
         ));
+    }
+    if layout.sss_transmission && shadows.is_some() {
+        // The thickness is the light-space maps' (glsl/common/sss_transmission.glsl).
+        plain.push(("LUCENT_SSS_TRANSMISSION", "1"));
     }
     if layout.lean {
         plain.push(("LUCENT_LEAN", "1"));

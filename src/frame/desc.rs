@@ -139,6 +139,10 @@ impl FrameDesc {
                     .iter()
                     .any(|(profile, _)| profile.texturing != Texturing::Pre)
             }),
+            // The thickness comes from the light-space maps: without them nothing transmits.
+            sss_transmission: settings.sss.transmission
+                && self.shadows.is_some()
+                && self.sss.as_ref().is_some_and(SssProfiles::transmits),
             lean: self.lean(),
             // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
             lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),
@@ -252,6 +256,9 @@ impl FrameDesc {
                     .map(|(p, _)| p.name.as_str())
                     .collect();
                 names.push(format!("sss {} ({})", chain.name(), profiles.join(", ")));
+            }
+            if s.transmits() {
+                names.push("sss transmission through thickness (media)".into());
             }
         }
         if let Some(l) = &self.layered {

@@ -215,11 +215,13 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 }
             ));
         }
-        if let Some(crate::scene::material::Medium {
-            layered: medium,
-            profile,
-            fit_error: errors,
-        }) = &m.medium
+        if let Some(
+            whole @ crate::scene::material::Medium {
+                layered: medium,
+                profile,
+                fit_error: errors,
+            },
+        ) = &m.medium
         {
             // What each technique took from the medium, and what the material wrote itself.
             let (albedo, rd) = (
@@ -273,6 +275,19 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                     errors[2]
                 ));
             }
+            // What a screen-space technique transmits through thickness (times the albedo).
+            let t = crate::features::sss::transmission::SssTransmission::of(whole);
+            let through: Vec<String> = [1.0, 4.0, 16.0]
+                .iter()
+                .map(|mm| {
+                    let [r, g, b] = t.transmittance(mm * f64::from(medium.units_per_mm));
+                    format!("{mm} mm {r:.3} / {g:.3} / {b:.3}")
+                })
+                .collect();
+            parts.push(format!(
+                "screen-space transmission through thickness (x albedo): {}",
+                through.join(", ")
+            ));
         }
         let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
         let parts = if parts.is_empty() {

@@ -13,6 +13,7 @@ pub mod raytrace;
 pub mod sss;
 pub mod tonemap;
 pub mod translucency;
+pub mod transmission;
 
 /// A 3-vector of f64 (the reference never rounds to f32 until the end).
 pub type DVec3 = glam::DVec3;

@@ -25,4 +25,5 @@ mod sss;
 mod sss_artifacts;
 mod sweep_layered;
 mod translucency;
+mod transmission;
 mod truth;

@@ -93,17 +93,20 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "marble-medium-sidelit",
             technique: technique("separable"),
-            error: 0.089,
-            energy: (0.9, 0.95),
-            why: "the separable blur with six Gaussians fitted to the medium's dipole: at \
-                  0.35 mm per pixel the kernel softens the terminator and carries little past it",
+            error: 0.106,
+            energy: (0.95, 1.0),
+            why: "the separable blur with six Gaussians fitted to the medium's dipole, and the \
+                  medium's transmission through the chords the light-space map measures: 2-4% \
+                  too dark, but the slab's diffusion puts too much on the dark side of a \
+                  sphere (0.089 without the transmission)",
         },
         Case {
             scene: "marble-medium-sidelit",
             technique: technique("burley"),
-            error: 0.094,
-            energy: (0.9, 0.95),
-            why: "Burley's normalized diffusion from the medium's mean free path and R_d",
+            error: 0.110,
+            energy: (0.95, 1.0),
+            why: "Burley's normalized diffusion from the medium's mean free path and albedo, \
+                  with the medium's transmission (0.094 without it)",
         },
         Case {
             scene: "skin1-medium-sidelit",
@@ -127,7 +130,7 @@ fn cases() -> Vec<Case> {
             scene: "skin1-medium-sidelit",
             technique: technique("separable"),
             error: 0.236,
-            energy: (0.7, 0.85),
+            energy: (0.75, 0.85),
             why: "the separable blur of the Gaussians fitted to skin1's dipole: a little of \
                   the wrap, at 0.35 mm per pixel",
         },

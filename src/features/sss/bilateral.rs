@@ -20,6 +20,7 @@ pub static BILATERAL: TwoPassChain = TwoPassChain {
         &knobs::KERNEL,
         &knobs::TEXTURING,
         &knobs::NO_TILES,
+        &knobs::NO_TRANSMISSION,
     ],
     scene: "teapot",
     published_timing: None,

@@ -49,6 +49,7 @@ pub static BURLEY: BurleyChain = BurleyChain {
         &HALF_RES,
         &super::knobs::TEXTURING,
         &super::knobs::NO_TILES,
+        &super::knobs::NO_TRANSMISSION,
     ],
     scene: "skin",
     published_timing: None,

@@ -21,6 +21,7 @@ pub static CONTROL: IterativeChain = IterativeChain {
         &knobs::PRECISION,
         &knobs::TEXTURING,
         &knobs::NO_TILES,
+        &knobs::NO_TRANSMISSION,
     ],
     scene: "skin",
     published_timing: Some(&THESIS_TABLE_2_CONTROL),

@@ -130,3 +130,14 @@ pub static NO_TILES: Knob = Knob {
     default: None,
     apply: |k, _| *k.sss_tiles = false,
 };
+
+/// `--no-sss-transmission`: leave out the light diffused through SSS materials' thickness.
+pub static NO_TRANSMISSION: Knob = Knob {
+    flag: "--no-sss-transmission",
+    help: "SSS materials with a [material.medium]: leave out the light their medium diffuses \
+           through the object's thickness from its far side (measured in the light-space maps; \
+           on by default; A/B comparison).",
+    takes: Takes::Switch,
+    default: None,
+    apply: |k, _| k.sss.transmission = false,
+};

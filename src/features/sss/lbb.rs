@@ -23,6 +23,7 @@ pub static LBB: IterativeChain = IterativeChain {
         &knobs::PRECISION,
         &knobs::TEXTURING,
         &knobs::NO_TILES,
+        &knobs::NO_TRANSMISSION,
     ],
     scene: "teapot",
     published_timing: Some(&THESIS_TABLE_1_LBB),

@@ -18,6 +18,7 @@ pub static LCB: IterativeChain = IterativeChain {
         &knobs::PRECISION,
         &knobs::TEXTURING,
         &knobs::NO_TILES,
+        &knobs::NO_TRANSMISSION,
     ],
     scene: "teapot",
     published_timing: Some(&super::lbb::THESIS_TABLE_1_LBB),

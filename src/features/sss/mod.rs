@@ -90,6 +90,7 @@ pub mod lcb;
 pub mod separable;
 pub mod settings;
 pub mod tables;
+pub mod transmission;
 mod two_pass;
 
 pub use settings::{SssKnobs, SssPrecision, DEFAULT_SENSITIVITY};
@@ -247,6 +248,9 @@ pub struct SssProfiles {
     /// The profiles in ID order (ID = index + 1), refitted when `--sss-gaussians` asks, with
     /// the blur each is diffused with.
     pub profiles: Vec<(SssProfile, SssBlur)>,
+    /// Per profile (as `profiles`): the diffuse transmission through thickness of its
+    /// material's medium ([`transmission`]), `None` for a material without one.
+    pub transmission: Vec<Option<transmission::SssTransmission>>,
     /// Per scene object: its profile ID (0: the object does not scatter).
     pub object_ids: Vec<u8>,
 }
@@ -258,7 +262,9 @@ impl SssProfiles {
     /// material's own when set (`--sss-texturing`). `None` when no object scatters. Under a
     /// `forced` blur, a material without a profile of its own but with a medium
     /// (`[material.medium]`) scatters with the profile fitted to its medium when it was made
-    /// ([`crate::scene::material::Medium::profile`]).
+    /// ([`crate::scene::material::Medium::profile`]). A material with a medium transmits light
+    /// diffused through its thickness ([`transmission`]): materials that share a profile but
+    /// not a medium get one ID each.
     pub fn new(
         scene: &Scene,
         forced: Option<SssBlur>,
@@ -267,6 +273,7 @@ impl SssProfiles {
         blur_of: &dyn Fn(&SssProfile) -> Result<SssBlur>,
     ) -> Result<Option<Self>> {
         let mut profiles: Vec<(SssProfile, SssBlur)> = Vec::new();
+        let mut transmissions: Vec<Option<transmission::SssTransmission>> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
         for object in &scene.objects {
             let material = &object.material;
@@ -290,7 +297,15 @@ impl SssProfiles {
                 profile.texturing = texturing;
             }
             let entry = (profile, blur);
-            let index = match profiles.iter().position(|e| *e == entry) {
+            let through = material
+                .medium
+                .as_ref()
+                .map(transmission::SssTransmission::of);
+            let index = match profiles
+                .iter()
+                .zip(&transmissions)
+                .position(|(e, t)| *e == entry && *t == through)
+            {
                 Some(i) => i,
                 None => {
                     if profiles.len() + 1 == MAX_SSS_PROFILES {
@@ -302,6 +317,7 @@ impl SssProfiles {
                         )));
                     }
                     profiles.push(entry);
+                    transmissions.push(through);
                     profiles.len() - 1
                 }
             };
@@ -309,8 +325,15 @@ impl SssProfiles {
         }
         Ok((!profiles.is_empty()).then_some(Self {
             profiles,
+            transmission: transmissions,
             object_ids,
         }))
+    }
+
+    /// Whether some profile's material has a medium, whose light diffuses through its
+    /// thickness ([`transmission`]).
+    pub fn transmits(&self) -> bool {
+        self.transmission.iter().any(Option::is_some)
     }
 
     /// The blurs in use, one chain each, in registry order.
@@ -362,9 +385,14 @@ impl SssProfiles {
             info: [[0.0; 4]; MAX_SSS_PROFILES],
             steps: [[[0.0; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
             gaussians: [[0.0; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+            transmission: [[0.0; 4]; MAX_SSS_PROFILES * 4],
         };
         for (i, (profile, blur)) in self.profiles.iter().enumerate() {
             let id = i + 1;
+            // Rows of zeros (mm per unit 0): no medium, or `--no-sss-transmission`.
+            if let Some(Some(t)) = knobs.transmission.then(|| self.transmission[i]) {
+                table.transmission[id * 4..id * 4 + 4].copy_from_slice(&t.rows());
+            }
             let chain = chains.iter().position(|c| c == blur).unwrap_or(0);
             let steps = blur_steps(profile);
             table.info[id] = [
@@ -428,6 +456,9 @@ pub struct ProfileTableGpu {
     /// (the two-pass bilateral blur evaluates the whole profile's 1-D form at each tap's 3D
     /// distance).
     pub gaussians: [[f32; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
+    /// Per ID, four rows (`id * 4 + row`): the medium's diffuse transmission
+    /// ([`transmission::SssTransmission::rows`]); zero where the profile has none.
+    pub transmission: [[f32; 4]; MAX_SSS_PROFILES * 4],
 }
 
 /// Bytes of [`ProfileTableGpu`] (the per-frame buffer's profile region).

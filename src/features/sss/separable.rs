@@ -24,6 +24,7 @@ pub static SEPARABLE: TwoPassChain = TwoPassChain {
         &knobs::FILTER,
         &knobs::TEXTURING,
         &knobs::NO_TILES,
+        &knobs::NO_TRANSMISSION,
     ],
     scene: "teapot",
     published_timing: None,

@@ -97,6 +97,9 @@ pub struct SssKnobs {
     pub burley_half_res: bool,
     /// Every SSS material's texturing mode instead of its own (`--sss-texturing`).
     pub texturing: Option<crate::scene::material::Texturing>,
+    /// SSS materials with a medium add the light diffused through their thickness
+    /// ([`super::transmission`]; on by default, `--no-sss-transmission` for A/B).
+    pub transmission: bool,
 }
 
 impl Default for SssKnobs {
@@ -116,6 +119,7 @@ impl Default for SssKnobs {
             burley_fit: crate::scene::profile::BurleyFit::Searchlight,
             burley_half_res: false,
             texturing: None,
+            transmission: true,
         }
     }
 }

@@ -1,0 +1,103 @@
+// Diffuse transmission through thickness for screen-space SSS materials with a medium
+// (issue 26; src/features/sss/transmission.rs), HDRP's "thick" mode from the medium: per
+// light, the light that entered on the far side of the object diffuses through the thickness
+// the light-space map measures and leaves here, before the blur (which then spreads it). The
+// lighting pass includes this with LUCENT_SHADOWS, the SSS profile table and the pixel's
+// profile ID. The thickness is the light's path through the object, so a back-lit slab gets
+// its thickness and a side-lit sphere its chords. The f64 twin is src/reference/transmission.rs (`transmittance`,
+// `sss_transmitted`): change both together.
+#ifndef LUCENT_SSS_TRANSMISSION_GLSL
+#define LUCENT_SSS_TRANSMISSION_GLSL
+
+#include "dipole.glsl"
+#include "sss.glsl"
+#include "shadows.glsl"
+
+// Whether profile `id` transmits (its material has a medium; ID 0's row is zero).
+bool sss_transmits(int id) {
+    return sss_profiles.transmission[id * 4].a > 0.0;
+}
+
+// The medium's diffuse transmittance through `a` scene units relative to its albedo A (its
+// white-sky albedo; src/reference/transmission.rs `transmittance_over_albedo`): the light
+// Donner and Jensen's multipole lets through a slab of that thickness, never less than the
+// light the semi-infinite dipole diffuses farther than a from its entry (what Li et al.'s
+// layered pass adds, layered.glsl `dipole_beyond`; it takes over where a slab thinner than a
+// mean free path leaves the multipole invalid), over A, times the albedo where the diffuse
+// light's is, so a material whose albedo is the medium's transmits the model's light.
+// Held in [0, min(1 / A, 1000)] (the slab lets through at most all the light).
+vec3 sss_transmittance(int id, float a) {
+    vec4 sigma_tr = sss_profiles.transmission[id * 4];
+    vec4 z_r = sss_profiles.transmission[id * 4 + 1];
+    vec4 z_v = sss_profiles.transmission[id * 4 + 2];
+    vec4 to_light_over_albedo = sss_profiles.transmission[id * 4 + 3];
+    vec3 most = vec3(z_r.a, z_v.a, to_light_over_albedo.a);
+    // Millimetres; held below 1e18 so a^2 stays finite in f32 (the map's far plane is nearer).
+    float a_mm = clamp(a * sigma_tr.a, 0.0, 1e18);
+    vec3 through = max(dipole_beyond_sum(sigma_tr.rgb, z_r.rgb, z_v.rgb, a_mm),
+                       multipole_slab_sum(sigma_tr.rgb, z_r.rgb, z_v.rgb, a_mm));
+    return clamp(to_light_over_albedo.rgb * through, vec3(0.0), most);
+}
+
+// Light `i`'s radiance diffused through the object to `pos` (outward normal `normal`, the
+// light towards `to_light`), before the albedo and 1 / pi: for each of the four map texels
+// around the point (bilinearly weighted, as a shadow lookup; the transmittance is filtered,
+// not the distance, which would leave a staircase where the first surface along the light
+// changes), the entry point P' the texel's depth gives on the segment towards the light, the
+// light's radiance x falloff there, times the transmittance through |P' - pos|, times the
+// back-facing cosine max(-n . l, 0) (the entry's cosine for a slab, HDRP's "thick" mode).
+// As layered.glsl's transmitted_light, the lookup is made from a point one map texel inside,
+// so the flat facets near the terminator do not find themselves at thickness 0. Lights without
+// a map, and points outside it, transmit nothing (nothing measures the thickness).
+vec3 sss_transmitted(int id, int i, vec3 pos, vec3 normal, vec3 to_light) {
+    float back = -dot(normal, to_light);
+    int index = shadow_face(i, pos);
+    if (!(back > 0.0) || index < 0) {
+        return vec3(0.0);
+    }
+#define FACE shadows.faces[index]
+    vec4 clip = FACE.view_proj * vec4(pos, 1.0);
+    float texel_size = FACE.params.x * abs(clip.w) + FACE.params.y;
+    vec3 inner = pos - normal * texel_size;
+    clip = FACE.view_proj * vec4(inner, 1.0);
+    // Outside the face's cone or map (w <= 0 would divide by zero): nothing measured.
+    if (!(clip.w > 0.0)) {
+        return vec3(0.0);
+    }
+    vec3 ndc = clip.xyz / clip.w;
+    if (!(all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 && ndc.z <= 1.0)) {
+        return vec3(0.0);
+    }
+    float d_x = shadow_distance(FACE.params, ndc.z);
+    vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
+    vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
+    vec2 base = floor(c);
+    vec4 d = textureGather(shadow_depth, (base + 1.0) * shadows.atlas.zw, 0);
+    vec2 f = c - base;
+    // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
+    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+    Light light = frame.lights[i];
+    vec3 l = light.position_type.xyz;
+    bool orthographic = FACE.params.z < 0.0;
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+        // Depth 1: nothing between the light and the far plane there.
+        if (!(d[k] < 1.0)) {
+            continue;
+        }
+        float d_map = shadow_distance(FACE.params, d[k]);
+        // The first surface the light meets on its way to `inner`: along the light's
+        // direction (orthographic) or on the ray from the light (perspective; d_x > 0 there,
+        // the max guards a point on the light's eye).
+        vec3 p_in = orthographic ? inner + to_light * max(d_x - d_map, 0.0)
+                                 : l + (inner - l) * min(d_map / max(d_x, 1e-12), 1.0);
+        vec3 unused;
+        float attenuation;
+        light_incidence(light, p_in, unused, attenuation);
+        sum += (w[k] * attenuation) * sss_transmittance(id, length(p_in - pos));
+    }
+    return sum * (back * light.radiance_range.rgb);
+#undef FACE
+}
+
+#endif

@@ -37,6 +37,10 @@ pub const BUDGETS: &[f64] = &[1.25, 1.5, 2.0, 4.0];
 /// best variant (the cheaper wins): far below any difference a viewer sees.
 pub const TIE: f64 = 0.005;
 
+/// "Near the best" in the report's choice of a technique: within this fraction of the least
+/// error.
+pub const NEAR_BEST: f64 = 0.1;
+
 /// What `lucent report truth` measures.
 #[derive(Clone, Debug)]
 pub struct TruthOptions {
@@ -173,6 +177,9 @@ pub struct TruthResult {
     pub error: std::result::Result<TruthError, String>,
     /// Whole frame (submit to fence), ms, at the timed size.
     pub frame: Stats,
+    /// It rendered exactly plain lighting's picture (nothing in the scene for it to act on):
+    /// never picked as the best choice.
+    pub renders_as_none: bool,
 }
 
 /// One truth scene's results.
@@ -188,12 +195,16 @@ pub struct SceneResults {
 }
 
 impl SceneResults {
-    /// Plain lighting's median frame in this run.
-    pub fn none_ms(&self) -> f64 {
+    /// Plain lighting's result.
+    pub fn none_result(&self) -> Option<&TruthResult> {
         self.results
             .iter()
             .find(|r| r.variant.technique == Technique::None && r.variant.knob.is_none())
-            .map_or(f64::NAN, |r| r.frame.median)
+    }
+
+    /// Plain lighting's median frame in this run.
+    pub fn none_ms(&self) -> f64 {
+        self.none_result().map_or(f64::NAN, |r| r.frame.median)
     }
 
     /// The variant with the least error whose frame is at most `budget` times plain
@@ -204,7 +215,7 @@ impl SceneResults {
         let within: Vec<(&TruthResult, f64)> = self
             .results
             .iter()
-            .filter(|r| r.frame.median <= limit)
+            .filter(|r| r.frame.median <= limit && !r.renders_as_none)
             .filter_map(|r| r.error.as_ref().ok().map(|e| (r, e.error)))
             .collect();
         let least = within.iter().map(|&(_, e)| e).fold(f64::INFINITY, f64::min);
@@ -264,7 +275,7 @@ pub fn run(
     for name in &names {
         let truth = load_truth(&opts.truths, name)?;
         let description = scene_description(&truth.scene_path);
-        let errors: Vec<std::result::Result<TruthError, String>> = variants
+        let frames: Vec<std::result::Result<Vec<f32>, String>> = variants
             .iter()
             .map(|v| {
                 let settings = FrameSettings {
@@ -272,22 +283,32 @@ pub fn run(
                     height: truth.height,
                     ..v.settings
                 };
-                let hdr = render_frame(gpu, shaders, cache, &truth.scene, settings)
+                render_frame(gpu, shaders, cache, &truth.scene, settings)
                     .map_err(|e| e.to_string())?
                     .hdr
-                    .ok_or_else(|| "no HDR frame exported".to_string())?;
-                measure(&truth, &hdr).map_err(|e| e.to_string())
+                    .ok_or_else(|| "no HDR frame exported".to_string())
             })
             .collect();
+        // Plain lighting's picture: a variant that renders exactly it has nothing to act on in
+        // this scene (an SSS blur on a scene without SSS materials).
+        let plain = variants
+            .iter()
+            .position(|v| v.technique == Technique::None && v.knob.is_none())
+            .and_then(|i| frames[i].as_ref().ok());
         let timed_size = opts.size.unwrap_or((truth.width, truth.height));
-        let frames = time_round_robin(gpu, shaders, cache, &truth, &variants, timed_size, opts)?;
+        let times = time_round_robin(gpu, shaders, cache, &truth, &variants, timed_size, opts)?;
         let results = variants
             .iter()
-            .zip(errors)
-            .zip(frames)
-            .map(|((variant, error), frame)| TruthResult {
+            .zip(&frames)
+            .zip(times)
+            .map(|((variant, hdr), frame)| TruthResult {
                 variant: variant.clone(),
-                error,
+                error: hdr
+                    .as_ref()
+                    .map_err(Clone::clone)
+                    .and_then(|hdr| measure(&truth, hdr).map_err(|e| e.to_string())),
+                renders_as_none: variant.technique != Technique::None
+                    && hdr.as_ref().ok().zip(plain).is_some_and(|(a, b)| a == b),
                 frame,
             })
             .collect();
@@ -415,7 +436,9 @@ pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> S
         out,
         "The variant with the least error whose frame costs at most the budget times plain \
          lighting's (same run), per scene: its error, and its cost as a multiple of plain \
-         lighting's. Errors within {:.1}% of each other count as equal; the cheaper wins.\n",
+         lighting's. Errors within {:.1}% of each other count as equal; the cheaper wins. A \
+         variant that renders exactly plain lighting's picture (marked `(= none)` in the \
+         scene's table: nothing in the scene for it to act on) is never picked.\n",
         TIE * 100.0
     );
     let mut header = "| scene | none |".to_string();
@@ -428,10 +451,7 @@ pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> S
     rule.push_str("---|");
     let _ = writeln!(out, "{header}\n{rule}");
     for s in scenes {
-        let none = s
-            .results
-            .iter()
-            .find(|r| r.variant.technique == Technique::None && r.variant.knob.is_none());
+        let none = s.none_result();
         let cell = |r: Option<&TruthResult>| match r {
             Some(r) => match &r.error {
                 Ok(e) => format!(
@@ -455,6 +475,53 @@ pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> S
         }
         let _ = write!(row, " {} |", cell(s.best_within(None)));
         let _ = writeln!(out, "{row}");
+    }
+    let _ = writeln!(
+        out,
+        "\n## Choosing a technique\n\n\
+         Per scene: the variant closest to the truth at any cost, the cheapest variant within \
+         {:.0}% of that error (what to pick when the frame budget matters), and plain \
+         lighting's error (what the techniques buy). A technique's error here is against the \
+         light transport it imitates, so a variant that is cheaper and as close is the better \
+         choice for that material, whatever its own equations' accuracy.\n",
+        NEAR_BEST * 100.0
+    );
+    for s in scenes {
+        let (Some(best), Some(none)) = (s.best_within(None), s.none_result()) else {
+            continue;
+        };
+        let (Ok(best_error), Ok(none_error)) = (&best.error, &none.error) else {
+            continue;
+        };
+        let near = s
+            .results
+            .iter()
+            .filter(|r| r.frame.median.is_finite() && !r.renders_as_none)
+            .filter(|r| {
+                r.error
+                    .as_ref()
+                    .is_ok_and(|e| e.error <= best_error.error * (1.0 + NEAR_BEST))
+            })
+            .min_by(|a, b| a.frame.median.total_cmp(&b.frame.median))
+            .unwrap_or(best);
+        let near_error = near.error.as_ref().map_or(f64::NAN, |e| e.error);
+        let _ = writeln!(
+            out,
+            "- **{}**: closest `{}` (error {:.3}, {:.2}x plain lighting's frame, energy {:.2} / \
+             {:.2} / {:.2}); cheapest within {:.0}%: `{}` ({:.3}, {:.2}x); plain lighting {:.3}.",
+            s.truth.name,
+            best.variant.name(),
+            best_error.error,
+            best.frame.median / s.none_ms(),
+            best_error.energy[0],
+            best_error.energy[1],
+            best_error.energy[2],
+            NEAR_BEST * 100.0,
+            near.variant.name(),
+            near_error,
+            near.frame.median / s.none_ms(),
+            none_error.error,
+        );
     }
     for s in scenes {
         let _ = writeln!(
@@ -486,8 +553,9 @@ pub fn markdown(scenes: &[SceneResults], opts: &TruthOptions, device: &str) -> S
                 Ok(e) => {
                     let _ = writeln!(
                         out,
-                        "| `{}` | {ms:.2} | {ratio:.2}x | {:.4} | {:.4} | {:.3} | {:.3} | {:.3} |",
+                        "| `{}`{} | {ms:.2} | {ratio:.2}x | {:.4} | {:.4} | {:.3} | {:.3} | {:.3} |",
                         r.variant.name(),
+                        if r.renders_as_none { " (= `none`)" } else { "" },
                         e.error,
                         e.flip,
                         e.energy[0],

@@ -49,6 +49,10 @@ fn quick_truth_report_measures_every_technique_on_every_truth() {
             row[row.len() - 1].starts_with('`'),
             "no best technique: {row:?}"
         );
+        assert!(
+            text.contains(&format!("- **{name}**: closest `")),
+            "no choice for {name}"
+        );
         // The scene's own table: one row per technique, in `Technique::all` order.
         let section = text
             .split(&format!("\n## {name}\n"))
@@ -58,7 +62,8 @@ fn quick_truth_report_measures_every_technique_on_every_truth() {
         let techniques = Technique::all();
         assert_eq!(rows.len(), techniques.len(), "{section}");
         for (row, (technique, _)) in rows.iter().zip(&techniques) {
-            assert_eq!(row[0], format!("`{technique}`"), "{row:?}");
+            // "`lbb` (= `none`)" where the scene has nothing for the technique to act on.
+            assert!(row[0].starts_with(&format!("`{technique}`")), "{row:?}");
             let ms: f64 = row[1].parse().unwrap();
             assert!(ms.is_finite() && ms > 0.0, "{row:?}");
             for cell in &row[3..8] {

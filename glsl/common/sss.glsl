@@ -24,13 +24,14 @@ layout(std140, set = 0, binding = LUCENT_SSS_PROFILES_BINDING) uniform SssProfil
     SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
     // The whole profile's 1-D form in world units: rgb = weight / sqrt(2 pi v), a = 1 / (2 v).
     vec4 gaussians[MAX_SSS_PROFILES * MAX_SSS_STEPS];
-    // Diffuse transmission through thickness from the material's medium (src/features/sss/
-    // transmission.rs `SssTransmission::rows`), 4 rows per ID: the medium's dipole in mm,
-    // sigma_tr (a: mm per scene unit, 0 = the profile has no medium: no transmission), z_r,
-    // z_v, and (alpha' / 2) / A (A: the medium's albedo); the alphas of the last three the
-    // largest transmittance per channel, min(1 / A, 1000). Read by the lighting pass
-    // (sss_transmission.glsl).
-    vec4 transmission[MAX_SSS_PROFILES * 4];
+    // The material's medium (src/features/sss/transmission.rs), 6 rows per ID. Its diffuse
+    // transmission through thickness (`SssTransmission::rows`): the medium's dipole in mm,
+    // sigma_tr (a: mm per scene unit, 0 = no transmission), z_r, z_v, and (alpha' / 2) / A
+    // (A: the medium's albedo); the alphas of rows 1-3 the largest transmittance per
+    // channel, min(1 / A, 1000). Its reflectance (`reflectance_rows`): gamma = sqrt(1 -
+    // omega) (a: 1 = the profile has a medium), omega / (4 A_1). Read by the lighting pass
+    // (sss_medium.glsl, sss_transmission.glsl).
+    vec4 medium[MAX_SSS_PROFILES * 6];
 } sss_profiles;
 
 // The profile ID stored at a texel (exact for UNORM8: rounding recovers the integer).

@@ -2,10 +2,11 @@
 // (issue 26; src/features/sss/transmission.rs), HDRP's "thick" mode from the medium: per
 // light, the light that entered on the far side of the object diffuses through the thickness
 // the light-space map measures and leaves here, before the blur (which then spreads it). The
-// lighting pass includes this with LUCENT_SHADOWS, the SSS profile table and the pixel's
-// profile ID. The thickness is the light's path through the object, so a back-lit slab gets
-// its thickness and a side-lit sphere its chords. The f64 twin is src/reference/transmission.rs (`transmittance`,
-// `sss_transmitted`): change both together.
+// lighting pass includes this (through sss_medium.glsl) with LUCENT_SHADOWS, the SSS profile
+// table and the pixel's profile ID. The thickness is the light's path through the object, so
+// a back-lit slab gets its thickness and a side-lit sphere its chords. The f64 twin is
+// src/reference/transmission.rs (`transmittance_over_albedo`, `sss_transmitted`): change both
+// together.
 #ifndef LUCENT_SSS_TRANSMISSION_GLSL
 #define LUCENT_SSS_TRANSMISSION_GLSL
 
@@ -13,9 +14,10 @@
 #include "sss.glsl"
 #include "shadows.glsl"
 
-// Whether profile `id` transmits (its material has a medium; ID 0's row is zero).
+// Whether profile `id` transmits (its material has a medium and `--no-sss-transmission` is
+// not given; the row is zero otherwise, and for ID 0).
 bool sss_transmits(int id) {
-    return sss_profiles.transmission[id * 4].a > 0.0;
+    return sss_profiles.medium[id * 6].a > 0.0;
 }
 
 // The medium's diffuse transmittance through `a` scene units relative to its albedo A (its
@@ -27,10 +29,10 @@ bool sss_transmits(int id) {
 // light's is, so a material whose albedo is the medium's transmits the model's light.
 // Held in [0, min(1 / A, 1000)] (the slab lets through at most all the light).
 vec3 sss_transmittance(int id, float a) {
-    vec4 sigma_tr = sss_profiles.transmission[id * 4];
-    vec4 z_r = sss_profiles.transmission[id * 4 + 1];
-    vec4 z_v = sss_profiles.transmission[id * 4 + 2];
-    vec4 to_light_over_albedo = sss_profiles.transmission[id * 4 + 3];
+    vec4 sigma_tr = sss_profiles.medium[id * 6];
+    vec4 z_r = sss_profiles.medium[id * 6 + 1];
+    vec4 z_v = sss_profiles.medium[id * 6 + 2];
+    vec4 to_light_over_albedo = sss_profiles.medium[id * 6 + 3];
     vec3 most = vec3(z_r.a, z_v.a, to_light_over_albedo.a);
     // Millimetres; held below 1e18 so a^2 stays finite in f32 (the map's far plane is nearer).
     float a_mm = clamp(a * sigma_tr.a, 0.0, 1e18);

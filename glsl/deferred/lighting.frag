@@ -17,7 +17,8 @@
 // permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SSS_TRANSMISSION
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SSS_MEDIUM
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SSS_MEDIUM
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
@@ -41,10 +42,11 @@
 #define LUCENT_SSS_PROFILES_BINDING (LUCENT_SSS_TEXTURING + 1)
 #include "../common/sss.glsl"
 #endif
-#ifdef LUCENT_SSS_TRANSMISSION
-// SSS materials with a medium: diffuse transmission through the thickness the light-space
-// maps measure (needs LUCENT_SHADOWS and LUCENT_SSS_TEXTURING's profile IDs and table).
-#include "../common/sss_transmission.glsl"
+#ifdef LUCENT_SSS_MEDIUM
+// SSS materials with a medium: their diffuse light as the medium reflects it, and with
+// LUCENT_SHADOWS the light it diffuses through the thickness the light-space maps measure
+// (needs LUCENT_SSS_TEXTURING's profile IDs and table).
+#include "../common/sss_medium.glsl"
 #endif
 
 // How much of light `i` reaches the pixel: x reflected, y transmitted through `material`.
@@ -101,13 +103,18 @@ void main() {
     int sss_id = sss_profile_id(subpassLoad(profile_ids).r);
     s.albedo = sss_albedo_before(sss_id, s.albedo);
 #endif
-#ifdef LUCENT_SSS_TRANSMISSION
-    // Only pixels whose profile has a medium look up thicknesses (a branch the pixels of one
-    // object take alike; the rest of the frame skips it).
-    bool transmits = sss_transmits(sss_id);
-#endif
     vec3 pos = world_position(gl_FragCoord.xy, d);
     vec3 to_eye = normalize(frame.camera_pos.xyz - pos);
+#ifdef LUCENT_SSS_MEDIUM
+    // Only pixels whose profile has a medium shade as it and look up thicknesses (a branch
+    // the pixels of one object take alike; the rest of the frame skips it).
+    bool medium = sss_has_medium(sss_id);
+    float n_dot_v = max(dot(s.normal, to_eye), 0.0);
+    vec3 h_view = medium ? sss_medium_h(sss_id, n_dot_v) : vec3(1.0);
+#ifdef LUCENT_SHADOWS
+    bool transmits = medium && sss_transmits(sss_id);
+#endif
+#endif
     vec3 color = ambient_radiance(s.normal) * s.albedo;
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);
 #ifdef LUCENT_TRANSLUCENCY
@@ -147,9 +154,14 @@ void main() {
 #endif
         float n_dot_l = max(dot(s.normal, to_light), 0.0);
         vec3 incident = light.radiance_range.rgb * (n_dot_l * attenuation * visible.x);
-        color += s.albedo / PI * incident;
         specular += s.specular * blinn_phong(s, to_eye, to_light) * incident;
-#ifdef LUCENT_SSS_TRANSMISSION
+#ifdef LUCENT_SSS_MEDIUM
+        if (medium) {
+            incident *= sss_medium_reflectance(sss_id, n_dot_l, n_dot_v, h_view);
+        }
+#endif
+        color += s.albedo / PI * incident;
+#if defined(LUCENT_SSS_MEDIUM) && defined(LUCENT_SHADOWS)
         // Light diffused through the object from its far side joins the diffuse before the
         // blur, which spreads it, with the albedo's part the diffuse light carries.
         if (transmits) {

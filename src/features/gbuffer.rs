@@ -79,11 +79,11 @@ pub struct GBufferLayout {
     /// lighting pass reads the profile IDs (an input attachment) and the profile table, and
     /// the SSS chains' last passes multiply the albedo (GB0) back in.
     pub sss_texturing: bool,
-    /// Some SSS profile's material has a medium and some light casts shadows: the lighting
-    /// pass reads the profile IDs and table (as for texturing) and adds the light the medium
-    /// diffuses through the object's thickness, which the light-space maps measure
-    /// ([`super::sss::transmission`]).
-    pub sss_transmission: bool,
+    /// Some SSS profile's material has a medium: the lighting pass reads the profile IDs and
+    /// table (as for texturing), shades those pixels' diffuse light as their medium reflects
+    /// it, and (when some light casts shadows) adds the light the medium diffuses through the
+    /// object's thickness, which the light-space maps measure ([`super::sss::transmission`]).
+    pub sss_medium: bool,
     /// LCB and LBB: the G-buffer pass projects LEAN data to the view plane (a LEAN target:
     /// slope y + moments) and the lighting pass stores slope x in the diffuse alpha.
     pub lean: bool,
@@ -417,7 +417,7 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
                     translucency,
                     sss: bit(0),
                     sss_texturing: bit(7),
-                    sss_transmission: bit(8),
+                    sss_medium: bit(8),
                     lean: bit(1),
                     lean_clear: false,
                     normal_maps: bit(2),

@@ -39,7 +39,7 @@ pub struct Lit {
 /// when some light casts shadows), writes lit HDR colour (with SSS: diffuse and specular
 /// apart). When some SSS profile applies its albedo after the blur
 /// (`GBufferLayout::sss_texturing`) or transmits light through its medium
-/// (`GBufferLayout::sss_transmission`), it also reads the profile IDs and `sss_profiles`, the
+/// (`GBufferLayout::sss_medium`), it also reads the profile IDs and `sss_profiles`, the
 /// SSS profile table's region (the SSS feature owns it), to leave that albedo out of the
 /// diffuse light.
 pub fn lighting_pass(
@@ -127,7 +127,7 @@ fn lighting_bindings_before_texturing(layout: &GBufferLayout) -> usize {
 /// Whether the lighting pass reads the SSS profile IDs and table: some profile applies its
 /// albedo after the blur, or transmits light through its medium.
 fn reads_profiles(layout: &GBufferLayout) -> bool {
-    layout.sss_texturing || layout.sss_transmission
+    layout.sss_texturing || layout.sss_medium
 }
 
 /// The lighting pass's descriptor bindings before the shadow bindings: then the profile IDs and
@@ -160,9 +160,10 @@ fn lighting_defines(layout: &GBufferLayout, shadows: Option<bool>) -> (Defines, 
             },
         ));
     }
-    if layout.sss_transmission && shadows.is_some() {
-        // The thickness is the light-space maps' (glsl/common/sss_transmission.glsl).
-        plain.push(("LUCENT_SSS_TRANSMISSION", "1"));
+    if layout.sss_medium {
+        // Media's reflectance, and their transmission where light-space maps measure the
+        // thickness (glsl/common/sss_medium.glsl).
+        plain.push(("LUCENT_SSS_MEDIUM", "1"));
     }
     if layout.lean {
         plain.push(("LUCENT_LEAN", "1"));

@@ -72,7 +72,7 @@ pub fn declare_frame(
         graph,
         &gb,
         shadow_maps.as_ref(),
-        (layout.sss_texturing || layout.sss_transmission).then_some(&sss::tables::PROFILES),
+        (layout.sss_texturing || layout.sss_medium).then_some(&sss::tables::PROFILES),
         scene_gpu,
     );
     let display_info = ImageInfo {

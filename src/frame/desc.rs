@@ -139,10 +139,9 @@ impl FrameDesc {
                     .iter()
                     .any(|(profile, _)| profile.texturing != Texturing::Pre)
             }),
-            // The thickness comes from the light-space maps: without them nothing transmits.
-            sss_transmission: settings.sss.transmission
-                && self.shadows.is_some()
-                && self.sss.as_ref().is_some_and(SssProfiles::transmits),
+            // Some profile's material has a medium: the lighting pass shades it as its medium
+            // reflects, and (with light-space maps and unless the knob is off) transmits.
+            sss_medium: self.sss.as_ref().is_some_and(SssProfiles::transmits),
             lean: self.lean(),
             // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
             lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),

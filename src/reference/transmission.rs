@@ -242,6 +242,7 @@ mod tests {
                     dipoles: [d; 3],
                     mm_per_unit: 20.0,
                     medium_albedo: [0.0, 0.5, 1.0],
+                    reflectance: [(0.0, 0.0), (0.5, 0.2), (1.0, 1.0)],
                 }
                 .rows();
                 assert!(

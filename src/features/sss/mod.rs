@@ -385,13 +385,18 @@ impl SssProfiles {
             info: [[0.0; 4]; MAX_SSS_PROFILES],
             steps: [[[0.0; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
             gaussians: [[0.0; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
-            transmission: [[0.0; 4]; MAX_SSS_PROFILES * 4],
+            medium: [[0.0; 4]; MAX_SSS_PROFILES * transmission::MEDIUM_ROWS],
         };
         for (i, (profile, blur)) in self.profiles.iter().enumerate() {
             let id = i + 1;
-            // Rows of zeros (mm per unit 0): no medium, or `--no-sss-transmission`.
-            if let Some(Some(t)) = knobs.transmission.then(|| self.transmission[i]) {
-                table.transmission[id * 4..id * 4 + 4].copy_from_slice(&t.rows());
+            // Rows of zeros: no medium; the transmission's (mm per unit 0) also with
+            // `--no-sss-transmission`.
+            if let Some(t) = self.transmission[i] {
+                let rows = &mut table.medium[id * transmission::MEDIUM_ROWS..];
+                if knobs.transmission {
+                    rows[..4].copy_from_slice(&t.rows());
+                }
+                rows[4..transmission::MEDIUM_ROWS].copy_from_slice(&t.reflectance_rows());
             }
             let chain = chains.iter().position(|c| c == blur).unwrap_or(0);
             let steps = blur_steps(profile);
@@ -456,9 +461,10 @@ pub struct ProfileTableGpu {
     /// (the two-pass bilateral blur evaluates the whole profile's 1-D form at each tap's 3D
     /// distance).
     pub gaussians: [[f32; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
-    /// Per ID, four rows (`id * 4 + row`): the medium's diffuse transmission
-    /// ([`transmission::SssTransmission::rows`]); zero where the profile has none.
-    pub transmission: [[f32; 4]; MAX_SSS_PROFILES * 4],
+    /// Per ID, [`transmission::MEDIUM_ROWS`] rows (`id * MEDIUM_ROWS + row`): the medium's
+    /// diffuse transmission ([`transmission::SssTransmission::rows`]) and reflectance
+    /// ([`transmission::SssTransmission::reflectance_rows`]); zero where the profile has none.
+    pub medium: [[f32; 4]; MAX_SSS_PROFILES * transmission::MEDIUM_ROWS],
 }
 
 /// Bytes of [`ProfileTableGpu`] (the per-frame buffer's profile region).

@@ -38,7 +38,11 @@
 use crate::scene::layered::{dipole_constants, Dipole};
 use crate::scene::material::Medium;
 
-/// What a screen-space SSS material's lighting reads of its medium for the transmission.
+/// Rows per profile of the table's `medium` array: four of transmission, two of reflectance.
+pub const MEDIUM_ROWS: usize = 6;
+
+/// What a screen-space SSS material's lighting reads of its medium: its transmission through
+/// thickness and (two rows more) its reflectance (Chandrasekhar's, relative to Lambert's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SssTransmission {
     /// The medium's dipole per channel (R, G, B), lengths in mm.
@@ -48,6 +52,10 @@ pub struct SssTransmission {
     /// The medium's white-sky albedo per channel, which the transmittance is relative to
     /// (the albedo a material with a medium takes when it writes none).
     pub medium_albedo: [f64; 3],
+    /// Its reduced single-scattering albedo `sigma_s' / (sigma_s' + sigma_a)` per channel
+    /// and its white-sky albedo behind an index-matched boundary: what its reflectance
+    /// relative to Lambert's takes ([`crate::reference::albedo::medium_reflectance`]).
+    pub reflectance: [(f64, f64); 3],
 }
 
 impl SssTransmission {
@@ -62,6 +70,15 @@ impl SssTransmission {
             // units_per_mm is validated finite and > 0.
             mm_per_unit: 1.0 / f64::from(m.units_per_mm),
             medium_albedo: m.white_sky_albedo().as_dvec3().to_array(),
+            reflectance: std::array::from_fn(|c| {
+                let (sp, sa) = (f64::from(sp[c]).max(0.0), f64::from(sa[c]).max(0.0));
+                // A medium that neither scatters nor absorbs (validated away) scatters nothing.
+                let omega = if sp + sa > 0.0 { sp / (sp + sa) } else { 0.0 };
+                (
+                    omega,
+                    crate::reference::albedo::white_sky_albedo(sp, sa, 1.0),
+                )
+            }),
         }
     }
 
@@ -98,5 +115,17 @@ impl SssTransmission {
             [vr, vg, vb, mg],
             [nr, ng, nb, mb],
         ]
+    }
+
+    /// The reflectance's two rows (glsl/common/sss_medium.glsl): `gamma = sqrt(1 - omega)`
+    /// (a: 1, the profile has a medium) and `omega / (4 A_1)`, `A_1` at least 1e-3 (finite).
+    pub fn reflectance_rows(&self) -> [[f32; 4]; 2] {
+        let [r, g, b] = self
+            .reflectance
+            .map(|(omega, _)| (1.0 - omega).max(0.0).sqrt() as f32);
+        let [sr, sg, sb] = self
+            .reflectance
+            .map(|(omega, matched)| (omega / (4.0 * matched.max(1e-3))) as f32);
+        [[r, g, b, 1.0], [sr, sg, sb, 0.0]]
     }
 }

@@ -58,6 +58,10 @@ fn cache_key(mesh: &Mesh, options: &BakeOptions) -> u128 {
         }
     }
     h.update(&options.seed.to_le_bytes());
+    // The talk's occlusion keeps the key it always had; a distance bake gets its own.
+    if options.measure == super::BakeMeasure::Distance {
+        h.update(b"distance");
+    }
     h.digest128()
 }
 

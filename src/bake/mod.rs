@@ -95,6 +95,25 @@ pub struct BakeOptions {
     /// Draw a progress bar on stderr (hidden when stderr is not a terminal); without the
     /// `report` feature, log the count at info level instead ([`crate::progress`]).
     pub progress: bool,
+    /// What a sample's value measures: the talk's occlusion (default) or a distance.
+    pub measure: BakeMeasure,
+}
+
+/// What a baked value measures. Both are in [0, 1], so textures, vertex colours and the cache
+/// hold either.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BakeMeasure {
+    /// The talk's artistic map: the cosine-weighted fraction of inward rays that meet the
+    /// mesh within the maximum distance `D` (1 = thin, 0 = thick).
+    #[default]
+    Occlusion,
+    /// A distance for materials with a medium (`[material.medium]`): the **slab-equivalent
+    /// thickness** over `D`, `t / D` with `t = E[min(chord, D)] / 2`, half the cosine-weighted
+    /// mean chord along the inward rays (rays that meet nothing within `D` count `D`). For a
+    /// slab of thickness `d` the mean chord is `2d - d^2 / D` (so `t` is `d` when `d << D`);
+    /// for a sphere of radius `R` (and `D >= 2R`) it is `4R / 3` (`t = 2R / 3`). Multiply by
+    /// `D` ([`BakeStats::max_distance`]) for scene units.
+    Distance,
 }
 
 impl Default for BakeOptions {
@@ -105,6 +124,7 @@ impl Default for BakeOptions {
             seed: 0,
             texture_size: 512,
             progress: false,
+            measure: BakeMeasure::Occlusion,
         }
     }
 }
@@ -293,6 +313,7 @@ pub(crate) struct Baker {
     rays: u32,
     seed: u64,
     progress: bool,
+    measure: BakeMeasure,
 }
 
 impl Baker {
@@ -315,6 +336,7 @@ impl Baker {
             rays: options.rays,
             seed: options.seed,
             progress: options.progress,
+            measure: options.measure,
         })
     }
 
@@ -372,6 +394,8 @@ impl Baker {
         let (tangent, bitangent) = inward.any_orthonormal_pair();
         let origin = p.position + inward * self.epsilon;
         let mut hits = 0u32;
+        // Distance mode: the sum of min(chord, D) / D over the rays, each term in [0, 1].
+        let mut chords = 0.0f64;
         for _ in 0..self.rays {
             // Malley's method: uniform on the unit disc, lifted to the hemisphere. u1 < 1, so
             // the lift is > 0 and no ray runs parallel to the surface.
@@ -381,11 +405,28 @@ impl Baker {
             let (s, c) = (std::f32::consts::TAU * u2).sin_cos();
             let lift = (1.0 - u1).max(0.0).sqrt();
             let dir = tangent * (r * c) + bitangent * (r * s) + inward * lift;
-            if self.bvh.any_hit(origin, dir, self.max_distance, p.triangle) {
-                hits += 1;
+            match self.measure {
+                BakeMeasure::Occlusion => {
+                    if self.bvh.any_hit(origin, dir, self.max_distance, p.triangle) {
+                        hits += 1;
+                    }
+                }
+                BakeMeasure::Distance => {
+                    // `dir` is unit length (r^2 + lift^2 = 1), so `t` is a distance; the
+                    // miss counts D, and max_distance > 0 was checked.
+                    let t = self
+                        .bvh
+                        .closest_hit(origin, dir, self.max_distance, p.triangle)
+                        .map_or(self.max_distance, |h| h.t.min(self.max_distance));
+                    chords += f64::from(t / self.max_distance).clamp(0.0, 1.0);
+                }
             }
         }
-        (hits as f32 / self.rays as f32).clamp(0.0, 1.0)
+        match self.measure {
+            BakeMeasure::Occlusion => (hits as f32 / self.rays as f32).clamp(0.0, 1.0),
+            // Half the mean chord (the slab-equivalent thickness), over D: in [0, 0.5].
+            BakeMeasure::Distance => (0.5 * chords / f64::from(self.rays)).clamp(0.0, 1.0) as f32,
+        }
     }
 }
 

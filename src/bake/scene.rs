@@ -38,16 +38,25 @@ pub fn load_scene_baked_in(
 /// keyed by mesh content (only the first load pays), meshes drawn with a thickness texture
 /// sample it at their vertices' UVs (the talk's vertex-colour path: per-vertex, so detail
 /// finer than the tessellation is lost; the texture is read as linear data).
+///
+/// Objects whose term derives from a medium (a material with a `[material.medium]`: its own
+/// `[material.translucency]` without `thickness`, or the one a forced `--technique
+/// translucency` derives, so every medium object is prepared) get distances instead: their
+/// mesh, placed by the object's transform (the thickness is the object's, in world units), is
+/// baked as slab-equivalent distances ([`crate::bake::BakeMeasure::Distance`]), converted to
+/// millimetres with the medium's `units_per_mm`, and the vertex colours hold the medium's
+/// transmittance through them ([`material::Extinction::transmittance`]). A mesh that other
+/// translucent objects also draw is copied for them, so each keeps its own thickness.
 pub fn prepare_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crate::Result<()> {
     sample_thickness_textures(scene)?;
+    prepare_medium_thickness(scene, cache_dir)?;
     let mut wanted: Vec<usize> = scene
         .objects
         .iter()
         .filter(|o| {
-            o.material
-                .translucency
-                .as_ref()
-                .is_some_and(|t| t.thickness == material::ThicknessSource::Bake)
+            o.material.translucency.as_ref().is_some_and(|t| {
+                t.thickness == material::ThicknessSource::Bake && t.extinction.is_none()
+            })
         })
         .map(|o| o.mesh)
         .collect();
@@ -59,6 +68,7 @@ pub fn prepare_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crat
         seed: 1,
         texture_size: 512,
         progress: false,
+        measure: crate::bake::BakeMeasure::Occlusion,
     };
     for m in wanted {
         if !scene.meshes[m].colors.is_empty() {
@@ -66,6 +76,79 @@ pub fn prepare_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crat
         }
         let values = crate::bake::cached_per_vertex(&scene.meshes[m], &options, cache_dir)?;
         scene.meshes[m].colors = values.into_iter().map(Vec3::splat).collect();
+    }
+    Ok(())
+}
+
+/// The distance bake of every object whose term derives from a medium (see
+/// [`prepare_thickness`]).
+fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> crate::Result<()> {
+    let options = crate::bake::BakeOptions {
+        rays: 256,
+        max_distance: None,
+        seed: 1,
+        texture_size: 512,
+        progress: false,
+        measure: crate::bake::BakeMeasure::Distance,
+    };
+    // (mesh, transform, extinction) -> the mesh index its objects draw.
+    let mut done: Vec<(usize, glam::Mat4, material::Extinction, usize)> = Vec::new();
+    for i in 0..scene.objects.len() {
+        let object = &scene.objects[i];
+        let Some(extinction) = object
+            .material
+            .translucency_in_table()
+            .and_then(|t| t.extinction)
+        else {
+            continue;
+        };
+        let (mesh, transform) = (object.mesh, object.transform);
+        if let Some(&(_, _, _, m)) = done
+            .iter()
+            .find(|(m, t, e, _)| *m == mesh && *t == transform && *e == extinction)
+        {
+            scene.objects[i].mesh = m;
+            continue;
+        }
+        // The object's own copy when another translucent object (or another medium, or the
+        // same mesh placed differently) reads the mesh's colours; the mesh itself otherwise.
+        let shared = scene.objects.iter().enumerate().any(|(j, o)| {
+            j != i
+                && o.mesh == mesh
+                && o.material.translucency_in_table().is_some()
+                && !(o.transform == transform
+                    && o.material
+                        .translucency_in_table()
+                        .and_then(|t| t.extinction)
+                        == Some(extinction))
+        }) || done.iter().any(|(m, ..)| *m == mesh);
+        let target = if shared {
+            scene.meshes.push(scene.meshes[mesh].clone());
+            scene.meshes.len() - 1
+        } else {
+            mesh
+        };
+        let mut placed = scene.meshes[mesh].clone();
+        placed.colors.clear();
+        let normal_matrix = transform.inverse().transpose();
+        for p in &mut placed.positions {
+            *p = transform.transform_point3(*p);
+        }
+        for n in &mut placed.normals {
+            // Outward stays outward (a mirroring transform flips the winding the baker does
+            // not read: it casts along -N). Zero normals stay zero (the baker falls back).
+            *n = normal_matrix.transform_vector3(*n);
+        }
+        let values = crate::bake::cached_per_vertex(&placed, &options, cache_dir)?;
+        // The values are t / D, D the placed mesh's diagonal (the bake's default distance).
+        let diagonal = crate::bake::bounding_box_diagonal(&placed);
+        let mm_per_value = diagonal * extinction.mm_per_unit;
+        scene.meshes[target].colors = values
+            .into_iter()
+            .map(|v| extinction.transmittance(v * mm_per_value))
+            .collect();
+        scene.objects[i].mesh = target;
+        done.push((mesh, transform, extinction, target));
     }
     Ok(())
 }

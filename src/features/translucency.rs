@@ -70,13 +70,17 @@ pub struct MaterialTable {
 }
 
 impl MaterialTable {
-    /// Assigns IDs to the distinct translucency parameters of `scene`'s objects.
-    pub fn new(scene: &Scene) -> Result<Self> {
+    /// Assigns IDs to the distinct translucency parameters of `scene`'s objects. Under a
+    /// `forced` `--technique translucency`, a material with a medium and no
+    /// `[material.translucency]` of its own gets the term derived from its medium
+    /// ([`crate::scene::material::Medium::translucency`]); under `auto` such a material is
+    /// another technique's (Li et al.'s layered passes).
+    pub fn new(scene: &Scene, forced: bool) -> Result<Self> {
         let mut rows: Vec<MaterialRow> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
         let mut any_colored = false;
         for object in &scene.objects {
-            let Some(t) = &object.material.translucency else {
+            let Some(t) = object.material.translucency_under(forced) else {
                 object_ids.push(0);
                 continue;
             };
@@ -231,7 +235,7 @@ mod tests {
     #[test]
     fn ids_are_shared_by_equal_parameters_and_zero_for_opaque() {
         let scene = builtin("grid125:50").unwrap();
-        let table = MaterialTable::new(&scene).unwrap();
+        let table = MaterialTable::new(&scene, false).unwrap();
         assert_eq!(table.rows.len(), 1);
         assert!(table.object_ids.contains(&0) && table.object_ids.contains(&1));
         assert_eq!(table.packing(), ThicknessPacking::Grayscale);
@@ -242,7 +246,7 @@ mod tests {
     #[test]
     fn a_coloured_tint_selects_the_coloured_packing() {
         let scene = builtin("cubes").unwrap();
-        let table = MaterialTable::new(&scene).unwrap();
+        let table = MaterialTable::new(&scene, false).unwrap();
         assert_eq!(table.packing(), ThicknessPacking::Colored);
         assert_eq!(
             table.rows.len(),
@@ -254,6 +258,6 @@ mod tests {
     #[test]
     fn scenes_without_translucency_need_no_table() {
         let scene = builtin("smoke").unwrap();
-        assert!(MaterialTable::new(&scene).unwrap().is_empty());
+        assert!(MaterialTable::new(&scene, false).unwrap().is_empty());
     }
 }

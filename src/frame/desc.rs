@@ -68,7 +68,8 @@ impl FrameDesc {
             None
         };
         let translucency = if technique.translucency() {
-            let table = MaterialTable::new(scene)?;
+            // Forced (not `auto`): media without a term of their own derive one.
+            let table = MaterialTable::new(scene, technique != crate::frame::Technique::Auto)?;
             let packing = if settings.force_grayscale {
                 ThicknessPacking::Grayscale
             } else {

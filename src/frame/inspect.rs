@@ -166,6 +166,53 @@ pub fn inspect_file(path: &Path) -> Result<String> {
     Ok(s)
 }
 
+/// What GDC 2011's term takes from a medium (`derived`, [`crate::scene::material::Medium`]'s)
+/// and what the material's own `[material.translucency]` (`written`) keeps.
+fn gdc_from_medium(
+    written: Option<&crate::scene::material::Translucency>,
+    derived: &crate::scene::material::Translucency,
+) -> String {
+    let Some(e) = derived.extinction else {
+        return String::new();
+    };
+    let per_mm = e.transmittance(1.0);
+    let through: Vec<String> = [1.0f32, 4.0, 16.0]
+        .iter()
+        .map(|&mm| {
+            let t = e.transmittance(mm) * derived.color;
+            format!("{mm} mm {:.3} / {:.3} / {:.3}", t.x, t.y, t.z)
+        })
+        .collect();
+    let lobe = |t: &crate::scene::material::Translucency| {
+        format!(
+            "power {}, distortion {}, ambient {}, gain {:?}",
+            t.power,
+            t.distortion,
+            t.ambient,
+            t.color.to_array()
+        )
+    };
+    let whose = match written {
+        None => "under a forced --technique translucency".to_string(),
+        Some(w) if w.extinction.is_some() => {
+            format!("its [material.translucency] over it: {}", lobe(w))
+        }
+        Some(w) => format!(
+            "not used: its [material.translucency] writes an artistic thickness ({})",
+            lobe(w)
+        ),
+    };
+    format!(
+        "GDC 2011 translucency from it ({whose}): sigma_tr {:?} mm^-1 (attenuation {:.3} / {:.3} / {:.3} per mm), thickness = the baked distance in mm, {}; colour through {}",
+        e.sigma_tr.to_array(),
+        per_mm.x,
+        per_mm.y,
+        per_mm.z,
+        lobe(derived),
+        through.join(", ")
+    )
+}
+
 /// Appends one line per material the scene's objects use, with the parts that decide what a
 /// frame of the scene shades under `--technique auto`.
 fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
@@ -220,6 +267,7 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 layered: medium,
                 profile,
                 fit_error: errors,
+                translucency: derived,
             },
         ) = &m.medium
         {
@@ -288,6 +336,7 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 "screen-space transmission through thickness (x albedo): {}",
                 through.join(", ")
             ));
+            parts.push(gdc_from_medium(m.translucency.as_ref(), derived));
         }
         let layer_lines = m.layers.as_ref().map(layered_lines).unwrap_or_default();
         let parts = if parts.is_empty() {

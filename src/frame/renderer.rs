@@ -208,7 +208,8 @@ impl Renderer {
                 &crate::features::translucency::TABLE_REGION,
                 bytemuck::bytes_of(&t.table.gpu()),
             )?;
-            let (columns, _, marked) = translucent_tiles(scene, mesh_bounds, width, height);
+            let (columns, _, marked) =
+                translucent_tiles(scene, &t.table.object_ids, mesh_bounds, width, height);
             tiles.lighting = tile_rects(columns, &marked, width, height);
         }
         if let Some(profiles) = &desc.sss {

@@ -519,7 +519,8 @@ impl SceneGpu {
                 .translucency_ids
                 .and_then(|ids| ids.get(index).copied())
                 .unwrap_or(0);
-            let thickness = match (&o.material.translucency, translucency_id) {
+            // A material in the table shades with its own term or, forced, its medium's.
+            let thickness = match (o.material.translucency_in_table(), translucency_id) {
                 (Some(t), id) if id > 0 => t.thickness_factor().extend(f32::from(id)).to_array(),
                 _ => [0.0; 4],
             };

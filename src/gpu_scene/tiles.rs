@@ -18,15 +18,17 @@ pub const TILE_SIZE: u32 = 64;
 /// (object space, `bounds[mesh]`) is projected, and every tile its screen rectangle touches is
 /// marked. Conservative: a box crossing the near plane marks every tile, one wholly behind the
 /// camera or outside the frustum marks none. Row-major, `columns x rows` tiles of
-/// [`TILE_SIZE`].
+/// [`TILE_SIZE`]. `ids` are the objects' translucency material IDs (0: not translucent in
+/// this frame; a forced technique makes media translucent).
 pub fn translucent_tiles(
     scene: &Scene,
+    ids: &[u8],
     bounds: &[(Vec3, Vec3)],
     width: u32,
     height: u32,
 ) -> (u32, u32, Vec<bool>) {
-    object_tiles(scene, bounds, width, height, |_, o| {
-        o.material.translucency.as_ref().map(|_| 0.0)
+    object_tiles(scene, bounds, width, height, |i, _| {
+        ids.get(i).is_some_and(|&id| id > 0).then_some(0.0)
     })
 }
 
@@ -197,12 +199,18 @@ mod tests {
     #[test]
     fn tiles_cover_translucent_objects_and_nothing_behind_the_camera() {
         let (w, h) = (320, 240);
+        let ids = |s: &Scene| {
+            crate::features::translucency::MaterialTable::new(s, false)
+                .unwrap()
+                .object_ids
+        };
         let full = builtin("grid125").unwrap();
-        let (columns, rows, tiles) = translucent_tiles(&full, &mesh_bounds(&full), w, h);
+        let (columns, rows, tiles) =
+            translucent_tiles(&full, &ids(&full), &mesh_bounds(&full), w, h);
         assert_eq!((columns, rows), (5, 4));
         assert!(tiles.iter().filter(|&&t| t).count() > tiles.len() * 3 / 4);
         let none = builtin("grid125:0").unwrap();
-        let (_, _, tiles) = translucent_tiles(&none, &mesh_bounds(&none), w, h);
+        let (_, _, tiles) = translucent_tiles(&none, &ids(&none), &mesh_bounds(&none), w, h);
         assert!(
             tiles.iter().all(|&t| !t),
             "the cube behind the camera marks no tile"

@@ -128,7 +128,9 @@ pub fn load_truth(dir: &Path, name: &str) -> Result<Truth> {
     let scene_text = scene_path.to_str().ok_or_else(|| {
         LucentError::InvalidInput(format!("{}: not a UTF-8 path", scene_path.display()))
     })?;
-    let scene = crate::scene::load_scene(scene_text)?;
+    // Baked as a frame of it is (GDC 2011's thickness; a medium's distances), through the
+    // default cache.
+    let scene = crate::bake::scene::load_scene_baked(scene_text)?;
     let truths = dir.join("truths");
     let (width, height, radiance) = read_exr(&truths.join(format!("{name}.exr")))?;
     let coverage_path = truths.join(format!("{name}.coverage.exr"));

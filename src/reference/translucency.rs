@@ -39,6 +39,17 @@ pub fn translucency_term(
     albedo * light_radiance * (attenuation * (lobe + ambient)) * thickness
 }
 
+/// The transmittance GDC 2011's term takes from a medium (twin of
+/// [`crate::scene::material::Extinction::transmittance`], in f64 from the medium's
+/// coefficients): `exp(-sigma_tr t)` per channel through `mm` millimetres, `sigma_tr =
+/// sqrt(3 sigma_a sigma_t')` with `sigma_t' = sigma_s (1 - g) + sigma_a`.
+pub fn medium_transmittance(sigma_a: [f64; 3], sigma_s: [f64; 3], g: f64, mm: f64) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        let sigma_t_prime = sigma_s[c] * (1.0 - g) + sigma_a[c];
+        (-(3.0 * sigma_a[c] * sigma_t_prime).sqrt() * mm).exp()
+    })
+}
+
 /// What the lighting pass needs besides the G-buffer.
 pub struct LightingInputs<'a> {
     /// The scene (camera, lights, ambient, sky).
@@ -159,5 +170,82 @@ mod tests {
         );
         let expected = 2.0 * 0.5 * (1.0 * 3.0 + 0.25);
         assert!((c - DVec3::new(expected, expected * 0.5, 0.0)).length() < 1e-12);
+    }
+
+    use crate::scene::layered::LayeredMedium;
+    use crate::scene::material::{Extinction, Translucency};
+    use glam::Vec3;
+
+    fn medium(sigma_a: Vec3, sigma_s: Vec3, g: f32, eta: f32) -> LayeredMedium {
+        let mut m = LayeredMedium::homogeneous("test", Vec3::ZERO, sigma_a, g, eta);
+        m.layers[0].sigma_s = sigma_s;
+        m.units_per_mm = 0.05;
+        m
+    }
+
+    #[test]
+    fn medium_transmittance_matches_its_f64_twin() {
+        for preset in ["skin1", "marble", "wholemilk", "ketchup"] {
+            let m = LayeredMedium::preset(preset).unwrap();
+            let l = &m.layers[0];
+            let e = Extinction::of(&m);
+            for mm in [0.0f32, 0.1, 1.0, 4.0, 20.0] {
+                let got = e.transmittance(mm);
+                let want = medium_transmittance(
+                    l.sigma_a.as_dvec3().to_array(),
+                    l.sigma_s.as_dvec3().to_array(),
+                    f64::from(l.g),
+                    f64::from(mm),
+                );
+                for c in 0..3 {
+                    assert!(
+                        (f64::from(got[c]) - want[c]).abs() < 1e-5 * want[c].max(1e-3),
+                        "{preset} {mm} mm channel {c}: {} vs {}",
+                        got[c],
+                        want[c]
+                    );
+                }
+            }
+            // 1 / units_per_mm millimetres per unit.
+            assert!((e.mm_per_unit * m.units_per_mm - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn the_derived_term_is_finite_at_extreme_media() {
+        let mut cases = 0;
+        for sigma in [0.0f32, 1e-9, 1.0, 1e6] {
+            for albedo in [0.0f32, 0.5, 0.999_999, 1.0] {
+                for g in [-0.999f32, 0.0, 0.999] {
+                    for eta in [1.0f32, 1.3, 2.5] {
+                        let m = medium(
+                            Vec3::splat(sigma * (1.0 - albedo)),
+                            Vec3::splat(sigma * albedo),
+                            g,
+                            eta,
+                        );
+                        let t = Translucency::from_medium(&m);
+                        let e = t.extinction.unwrap();
+                        assert!(e.sigma_tr.is_finite() && e.sigma_tr.min_element() >= 0.0);
+                        for mm in [0.0f32, 1e-6, 1.0, 1e6, f32::MAX, f32::NAN] {
+                            let x = e.transmittance(mm);
+                            assert!(
+                                x.is_finite() && x.min_element() >= 0.0 && x.max_element() <= 1.0,
+                                "sigma {sigma} albedo {albedo} g {g} eta {eta} {mm} mm: {x}"
+                            );
+                            cases += 1;
+                        }
+                        // A clear medium lets everything through; a dense one nothing at 1 mm.
+                        if sigma == 0.0 || albedo == 1.0 {
+                            assert_eq!(e.transmittance(1.0), Vec3::ONE);
+                        }
+                        if sigma == 1e6 && albedo < 1.0 {
+                            assert!(e.transmittance(1.0).max_element() < 1e-20);
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(cases, 4 * 4 * 3 * 3 * 6);
     }
 }

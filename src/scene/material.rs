@@ -93,6 +93,78 @@ pub struct Translucency {
     pub ambient: f32,
     /// Exact `pow` or the spherical-Gaussian `exp2` form.
     pub pow_mode: PowMode,
+    /// The material's medium, when the term's thickness derives from it: the thickness stream
+    /// then holds the medium's transmittance through the baked slab-equivalent distance in
+    /// millimetres (`thickness` is [`ThicknessSource::Bake`], baked as distances), and
+    /// `color` scales it. `None`: the talk's artistic 0-1 thickness.
+    pub extinction: Option<Extinction>,
+}
+
+/// GDC 2011's power, distortion and gain for a material with a medium, fitted once against the
+/// path-traced truth of the back-lit 4 mm skin1 slab (`tools/truth/truths/skin1-slab-backlit`,
+/// the 160x120 truth committed with issue 26; docs/translucency.md, "From the medium", has the
+/// grid; `cargo test --test gpu translucency_fit -- --ignored --nocapture` redoes it): the
+/// slab alone prefers power 0 (error 0.321), a view-independent term that wraps light onto
+/// lit faces (the side-lit marble sphere: 0.093 -> 0.73), so the power is the smallest that
+/// keeps the side-lit spheres within 0.011 of plain shading: 2 (slab 0.433 at gain 0.53).
+pub const MEDIUM_POWER: f32 = 2.0;
+/// See [`MEDIUM_POWER`].
+pub const MEDIUM_DISTORTION: f32 = 0.0;
+/// See [`MEDIUM_POWER`]: the fitted gain on the transmittance, the derived `color` (grey).
+pub const MEDIUM_GAIN: f32 = 0.53;
+
+/// A medium's extinction as GDC 2011's term reads it: the per-channel transmittance
+/// `exp(-sigma_tr t)` through a thickness `t` in millimetres, `sigma_tr = sqrt(3 sigma_a
+/// sigma_t')` the diffusion's effective extinction (the far-field decay of the medium's
+/// dipole, Jensen et al. 2001), so the colour of the light let through is the medium's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extinction {
+    /// `sigma_tr` per channel, mm^-1 (finite, >= 0).
+    pub sigma_tr: Vec3,
+    /// Millimetres per scene unit (`1 / units_per_mm`, finite, > 0).
+    pub mm_per_unit: f32,
+}
+
+impl Extinction {
+    /// The extinction of `medium` (one semi-infinite layer at its eta).
+    pub fn of(medium: &LayeredMedium) -> Self {
+        let layer = &medium.layers[0];
+        let (sp, sa) = (layer.sigma_s_prime(), layer.sigma_a);
+        let sigma_tr = [0, 1, 2].map(|c| {
+            super::layered::dipole_constants(
+                f64::from(sp[c]),
+                f64::from(sa[c]),
+                f64::from(medium.eta),
+            )
+            .sigma_tr as f32
+        });
+        Self {
+            // Validated coefficients are at most 1e6 / mm, so sigma_tr <= sqrt(3) 1e6 * ~1.4:
+            // finite; the max drops a NaN a future model might give to 0 (clear).
+            sigma_tr: Vec3::from(sigma_tr).max(Vec3::ZERO),
+            // units_per_mm is validated finite and in [1e-6, 1e6].
+            mm_per_unit: 1.0 / medium.units_per_mm,
+        }
+    }
+
+    /// The transmittance per channel through `mm` millimetres, in [0, 1]:
+    /// `exp(-sigma_tr mm)`. The exponent is held in [0, 1e4] (a NaN thickness reads as
+    /// opaque), so it never overflows and `0 * inf` never happens.
+    pub fn transmittance(&self, mm: f32) -> Vec3 {
+        let tau = |s: f32| {
+            let x = s * mm;
+            if x.is_nan() {
+                1e4
+            } else {
+                x.clamp(0.0, 1e4)
+            }
+        };
+        Vec3::new(
+            (-tau(self.sigma_tr.x)).exp(),
+            (-tau(self.sigma_tr.y)).exp(),
+            (-tau(self.sigma_tr.z)).exp(),
+        )
+    }
 }
 
 impl Translucency {
@@ -105,6 +177,22 @@ impl Translucency {
             distortion: 0.2,
             ambient: 0.0,
             pow_mode: PowMode::Exact,
+            extinction: None,
+        }
+    }
+
+    /// GDC 2011's term derived from `medium`: the transmittance through the baked distance
+    /// (a distance bake, in mm through the medium's `units_per_mm`), with the power,
+    /// distortion and gain fitted against the path-traced truth ([`MEDIUM_POWER`]).
+    pub fn from_medium(medium: &LayeredMedium) -> Self {
+        Self {
+            thickness: ThicknessSource::Bake,
+            color: Vec3::splat(MEDIUM_GAIN),
+            power: MEDIUM_POWER,
+            distortion: MEDIUM_DISTORTION,
+            ambient: 0.0,
+            pow_mode: PowMode::Exact,
+            extinction: Some(Extinction::of(medium)),
         }
     }
 
@@ -417,16 +505,22 @@ pub struct Medium {
     pub profile: SssProfile,
     /// That fit's relative L2 error per channel.
     pub fit_error: [f64; 3],
+    /// GDC 2011's term from the medium ([`Translucency::from_medium`]): what a forced
+    /// `--technique translucency` renders a material without a `[material.translucency]` of
+    /// its own with.
+    pub translucency: Translucency,
 }
 
 impl Medium {
     /// `layered` (one semi-infinite layer) with its SSS profile fitted.
     pub fn new(layered: LayeredMedium) -> Self {
         let (profile, fit_error) = crate::scene::profile::medium_profile(&layered);
+        let translucency = Translucency::from_medium(&layered);
         Self {
             layered,
             profile,
             fit_error,
+            translucency,
         }
     }
 }
@@ -446,6 +540,23 @@ impl Material {
             layers: None,
             medium: None,
         }
+    }
+
+    /// GDC 2011's term under `--technique translucency` (`forced`) or `auto`: the material's
+    /// own `[material.translucency]`, else, forced, the one derived from its medium.
+    pub fn translucency_under(&self, forced: bool) -> Option<&Translucency> {
+        match (&self.translucency, &self.medium) {
+            (Some(t), _) => Some(t),
+            (None, Some(m)) if forced => Some(&m.translucency),
+            _ => None,
+        }
+    }
+
+    /// The term a frame with this material in its translucency table shades it with
+    /// ([`Material::translucency_under`] with the force on: a table lists a material without
+    /// its own term only when forced).
+    pub fn translucency_in_table(&self) -> Option<&Translucency> {
+        self.translucency_under(true)
     }
 
     /// Checks ranges: albedo, specular and roughness in [0, 1], finite; the optional parts valid.

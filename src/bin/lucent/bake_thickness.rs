@@ -14,6 +14,7 @@ pub fn run(args: BakeThicknessArgs) -> Result<()> {
         rays,
         size,
         max_distance,
+        distances,
         seed,
     } = args;
     if out.is_none() && per_vertex.is_none() {
@@ -34,6 +35,11 @@ pub fn run(args: BakeThicknessArgs) -> Result<()> {
         seed,
         texture_size: size,
         progress: true,
+        measure: if distances {
+            lucent::bake::BakeMeasure::Distance
+        } else {
+            lucent::bake::BakeMeasure::Occlusion
+        },
     };
     if let Some(out) = &out {
         let (map, stats) = lucent::bake::bake_texture(&loaded.mesh, &options)?;

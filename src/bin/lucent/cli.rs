@@ -262,6 +262,11 @@ pub struct BakeThicknessArgs {
     /// Occlusion distance (default: the mesh's bounding-box diagonal).
     #[arg(long, allow_negative_numbers = true, value_parser = finite(|v| v > 0.0, "a finite number > 0"))]
     pub max_distance: Option<f32>,
+    /// Bake distances instead of the talk's occlusion: each value is the slab-equivalent
+    /// thickness (half the cosine-weighted mean chord along the inward rays) over the maximum
+    /// distance, what materials with a [material.medium] read (docs/translucency.md).
+    #[arg(long)]
+    pub distances: bool,
     /// Random seed (the bake is deterministic for a seed).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

@@ -76,7 +76,7 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
     material.albedo_texture = texture(&m.albedo_texture, "albedo_texture")?;
     material.normal_texture = texture(&m.normal_texture, "normal_texture")?;
     if let Some(t) = &m.translucency {
-        material.translucency = Some(translucency(file, at, t)?);
+        material.translucency = Some(translucency(file, at, t, medium.as_ref())?);
     }
     if let Some(s) = &m.sss {
         material.sss = Some(sss(at, s, material.albedo)?);
@@ -111,7 +111,7 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
             ("power", t.and_then(|t| span(&t.power))),
             ("distortion", t.and_then(|t| span(&t.distortion))),
             ("ambient", t.and_then(|t| span(&t.ambient))),
-            ("thickness", t.map(|t| t.thickness.span())),
+            ("thickness", t.and_then(|t| span(&t.thickness))),
             ("color", t.and_then(|t| span(&t.color))),
         ];
         let (key, key_span) = keys
@@ -123,9 +123,30 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
     Ok(material)
 }
 
-/// `[material.translucency]`.
-fn translucency(file: &SceneFile<'_>, at: Table<'_>, t: &TranslucencyToml) -> Result<Translucency> {
-    let thickness = match t.thickness.get_ref() {
+/// `[material.translucency]`. With a `[material.medium]` (`medium`), what the table does not
+/// write derives from it ([`Translucency::from_medium`]): without `thickness`, the medium's
+/// transmittance through the baked distance (its colour), and the fitted power and
+/// distortion; a written key overrides (a written `thickness` is the talk's artistic 0-1 map,
+/// whose colour is `color`, white by default, as without a medium).
+fn translucency(
+    file: &SceneFile<'_>,
+    at: Table<'_>,
+    t: &TranslucencyToml,
+    medium: Option<&LayeredMedium>,
+) -> Result<Translucency> {
+    let Some(written) = &t.thickness else {
+        let Some(medium) = medium else {
+            return Err(at.error(
+                "translucency.thickness",
+                None,
+                "missing `thickness`: a number in [0, 1], \"bake\", \"vertex\" or a texture (only a material with a [material.medium] may leave it out: its thickness is then the baked distance through the medium)",
+            ));
+        };
+        let mut translucency = Translucency::from_medium(medium);
+        overrides(at, t, &mut translucency)?;
+        return Ok(translucency);
+    };
+    let thickness = match written.get_ref() {
         ThicknessToml::Value(v) => ThicknessSource::Constant(*v),
         ThicknessToml::Named(s) if s == "bake" => ThicknessSource::Bake,
         ThicknessToml::Named(s) if s == "vertex" => ThicknessSource::PerVertex,
@@ -134,7 +155,7 @@ fn translucency(file: &SceneFile<'_>, at: Table<'_>, t: &TranslucencyToml) -> Re
             if !full.exists() {
                 return Err(at.error(
                     "thickness",
-                    Some(t.thickness.span()),
+                    Some(written.span()),
                     format!(
                         "thickness texture {} not found (or use a number, \"bake\" or \"vertex\")",
                         full.display()
@@ -145,6 +166,18 @@ fn translucency(file: &SceneFile<'_>, at: Table<'_>, t: &TranslucencyToml) -> Re
         }
     };
     let mut translucency = Translucency::new(thickness);
+    if let Some(medium) = medium {
+        // The lobe's fit holds whatever the thickness: the medium's power and distortion.
+        let derived = Translucency::from_medium(medium);
+        translucency.power = derived.power;
+        translucency.distortion = derived.distortion;
+    }
+    overrides(at, t, &mut translucency)?;
+    Ok(translucency)
+}
+
+/// The keys of `[material.translucency]` besides `thickness`, over what `translucency` holds.
+fn overrides(at: Table<'_>, t: &TranslucencyToml, translucency: &mut Translucency) -> Result<()> {
     if let Some(c) = value(&t.color) {
         translucency.color = Vec3::from(c);
     }
@@ -163,7 +196,7 @@ fn translucency(file: &SceneFile<'_>, at: Table<'_>, t: &TranslucencyToml) -> Re
             ))
         }
     };
-    Ok(translucency)
+    Ok(())
 }
 
 /// `[material.sss]`: a preset or Gaussians, their scale, Burley's distances, and the blur that

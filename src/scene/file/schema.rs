@@ -83,7 +83,8 @@ pub(super) enum ThicknessToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct TranslucencyToml {
-    pub(super) thickness: Spanned<ThicknessToml>,
+    /// Required without a `[material.medium]`; with one, omitted = the medium's distances.
+    pub(super) thickness: Option<Spanned<ThicknessToml>>,
     pub(super) color: Option<Spanned<[f32; 3]>>,
     pub(super) power: Option<Spanned<f32>>,
     pub(super) distortion: Option<Spanned<f32>>,

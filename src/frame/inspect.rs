@@ -203,7 +203,8 @@ fn gdc_from_medium(
         ),
     };
     format!(
-        "GDC 2011 translucency from it ({whose}): sigma_tr {:?} mm^-1 (attenuation {:.3} / {:.3} / {:.3} per mm), thickness = the baked distance in mm, {}; colour through {}",
+        "GDC 2011 translucency from it ({whose}): sigma_tr {:?} mm^-1 (attenuation {:.3} / \
+         {:.3} / {:.3} per mm), thickness = the baked distance in mm, {}; colour through {}",
         e.sigma_tr.to_array(),
         per_mm.x,
         per_mm.y,

@@ -139,7 +139,9 @@ fn translucency(
             return Err(at.error(
                 "translucency.thickness",
                 None,
-                "missing `thickness`: a number in [0, 1], \"bake\", \"vertex\" or a texture (only a material with a [material.medium] may leave it out: its thickness is then the baked distance through the medium)",
+                "missing `thickness`: a number in [0, 1], \"bake\", \"vertex\" or a texture \
+                 (only a material with a [material.medium] may leave it out: its thickness is \
+                 then the baked distance through the medium)",
             ));
         };
         let mut translucency = Translucency::from_medium(medium);

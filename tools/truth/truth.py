@@ -216,7 +216,10 @@ def main(argv=None) -> int:
         images.write_exr(coverage_path, np.repeat(1.0 - uncovered, 3, axis=2))
 
         summary = {
-            "scene": str(args.scene), "size": [width, height], "spp_per_seed": args.spp,
+            # The scene relative to tools/truth (what measure.py and the tests resolve).
+            "scene": os.path.relpath(args.scene.resolve(), Path(__file__).resolve().parent),
+            "size": [width, height], "spp_per_seed": args.spp,
+            "sss_texturing": args.sss_texturing,
             "seeds": [args.seed + k for k in range(args.seeds)],
             "spp_total": args.spp * args.seeds, "seconds": [round(s, 2) for s in seconds],
             "variant": variant, "integrator": integrator_name, "exr": "RGB half float, PIZ (lossless)",

@@ -31,7 +31,14 @@ The conventions matched (each checked against lucent's source, cited where it is
   - media (src/scene/layered.rs): sigma_a and sigma_s in mm^-1, scene units per mm u, so per
     scene unit sigma / u; Mitsuba `homogeneous` with sigma_t = (sigma_a + sigma_s) / u,
     albedo = sigma_s / sigma_t, Henyey-Greenstein g; boundary `null` at eta 1, `dielectric`
-    (int_ior = eta, ext_ior = 1) otherwise.
+    (int_ior = eta, ext_ior = 1) otherwise; a medium behind a dielectric lit by point lights is
+    left to refracted_nee.py (`Converted.refracted_nee` holds its configuration, or why not).
+  - layer stacks ([material.layered] with several layers, `skin-layered`): nested media on the
+    analytic sphere, layer i inside the concentric sphere r - u x (the thicknesses above it),
+    index-matched interfaces between layers (lucent's Li et al. layers are planar, of constant
+    thickness in mm along the normal).
+  - an albedo texture on a medium: a pigment film at the surface (film.py), whose exponents
+    follow lucent's `texturing` mode (FILM_EXPONENTS); sphere UVs matched to lucent's.
 """
 
 from __future__ import annotations

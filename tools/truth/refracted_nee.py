@@ -29,7 +29,10 @@ Per camera ray:
         E = I (1 - F(p)) exp(-sigma_t |x - p|) / J,   J = dA_perp(x) / dOmega(light),
     J from central differences of four rays traced from the light (perturbed by 1e-3 rad),
     refracted at the sphere and cut by the plane through x across the beam (at eta = 1, J =
-    |x - y|^2). L += throughput x phase x E.
+    |x - y|^2). L += throughput x phase x E. Where x lies outside the region the refracted
+    light reaches directly (beyond the envelope of the grazing rays) the bisection ends at the
+    edge of the visible cap without satisfying Snell's law: no connection (checked by the
+    refracted direction, within 1e-3).
   - Not sampled: light that reaches a scattering vertex after an internal reflection but before
     any scattering (the light would have to cross the sphere unscattered: transmittance below
     e^-15 for Jensen's media at 20 mm; noted in README).
@@ -189,7 +192,11 @@ class RefractedNee(mi.SamplingIntegrator):
             qb1, hb1 = self._beam_point(y, dr.normalize(w0 + h * frame.t), x, d0)
             qb0, hb0 = self._beam_point(y, dr.normalize(w0 - h * frame.t), x, d0)
             J = dr.norm(dr.cross(qa1 - qa0, qb1 - qb0)) / (4.0 * h * h)
-            ok = visible & ha1 & ha0 & hb1 & hb0 & (J > 0)
+            # The bisection ends at the edge of the visible cap where x lies outside the
+            # region refracted light reaches directly (beyond the grazing rays' envelope):
+            # there Snell's law does not hold at p and there is no connection.
+            snell = dr.norm(dr.cross(dr.normalize(x - p), d0)) < 1e-3
+            ok = visible & snell & ha1 & ha0 & hb1 & hb0 & (J > 0)
             dist = dr.norm(x - p)
             tr = dr.exp(-mi.Spectrum(self.sigma_t) * dist)
             to_light = dr.normalize(p - x)

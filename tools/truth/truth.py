@@ -84,6 +84,11 @@ def main(argv=None) -> int:
                    help="refracted-nee: also count the camera ray's specular reflection of the "
                    "environment off the boundary (not counted by default: lucent's truth "
                    "scenes have specular 0)")
+    p.add_argument("--per-channel", action="store_true",
+                   help="volpath: render R, G and B apart, each with every medium grey at that "
+                   "channel's coefficients (volpath's one-channel-per-path spectral sampling "
+                   "weighs the other channels by exp((sigma_t,hero - sigma_t,c) t) per flight, "
+                   "which explodes in dense media whose channels differ: fireflies)")
     p.add_argument("--pass-spp", type=int, default=32,
                    help="refracted-nee: samples per pixel per render pass (memory)")
     args = p.parse_args(argv)
@@ -155,8 +160,41 @@ def main(argv=None) -> int:
         main_scene["integrator"] = {"type": "volpath", "max_depth": -1,
                                     "rr_depth": args.rr_depth}
         scene = mi.load_dict(main_scene)
+        channel_scenes = []
+        if args.per_channel and not use_nee:
+            def grey(value, c):
+                # An `rgb` dict {"type": "rgb", "value": [r, g, b]} -> channel c everywhere.
+                v = value["value"][c]
+                return {"type": "rgb", "value": [v, v, v]}
+
+            for c in range(3):
+                d = {}
+                for name, shape in main_scene.items():
+                    if isinstance(shape, dict) and any(
+                            isinstance(shape.get(side), dict) for side in ("interior", "exterior")):
+                        shape = dict(shape)
+                        for side in ("interior", "exterior"):
+                            medium = shape.get(side)
+                            if isinstance(medium, dict) and medium.get("type") == "homogeneous":
+                                medium = dict(medium)
+                                medium["sigma_t"] = grey(medium["sigma_t"], c)
+                                medium["albedo"] = grey(medium["albedo"], c)
+                                shape[side] = medium
+                    d[name] = shape
+                d["sensor"] = main_scene["sensor"]
+                channel_scenes.append(mi.load_dict(d))
+            converted.notes.append("rendered per channel (--per-channel): each of R, G, B with "
+                                   "every medium grey at that channel's coefficients")
 
         def render(seed):
+            if channel_scenes:
+                out = None
+                for c, cs in enumerate(channel_scenes):
+                    image = np.array(mi.render(cs, seed=seed, spp=args.spp), dtype=np.float64)
+                    if out is None:
+                        out = image[:, :, :3].copy()
+                    out[:, :, c] = image[:, :, c]
+                return out
             if not use_nee:
                 return np.array(mi.render(scene, seed=seed, spp=args.spp), dtype=np.float64)
             # The Python integrator's wavefront holds every sample of a pass: render in passes
@@ -222,7 +260,8 @@ def main(argv=None) -> int:
             "sss_texturing": args.sss_texturing,
             "seeds": [args.seed + k for k in range(args.seeds)],
             "spp_total": args.spp * args.seeds, "seconds": [round(s, 2) for s in seconds],
-            "variant": variant, "integrator": integrator_name, "exr": "RGB half float, PIZ (lossless)",
+            "variant": variant, "integrator": integrator_name,
+            "per_channel": bool(channel_scenes), "exr": "RGB half float, PIZ (lossless)",
             "half_rounding": round(rounding, 6), "notes": converted.notes,
         }
         if args.seeds >= 2:

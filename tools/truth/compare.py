@@ -5,7 +5,9 @@
         [--mask MASK.exr] [--erode 1] [--json OUT.json]
 
 Prints the relative mean absolute error sum |L - T| / sum T over the object's pixels (all three
-channels together) and the energy per channel sum L / sum T (images.py).
+channels together), the energy per channel sum L / sum T, and the same error over 4x4-pixel
+block means (the scale truth.py states the noise at; what two truths of one scene are compared
+by) (images.py).
 
 The object's pixels: by default TRUTH.coverage.exr, which truth.py writes beside the truth (the
 fraction of each pixel's camera rays that hit an object, from a Mitsuba render of the same
@@ -56,11 +58,12 @@ def main(argv=None) -> int:
         print(f"compare: the mask {mask_path} is empty", file=sys.stderr)
         return 2
     error, energy = images.relative_error(lucent, truth, mask)
+    blocks = images.block_error(lucent, truth, mask, 4)
     numbers = {"lucent": str(args.lucent), "truth": str(args.truth), "mask": str(mask_path),
-               "pixels": int(mask.sum()), "error": round(error, 4),
+               "pixels": int(mask.sum()), "error": round(error, 4), "error_4x4": round(blocks, 4),
                "energy": [round(e, 4) for e in energy]}
     print(f"error {error:.4f}  energy R {energy[0]:.4f} G {energy[1]:.4f} B {energy[2]:.4f}  "
-          f"over {numbers['pixels']} pixels")
+          f"over {numbers['pixels']} pixels (4x4 block means: {blocks:.4f})")
     if args.json:
         args.json.write_text(json.dumps(numbers, indent=1) + "\n")
     return 0

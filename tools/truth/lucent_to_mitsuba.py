@@ -31,7 +31,14 @@ The conventions matched (each checked against lucent's source, cited where it is
   - media (src/scene/layered.rs): sigma_a and sigma_s in mm^-1, scene units per mm u, so per
     scene unit sigma / u; Mitsuba `homogeneous` with sigma_t = (sigma_a + sigma_s) / u,
     albedo = sigma_s / sigma_t, Henyey-Greenstein g; boundary `null` at eta 1, `dielectric`
-    (int_ior = eta, ext_ior = 1) otherwise.
+    (int_ior = eta, ext_ior = 1) otherwise; a medium behind a dielectric lit by point lights is
+    left to refracted_nee.py (`Converted.refracted_nee` holds its configuration, or why not).
+  - layer stacks ([material.layered] with several layers, `skin-layered`): nested media on the
+    analytic sphere, layer i inside the concentric sphere r - u x (the thicknesses above it),
+    index-matched interfaces between layers (lucent's Li et al. layers are planar, of constant
+    thickness in mm along the normal).
+  - an albedo texture on a medium: a pigment film at the surface (film.py), whose exponents
+    follow lucent's `texturing` mode (FILM_EXPONENTS); sphere UVs matched to lucent's.
 """
 
 from __future__ import annotations
@@ -91,6 +98,8 @@ class Converted:
     environment: dict | None  # the emitter seen where no geometry is, or None (black)
     notes: list = field(default_factory=list)  # keys the truth does not render, and why
     has_dielectric: bool = False
+    # refracted_nee.py's configuration (a dict) where it applies, else why not (a string)
+    refracted_nee: object = None
 
 
 def _rgb(value) -> dict:
@@ -225,8 +234,12 @@ def box_corners(lo, hi, matrix) -> np.ndarray:
 # The converter
 
 
-def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = False) -> Converted:
-    """`path` (a lucent scene file) as a Mitsuba scene; generated meshes go to `work_dir`."""
+def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = False,
+            refracted_nee: bool = False, texturing_override: str | None = None) -> Converted:
+    """`path` (a lucent scene file) as a Mitsuba scene; generated meshes go to `work_dir`.
+    `refracted_nee`: the caller renders with refracted_nee.py, so a medium behind a dielectric
+    lit by point lights is accepted where that integrator applies. `texturing_override`:
+    lucent's `--sss-texturing` (which film an albedo texture on a medium is)."""
     sc = _Scene(path)
     t = sc.toml
     notes: list[str] = []
@@ -257,6 +270,7 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
     corners = []  # world-space bounding-box corners of every object
     has_dielectric = False
     dielectric_key = None  # the first material with eta != 1, for the refusal below
+    spheres = []  # per object: the analytic sphere (centre, radius) with its parts, or None
     for k, obj in enumerate(t.get("object", [])):
         okey = f"object[{k}]"
         if obj.get("mesh") not in meshes:
@@ -268,35 +282,134 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
         matrix = object_matrix(obj)
         shape, bounds, closed = mesh_shape(sc, mi_index, mesh, obj, okey, matrix, work_dir)
         corners.append(box_corners(*bounds, matrix))
-        bsdf, medium, eta = material_parts(sc, ma_index, material, notes)
-        if medium is not None:
+        parts = material_parts(sc, ma_index, material, notes, texturing_override)
+        is_sphere = shape["type"] == "sphere"
+        radius = float(np.linalg.norm(matrix[:3, 0])) if is_sphere else None
+        spheres.append((matrix[:3, 3].copy(), radius, parts) if is_sphere else None)
+        if parts.layers:
             if not closed:
                 raise sc.refuse(f"{okey}.mesh", f"mesh {mesh['name']!r} is not a closed surface; "
                                 "a medium needs one to be inside of")
-            shape["interior"] = medium
-            if eta != 1.0 and dielectric_key is None:
-                table = "medium" if "medium" in material else "layered"
-                dielectric_key = f"material[{ma_index}].{table}.eta"
-            has_dielectric |= eta != 1.0
+            shape["interior"] = parts.layers[0].medium
+            if parts.eta != 1.0 and dielectric_key is None:
+                dielectric_key = f"material[{ma_index}].{parts.table}.eta"
+            has_dielectric |= parts.eta != 1.0
+        bsdf = parts.bsdf
+        if parts.texture is not None:
+            if not is_sphere:
+                raise sc.refuse(parts.texture["key"], f"on mesh {mesh['name']!r}: a texture is "
+                                "converted on the analytic sphere only (its UVs are matched to "
+                                "lucent's latitude-longitude sphere; other meshes' are not)")
+            bsdf = film_bsdf(parts.texture)
+            # Mitsuba's sphere: u = atan2(y, x) / 2 pi, v = acos(z) / pi in its local frame;
+            # lucent's (mesh.rs Shape::Sphere): u = atan2(z, x) / 2 pi, v = acos(y) / pi.
+            # Rx(-90 degrees) takes Mitsuba's local (x, y, z) to lucent's (x, -z, y)... i.e.
+            # lucent (x, y, z) = (x_M, z_M, -y_M): v agrees and u_M = 1 - u_L (film_bsdf
+            # flips the texture's columns).
+            turn = mi_transform().rotate(axis=[1, 0, 0], angle=-90.0)
+            shape["to_world"] = shape["to_world"] @ turn
         shape["bsdf"] = bsdf
         scene[f"object{k}"] = shape
+        if len(parts.layers) > 1:
+            # A stack: nested media. Layer i fills the sphere of radius r - (the thicknesses
+            # above it) inside the one above: concentric spheres, index-matched (null)
+            # interfaces between layers; thickness along the normal in scene units (lucent's
+            # Li et al. layers: planar layers of constant thickness in mm along the normal,
+            # units_per_mm scene units per mm).
+            if not is_sphere:
+                raise sc.refuse(f"material[{ma_index}].{parts.table}", f"a stack of "
+                                f"{len(parts.layers)} layers on mesh {mesh['name']!r}: stacks are "
+                                "converted on the analytic sphere only (nested concentric "
+                                "spheres); a mesh would need its surface offset inward")
+            depth = 0.0
+            for i in range(1, len(parts.layers)):
+                depth += parts.layers[i - 1].thickness
+                inner = radius - depth
+                if inner <= 0.0:
+                    notes.append(f"object[{k}]: layers {i}.. lie deeper than the sphere's "
+                                 "centre: not there")
+                    break
+                to_world = mi_transform().translate(matrix[:3, 3].tolist()).scale(inner)
+                scene[f"object{k}_layer{i}"] = {
+                    "type": "sphere", "to_world": to_world, "bsdf": {"type": "null"},
+                    "interior": parts.layers[i].medium, "exterior": parts.layers[i - 1].medium}
+                notes.append(f"object[{k}]: layer {i} inside radius {inner:.6g} "
+                             f"({depth:.6g} units under the surface)")
     if not corners:
         raise sc.refuse("object", "the scene has no [[object]]")
     corners = np.concatenate(corners)
 
     for k, light in enumerate(t.get("light", [])):
         scene[f"light{k}"] = light_emitter(sc, k, light, corners, notes)
-    if has_dielectric and t.get("light") and not allow_dielectric_delta_lights:
+    nee = refracted_nee_setup(t, spheres, environment)
+    if has_dielectric and t.get("light") and not allow_dielectric_delta_lights and not (
+            refracted_nee and isinstance(nee, dict)):
+        why = ("" if not refracted_nee else
+               f" (--integrator refracted-nee does not apply: {nee})")
         raise sc.refuse(
             dielectric_key,
             "a medium behind a dielectric boundary (eta != 1) cannot be lit by point, spot or "
             "directional lights in Mitsuba's volpath: its shadow rays do not cross a smooth "
             "dielectric, so only paths that hit an emitter by chance carry light, and a delta "
-            "light is never hit (../../shared/truth-notes.md). Use eta = 1, or pass "
-            "--allow-dielectric-delta-lights to render anyway (the medium then receives only "
-            "the environment)")
+            "light is never hit (../../shared/truth-notes.md). Use eta = 1, the refracted "
+            "next-event estimation of refracted_nee.py (truth.py --integrator refracted-nee: "
+            "one sphere, point lights), or pass --allow-dielectric-delta-lights to render "
+            "anyway (the medium then receives only the environment)" + why)
     return Converted(scene=scene, sensor=sensor, sky=list(sky), environment=environment,
-                     notes=notes, has_dielectric=has_dielectric)
+                     notes=notes, has_dielectric=has_dielectric, refracted_nee=nee)
+
+
+def mi_transform():
+    import mitsuba as mi  # the caller has chosen the variant
+
+    return mi.ScalarTransform4f()
+
+
+def film_bsdf(texture: dict) -> dict:
+    """The pigment film (film.py) of an albedo texture: lucent decodes the PNG as sRGB, so the
+    linear albedo A is the sRGB decode of its 8-bit values; the film passes A^a_in of light
+    entering and A^a_out of light leaving. Columns flipped: Mitsuba's sphere u = 1 - lucent's."""
+    import mitsuba as mi
+
+    raw = np.array(mi.Bitmap(str(texture["file"])), dtype=np.float64)
+    if raw.ndim == 2:
+        raw = raw[:, :, None]
+    rgb = raw[:, :, :3] if raw.shape[2] >= 3 else np.repeat(raw[:, :, :1], 3, axis=2)
+    c = rgb / 255.0
+    albedo = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    albedo = np.ascontiguousarray(albedo[:, ::-1, :], dtype=np.float32)
+    a_in, a_out = texture["exponents"]
+    return {"type": "truth_film", "albedo": {
+        "type": "bitmap", "bitmap": mi.Bitmap(albedo, mi.Bitmap.PixelFormat.RGB), "raw": True,
+        "filter_type": "bilinear", "wrap_mode": "repeat"},
+        "a_in": a_in, "a_out": a_out}
+
+
+def refracted_nee_setup(t: dict, spheres: list, environment: dict | None):
+    """refracted_nee.py's configuration when the scene is what it renders (one analytic sphere
+    with one homogeneous medium, point lights, a constant or no environment), else why not."""
+    if len(spheres) != 1 or spheres[0] is None:
+        return "it renders exactly one object, an analytic sphere"
+    centre, radius, parts = spheres[0]
+    if len(parts.layers) != 1 or parts.texture is not None:
+        return "it renders one homogeneous medium without a texture"
+    if not (1.0 <= parts.eta < 2.0):
+        return f"eta {parts.eta} outside [1, 2)"
+    if environment is not None and environment.get("type") != "constant":
+        return "the environment must be constant (or none)"
+    lights = []
+    for light in t.get("light", []):
+        if light.get("type") != "point":
+            return "point lights only"
+        radiance = np.array(light.get("color", [1.0, 1.0, 1.0]), dtype=float) * light["intensity"]
+        position = np.array(light["position"], dtype=float)
+        if np.linalg.norm(position - centre) <= radius:
+            return "a light inside the sphere"
+        lights.append((position.tolist(), radiance.tolist()))
+    layer = parts.layers[0]
+    return {"centre": centre.tolist(), "radius": radius, "eta": parts.eta,
+            "sigma_t": layer.sigma_t.tolist(), "albedo": layer.albedo.tolist(), "g": layer.g,
+            "lights": lights}
 
 
 def camera(sc: _Scene, cam: dict | None) -> dict:
@@ -410,89 +523,192 @@ def mesh_shape(sc, index, mesh, obj, okey, matrix, work_dir):
     raise sc.refuse(f"{mkey}.generator", f"unknown generator {generator!r}")
 
 
-def material_parts(sc, index, m, notes):
-    """(bsdf, medium or None, eta) of `[[material]]` number `index`."""
+@dataclass
+class Layer:
+    """One homogeneous layer of a material's medium, per scene unit."""
+
+    medium: dict  # the Mitsuba `homogeneous` medium
+    sigma_t: np.ndarray  # extinction per scene unit, RGB
+    albedo: np.ndarray  # sigma_s / sigma_t, RGB
+    g: float
+    thickness: float | None  # along the normal, scene units; None: the rest of the object
+
+
+@dataclass
+class MaterialParts:
+    """What `[[material]]` number `index` is to the truth."""
+
+    bsdf: dict  # the boundary (a surface material when `layers` is empty)
+    layers: list  # [Layer], outermost first; empty: an opaque surface
+    eta: float
+    table: str = ""  # "medium" or "layered": where eta was given
+    texture: dict | None = None  # {"file", "texturing", "key"}: a pigment film (below)
+
+
+# lucent's texturing modes (src/scene/material.rs `Texturing`) as a film at the surface: the
+# fraction A^a_in of light entering the medium and A^a_out of light leaving it passes, A the
+# albedo texture (linear). `pre-post` is a physical (reciprocal) film of transmittance sqrt(A)
+# crossed on the way in and on the way out; `post` and `pre` are the non-reciprocal readings of
+# lucent's approximations (A on light leaving only: the albedo multiplies the diffused light at
+# the exit pixel; A on light entering only: the albedo goes into the blurred light).
+FILM_EXPONENTS = {"pre-post": (0.5, 0.5), "post": (0.0, 1.0), "pre": (1.0, 0.0)}
+# lucent's texturing of a profile its material does not write (Texturing::default()).
+DEFAULT_TEXTURING = "post"
+
+# `skin-layered` (layered.rs SKIN_LAYERED): (thickness mm, sigma_s' RGB, sigma_a RGB, g),
+# epidermis then dermis (None: the semi-infinite rest), and its eta.
+SKIN_LAYERED = [
+    (0.25, [4.6657, 5.8637, 8.7214], [0.2054, 0.3722, 0.8156], 0.9),
+    (None, [2.3329, 2.9318, 4.3607], [0.0339, 0.2629, 0.4627], 0.8),
+]
+SKIN_LAYERED_ETA = 1.4
+
+
+def _sigma_s_from_reduced(sigma_s_prime, g):
+    # lucent stores sigma_s = sigma_s' / (1 - g), |g| clamped to 0.999.
+    one_minus_g = max(1.0 - max(-MAX_ABS_G, min(MAX_ABS_G, g)), 1.0 - MAX_ABS_G)
+    return [s / one_minus_g for s in sigma_s_prime]
+
+
+def material_parts(sc, index, m, notes, texturing_override=None) -> MaterialParts:
+    """The truth's view of `[[material]]` number `index`."""
     key = f"material[{index}]"
     known = {"name", "albedo", "specular", "roughness", "albedo_texture", "normal_texture",
              "translucency", "sss", "layered", "layers", "medium"}
     for k in m:
         if k not in known:
             raise sc.refuse(f"{key}.{k}", "unknown key")
-    for k in ("albedo_texture", "normal_texture"):
-        if k in m:
-            raise sc.refuse(f"{key}.{k}", "textures are not converted")
+    if "normal_texture" in m:
+        raise sc.refuse(f"{key}.normal_texture", "normal maps are not converted")
     if "layers" in m:
         raise sc.refuse(f"{key}.layers", "gone from lucent: use [material.layered]")
     layered = m.get("layered")
     if "medium" in m:
-        return _medium_parts(sc, key, m, notes)
-    if layered is None:
+        parts = _medium_parts(sc, key, m, notes)
+    elif layered is not None:
+        parts = _layered_parts(sc, key, m, layered, notes)
+    else:
+        if "albedo_texture" in m:
+            raise sc.refuse(f"{key}.albedo_texture", "a texture on a plain (Lambertian) "
+                            "material is not converted (only the pigment film on a medium)")
         for part in ("sss", "translucency"):
             if part in m:
                 raise sc.refuse(f"{key}.{part}", f"a [material.{part}] alone describes no "
                                 "medium (an SSS profile or GDC 2011's artistic thickness term); "
-                                "the truth needs a [material.layered] medium")
+                                "the truth needs a [material.medium] or [material.layered]")
         specular = m.get("specular", DEFAULT_SPECULAR)
         if specular != 0:
             raise sc.refuse(f"{key}.specular", f"{specular}{' (the default)' if 'specular' not in m else ''}: "
                             "lucent adds a normalised Blinn-Phong lobe (lighting.glsl), which no "
                             "Mitsuba BSDF is; write specular = 0 for a Lambertian truth")
-        return {"type": "diffuse", "reflectance": _rgb(m.get("albedo", [0.8] * 3))}, None, 1.0
+        return MaterialParts({"type": "diffuse", "reflectance": _rgb(m.get("albedo", [0.8] * 3))},
+                             [], 1.0)
+    if "albedo_texture" in m:
+        parts.texture = _film(sc, key, m, parts, notes, texturing_override)
+    return parts
 
-    # A medium: its single homogeneous semi-infinite layer is the object's interior.
+
+def _film(sc, key, m, parts, notes, texturing_override):
+    """The albedo texture of a medium as a pigment film at its surface (FILM_EXPONENTS)."""
+    tkey = f"{key}.albedo_texture"
+    file = sc.resolve(m["albedo_texture"])
+    if not file.exists():
+        raise sc.refuse(tkey, f"texture file {file} not found")
+    if file.suffix.lower() != ".png":
+        raise sc.refuse(tkey, f"{file.name}: only PNG (sRGB, 8-bit) albedo textures are converted")
+    if parts.eta != 1.0:
+        raise sc.refuse(tkey, f"a pigment film on a medium behind a dielectric (eta "
+                        f"{parts.eta}) is not converted: the film and the refracting boundary "
+                        "would be two interfaces; use eta = 1")
+    written = (m.get("sss") or {}).get("texturing")
+    mode = texturing_override or written or DEFAULT_TEXTURING
+    where = ("--sss-texturing" if texturing_override else
+             f"{key}.sss.texturing" if written else
+             f"lucent's default for a profile derived from the medium ({DEFAULT_TEXTURING})")
+    if mode not in FILM_EXPONENTS:
+        raise sc.refuse(f"{key}.sss.texturing", f"unknown texturing {mode!r}")
+    a_in, a_out = FILM_EXPONENTS[mode]
+    notes.append(f"{key} ({m.get('name')}): albedo_texture {file.name} rendered as a film at "
+                 f"the surface passing A^{a_in} of light entering and A^{a_out} of light "
+                 f"leaving: texturing {mode!r} ({where})"
+                 + ("; the reciprocal, physical film" if mode == "pre-post" else
+                    "; non-reciprocal: the exact reading of lucent's mode, not a physical film"))
+    return {"file": file, "texturing": mode, "key": tkey, "exponents": (a_in, a_out)}
+
+
+def _layered_parts(sc, key, m, layered, notes):
+    """A `[material.layered]` medium: one or more homogeneous layers (a stack is rendered as
+    nested media, `convert`)."""
     lkey = f"{key}.layered"
     for k in layered:
         if k not in {"preset", "layer", "eta", "weights", "units_per_mm", "depth_texture"}:
             raise sc.refuse(f"{lkey}.{k}", "unknown key")
     if "depth_texture" in layered:
         raise sc.refuse(f"{lkey}.depth_texture", "per-texel layer depths are not converted")
-    preset, layers = layered.get("preset"), layered.get("layer")
-    if (preset is None) == (layers is None):
+    preset, tables = layered.get("preset"), layered.get("layer")
+    if (preset is None) == (tables is None):
         raise sc.refuse(lkey, "give a `preset` or [[material.layered.layer]] tables")
-    if preset is not None:
-        if preset == "skin-layered":
-            raise sc.refuse(f"{lkey}.preset", "skin-layered is a two-layer stack (epidermis "
-                            "0.25 mm over dermis): multi-layer stacks are not converted")
+    # (sigma_a, sigma_s, g, thickness mm or None) per layer, outermost first.
+    raw = []
+    if preset == "skin-layered":
+        for t, sp, sa, g in SKIN_LAYERED:
+            raw.append((sa, _sigma_s_from_reduced(sp, g), g, t))
+        default_eta = SKIN_LAYERED_ETA
+    elif preset is not None:
         if preset not in JENSEN_2001:
             raise sc.refuse(f"{lkey}.preset", f"unknown preset {preset!r}")
         sigma_s_prime, sigma_a = JENSEN_2001[preset]
-        sigma_s, g = list(sigma_s_prime), 0.0
+        raw.append((sigma_a, list(sigma_s_prime), 0.0, None))
+        default_eta = PRESET_ETA
     else:
-        if len(layers) != 1:
-            raise sc.refuse(f"{lkey}.layer", f"{len(layers)} layers: multi-layer stacks are "
-                            "not converted (only one homogeneous layer)")
-        layer = layers[0]
-        ykey = f"{lkey}.layer[0]"
-        for k in layer:
-            if k not in {"sigma_a", "sigma_s", "sigma_s_prime", "g", "thickness"}:
-                raise sc.refuse(f"{ykey}.{k}", "not converted")
-        if layer.get("thickness") != "rest":
-            raise sc.refuse(f"{ykey}.thickness", f"{layer.get('thickness')!r}: only "
-                            "thickness = \"rest\" (the medium fills the object) is converted")
-        g = float(layer.get("g", 0.0))
-        sigma_a = layer["sigma_a"]
-        if "sigma_s" in layer and "sigma_s_prime" in layer:
-            raise sc.refuse(f"{ykey}.sigma_s_prime", "give sigma_s or sigma_s_prime, not both")
-        if "sigma_s" in layer:
-            sigma_s = layer["sigma_s"]
-        else:
-            # lucent stores sigma_s = sigma_s' / (1 - g), |g| clamped to 0.999.
-            one_minus_g = max(1.0 - max(-MAX_ABS_G, min(MAX_ABS_G, g)), 1.0 - MAX_ABS_G)
-            sigma_s = [s / one_minus_g for s in layer["sigma_s_prime"]]
-    eta = float(layered.get("eta", PRESET_ETA if preset is not None else 1.3))
+        for i, layer in enumerate(tables):
+            ykey = f"{lkey}.layer[{i}]"
+            for k in layer:
+                if k not in {"sigma_a", "sigma_s", "sigma_s_prime", "g", "thickness"}:
+                    raise sc.refuse(f"{ykey}.{k}", "not converted")
+            thickness = layer.get("thickness")
+            last = i + 1 == len(tables)
+            if thickness == "rest":
+                if not last:
+                    raise sc.refuse(f"{ykey}.thickness", "\"rest\" only on the last layer "
+                                    "(lucent refuses it too)")
+                thickness = None
+            elif isinstance(thickness, (int, float)) and not isinstance(thickness, bool):
+                if last:
+                    raise sc.refuse(f"{ykey}.thickness", f"{thickness}: the last layer of a "
+                                    "stack must be \"rest\" for the truth (what lies under a "
+                                    "finite stack is not defined)")
+                if not (thickness >= 0 and math.isfinite(thickness)):
+                    raise sc.refuse(f"{ykey}.thickness", f"{thickness} must be >= 0 (mm)")
+                thickness = float(thickness)
+            else:
+                raise sc.refuse(f"{ykey}.thickness", f"{thickness!r}: only a constant in mm "
+                                "or \"rest\" is converted (not per-texel \"texture\" depths)")
+            g = float(layer.get("g", 0.0))
+            if "sigma_s" in layer and "sigma_s_prime" in layer:
+                raise sc.refuse(f"{ykey}.sigma_s_prime", "give sigma_s or sigma_s_prime, not both")
+            sigma_s = (layer["sigma_s"] if "sigma_s" in layer
+                       else _sigma_s_from_reduced(layer["sigma_s_prime"], g))
+            raw.append((layer["sigma_a"], sigma_s, g, thickness))
+        default_eta = 1.3
+    eta = float(layered.get("eta", default_eta))
     units_per_mm = float(layered.get("units_per_mm", DEFAULT_UNITS_PER_MM))
-
     # Knobs of lucent's approximations, not of the medium: listed, not rendered.
     knobs = [k for k in ("albedo", "specular", "roughness") if k in m]
     knobs += [f"layered.{k}" for k in ("weights",) if k in layered]
     knobs += [k for k in ("sss", "translucency") if k in m]
-    return _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes)
+    if knobs:
+        notes.append(f"{key} ({m.get('name')}): {', '.join(knobs)} tune lucent's techniques, "
+                     "not the medium: not rendered by the truth")
+    layers = [_layer(key, m, i, sa, ss, g, t, units_per_mm, notes)
+              for i, (sa, ss, g, t) in enumerate(raw)]
+    return MaterialParts(_boundary(eta, notes, key, m), layers, eta, "layered")
 
 
 def _medium_parts(sc, key, m, notes):
-    """(bsdf, medium, eta) of a material with `[material.medium]`: the one medium lucent's
-    techniques derive their parameters from (src/scene/file/materials.rs `medium`), so the
-    truth renders it; a `[material.layered]` beside it is one of lucent's approximations."""
+    """A material with `[material.medium]`: the one medium lucent's techniques derive their
+    parameters from (src/scene/file/materials.rs `medium`), so the truth renders it; a
+    `[material.layered]` beside it is one of lucent's approximations."""
     medium = m["medium"]
     mkey = f"{key}.medium"
     for k in medium:
@@ -515,26 +731,22 @@ def _medium_parts(sc, key, m, notes):
         sigma_a = medium["sigma_a"]
         if ("sigma_s" in medium) == ("sigma_s_prime" in medium):
             raise sc.refuse(mkey, "give sigma_s or sigma_s_prime (one of them)")
-        if "sigma_s" in medium:
-            sigma_s = medium["sigma_s"]
-        else:
-            one_minus_g = max(1.0 - max(-MAX_ABS_G, min(MAX_ABS_G, g)), 1.0 - MAX_ABS_G)
-            sigma_s = [s / one_minus_g for s in medium["sigma_s_prime"]]
+        sigma_s = (medium["sigma_s"] if "sigma_s" in medium
+                   else _sigma_s_from_reduced(medium["sigma_s_prime"], g))
     # lucent's defaults for a medium: eta 1.3 (presets and coefficients alike), 0.04 units/mm.
     eta = float(medium.get("eta", PRESET_ETA if preset is not None else 1.3))
     units_per_mm = float(medium.get("units_per_mm", DEFAULT_UNITS_PER_MM))
     knobs = [k for k in ("albedo", "specular", "roughness", "layered", "sss", "translucency")
              if k in m]
-    return _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes)
-
-
-def _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes):
-    """(bsdf, medium, eta) of a homogeneous interior in mm^-1 at `units_per_mm`; `knobs`:
-    the material's keys that tune lucent's techniques only (noted, not rendered)."""
     if knobs:
         notes.append(f"{key} ({m.get('name')}): {', '.join(knobs)} tune lucent's techniques, "
                      "not the medium: not rendered by the truth")
-    # Physical units: mm^-1 -> per scene unit (1 unit = 1 / units_per_mm mm).
+    layer = _layer(key, m, 0, sigma_a, sigma_s, g, None, units_per_mm, notes)
+    return MaterialParts(_boundary(eta, notes, key, m), [layer], eta, "medium")
+
+
+def _layer(key, m, i, sigma_a, sigma_s, g, thickness_mm, units_per_mm, notes) -> Layer:
+    """A homogeneous layer in mm^-1 at `units_per_mm` as a Mitsuba medium per scene unit."""
     sigma_a = np.array(sigma_a, dtype=float) / units_per_mm
     sigma_s = np.array(sigma_s, dtype=float) / units_per_mm
     sigma_t = sigma_a + sigma_s
@@ -549,14 +761,21 @@ def _interior(key, m, knobs, sigma_a, sigma_s, g, eta, units_per_mm, notes):
         "albedo": _rgb(albedo),
         "phase": {"type": "hg", "g": g},
     }
-    notes.append(f"{key} ({m.get('name')}): medium sigma_t {np.round(sigma_t, 4).tolist()} per "
-                 f"unit, albedo {np.round(albedo, 5).tolist()}, g {g}, eta {eta} "
+    thickness = None if thickness_mm is None else thickness_mm * units_per_mm
+    notes.append(f"{key} ({m.get('name')}): layer {i}: medium sigma_t "
+                 f"{np.round(sigma_t, 4).tolist()} per unit, albedo "
+                 f"{np.round(albedo, 5).tolist()}, g {g}, thickness "
+                 + ("rest" if thickness is None else
+                    f"{thickness_mm} mm = {thickness:.6g} units"))
+    return Layer(medium, sigma_t, albedo, float(g), thickness)
+
+
+def _boundary(eta, notes, key, m):
+    notes.append(f"{key} ({m.get('name')}): eta {eta} "
                  f"({'null' if eta == 1.0 else 'dielectric'} boundary)")
     if eta == 1.0:
-        bsdf = {"type": "null"}  # index-matched: no boundary at all
-    else:
-        bsdf = {"type": "dielectric", "int_ior": eta, "ext_ior": 1.0}
-    return bsdf, medium, eta
+        return {"type": "null"}  # index-matched: no boundary at all
+    return {"type": "dielectric", "int_ior": eta, "ext_ior": 1.0}
 
 
 def light_emitter(sc, k, light, corners, notes):

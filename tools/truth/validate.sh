@@ -5,12 +5,12 @@
 #
 #   LUCENT=target/release/lucent tools/truth/validate.sh [OUT_DIR]
 #
-# SIZE (160x120), SPP (256 per seed, the slab 1024) and NICE (19) are read from the environment.
+# SIZE (256x192), SPP (256 per seed, the slab 1024) and NICE (19) are read from the environment.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 out="${1:-$here/out}"
 lucent="${LUCENT:-$here/../../target/release/lucent}"
-size="${SIZE:-160x120}"
+size="${SIZE:-256x192}"
 nice="nice -n ${NICE:-19}"
 py="$here/.venv/bin/python"
 mkdir -p "$out"

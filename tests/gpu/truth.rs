@@ -442,8 +442,8 @@ fn best_gain(truth: &lucent::measure::truth::Truth, frame: &[f32]) -> (f64, f64)
 }
 
 /// GDC 2011's power and distortion for materials with a medium, fitted once against the
-/// back-lit 4 mm skin1 slab's truth (the committed `skin1-slab-backlit`; the published fit was made on its 160x120 render): each
-/// (power, distortion) of the grid rendered under `--technique translucency` with the term
+/// back-lit 4 mm skin1 slab's truth (the committed `skin1-slab-backlit`; the published fit
+/// was made on its 160x120 render): each (power, distortion) of the grid rendered under `--technique translucency` with the term
 /// derived from the medium at gain 1, the best gain found for it, and the error grid printed
 /// (docs/translucency.md, "From the medium", publishes it; the chosen values are
 /// `lucent::scene::material::MEDIUM_POWER`, `MEDIUM_DISTORTION`, `MEDIUM_GAIN`).

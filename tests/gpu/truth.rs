@@ -348,6 +348,23 @@ fn cases() -> Vec<Case> {
             energy: (0.8, 1.05),
             why: "mixed-medium with every medium forced to GDC 2011's term from it",
         },
+        Case {
+            scene: "textured-medium-sidelit-prepost",
+            technique: technique("separable"),
+            error: 0.173,
+            energy: (0.73, 0.99),
+            why: "the textured medium as a physical pigment film (lucent's `pre-post`, which \
+                  a [material.sss] without a profile states beside the medium): the blur keeps \
+                  the stripes, 7-22% too dark",
+        },
+        Case {
+            scene: "textured-medium-sidelit-prepost",
+            technique: Technique::Auto,
+            error: 0.173,
+            energy: (0.73, 0.99),
+            why: "auto renders the material with its [material.sss] table's blur (separable), \
+                  not Li et al.'s passes, which would ignore the texture",
+        },
     ]
 }
 

@@ -78,8 +78,10 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
     if let Some(t) = &m.translucency {
         material.translucency = Some(translucency(file, at, t, medium.as_ref())?);
     }
+    // What the techniques derive from the medium, made once (the profile fit takes a few ms).
+    let derived = medium.clone().map(Medium::new);
     if let Some(s) = &m.sss {
-        material.sss = Some(sss(at, s, material.albedo)?);
+        material.sss = Some(sss(at, s, material.albedo, derived.as_ref())?);
     }
     if m.layers.is_some() {
         return Err(at.error(
@@ -99,7 +101,7 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         (None, Some(medium)) if !other_technique => Some(medium.clone()),
         (None, _) => None,
     };
-    material.medium = medium.map(Medium::new);
+    material.medium = derived;
     // Map a range failure to the key it names.
     material.validate().map_err(|e| {
         let message = e.to_string();
@@ -203,13 +205,17 @@ fn overrides(at: Table<'_>, t: &TranslucencyToml, translucency: &mut Translucenc
 
 /// `[material.sss]`: a preset or Gaussians, their scale, Burley's distances, and the blur that
 /// renders them. `albedo` is the material's, which a `mean_free_path` is scaled by.
-fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
+fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3, medium: Option<&Medium>) -> Result<SssProfile> {
     let burley = burley_distance(at, s, albedo)?;
     let mut profile =
-        match (&s.preset, &s.gaussians) {
-            (Some(p), None) => SssProfile::preset(p.get_ref())
+        match (&s.preset, &s.gaussians, medium) {
+            // Beside a [material.medium], a table that gives no profile takes the medium's
+            // (the Gaussians and Burley's distance fitted to its dipole): the table then says
+            // how to blur it (`blur`, `texturing`), and that the material is screen-space SSS.
+            (None, None, Some(medium)) if burley.is_none() => medium.profile.clone(),
+            (Some(p), None, _) => SssProfile::preset(p.get_ref())
                 .map_err(|e| at.error("preset", Some(p.span()), e))?,
-            (None, Some(rows)) => SssProfile {
+            (None, Some(rows), _) => SssProfile {
                 name: "custom".into(),
                 gaussians: rows
                     .get_ref()
@@ -226,7 +232,7 @@ fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
             },
             // Burley's distances alone: the Gaussian blurs get six Gaussians fitted to the profile
             // (a mean free path through the default fit).
-            (None, None) if burley.is_some() => SssProfile {
+            (None, None, _) if burley.is_some() => SssProfile {
                 name: "burley".into(),
                 gaussians: Vec::new(),
                 units_per_mm: 0.01,
@@ -238,10 +244,12 @@ fn sss(at: Table<'_>, s: &SssToml, albedo: Vec3) -> Result<SssProfile> {
                 "sss",
                 None,
                 "give exactly one of `preset` or `gaussians` (or only `scattering_distance` or \
-                 `mean_free_path`)",
+                 `mean_free_path`, or neither beside a [material.medium]: its fitted profile)",
             )),
         };
-    profile.burley = burley;
+    if burley.is_some() || medium.is_none() || s.preset.is_some() || s.gaussians.is_some() {
+        profile.burley = burley;
+    }
     if profile.gaussians.is_empty() {
         profile.gaussians =
             crate::scene::profile::burley_gaussians(profile.burley_d(Default::default()));

@@ -594,6 +594,29 @@ units_per_mm = 0.05
     }
 
     #[test]
+    fn an_sss_table_without_a_profile_takes_the_medium_s_and_says_how_to_blur_it() {
+        let s = parse(&with_layered(&format!(
+            "{MEDIUM}\n[material.sss]\ntexturing = \"pre-post\"\nblur = \"burley\"\n"
+        )))
+        .unwrap();
+        let m = &s.objects[0].material;
+        let medium = m.medium.as_ref().unwrap();
+        let sss = m.sss.as_ref().unwrap();
+        assert_eq!(sss.gaussians, medium.profile.gaussians);
+        assert_eq!(sss.burley, medium.profile.burley);
+        assert_eq!(sss.units_per_mm, medium.profile.units_per_mm);
+        assert_eq!(sss.texturing, crate::scene::material::Texturing::PrePost);
+        assert!(sss.blur.is_some());
+        // Written, the table makes the material screen-space SSS: no layered passes under auto.
+        assert!(m.layers.is_none());
+        // Without a medium there is still no profile to take.
+        let e = parse(&with_layered("[material.sss]\ntexturing = \"pre-post\"\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("beside a [material.medium]"), "{e}");
+    }
+
+    #[test]
     fn a_medium_is_layered_under_auto_and_fitted_under_a_forced_sss_technique() {
         use crate::frame::{FrameDesc, FrameSettings, Technique};
         let scene = parse(&with_layered(MEDIUM)).unwrap();

@@ -269,14 +269,12 @@ fn write_scene_materials(s: &mut String, scene: &crate::scene::Scene) {
                 profile,
                 fit_error: errors,
                 translucency: derived,
+                ..
             },
         ) = &m.medium
         {
             // What each technique took from the medium, and what the material wrote itself.
-            let (albedo, rd) = (
-                medium.white_sky_albedo(),
-                medium.total_diffuse_reflectance(),
-            );
+            let (albedo, rd) = (whole.albedo, medium.total_diffuse_reflectance());
             let layer = &medium.layers[0];
             parts.push(format!(
                 "medium {} (sigma_a {:?}, sigma_s {:?} mm^-1, g {}, eta {}, {} units/mm): albedo \

@@ -330,12 +330,18 @@ impl LayeredMedium {
     /// (the dipole's, which misses single scattering and underestimates diffusion at moderate
     /// albedo): skin1 (0.625, 0.385, 0.241) against R_d (0.547, 0.291, 0.161).
     pub fn white_sky_albedo(&self) -> Vec3 {
+        self.white_sky_albedo_at(self.eta)
+    }
+
+    /// [`LayeredMedium::white_sky_albedo`] behind a boundary of relative index `eta` instead
+    /// of the medium's own (1: index-matched, what its reflectance's shape is normalised to).
+    pub fn white_sky_albedo_at(&self, eta: f32) -> Vec3 {
         let r = self.first_layer_reduced();
         Vec3::from_array(std::array::from_fn(|c| {
             crate::reference::albedo::white_sky_albedo(
                 f64::from(r.sigma_s_prime[c]),
                 f64::from(r.sigma_a[c]),
-                f64::from(self.eta),
+                f64::from(eta),
             ) as f32
         }))
     }

@@ -509,18 +509,31 @@ pub struct Medium {
     /// `--technique translucency` renders a material without a `[material.translucency]` of
     /// its own with.
     pub translucency: Translucency,
+    /// Its white-sky albedo at its eta ([`LayeredMedium::white_sky_albedo`]): the albedo a
+    /// material takes from it, Burley's surface albedo, what its screen-space transmission is
+    /// relative to.
+    pub albedo: Vec3,
+    /// Its white-sky albedo behind an index-matched boundary: what its screen-space
+    /// reflectance's shape is normalised to (`crate::features::sss::transmission`).
+    pub matched_albedo: Vec3,
 }
 
 impl Medium {
-    /// `layered` (one semi-infinite layer) with its SSS profile fitted.
+    /// `layered` (one semi-infinite layer) with what the techniques derive from it: its
+    /// albedos (an H-function iteration each), its SSS profile fitted, GDC 2011's term. Made
+    /// once with the material; frames read it.
     pub fn new(layered: LayeredMedium) -> Self {
-        let (profile, fit_error) = crate::scene::profile::medium_profile(&layered);
+        let albedo = layered.white_sky_albedo();
+        let matched_albedo = layered.white_sky_albedo_at(1.0);
+        let (profile, fit_error) = crate::scene::profile::medium_profile(&layered, albedo);
         let translucency = Translucency::from_medium(&layered);
         Self {
             layered,
             profile,
             fit_error,
             translucency,
+            albedo,
+            matched_albedo,
         }
     }
 }

@@ -180,10 +180,10 @@ pub const MEDIUM_GAUSSIANS: usize = 6;
 /// `z_r = 1 / sigma_t'` to three diffusion lengths `1 / sigma_tr` of the widest channel (at
 /// most 300 transport mean free paths: a medium that absorbs nothing diffuses without end);
 /// and Burley's normalized diffusion from the medium's diffuse mean free path `1 / sigma_t'`
-/// with its white-sky albedo ([`LayeredMedium::white_sky_albedo`], Christensen and Burley's
-/// surface albedo is a Monte Carlo total reflectance too). Returns the profile and the fit's relative L2 error per
-/// channel (`inspect` prints it).
-pub fn medium_profile(medium: &LayeredMedium) -> (SssProfile, [f64; 3]) {
+/// with `albedo`, its white-sky albedo ([`LayeredMedium::white_sky_albedo`]; Christensen and
+/// Burley's surface albedo is a Monte Carlo total reflectance too). Returns the profile and the
+/// fit's relative L2 error per channel (`inspect` prints it).
+pub fn medium_profile(medium: &LayeredMedium, albedo: glam::Vec3) -> (SssProfile, [f64; 3]) {
     let layer = &medium.layers[0];
     let (sp, sa) = (layer.sigma_s_prime(), layer.sigma_a);
     let dipoles: Vec<_> = (0..3)
@@ -236,10 +236,7 @@ pub fn medium_profile(medium: &LayeredMedium) -> (SssProfile, [f64; 3]) {
             .collect(),
         units_per_mm: medium.units_per_mm,
         blur: None,
-        burley: Some(BurleyDistance::MeanFreePath {
-            mfp,
-            albedo: medium.white_sky_albedo(),
-        }),
+        burley: Some(BurleyDistance::MeanFreePath { mfp, albedo }),
         texturing: Texturing::default(),
     };
     (profile, errors)
@@ -403,7 +400,7 @@ mod tests {
                             g,
                             eta,
                         );
-                        let (profile, errors) = medium_profile(&medium);
+                        let (profile, errors) = medium_profile(&medium, medium.white_sky_albedo());
                         let case = format!("sigma_s' {sp}, sigma_a {sa}, g {g}, eta {eta}");
                         profile.validate().unwrap_or_else(|e| panic!("{case}: {e}"));
                         assert!(errors.iter().all(|e| e.is_finite()), "{case}: {errors:?}");
@@ -437,7 +434,7 @@ mod tests {
             }
             for eta in [1.0, 1.3] {
                 medium.eta = eta;
-                let (profile, errors) = medium_profile(&medium);
+                let (profile, errors) = medium_profile(&medium, medium.white_sky_albedo());
                 profile.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
                 let sum = profile
                     .gaussians

@@ -69,15 +69,12 @@ impl SssTransmission {
                 .map(|c| dipole_constants(f64::from(sp[c]), f64::from(sa[c]), f64::from(m.eta))),
             // units_per_mm is validated finite and > 0.
             mm_per_unit: 1.0 / f64::from(m.units_per_mm),
-            medium_albedo: m.white_sky_albedo().as_dvec3().to_array(),
+            medium_albedo: medium.albedo.as_dvec3().to_array(),
             reflectance: std::array::from_fn(|c| {
                 let (sp, sa) = (f64::from(sp[c]).max(0.0), f64::from(sa[c]).max(0.0));
                 // A medium that neither scatters nor absorbs (validated away) scatters nothing.
                 let omega = if sp + sa > 0.0 { sp / (sp + sa) } else { 0.0 };
-                (
-                    omega,
-                    crate::reference::albedo::white_sky_albedo(sp, sa, 1.0),
-                )
+                (omega, f64::from(medium.matched_albedo[c]))
             }),
         }
     }

@@ -60,11 +60,13 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
         Ok(Some(TextureSource::File(full)))
     };
     let medium = m.medium.as_ref().map(|t| medium(at, t)).transpose()?;
+    // What the techniques derive from the medium, made once (the profile fit takes a few ms).
+    let derived = medium.clone().map(Medium::new);
     // The albedo a technique shades with: as written, else the medium's white-sky albedo
     // (what a Lambertian surface of it reflects), else a light grey.
-    let albedo = match (value(&m.albedo), &medium) {
+    let albedo = match (value(&m.albedo), &derived) {
         (Some(written), _) => Vec3::from(written),
-        (None, Some(medium)) => medium.white_sky_albedo(),
+        (None, Some(derived)) => derived.albedo,
         (None, None) => Vec3::splat(0.8),
     };
     let mut material = Material::opaque(
@@ -78,8 +80,6 @@ fn material(file: &SceneFile<'_>, at: Table<'_>, m: &MaterialToml) -> Result<Mat
     if let Some(t) = &m.translucency {
         material.translucency = Some(translucency(file, at, t, medium.as_ref())?);
     }
-    // What the techniques derive from the medium, made once (the profile fit takes a few ms).
-    let derived = medium.clone().map(Medium::new);
     if let Some(s) = &m.sss {
         material.sss = Some(sss(at, s, material.albedo, derived.as_ref())?);
     }

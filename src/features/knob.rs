@@ -128,6 +128,19 @@ impl Takes {
         }
     }
 
+    /// The values a knob is tried at (tests, `lucent report truth`): a switch given, both ends
+    /// of a whole range, every listed whole number or choice; `None` for a continuous number
+    /// (no finite set of values to try).
+    pub fn values(&self) -> Option<Vec<Given>> {
+        Some(match *self {
+            Takes::Switch => vec![Given::Switch],
+            Takes::Whole { min, max } => vec![Given::Whole(min), Given::Whole(max)],
+            Takes::WholeOf(values) => values.iter().map(|&n| Given::Whole(n)).collect(),
+            Takes::Choice(names) => names.iter().map(|&n| Given::Choice(n)).collect(),
+            Takes::Number { .. } => return None,
+        })
+    }
+
     /// The value's placeholder in `--help` (`N`, `X`, `NAME`; the help text says which);
     /// `None` for a switch.
     pub fn placeholder(&self) -> Option<&'static str> {
@@ -200,13 +213,10 @@ mod tests {
     #[test]
     fn every_knob_acts() {
         for knob in registry::knobs() {
-            let values: Vec<Given> = match knob.takes {
-                Takes::Switch => vec![Given::Switch],
-                Takes::Whole { min, max } => vec![Given::Whole(min), Given::Whole(max)],
-                Takes::WholeOf(values) => values.iter().map(|&n| Given::Whole(n)).collect(),
-                Takes::Number { .. } => vec![knob.takes.parse("0.5").unwrap()],
-                Takes::Choice(names) => names.iter().map(|&n| Given::Choice(n)).collect(),
-            };
+            let values: Vec<Given> = knob
+                .takes
+                .values()
+                .unwrap_or_else(|| vec![knob.takes.parse("0.5").unwrap()]);
             for value in values {
                 if Some(value) == knob.default {
                     continue;

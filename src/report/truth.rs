@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::features::knob::{Given, Takes};
+use crate::features::knob::Given;
 use crate::frame::{render_frame, FrameRunner, FrameSettings, Renderer, Technique};
 use crate::measure::stats::Stats;
 use crate::measure::truth::{load_truth, measure, truth_names, Truth, TruthError};
@@ -103,18 +103,6 @@ impl TruthVariant {
     }
 }
 
-/// The values a knob is measured at: a switch given, both ends of a whole range, every listed
-/// whole number or choice; `None` for a continuous knob (no finite set of values to try).
-fn knob_values(takes: &Takes) -> Option<Vec<Given>> {
-    Some(match *takes {
-        Takes::Switch => vec![Given::Switch],
-        Takes::Whole { min, max } => vec![Given::Whole(min), Given::Whole(max)],
-        Takes::WholeOf(values) => values.iter().map(|&n| Given::Whole(n)).collect(),
-        Takes::Choice(names) => names.iter().map(|&n| Given::Choice(n)).collect(),
-        Takes::Number { .. } => return None,
-    })
-}
-
 fn given_text(value: Given) -> String {
     match value {
         Given::Switch => String::new(),
@@ -148,7 +136,7 @@ pub fn truth_variants(quick: bool) -> (Vec<TruthVariant>, Vec<&'static str>) {
     for &module in crate::features::registry::TECHNIQUES {
         let technique = Technique::Only(module);
         for &knob in module.knobs() {
-            let Some(values) = knob_values(&knob.takes) else {
+            let Some(values) = knob.takes.values() else {
                 if !continuous.contains(&knob.flag) {
                     continuous.push(knob.flag);
                 }

@@ -98,6 +98,12 @@ bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, uvec4
                                     shadow_distance(FACE.params, d.y),
                                     shadow_distance(FACE.params, d.z),
                                     shadow_distance(FACE.params, d.w)));
+                // The normal too, with the same weights: the nearest texel's changed at
+                // every texel edge, a staircase in the Fresnel transmittance into the medium
+                // (issue 25: part of the structure the grain metric counted).
+                entry.xyz = vec3(dot(w, textureGather(shadow_entry, corner, 0)),
+                                 dot(w, textureGather(shadow_entry, corner, 1)),
+                                 dot(w, textureGather(shadow_entry, corner, 2)));
             } else {
                 float raw = texelFetch(shadow_depth, texel, 0).r;
                 if (raw >= 1.0) {
@@ -159,11 +165,11 @@ float unseen_entry(vec3 p, vec3 n) {
 // L_t's light from light `i` at x_o (facing away from it): the light that entered on the
 // light's side and crossed the object, unscattered (its transmittance) and by diffusion
 // (dipole_beyond, issue 26: a back-lit thin slab glows as the path-traced truth does), from the
-// entry point, filtered like a shadow lookup (each of the four texels around
-// x_o's map position gives its own entry distance and transmittance, bilinearly weighted;
-// texels of another material block): filtering the distance instead would leave a staircase
-// where the first surface along the light changes (the object's rim and its self-occlusion
-// as the light sees it). Lights without a map give none (the plane at x_o is its own entry).
+// entry point, filtered like a shadow lookup (each of the four texels around x_o's map
+// position gives its own entry distance, normal and transmittance, bilinearly weighted; texels
+// of another material block): filtering the distance instead would leave a staircase where
+// the first surface along the light changes (the object's rim and its self-occlusion as the
+// light sees it). Lights without a map give none (the plane at x_o is its own entry).
 vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float eta, int mat,
                        uvec4 texels_o) {
 #ifdef LUCENT_ENTRY_BINDING
@@ -191,7 +197,6 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
     vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
     ivec2 lo = ivec2(FACE.rect.xy);
     ivec2 texel = clamp(ivec2(t), lo, lo + ivec2(FACE.rect.z) - 1);
-    vec3 n_in = sanitize_normal(texelFetch(shadow_entry, texel, 0).xyz * 2.0 - 1.0);
     // The entry's layers as the nearest texel has them (the four filtered texels share them).
     uvec4 texels_in = entry_texels(texel, texels_o);
     vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
@@ -199,6 +204,13 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
     vec2 corner = (base + 1.0) * shadows.atlas.zw;
     vec4 d = textureGather(shadow_depth, corner, 0);
     vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
+    // Each texel's own entry normal (encoded n * 0.5 + 0.5): one normal for all four, the
+    // nearest texel's, jumped at every texel edge where the first surface changes (the other
+    // candle's shadow on a back-lit one) and drew a diamond moire across the band (issue 25:
+    // the converged frame's grain, 1.16x plain lighting's, fell to 1.10x).
+    vec4 normal_x = textureGather(shadow_entry, corner, 0);
+    vec4 normal_y = textureGather(shadow_entry, corner, 1);
+    vec4 normal_z = textureGather(shadow_entry, corner, 2);
     vec2 f = c - base;
     // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
     vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
@@ -213,6 +225,7 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
                                         : l + (inner - l) * min(d_map / max(d_x, 1e-12), 1.0);
         float thickness = length(p_in - x_o);
         float fade = smoothstep(0.0, 3.0 * texel_size, thickness);
+        vec3 n_in = sanitize_normal(vec3(normal_x[k], normal_y[k], normal_z[k]) * 2.0 - 1.0);
         vec3 e = entering(i, p_in, n_in, to_light, eta);
         // Unscattered: the beam's flux through x_o's surface, so the cosine at the exit (the
         // beam spreads over 1 / |cos| of it; without it the rim just past a side light's

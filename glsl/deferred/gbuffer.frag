@@ -93,7 +93,11 @@ layout(location = LUCENT_SSS_LOCATION) out vec4 out_sss;
 #endif
 
 #ifdef LUCENT_LAYERED
-// Li et al.'s layered material ID / 255 (0: not layered), for the scattering passes.
+// Li et al.'s layered material ID / 255 (0: not layered) in r, for the scattering passes;
+// with albedo maps, the albedo texture's texel in gba (white for a draw without one): the
+// pigment film single scattering applies to the light leaving a layered surface
+// (glsl/layered/single.frag, LUCENT_LAYERED_FILM). The target is RGBA only when a layered
+// material has a texture (GBufferLayout::layered_format); an R8 target drops gba.
 layout(location = LUCENT_LAYERED_LOCATION) out vec4 out_layered;
 #endif
 
@@ -114,8 +118,10 @@ layout(location = 1) out vec4 out_gb1;
 void main() {
     Surface s;
     s.albedo = object.albedo_specular.rgb;
+    vec3 albedo_texel = vec3(1.0);
 #ifdef LUCENT_ALBEDO_MAP
-    s.albedo *= texture(albedo_map, in_uv).rgb;
+    albedo_texel = texture(albedo_map, in_uv).rgb;
+    s.albedo *= albedo_texel;
 #endif
     s.specular = object.albedo_specular.a;
 #if defined(LUCENT_LEAN)
@@ -163,7 +169,8 @@ void main() {
     out_sss = vec4(clamp(object.roughness.y, 0.0, 255.0) / 255.0);
 #endif
 #ifdef LUCENT_LAYERED
-    out_layered = vec4(clamp(object.roughness.z, 0.0, 255.0) / 255.0);
+    out_layered = vec4(clamp(object.roughness.z, 0.0, 255.0) / 255.0,
+                       clamp(albedo_texel, vec3(0.0), vec3(1.0)));
 #endif
 #ifdef LUCENT_LAYER_DEPTHS
     vec4 second = vec4(0.0);

@@ -3,6 +3,7 @@
 // permutation: LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_BINDING=5
 // permutation: LUCENT_HALF_TERM_BINDING=5
 // permutation: LUCENT_HALF_TERM_BINDING=5 LUCENT_FULL_RES_TERM
+// permutation: LUCENT_HALF_TERM_BINDING=5 LUCENT_LAYERED_FILM
 // permutation: LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_BINDING=5 LUCENT_ENTRY_BINDING=6 LUCENT_ENTRY_DEPTH_BINDING=7 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=8
 // Li et al.'s single scattering (eqs. 4-11) and the transmitted term L_t, added into the lit
 // image (src/features/layered.rs, `single scattering`), weighted by eq. 3's λ4 and λ3.
@@ -10,7 +11,8 @@
 // depth texels, then (lights with maps) the entry atlas, its layer depth texels (with TexDep)
 // and the shadow bindings; the multiple-scattering term (LUCENT_HALF_TERM_BINDING), which this
 // pass resolves over 3x3 pixels (LUCENT_FULL_RES_TERM) or, with `--half-gather`, upsamples,
-// and adds.
+// and adds. With LUCENT_LAYERED_FILM (a layered material has an albedo texture) the sum is
+// multiplied by the texel the G-buffer stored beside the material ID.
 #include "../common/layered.glsl"
 #ifdef LUCENT_HALF_TERM_BINDING
 #include "../common/layered_upsample.glsl"
@@ -434,6 +436,13 @@ void main() {
     vec3 terms = MAT.weights.x * l_t + MAT.weights.y * l_ss;
 #ifdef LUCENT_HALF_TERM_BINDING
     terms += upsampled_multiple(px, id); // already weighted by λ5
+#endif
+#ifdef LUCENT_LAYERED_FILM
+    // The albedo texture as a pigment film on the light leaving the surface (the screen-space
+    // blurs' `post` texturing): every term here leaves through x_o, while the light entering
+    // (the irradiance gathered, the entry points) is left alone. The G-buffer stores the
+    // texel beside the material ID (white for untextured draws).
+    terms *= texelFetch(gbuffer_layered, px, 0).gba;
 #endif
     out_color = vec4(finite_term(terms), 0.0);
 }

@@ -30,7 +30,8 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 pub const SSS_PROFILE_FORMAT: vk::Format = vk::Format::R8_UNORM;
 /// LCB and LBB: view-plane LEAN slope y and moments (blurred, so at least fp16).
 pub const LEAN_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
-/// Layered media: the layered material ID per pixel (ID / 255; 0: not layered).
+/// Layered media: the layered material ID per pixel (ID / 255; 0: not layered), in frames
+/// whose layered materials have no albedo texture ([`GBufferLayout::layered_format`]).
 pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;
 
 /// Precision of the G-buffer's colour targets (the report measures what each costs and how
@@ -99,6 +100,10 @@ pub struct GBufferLayout {
     pub depth_in_alpha: bool,
     /// Layered media (Li et al.): the G-buffer stores each pixel's layered material ID.
     pub layered: bool,
+    /// Some layered material has an albedo texture: the layered target holds the texel beside
+    /// the ID (RGBA at GB0's precision instead of R8), which single scattering applies to the
+    /// light leaving the surface as a pigment film.
+    pub layered_film: bool,
     /// `TexDep` depth textures the layered media read per object (0: none, 1 or 2): the
     /// G-buffer samples them at each pixel's UV and stores the texels (layer depth target).
     pub layer_depth_textures: usize,
@@ -189,6 +194,17 @@ impl GBufferLayout {
             GBufferPrecision::Compact => vk::Format::R8G8B8A8_UNORM,
             GBufferPrecision::Half => vk::Format::R16G16B16A16_SFLOAT,
             GBufferPrecision::Full => vk::Format::R32G32B32A32_SFLOAT,
+        }
+    }
+
+    /// The layered target: the material ID alone, or (`layered_film`) the ID in r and the
+    /// albedo texel in gba at GB0's precision (the film is an albedo: the same bits as the
+    /// albedo Lambert reads).
+    pub fn layered_format(&self) -> vk::Format {
+        if self.layered_film {
+            self.gb0_format()
+        } else {
+            LAYERED_ID_FORMAT
         }
     }
 
@@ -325,7 +341,7 @@ pub fn gbuffer_pass(
             .then(|| graph.create_image("gbuffer.lean", image(LEAN_FORMAT))),
         layered: layout
             .layered
-            .then(|| graph.create_image("gbuffer.layered", image(LAYERED_ID_FORMAT))),
+            .then(|| graph.create_image("gbuffer.layered", image(layout.layered_format()))),
         layer_depths: layout
             .layer_depths()
             .then(|| layer_depth_format(layout.layer_depth_textures))
@@ -424,6 +440,8 @@ pub(crate) fn all_layouts() -> Vec<GBufferLayout> {
                     albedo_maps: bit(3),
                     depth_in_alpha: bit(4),
                     layered: bit(5),
+                    // Only the layered target's format: the shader is the same.
+                    layered_film: false,
                     layer_depth_textures,
                     fault_injection: bit(6),
                 });

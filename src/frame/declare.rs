@@ -147,6 +147,7 @@ pub fn declare_frame(
                 layer_depths: gb.layer_depths.as_ref(),
                 layer_depth_textures: gb.layout.layer_depth_textures,
                 shadows: shadow_maps.as_ref(),
+                film: gb.layout.layered_film,
             },
             &settings.layered,
             scene_gpu,

@@ -150,6 +150,7 @@ impl FrameDesc {
             albedo_maps: self.albedo_maps,
             depth_in_alpha: self.sss.as_ref().is_some_and(SssProfiles::depth_in_alpha),
             layered: self.layered.is_some(),
+            layered_film: self.layered.as_ref().is_some_and(|l| l.film),
             layer_depth_textures: self.layer_depth_textures(),
             fault_injection: settings.fault.is_some(),
         }

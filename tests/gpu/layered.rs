@@ -539,6 +539,59 @@ fn the_pixel_light_gather_leaves_no_grain_in_a_still() {
     test.finish();
 }
 
+/// An albedo texture on a layered material is a pigment film on the light leaving the surface
+/// (`post`, as the screen-space blurs apply it): every layered term is multiplied by the
+/// texel, which the G-buffer stores beside the material ID. It was parsed and never applied
+/// (the textured truth came out 17-34% too bright under `auto`). On the truth set's
+/// validation scene, skin1's sphere with a uniform grey texture (sRGB 137: A = 0.2502; the
+/// compact G-buffer stores it in 8 bits, 64 / 255 = 0.2510), every pixel of the textured frame
+/// is A times the untextured one's: with physical weights and no specular the frame is the
+/// layered terms alone. The ID target is RGBA only in frames whose layered materials have a
+/// texture; the untextured frame keeps its R8 target.
+#[test]
+fn an_albedo_texture_on_a_layered_material_filters_the_light_leaving_it() {
+    let test = TestGpu::new();
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/truth/scenes");
+    let load = |name: &str| {
+        let path = scenes.join(name);
+        lucent::scene::load_scene(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let textured = load("validation/textured-grey.toml");
+    let plain = load("skin1-medium-sidelit.toml");
+    let (w, h) = (160usize, 120usize);
+    let s = FrameSettings {
+        export_hdr: true,
+        ..settings(w as u32, h as u32)
+    };
+    let format = |scene: &lucent::scene::Scene| {
+        let p = common::plan(scene, &s);
+        let id = p.resource_by_name("gbuffer.layered").unwrap();
+        p.resources[id].info.format
+    };
+    assert_eq!(format(&plain), ash::vk::Format::R8_UNORM);
+    assert_eq!(format(&textured), ash::vk::Format::R8G8B8A8_UNORM);
+    let t = test.render(&textured, s).hdr.unwrap();
+    let u = test.render(&plain, s).hdr.unwrap();
+    let mut sphere = 0;
+    for i in 0..w * h {
+        let lit = (0..3).all(|c| u[i * 4 + c] > 1e-4);
+        // The background is the sky's constant colour in both.
+        if !lit || (0..3).all(|c| t[i * 4 + c] == u[i * 4 + c]) {
+            continue;
+        }
+        sphere += 1;
+        for c in 0..3 {
+            let ratio = f64::from(t[i * 4 + c]) / f64::from(u[i * 4 + c]);
+            assert!(
+                (ratio - 64.0 / 255.0).abs() < 0.003,
+                "pixel {i} channel {c}: textured / untextured {ratio:.5}, not the film's 0.2510"
+            );
+        }
+    }
+    assert!(sphere > 2000, "{sphere} sphere pixels");
+    test.finish();
+}
+
 /// Issue 26: a thin layered slab lit only from behind glows through. It rendered black: the
 /// light's range (1000 units) put its shadow map's near plane 5 units out, past the slab, so
 /// the map held no entry points for it (src/features/shadows.rs now ends a face's depth range

@@ -72,6 +72,10 @@ pub struct LayeredDesc {
     pub materials: Vec<LayeredMedium>,
     /// Per scene object: its layered material ID (0: not layered).
     pub object_ids: Vec<u8>,
+    /// Some layered object's material has an albedo texture: the G-buffer stores the texel
+    /// beside the ID and single scattering multiplies the light leaving the surface by it (a
+    /// pigment film, the screen-space blurs' `post` texturing); without one, none of that.
+    pub film: bool,
 }
 
 impl LayeredDesc {
@@ -82,11 +86,13 @@ impl LayeredDesc {
     pub fn new(scene: &Scene) -> Result<Option<Self>> {
         let mut materials: Vec<LayeredMedium> = Vec::new();
         let mut object_ids = Vec::with_capacity(scene.objects.len());
+        let mut film = false;
         for o in &scene.objects {
             let Some(medium) = &o.material.layers else {
                 object_ids.push(0);
                 continue;
             };
+            film |= o.material.albedo_texture.is_some();
             medium.validate().map_err(|e| {
                 LucentError::InvalidInput(format!("material '{}': {e}", o.material.name))
             })?;
@@ -119,6 +125,7 @@ impl LayeredDesc {
         Ok((!materials.is_empty()).then_some(Self {
             materials,
             object_ids,
+            film,
         }))
     }
 
@@ -299,6 +306,8 @@ pub struct LayeredInputs<'a> {
     pub layer_depth_textures: usize,
     /// The light-space maps (with their entry target), when some light casts.
     pub shadows: Option<&'a ShadowMaps>,
+    /// The ID target holds each pixel's albedo texel too ([`LayeredDesc::film`]).
+    pub film: bool,
 }
 
 /// Declares `layered irradiance`, `single scattering` and `multiple scattering`; both
@@ -447,6 +456,9 @@ fn layered_pass<'g>(
             pass.define("LUCENT_FULL_RES_TERM", "1");
         }
     }
+    if single && inputs.film {
+        pass.define("LUCENT_LAYERED_FILM", "1");
+    }
     if let Some(depths) = layer_depths {
         pass.define(
             "LUCENT_LAYER_DEPTHS",
@@ -551,6 +563,8 @@ struct LayeredShape {
     shadows: bool,
     entry: bool,
     entry_depths: bool,
+    /// The ID target carries the albedo film (single scattering applies it).
+    film: bool,
 }
 
 impl LayeredShape {
@@ -568,6 +582,9 @@ impl LayeredShape {
             if self.full_res_term && !self.half_res {
                 defines.push(("LUCENT_FULL_RES_TERM", "1"));
             }
+        }
+        if single && self.film {
+            defines.push(("LUCENT_LAYERED_FILM", "1"));
         }
         let texdep = single && self.layer_depths.is_some();
         if let (true, Some(textures)) = (texdep, self.layer_depths) {
@@ -601,10 +618,14 @@ impl LayeredShape {
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
 fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for kind in Kind::ALL {
-        for flags in 0u32..1 << 7 {
+        for flags in 0u32..1 << 8 {
             let bit = |i: u32| flags & (1 << i) != 0;
             // The full-resolution term only tells a single scattering pass that reads one apart.
             if bit(6) && !(kind == Kind::Single && bit(2) && !bit(0)) {
+                continue;
+            }
+            // Only single scattering applies the film.
+            if bit(7) && kind != Kind::Single {
                 continue;
             }
             for layer_depths in [None, Some(1), Some(2)] {
@@ -618,6 +639,7 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
                     shadows: bit(3),
                     entry: bit(4),
                     entry_depths: bit(5),
+                    film: bit(7),
                 };
                 out.push(crate::backend::shader::PipelineShaders::fullscreen(
                     kind.fragment(),
@@ -702,7 +724,7 @@ mod tests {
             format: IRRADIANCE_FORMAT,
         };
         for kind in Kind::ALL {
-            for flags in 0u32..1 << 7 {
+            for flags in 0u32..1 << 8 {
                 let bit = |i: u32| flags & (1 << i) != 0;
                 for textures in 0..=2 {
                     let mut graph = RenderGraph::new();
@@ -729,6 +751,7 @@ mod tests {
                         layer_depths: layer_depths.as_ref(),
                         layer_depth_textures: textures,
                         shadows: maps.as_ref(),
+                        film: bit(7),
                     };
                     let scale = if bit(0) { 2 } else { 1 };
                     let pass = layered_pass(
@@ -750,6 +773,7 @@ mod tests {
                         shadows: bit(3),
                         entry: bit(4),
                         entry_depths: bit(5),
+                        film: bit(7),
                     };
                     assert_eq!(pass.shader_defines(), shape.defines(), "{shape:?}");
                 }

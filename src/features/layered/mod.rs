@@ -31,6 +31,10 @@
 //!   weighted mean of the accepted samples' `E` times the dipole's total reflectance, so a
 //!   uniformly lit surface gets exactly `E R_d,total`: energy normalised); times
 //!   `T(x_o) / pi`.
+//! - `multiple scattering blur`: the gathered term's texels of a medium that diffuses far on
+//!   screen become the mean of the 3x3 of their material and depth around them, which single
+//!   scattering resolves: half the sampling grain left, where the term has no detail at that
+//!   scale (glsl/layered/term_blur.frag).
 //!
 //! Both scattering passes add into the lit image (after the SSS blurs, which layered pixels
 //! are not part of) and draw only the screen rectangles layered objects may cover. A frame
@@ -357,6 +361,7 @@ pub fn layered_passes(
         // Cleared: pixels outside the rectangles read material 0, which the resolve skips.
         pass.color(&mut term, LoadOp::Clear([0.0; 4]));
         pass.finish();
+        let term = term_blur(graph, inputs, 1, &term, scene);
         let mut pass = layered_pass(graph, Kind::Single, inputs, 1, None, Some(&term), scene);
         pass.color_add(&mut hdr, LoadOp::Load);
         pass.finish();
@@ -384,6 +389,7 @@ pub fn layered_passes(
     // Cleared: texels outside the rectangles read material 0, which the upsample skips.
     pass.color(&mut half_term, LoadOp::Clear([0.0; 4]));
     pass.finish();
+    let half_term = term_blur(graph, inputs, 2, &half_term, scene);
     let mut pass = layered_pass(
         graph,
         Kind::Single,
@@ -396,6 +402,26 @@ pub fn layered_passes(
     pass.color_add(&mut hdr, LoadOp::Load);
     pass.finish();
     hdr
+}
+
+/// Declares `multiple scattering blur`: the term gathered at `1 / scale` of the screen per side,
+/// each texel of a medium that diffuses far on screen replaced by the mean of the 3x3 texels
+/// of its material and depth around it (glsl/layered/term_blur.frag), which single scattering
+/// then resolves. Returns the blurred term, the same size and format.
+fn term_blur(
+    graph: &mut RenderGraph,
+    inputs: &LayeredInputs<'_>,
+    scale: u32,
+    term: &Handle<Image>,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let info = graph.resources()[term.id()].info;
+    let mut blurred = graph.create_image("layered.multiple-blurred", info);
+    let mut pass = layered_pass(graph, Kind::Blur, inputs, scale, Some(term), None, scene);
+    // Cleared: texels outside the rectangles read material 0, which the resolve skips.
+    pass.color(&mut blurred, LoadOp::Clear([0.0; 4]));
+    pass.finish();
+    blurred
 }
 
 /// Starts a layered pass of `kind` at `1 / scale` of the screen per side, reading the gather's
@@ -446,6 +472,8 @@ fn layered_pass<'g>(
     {
         pass.graph().sample(h);
     }
+    // The image the pass reads at binding 5: the irradiance (the gather) or the term (its
+    // blur).
     if let Some(irradiance) = irradiance {
         pass.bind_sampled(irradiance, vk::Filter::NEAREST);
     }
@@ -482,7 +510,7 @@ fn layered_pass<'g>(
         (Kind::Irradiance, 2) => {
             pass.define("LUCENT_HALF_RES", "1");
         }
-        (Kind::HalfGather, _) => {
+        (Kind::HalfGather, _) | (Kind::Blur, 2) => {
             pass.define("LUCENT_HALF_GATHER", "1");
         }
         _ => {}
@@ -519,14 +547,17 @@ enum Kind {
     Multiple,
     /// Multiple scattering into the half-resolution target.
     HalfGather,
+    /// The multiple-scattering term's blur (at the gather's resolution).
+    Blur,
 }
 
 impl Kind {
-    const ALL: [Kind; 4] = [
+    const ALL: [Kind; 5] = [
         Kind::Irradiance,
         Kind::Single,
         Kind::Multiple,
         Kind::HalfGather,
+        Kind::Blur,
     ];
 
     /// The pass's name.
@@ -535,6 +566,7 @@ impl Kind {
             Kind::Irradiance => "layered irradiance",
             Kind::Single => "single scattering",
             Kind::Multiple | Kind::HalfGather => "multiple scattering",
+            Kind::Blur => "multiple scattering blur",
         }
     }
 
@@ -543,6 +575,7 @@ impl Kind {
             Kind::Irradiance => "layered/irradiance.frag",
             Kind::Single => "layered/single.frag",
             Kind::Multiple | Kind::HalfGather => "layered/multiple.frag",
+            Kind::Blur => "layered/term_blur.frag",
         }
     }
 }
@@ -608,7 +641,7 @@ impl LayeredShape {
         }
         match (self.kind, self.half_res) {
             (Kind::Irradiance, true) => defines.push(("LUCENT_HALF_RES", "1")),
-            (Kind::HalfGather, _) => defines.push(("LUCENT_HALF_GATHER", "1")),
+            (Kind::HalfGather, _) | (Kind::Blur, true) => defines.push(("LUCENT_HALF_GATHER", "1")),
             _ => {}
         }
         defines

@@ -1,6 +1,8 @@
 //! Measurement: everything that times frames or checks their numbers, above the frame layer.
 //!
 //! - [`stats`]: medians, minima and maxima of samples, the one summary every table uses.
+//! - [`round_robin`]: variants' frames timed in turn, one of each per round, so a noisy machine
+//!   slows them alike (the truth and SSS reports, and [`scaling`]).
 //! - [`bench`](mod@bench): the benchmark (`lucent bench`): per-pass GPU times proven to add up, and its
 //!   timing modes, formats and alternating comparisons.
 //! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
@@ -17,6 +19,7 @@ pub mod bench;
 pub mod gallery;
 pub mod layered_error;
 pub mod look;
+pub mod round_robin;
 pub mod scaling;
 pub mod speed_of_light;
 pub mod stats;

@@ -1,10 +1,11 @@
 //! Scaling: frame and per-pass time against triangle count, resolution and light count.
 //!
 //! Every point of one axis is a frame of its own (its scene and settings built once), and the
-//! points are measured round-robin: one frame of each per round, after warm-up rounds, so a noisy,
-//! shared machine slows every point alike and the curve's shape holds. Frames are compiled
-//! without subpass merging, so the G-buffer and the lighting pass have their own timestamp pairs
-//! (the geometry cost and the per-pixel lighting cost are what the axes separate).
+//! points are measured round-robin ([`round_robin`]): one frame of each per round, after warm-up
+//! rounds, so a noisy, shared machine slows every point alike and the curve's shape holds.
+//! Frames are compiled without subpass merging, so the G-buffer and the lighting pass have their
+//! own timestamp pairs (the geometry cost and the per-pixel lighting cost are what the axes
+//! separate).
 //!
 //! [`growth`] fits each pass's time as `a * x^s` over the axis (least squares in log-log) and
 //! says what the exponent means: about 1 grows in proportion, about 0 does not grow.
@@ -15,8 +16,9 @@ use serde::Serialize;
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::frame::{FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{FrameSettings, Technique};
 use crate::graph::CompileOptions;
+use crate::measure::round_robin::{self, IfUnbuildable};
 use crate::measure::stats::Stats;
 use crate::scene::Scene;
 use crate::Result;
@@ -92,57 +94,30 @@ pub fn measure(
     configs: &[Config],
     rounds: usize,
     warmup: usize,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Vec<Measured>> {
-    let mut renderers = Vec::with_capacity(configs.len());
-    let mut runners = Vec::with_capacity(configs.len());
-    let result = (|| -> Result<Vec<Measured>> {
-        for c in configs {
-            let r = Renderer::new(gpu, shaders, pipeline_cache, &c.scene, c.settings)?;
-            runners.push(FrameRunner::new(gpu, r.executable.plan.physical.len())?);
-            renderers.push(r);
-        }
-        let mut walls = vec![Vec::new(); configs.len()];
-        let mut passes: Vec<Vec<Vec<f64>>> = renderers
-            .iter()
-            .map(|r| vec![Vec::new(); r.executable.plan.physical.len()])
-            .collect();
-        let total = warmup + rounds.max(1);
-        for round in 0..total {
-            for (i, (renderer, runner)) in renderers.iter().zip(&mut runners).enumerate() {
-                let timing = runner.run_frame(gpu, &renderer.executable)?;
-                if round < warmup {
-                    continue;
-                }
-                walls[i].push(timing.wall_ms);
-                for (samples, pass) in passes[i].iter_mut().zip(&timing.passes) {
-                    samples.push(pass.ms);
-                }
-            }
-            progress(round + 1, total);
-        }
-        Ok(configs
-            .iter()
-            .zip(&renderers)
-            .enumerate()
-            .map(|(i, (c, r))| Measured {
-                label: c.label.clone(),
-                x: c.x,
-                passes: r
-                    .executable
-                    .plan
-                    .physical
-                    .iter()
-                    .zip(&passes[i])
-                    .map(|(p, s)| (p.name.clone(), Stats::of(s)))
-                    .collect(),
-                frame: Stats::of(&walls[i]),
-                triangles: triangles(&c.scene),
-            })
-            .collect())
-    })();
-    crate::frame::destroy_after_idle(gpu, renderers, runners)?;
-    result
+    let frames = round_robin::time_frames(
+        gpu,
+        shaders,
+        pipeline_cache,
+        configs.iter().map(|c| (&c.scene, c.settings)),
+        IfUnbuildable::Fail,
+        // At least one measured round: every point needs a median.
+        rounds.max(1),
+        warmup,
+        progress,
+    )?;
+    Ok(configs
+        .iter()
+        .zip(&frames)
+        .map(|(c, frames)| Measured {
+            label: c.label.clone(),
+            x: c.x,
+            passes: frames.pass_stats(),
+            frame: frames.wall(),
+            triangles: triangles(&c.scene),
+        })
+        .collect())
 }
 
 /// Triangles a frame of `scene` draws (each object draws its whole mesh).

@@ -22,7 +22,8 @@ use std::path::{Path, PathBuf};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::sss::SssPrecision;
-use crate::frame::{render_frame, FrameDesc, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{render_frame, FrameDesc, FrameSettings, Technique};
+use crate::measure::round_robin::{self, IfUnbuildable};
 use crate::measure::stats::Stats;
 use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
 use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
@@ -301,61 +302,35 @@ pub fn run(
     }
     // Times: every variant's frames round-robin.
     let teapot = crate::bake::scene::load_scene_baked("teapot")?;
-    let mut renderers = Vec::with_capacity(variants.len());
-    let mut runners = Vec::with_capacity(variants.len());
-    let timed = (|| -> Result<Vec<(Stats, Stats, usize)>> {
-        for v in variants {
-            let r = Renderer::new(
-                gpu,
-                shaders,
-                cache,
-                &teapot,
-                sized(&v.settings, opts.width, opts.height),
-            )?;
-            runners.push(FrameRunner::new(gpu, r.executable.plan.physical.len())?);
-            renderers.push(r);
-        }
-        let mut samples = vec![(Vec::new(), Vec::new()); variants.len()];
-        for round in 0..opts.warmup + opts.rounds {
-            for (i, (renderer, runner)) in renderers.iter().zip(&mut runners).enumerate() {
-                let t = runner.run_frame(gpu, &renderer.executable)?;
-                if round >= opts.warmup {
-                    samples[i].0.push(t.wall_ms);
-                    samples[i].1.push(sss_ms(&t.passes));
-                }
-            }
-        }
-        Ok(samples
+    let frames = round_robin::time_frames(
+        gpu,
+        shaders,
+        cache,
+        variants
             .iter()
-            .zip(&renderers)
-            .map(|((frame, sss), r)| {
-                let pairs = r
-                    .executable
-                    .plan
-                    .physical
-                    .iter()
-                    .filter(|p| p.name.starts_with("vertical blur"))
-                    .count();
-                (Stats::of(frame), Stats::of(sss), pairs)
-            })
-            .collect())
-    })();
-    crate::frame::destroy_after_idle(gpu, renderers, runners)?;
+            .map(|v| (&teapot, sized(&v.settings, opts.width, opts.height))),
+        IfUnbuildable::Fail,
+        opts.rounds,
+        opts.warmup,
+        |_, _| {},
+    )?;
     Ok(variants
         .iter()
-        .zip(timed?)
+        .zip(&frames)
         .zip(errors)
-        .map(
-            |((v, (frame, sss, blur_pairs)), (edges, mean_error, fit_error))| SssResult {
-                variant: v.clone(),
-                frame,
-                sss,
-                blur_pairs,
-                edges,
-                mean_error,
-                fit_error,
-            },
-        )
+        .map(|((v, frames), (edges, mean_error, fit_error))| SssResult {
+            variant: v.clone(),
+            frame: frames.wall(),
+            sss: frames.stats_of(|t| sss_ms(&t.passes)),
+            blur_pairs: frames
+                .pass_names
+                .iter()
+                .filter(|name| name.starts_with("vertical blur"))
+                .count(),
+            edges,
+            mean_error,
+            fit_error,
+        })
         .collect())
 }
 

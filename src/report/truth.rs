@@ -24,7 +24,8 @@ use std::path::{Path, PathBuf};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::knob::Given;
-use crate::frame::{render_frame, FrameRunner, FrameSettings, Renderer, Technique};
+use crate::frame::{render_frame, FrameSettings, Technique};
+use crate::measure::round_robin::{self, IfUnbuildable};
 use crate::measure::stats::Stats;
 use crate::measure::truth::{load_truth, measure, truth_names, Truth, TruthError};
 use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
@@ -284,12 +285,32 @@ pub fn run(
             .position(|v| v.technique == Technique::None && v.knob.is_none())
             .and_then(|i| frames[i].as_ref().ok());
         let timed_size = opts.size.unwrap_or((truth.width, truth.height));
-        let times = time_round_robin(gpu, shaders, cache, &truth, &variants, timed_size, opts)?;
+        let (width, height) = timed_size;
+        // A variant that cannot build its frame sits the timing out with NaN times; its error
+        // says why.
+        let timed = round_robin::time_frames(
+            gpu,
+            shaders,
+            cache,
+            variants.iter().map(|v| {
+                let settings = FrameSettings {
+                    width,
+                    height,
+                    export_hdr: false,
+                    ..v.settings
+                };
+                (&truth.scene, settings)
+            }),
+            IfUnbuildable::SitOut,
+            opts.rounds,
+            opts.warmup,
+            |_, _| {},
+        )?;
         let results = variants
             .iter()
             .zip(&frames)
-            .zip(times)
-            .map(|((variant, hdr), frame)| TruthResult {
+            .zip(&timed)
+            .map(|((variant, hdr), timed)| TruthResult {
                 variant: variant.clone(),
                 error: hdr
                     .as_ref()
@@ -297,7 +318,7 @@ pub fn run(
                     .and_then(|hdr| measure(&truth, hdr).map_err(|e| e.to_string())),
                 renders_as_none: variant.technique != Technique::None
                     && hdr.as_ref().ok().zip(plain).is_some_and(|(a, b)| a == b),
-                frame,
+                frame: timed.wall(),
             })
             .collect();
         out.push(SceneResults {
@@ -308,72 +329,6 @@ pub fn run(
         });
     }
     Ok(out)
-}
-
-/// Every variant's frames of the truth's scene at `size`, round-robin; a variant that cannot
-/// build its frame gets NaN times (its error says why).
-fn time_round_robin(
-    gpu: &GpuContext,
-    shaders: &ShaderCompiler,
-    cache: &PipelineCache,
-    truth: &Truth,
-    variants: &[TruthVariant],
-    (width, height): (u32, u32),
-    opts: &TruthOptions,
-) -> Result<Vec<Stats>> {
-    let mut renderers: Vec<Option<Renderer>> = Vec::with_capacity(variants.len());
-    let mut runners = Vec::with_capacity(variants.len());
-    let timed = (|| -> Result<Vec<Stats>> {
-        for v in variants {
-            let settings = FrameSettings {
-                width,
-                height,
-                export_hdr: false,
-                ..v.settings
-            };
-            let renderer = Renderer::new(gpu, shaders, cache, &truth.scene, settings).ok();
-            if let Some(r) = &renderer {
-                runners.push(Some(FrameRunner::new(
-                    gpu,
-                    r.executable.plan.physical.len(),
-                )?));
-            } else {
-                runners.push(None);
-            }
-            renderers.push(renderer);
-        }
-        let mut samples = vec![Vec::new(); variants.len()];
-        for round in 0..opts.warmup + opts.rounds {
-            for (i, (renderer, runner)) in renderers.iter().zip(&mut runners).enumerate() {
-                if let (Some(renderer), Some(runner)) = (renderer, runner) {
-                    let t = runner.run_frame(gpu, &renderer.executable)?;
-                    if round >= opts.warmup {
-                        samples[i].push(t.wall_ms);
-                    }
-                }
-            }
-        }
-        Ok(samples
-            .iter()
-            .map(|s| {
-                if s.is_empty() {
-                    Stats {
-                        median: f64::NAN,
-                        min: f64::NAN,
-                        max: f64::NAN,
-                    }
-                } else {
-                    Stats::of(s)
-                }
-            })
-            .collect())
-    })();
-    crate::frame::destroy_after_idle(
-        gpu,
-        renderers.into_iter().flatten().collect(),
-        runners.into_iter().flatten().collect(),
-    )?;
-    timed
 }
 
 /// The report as Markdown.

@@ -12,7 +12,8 @@
 //!   subpasses unmerged ([`crate::measure::scaling::settings`]); all variants in one
 //!   round-robin run ([`crate::measure::scaling::measure`]), so a shared, noisy machine slows
 //!   every variant alike. The cost is the sum of the medians of the three layered passes
-//!   ([`LAYERED_PASSES`]); the frame median is printed beside it.
+//!   ([`LAYERED_PASSES`], multiple scattering's with the blur of its term); the frame median
+//!   is printed beside it.
 //!
 //! Identical configurations (a knob's default is every knob's default) are rendered and timed
 //! once and shared by their rows. Writes `li.md` and `li-error-vs-time.png`.
@@ -35,12 +36,27 @@ use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
 use crate::scene::layered::{Layer, LayeredMedium, Thickness};
 use crate::{LucentError, Result};
 
-/// The passes whose medians make a variant's cost.
+/// The passes whose medians make a variant's cost, one column each.
 pub const LAYERED_PASSES: [&str; 3] = [
     "layered irradiance",
     "single scattering",
     "multiple scattering",
 ];
+
+/// Passes a column's time includes beside the one it is named after: the blur of the gathered
+/// term is multiple scattering's (it runs only to finish that term).
+const COLUMN_EXTRAS: [(&str, &str); 1] = [("multiple scattering", "multiple scattering blur")];
+
+/// The median of pass `column` in `m` plus those of the passes [`COLUMN_EXTRAS`] adds to it
+/// (each when the frame has it); `None` when the frame has no `column` pass.
+pub fn column_ms(m: &Measured, column: &str) -> Option<f64> {
+    let extras: f64 = COLUMN_EXTRAS
+        .iter()
+        .filter(|(c, _)| *c == column)
+        .filter_map(|(_, extra)| m.pass_ms(extra))
+        .sum();
+    m.pass_ms(column).map(|ms| ms + extras)
+}
 
 /// Every knob the report turns, in order (the Markdown names each).
 pub const KNOBS: [&str; 7] = [
@@ -186,7 +202,7 @@ impl LiResult {
 /// The sum of the medians of [`LAYERED_PASSES`] in `m`; `None` when one is missing or the sum
 /// is not a positive finite number.
 pub fn layered_sum(m: &Measured) -> Option<f64> {
-    sum_positive(LAYERED_PASSES.map(|p| m.pass_ms(p)))
+    sum_positive(LAYERED_PASSES.map(|p| column_ms(m, p)))
 }
 
 fn sum_positive(parts: [Option<f64>; 3]) -> Option<f64> {
@@ -474,7 +490,7 @@ pub fn run(
                 variant: v.clone(),
                 error: errors[error_of[i]],
                 own_form_error: own_of[i].map(|k| errors[k].relative_l1),
-                passes_ms: LAYERED_PASSES.map(|p| m.pass_ms(p)),
+                passes_ms: LAYERED_PASSES.map(|p| column_ms(m, p)),
                 frame_ms: m.frame.median,
                 triangles: m.triangles,
             }
@@ -510,7 +526,8 @@ pub fn markdown(results: &[LiResult], opts: &LiOptions, device: &str) -> String 
          - time: the same sphere with every term on ({triangles} triangles), {w}x{h}, technique \
          `auto`, subpasses unmerged, {r} rounds round-robin after {wu} warm-up, every \
          configuration in one run; \"layered ms\" is the sum of the medians of `{p0}`, `{p1}` \
-         and `{p2}`; frame: submit to fence\n\
+         and `{p2}` (with `multiple scattering blur`, the blur of its term); frame: submit to \
+         fence\n\
          - defaults where a row does not turn the knob: K = {k}, M = {m}, {phase}, \
          full-resolution irradiance, {gather} gather, {map}^2-texel light-space maps, D_max = \
          {d} mean free paths\n\
@@ -740,5 +757,34 @@ mod tests {
         r.passes_ms = [Some(0.0); 3];
         let text = markdown(&[r], &LiOptions::quick(), "llvmpipe");
         assert!(!text.contains("NaN") && text.contains("| - |"), "{text}");
+    }
+
+    #[test]
+    fn multiple_scatterings_column_counts_the_blur_of_its_term() {
+        let stats = |median| crate::measure::stats::Stats {
+            median,
+            min: median,
+            max: median,
+        };
+        let mut m = Measured {
+            label: String::new(),
+            x: 0.0,
+            passes: vec![
+                ("layered irradiance".into(), stats(1.0)),
+                ("multiple scattering".into(), stats(2.0)),
+                ("multiple scattering blur".into(), stats(0.5)),
+                ("single scattering".into(), stats(4.0)),
+            ],
+            frame: stats(10.0),
+            triangles: 0,
+        };
+        assert_eq!(column_ms(&m, "multiple scattering"), Some(2.5));
+        assert_eq!(column_ms(&m, "single scattering"), Some(4.0));
+        assert_eq!(layered_sum(&m), Some(7.5));
+        // A frame without the blur (or without the gather) is measured as it is.
+        m.passes.remove(2);
+        assert_eq!(column_ms(&m, "multiple scattering"), Some(2.0));
+        m.passes.remove(1);
+        assert_eq!(column_ms(&m, "multiple scattering"), None);
     }
 }

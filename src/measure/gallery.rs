@@ -1,9 +1,12 @@
-//! `lucent gallery`: every showcase scene under the techniques its materials ask for and beside
-//! plain lighting, as PNGs and a Markdown page with the [`super::look`] numbers of each.
+//! `lucent gallery`: every showcase scene under the techniques its materials ask for (and
+//! `showcase-skin` under 2-D Burley too) and beside plain lighting, as PNGs and a Markdown page
+//! with the [`super::look`] numbers of each.
 //!
-//! For each scene of [`GALLERY_SCENES`] it writes `NAME.png` (the frame), `NAME-none.png`
-//! (`--technique none`), `NAME-difference.png` (|frame - none| x 4) and a row of `index.md`:
-//! pixels changed, technique pixels, halo pixels, and the wall time of one frame of each.
+//! For each entry of [`GALLERY_SCENES`] (a scene, under its materials' techniques or a named
+//! one) it writes `NAME.png` (the frame; `NAME-TECHNIQUE.png` under a named technique),
+//! `NAME-none.png` (`--technique none`), `NAME-difference.png` (|frame - none| x 4) and a row
+//! of `index.md`: pixels changed, technique pixels, halo pixels, and the wall time of one frame
+//! of each.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -12,35 +15,83 @@ use super::look::{self, Look, CHANGED_THRESHOLD, HALO_THRESHOLD};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::bake::scene::load_scene_baked;
-use crate::frame::FrameSettings;
+use crate::frame::{FrameSettings, Technique};
 use crate::images::output::write_png_rgba8;
 use crate::{LucentError, Result};
 
-/// The scenes of the gallery: (scene, what it shows).
-pub const GALLERY_SCENES: &[(&str, &str)] = &[
-    (
-        "showcase-translucency",
-        "GDC 2011 thickness-based translucency: an ear, leaves and a wax panel lit from behind",
-    ),
-    (
-        "showcase-skin",
-        "separable SSS with d'Eon's skin profile (10x): the red terminator; the ears also translucent",
-    ),
-    (
-        "showcase-marble",
-        "separable SSS with the marble profile (5x) on veined, normal-mapped marble under a grazing light",
-    ),
-    (
-        "showcase-layered",
-        "Li et al.'s single + dipole multiple scattering in jade and wax",
-    ),
-    ("mixed", "every technique in one frame"),
+/// One picture of the gallery: a scene, the technique it is shown under (`None`: what its
+/// materials ask for, `--technique auto`) and what it shows.
+#[derive(Clone, Copy, Debug)]
+pub struct GalleryScene<'a> {
+    /// Scene name (a built-in scene or a scene file).
+    pub scene: &'a str,
+    /// A technique's command-line name (`lucent render --technique`), or `None` for what the
+    /// scene's materials ask for.
+    pub technique: Option<&'a str>,
+    /// What it shows (empty: the scene's own name).
+    pub shows: &'a str,
+}
+
+/// The gallery's pictures, in order.
+pub const GALLERY_SCENES: &[GalleryScene<'static>] = &[
+    GalleryScene {
+        scene: "showcase-translucency",
+        technique: None,
+        shows: "GDC 2011 thickness-based translucency: an ear, leaves and a wax panel lit from \
+                behind",
+    },
+    GalleryScene {
+        scene: "showcase-skin",
+        technique: None,
+        shows: "separable SSS with d'Eon's skin profile (10x): the red terminator; the ears also \
+                translucent",
+    },
+    GalleryScene {
+        scene: "showcase-skin",
+        technique: Some("burley"),
+        shows: "the same head under 2-D Burley diffusion (Christensen and Burley's profile \
+                importance-sampled around each pixel, `--technique burley`)",
+    },
+    GalleryScene {
+        scene: "showcase-marble",
+        technique: None,
+        shows: "separable SSS with the marble profile (5x) on veined, normal-mapped marble under \
+                a grazing light",
+    },
+    GalleryScene {
+        scene: "showcase-layered",
+        technique: None,
+        shows: "Li et al.'s single + dipole multiple scattering in jade and wax",
+    },
+    GalleryScene {
+        scene: "mixed",
+        technique: None,
+        shows: "every technique in one frame",
+    },
 ];
+
+impl GalleryScene<'_> {
+    /// The stem of its PNGs: the scene's file stem, then `-TECHNIQUE` under a named technique.
+    pub fn stem(&self) -> String {
+        match self.technique {
+            Some(t) => format!("{}-{}", file_stem(self.scene), file_stem(t)),
+            None => file_stem(self.scene),
+        }
+    }
+
+    /// How `index.md` names it: the scene, and the technique when one is named.
+    pub fn title(&self) -> String {
+        match self.technique {
+            Some(t) => format!("`{}` under `{t}`", self.scene),
+            None => format!("`{}`", self.scene),
+        }
+    }
+}
 
 /// One scene of the gallery, written.
 #[derive(Clone, Debug)]
 pub struct GalleryEntry {
-    /// Scene name.
+    /// Scene name (and the technique, when the entry names one), as `index.md` titles it.
     pub scene: String,
     /// What it shows.
     pub shows: String,
@@ -54,14 +105,15 @@ pub struct GalleryEntry {
     pub look: Look,
 }
 
-/// Renders the gallery's `scenes` (names from [`GALLERY_SCENES`] or any scene) into `out`
-/// with `settings` (size, knobs; the technique is each scene's own unless `settings` names
-/// one), writes `index.md`, and returns the entries. `progress` is told each scene's name.
+/// Renders the gallery's `scenes` ([`GALLERY_SCENES`], or any others) into `out` with
+/// `settings` (size, knobs; the technique is each entry's own when it names one, else the one
+/// `settings` names), writes `index.md`, and returns the entries. `progress` is told each scene's name. A technique name no technique
+/// has is an error before anything is rendered.
 pub fn gallery(
     gpu: &GpuContext,
     shaders: &ShaderCompiler,
     pipeline_cache: &PipelineCache,
-    scenes: &[&str],
+    scenes: &[GalleryScene<'_>],
     settings: FrameSettings,
     out: &Path,
     mut progress: impl FnMut(&str),
@@ -70,15 +122,18 @@ pub fn gallery(
         .map_err(|e| LucentError::file(out, format!("cannot create the gallery folder: {e}")))?;
     // Nothing the gallery writes may be a file a scene reads (a scene file, its mesh or a
     // texture in the same folder), checked before any work.
+    let techniques = scenes
+        .iter()
+        .map(|s| s.technique.map(Technique::parse).transpose())
+        .collect::<Result<Vec<_>>>()?;
     let inputs: Vec<(String, PathBuf)> = scenes
         .iter()
-        .flat_map(|name| crate::scene::inputs::scene_inputs(name))
+        .flat_map(|s| crate::scene::inputs::scene_inputs(s.scene))
         .collect();
     let outputs: Vec<PathBuf> = scenes
         .iter()
-        .flat_map(|name| {
-            ["", "-none", "-difference"]
-                .map(|suffix| out.join(format!("{}{suffix}.png", file_stem(name))))
+        .flat_map(|s| {
+            ["", "-none", "-difference"].map(|suffix| out.join(format!("{}{suffix}.png", s.stem())))
         })
         .chain([out.join("index.md")])
         .collect();
@@ -93,18 +148,23 @@ pub fn gallery(
             .collect::<Vec<_>>(),
     )?;
     let mut entries = Vec::new();
-    for &name in scenes {
-        progress(name);
-        let scene = load_scene_baked(name)?;
+    for (subject, technique) in scenes.iter().zip(techniques) {
+        progress(subject.scene);
+        let scene = load_scene_baked(subject.scene)?;
+        let settings = FrameSettings {
+            technique: technique.unwrap_or(settings.technique),
+            ..settings
+        };
         let images = look::look(gpu, shaders, pipeline_cache, &scene, settings)?;
-        let file = |suffix: &str| out.join(format!("{}{suffix}.png", file_stem(name)));
+        let file = |suffix: &str| out.join(format!("{}{suffix}.png", subject.stem()));
         let (w, h) = (settings.width, settings.height);
         let entry = GalleryEntry {
-            scene: name.to_string(),
-            shows: GALLERY_SCENES
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map_or_else(|| scene.name.clone(), |(_, s)| s.to_string()),
+            scene: subject.title(),
+            shows: if subject.shows.is_empty() {
+                scene.name.clone()
+            } else {
+                subject.shows.to_string()
+            },
             frame: file(""),
             plain: file("-none"),
             difference: file("-difference"),
@@ -150,7 +210,8 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
     let _ = writeln!(out, "# lucent gallery\n");
     let _ = writeln!(
         out,
-        "{}x{}, technique `{}`, anti-aliasing `{}`, on {device}. Each scene beside plain \
+        "{}x{}, technique `{}` unless a title names another, anti-aliasing `{}`, on {device}. \
+         Each scene beside plain \
          lighting (`--technique none`) and their difference (x4). *Changed*: pixels that \
          moved by more than {CHANGED_THRESHOLD}/255; *halo*: pixels of objects with no \
          technique that moved by more than {HALO_THRESHOLD}/255. Frame times are one frame \
@@ -167,7 +228,7 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
     for e in entries {
         let _ = writeln!(
             out,
-            "| `{}` | {:.1}% | {} | {} (max {}/255) | {:.0} / {:.0} |",
+            "| {} | {:.1}% | {} | {} (max {}/255) | {:.0} / {:.0} |",
             e.scene,
             100.0 * e.look.changed,
             e.look.technique_pixels,
@@ -182,7 +243,7 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
             p.file_name()
                 .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
         };
-        let _ = writeln!(out, "\n## `{}`\n\n{}\n", e.scene, e.shows);
+        let _ = writeln!(out, "\n## {}\n\n{}\n", e.scene, e.shows);
         let _ = writeln!(
             out,
             "| {} | plain lighting | difference x4 |\n|---|---|---|\n| ![]({}) | ![]({}) | ![]({}) |",

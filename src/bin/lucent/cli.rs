@@ -161,9 +161,14 @@ pub struct GalleryArgs {
     /// Resolution as WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Only these scenes (repeatable; default: every showcase scene and `mixed`).
+    /// Only these scenes (repeatable; default: every showcase scene and `mixed`, and
+    /// `showcase-skin` under `burley` too).
     #[arg(long)]
     pub scene: Vec<String>,
+    /// Show every scene under this technique (as `lucent render --technique`) instead of the
+    /// techniques its materials ask for; the file names end in `-TECHNIQUE`.
+    #[arg(long)]
+    pub technique: Option<String>,
     /// Anti-aliasing after the tonemap: `off` (default) or `fxaa`.
     #[arg(long, default_value = "off")]
     pub aa: String,

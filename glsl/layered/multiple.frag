@@ -4,7 +4,8 @@
 // λ5 (src/features/layered.rs, `multiple scattering`): Jensen's dipole of the first layer
 // gathered over M pixel lights of the irradiance image. Set 0 as glsl/common/layered.glsl,
 // then the irradiance image (binding 5). It stores the weighted term with the material ID in
-// alpha, which single scattering reads back (glsl/common/layered_upsample.glsl): at full
+// alpha, twice (the second copy is what the term's blur overwrites where it blurs), which
+// single scattering reads back (glsl/common/layered_upsample.glsl): at full
 // resolution the spiral is rotated by one of nine angles per 3x3 block
 // (glsl/common/sampling.glsl) and single scattering averages each pixel's 3x3 neighbours; with
 // LUCENT_HALF_GATHER each texel of a half-resolution target gathers for its 2x2 block's
@@ -17,6 +18,9 @@ layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
+// The same term again: the blur's target (src/features/layered/mod.rs `term_blur`), which the
+// blur then overwrites only over the objects it blurs; elsewhere single scattering reads this.
+layout(location = 1) out vec4 out_copy;
 
 void main() {
 #ifdef LUCENT_HALF_GATHER
@@ -26,6 +30,7 @@ void main() {
 #endif
     int id = layered_id_at(px);
     out_color = vec4(0.0);
+    out_copy = vec4(0.0);
     if (id == 0) {
         return;
     }
@@ -91,4 +96,5 @@ void main() {
     vec3 l_ms = fresnel_transmittance(cos_o, eta) / PI * MAT.total.rgb * gathered /
                 max(weight, vec3(1e-30));
     out_color = vec4(finite_term(MAT.weights.z * l_ms), float(id));
+    out_copy = out_color;
 }

@@ -9,9 +9,12 @@
 // gather's sampling noise where the medium is clear (the wax candles of `showcase-layered`).
 // A medium whose narrowest channel diffuses over fewer than BLUR_FULL_KERNEL_PX pixels is
 // blurred less, and not at all under BLUR_NO_KERNEL_PX: its term has detail at the scale of
-// the blur (jade's red), which a blur would wash out. Set 0 as glsl/common/layered.glsl, then
-// the term (binding 5: rgb the weighted term, alpha the material ID). With LUCENT_HALF_GATHER
-// the term is at half resolution and texel k holds pixel 2k.
+// the blur (jade's red), which a blur would wash out. The pass draws only over objects whose
+// medium reaches that at their nearest point (src/features/layered/mod.rs `blurs_on_screen`,
+// whose BLUR_MIN_KERNEL_TEXELS is the same number); elsewhere its target keeps the gather's
+// copy of the term. Set 0 as glsl/common/layered.glsl, then the term (binding 5: rgb the
+// weighted term, alpha the material ID). With LUCENT_HALF_GATHER the term is at half
+// resolution and texel k holds pixel 2k.
 #include "../common/layered.glsl"
 
 layout(set = 0, binding = 5) uniform sampler2D term_tex;

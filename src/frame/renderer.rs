@@ -14,7 +14,7 @@ use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::sss;
 use crate::gpu_scene::tiles::{
-    bounds_of, mesh_bounds, object_tiles, tile_rects, translucent_tiles,
+    bounds_of, mesh_bounds, object_tiles, object_tiles_at_depth, tile_rects, translucent_tiles,
 };
 use crate::gpu_scene::{FrameUniforms, SceneGpu, SlotTiles, FRAME};
 use crate::graph::{Executable, RenderGraph, ResourceId};
@@ -242,6 +242,21 @@ impl Renderer {
                 (layered.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)
             });
             tiles.layered = tile_rects(columns, &marked, width, height);
+            // The term's blur only over objects whose medium it acts on at their distance.
+            let focal_px = scene.camera.focal_px(height);
+            let texel_px = if self.settings.layered.half_gather {
+                2.0
+            } else {
+                1.0
+            };
+            let (columns, _, marked) =
+                object_tiles_at_depth(scene, mesh_bounds, width, height, |i, _, nearest| {
+                    let id = usize::from(layered.object_ids.get(i).copied().unwrap_or(0));
+                    let medium = layered.materials.get(id.checked_sub(1)?)?;
+                    crate::features::layered::blurs_on_screen(medium, nearest, focal_px, texel_px)
+                        .then_some(0.0)
+                });
+            tiles.layered_blur = tile_rects(columns, &marked, width, height);
         }
         *per_frame.tiles(slot) = tiles;
         Ok(())

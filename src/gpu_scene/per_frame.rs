@@ -156,6 +156,9 @@ pub struct SlotTiles {
     /// The layered passes' rectangles, marked where layered objects may be (frames with
     /// layered materials).
     pub layered: Vec<TileRect>,
+    /// The multiple-scattering term's blur's rectangles: marked where layered objects whose
+    /// medium the blur acts on at their distance may be (none: the blur draws nothing).
+    pub layered_blur: Vec<TileRect>,
 }
 
 /// A binding of one region of the per-frame buffer: a dynamic uniform buffer whose offset the

@@ -43,6 +43,21 @@ pub fn object_tiles(
     height: u32,
     reach: impl Fn(usize, &crate::scene::Object) -> Option<f32>,
 ) -> (u32, u32, Vec<bool>) {
+    object_tiles_at_depth(scene, bounds, width, height, |i, object, _| {
+        reach(i, object)
+    })
+}
+
+/// [`object_tiles`] for a `reach` that also depends on how near the object comes to the eye:
+/// its third argument is the view depth of the nearest corner of the object's box (scene
+/// units; 0 when the box reaches the eye's plane).
+pub fn object_tiles_at_depth(
+    scene: &Scene,
+    bounds: &[(Vec3, Vec3)],
+    width: u32,
+    height: u32,
+    reach: impl Fn(usize, &crate::scene::Object, f32) -> Option<f32>,
+) -> (u32, u32, Vec<bool>) {
     let (columns, rows) = (width.div_ceil(TILE_SIZE), height.div_ceil(TILE_SIZE));
     let mut tiles = vec![false; (columns * rows) as usize];
     let aspect = width as f32 / height.max(1) as f32;
@@ -50,9 +65,6 @@ pub fn object_tiles(
     let focal_px = scene.camera.focal_px(height);
     let max_margin = 0.25 * width.max(height) as f32;
     for (index, object) in scene.objects.iter().enumerate() {
-        let Some(reach_world) = reach(index, object) else {
-            continue;
-        };
         let (lo, hi) = bounds[object.mesh];
         let clip_from_object = view_proj * object.transform;
         let corners = (0..8).map(|i| {
@@ -69,6 +81,14 @@ pub fn object_tiles(
         if behind == corners.len() {
             continue;
         }
+        let nearest = if behind == 0 {
+            corners.iter().fold(f32::MAX, |m, c| m.min(c.w))
+        } else {
+            0.0
+        };
+        let Some(reach_world) = reach(index, object, nearest) else {
+            continue;
+        };
         // A box crossing the near plane covers the whole screen.
         let (mut min, mut max) = (glam::Vec2::splat(-1.0), glam::Vec2::splat(1.0));
         if behind == 0 {
@@ -77,7 +97,6 @@ pub fn object_tiles(
                 (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN)),
                 |(lo, hi), p| (lo.min(p), hi.max(p)),
             );
-            let nearest = corners.iter().fold(f32::MAX, |m, c| m.min(c.w));
             // Guarded: a non-finite reach counts as the largest.
             let margin = (reach_world * focal_px / nearest).clamp(0.0, max_margin);
             let margin = if margin.is_finite() {

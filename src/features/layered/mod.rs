@@ -342,13 +342,12 @@ pub fn layered_passes(
         // Full-resolution gather: the term per pixel (alpha: its material), rotated by one of
         // nine angles per 3x3 block; single scattering then adds its own terms and the term
         // averaged over 3x3 pixels (glsl/common/layered_upsample.glsl): no grain in a still.
-        let mut term = graph.create_image(
-            "layered.multiple",
-            ImageInfo {
-                format: IRRADIANCE_FORMAT,
-                ..info
-            },
-        );
+        let term_info = ImageInfo {
+            format: IRRADIANCE_FORMAT,
+            ..info
+        };
+        let mut term = graph.create_image("layered.multiple", term_info);
+        let mut blurred = graph.create_image("layered.multiple-blurred", term_info);
         let mut pass = layered_pass(
             graph,
             Kind::Multiple,
@@ -359,9 +358,10 @@ pub fn layered_passes(
             scene,
         );
         // Cleared: pixels outside the rectangles read material 0, which the resolve skips.
-        pass.color(&mut term, LoadOp::Clear([0.0; 4]));
+        pass.color(&mut term, LoadOp::Clear([0.0; 4]))
+            .color(&mut blurred, LoadOp::Clear([0.0; 4]));
         pass.finish();
-        let term = term_blur(graph, inputs, 1, &term, scene);
+        let term = term_blur(graph, inputs, 1, &term, blurred, scene);
         let mut pass = layered_pass(graph, Kind::Single, inputs, 1, None, Some(&term), scene);
         pass.color_add(&mut hdr, LoadOp::Load);
         pass.finish();
@@ -369,14 +369,13 @@ pub fn layered_passes(
     }
     // Half-resolution gather: the term per 2x2 block (alpha: its material) first, then single
     // scattering adds its own terms and the upsampled one (glsl/common/layered_upsample.glsl).
-    let mut half_term = graph.create_image(
-        "layered.multiple",
-        ImageInfo {
-            width: info.width.div_ceil(2),
-            height: info.height.div_ceil(2),
-            format: IRRADIANCE_FORMAT,
-        },
-    );
+    let half_info = ImageInfo {
+        width: info.width.div_ceil(2),
+        height: info.height.div_ceil(2),
+        format: IRRADIANCE_FORMAT,
+    };
+    let mut half_term = graph.create_image("layered.multiple", half_info);
+    let mut blurred = graph.create_image("layered.multiple-blurred", half_info);
     let mut pass = layered_pass(
         graph,
         Kind::HalfGather,
@@ -387,9 +386,10 @@ pub fn layered_passes(
         scene,
     );
     // Cleared: texels outside the rectangles read material 0, which the upsample skips.
-    pass.color(&mut half_term, LoadOp::Clear([0.0; 4]));
+    pass.color(&mut half_term, LoadOp::Clear([0.0; 4]))
+        .color(&mut blurred, LoadOp::Clear([0.0; 4]));
     pass.finish();
-    let half_term = term_blur(graph, inputs, 2, &half_term, scene);
+    let half_term = term_blur(graph, inputs, 2, &half_term, blurred, scene);
     let mut pass = layered_pass(
         graph,
         Kind::Single,
@@ -404,24 +404,49 @@ pub fn layered_passes(
     hdr
 }
 
-/// Declares `multiple scattering blur`: the term gathered at `1 / scale` of the screen per side,
-/// each texel of a medium that diffuses far on screen replaced by the mean of the 3x3 texels
-/// of its material and depth around it (glsl/layered/term_blur.frag), which single scattering
-/// then resolves. Returns the blurred term, the same size and format.
+/// Declares `multiple scattering blur`: the term gathered at `1 / scale` of the screen per
+/// side, each texel of a medium that diffuses far on screen replaced by the mean of the 3x3
+/// texels of its material and depth around it (glsl/layered/term_blur.frag), written over
+/// `blurred`, the gather's second copy of the term, which single scattering then resolves. It
+/// draws only the rectangles of objects whose medium can be blurred this frame
+/// ([`blurs_on_screen`]); elsewhere `blurred` keeps the gather's copy, and a frame with no such
+/// object draws nothing. Returns `blurred`.
 fn term_blur(
     graph: &mut RenderGraph,
     inputs: &LayeredInputs<'_>,
     scale: u32,
     term: &Handle<Image>,
+    mut blurred: Handle<Image>,
     scene: Option<&Arc<SceneGpu>>,
 ) -> Handle<Image> {
-    let info = graph.resources()[term.id()].info;
-    let mut blurred = graph.create_image("layered.multiple-blurred", info);
     let mut pass = layered_pass(graph, Kind::Blur, inputs, scale, Some(term), None, scene);
-    // Cleared: texels outside the rectangles read material 0, which the resolve skips.
-    pass.color(&mut blurred, LoadOp::Clear([0.0; 4]));
+    pass.color(&mut blurred, LoadOp::Load);
     pass.finish();
     blurred
+}
+
+/// The narrowest channel's diffusion length `1 / sigma_tr` on screen, in the gather's texels,
+/// from which the term's blur starts to act (glsl/layered/term_blur.frag `BLUR_NO_KERNEL_PX`
+/// is this times the texel's pixels: keep the two equal); it acts fully from twice this.
+pub const BLUR_MIN_KERNEL_TEXELS: f32 = 6.0;
+
+/// Whether the term's blur acts anywhere on an object of `medium` whose nearest point is
+/// `nearest_depth` (view depth, scene units; 0 or less: it reaches the eye) from the eye, with
+/// `focal_px` the focal length in pixels and `texel_px` the gather's texel size in pixels (1
+/// or 2): its narrowest channel's diffusion length, at that depth, spans at least
+/// [`BLUR_MIN_KERNEL_TEXELS`] texels.
+pub fn blurs_on_screen(
+    medium: &LayeredMedium,
+    nearest_depth: f32,
+    focal_px: f32,
+    texel_px: f32,
+) -> bool {
+    // At or behind the eye's plane (or not a number): the object may come arbitrarily close.
+    if nearest_depth.is_nan() || nearest_depth <= 0.0 {
+        return true;
+    }
+    let sigma_max = medium.dipole_constants().sigma_tr.max_element().max(1e-12);
+    focal_px / (nearest_depth * sigma_max) >= BLUR_MIN_KERNEL_TEXELS * texel_px
 }
 
 /// Starts a layered pass of `kind` at `1 / scale` of the screen per side, reading the gather's
@@ -516,7 +541,12 @@ fn layered_pass<'g>(
         _ => {}
     }
     pass.tiles(move |scene, ctx| {
-        let rects = scene.per_frame.tiles(ctx.frame).layered.clone();
+        let tiles = scene.per_frame.tiles(ctx.frame);
+        let rects = if kind == Kind::Blur {
+            tiles.layered_blur.clone()
+        } else {
+            tiles.layered.clone()
+        };
         Some(
             rects
                 .iter()
@@ -812,6 +842,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_terms_blur_acts_where_the_narrowest_channel_spans_six_texels() {
+        // skin1 at 0.04 units/mm: its largest sigma_tr (blue) makes 1 / sigma_tr about 0.7 mm,
+        // 0.027 units: at 3 units from a 1000-pixel focal length, 4.5 half-resolution texels.
+        let skin1 = LayeredMedium::preset("skin1").unwrap();
+        assert!(!blurs_on_screen(&skin1, 3.0, 1000.0, 2.0));
+        // The same medium right at the eye, or a box crossing the eye's plane, is blurred.
+        assert!(blurs_on_screen(&skin1, 0.0, 1000.0, 2.0));
+        assert!(blurs_on_screen(&skin1, -1.0, 1000.0, 2.0));
+        // The threshold: exactly six texels of diffusion length.
+        let sigma_max = skin1.dipole_constants().sigma_tr.max_element();
+        let depth = 1000.0 / (sigma_max * BLUR_MIN_KERNEL_TEXELS * 2.0);
+        assert!(blurs_on_screen(&skin1, depth * 0.99, 1000.0, 2.0));
+        assert!(!blurs_on_screen(&skin1, depth * 1.01, 1000.0, 2.0));
+        // Full-resolution texels are half as wide: the same depth is blurred.
+        assert!(blurs_on_screen(&skin1, depth * 1.01, 1000.0, 1.0));
+        // A medium that absorbs nothing (sigma_tr 0) is blurred at any distance, finitely.
+        let mut clear = skin1.clone();
+        for layer in &mut clear.layers {
+            layer.sigma_a = glam::Vec3::ZERO;
+        }
+        assert!(blurs_on_screen(&clear, 1e6, 1000.0, 2.0));
     }
 
     #[test]

@@ -47,8 +47,9 @@ pub const LAYERED_PASSES: [&str; 3] = [
 /// term is multiple scattering's (it runs only to finish that term).
 const COLUMN_EXTRAS: [(&str, &str); 1] = [("multiple scattering", "multiple scattering blur")];
 
-/// The median of pass `column` in `m` plus those of the passes [`COLUMN_EXTRAS`] adds to it
-/// (each when the frame has it); `None` when the frame has no `column` pass.
+/// The median of pass `column` in `m` plus those of the passes counted with it (multiple
+/// scattering's with `multiple scattering blur`, each when the frame has it); `None` when the
+/// frame has no `column` pass.
 pub fn column_ms(m: &Measured, column: &str) -> Option<f64> {
     let extras: f64 = COLUMN_EXTRAS
         .iter()

@@ -28,6 +28,7 @@ use crate::measure::stats::Stats;
 use crate::reference::sss::{edge_metrics, reference_image, EdgeMetrics, ReferenceSpecular};
 use crate::report::plot::{write_scatter_png, PlotPoint, PlotSeries};
 use crate::report::section::ReportOptions;
+use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::profile::fit_profile;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -194,6 +195,27 @@ pub fn sss_variants() -> Vec<SssVariant> {
         name: "burley without rotation".into(),
         settings: fixed,
     });
+    let mut half_res = base(burley);
+    half_res.sss.burley_half_res = true;
+    v.push(SssVariant {
+        knob: "Burley resolution",
+        name: "burley half resolution".into(),
+        settings: half_res,
+    });
+    // Each texturing mode beside the default (post), every material forced to it; the
+    // reference applies the albedo the same way.
+    for (name, texturing) in Texturing::ALL {
+        if texturing == Texturing::default() {
+            continue;
+        }
+        let mut s = base(burley);
+        s.sss.texturing = Some(texturing);
+        v.push(SssVariant {
+            knob: "Burley texturing",
+            name: format!("burley texturing {name}"),
+            settings: s,
+        });
+    }
     v
 }
 
@@ -264,8 +286,26 @@ pub fn run(
         .sss
         .and_then(|s| s.profiles.into_iter().next())
         .ok_or_else(|| LucentError::InvalidInput("the edges scene has no SSS profile".into()))?;
-    // Specular is off on the SSS objects: both specular models add nothing there.
-    let reference = reference_image(&edges, &gbuffer, &profile, ReferenceSpecular::Lean);
+    // Specular is off on the SSS objects: both specular models add nothing there. One
+    // reference per texturing mode the variants use (the profile's own unless a variant
+    // forces every material's), the albedo applied as that mode says.
+    let mut references: Vec<(Texturing, Vec<glam::DVec3>)> = Vec::new();
+    let mut reference_for = |texturing: Texturing| {
+        if let Some(i) = references.iter().position(|(t, _)| *t == texturing) {
+            return i;
+        }
+        let profile = SssProfile {
+            texturing,
+            ..profile.clone()
+        };
+        let image = reference_image(&edges, &gbuffer, &profile, ReferenceSpecular::Lean);
+        references.push((texturing, image));
+        references.len() - 1
+    };
+    let reference_of: Vec<usize> = variants
+        .iter()
+        .map(|v| reference_for(v.settings.sss.texturing.unwrap_or(profile.texturing)))
+        .collect();
     let strength = gbuffer.sss.clone().unwrap_or_default();
     let plain = render_frame(
         gpu,
@@ -280,7 +320,8 @@ pub fn run(
     .hdr
     .unwrap_or_default();
     let mut errors = Vec::with_capacity(variants.len());
-    for v in variants {
+    for (v, &r) in variants.iter().zip(&reference_of) {
+        let reference = &references[r].1;
         let settings = FrameSettings {
             export_hdr: true,
             ..sized(&v.settings, ew, eh)
@@ -288,7 +329,7 @@ pub fn run(
         let hdr = render_frame(gpu, shaders, cache, &edges, settings)?
             .hdr
             .unwrap_or_default();
-        let m = edge_metrics(ew as usize, &strength, &plain, &hdr, &reference, 2);
+        let m = edge_metrics(ew as usize, &strength, &plain, &hdr, reference, 2);
         let n = (m.edge_pixels + m.interior_pixels).max(1) as f64;
         let mean =
             (m.edge_error * m.edge_pixels as f64 + m.interior_error * m.interior_pixels as f64) / n;
@@ -392,7 +433,11 @@ pub fn markdown(results: &[SssResult], opts: &ReportOptions, device: &str) -> St
     out.push_str(
         "\nRatios are against the control (Jimenez, d'Eon's six Gaussians) measured in the same \
          run. Silhouette band: scattering pixels within 2 pixels of a non-scattering one (where \
-         background light bleeds in); halo: non-scattering pixels the SSS passes changed.\n",
+         background light bleeds in); halo: non-scattering pixels the SSS passes changed. \
+         Texturing rows: the `edges` scene's albedo is uniform, so where the albedo meets the \
+         blur changes the picture there only by rounding and the rows differ in time; what \
+         each mode does to a texture is measured on `showcase-marble`'s veins (docs/sss.md, \
+         \"Albedo after the scatter\").\n",
     );
     out
 }

@@ -114,7 +114,7 @@ pub static TEXTURING: Knob = Knob {
     flag: "--sss-texturing",
     help: "Every screen-space SSS material: where its albedo (texture included) is applied: \
            post (after the blur), pre-post (its square root before and after) or pre (blurred \
-           with the light: textures smear). Default: each material's `texturing` (pre-post \
+           with the light: textures smear). Default: each material's `texturing` (post \
            unless it says otherwise).",
     takes: Takes::Choice(&["pre", "post", "pre-post"]),
     default: None,

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::features::sss::SssPrecision;
+use crate::features::sss::{SssKnobs, SssPrecision};
 use crate::frame::{render_frame, FrameDesc, FrameSettings, Technique};
 use crate::measure::round_robin::{self, IfUnbuildable};
 use crate::measure::stats::Stats;
@@ -178,43 +178,40 @@ pub fn sss_variants() -> Vec<SssVariant> {
         settings: half_res,
     });
     let burley = Technique::Only(&crate::features::sss::burley::BURLEY);
+    // Burley with one knob turned: the row's knob, its name and the turn.
+    let mut burley_with = |knob, name: String, turn: &dyn Fn(&mut SssKnobs)| {
+        let mut settings = base(burley);
+        turn(&mut settings.sss);
+        v.push(SssVariant {
+            knob,
+            name,
+            settings,
+        });
+    };
     // Each budget beside the default (8).
     for budget in [4, 20, 40] {
-        let mut s = base(burley);
-        s.sss.burley_budget = budget;
-        v.push(SssVariant {
-            knob: "Burley sample budget",
-            name: format!("burley budget {budget}"),
-            settings: s,
-        });
+        burley_with(
+            "Burley sample budget",
+            format!("burley budget {budget}"),
+            &|k| k.burley_budget = budget,
+        );
     }
-    let mut fixed = base(burley);
-    fixed.sss.burley_rotation = false;
-    v.push(SssVariant {
-        knob: "Burley rotation",
-        name: "burley without rotation".into(),
-        settings: fixed,
+    burley_with("Burley rotation", "burley without rotation".into(), &|k| {
+        k.burley_rotation = false
     });
-    let mut half_res = base(burley);
-    half_res.sss.burley_half_res = true;
-    v.push(SssVariant {
-        knob: "Burley resolution",
-        name: "burley half resolution".into(),
-        settings: half_res,
+    burley_with("Burley resolution", "burley half resolution".into(), &|k| {
+        k.burley_half_res = true
     });
     // Each texturing mode beside the default (post), every material forced to it; the
     // reference applies the albedo the same way.
     for (name, texturing) in Texturing::ALL {
-        if texturing == Texturing::default() {
-            continue;
+        if texturing != Texturing::default() {
+            burley_with(
+                "Burley texturing",
+                format!("burley texturing {name}"),
+                &|k| k.texturing = Some(texturing),
+            );
         }
-        let mut s = base(burley);
-        s.sss.texturing = Some(texturing);
-        v.push(SssVariant {
-            knob: "Burley texturing",
-            name: format!("burley texturing {name}"),
-            settings: s,
-        });
     }
     v
 }

@@ -80,6 +80,59 @@ float shadow_device_depth(vec4 params, float z) {
     return far * (z - near) / (max(z, 1e-12) * range);
 }
 
+// A map texel's world size at `p` on face `face`: how far a lookup moves to step one texel.
+float map_texel_size(int face, vec3 p) {
+    vec4 clip = shadows.faces[face].view_proj * vec4(p, 1.0);
+    return shadows.faces[face].params.x * abs(clip.w) + shadows.faces[face].params.y;
+}
+
+// Where `p` falls in face `face`'s map: its atlas position `t` in texels (texel k's centre at
+// k + 0.5) and its distance along the face's axis; false outside the face's cone (w <= 0
+// would divide by zero) or map.
+bool map_position(int face, vec3 p, out vec2 t, out float distance) {
+    vec4 clip = shadows.faces[face].view_proj * vec4(p, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
+          ndc.z <= 1.0)) {
+        return false;
+    }
+    t = shadows.faces[face].rect.xy + (ndc.xy * 0.5 + 0.5) * shadows.faces[face].rect.z;
+    distance = shadow_distance(shadows.faces[face].params, ndc.z);
+    return true;
+}
+
+// The texel of face `face`'s tile nearest atlas position `t`.
+ivec2 map_texel(int face, vec2 t) {
+    vec4 rect = shadows.faces[face].rect;
+    ivec2 lo = ivec2(rect.xy);
+    return clamp(ivec2(t), lo, lo + ivec2(rect.z) - 1);
+}
+
+// The 2x2 texels of face `face`'s tile whose centres surround atlas position `t` (kept inside
+// the tile): the textureGather coordinate that returns them and their bilinear weights, in
+// gather order (x0 y1, x1 y1, x1 y0, x0 y0).
+void map_bilinear(int face, vec2 t, out vec2 corner, out vec4 weights) {
+    vec4 rect = shadows.faces[face].rect;
+    vec2 c = clamp(t - 0.5, rect.xy, rect.xy + rect.z - 1.001);
+    vec2 base = floor(c);
+    corner = (base + 1.0) * shadows.atlas.zw;
+    vec2 f = c - base;
+    weights = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+}
+
+// Where light `light`'s ray to `p` (at distance `d_p` along face `face`'s axis) meets a
+// surface the map holds at distance `d_map`: along the light's direction on an orthographic
+// (directional) face; on a perspective one, on the ray from the light, where axial distances
+// scale with the distance from it (d_p > 0 there; the max guards a point on the light's eye).
+// A point nearer than the surface is its own entry point.
+vec3 map_entry_point(int face, int light, vec3 p, vec3 to_light, float d_p, float d_map) {
+    if (shadows.faces[face].params.z < 0.0) {
+        return p + to_light * max(d_p - d_map, 0.0);
+    }
+    vec3 l = frame.lights[light].position_type.xyz;
+    return l + (p - l) * min(d_map / max(d_p, 1e-12), 1.0);
+}
+
 // How much of `light` reaches `pos` (normal `normal`, towards the light `to_light`): x for light
 // reflected at the surface, y for light transmitted through translucency material `material`
 // (GDC 2011: occluders of the pixel's own material do not shadow it; material 0 = not

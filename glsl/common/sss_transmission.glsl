@@ -48,58 +48,43 @@ vec3 sss_transmittance(int id, float a) {
 // changes), the entry point P' the texel's depth gives on the segment towards the light, the
 // light's radiance x falloff there, times the transmittance through |P' - pos|, times the
 // back-facing cosine max(-n . l, 0) (the entry's cosine for a slab, HDRP's "thick" mode).
-// As layered.glsl's transmitted_light, the lookup is made from a point one map texel inside,
-// so the flat facets near the terminator do not find themselves at thickness 0. Lights without
+// As Li et al.'s transmitted_light (glsl/layered/single.frag, which shares these map lookups:
+// shadows.glsl's map_*), the lookup is made from a point one map texel inside, so the flat
+// facets near the terminator do not find themselves at thickness 0. Lights without
 // a map, and points outside it, transmit nothing (nothing measures the thickness).
 vec3 sss_transmitted(int id, int i, vec3 pos, vec3 normal, vec3 to_light) {
     float back = -dot(normal, to_light);
-    int index = shadow_face(i, pos);
-    if (!(back > 0.0) || index < 0) {
+    int face = shadow_face(i, pos);
+    if (!(back > 0.0) || face < 0) {
         return vec3(0.0);
     }
-#define FACE shadows.faces[index]
-    vec4 clip = FACE.view_proj * vec4(pos, 1.0);
-    float texel_size = FACE.params.x * abs(clip.w) + FACE.params.y;
-    vec3 inner = pos - normal * texel_size;
-    clip = FACE.view_proj * vec4(inner, 1.0);
-    // Outside the face's cone or map (w <= 0 would divide by zero): nothing measured.
-    if (!(clip.w > 0.0)) {
+    vec3 inner = pos - normal * map_texel_size(face, pos);
+    vec2 t;
+    float d_x;
+    // Outside the face's cone or map: nothing measured.
+    if (!map_position(face, inner, t, d_x)) {
         return vec3(0.0);
     }
-    vec3 ndc = clip.xyz / clip.w;
-    if (!(all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 && ndc.z <= 1.0)) {
-        return vec3(0.0);
-    }
-    float d_x = shadow_distance(FACE.params, ndc.z);
-    vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
-    vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
-    vec2 base = floor(c);
-    vec4 d = textureGather(shadow_depth, (base + 1.0) * shadows.atlas.zw, 0);
-    vec2 f = c - base;
-    // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
-    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+    vec2 corner;
+    vec4 w;
+    map_bilinear(face, t, corner, w);
+    vec4 d = textureGather(shadow_depth, corner, 0);
     Light light = frame.lights[i];
-    vec3 l = light.position_type.xyz;
-    bool orthographic = FACE.params.z < 0.0;
     vec3 sum = vec3(0.0);
     for (int k = 0; k < 4; ++k) {
         // Depth 1: nothing between the light and the far plane there.
         if (!(d[k] < 1.0)) {
             continue;
         }
-        float d_map = shadow_distance(FACE.params, d[k]);
-        // The first surface the light meets on its way to `inner`: along the light's
-        // direction (orthographic) or on the ray from the light (perspective; d_x > 0 there,
-        // the max guards a point on the light's eye).
-        vec3 p_in = orthographic ? inner + to_light * max(d_x - d_map, 0.0)
-                                 : l + (inner - l) * min(d_map / max(d_x, 1e-12), 1.0);
+        // The first surface the light meets on its way to `inner`.
+        vec3 p_in = map_entry_point(face, i, inner, to_light, d_x,
+                                    shadow_distance(shadows.faces[face].params, d[k]));
         vec3 unused;
         float attenuation;
         light_incidence(light, p_in, unused, attenuation);
         sum += (w[k] * attenuation) * sss_transmittance(id, length(p_in - pos));
     }
     return sum * (back * light.radiance_range.rgb);
-#undef FACE
 }
 
 #endif

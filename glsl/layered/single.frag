@@ -68,71 +68,49 @@ bool light_entry_plane(vec3 m, vec3 to_light, vec3 x_o, vec3 n_o, uvec4 texels_o
 bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, uvec4 texels_o,
                  out vec3 p_in, out vec3 n_in, out uvec4 texels_in) {
 #ifdef LUCENT_ENTRY_BINDING
-    int index = shadow_face(i, m);
-    if (index >= 0) {
-        // Read through the table (a local copy of the face would spill on llvmpipe).
-#define FACE shadows.faces[index]
-        vec4 clip = FACE.view_proj * vec4(m, 1.0);
-        vec3 ndc = clip.xyz / clip.w;
-        if (clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
-            ndc.z <= 1.0) {
-            vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
-            ivec2 lo = ivec2(FACE.rect.xy);
-            ivec2 texel = clamp(ivec2(t), lo, lo + ivec2(FACE.rect.z) - 1);
-            vec4 entry = texelFetch(shadow_entry, texel, 0);
-            // The entry distance, interpolated bilinearly between the four texel centres
-            // around t where all four are this material's surface (a nearest texel's
-            // staircase is a tenth of a millimetre at 512^2, as thick as a skin layer);
-            // else the nearest texel's. The entry target is not cleared: a texel no surface
-            // was drawn into (depth 1) has no entry data.
-            vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
-            vec2 base = floor(c);
-            vec2 corner = (base + 1.0) * shadows.atlas.zw;
-            vec4 d = textureGather(shadow_depth, corner, 0);
-            vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
-            float d_map;
-            if (all(lessThan(abs(ids - float(id)), vec4(0.5))) && all(lessThan(d, vec4(1.0)))) {
-                vec2 f = c - base;
-                // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
-                vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y),
-                              (1.0 - f.x) * (1.0 - f.y));
-                d_map = dot(w, vec4(shadow_distance(FACE.params, d.x),
-                                    shadow_distance(FACE.params, d.y),
-                                    shadow_distance(FACE.params, d.z),
-                                    shadow_distance(FACE.params, d.w)));
-                // The normal too, with the same weights: the nearest texel's changed at
-                // every texel edge, a staircase in the Fresnel transmittance into the medium
-                // (issue 25: part of the structure the grain metric counted).
-                entry.xyz = vec3(dot(w, textureGather(shadow_entry, corner, 0)),
-                                 dot(w, textureGather(shadow_entry, corner, 1)),
-                                 dot(w, textureGather(shadow_entry, corner, 2)));
-            } else {
-                float raw = texelFetch(shadow_depth, texel, 0).r;
-                if (raw >= 1.0) {
-                    return light_entry_plane(m, to_light, x_o, n_o, texels_o, p_in, n_in,
-                                             texels_in);
-                }
-                if (int(entry.a * 255.0 + 0.5) != id) {
-                    texels_in = texels_o;
-                    return false; // another material's surface is first: blocked
-                }
-                d_map = shadow_distance(FACE.params, raw);
+    int face = shadow_face(i, m);
+    vec2 t;
+    float d_m;
+    if (face >= 0 && map_position(face, m, t, d_m)) {
+        ivec2 texel = map_texel(face, t);
+        vec4 entry = texelFetch(shadow_entry, texel, 0);
+        // The entry distance, interpolated bilinearly between the four texel centres around t
+        // where all four are this material's surface (a nearest texel's staircase is a tenth
+        // of a millimetre at 512^2, as thick as a skin layer); else the nearest texel's. The
+        // entry target is not cleared: a texel no surface was drawn into (depth 1) has no
+        // entry data.
+        vec2 corner;
+        vec4 w;
+        map_bilinear(face, t, corner, w);
+        vec4 d = textureGather(shadow_depth, corner, 0);
+        vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
+        vec4 params = shadows.faces[face].params;
+        float d_map;
+        if (all(lessThan(abs(ids - float(id)), vec4(0.5))) && all(lessThan(d, vec4(1.0)))) {
+            d_map = dot(w, vec4(shadow_distance(params, d.x), shadow_distance(params, d.y),
+                                shadow_distance(params, d.z), shadow_distance(params, d.w)));
+            // The normal too, with the same weights: the nearest texel's changed at every
+            // texel edge, a staircase in the Fresnel transmittance into the medium (issue 25:
+            // part of the structure the grain metric counted).
+            entry.xyz = vec3(dot(w, textureGather(shadow_entry, corner, 0)),
+                             dot(w, textureGather(shadow_entry, corner, 1)),
+                             dot(w, textureGather(shadow_entry, corner, 2)));
+        } else {
+            float raw = texelFetch(shadow_depth, texel, 0).r;
+            if (raw >= 1.0) {
+                return light_entry_plane(m, to_light, x_o, n_o, texels_o, p_in, n_in,
+                                         texels_in);
             }
-            float d_m = shadow_distance(FACE.params, ndc.z);
-            if (FACE.params.z < 0.0) {
-                // Orthographic (directional): distances run along the light's direction.
-                p_in = m + to_light * max(d_m - d_map, 0.0);
-            } else {
-                // Perspective: axial distances scale with the distance along the ray from
-                // the light; a point nearer than the map's surface is its own entry point.
-                vec3 l = frame.lights[i].position_type.xyz;
-                p_in = l + (m - l) * min(d_map / max(d_m, 1e-12), 1.0);
+            if (int(entry.a * 255.0 + 0.5) != id) {
+                texels_in = texels_o;
+                return false; // another material's surface is first: blocked
             }
-            n_in = sanitize_normal(entry.xyz * 2.0 - 1.0);
-            texels_in = entry_texels(texel, texels_o);
-            return true;
-#undef FACE
+            d_map = shadow_distance(params, raw);
         }
+        p_in = map_entry_point(face, i, m, to_light, d_m, d_map);
+        n_in = sanitize_normal(entry.xyz * 2.0 - 1.0);
+        texels_in = entry_texels(texel, texels_o);
+        return true;
     }
 #endif
     return light_entry_plane(m, to_light, x_o, n_o, texels_o, p_in, n_in, texels_in);
@@ -175,35 +153,28 @@ float unseen_entry(vec3 p, vec3 n) {
 vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float eta, int mat,
                        uvec4 texels_o) {
 #ifdef LUCENT_ENTRY_BINDING
-    int index = shadow_face(i, x_o);
-    if (index < 0) {
+    int face = shadow_face(i, x_o);
+    if (face < 0) {
         return vec3(0.0);
     }
-#define FACE shadows.faces[index]
-    vec4 clip = FACE.view_proj * vec4(x_o, 1.0);
     // Near the terminator the mesh's flat facets can face the light where the interpolated
     // normal does not: the map's first surface is then x_o's own facet, a thickness of ~0 and
     // a bright hatching along the facets. So the lookup is made from a point one map texel
     // inside (as shadow lookups move out), whose ray to the light gives the entry point, and
     // the term fades in over the first 3 texels of thickness. (The cost: on the clear test
     // sphere the term comes out 8% high, against 3% from x_o itself, docs/layered.md.)
-    float texel_size = FACE.params.x * abs(clip.w) + FACE.params.y;
+    float texel_size = map_texel_size(face, x_o);
     vec3 inner = x_o - n_o * texel_size;
-    clip = FACE.view_proj * vec4(inner, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    float d_x = shadow_distance(FACE.params, ndc.z);
-    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
-          ndc.z <= 1.0)) {
+    vec2 t;
+    float d_x;
+    if (!map_position(face, inner, t, d_x)) {
         return vec3(0.0);
     }
-    vec2 t = FACE.rect.xy + (ndc.xy * 0.5 + 0.5) * FACE.rect.z;
-    ivec2 lo = ivec2(FACE.rect.xy);
-    ivec2 texel = clamp(ivec2(t), lo, lo + ivec2(FACE.rect.z) - 1);
     // The entry's layers as the nearest texel has them (the four filtered texels share them).
-    uvec4 texels_in = entry_texels(texel, texels_o);
-    vec2 c = clamp(t - 0.5, FACE.rect.xy, FACE.rect.xy + FACE.rect.z - 1.001);
-    vec2 base = floor(c);
-    vec2 corner = (base + 1.0) * shadows.atlas.zw;
+    uvec4 texels_in = entry_texels(map_texel(face, t), texels_o);
+    vec2 corner;
+    vec4 w;
+    map_bilinear(face, t, corner, w);
     vec4 d = textureGather(shadow_depth, corner, 0);
     vec4 ids = textureGather(shadow_entry, corner, 3) * 255.0;
     // Each texel's own entry normal (encoded n * 0.5 + 0.5): one normal for all four, the
@@ -213,18 +184,13 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
     vec4 normal_x = textureGather(shadow_entry, corner, 0);
     vec4 normal_y = textureGather(shadow_entry, corner, 1);
     vec4 normal_z = textureGather(shadow_entry, corner, 2);
-    vec2 f = c - base;
-    // Gather order: (x0 y1, x1 y1, x1 y0, x0 y0).
-    vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
-    vec3 l = frame.lights[i].position_type.xyz;
     vec3 sum = vec3(0.0);
     for (int k = 0; k < 4; ++k) {
         if (!(abs(ids[k] - float(id)) < 0.5 && d[k] < 1.0)) {
             continue;
         }
-        float d_map = shadow_distance(FACE.params, d[k]);
-        vec3 p_in = FACE.params.z < 0.0 ? inner + to_light * max(d_x - d_map, 0.0)
-                                        : l + (inner - l) * min(d_map / max(d_x, 1e-12), 1.0);
+        vec3 p_in = map_entry_point(face, i, inner, to_light, d_x,
+                                    shadow_distance(shadows.faces[face].params, d[k]));
         float thickness = length(p_in - x_o);
         float fade = smoothstep(0.0, 3.0 * texel_size, thickness);
         vec3 n_in = sanitize_normal(vec3(normal_x[k], normal_y[k], normal_z[k]) * 2.0 - 1.0);
@@ -241,7 +207,6 @@ vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float e
         sum += (w[k] * fade) * e * crossed;
     }
     return sum;
-#undef FACE
 #else
     return vec3(0.0);
 #endif

@@ -464,14 +464,12 @@ pub fn li_bench_beside(report: &BenchReport, triangles: u64, map_size: Option<u3
     let layered: Vec<&crate::measure::bench::PassRow> = report
         .passes
         .iter()
+        // Every layered pass (`contains`: multiple scattering's blur counts with it, as in
+        // `report li`).
         .filter(|p| {
-            [
-                "layered irradiance",
-                "single scattering",
-                "multiple scattering",
-            ]
-            .iter()
-            .any(|n| p.name.contains(n))
+            crate::report::li::LAYERED_PASSES
+                .iter()
+                .any(|n| p.name.contains(n))
         })
         .collect();
     let layered_ms: f64 = layered.iter().map(|p| p.median_ms).sum();

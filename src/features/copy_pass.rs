@@ -1,9 +1,15 @@
-//! The copy pass's shader (`glsl/bench/copy.frag`): a fullscreen pass that fetches one texel
-//! from each image it reads and writes every colour image (and depth) it has, nothing else:
-//! the cheapest pass that moves a given pass's bytes. The speed of light
-//! (`crate::measure::speed_of_light`, feature `measure`) puts one in place of each pass of a
-//! plan. Its defines and every permutation of them are here, with the passes, so the shipped
-//! SPIR-V ([`super::shipped`]) holds them whatever features the library is built with.
+//! The speed-of-light floors' shaders, of two kinds:
+//! - the copy (`glsl/bench/copy.frag`): a fullscreen pass that fetches one texel from each
+//!   image it reads and writes every colour image (and depth) it has, nothing else: the
+//!   cheapest pass that moves a given fullscreen pass's bytes;
+//! - the mesh floor (`glsl/bench/floor.vert`, `floor.frag`): the objects a mesh pass draws,
+//!   with its views, transformed by one matrix and writing a constant to each target: the
+//!   cheapest pass that draws a given mesh pass's geometry.
+//!
+//! The speed of light (`crate::measure::speed_of_light`, feature `measure`) puts them in
+//! place of each pass of a plan. Their defines and every permutation of them are here, with
+//! the passes, so the shipped SPIR-V ([`super::shipped`]) holds them whatever features the
+//! library is built with.
 
 use crate::backend::shader::PipelineShaders;
 
@@ -15,6 +21,10 @@ pub const MAX_COPY_INPUTS: usize = 10;
 
 /// The copy's fragment shader.
 pub const COPY_FRAGMENT: &str = "bench/copy.frag";
+/// The mesh floor's vertex shader.
+pub const FLOOR_VERTEX: &str = "bench/floor.vert";
+/// The mesh floor's fragment shader.
+pub const FLOOR_FRAGMENT: &str = "bench/floor.frag";
 
 /// Image counts as define strings (at most [`MAX_COPY_INPUTS`]).
 const COUNTS: [&str; MAX_COPY_INPUTS + 1] =
@@ -37,7 +47,17 @@ pub fn copy_defines(
     defines
 }
 
-/// The pipelines the copies of any plan's passes build (the speed of light leaves out passes
+/// The mesh floor's defines: colour targets written (at most [`MAX_COPY_IMAGES`]) and whether
+/// its views are light-space faces (else the camera).
+pub fn floor_defines(outputs: usize, shadow_faces: bool) -> Vec<(&'static str, &'static str)> {
+    let mut defines = vec![("LUCENT_FLOOR_OUTPUTS", COUNTS[outputs.min(MAX_COPY_IMAGES)])];
+    if shadow_faces {
+        defines.push(("LUCENT_FLOOR_SHADOW_FACES", "1"));
+    }
+    defines
+}
+
+/// The pipelines the floors of any plan's passes build (the speed of light leaves out passes
 /// with more images than the copy has).
 pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
     for inputs in 0..=MAX_COPY_INPUTS {
@@ -48,6 +68,15 @@ pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
                     &copy_defines(inputs, outputs, depth),
                 ));
             }
+        }
+    }
+    for outputs in 0..=MAX_COPY_IMAGES {
+        for shadow_faces in [false, true] {
+            out.push(PipelineShaders::new(
+                FLOOR_VERTEX,
+                FLOOR_FRAGMENT,
+                &floor_defines(outputs, shadow_faces),
+            ));
         }
     }
 }

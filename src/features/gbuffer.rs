@@ -13,8 +13,8 @@ use ash::vk;
 use crate::backend::shader::PipelineShaders;
 use crate::gpu_scene::{SceneGpu, FRAME};
 use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph,
+    Handle, Image, ImageInfo, LoadOp, MeshDraws, MeshViews, PassExec, PassKind, PrepareContext,
+    RecordContext, RenderGraph,
 };
 use crate::Result;
 
@@ -385,6 +385,12 @@ pub fn gbuffer_pass(
         pass.color(depths, LoadOp::DontCare);
     }
     pass.depth(&mut gb.depth, LoadOp::Clear([1.0; 4]));
+    // Every object once with the camera, back faces culled (the benchmark's floor draws the
+    // same).
+    pass.mesh_draws(MeshDraws {
+        views: MeshViews::Camera,
+        cull_back: true,
+    });
     match scene {
         Some(scene) => pass.execute(GBufferPass {
             scene: scene.clone(),

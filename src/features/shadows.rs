@@ -24,8 +24,8 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::graph::{
-    Handle, Image, ImageInfo, LoadOp, PassExec, PassKind, PrepareContext, RecordContext,
-    RenderGraph,
+    Handle, Image, ImageInfo, LoadOp, MeshDraws, MeshViews, PassExec, PassKind, PrepareContext,
+    RecordContext, RenderGraph,
 };
 use crate::scene::{LightKind, Scene, MAX_LIGHTS};
 use crate::Result;
@@ -394,6 +394,14 @@ pub fn shadow_pass(
         pass.color(depths, LoadOp::DontCare);
     }
     pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
+    // Every object into every face's tile, both sides (the benchmark's floor draws the same).
+    pass.mesh_draws(MeshDraws {
+        views: MeshViews::ShadowFaces {
+            origins: (0..desc.faces()).map(|f| desc.tile_origin(f)).collect(),
+            tile: desc.tile,
+        },
+        cull_back: false,
+    });
     match scene {
         Some(scene) => pass.execute(ShadowPass {
             scene: scene.clone(),

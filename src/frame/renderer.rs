@@ -344,6 +344,12 @@ impl Renderer {
         self.scene_gpu.as_ref().expect("alive until destroy")
     }
 
+    /// The scene's GPU meshes and per-frame buffer, shared (the benchmark's mesh floors draw
+    /// the same objects); `None` once destroyed.
+    pub(crate) fn scene_gpu_shared(&self) -> Option<&Arc<SceneGpu>> {
+        self.scene_gpu.as_ref()
+    }
+
     /// Reads lucent's own display image of the last frame: RGBA8, sRGB-encoded, tightly
     /// packed (a frame with a caller's target has none: the caller reads its image).
     pub fn read_display(&self, gpu: &GpuContext) -> Result<Vec<u8>> {

@@ -240,6 +240,7 @@ fn compile_plan(graph: &RenderGraph, options: CompileOptions) -> Result<Plan> {
             reads: decls[i].reads.clone(),
             writes: decls[i].writes.clone(),
             taps: decls[i].taps,
+            mesh: decls[i].mesh.clone(),
         })
         .collect();
 

@@ -115,6 +115,35 @@ pub enum PassKind {
     Transfer,
 }
 
+/// What a mesh pass draws, as its speed-of-light floor needs to know it
+/// ([`PassBuilder::mesh_draws`]): every object of the scene, once per view, with the pass's
+/// culling. The floor (`crate::measure::speed_of_light`) draws the same objects into the
+/// same attachments with a trivial shader, so a pass that draws each object twice, or shades
+/// each fragment twice as hard, is measured against what its geometry costs by itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshDraws {
+    /// Where the objects are drawn and with which matrix.
+    pub views: MeshViews,
+    /// Back faces are culled (the G-buffer) or not (the light-space maps: open meshes cast
+    /// from both sides).
+    pub cull_back: bool,
+}
+
+/// The views a mesh pass draws every object into.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshViews {
+    /// Once, with the camera's matrix, over the whole render area.
+    Camera,
+    /// Once per light-space face: the face's matrix from the shadow table, its viewport the
+    /// tile at `(x, y)` with edge `tile` texels (in face order).
+    ShadowFaces {
+        /// Each face's tile origin in the atlas, in texels.
+        origins: Vec<(u32, u32)>,
+        /// A tile's edge in texels.
+        tile: u32,
+    },
+}
+
 /// One read or write of one version of one resource.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Use {
@@ -143,6 +172,8 @@ pub struct PassDecl {
     /// Texture taps per shaded pixel, when the pass declares them ([`PassBuilder::taps`]);
     /// the benchmark's speed-of-light table counts one per image read otherwise.
     pub taps: Option<u32>,
+    /// What the pass draws, when it draws the scene's meshes ([`PassBuilder::mesh_draws`]).
+    pub mesh: Option<MeshDraws>,
     /// The code that records the pass; `None` in graph-only tests.
     pub exec: Option<Box<dyn PassExec>>,
 }
@@ -203,6 +234,7 @@ impl RenderGraph {
                 writes: Vec::new(),
                 side_effects: false,
                 taps: None,
+                mesh: None,
                 exec: None,
             },
         }
@@ -364,6 +396,14 @@ impl PassBuilder<'_> {
     /// without it, each image the pass reads counts as one tap.
     pub fn taps(&mut self, per_pixel: u32) -> &mut Self {
         self.decl.taps = Some(per_pixel);
+        self
+    }
+
+    /// Declares that the pass draws the scene's meshes, and how ([`MeshDraws`]): the
+    /// benchmark then holds it against the same draws with a trivial shader, instead of a
+    /// fullscreen copy of its bytes.
+    pub fn mesh_draws(&mut self, draws: MeshDraws) -> &mut Self {
+        self.decl.mesh = Some(draws);
         self
     }
 

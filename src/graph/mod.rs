@@ -46,7 +46,8 @@ pub mod plan;
 
 pub use compile::{CompileOptions, Plan};
 pub use declare::{
-    Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, PingPong, RenderGraph, ResourceId,
+    Handle, Image, ImageInfo, ImportedImage, LoadOp, MeshDraws, MeshViews, PassKind, PingPong,
+    RenderGraph, ResourceId,
 };
 pub use execute::{Executable, PrepareContext, RecordContext};
 

@@ -7,7 +7,7 @@ use ash::vk;
 
 use crate::backend::access::Access;
 
-use super::declare::{ImageInfo, PassKind, ResourceId, Use};
+use super::declare::{ImageInfo, MeshDraws, PassKind, ResourceId, Use};
 
 /// A pass that survived culling, in execution order.
 #[derive(Clone, Debug)]
@@ -24,6 +24,9 @@ pub struct PlannedPass {
     pub writes: Vec<Use>,
     /// Texture taps per pixel, when declared ([`super::declare::PassBuilder::taps`]).
     pub taps: Option<u32>,
+    /// What it draws, when it draws the scene's meshes
+    /// ([`super::declare::PassBuilder::mesh_draws`]).
+    pub mesh: Option<MeshDraws>,
 }
 
 /// One synchronisation2 barrier.

@@ -14,8 +14,9 @@
 //! instead and says so. If even those do not add up, the report is marked untrusted and the
 //! command exits non-zero.
 //!
-//! With a [`CopyFrame`] the same run also times every pass's
-//! speed-of-light copy, alternating with the frames, and the report gains the pass / copy table.
+//! With a [`FloorFrame`] the same run also times every pass's
+//! speed-of-light floor, alternating with the frames, and the report gains the pass / floor
+//! table.
 //! Output: [`BenchReport::markdown`], [`BenchReport::csv`], [`BenchReport::json`]. Runs longer
 //! than [`PROGRESS_AFTER_S`] show a progress bar on stderr when it is a terminal (without the
 //! `report` feature, log lines instead: [`crate::progress`]).
@@ -26,7 +27,7 @@ use serde::Serialize;
 
 use crate::backend::GpuContext;
 use crate::frame::{FrameRunner, FrameTiming, Renderer};
-use crate::measure::speed_of_light::{CopyFrame, FloorRow};
+use crate::measure::speed_of_light::{FloorFrame, FloorRow};
 use crate::measure::stats::Stats;
 use crate::progress::Progress;
 use crate::scene::Scene;
@@ -139,13 +140,44 @@ pub struct BenchReport {
     pub checks: Vec<Check>,
     /// Whether the reported numbers passed their checks.
     pub trusted: bool,
-    /// Each pass against its speed-of-light copy, when measured.
+    /// Each pass against its speed-of-light floor, when measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub speed_of_light: Option<Vec<FloorRow>>,
     /// A deforming scene: the CPU time per frame to deform its meshes and write them into
     /// the frame's vertex buffers, before the frame is submitted (not in `frame_ms`). Null
     /// for static scenes.
     pub deformation_ms: Option<Stats>,
+    /// With `--against`: the same scene under another technique, alternating frames with
+    /// this one, each pass's ratio ([`Comparison::against`]); in the JSON only when measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub against: Option<Against>,
+}
+
+/// A [`Comparison`] as the report's JSON carries it: each pass (and the frame) under both
+/// techniques, and the ratio of the benchmarked technique to the other.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Against {
+    /// The technique measured against (`--against`).
+    pub baseline: String,
+    /// The benchmarked technique.
+    pub technique: String,
+    /// Frames measured per side, alternating.
+    pub frames: usize,
+    /// Per physical pass, then `frame` (submit to fence).
+    pub passes: Vec<AgainstRow>,
+}
+
+/// One pass of an [`Against`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AgainstRow {
+    /// Physical pass name, or `frame`.
+    pub pass: String,
+    /// Median ms under the baseline technique (`None`: it has no such pass).
+    pub baseline_ms: Option<f64>,
+    /// Median ms under the benchmarked technique (`None`: it has no such pass).
+    pub technique_ms: Option<f64>,
+    /// `technique_ms / baseline_ms` when both exist.
+    pub ratio: Option<f64>,
 }
 
 /// The report formats `lucent bench --format` offers.
@@ -189,12 +221,12 @@ pub fn run(
     run_with_floor(gpu, renderer, None, scene, scene_name, options)
 }
 
-/// [`run`], and with `copies` (built from the renderer's plan) each pass's speed-of-light copy
-/// timed in the same run, one copy frame after each measured frame.
+/// [`run`], and with `copies` (built from the renderer's plan) each pass's speed-of-light floor
+/// timed in the same run, one floor frame after each measured frame.
 pub fn run_with_floor(
     gpu: &GpuContext,
     renderer: &Renderer,
-    copies: Option<&mut CopyFrame>,
+    copies: Option<&mut FloorFrame>,
     scene: &Scene,
     scene_name: &str,
     options: &BenchOptions,
@@ -290,7 +322,7 @@ fn measure(
     gpu: &GpuContext,
     renderer: &Renderer,
     runner: &mut FrameRunner,
-    mut copies: Option<&mut CopyFrame>,
+    mut copies: Option<&mut FloorFrame>,
     mut animation: Option<&mut Animation>,
     names: &[String],
     scene_name: &str,
@@ -383,6 +415,7 @@ fn measure(
         trusted: verdict.trusted,
         speed_of_light,
         deformation_ms: (!deformation_ms.is_empty()).then(|| Stats::of(&deformation_ms)),
+        against: None,
     })
 }
 
@@ -616,7 +649,7 @@ impl BenchReport {
             ));
         }
         if let Some(rows) = &self.speed_of_light {
-            out.push_str("\n### Speed of light: each pass against a copy of the same formats\n\n");
+            out.push_str("\n### Speed of light: each pass against its floor (its draws, or a copy of its formats)\n\n");
             out.push_str(&crate::measure::speed_of_light::markdown(rows));
         }
         out
@@ -633,7 +666,7 @@ impl BenchReport {
         };
         let mut out = String::from(
             "scene,technique,width,height,device,timing_mode,trusted,pass,median_ms,min_ms,max_ms,\
-             isolated_ms,share,copy_ms,pass_per_copy,taps,ms_per_tap\n",
+             isolated_ms,share,floor,floor_ms,pass_per_floor,taps,ms_per_tap\n",
         );
         let prefix = format!(
             "{},{},{},{},{},{mode},{}",
@@ -651,21 +684,22 @@ impl BenchReport {
                 .as_ref()
                 .and_then(|rows| rows.iter().find(|r| r.pass == p.name));
             out.push_str(&format!(
-                "{prefix},{},{:.6},{:.6},{:.6},{},{:.6},{},{},{},{}\n",
+                "{prefix},{},{:.6},{:.6},{:.6},{},{:.6},{},{},{},{},{}\n",
                 csv_field(&p.name),
                 p.median_ms,
                 p.min_ms,
                 p.max_ms,
                 opt(p.isolated_ms),
                 p.share,
-                opt(floor.and_then(|f| f.copy_ms)),
+                floor.map_or(String::new(), |f| csv_field(&f.floor)),
+                opt(floor.and_then(|f| f.floor_ms)),
                 opt(floor.and_then(|f| f.ratio)),
                 floor.map_or(String::new(), |f| f.taps.to_string()),
                 opt(floor.and_then(|f| f.ms_per_tap)),
             ));
         }
         out.push_str(&format!(
-            "{prefix},frame,{:.6},{:.6},{:.6},,1.000000,,,,\n",
+            "{prefix},frame,{:.6},{:.6},{:.6},,1.000000,,,,,\n",
             self.frame_ms.median, self.frame_ms.min, self.frame_ms.max
         ));
         out
@@ -913,6 +947,38 @@ pub fn compare(
 }
 
 impl Comparison {
+    /// The comparison as the report's JSON carries it: side `b` (the benchmarked technique)
+    /// against side `a`, per pass and for the frame.
+    pub fn against(&self) -> Against {
+        let ratio = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            // Guarded: a 0 ms pass (timer granularity) gives no ratio, not Inf.
+            (Some(a), Some(b)) if a > 0.0 => Some(b / a),
+            _ => None,
+        };
+        let row = |pass: &str, a: Option<f64>, b: Option<f64>| AgainstRow {
+            pass: pass.to_string(),
+            baseline_ms: a,
+            technique_ms: b,
+            ratio: ratio(a, b),
+        };
+        let mut passes: Vec<AgainstRow> = self
+            .passes
+            .iter()
+            .map(|(name, [a, b])| row(name, a.map(|s| s.median), b.map(|s| s.median)))
+            .collect();
+        passes.push(row(
+            "frame",
+            Some(self.frame[0].median),
+            Some(self.frame[1].median),
+        ));
+        Against {
+            baseline: self.names[0].clone(),
+            technique: self.names[1].clone(),
+            frames: self.frames,
+            passes,
+        }
+    }
+
     /// The comparison as a Markdown table: each pass's medians and the ratio b / a.
     pub fn markdown(&self, device: &str) -> String {
         let [a, b] = &self.names;

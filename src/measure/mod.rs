@@ -5,7 +5,10 @@
 //!   slows them alike (the truth and SSS reports, and [`scaling`]).
 //! - [`bench`](mod@bench): the benchmark (`lucent bench`): per-pass GPU times proven to add up, and its
 //!   timing modes, formats and alternating comparisons.
-//! - [`speed_of_light`]: each pass's floor, a copy reading and writing the same formats.
+//! - [`speed_of_light`]: each pass's floor: the same draws with a trivial shader (a mesh pass),
+//!   or a copy reading and writing the same formats (a fullscreen pass).
+//! - [`gate`]: the speed-of-light gate (`lucent bench --gate`): each pass against its floor and
+//!   a technique against `none`, held under limits.
 //! - [`scaling`]: frame and pass time against triangles, resolution and light count.
 //! - [`look`]: how much a technique changes a frame against plain lighting, and its halos.
 //! - [`gallery`](mod@gallery): `lucent gallery`, the showcase scenes as PNGs and a Markdown page.
@@ -17,6 +20,7 @@
 
 pub mod bench;
 pub mod gallery;
+pub mod gate;
 pub mod layered_error;
 pub mod look;
 pub mod round_robin;

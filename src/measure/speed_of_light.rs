@@ -1,64 +1,111 @@
 //! Speed of light: the floor each pass of a frame is measured against.
 //!
-//! For every physical pass of a compiled [`Plan`], [`floors`] derives what the pass touches in
-//! memory: the images it reads from outside itself (a merged group's internal reads stay in
-//! tile memory on a tiler and are not counted) and every image it writes, with their formats,
-//! at the pass's resolution. [`CopyFrame`] builds a small graph from those: per pass, one
-//! fullscreen fragment pass (`glsl/bench/copy.frag`) that fetches one texel from an image of
-//! each read format and writes every written format, nothing else. That is the cheapest pass
-//! that moves the same bytes, so `pass / copy` says how much of a pass is its own work (ALU,
-//! extra taps, geometry) rather than bandwidth. Because it is derived from the plan, it covers
-//! any pass a technique adds. Integer formats (LBB's packed RGBA32UI ping-pong target) are read
-//! with integer samplers and written as integer vectors, as the format table
-//! ([`crate::backend::format`]) says: reading them as floats would be undefined behaviour and
-//! the copy's time meaningless.
+//! Every physical pass of a compiled [`Plan`] gets a floor of its own kind ([`floors`]):
+//! - **a fullscreen pass** (a blur, the tonemap, lighting) against its **copy**: one
+//!   fullscreen fragment pass (`glsl/bench/copy.frag`) that fetches one texel from an image of
+//!   each format the pass reads from outside its group (a merged group's internal reads stay
+//!   in tile memory on a tiler and are not counted) and writes every format it writes, at the
+//!   pass's resolution, nothing else. That is the cheapest pass that moves the same bytes, so
+//!   `pass / copy` says how much of a pass is its own work (ALU, extra taps) rather than
+//!   bandwidth.
+//! - **a mesh pass** (the light-space maps, the G-buffer: a pass that declares
+//!   [`crate::graph::MeshDraws`]) against **the same draws with a trivial shader**
+//!   (`glsl/bench/floor.vert`, `floor.frag`): every object of the scene once per view of the
+//!   pass (the camera, or each light-space face's tile), the pass's culling and depth test,
+//!   the position stream only, one matrix product per vertex and a constant written to each
+//!   of the pass's targets. A mesh pass's time is vertex work, binning and rasterisation,
+//!   which a fullscreen copy does not have: held to a copy, its ratio follows the CPU's
+//!   vertex-to-fill balance under lavapipe (1.5-2x apart between two machines of the same
+//!   kind, issue 34), held to its own draws it follows only what its shaders add.
+//! - **a merged group** of both (`gbuffer + lighting`) against the sum: its mesh passes'
+//!   floors plus one copy of its fullscreen passes (their reads from outside the group, their
+//!   writes).
 //!
-//! The copies are timed submitted one by one with the device idle (the isolated mode of
-//! [`crate::measure::bench`]), alternating with the frames of the same run, so machine noise hits both.
+//! [`FloorFrame`] builds the floors as a small graph of their own, one physical pass per
+//! part, and times them submitted one by one with the device idle (the isolated mode of
+//! [`crate::measure::bench`]), alternating with the frames of the same run, so machine noise
+//! hits both. Because the floors are derived from the plan (and the scene the renderer drew),
+//! they cover any pass a technique adds. Integer formats (LBB's packed RGBA32UI ping-pong
+//! target, the light-space maps' ID target) are read and written as the float format of the
+//! same texel size, as the format table ([`crate::backend::format`]) says: reading them as
+//! floats would be undefined behaviour and the floor's time meaningless.
 //!
 //! Taps: a pass that declares its texture taps per pixel ([`crate::graph::declare::PassBuilder::taps`])
 //! is divided by that; otherwise each image a pass reads (an input attachment, a sampled image,
 //! a depth test, a loaded attachment) counts as one tap, which is exact for same-pixel passes and
 //! an undercount for blurs; the table says which count it used.
 //!
-//! A pass above [`FAR_ABOVE_FLOOR`] times its copy is named in the output: lucent's same-pixel
+//! A pass above [`FAR_ABOVE_FLOOR`] times its floor is named in the output: lucent's same-pixel
 //! passes measure within about 1-3x their copy on lavapipe (DESIGN.md: a 1024x768 RGBA16F copy
 //! is about 2 ms, each extra tap about 1.1 ms), so 4x means the pass does several copies' worth
 //! of work of its own.
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
 use ash::vk;
 use serde::Serialize;
 
+use crate::backend::descriptor::Binding;
 use crate::backend::format::{format_info, format_name};
+use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::features::copy_pass::{copy_defines, COPY_FRAGMENT, MAX_COPY_IMAGES, MAX_COPY_INPUTS};
+use crate::features::copy_pass::{
+    copy_defines, floor_defines, COPY_FRAGMENT, FLOOR_FRAGMENT, FLOOR_VERTEX, MAX_COPY_IMAGES,
+    MAX_COPY_INPUTS,
+};
 use crate::features::pass::FullscreenPass;
-use crate::frame::FrameRunner;
+use crate::features::util::PassPipeline;
+use crate::frame::{FrameRunner, Renderer};
+use crate::gpu_scene::SceneGpu;
 use crate::graph::{
-    CompileOptions, Executable, ImageInfo, LoadOp, PassKind, Plan, RenderGraph, ResourceId,
+    CompileOptions, Executable, ImageInfo, LoadOp, MeshDraws, MeshViews, PassExec, PassKind, Plan,
+    PrepareContext, RecordContext, RenderGraph, ResourceId,
 };
 use crate::{LucentError, Result};
 
-/// Passes at more than this many times their copy's time are named as far above their floor.
+/// Passes at more than this many times their floor's time are named as far above it.
 pub const FAR_ABOVE_FLOOR: f64 = 4.0;
 
-/// What one physical pass moves, and how many taps it makes.
+/// The floor of one mesh pass: the objects it draws, with its views, into its targets.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MeshFloor {
+    /// The mesh pass's name (a pass of the physical pass).
+    pub pass: String,
+    /// Its render area.
+    pub extent: (u32, u32),
+    /// What it draws.
+    #[serde(skip)]
+    pub draws: MeshDraws,
+    /// Formats of its colour writes.
+    #[serde(skip)]
+    pub colour_writes: Vec<vk::Format>,
+    /// Format of its depth target (every mesh pass tests depth).
+    #[serde(skip)]
+    pub depth: vk::Format,
+}
+
+/// What one physical pass moves and draws, and how many taps it makes: its floor is the sum
+/// of its mesh passes' floors ([`Self::meshes`]) and, when it has fullscreen passes, one copy
+/// of those ([`Self::copies`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PassFloor {
     /// The physical pass's name.
     pub pass: String,
     /// Its render area.
     pub extent: (u32, u32),
-    /// Formats of the images it reads from outside itself (one per image).
+    /// The floors of its mesh passes (none for a fullscreen pass).
+    pub meshes: Vec<MeshFloor>,
+    /// Whether a copy stands for (some of) it: it has passes that draw no mesh.
+    pub copies: bool,
+    /// Formats of the images its fullscreen passes read from outside the group (one per image).
     #[serde(skip)]
     pub reads: Vec<ImageInfo>,
-    /// Formats of its colour (or storage) writes.
+    /// Formats of its fullscreen passes' colour (or storage) writes.
     #[serde(skip)]
     pub colour_writes: Vec<vk::Format>,
-    /// Format of its depth write, if it writes depth.
+    /// Format of its fullscreen passes' depth write, if they write depth.
     #[serde(skip)]
     pub depth_write: Option<vk::Format>,
     /// Texture taps per pixel.
@@ -68,8 +115,22 @@ pub struct PassFloor {
 }
 
 impl PassFloor {
-    /// Why no copy can stand in for this pass, if none can.
+    /// Why no floor can stand in for this pass, if none can.
     pub fn unsupported(&self) -> Option<String> {
+        if let Some(mesh) = self
+            .meshes
+            .iter()
+            .find(|m| m.colour_writes.len() > MAX_COPY_IMAGES)
+        {
+            return Some(format!(
+                "'{}' draws into {} colour targets; the mesh floor writes at most {MAX_COPY_IMAGES}",
+                mesh.pass,
+                mesh.colour_writes.len()
+            ));
+        }
+        if !self.copies {
+            return None;
+        }
         if self.reads.len() > MAX_COPY_INPUTS || self.colour_writes.len() > MAX_COPY_IMAGES {
             return Some(format!(
                 "'{}' reads {} and writes {} images; the copy reads at most {MAX_COPY_INPUTS} \
@@ -79,10 +140,19 @@ impl PassFloor {
                 self.colour_writes.len()
             ));
         }
-        if self.colour_writes.is_empty() && self.depth_write.is_none() {
+        if self.meshes.is_empty() && self.colour_writes.is_empty() && self.depth_write.is_none() {
             return Some(format!("'{}' writes no image", self.pass));
         }
         None
+    }
+
+    /// The kind of floor, as the table names it: `copy`, `draws`, or `draws + copy`.
+    pub fn kind(&self) -> &'static str {
+        match (self.meshes.is_empty(), self.copies) {
+            (true, _) => "copy",
+            (false, false) => "draws",
+            (false, true) => "draws + copy",
+        }
     }
 }
 
@@ -93,24 +163,55 @@ pub fn floors(plan: &Plan) -> Vec<PassFloor> {
         .map(|phys| {
             let group: Vec<&crate::graph::compile::PlannedPass> =
                 phys.passes.iter().map(|&i| &plan.passes[i]).collect();
+            let info = |id: ResourceId| plan.resources[id].info;
+            let is_depth = |id: ResourceId| info(id).aspect().contains(vk::ImageAspectFlags::DEPTH);
             let produced: HashSet<(ResourceId, u32)> = group
                 .iter()
                 .flat_map(|p| p.writes.iter().map(|w| (w.resource, w.version)))
                 .collect();
+            // The images a set of passes writes, each once, in order.
+            let writes_of = |passes: &[&&crate::graph::compile::PlannedPass]| {
+                let mut ids: Vec<ResourceId> = Vec::new();
+                for u in passes.iter().flat_map(|p| p.writes.iter()) {
+                    if !ids.contains(&u.resource) {
+                        ids.push(u.resource);
+                    }
+                }
+                ids
+            };
+            let mesh_passes: Vec<&&crate::graph::compile::PlannedPass> =
+                group.iter().filter(|p| p.mesh.is_some()).collect();
+            let other_passes: Vec<&&crate::graph::compile::PlannedPass> =
+                group.iter().filter(|p| p.mesh.is_none()).collect();
+            let meshes = mesh_passes
+                .iter()
+                .filter_map(|p| {
+                    let writes = writes_of(&[*p]);
+                    Some(MeshFloor {
+                        pass: p.name.clone(),
+                        extent: phys.extent,
+                        draws: p.mesh.clone()?,
+                        colour_writes: writes
+                            .iter()
+                            .filter(|&&id| !is_depth(id))
+                            .map(|&id| info(id).format)
+                            .collect(),
+                        depth: writes
+                            .iter()
+                            .find(|&&id| is_depth(id))
+                            .map_or(crate::features::gbuffer::DEPTH_FORMAT, |&id| {
+                                info(id).format
+                            }),
+                    })
+                })
+                .collect();
             let mut read_ids: Vec<ResourceId> = Vec::new();
-            for u in group.iter().flat_map(|p| p.reads.iter()) {
+            for u in other_passes.iter().flat_map(|p| p.reads.iter()) {
                 if !produced.contains(&(u.resource, u.version)) && !read_ids.contains(&u.resource) {
                     read_ids.push(u.resource);
                 }
             }
-            let mut write_ids: Vec<ResourceId> = Vec::new();
-            for u in group.iter().flat_map(|p| p.writes.iter()) {
-                if !write_ids.contains(&u.resource) {
-                    write_ids.push(u.resource);
-                }
-            }
-            let info = |id: ResourceId| plan.resources[id].info;
-            let is_depth = |id: ResourceId| info(id).aspect().contains(vk::ImageAspectFlags::DEPTH);
+            let write_ids = writes_of(&other_passes);
             let depth_write = write_ids
                 .iter()
                 .find(|&&id| is_depth(id))
@@ -143,6 +244,8 @@ pub fn floors(plan: &Plan) -> Vec<PassFloor> {
             PassFloor {
                 pass: phys.name.clone(),
                 extent,
+                meshes,
+                copies: !other_passes.is_empty(),
                 reads: read_ids.iter().map(|&id| info(id)).collect(),
                 colour_writes,
                 depth_write,
@@ -153,110 +256,85 @@ pub fn floors(plan: &Plan) -> Vec<PassFloor> {
         .collect()
 }
 
-/// Name of the copy pass standing in for `pass`.
+/// Name of the copy pass standing in for `pass`'s fullscreen passes.
 pub fn copy_name(pass: &str) -> String {
     format!("copy of {pass}")
 }
 
-/// The copy passes of a frame's floors, compiled and ready to time.
-pub struct CopyFrame {
+/// Name of the floor pass standing in for mesh pass `pass`.
+pub fn draws_name(pass: &str) -> String {
+    format!("draws of {pass}")
+}
+
+/// The floors of a frame's passes, compiled and ready to time.
+pub struct FloorFrame {
     executable: Executable,
     runner: FrameRunner,
-    /// Per floor (in [`floors`] order): the physical pass index of its copy, `None` when no copy
-    /// can stand in for it (see [`PassFloor::unsupported`]).
-    copy_index: Vec<Option<usize>>,
+    /// Per floor (in [`floors`] order): the physical pass indices of its parts (mesh floors
+    /// and copy) in the floor frame; empty when no floor can stand in for it (see
+    /// [`PassFloor::unsupported`]).
+    part_indices: Vec<Vec<usize>>,
     /// The floors it was built from.
     pub floors: Vec<PassFloor>,
     samples: Vec<Vec<f64>>,
 }
 
-impl CopyFrame {
-    /// Builds the copy graph of `floors`: per supported floor, clears of its input images (not
-    /// timed) and one copy pass.
+impl FloorFrame {
+    /// Builds the floor graph of `floors`: per supported floor, a mesh floor pass per mesh
+    /// pass (drawing `scene`'s objects; needed when some floor has mesh passes), and for its
+    /// fullscreen passes clears of their input images (not timed) and one copy pass.
     pub fn new(
         gpu: &GpuContext,
         shaders: &ShaderCompiler,
         pipeline_cache: &PipelineCache,
         floors: Vec<PassFloor>,
+        scene: Option<&Arc<SceneGpu>>,
     ) -> Result<Self> {
         let mut graph = RenderGraph::new();
-        let mut names = Vec::new();
+        let mut names: Vec<Vec<String>> = Vec::new();
         for (f, floor) in floors.iter().enumerate() {
             if floor.unsupported().is_some() {
-                names.push(None);
+                names.push(Vec::new());
                 continue;
             }
-            let (width, height) = floor.extent;
-            let mut inputs = Vec::new();
-            for (k, read) in floor.reads.iter().enumerate() {
-                let info = ImageInfo {
-                    width: read.width,
-                    height: read.height,
-                    format: copy_format(read.format),
-                };
-                let mut image = graph.create_image(&format!("floor {f} in {k}"), info);
-                let mut fill = graph.add_pass(&format!("fill floor {f} in {k}"), PassKind::Raster);
-                if info.aspect().contains(vk::ImageAspectFlags::DEPTH) {
-                    fill.depth(&mut image, LoadOp::Clear([1.0, 0.0, 0.0, 0.0]));
-                } else {
-                    fill.color(&mut image, LoadOp::Clear([0.25, 0.5, 0.75, 1.0]));
-                }
-                fill.clears_only();
-                inputs.push(image);
+            let mut parts = Vec::new();
+            for (m, mesh) in floor.meshes.iter().enumerate() {
+                let scene = scene.ok_or_else(|| {
+                    LucentError::InvalidInput(format!(
+                        "the floor of '{}' draws the scene's meshes, and no scene was given",
+                        mesh.pass
+                    ))
+                })?;
+                let name = draws_name(&mesh.pass);
+                declare_mesh_floor(
+                    &mut graph,
+                    &format!("floor {f} mesh {m}"),
+                    &name,
+                    mesh,
+                    scene,
+                );
+                parts.push(name);
             }
-            let name = copy_name(&floor.pass);
-            let mut outputs: Vec<_> = floor
-                .colour_writes
-                .iter()
-                .enumerate()
-                .map(|(k, &format)| {
-                    graph.create_image(
-                        &format!("floor {f} out {k}"),
-                        ImageInfo {
-                            width,
-                            height,
-                            format: copy_format(format),
-                        },
-                    )
-                })
-                .collect();
-            let mut depth = floor.depth_write.map(|format| {
-                graph.create_image(
-                    &format!("floor {f} depth"),
-                    ImageInfo {
-                        width,
-                        height,
-                        format,
-                    },
-                )
-            });
-            let defines = copy_defines(inputs.len(), floor.colour_writes.len(), depth.is_some());
-            let mut pass = FullscreenPass::standalone(&mut graph, &name, COPY_FRAGMENT);
-            pass.defines(&defines);
-            for input in &inputs {
-                pass.sample(input);
+            if floor.copies {
+                let name = copy_name(&floor.pass);
+                declare_copy(&mut graph, f, &name, floor);
+                parts.push(name);
             }
-            for output in &mut outputs {
-                pass.color(output, LoadOp::DontCare);
-            }
-            if let Some(depth) = &mut depth {
-                pass.depth(depth, LoadOp::Clear([1.0, 0.0, 0.0, 0.0]));
-            }
-            pass.taps(inputs.len() as u32).graph().side_effects();
-            pass.finish();
-            names.push(Some(name));
+            names.push(parts);
         }
-        // Unmerged: each copy is its own render pass with its own timestamp pair.
+        // Unmerged: each part is its own render pass with its own timestamp pair.
         let (plan, execs) = graph.compile(CompileOptions {
             merge: false,
             alias: true,
             ..CompileOptions::default()
         })?;
-        let copy_index = names
+        let part_indices = names
             .iter()
-            .map(|n| {
-                n.as_ref()
-                    .and_then(|n| plan.physical.iter().position(|p| &p.name == n))
+            .map(|parts| {
+                parts
+                    .iter()
+                    .filter_map(|n| plan.physical.iter().position(|p| &p.name == n))
+                    .collect()
             })
             .collect();
         let executable = Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)?;
@@ -271,45 +349,55 @@ impl CopyFrame {
         Ok(Self {
             executable,
             runner,
-            copy_index,
+            part_indices,
             floors,
             samples,
         })
     }
 
-    /// The copies of `plan`'s passes.
-    pub fn for_plan(
+    /// The floors of `renderer`'s passes, the mesh floors drawing its scene.
+    pub fn for_renderer(
         gpu: &GpuContext,
         shaders: &ShaderCompiler,
         pipeline_cache: &PipelineCache,
-        plan: &Plan,
+        renderer: &Renderer,
     ) -> Result<Self> {
-        Self::new(gpu, shaders, pipeline_cache, floors(plan))
+        Self::new(
+            gpu,
+            shaders,
+            pipeline_cache,
+            floors(&renderer.executable.plan),
+            renderer.scene_gpu_shared(),
+        )
     }
 
-    /// Runs every copy once, each alone with the device idle, and records their times; with
-    /// `keep == false` (warm-up) the times are dropped.
+    /// Runs every floor part once, each alone with the device idle, and records each floor's
+    /// time (the sum of its parts); with `keep == false` (warm-up) the times are dropped.
     pub fn measure(&mut self, gpu: &GpuContext, keep: bool) -> Result<()> {
         let timing = self.runner.run_isolated(gpu, &self.executable)?;
         if !keep {
             return Ok(());
         }
-        for (f, index) in self.copy_index.iter().enumerate() {
-            if let Some(i) = *index {
-                let ms = timing.passes.get(i).map(|p| p.ms).ok_or_else(|| {
+        for (f, parts) in self.part_indices.iter().enumerate() {
+            if parts.is_empty() {
+                continue;
+            }
+            let mut ms = 0.0;
+            for &i in parts {
+                ms += timing.passes.get(i).map(|p| p.ms).ok_or_else(|| {
                     LucentError::Timing(format!(
-                        "copy timing: expected {} scopes, got {}",
+                        "floor timing: expected {} scopes, got {}",
                         self.executable.plan.physical.len(),
                         timing.passes.len()
                     ))
                 })?;
-                self.samples[f].push(ms);
             }
+            self.samples[f].push(ms);
         }
         Ok(())
     }
 
-    /// Median copy time of each floor (`None`: no copy for it, or not measured yet).
+    /// Median floor time of each pass (`None`: no floor for it, or not measured yet).
     pub fn medians(&self) -> Vec<Option<crate::measure::stats::Stats>> {
         self.samples
             .iter()
@@ -317,10 +405,232 @@ impl CopyFrame {
             .collect()
     }
 
-    /// Destroys the copy graph. The GPU must be idle.
+    /// Destroys the floor graph. The GPU must be idle.
     pub fn destroy(self, gpu: &GpuContext) {
         self.runner.destroy(gpu);
         self.executable.destroy(gpu);
+    }
+}
+
+/// Declares the copy of `floor`'s fullscreen passes (the `f`-th floor) as pass `name`: clears
+/// of images of its input formats (not timed: separate passes), then one fullscreen pass that
+/// fetches a texel of each and writes each of its output formats.
+fn declare_copy(graph: &mut RenderGraph, f: usize, name: &str, floor: &PassFloor) {
+    let (width, height) = floor.extent;
+    let mut inputs = Vec::new();
+    for (k, read) in floor.reads.iter().enumerate() {
+        let info = ImageInfo {
+            width: read.width,
+            height: read.height,
+            format: copy_format(read.format),
+        };
+        let mut image = graph.create_image(&format!("floor {f} in {k}"), info);
+        let mut fill = graph.add_pass(&format!("fill floor {f} in {k}"), PassKind::Raster);
+        if info.aspect().contains(vk::ImageAspectFlags::DEPTH) {
+            fill.depth(&mut image, LoadOp::Clear([1.0, 0.0, 0.0, 0.0]));
+        } else {
+            fill.color(&mut image, LoadOp::Clear([0.25, 0.5, 0.75, 1.0]));
+        }
+        fill.clears_only();
+        inputs.push(image);
+    }
+    let mut outputs: Vec<_> = floor
+        .colour_writes
+        .iter()
+        .enumerate()
+        .map(|(k, &format)| {
+            graph.create_image(
+                &format!("floor {f} out {k}"),
+                ImageInfo {
+                    width,
+                    height,
+                    format: copy_format(format),
+                },
+            )
+        })
+        .collect();
+    let mut depth = floor.depth_write.map(|format| {
+        graph.create_image(
+            &format!("floor {f} depth"),
+            ImageInfo {
+                width,
+                height,
+                format,
+            },
+        )
+    });
+    let defines = copy_defines(inputs.len(), floor.colour_writes.len(), depth.is_some());
+    let mut pass = FullscreenPass::standalone(graph, name, COPY_FRAGMENT);
+    pass.defines(&defines);
+    for input in &inputs {
+        pass.sample(input);
+    }
+    for output in &mut outputs {
+        pass.color(output, LoadOp::DontCare);
+    }
+    if let Some(depth) = &mut depth {
+        pass.depth(depth, LoadOp::Clear([1.0, 0.0, 0.0, 0.0]));
+    }
+    pass.taps(inputs.len() as u32).graph().side_effects();
+    pass.finish();
+}
+
+/// Declares `mesh`'s floor as pass `name` (its images named after `prefix`): targets of its
+/// formats (integer ones as floats of the same size) and depth, cleared as the pass clears
+/// them, and `scene`'s objects drawn into them with the pass's views.
+fn declare_mesh_floor(
+    graph: &mut RenderGraph,
+    prefix: &str,
+    name: &str,
+    mesh: &MeshFloor,
+    scene: &Arc<SceneGpu>,
+) {
+    let (width, height) = mesh.extent;
+    let image = |format| ImageInfo {
+        width,
+        height,
+        format,
+    };
+    let mut outputs: Vec<_> = mesh
+        .colour_writes
+        .iter()
+        .enumerate()
+        .map(|(k, &format)| {
+            graph.create_image(&format!("{prefix} out {k}"), image(copy_format(format)))
+        })
+        .collect();
+    let mut depth = graph.create_image(&format!("{prefix} depth"), image(mesh.depth));
+    let mut pass = graph.add_pass(name, PassKind::Raster);
+    for output in &mut outputs {
+        pass.color(output, LoadOp::Clear([0.0; 4]));
+    }
+    pass.depth(&mut depth, LoadOp::Clear([1.0; 4]));
+    pass.side_effects();
+    pass.execute(MeshFloorPass {
+        scene: scene.clone(),
+        draws: mesh.draws.clone(),
+        outputs: mesh.colour_writes.len(),
+        pipeline: None,
+    });
+}
+
+/// Push constants of the mesh floor (glsl/bench/floor.vert).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FloorConstants {
+    model: [[f32; 4]; 4],
+    /// x: the light-space face.
+    face: [i32; 4],
+}
+
+/// A mesh pass's floor: the scene's objects with the pass's views and culling, the trivial
+/// shaders of `glsl/bench/floor.*`.
+struct MeshFloorPass {
+    scene: Arc<SceneGpu>,
+    draws: MeshDraws,
+    outputs: usize,
+    pipeline: Option<PassPipeline>,
+}
+
+impl PassExec for MeshFloorPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        let shadow_faces = matches!(self.draws.views, MeshViews::ShadowFaces { .. });
+        // The views' matrices: the shadow table's faces, or the frame uniforms' camera.
+        let region = if shadow_faces {
+            &crate::features::shadows::TABLE_REGION
+        } else {
+            &crate::gpu_scene::FRAME
+        };
+        let defines = floor_defines(self.outputs, shadow_faces);
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &[Binding::PerFrame(self.scene.per_frame.binding(region))],
+            &GraphicsPipelineDesc {
+                vertex: FLOOR_VERTEX,
+                fragment: FLOOR_FRAGMENT,
+                defines: &defines,
+                vertex_input: VertexInput::Positions,
+                depth_test: true,
+                cull_back: self.draws.cull_back,
+                additive_attachments: 0,
+                set_layouts: &[],
+                push_constant_bytes: std::mem::size_of::<FloorConstants>() as u32,
+                name: "mesh floor",
+            },
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        pipeline.bind(ctx);
+        let device = &ctx.gpu.device;
+        // Each view: the face it draws with and its tile (None: the whole render area, as the
+        // executor set it).
+        let views: Vec<(u32, Option<vk::Rect2D>)> = match &self.draws.views {
+            MeshViews::Camera => vec![(0, None)],
+            MeshViews::ShadowFaces { origins, tile } => origins
+                .iter()
+                .enumerate()
+                .map(|(face, &(x, y))| {
+                    let rect = vk::Rect2D {
+                        offset: vk::Offset2D {
+                            x: x as i32,
+                            y: y as i32,
+                        },
+                        extent: vk::Extent2D {
+                            width: *tile,
+                            height: *tile,
+                        },
+                    };
+                    (face as u32, Some(rect))
+                })
+                .collect(),
+        };
+        for (face, rect) in views {
+            if let Some(rect) = rect {
+                let viewport = vk::Viewport {
+                    x: rect.offset.x as f32,
+                    y: rect.offset.y as f32,
+                    width: rect.extent.width as f32,
+                    height: rect.extent.height as f32,
+                    min_depth: 0.0,
+                    max_depth: 1.0,
+                };
+                // SAFETY: viewport and scissor are dynamic state of every lucent pipeline;
+                // recording inside this pass's render pass with its pipeline bound.
+                unsafe {
+                    device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
+                    device.cmd_set_scissor(ctx.cmd, 0, &[rect]);
+                }
+            }
+            for draw in &self.scene.draws {
+                let constants = FloorConstants {
+                    model: draw.constants.model,
+                    face: [face as i32, 0, 0, 0],
+                };
+                // SAFETY: the bound pipeline's layout has this push-constant range.
+                unsafe {
+                    device.cmd_push_constants(
+                        ctx.cmd,
+                        pipeline.pipeline.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&constants),
+                    );
+                }
+                // The position stream only: no thickness, no surface stream.
+                self.scene.meshes[draw.mesh].draw(device, ctx.cmd, ctx.frame, false, false);
+            }
+        }
+    }
+
+    fn destroy(&mut self, gpu: &GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
     }
 }
 
@@ -331,9 +641,12 @@ pub struct FloorRow {
     pub pass: String,
     /// The pass's reported median, ms.
     pub pass_ms: f64,
-    /// Its copy's median (isolated), ms; `None` when no copy can stand in for it.
-    pub copy_ms: Option<f64>,
-    /// `pass_ms / copy_ms`.
+    /// The kind of its floor: `copy`, `draws` or `draws + copy` ([`PassFloor::kind`]).
+    pub floor: String,
+    /// Its floor's median (isolated; the sum of its parts), ms; `None` when no floor can stand
+    /// in for it.
+    pub floor_ms: Option<f64>,
+    /// `pass_ms / floor_ms`.
     pub ratio: Option<f64>,
     /// Texture taps per pixel.
     pub taps: u32,
@@ -341,52 +654,72 @@ pub struct FloorRow {
     pub taps_declared: bool,
     /// `pass_ms / taps` (`None` for a pass without taps).
     pub ms_per_tap: Option<f64>,
-    /// Images the copy reads and writes, as text (`2 in (RGBA16F, D32) -> 1 out (RGBA8)`).
+    /// What the floor draws, reads and writes, as text (`draws (camera) -> 3 out (RGBA8,
+    /// RGBA8, D32)`, `2 in (RGBA16F, D32) -> 1 out (RGBA8)`).
     pub io: String,
-    /// Above [`FAR_ABOVE_FLOOR`] times its copy.
+    /// Above [`FAR_ABOVE_FLOOR`] times its floor.
     pub far_above: bool,
-    /// Why there is no copy, when there is none.
+    /// Why there is no floor, when there is none.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
 }
 
-/// The copy's inputs and outputs as text.
+/// What the floor draws, reads and writes, as text: each mesh floor (`draws (6 faces) -> 1
+/// out (D32)`), then the copy (`2 in (RGBA16F, D32) -> 1 out (RGBA8)`), joined by ` + `.
 pub fn describe_io(floor: &PassFloor) -> String {
-    let reads: Vec<String> = floor.reads.iter().map(|i| format_name(i.format)).collect();
-    let writes: Vec<String> = floor
-        .colour_writes
+    let names = |formats: &mut dyn Iterator<Item = vk::Format>| -> Vec<String> {
+        formats.map(format_name).collect()
+    };
+    let mut parts: Vec<String> = floor
+        .meshes
         .iter()
-        .chain(floor.depth_write.as_ref())
-        .map(|&f| format_name(f))
+        .map(|m| {
+            let views = match &m.draws.views {
+                MeshViews::Camera => "camera".to_string(),
+                MeshViews::ShadowFaces { origins, .. } => format!("{} faces", origins.len()),
+            };
+            let writes = names(&mut m.colour_writes.iter().copied().chain([m.depth]));
+            format!(
+                "draws ({views}) -> {} out ({})",
+                writes.len(),
+                writes.join(", ")
+            )
+        })
         .collect();
-    format!(
-        "{} in ({}) -> {} out ({})",
-        reads.len(),
-        reads.join(", "),
-        writes.len(),
-        writes.join(", ")
-    )
+    if floor.copies {
+        let reads = names(&mut floor.reads.iter().map(|i| i.format));
+        let writes = names(&mut floor.colour_writes.iter().copied().chain(floor.depth_write));
+        parts.push(format!(
+            "{} in ({}) -> {} out ({})",
+            reads.len(),
+            reads.join(", "),
+            writes.len(),
+            writes.join(", ")
+        ));
+    }
+    parts.join(" + ")
 }
 
 /// The table's rows: each floor beside the measured pass of the same name (`pass_ms` looks a
 /// pass's reported median up by name).
 pub fn rows(
     floors: &[PassFloor],
-    copies: &[Option<crate::measure::stats::Stats>],
+    floor_times: &[Option<crate::measure::stats::Stats>],
     pass_ms: impl Fn(&str) -> Option<f64>,
 ) -> Vec<FloorRow> {
     floors
         .iter()
-        .zip(copies)
-        .filter_map(|(floor, copy)| {
+        .zip(floor_times)
+        .filter_map(|(floor, time)| {
             let ms = pass_ms(&floor.pass)?;
-            // Guarded: a copy measured as 0 ms (timer granularity) gives no ratio, not Inf.
-            let copy_ms = copy.map(|c| c.median).filter(|&c| c > 0.0);
-            let ratio = copy_ms.map(|c| ms / c);
+            // Guarded: a floor measured as 0 ms (timer granularity) gives no ratio, not Inf.
+            let floor_ms = time.map(|c| c.median).filter(|&c| c > 0.0);
+            let ratio = floor_ms.map(|c| ms / c);
             Some(FloorRow {
                 pass: floor.pass.clone(),
                 pass_ms: ms,
-                copy_ms,
+                floor: floor.kind().to_string(),
+                floor_ms,
                 ratio,
                 taps: floor.taps,
                 taps_declared: floor.taps_declared,
@@ -402,15 +735,16 @@ pub fn rows(
 /// The speed-of-light table as Markdown, with the passes far above their floor named.
 pub fn markdown(rows: &[FloorRow]) -> String {
     let mut out = String::from(
-        "| pass | pass ms | copy ms | pass / copy | taps / px | ms per tap | copy reads -> writes |\n\
-         |---|---:|---:|---:|---:|---:|---|\n",
+        "| pass | pass ms | floor | floor ms | pass / floor | taps / px | ms per tap | floor draws, reads -> writes |\n\
+         |---|---:|---|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         out.push_str(&format!(
-            "| {} | {:.3} | {} | {} | {}{} | {} | {} |\n",
+            "| {} | {:.3} | {} | {} | {} | {}{} | {} | {} |\n",
             r.pass,
             r.pass_ms,
-            r.copy_ms.map_or("-".into(), |c| format!("{c:.3}")),
+            r.floor,
+            r.floor_ms.map_or("-".into(), |c| format!("{c:.3}")),
             r.ratio.map_or("-".into(), |x| format!(
                 "{x:.2}x{}",
                 if r.far_above { " **far above**" } else { "" }
@@ -427,22 +761,27 @@ pub fn markdown(rows: &[FloorRow]) -> String {
         .map(|r| format!("`{}` ({:.1}x)", r.pass, r.ratio.unwrap_or(0.0)))
         .collect();
     out.push_str(
-        "\nCopy: a fullscreen pass fetching one texel of each image the pass reads and writing \
-         every format it writes, same resolution, timed alone (device idle), alternating with \
-         the frames. Taps: declared by the pass, or \"(reads)\": one per image read. ",
+        "\nFloors, each timed alone (device idle), alternating with the frames: a fullscreen \
+         pass against its copy (one texel fetched from each image it reads, every format it \
+         writes, same resolution); a mesh pass against its draws (the same objects and views, \
+         a trivial shader writing its targets); a merged group against the sum. Taps: declared \
+         by the pass, or \"(reads)\": one per image read. ",
     );
     if far.is_empty() {
         out.push_str(&format!(
-            "No pass is more than {FAR_ABOVE_FLOOR}x its copy.\n"
+            "No pass is more than {FAR_ABOVE_FLOOR}x its floor.\n"
         ));
     } else {
         out.push_str(&format!(
-            "Far above their floor (more than {FAR_ABOVE_FLOOR}x their copy): {}.\n",
+            "Far above their floor (more than {FAR_ABOVE_FLOOR}x it): {}.\n",
             far.join(", ")
         ));
     }
     for r in rows.iter().filter(|r| r.note.is_some()) {
-        out.push_str(&format!("- no copy: {}\n", r.note.as_deref().unwrap_or("")));
+        out.push_str(&format!(
+            "- no floor: {}\n",
+            r.note.as_deref().unwrap_or("")
+        ));
     }
     out
 }
@@ -480,33 +819,67 @@ mod tests {
     }
 
     #[test]
-    fn merged_deferred_floor_writes_the_gbuffer_and_reads_nothing_outside() {
+    fn mesh_passes_are_held_to_their_draws_and_fullscreen_passes_to_their_copy() {
         let plan = plan("smoke", Technique::None);
         let floors = floors(&plan);
         assert_eq!(floors.len(), plan.physical.len());
-        // The light-space maps come first: a depth-only pass reading nothing.
+        // The light-space maps come first: a mesh pass alone, depth only, every face's tile.
         let maps = &floors[0];
         assert_eq!(maps.pass, "light-space maps");
+        assert_eq!(maps.kind(), "draws");
+        assert!(!maps.copies && maps.reads.is_empty(), "{maps:?}");
+        assert_eq!(maps.meshes.len(), 1);
+        assert_eq!(maps.meshes[0].pass, "light-space maps");
+        assert!(maps.meshes[0].colour_writes.is_empty());
+        assert_eq!(maps.meshes[0].depth, vk::Format::D32_SFLOAT);
         assert!(
-            maps.reads.is_empty() && maps.colour_writes.is_empty(),
-            "{maps:?}"
+            !maps.meshes[0].draws.cull_back,
+            "open meshes cast from both sides"
         );
-        assert_eq!(maps.depth_write, Some(vk::Format::D32_SFLOAT));
+        // smoke: a point light (six faces) and a directional light (one).
+        match &maps.meshes[0].draws.views {
+            MeshViews::ShadowFaces { origins, tile } => {
+                assert_eq!(origins.len(), 7, "{origins:?}");
+                assert!(*tile > 0);
+                let distinct: HashSet<_> = origins.iter().collect();
+                assert_eq!(distinct.len(), 7, "each face its own tile");
+            }
+            other => panic!("light-space maps draw with {other:?}"),
+        }
+        assert_eq!(describe_io(maps), "draws (7 faces) -> 1 out (D32)");
+        // The merged deferred pass: the G-buffer's draws plus a copy of the lighting subpass.
         let deferred = &floors[1];
         assert_eq!(deferred.pass, "gbuffer + lighting");
-        // From outside its group it reads only the light-space atlas.
+        assert_eq!(deferred.kind(), "draws + copy");
+        assert_eq!(deferred.meshes.len(), 1);
+        let gbuffer = &deferred.meshes[0];
+        assert_eq!(gbuffer.pass, "gbuffer");
+        assert_eq!(gbuffer.draws.views, MeshViews::Camera);
+        assert!(gbuffer.draws.cull_back);
+        // Albedo and normal at least, and depth.
+        assert!(gbuffer.colour_writes.len() >= 2, "{gbuffer:?}");
+        assert_eq!(gbuffer.depth, vk::Format::D32_SFLOAT);
+        // The lighting subpass reads only the light-space atlas from outside the group, and
+        // writes the lit image, no depth.
         assert_eq!(deferred.reads.len(), 1, "{deferred:?}");
         assert_eq!(deferred.reads[0].format, vk::Format::D32_SFLOAT);
-        assert_eq!(deferred.depth_write, Some(vk::Format::D32_SFLOAT));
-        // Albedo, normal and the lit image at least.
-        assert!(deferred.colour_writes.len() >= 3, "{deferred:?}");
+        assert_eq!(deferred.depth_write, None);
+        assert_eq!(
+            deferred.colour_writes,
+            [vk::Format::R16G16B16A16_SFLOAT],
+            "{deferred:?}"
+        );
         // The lighting subpass reads depth, GB0 and GB1 as input attachments: three taps.
         assert!(
             deferred.taps >= 3 && !deferred.taps_declared,
             "{deferred:?}"
         );
+        assert!(describe_io(deferred).starts_with("draws (camera) -> "));
+        assert!(describe_io(deferred).contains(" + 1 in (D32) -> 1 out (RGBA16F)"));
         let tonemap = &floors[2];
         assert_eq!(tonemap.pass, "tonemap");
+        assert_eq!(tonemap.kind(), "copy");
+        assert!(tonemap.meshes.is_empty());
         assert_eq!(tonemap.reads.len(), 1);
         assert_eq!(tonemap.reads[0].format, vk::Format::R16G16B16A16_SFLOAT);
         assert_eq!(tonemap.colour_writes, [vk::Format::R8G8B8A8_UNORM]);
@@ -515,7 +888,34 @@ mod tests {
     }
 
     #[test]
-    fn every_pass_of_every_technique_gets_a_floor_a_copy_can_stand_in_for() {
+    fn unmerged_passes_keep_their_own_kind_of_floor() {
+        let scene = crate::bake::scene::load_scene_baked("smoke").unwrap();
+        let settings = FrameSettings {
+            technique: Technique::None,
+            compile: CompileOptions {
+                merge: false,
+                ..CompileOptions::default()
+            },
+            ..FrameSettings::new(64, 48)
+        };
+        let plan = plan_frame(&settings, &FrameDesc::new(&scene, &settings).unwrap()).unwrap();
+        let kinds: Vec<(String, &str)> = floors(&plan)
+            .iter()
+            .map(|f| (f.pass.clone(), f.kind()))
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                ("light-space maps".to_string(), "draws"),
+                ("gbuffer".to_string(), "draws"),
+                ("lighting".to_string(), "copy"),
+                ("tonemap".to_string(), "copy"),
+            ]
+        );
+    }
+
+    #[test]
+    fn every_pass_of_every_technique_gets_a_floor_that_can_stand_in_for_it() {
         for (name, technique) in Technique::all() {
             for scene in ["smoke", "cubes", "skin", "teapot"] {
                 let plan = plan(scene, technique);
@@ -574,6 +974,8 @@ mod tests {
             }],
             colour_writes: vec![vk::Format::R16G16B16A16_SFLOAT],
             depth_write: None,
+            meshes: Vec::new(),
+            copies: true,
             taps: 7,
             taps_declared: true,
         };

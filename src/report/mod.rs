@@ -28,7 +28,7 @@ use crate::backend::GpuContext;
 use crate::frame::{FrameSettings, Renderer, Technique};
 use crate::measure::bench::{BenchOptions, BenchReport};
 use crate::measure::scaling::{Config, Measured};
-use crate::measure::speed_of_light::CopyFrame;
+use crate::measure::speed_of_light::FloorFrame;
 use crate::report::plot::{write_bars_png, write_curves_png, BarRow, PlotPoint, PlotSeries};
 use crate::report::seeds::{LiOurs, TranslucencyCost, LI_TABLE_1};
 use crate::{LucentError, Result};
@@ -239,12 +239,7 @@ pub fn bench_technique(
         ..FrameSettings::new(ctx.options.width, ctx.options.height)
     };
     let renderer = Renderer::new(ctx.gpu, ctx.shaders, ctx.pipeline_cache, &scene, settings)?;
-    let copies = CopyFrame::for_plan(
-        ctx.gpu,
-        ctx.shaders,
-        ctx.pipeline_cache,
-        &renderer.executable.plan,
-    );
+    let copies = FloorFrame::for_renderer(ctx.gpu, ctx.shaders, ctx.pipeline_cache, &renderer);
     let result = copies.and_then(|mut copies| {
         let report = crate::measure::bench::run_with_floor(
             ctx.gpu,
@@ -326,7 +321,7 @@ fn techniques_section(ctx: &SuiteContext<'_>) -> Result<SectionOutput> {
                     .speed_of_light
                     .as_ref()
                     .and_then(|rows| rows.iter().find(|r| r.pass == p.name))
-                    .and_then(|r| r.copy_ms),
+                    .and_then(|r| r.floor_ms),
             })
             .collect();
         write_bars_png(

@@ -5,7 +5,7 @@ use crate::common;
 
 use crate::common::{run_bench, TestGpu};
 use lucent::frame::{FrameSettings, Renderer, Technique};
-use lucent::measure::speed_of_light::{floors, CopyFrame};
+use lucent::measure::speed_of_light::{floors, FloorFrame};
 
 /// A validated bench of `cubes` under translucency, with `extra` arguments.
 fn bench_args(extra: &str) -> String {
@@ -28,7 +28,7 @@ fn csv_has_a_row_per_pass_with_its_speed_of_light_ratio() {
     };
     let (pass, ratio, taps, median) = (
         column("pass"),
-        column("pass_per_copy"),
+        column("pass_per_floor"),
         column("taps"),
         column("median_ms"),
     );
@@ -75,10 +75,10 @@ fn json_on_stdout_carries_the_speed_of_light_rows() {
     assert_eq!(passes.len(), floors.len(), "{v}");
     for (p, f) in passes.iter().zip(floors) {
         assert_eq!(p["name"], f["pass"]);
-        assert!(f["copy_ms"].as_f64().is_some_and(|c| c > 0.0), "{f}");
+        assert!(f["floor_ms"].as_f64().is_some_and(|c| c > 0.0), "{f}");
         let ratio = f["ratio"].as_f64().unwrap();
         assert!(
-            (ratio - p["median_ms"].as_f64().unwrap() / f["copy_ms"].as_f64().unwrap()).abs()
+            (ratio - p["median_ms"].as_f64().unwrap() / f["floor_ms"].as_f64().unwrap()).abs()
                 < 1e-9,
             "{f}"
         );
@@ -214,7 +214,8 @@ fn every_technique_s_copies_run_clean_under_validation_and_time_every_pass() {
         let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
         let plan = &renderer.executable.plan;
         assert_eq!(floors(plan).len(), plan.physical.len());
-        let mut copies = CopyFrame::for_plan(gpu, &test.shaders, &test.cache, plan).unwrap();
+        let mut copies =
+            FloorFrame::for_renderer(gpu, &test.shaders, &test.cache, &renderer).unwrap();
         copies.measure(gpu, false).unwrap();
         copies.measure(gpu, true).unwrap();
         let medians = copies.medians();

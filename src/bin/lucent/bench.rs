@@ -66,9 +66,15 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let against = args.against.as_deref().map(Technique::parse).transpose()?;
     let technique = Technique::parse(&args.frame.technique)?;
     let seeds = Seeds::new(args.compare_thesis, technique)?;
-    if format != Format::Markdown && (args.compare_thesis || against.is_some()) {
+    if format != Format::Markdown && args.compare_thesis {
         return Err(LucentError::InvalidInput(
-            "--compare-thesis and --against print Markdown tables; use them with --format markdown"
+            "--compare-thesis prints Markdown tables; use it with --format markdown".into(),
+        ));
+    }
+    if format == Format::Csv && against.is_some() {
+        return Err(LucentError::InvalidInput(
+            "--against prints a Markdown table (or an `against` object with --format json); \
+             use it with --format markdown or json"
                 .into(),
         ));
     }
@@ -91,14 +97,23 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 args.frame.scene
             )));
         }
-        let report = measure(session, renderer, scene, &args, &options)?;
+        let mut report = measure(session, renderer, scene, &args, &options)?;
+        let compared = against
+            .map(|technique| compare(session, renderer, scene, technique, &options))
+            .transpose()?;
+        report.against = compared.as_ref().map(bench::Comparison::against);
         print!("{}", report.format(format));
         if format != Format::Csv {
             println!();
         }
         print_seeds(session, renderer, scene, &args, &options, &seeds, &report)?;
-        if let Some(technique) = against {
-            compare(session, renderer, scene, technique, &options, &seeds)?;
+        if let (Some(compared), Format::Markdown) = (&compared, format) {
+            println!("{}", compared.markdown(&session.gpu.info.describe()));
+            if seeds.thesis.is_some() {
+                if let Some(line) = seed_tables::thesis_ratio_line(compared) {
+                    println!("{line}");
+                }
+            }
         }
         write_outputs(session, renderer, &args, format, &report)?;
         trusted(&report, &options)
@@ -117,11 +132,11 @@ fn measure(
     if !args.speed_of_light {
         return bench::run(gpu, renderer, scene, &args.frame.scene, options);
     }
-    let mut copies = lucent::measure::speed_of_light::CopyFrame::for_plan(
+    let mut copies = lucent::measure::speed_of_light::FloorFrame::for_renderer(
         gpu,
         &session.shaders,
         &session.pipeline_cache,
-        &renderer.executable.plan,
+        renderer,
     )?;
     let report = bench::run_with_floor(
         gpu,
@@ -176,16 +191,14 @@ fn print_seeds(
     Ok(())
 }
 
-/// `--against`: the same scene under `technique`, alternating frames with the main one, both
-/// printed side by side (with the thesis's ratio when its table is compared).
+/// `--against`: the same scene under `technique`, alternating frames with the main one.
 fn compare(
     session: &Session,
     renderer: &Renderer,
     scene: &scene::Scene,
     technique: Technique,
     options: &BenchOptions,
-    seeds: &Seeds,
-) -> Result<()> {
+) -> Result<bench::Comparison> {
     let gpu = &session.gpu;
     let other = Renderer::new(
         gpu,
@@ -210,14 +223,7 @@ fn compare(
     let idle = gpu.wait_idle();
     other.destroy(gpu);
     idle?;
-    let compared = compared?;
-    println!("{}", compared.markdown(&gpu.info.describe()));
-    if seeds.thesis.is_some() {
-        if let Some(line) = seed_tables::thesis_ratio_line(&compared) {
-            println!("{line}");
-        }
-    }
-    Ok(())
+    compared
 }
 
 /// Writes `--json` and `--out`; with CSV or JSON on stdout, the `wrote` lines go to stderr so

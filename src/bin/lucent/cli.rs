@@ -121,6 +121,18 @@ pub struct BenchArgs {
     /// 1 nearest its triangle count. Alias: --compare-seeds.
     #[arg(long, alias = "compare-seeds")]
     pub compare_thesis: bool,
+    /// Run the speed-of-light gate instead of one benchmark: every built-in scene's passes
+    /// against their floors and the techniques that add to shared passes against `none`,
+    /// each held under its limit (docs/performance.md); prints each pass, its ratio and its
+    /// limit, and fails when a pass is over it. Takes only --validation, --device and
+    /// --shaders (the gate sets every other flag itself).
+    #[arg(long)]
+    pub gate: bool,
+    /// With --gate: measure the gate's tables anew instead of judging them: every benchmark
+    /// N times (2 to 50), each pass's median, least and largest ratio, and the table lines of
+    /// the medians to paste into src/measure/gate.rs (docs/performance.md says when).
+    #[arg(long, value_name = "N", requires = "gate", value_parser = whole(2..=50usize))]
+    pub gate_baseline: Option<usize>,
 }
 
 /// `lucent demo`.

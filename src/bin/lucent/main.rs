@@ -5,8 +5,6 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
-
 use lucent::Result;
 
 use crate::cli::{Cli, Command};
@@ -17,6 +15,7 @@ mod cli;
 #[cfg(feature = "window")]
 mod demo;
 mod gallery;
+mod gate;
 mod inspect;
 mod plan;
 mod render;
@@ -30,6 +29,10 @@ fn run(command: Command) -> Result<()> {
     match command {
         Command::Scenes => scenes::run(),
         Command::Render(args) => render::run(args),
+        Command::Bench(args) if args.gate => match args.gate_baseline {
+            Some(runs) => gate::baseline(&args.gpu, runs),
+            None => gate::run(&args.gpu),
+        },
         Command::Bench(args) => bench::run(args),
         #[cfg(feature = "window")]
         Command::Demo(args) => demo::run(args),
@@ -39,6 +42,42 @@ fn run(command: Command) -> Result<()> {
         Command::Report(args) => report::run(args),
         Command::Inspect(args) => inspect::run(args),
         Command::BakeThickness(args) => bake_thickness::run(args),
+    }
+}
+
+/// `bench --gate` sets every benchmark's flags itself: refuses any other `bench` flag given
+/// with it on the command line (but the GPU's: --validation, --device, --shaders), naming
+/// them, rather than ignoring them.
+fn refuse_with_gate(cli: &Cli, matches: &clap::ArgMatches) -> std::result::Result<(), String> {
+    let (Command::Bench(args), Some(("bench", bench))) = (&cli.command, matches.subcommand())
+    else {
+        return Ok(());
+    };
+    if !args.gate {
+        return Ok(());
+    }
+    const TAKEN: [&str; 5] = ["gate", "gate_baseline", "validation", "device", "shaders"];
+    let command = <Cli as clap::CommandFactory>::command();
+    let Some(bench_command) = command.find_subcommand("bench") else {
+        return Ok(());
+    };
+    // Arguments only (the ids also name the flattened groups).
+    let is_argument = |id: &str| bench_command.get_arguments().any(|a| a.get_id() == id);
+    let given: Vec<String> = bench
+        .ids()
+        .map(|id| id.as_str())
+        .filter(|id| !TAKEN.contains(id) && is_argument(id))
+        .filter(|id| bench.value_source(id) == Some(clap::parser::ValueSource::CommandLine))
+        .map(|id| format!("--{}", id.replace('_', "-")))
+        .collect();
+    if given.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "--gate sets the benchmarks' flags itself and takes only --gate-baseline, \
+             --validation, --device and --shaders; remove {}",
+            given.join(", ")
+        ))
     }
 }
 
@@ -76,8 +115,20 @@ fn usage_error(error: &clap::Error) -> String {
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
+    let parsed = <Cli as clap::CommandFactory>::command()
+        .try_get_matches()
+        .and_then(|matches| {
+            let cli = <Cli as clap::FromArgMatches>::from_arg_matches(&matches)?;
+            Ok((cli, matches))
+        });
+    let cli = match parsed {
+        Ok((cli, matches)) => match refuse_with_gate(&cli, &matches) {
+            Ok(()) => cli,
+            Err(why) => {
+                eprintln!("lucent: error: {why} (see `lucent bench --help`)");
+                return ExitCode::from(2);
+            }
+        },
         Err(e) => {
             use clap::error::ErrorKind;
             if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {

@@ -11,9 +11,13 @@
 
 #define POW_EXACT 0
 #define POW_SPHERICAL_GAUSSIAN 1
+// Added to a row's pow mode when other objects' shadows fall on the material's transmitted
+// light (src/features/translucency.rs, SHADOWED): lucent's extension; the talk's term is
+// attenuated by its local thickness alone.
+#define TRANSLUCENCY_SHADOWED 2.0
 
-// x: power (iLTPower), y: distortion (fLTDistortion), z: ambient (fLTAmbient), w: pow mode.
-// Row 0 is unused: material ID 0 means "not translucent".
+// x: power (iLTPower), y: distortion (fLTDistortion), z: ambient (fLTAmbient), w: pow mode
+// (+ TRANSLUCENCY_SHADOWED). Row 0 is unused: material ID 0 means "not translucent".
 layout(std140, set = 0, binding = 5) uniform TranslucencyMaterials {
     vec4 rows[256];
 } translucency_materials;
@@ -26,6 +30,8 @@ layout(std140, set = 0, binding = 5) uniform TranslucencyMaterials {
 // exp2(n*x - n) = exp2(n (x - 1)) <= 1: no overflow for any n >= 0.
 float translucency_lobe(float x, float n, float mode) {
     x = clamp(x, 0.0, 1.0);
+    // The row's w carries the shadowed flag above the pow mode.
+    mode = mode >= TRANSLUCENCY_SHADOWED ? mode - TRANSLUCENCY_SHADOWED : mode;
 #if LUCENT_POW_MODES == 1
     return pow(max(x, 1e-30), n);
 #elif LUCENT_POW_MODES == 2
@@ -59,6 +65,11 @@ vec3 shade_incident_translucent(Surface s, vec3 to_eye, float v_dot_n, vec3 to_l
     float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
     vec3 diffuse = s.albedo * (n_dot_l / PI * reflected + (lobe + material.z) * thickness * transmitted);
     return (diffuse + vec3(s.specular * spec * n_dot_l * reflected)) * light.radiance_range.rgb;
+}
+
+// Whether other objects' shadows fall on the transmitted light of a material (its table row).
+bool translucency_shadowed(vec4 material) {
+    return material.w >= TRANSLUCENCY_SHADOWED;
 }
 
 // The talk's term alone (what shade_incident_translucent adds to diffuse + specular): the

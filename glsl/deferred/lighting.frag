@@ -58,6 +58,26 @@ vec2 light_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, int material)
 #endif
 }
 
+#ifdef LUCENT_TRANSLUCENCY
+// The translucent variant's visibility of light `i` (attenuation `attenuation` at the pixel):
+// x reflected, y transmitted through translucency material `material`. The talk's term is not
+// shadowed (its local thickness is its only attenuation), so a material that does not ask for
+// shadows (`shadowed`) looks up reflected light only, and only where the light reaches the
+// surface, as the plain variant does; a shadowed one (frames with the ID atlas) looks up every
+// light that reaches the pixel, from behind too.
+vec2 translucent_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float attenuation,
+                            int material, bool shadowed) {
+#ifdef LUCENT_SHADOW_IDS
+    if (shadowed) {
+        return attenuation > 0.0 ? light_visibility(i, pos, normal, to_light, material)
+                                 : vec2(0.0);
+    }
+#endif
+    bool lit_side = attenuation > 0.0 && dot(normal, to_light) > 0.0;
+    return vec2(lit_side ? light_visibility(i, pos, normal, to_light, 0).x : 0.0, 1.0);
+}
+#endif
+
 layout(input_attachment_index = 0, set = 0, binding = 1) uniform subpassInput gb0;
 layout(input_attachment_index = 1, set = 0, binding = 2) uniform subpassInput gb1;
 layout(input_attachment_index = 2, set = 0, binding = 3) uniform subpassInput depth;
@@ -129,6 +149,7 @@ void main() {
 #endif
     vec3 thickness = unpack_thickness(t);
     float v_dot_n = dot(to_eye, s.normal);
+    bool shadowed = translucency_shadowed(material);
 #endif
 #if defined(LUCENT_TRANSLUCENCY) && !defined(LUCENT_SPLIT_SPECULAR)
     for (int i = 0; i < count; ++i) {
@@ -136,7 +157,8 @@ void main() {
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
-        vec2 visible = light_visibility(i, pos, s.normal, to_light, material_id);
+        vec2 visible = translucent_visibility(i, pos, s.normal, to_light, attenuation,
+                                              material_id, shadowed);
         color += shade_incident_translucent(s, to_eye, v_dot_n, to_light, attenuation * visible.x,
                                             attenuation * visible.y, light, material, thickness);
     }
@@ -148,7 +170,8 @@ void main() {
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
 #ifdef LUCENT_TRANSLUCENCY
-        vec2 visible = light_visibility(i, pos, s.normal, to_light, material_id);
+        vec2 visible = translucent_visibility(i, pos, s.normal, to_light, attenuation,
+                                              material_id, shadowed);
 #else
         vec2 visible = light_visibility(i, pos, s.normal, to_light, 0);
 #endif

@@ -8,11 +8,14 @@
 //! so acne is gone at every distance without a depth bias that detaches shadows), projected
 //! with its face's matrix and compared with a 4x4-texel tent of the map (four gathers).
 //!
-//! The GDC 2011 term is light that went *through* the object: its own front faces must not
-//! shadow it. In frames with translucency the atlas also stores which translucency material
-//! each texel's first surface belongs to (`light-space.ids`), and the transmitted term counts a
-//! tap as lit when its occluder is the shaded pixel's own material: only other objects (other
-//! materials) shadow transmission. Frames without translucency have no ID target.
+//! The GDC 2011 term is light that went *through* the object. As the talk has it, only its
+//! local thickness attenuates it: no shadow falls on it, and it costs no lookup. A material
+//! may ask for other objects' shadows on it (`shadowed = true`, lucent's extension); then its
+//! own front faces must still not shadow it, so in frames with such a material the atlas also
+//! stores which translucency material each texel's first surface belongs to
+//! (`light-space.ids`), and the transmitted term counts a tap as lit when its occluder is the
+//! shaded pixel's own material: only other objects (other materials) shadow transmission.
+//! Frames without a shadowed translucent material have no ID target.
 //!
 //! A frame has the pass and its images exactly when some light casts and the scene has
 //! objects (`--no-shadows` or every light's `shadows = false`: no pass, no image, no shader
@@ -80,7 +83,8 @@ pub struct ShadowDesc {
     pub columns: u32,
     /// Atlas rows.
     pub rows: u32,
-    /// The atlas stores each texel's translucency material (frames with translucency).
+    /// The atlas stores each texel's translucency material (frames with a translucent
+    /// material whose transmitted light other objects shadow: `Translucency::shadowed`).
     pub transmission_ids: bool,
     /// The atlas stores each texel's entry normal and layered material (frames with layered
     /// media: single scattering's light entry points).
@@ -91,9 +95,14 @@ pub struct ShadowDesc {
 }
 
 impl ShadowDesc {
-    /// The maps `scene`'s lights ask for under `settings`; `None` when no light casts (or
-    /// nothing could cast: the scene has no object).
-    pub fn new(scene: &Scene, settings: &ShadowSettings, translucency: bool) -> Option<Self> {
+    /// The maps `scene`'s lights ask for under `settings`, with the translucency ID target
+    /// when `shadowed_transmission`; `None` when no light casts (or nothing could cast: the
+    /// scene has no object).
+    pub fn new(
+        scene: &Scene,
+        settings: &ShadowSettings,
+        shadowed_transmission: bool,
+    ) -> Option<Self> {
         if !settings.enabled || scene.objects.is_empty() {
             return None;
         }
@@ -124,7 +133,7 @@ impl ShadowDesc {
             tile,
             columns,
             rows,
-            transmission_ids: translucency,
+            transmission_ids: shadowed_transmission,
             entry: false,
             layer_depth_textures: 0,
         })
@@ -381,8 +390,10 @@ pub fn shadow_pass(
     };
     let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
     if let Some(ids) = &mut maps.ids {
-        // 0: no translucent material (texels no object covers are never closer than a point).
-        pass.color(ids, LoadOp::Clear([0.0; 4]));
+        // Not cleared (a clear of the whole atlas cost as much as drawing it on lavapipe): a
+        // texel no object covers keeps depth 1, never nearer than a point, so every lookup
+        // counts it lit whatever its ID says.
+        pass.color(ids, LoadOp::DontCare);
     }
     if let Some(entry) = &mut maps.entry {
         // Not cleared (a clear of the whole atlas cost as much as drawing it on lavapipe):

@@ -55,7 +55,8 @@ pub fn luminance(c: Vec3) -> f32 {
 }
 
 /// One material table row as the lighting pass reads it (`glsl/common/translucency.glsl`):
-/// x power, y distortion, z ambient, w pow mode (0 exact, 1 spherical Gaussian).
+/// x power, y distortion, z ambient, w pow mode (0 exact, 1 spherical Gaussian) plus
+/// [`SHADOWED`] when other objects' shadows fall on its transmitted light.
 pub type MaterialRow = [f32; 4];
 
 /// The translucent materials of a scene, each with its ID (row `id - 1`).
@@ -113,6 +114,13 @@ impl MaterialTable {
         })
     }
 
+    /// Whether some material's transmitted light is shadowed by other objects
+    /// ([`Translucency::shadowed`]): only then do the light-space maps store each texel's
+    /// material, and the lighting pass look up lights behind a surface.
+    pub fn any_shadowed(&self) -> bool {
+        self.rows.iter().any(|r| r[3] >= SHADOWED)
+    }
+
     /// Whether the frame needs translucency at all.
     pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
@@ -132,7 +140,7 @@ impl MaterialTable {
     pub fn pow_modes(&self) -> u8 {
         self.rows
             .iter()
-            .map(|r| if r[3] == 1.0 { 2 } else { 1 })
+            .map(|r| if row_pow_mode(r) == 1.0 { 2 } else { 1 })
             .fold(0, |a, b| a | b)
     }
 
@@ -150,16 +158,31 @@ impl MaterialTable {
 
 /// The table row of one material's parameters.
 pub fn material_row(t: &Translucency) -> MaterialRow {
+    let shadowed = if t.shadowed { SHADOWED } else { 0.0 };
     match t.pow_mode {
-        PowMode::Exact => [t.power, t.distortion, t.ambient, 0.0],
-        PowMode::SphericalGaussian => [t.power, t.distortion, t.ambient, 1.0],
+        PowMode::Exact => [t.power, t.distortion, t.ambient, shadowed],
+        PowMode::SphericalGaussian => [t.power, t.distortion, t.ambient, 1.0 + shadowed],
         // The seed's scale and bias, "handled offline": the shader runs the plain exp2 form.
         PowMode::SphericalGaussianScaled => [
             (t.power + 1.0) * std::f32::consts::LOG2_E,
             t.distortion,
             t.ambient,
-            1.0,
+            1.0 + shadowed,
         ],
+    }
+}
+
+/// Added to a row's pow mode (`w`) when other objects' shadows fall on the material's
+/// transmitted light ([`Translucency::shadowed`]; `TRANSLUCENCY_SHADOWED` in
+/// `glsl/common/translucency.glsl`).
+pub const SHADOWED: f32 = 2.0;
+
+/// A row's pow mode without the [`SHADOWED`] flag: 0 exact, 1 spherical Gaussian.
+pub fn row_pow_mode(row: &MaterialRow) -> f32 {
+    if row[3] >= SHADOWED {
+        row[3] - SHADOWED
+    } else {
+        row[3]
     }
 }
 

@@ -87,7 +87,12 @@ impl FrameDesc {
         } else {
             None
         };
-        let mut shadows = ShadowDesc::new(scene, &settings.shadows, translucency.is_some());
+        // The atlas stores each texel's translucency material only for materials whose
+        // transmitted light other objects shadow (the talk's term needs no lookup).
+        let shadowed_transmission = translucency
+            .as_ref()
+            .is_some_and(|t| t.table.any_shadowed());
+        let mut shadows = ShadowDesc::new(scene, &settings.shadows, shadowed_transmission);
         if let Some(s) = &mut shadows {
             // Single scattering reads each map texel's entry normal and layered material, and
             // with TexDep media its depth texels.

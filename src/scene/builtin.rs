@@ -388,12 +388,16 @@ fn mixed() -> Result<Scene> {
     disc.normals = super::normals::angle_weighted_normals(&disc.positions, &disc.indices);
     disc.shape = None;
     let disc = s.add_mesh(disc);
-    let cube_material = translucent(
+    let mut cube_material = translucent(
         "translucent-jade",
         Vec3::new(0.55, 0.8, 0.6),
         ThicknessSource::Bake,
         Vec3::new(0.6, 1.0, 0.7),
     );
+    // lucent's extension beside the talk's term: the skin sphere's shadow falls on the light
+    // through the cube and the disc (`shadowed`; the other built-in scenes keep the talk's
+    // unshadowed term, which no object of theirs would shadow anyway).
+    set_shadowed(&mut cube_material);
     s.add(
         cube,
         Mat4::from_scale_rotation_translation(
@@ -436,6 +440,7 @@ fn mixed() -> Result<Scene> {
         Vec3::new(1.0, 0.35, 0.25),
     );
     ear.sss = Some(skin_profile);
+    set_shadowed(&mut ear);
     s.add(
         disc,
         Mat4::from_scale_rotation_translation(
@@ -464,6 +469,13 @@ fn mixed() -> Result<Scene> {
         Light::directional(Vec3::new(0.2, -0.5, -1.0), Vec3::new(0.55, 0.65, 0.8), 0.35),
     ];
     Ok(s)
+}
+
+/// Other objects' shadows fall on `material`'s transmitted light (`Translucency::shadowed`).
+fn set_shadowed(material: &mut Material) {
+    if let Some(t) = &mut material.translucency {
+        t.shadowed = true;
+    }
 }
 
 fn skin() -> Result<Scene> {

@@ -260,10 +260,19 @@ fn has_pass(plan: &Plan) -> bool {
 #[test]
 fn maps_exist_exactly_for_the_lights_that_cast() {
     let s = FrameSettings::new(320, 240);
-    // Built-in scenes: every light casts by default; the translucent cubes carry the IDs.
+    // Built-in scenes: every light casts by default. The translucent cubes have the talk's
+    // term, which no shadow falls on: no ID target; `mixed`'s cube and disc ask for shadows on
+    // their transmitted light (`shadowed`): the atlas carries the IDs.
     let cubes = builtin("cubes").unwrap();
     let p = common::plan(&cubes, &s);
-    assert!(has_pass(&p) && has(&p, "light-space.depth") && has(&p, "light-space.ids"));
+    assert!(has_pass(&p) && has(&p, "light-space.depth"));
+    assert!(!has(&p, "light-space.ids"), "the talk's term: no ID target");
+    let mixed = builtin("mixed").unwrap();
+    let p = common::plan(&mixed, &s);
+    assert!(
+        has(&p, "light-space.ids"),
+        "shadowed transmission: the ID target"
+    );
     let layered = builtin("layered").unwrap();
     let p = common::plan(&layered, &s);
     assert!(has_pass(&p) && has(&p, "light-space.depth"));
@@ -315,13 +324,17 @@ fn maps_exist_exactly_for_the_lights_that_cast() {
 
 #[test]
 fn translucent_objects_are_not_shadowed_by_their_own_faces() {
-    // A translucent cube lit from behind: its transmitted light survives shadows (its own
-    // faces do not shadow it) while an opaque wall between light and cube removes it.
+    // A translucent cube lit from behind, its transmitted light shadowed by other objects
+    // (`shadowed`): it survives shadows (its own faces do not shadow it) while an opaque wall
+    // between light and cube removes it. With the talk's term (not `shadowed`) the wall
+    // leaves it as it is.
     let test = TestGpu::new();
     let light = Light::point(Vec3::new(-3.0, 1.5, 0.0), Vec3::ONE, 40.0, 20.0);
     let mut scene = occluder_scene(light);
     let mut glass = Material::opaque("glass", Vec3::splat(0.9), 0.0, 1.0);
-    glass.translucency = Some(Translucency::new(ThicknessSource::Constant(1.0)));
+    let mut term = Translucency::new(ThicknessSource::Constant(1.0));
+    term.shadowed = true;
+    glass.translucency = Some(term);
     scene.objects[1].material = glass;
     let cube_pixel = pixel_of(&scene, Vec3::new(0.5, 1.5, 0.0));
     let lit = test.render(&scene, settings(false));
@@ -353,6 +366,21 @@ fn translucent_objects_are_not_shadowed_by_their_own_faces() {
     assert!(
         c < 0.1 * a,
         "the wall does not shadow the transmission: {c}"
+    );
+    // The talk's term: the wall shadows no transmitted light, and the atlas has no IDs.
+    if let Some(t) = &mut scene.objects[1].material.translucency {
+        t.shadowed = false;
+    }
+    assert!(!has(
+        &common::plan(&scene, &settings(true)),
+        "light-space.ids"
+    ));
+    let unshadowed = test.render(&scene, settings(true));
+    let d = luminance(&unshadowed, cube_pixel);
+    println!("the talk's term with the wall between: {d:.4}");
+    assert!(
+        (d - a).abs() <= 0.05 * a,
+        "the wall shadowed the talk's term: {a} -> {d}"
     );
     test.finish();
 }

@@ -188,6 +188,7 @@ fn overrides(at: Table<'_>, t: &TranslucencyToml, translucency: &mut Translucenc
     translucency.power = value(&t.power).unwrap_or(translucency.power);
     translucency.distortion = value(&t.distortion).unwrap_or(translucency.distortion);
     translucency.ambient = value(&t.ambient).unwrap_or(translucency.ambient);
+    translucency.shadowed = value(&t.shadowed).unwrap_or(translucency.shadowed);
     translucency.pow_mode = match t.pow.as_ref().map(|p| p.get_ref().as_str()) {
         None | Some("exact") => PowMode::Exact,
         Some("exp2") => PowMode::SphericalGaussian,

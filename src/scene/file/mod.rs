@@ -482,6 +482,7 @@ material = "red"
             jade.translucency.as_ref().unwrap().thickness,
             ThicknessSource::Bake
         );
+        assert!(jade.translucency.as_ref().unwrap().shadowed);
         assert!(scene.objects[1].material.sss.is_some());
     }
 

@@ -90,6 +90,8 @@ pub(super) struct TranslucencyToml {
     pub(super) distortion: Option<Spanned<f32>>,
     pub(super) ambient: Option<Spanned<f32>>,
     pub(super) pow: Option<Spanned<String>>,
+    /// Other objects' shadows fall on the transmitted light (default false: the talk's term).
+    pub(super) shadowed: Option<Spanned<bool>>,
 }
 
 #[derive(Deserialize)]

@@ -40,254 +40,262 @@ pub const BENCH: &str = "--size 512x384 --frames 15 --warmup 3 --shadow-size 512
 pub const AGAINST_BENCH: &str = BENCH;
 
 /// How far above today's ratio a pass may go against its floor, and how far today's extra cost
-/// of a technique over `none` may grow: a doubling (2x) trips it; the spread of the table
-/// across machines and runs (docs/performance.md) does not.
-pub const MARGIN: f64 = 1.6;
+/// of a technique over `none` may grow. Set from the table's measured spread
+/// (docs/performance.md): each pass's ratio moved at most 1.43x between two configurations of
+/// lavapipe (one thread and two) and 1.21x between two runs of the gate; a pass that does its
+/// work twice reads 1.17-2.34x (median 1.73x), and 89 of 132 such passes go over it.
+pub const MARGIN: f64 = 1.5;
 
 /// Added to the limit on a technique's extra cost over `none` (a ratio of 1.05 is 5%): the
-/// run-to-run and machine-to-machine spread of an alternating comparison whose extra cost is
-/// near zero, where a multiple of it would be no room at all.
-pub const AGAINST_NOISE: f64 = 0.08;
+/// spread of an alternating comparison whose extra cost is near zero, where a multiple of it
+/// would be no room at all (`grid125`'s translucency over `none` read 1.00-1.11x between runs
+/// and lavapipe's thread counts); issue 34's own limit on that cost, 15%.
+pub const AGAINST_NOISE: f64 = 0.15;
 
 /// Runs of each benchmark; a pass is judged by the median of its runs' ratios.
 pub const RUNS: usize = 3;
 
+/// One benchmark of the gate's tables: its `lucent bench` options after `--scene` (a built-in
+/// scene, then any other options), and each held pass with today's ratio.
+pub type Benchmark = (&'static str, &'static [(&'static str, f64)]);
+
 /// Today's ratio of each pass to its floor, per benchmark (a built-in scene, with the options
-/// after its name), with [`BENCH`]'s settings: medians of five runs on the project's 2-core
-/// lavapipe machine (Mesa 22.3.6), the machine otherwise idle. Every built-in scene under its
+/// after its name), with [`BENCH`]'s settings, each pass's time alone (isolated) over its
+/// floor's: medians of five runs (`lucent bench --gate --gate-baseline 5 --validation`) on the
+/// project's 2-core lavapipe machine (Mesa 22.3.6), the machine otherwise idle. Every built-in scene under its
 /// own materials (`auto`), and the techniques no built-in scene picks by itself on `skin`
 /// (Burley, the bilateral blur, LBB, LCB, the 12-pass control) and FXAA on `smoke`.
-pub const BASELINE: &[(&str, &[(&str, f64)])] = &[
+pub const BASELINE: &[Benchmark] = &[
     (
         "smoke",
         &[
-            ("light-space maps", 1.01),
-            ("gbuffer + lighting", 5.34),
-            ("tonemap", 1.85),
+            ("light-space maps", 0.98),
+            ("gbuffer + lighting", 5.47),
+            ("tonemap", 1.97),
         ],
     ),
     (
         "cubes",
         &[
-            ("light-space maps", 1.02),
-            ("gbuffer + lighting", 6.91),
-            ("tonemap", 1.98),
+            ("light-space maps", 1.04),
+            ("gbuffer + lighting", 6.92),
+            ("tonemap", 2.01),
         ],
     ),
     (
         "grid125",
         &[
-            ("light-space maps", 1.03),
-            ("gbuffer + lighting", 3.99),
-            ("tonemap", 2.08),
+            ("light-space maps", 0.97),
+            ("gbuffer + lighting", 4.37),
+            ("tonemap", 1.71),
         ],
     ),
     (
         "teapot",
         &[
-            ("light-space maps", 0.99),
-            ("gbuffer + lighting", 5.22),
-            ("horizontal blur", 2.84),
-            ("vertical blur", 1.83),
-            ("tonemap", 1.90),
+            ("light-space maps", 0.98),
+            ("gbuffer + lighting", 5.27),
+            ("horizontal blur", 2.78),
+            ("vertical blur", 1.82),
+            ("tonemap", 1.72),
         ],
     ),
     (
         "skin",
         &[
-            ("light-space maps", 1.02),
-            ("gbuffer + lighting", 3.78),
-            ("horizontal blur", 1.55),
-            ("vertical blur", 1.44),
-            ("tonemap", 1.49),
+            ("light-space maps", 1.01),
+            ("gbuffer + lighting", 4.24),
+            ("horizontal blur", 2.34),
+            ("vertical blur", 1.54),
+            ("tonemap", 1.73),
         ],
     ),
     (
         "mixed",
         &[
-            ("light-space maps", 1.05),
-            ("gbuffer + lighting", 4.61),
-            ("horizontal blur", 1.58),
-            ("vertical blur", 1.54),
-            ("tonemap", 1.35),
+            ("light-space maps", 1.01),
+            ("gbuffer + lighting", 4.91),
+            ("horizontal blur", 2.17),
+            ("vertical blur", 1.74),
+            ("tonemap", 1.82),
         ],
     ),
     (
         "edges",
         &[
-            ("light-space maps", 1.00),
-            ("gbuffer + lighting", 5.58),
-            ("horizontal blur", 3.02),
-            ("vertical blur", 2.04),
-            ("tonemap", 1.86),
+            ("light-space maps", 0.93),
+            ("gbuffer + lighting", 5.66),
+            ("horizontal blur", 3.16),
+            ("vertical blur", 1.87),
+            ("tonemap", 2.02),
         ],
     ),
     (
         "layered",
         &[
-            ("light-space maps", 1.28),
-            ("gbuffer + lighting", 3.96),
-            ("layered irradiance", 1.68),
-            ("multiple scattering", 2.51),
+            ("light-space maps", 1.18),
+            ("gbuffer + lighting", 4.02),
+            ("layered irradiance", 1.78),
+            ("multiple scattering", 2.79),
             ("multiple scattering blur", 0.12),
-            ("single scattering", 4.00),
-            ("tonemap", 1.91),
+            ("single scattering", 3.82),
+            ("tonemap", 1.99),
         ],
     ),
     (
         "dynamic",
         &[
-            ("light-space maps", 1.13),
-            ("gbuffer + lighting", 5.30),
-            ("layered irradiance", 3.43),
-            ("multiple scattering", 5.02),
+            ("light-space maps", 1.12),
+            ("gbuffer + lighting", 5.39),
+            ("layered irradiance", 3.74),
+            ("multiple scattering", 5.39),
             ("multiple scattering blur", 0.13),
-            ("single scattering", 8.79),
-            ("tonemap", 1.78),
+            ("single scattering", 8.92),
+            ("tonemap", 1.96),
         ],
     ),
     (
         "scaling",
         &[
-            ("light-space maps", 1.27),
-            ("gbuffer + lighting", 1.96),
-            ("layered irradiance", 3.06),
-            ("multiple scattering", 4.49),
-            ("multiple scattering blur", 0.11),
-            ("single scattering", 6.31),
-            ("tonemap", 1.64),
+            ("light-space maps", 1.13),
+            ("gbuffer + lighting", 2.11),
+            ("layered irradiance", 3.92),
+            ("multiple scattering", 5.70),
+            ("multiple scattering blur", 0.12),
+            ("single scattering", 6.72),
+            ("tonemap", 1.90),
         ],
     ),
     (
         "showcase-translucency",
         &[
-            ("light-space maps", 1.03),
-            ("gbuffer + lighting", 3.24),
-            ("tonemap", 1.31),
+            ("light-space maps", 0.95),
+            ("gbuffer + lighting", 4.55),
+            ("tonemap", 1.97),
         ],
     ),
     (
         "showcase-skin",
         &[
-            ("light-space maps", 1.09),
-            ("gbuffer + lighting", 3.29),
-            ("horizontal blur", 3.10),
-            ("vertical blur", 2.12),
-            ("tonemap", 1.73),
+            ("light-space maps", 0.96),
+            ("gbuffer + lighting", 3.23),
+            ("horizontal blur", 3.77),
+            ("vertical blur", 2.39),
+            ("tonemap", 1.86),
         ],
     ),
     (
         "showcase-marble",
         &[
-            ("light-space maps", 1.02),
-            ("gbuffer + lighting", 4.27),
-            ("horizontal blur", 2.97),
-            ("vertical blur", 2.17),
-            ("tonemap", 1.79),
+            ("light-space maps", 0.98),
+            ("gbuffer + lighting", 4.80),
+            ("horizontal blur", 4.47),
+            ("vertical blur", 2.90),
+            ("tonemap", 1.90),
         ],
     ),
     (
         "showcase-layered",
         &[
-            ("light-space maps", 1.22),
-            ("gbuffer + lighting", 3.78),
-            ("layered irradiance", 2.47),
-            ("multiple scattering", 4.06),
-            ("multiple scattering blur", 0.67),
-            ("single scattering", 5.62),
-            ("tonemap", 1.77),
+            ("light-space maps", 1.16),
+            ("gbuffer + lighting", 3.88),
+            ("layered irradiance", 2.69),
+            ("multiple scattering", 3.89),
+            ("multiple scattering blur", 0.69),
+            ("single scattering", 5.23),
+            ("tonemap", 1.89),
         ],
     ),
     (
         "skin --technique burley",
         &[
-            ("light-space maps", 1.02),
-            ("gbuffer + lighting", 4.34),
-            ("burley", 2.91),
-            ("burley resolve", 1.66),
-            ("tonemap", 1.79),
+            ("light-space maps", 0.92),
+            ("gbuffer + lighting", 4.18),
+            ("burley", 3.36),
+            ("burley resolve", 1.95),
+            ("tonemap", 1.92),
         ],
     ),
     (
         "skin --technique bilateral",
         &[
-            ("light-space maps", 1.00),
-            ("projection + lighting", 4.11),
-            ("horizontal blur", 4.12),
-            ("vertical blur", 3.77),
-            ("tonemap", 1.83),
+            ("light-space maps", 1.01),
+            ("projection + lighting", 3.99),
+            ("horizontal blur", 4.43),
+            ("vertical blur", 3.98),
+            ("tonemap", 1.75),
         ],
     ),
     (
         "skin --technique lbb",
         &[
-            ("light-space maps", 0.97),
-            ("projection + lighting", 3.64),
-            ("horizontal blur #1", 2.02),
-            ("vertical blur #1", 2.27),
-            ("horizontal blur #2", 2.16),
-            ("vertical blur #2", 1.27),
+            ("light-space maps", 0.98),
+            ("projection + lighting", 4.15),
+            ("horizontal blur #1", 2.37),
+            ("vertical blur #1", 2.60),
+            ("horizontal blur #2", 2.42),
+            ("vertical blur #2", 1.43),
             ("horizontal blur #3", 2.39),
-            ("vertical blur #3", 1.35),
-            ("horizontal blur #4", 2.02),
-            ("vertical blur #4", 1.31),
-            ("horizontal blur #5", 2.03),
-            ("vertical blur #5", 1.37),
-            ("horizontal blur #6", 2.10),
-            ("vertical blur #6", 1.47),
-            ("final lighting", 1.69),
-            ("tonemap", 1.68),
+            ("vertical blur #3", 1.55),
+            ("horizontal blur #4", 2.42),
+            ("vertical blur #4", 1.36),
+            ("horizontal blur #5", 2.43),
+            ("vertical blur #5", 1.52),
+            ("horizontal blur #6", 2.40),
+            ("vertical blur #6", 1.55),
+            ("final lighting", 1.97),
+            ("tonemap", 1.80),
         ],
     ),
     (
         "skin --technique lcb",
         &[
-            ("light-space maps", 1.03),
-            ("projection + lighting", 3.98),
-            ("horizontal blur #1", 3.46),
-            ("vertical blur #1", 3.26),
-            ("horizontal blur #2", 3.21),
-            ("vertical blur #2", 2.01),
-            ("horizontal blur #3", 3.07),
-            ("vertical blur #3", 1.84),
-            ("horizontal blur #4", 3.22),
-            ("vertical blur #4", 1.82),
-            ("horizontal blur #5", 3.29),
-            ("vertical blur #5", 2.06),
-            ("horizontal blur #6", 3.23),
-            ("vertical blur #6", 1.97),
-            ("final lighting", 1.89),
-            ("tonemap", 1.69),
+            ("light-space maps", 0.98),
+            ("projection + lighting", 3.95),
+            ("horizontal blur #1", 3.26),
+            ("vertical blur #1", 3.27),
+            ("horizontal blur #2", 3.45),
+            ("vertical blur #2", 1.93),
+            ("horizontal blur #3", 3.22),
+            ("vertical blur #3", 1.92),
+            ("horizontal blur #4", 3.48),
+            ("vertical blur #4", 1.91),
+            ("horizontal blur #5", 3.35),
+            ("vertical blur #5", 2.04),
+            ("horizontal blur #6", 3.54),
+            ("vertical blur #6", 2.02),
+            ("final lighting", 1.93),
+            ("tonemap", 1.77),
         ],
     ),
     (
         "skin --technique control",
         &[
-            ("light-space maps", 1.08),
-            ("gbuffer + lighting", 3.97),
-            ("horizontal blur #1", 2.67),
-            ("vertical blur #1", 2.51),
-            ("horizontal blur #2", 2.85),
-            ("vertical blur #2", 1.73),
-            ("horizontal blur #3", 2.27),
-            ("vertical blur #3", 1.66),
-            ("horizontal blur #4", 2.36),
-            ("vertical blur #4", 1.81),
-            ("horizontal blur #5", 2.86),
-            ("vertical blur #5", 1.81),
-            ("horizontal blur #6", 2.94),
-            ("vertical blur #6", 1.84),
-            ("combine", 1.14),
-            ("tonemap", 1.56),
+            ("light-space maps", 1.00),
+            ("gbuffer + lighting", 4.35),
+            ("horizontal blur #1", 2.84),
+            ("vertical blur #1", 2.80),
+            ("horizontal blur #2", 2.88),
+            ("vertical blur #2", 1.79),
+            ("horizontal blur #3", 3.16),
+            ("vertical blur #3", 1.78),
+            ("horizontal blur #4", 2.84),
+            ("vertical blur #4", 1.77),
+            ("horizontal blur #5", 2.75),
+            ("vertical blur #5", 1.63),
+            ("horizontal blur #6", 2.78),
+            ("vertical blur #6", 1.77),
+            ("combine", 1.11),
+            ("tonemap", 1.80),
         ],
     ),
     (
         "smoke --aa fxaa",
         &[
-            ("light-space maps", 0.87),
-            ("gbuffer + lighting", 3.92),
-            ("tonemap", 1.24),
-            ("fxaa", 1.94),
+            ("light-space maps", 1.02),
+            ("gbuffer + lighting", 5.43),
+            ("tonemap", 1.83),
+            ("fxaa", 3.32),
         ],
     ),
 ];
@@ -295,21 +303,21 @@ pub const BASELINE: &[(&str, &[(&str, f64)])] = &[
 /// Today's ratio of the listed passes (and `frame`) of a benchmark under its technique to the
 /// same scene under `none`, alternating frames, with [`AGAINST_BENCH`]'s settings: medians of
 /// five runs, as [`BASELINE`].
-pub const AGAINST: &[(&str, &[(&str, f64)])] = &[
+pub const AGAINST: &[Benchmark] = &[
     (
         "grid125 --technique translucency",
         &[
-            ("light-space maps", 1.02),
-            ("gbuffer + lighting", 1.06),
-            ("frame", 1.02),
+            ("light-space maps", 1.00),
+            ("gbuffer + lighting", 1.00),
+            ("frame", 1.00),
         ],
     ),
     (
         "mixed",
         &[
-            ("light-space maps", 1.14),
-            ("gbuffer + lighting", 1.38),
-            ("frame", 1.48),
+            ("light-space maps", 1.08),
+            ("gbuffer + lighting", 1.44),
+            ("frame", 1.52),
         ],
     ),
 ];
@@ -460,7 +468,7 @@ mod tests {
         assert_eq!(failures.len(), 1, "{failures:?}");
         assert!(
             failures[0].contains("'gbuffer + lighting' is 10.00x its floor")
-                && failures[0].contains("limit 8.00x"),
+                && failures[0].contains("limit 7.50x"),
             "{failures:?}"
         );
     }
@@ -487,7 +495,7 @@ mod tests {
         let rows = markdown_rows("smoke", "its floor", &judged);
         assert!(rows.contains("| smoke | fxaa | its floor | 2.00x | - | **new pass: no limit** |"));
         assert!(
-            rows.contains("| smoke | tonemap | its floor | - | 3.20x | **gone from the frame** |")
+            rows.contains("| smoke | tonemap | its floor | - | 3.00x | **gone from the frame** |")
         );
     }
 

@@ -529,31 +529,7 @@ impl PassExec for ShadowPass {
         // viewport changes between faces.
         let mut bound_pair = 0usize;
         for face in 0..self.desc.faces() {
-            let (x, y) = self.desc.tile_origin(face);
-            let tile = self.desc.tile;
-            let viewport = vk::Viewport {
-                x: x as f32,
-                y: y as f32,
-                width: tile as f32,
-                height: tile as f32,
-                min_depth: 0.0,
-                max_depth: 1.0,
-            };
-            let scissor = vk::Rect2D {
-                offset: vk::Offset2D {
-                    x: x as i32,
-                    y: y as i32,
-                },
-                extent: vk::Extent2D {
-                    width: tile,
-                    height: tile,
-                },
-            };
-            // SAFETY: recording inside this pass's render pass with its pipeline bound.
-            unsafe {
-                device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
-                device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
-            }
+            super::util::set_tile_viewport(ctx, self.desc.tile_origin(face), self.desc.tile);
             for draw in &self.scene.draws {
                 if self.layer_depths() && draw.depth_maps != bound_pair {
                     let set = match draw.depth_maps {

@@ -184,3 +184,35 @@ impl PassPipeline {
         self.set.destroy(device);
     }
 }
+
+/// Sets the viewport and scissor to the square tile of edge `edge` texels at `origin` (a
+/// light-space face's tile of the atlas): where the light-space maps pass, and its floor in the
+/// benchmark, draw one face. A pipeline must be bound (viewport and scissor are dynamic state
+/// of every lucent pipeline); nothing restores the executor's full-area viewport afterwards,
+/// so a pass that draws into tiles sets each tile it draws.
+pub fn set_tile_viewport(ctx: &RecordContext<'_>, origin: (u32, u32), edge: u32) {
+    let (x, y) = origin;
+    let viewport = vk::Viewport {
+        x: x as f32,
+        y: y as f32,
+        width: edge as f32,
+        height: edge as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D {
+            x: x as i32,
+            y: y as i32,
+        },
+        extent: vk::Extent2D {
+            width: edge,
+            height: edge,
+        },
+    };
+    // SAFETY: called while recording inside a render pass with a lucent pipeline bound.
+    unsafe {
+        ctx.gpu.device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
+        ctx.gpu.device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
+    }
+}

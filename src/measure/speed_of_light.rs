@@ -567,44 +567,17 @@ impl PassExec for MeshFloorPass {
         };
         pipeline.bind(ctx);
         let device = &ctx.gpu.device;
-        // Each view: the face it draws with and its tile (None: the whole render area, as the
-        // executor set it).
-        let views: Vec<(u32, Option<vk::Rect2D>)> = match &self.draws.views {
-            MeshViews::Camera => vec![(0, None)],
-            MeshViews::ShadowFaces { origins, tile } => origins
-                .iter()
-                .enumerate()
-                .map(|(face, &(x, y))| {
-                    let rect = vk::Rect2D {
-                        offset: vk::Offset2D {
-                            x: x as i32,
-                            y: y as i32,
-                        },
-                        extent: vk::Extent2D {
-                            width: *tile,
-                            height: *tile,
-                        },
-                    };
-                    (face as u32, Some(rect))
-                })
-                .collect(),
+        // Each view's tile, in face order (None: the whole render area, as the executor set
+        // it, with the camera).
+        let (tiles, edge): (Vec<Option<(u32, u32)>>, u32) = match &self.draws.views {
+            MeshViews::Camera => (vec![None], 0),
+            MeshViews::ShadowFaces { origins, tile } => {
+                (origins.iter().copied().map(Some).collect(), *tile)
+            }
         };
-        for (face, rect) in views {
-            if let Some(rect) = rect {
-                let viewport = vk::Viewport {
-                    x: rect.offset.x as f32,
-                    y: rect.offset.y as f32,
-                    width: rect.extent.width as f32,
-                    height: rect.extent.height as f32,
-                    min_depth: 0.0,
-                    max_depth: 1.0,
-                };
-                // SAFETY: viewport and scissor are dynamic state of every lucent pipeline;
-                // recording inside this pass's render pass with its pipeline bound.
-                unsafe {
-                    device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
-                    device.cmd_set_scissor(ctx.cmd, 0, &[rect]);
-                }
+        for (face, tile) in tiles.into_iter().enumerate() {
+            if let Some(origin) = tile {
+                crate::features::util::set_tile_viewport(ctx, origin, edge);
             }
             for draw in &self.scene.draws {
                 let constants = FloorConstants {

@@ -395,8 +395,9 @@ fn mixed() -> Result<Scene> {
         Vec3::new(0.6, 1.0, 0.7),
     );
     // lucent's extension beside the talk's term: the skin sphere's shadow falls on the light
-    // through the cube and the disc (`shadowed`; the other built-in scenes keep the talk's
-    // unshadowed term, which no object of theirs would shadow anyway).
+    // through the cube and the disc (`shadowed`; so does the head's on showcase-skin's far ear;
+    // the other built-in scenes keep the talk's unshadowed term, which no object of theirs
+    // would shadow anyway).
     set_shadowed(&mut cube_material);
     s.add(
         cube,

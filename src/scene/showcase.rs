@@ -241,6 +241,9 @@ pub fn skin() -> Result<Scene> {
         t.power = 5.0;
         t.distortion = 0.3;
         t.ambient = 0.1;
+        // The head stands between the back light and the far ear: its shadow falls on the
+        // light through that ear (lucent's extension; the talk's term would light it anyway).
+        t.shadowed = true;
     }
     for side in [-1.0f32, 1.0] {
         s.add(

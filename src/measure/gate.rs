@@ -308,7 +308,9 @@ pub const AGAINST: &[Benchmark] = &[
         "grid125 --technique translucency",
         &[
             ("light-space maps", 1.00),
-            ("gbuffer + lighting", 1.00),
+            // Not the five-run median (1.00x): the median of the nine runs of the gate this
+            // table was made in (1.00-1.11x); issue 34 measured +45-63% before.
+            ("gbuffer + lighting", 1.07),
             ("frame", 1.00),
         ],
     ),

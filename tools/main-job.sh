@@ -6,7 +6,7 @@
 #   lighting).
 # - Without one: the headless benchmark of the built-in `mixed` scene (every technique in one
 #   frame: GDC 2011 translucency, skin and marble SSS, translucency and SSS on one object,
-#   shadows), each pass against its speed-of-light copy, timed in-frame and alone. It prints the
+#   shadows), each pass against its speed-of-light floor, timed in-frame and alone. It prints the
 #   table and writes it to bench.md, the numbers to bench.json and the frame to mixed.png.
 #   About 15 s of benchmark on lavapipe with 2 cores, after the build.
 set -euo pipefail

@@ -312,3 +312,24 @@ fn shaders_dir_compiles_an_edited_tree_at_run_time_and_a_bad_one_is_refused() {
         "{stderr}"
     );
 }
+
+#[test]
+fn the_gate_refuses_the_flags_it_sets_itself_naming_them() {
+    // --gate sets every benchmark's flags: a frame flag given with it is refused by name,
+    // before any GPU work (exit 2, clap's convention), not silently ignored.
+    let out = common::lucent(&["bench", "--gate", "--scene", "skin", "--frames", "5"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--gate") && stderr.contains("--scene") && stderr.contains("--frames"),
+        "{stderr}"
+    );
+    // --gate-baseline measures the gate's tables: it needs --gate, and the message says so.
+    let out = common::lucent(&["bench", "--gate-baseline", "3"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("not provided: --gate"), "{stderr}");
+    // Out of range.
+    let out = common::lucent(&["bench", "--gate", "--gate-baseline", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+}

@@ -98,7 +98,16 @@ fn usage_error(error: &clap::Error) -> String {
     let text = error.render().to_string();
     let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
     let first = lines.next().unwrap_or("invalid command line");
-    let mut parts = vec![first.trim_start_matches("error: ").to_string()];
+    let mut first = first.trim_start_matches("error: ").to_string();
+    if first.ends_with(':') {
+        // A list follows on its own lines (the missing arguments): keep it in the one line.
+        let listed: Vec<&str> = lines
+            .clone()
+            .take_while(|l| l.starts_with('-') || l.starts_with('<'))
+            .collect();
+        first = format!("{first} {}", listed.join(", "));
+    }
+    let mut parts = vec![first];
     parts.extend(
         lines
             .filter_map(|l| l.strip_prefix("tip: "))

@@ -346,6 +346,7 @@ impl Renderer {
 
     /// The scene's GPU meshes and per-frame buffer, shared (the benchmark's mesh floors draw
     /// the same objects); `None` once destroyed.
+    #[cfg(feature = "measure")]
     pub(crate) fn scene_gpu_shared(&self) -> Option<&Arc<SceneGpu>> {
         self.scene_gpu.as_ref()
     }

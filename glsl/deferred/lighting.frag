@@ -58,6 +58,14 @@ vec2 light_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, int material)
 #endif
 }
 
+// How much of light `i` (attenuation `attenuation` at the pixel) reaches the surface to be
+// reflected. Light that cannot reach the surface (outside the range, behind it) reflects
+// nothing: no shadow lookup for it.
+float reflected_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float attenuation) {
+    bool lit_side = attenuation > 0.0 && dot(normal, to_light) > 0.0;
+    return lit_side ? light_visibility(i, pos, normal, to_light, 0).x : 0.0;
+}
+
 #ifdef LUCENT_TRANSLUCENCY
 // The translucent variant's visibility of light `i` (attenuation `attenuation` at the pixel):
 // x reflected, y transmitted through translucency material `material`. The talk's term is not
@@ -73,8 +81,7 @@ vec2 translucent_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float a
                                  : vec2(0.0);
     }
 #endif
-    bool lit_side = attenuation > 0.0 && dot(normal, to_light) > 0.0;
-    return vec2(lit_side ? light_visibility(i, pos, normal, to_light, 0).x : 0.0, 1.0);
+    return vec2(reflected_visibility(i, pos, normal, to_light, attenuation), 1.0);
 }
 #endif
 
@@ -209,10 +216,7 @@ void main() {
         vec3 to_light;
         float attenuation;
         light_incidence(light, pos, to_light, attenuation);
-        // Light that cannot reach the surface (outside the range, behind it) reflects
-        // nothing: no shadow lookup for it.
-        bool lit_side = attenuation > 0.0 && dot(s.normal, to_light) > 0.0;
-        float visible = lit_side ? light_visibility(i, pos, s.normal, to_light, 0).x : 0.0;
+        float visible = reflected_visibility(i, pos, s.normal, to_light, attenuation);
         color += shade_incident(s, to_eye, to_light, attenuation * visible, light);
     }
 #endif

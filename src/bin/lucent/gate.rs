@@ -89,11 +89,9 @@ pub fn baseline(gpu: &GpuArgs, runs: usize) -> Result<()> {
         let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         for _ in 0..runs {
             // A run the benchmark's timing checks refuse adds nothing.
-            if let Ok(measured) = ratios(&exe, &forwarded, bench, held)? {
+            if let Ok(measured) = ratios(&exe, &forwarded, bench, table, held)? {
                 for (pass, ratio) in measured {
-                    if matches!(held, Held::Floor) || table.iter().any(|(p, _)| *p == pass) {
-                        samples.entry(pass).or_default().push(ratio);
-                    }
+                    samples.entry(pass).or_default().push(ratio);
                 }
             }
         }
@@ -172,15 +170,8 @@ fn measure(
     let mut runs = Vec::new();
     let mut refused = Vec::new();
     for _ in 0..gate::RUNS {
-        match ratios(exe, forwarded, bench, held)? {
-            Ok(measured) => runs.push(match held {
-                Held::Floor => measured,
-                // Only the passes the two techniques share and the table holds.
-                Held::AgainstNone => measured
-                    .into_iter()
-                    .filter(|(pass, _)| table.iter().any(|(p, _)| p == pass))
-                    .collect(),
-            }),
+        match ratios(exe, forwarded, bench, table, held)? {
+            Ok(measured) => runs.push(measured),
             Err(why) => refused.push(why),
         }
     }
@@ -194,12 +185,14 @@ fn measure(
     Ok((gate::judge(&measured, table, held.limit()), runs.len()))
 }
 
-/// One run of `bench`: each pass's ratio (to its floor, or to `none`), or why the run measured
-/// nothing (the benchmark's own timing checks can refuse a run on a loaded machine).
+/// One run of `bench`: each pass's ratio (to its floor; against `none`, only the passes the
+/// two techniques share and `table` holds), or why the run measured nothing (the benchmark's
+/// own timing checks can refuse a run on a loaded machine).
 fn ratios(
     exe: &std::path::Path,
     forwarded: &[String],
     bench: &str,
+    table: &[(&str, f64)],
     held: Held,
 ) -> Result<std::result::Result<BTreeMap<String, f64>, String>> {
     let line = format!("bench --scene {bench} {}", held.flags());
@@ -251,8 +244,13 @@ fn ratios(
             Held::AgainstNone => row["ratio"].as_f64(),
         };
         match (ratio, held) {
-            (Some(ratio), _) => {
+            (Some(ratio), Held::Floor) => {
                 ratios.insert(pass, ratio);
+            }
+            (Some(ratio), Held::AgainstNone) => {
+                if table.iter().any(|(p, _)| *p == pass) {
+                    ratios.insert(pass, ratio);
+                }
             }
             // A pass only one technique has (a blur): nothing to compare.
             (None, Held::AgainstNone) => {}

@@ -69,19 +69,21 @@ float reflected_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float at
 #ifdef LUCENT_TRANSLUCENCY
 // The translucent variant's visibility of light `i` (attenuation `attenuation` at the pixel):
 // x reflected, y transmitted through translucency material `material`. The talk's term is not
-// shadowed (its local thickness is its only attenuation), so a material that does not ask for
-// shadows (`shadowed`) looks up reflected light only, and only where the light reaches the
-// surface, as the plain variant does; a shadowed one (frames with the ID atlas) looks up every
-// light that reaches the pixel, from behind too.
+// shadowed (its local thickness is its only attenuation): frames without a `shadowed`
+// material (no ID atlas) look up reflected light only, and only where the light reaches the
+// surface, as the plain variant does. Frames with one look up every light that reaches the
+// pixel, from behind too, once, and a material that is not `shadowed` keeps only the
+// reflected part: llvmpipe runs both sides of a per-pixel branch, so a branch between the two
+// lookups would make every pixel pay for both.
 vec2 translucent_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float attenuation,
                             int material, bool shadowed) {
 #ifdef LUCENT_SHADOW_IDS
-    if (shadowed) {
-        return attenuation > 0.0 ? light_visibility(i, pos, normal, to_light, material)
-                                 : vec2(0.0);
-    }
-#endif
+    vec2 visible = attenuation > 0.0 ? light_visibility(i, pos, normal, to_light, material)
+                                     : vec2(0.0);
+    return shadowed ? visible : vec2(visible.x, 1.0);
+#else
     return vec2(reflected_visibility(i, pos, normal, to_light, attenuation), 1.0);
+#endif
 }
 #endif
 

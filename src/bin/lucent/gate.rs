@@ -8,7 +8,7 @@
 use std::collections::BTreeMap;
 use std::io::Write as _;
 
-use lucent::measure::gate::{self, Judged};
+use lucent::measure::gate;
 use lucent::{LucentError, Result};
 
 use crate::cli::GpuArgs;
@@ -68,11 +68,35 @@ fn lucent_and_flags(gpu: &GpuArgs) -> Result<(std::path::PathBuf, Vec<String>)> 
 }
 
 /// Every benchmark of the gate's tables, with what it holds its passes against.
-fn benchmarks() -> impl Iterator<Item = (&'static gate::Benchmark, Held)> {
-    gate::BASELINE
-        .iter()
+fn benchmarks() -> impl Iterator<Item = (&'static str, Held)> {
+    gate::floor_benchmarks()
         .map(|b| (b, Held::Floor))
-        .chain(gate::AGAINST.iter().map(|b| (b, Held::AgainstNone)))
+        .chain(gate::AGAINST.iter().map(|(b, _)| (*b, Held::AgainstNone)))
+}
+
+/// Today's ratios of `bench`'s passes: the machine's floor table, or the one `none` table.
+fn table_of(bench: &str, held: Held, choice: &gate::TableChoice) -> Vec<(&'static str, f64)> {
+    match held {
+        Held::Floor => choice.baseline(bench),
+        Held::AgainstNone => gate::AGAINST
+            .iter()
+            .find(|(b, _)| *b == bench)
+            .map(|(_, t)| t.to_vec())
+            .unwrap_or_default(),
+    }
+}
+
+/// The table this machine is judged by: its kind's, from the device a benchmark ran on and
+/// the CPU (lavapipe compiles every shader for the CPU).
+fn choose_table(device: &str) -> gate::TableChoice {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let vendor = gate::cpu_vendor(&cpuinfo);
+    let choice = gate::TableChoice::for_machine(device, &vendor);
+    println!(
+        "Machine: {device}, CPU {vendor}; judged by {}.\n",
+        choice.describe()
+    );
+    choice
 }
 
 /// `--gate-baseline N`: every benchmark of the gate `runs` times; prints each pass's median,
@@ -85,11 +109,13 @@ pub fn baseline(gpu: &GpuArgs, runs: usize) -> Result<()> {
          |---|---|---|---:|---:|---:|---:|"
     );
     let mut table_lines = String::new();
-    for (&(bench, table), held) in benchmarks() {
+    for (bench, held) in benchmarks() {
+        // Only the `none` comparison filters by its table, which is the same on every machine.
+        let table = table_of(bench, held, &gate::TableChoice::Envelope);
         let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         for _ in 0..runs {
             // A run the benchmark's timing checks refuse adds nothing.
-            if let Ok(measured) = ratios(&exe, &forwarded, bench, table, held)? {
+            if let Ok((measured, _)) = ratios(&exe, &forwarded, bench, &table, held)? {
                 for (pass, ratio) in measured {
                     samples.entry(pass).or_default().push(ratio);
                 }
@@ -122,17 +148,27 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     println!(
         "## lucent bench --gate\n\n\
          Each pass's ratio (the median of {} runs) against its limit (today's ratio times {}; \
-         against `none`, today's extra cost times it, plus {}: docs/performance.md).\n\n\
-         | benchmark | pass | against | ratio | limit | verdict |\n\
-         |---|---|---|---:|---:|---|",
+         against `none`, today's extra cost times it, plus {}: docs/performance.md).\n",
         gate::RUNS,
         gate::MARGIN,
         gate::AGAINST_NOISE
     );
     let mut failures = Vec::new();
     let mut table_lines = String::new();
-    for (&(bench, table), held) in benchmarks() {
-        let (judged, runs) = measure(&exe, &forwarded, bench, table, held)?;
+    let mut choice = None;
+    for (bench, held) in benchmarks() {
+        let against = table_of(bench, held, &gate::TableChoice::Envelope);
+        let (measured, runs, device) = measure(&exe, &forwarded, bench, &against, held)?;
+        let choice = *choice.get_or_insert_with(|| {
+            let chosen = choose_table(&device);
+            println!(
+                "| benchmark | pass | against | ratio | limit | verdict |\n\
+                 |---|---|---|---:|---:|---|"
+            );
+            chosen
+        });
+        let table = table_of(bench, held, &choice);
+        let judged = gate::judge(&measured, &table, held.limit());
         print!("{}", gate::markdown_rows(bench, held.what(), &judged));
         let _ = std::io::stdout().flush();
         failures.extend(judged.iter().filter_map(|j| j.failure(bench, held.what())));
@@ -158,20 +194,24 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     }
 }
 
-/// Measures `bench` [`gate::RUNS`] times: each pass of `table` judged by the median of its
-/// runs' ratios, and the runs that measured.
+/// Measures `bench` [`gate::RUNS`] times: each pass's median ratio over its runs, the runs
+/// that measured, and the device they ran on.
 fn measure(
     exe: &std::path::Path,
     forwarded: &[String],
     bench: &str,
     table: &[(&str, f64)],
     held: Held,
-) -> Result<(Vec<Judged>, usize)> {
+) -> Result<(BTreeMap<String, f64>, usize, String)> {
     let mut runs = Vec::new();
     let mut refused = Vec::new();
+    let mut device = String::new();
     for _ in 0..gate::RUNS {
         match ratios(exe, forwarded, bench, table, held)? {
-            Ok(measured) => runs.push(measured),
+            Ok((measured, on)) => {
+                runs.push(measured);
+                device = on;
+            }
             Err(why) => refused.push(why),
         }
     }
@@ -181,12 +221,12 @@ fn measure(
             refused.join("; ")
         )));
     }
-    let measured = gate::median_of_runs(&runs);
-    Ok((gate::judge(&measured, table, held.limit()), runs.len()))
+    Ok((gate::median_of_runs(&runs), runs.len(), device))
 }
 
 /// One run of `bench`: each pass's ratio (to its floor; against `none`, only the passes the
-/// two techniques share and `table` holds), or why the run measured nothing (the benchmark's
+/// two techniques share and `table` holds) and the device it ran on, or why the run measured
+/// nothing (the benchmark's
 /// own timing checks can refuse a run on a loaded machine).
 fn ratios(
     exe: &std::path::Path,
@@ -194,7 +234,7 @@ fn ratios(
     bench: &str,
     table: &[(&str, f64)],
     held: Held,
-) -> Result<std::result::Result<BTreeMap<String, f64>, String>> {
+) -> Result<std::result::Result<(BTreeMap<String, f64>, String), String>> {
     let line = format!("bench --scene {bench} {}", held.flags());
     let out = std::process::Command::new(exe)
         .args(line.split_whitespace())
@@ -261,5 +301,6 @@ fn ratios(
             }
         }
     }
-    Ok(Ok(ratios))
+    let device = json["device"].as_str().unwrap_or("unknown").to_string();
+    Ok(Ok((ratios, device)))
 }

@@ -20,9 +20,11 @@
 //!
 //! Each benchmark runs [`RUNS`] times and each pass is judged by the median of its runs' ratios
 //! (each run's ratio is itself of medians over its frames): a noise spike in one run, up or
-//! down, moves it little, and a pass that really got heavier is heavy in most runs. A pass the
-//! table does not know, or a pass it lists that the frame no longer has, fails too: a new pass
-//! is what a new feature adds.
+//! down, moves it little, and a pass that really got heavier is heavy in most runs. A
+//! benchmark with a pass over its limit runs [`RUNS`] times more and is judged by the median of
+//! all its runs, so a load that came and went fails nothing. A pass the table does not know,
+//! or a pass it lists that the frame no longer has, fails too: a new pass is what a new
+//! feature adds.
 //!
 //! The tables, their spread across machines and how the margins were chosen:
 //! docs/performance.md ("Speed-of-light gate"). `lucent bench --gate` prints each pass's

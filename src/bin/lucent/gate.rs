@@ -8,7 +8,7 @@
 use std::collections::BTreeMap;
 use std::io::Write as _;
 
-use lucent::measure::gate;
+use lucent::measure::gate::{self, Judged};
 use lucent::{LucentError, Result};
 
 use crate::cli::GpuArgs;
@@ -158,7 +158,7 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     let mut choice = None;
     for (bench, held) in benchmarks() {
         let against = table_of(bench, held, &gate::TableChoice::Envelope);
-        let (measured, runs, device) = measure(&exe, &forwarded, bench, &against, held)?;
+        let (mut samples, device) = measure(&exe, &forwarded, bench, &against, held)?;
         let choice = *choice.get_or_insert_with(|| {
             let chosen = choose_table(&device);
             println!(
@@ -168,7 +168,20 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
             chosen
         });
         let table = table_of(bench, held, &choice);
-        let judged = gate::judge(&measured, &table, held.limit());
+        let mut judged = gate::judge(&gate::median_of_runs(&samples), &table, held.limit());
+        // A pass over its limit is measured again before it fails the gate: a transient load
+        // on the machine (another process, a CPU's frequency step) moves a few runs, a pass
+        // that got heavier stays heavy in twice as many (the median of all of them decides).
+        if judged.iter().any(Judged::over) {
+            println!(
+                "| {bench} | (over its limit: measured {} more times) | | | | |",
+                gate::RUNS
+            );
+            let (more, _) = measure(&exe, &forwarded, bench, &against, held)?;
+            samples.extend(more);
+            judged = gate::judge(&gate::median_of_runs(&samples), &table, held.limit());
+        }
+        let runs = samples.len();
         print!("{}", gate::markdown_rows(bench, held.what(), &judged));
         let _ = std::io::stdout().flush();
         failures.extend(judged.iter().filter_map(|j| j.failure(bench, held.what())));
@@ -194,15 +207,15 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     }
 }
 
-/// Measures `bench` [`gate::RUNS`] times: each pass's median ratio over its runs, the runs
-/// that measured, and the device they ran on.
+/// Measures `bench` [`gate::RUNS`] times: each run's ratios (the runs the benchmark's timing
+/// checks did not refuse), and the device they ran on.
 fn measure(
     exe: &std::path::Path,
     forwarded: &[String],
     bench: &str,
     table: &[(&str, f64)],
     held: Held,
-) -> Result<(BTreeMap<String, f64>, usize, String)> {
+) -> Result<(Vec<BTreeMap<String, f64>>, String)> {
     let mut runs = Vec::new();
     let mut refused = Vec::new();
     let mut device = String::new();
@@ -221,7 +234,7 @@ fn measure(
             refused.join("; ")
         )));
     }
-    Ok((gate::median_of_runs(&runs), runs.len(), device))
+    Ok((runs, device))
 }
 
 /// One run of `bench`: each pass's ratio (to its floor; against `none`, only the passes the

@@ -237,6 +237,9 @@ fn measure(
     Ok((runs, device))
 }
 
+/// What one run measured: each pass's ratio, and the device it ran on.
+type OneRun = (BTreeMap<String, f64>, String);
+
 /// One run of `bench`: each pass's ratio (to its floor; against `none`, only the passes the
 /// two techniques share and `table` holds) and the device it ran on, or why the run measured
 /// nothing (the benchmark's
@@ -247,7 +250,7 @@ fn ratios(
     bench: &str,
     table: &[(&str, f64)],
     held: Held,
-) -> Result<std::result::Result<(BTreeMap<String, f64>, String), String>> {
+) -> Result<std::result::Result<OneRun, String>> {
     let line = format!("bench --scene {bench} {}", held.flags());
     let out = std::process::Command::new(exe)
         .args(line.split_whitespace())

@@ -89,11 +89,10 @@ fn table_of(bench: &str, held: Held, choice: &gate::TableChoice) -> Vec<(&'stati
 /// The table this machine is judged by: its kind's, from the device a benchmark ran on and
 /// the CPU (lavapipe compiles every shader for the CPU).
 fn choose_table(device: &str) -> gate::TableChoice {
-    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let vendor = gate::cpu_vendor(&cpuinfo);
-    let choice = gate::TableChoice::for_machine(device, &vendor);
+    let cpu = gate::CpuKind::this_machine();
+    let choice = gate::TableChoice::for_machine(device, &cpu);
     println!(
-        "Machine: {device}, CPU {vendor}; judged by {}.\n",
+        "Machine: {device}, CPU {cpu}; judged by {}.\n",
         choice.describe()
     );
     choice

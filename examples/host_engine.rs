@@ -1,19 +1,31 @@
-//! A small ash "engine" that embeds lucent, the way a host engine would.
+//! A small deferred engine in ash that inserts lucent's screen-space SSS into its own frame, the
+//! way a host engine would.
 //!
-//! The engine owns everything Vulkan: its instance (with the Khronos validation layer and
-//! synchronization validation when the layer is installed), its device (created with what
-//! `lucent::embed::requirements()` asks for), its `gpu-allocator` (shared with lucent), its
-//! pipeline cache, and a frame loop with three frames in flight, each with its own command
-//! buffer, fence and output image. lucent records the scene into the engine's command buffer
-//! each frame and leaves the image in the state the engine asks for; the engine submits,
-//! and at the end copies the last frame's image to a buffer and writes it as PNG.
+//! Everything here is the engine's, not lucent's: its instance (with the Khronos validation
+//! layer and synchronization validation when the layer is installed) and debug messenger, its
+//! device (created with what `lucent::embed::requirements()` asks for, plus dynamic rendering
+//! for itself), its `gpu-allocator` and pipeline cache (shared with lucent), its shaders (GLSL
+//! compiled with shaderc at start-up), three frames in flight with their own command buffers,
+//! fences and targets, and a frame of its own layout:
+//!
+//! 1. **G-buffer** (raster, procedural spheres and a floor): reversed-Z D32 depth with an
+//!    infinite far plane, octahedral normals in RG16_SNORM, albedo in RGBA8, and the engine's
+//!    own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5, floor 0).
+//! 2. **Lighting** (fullscreen): one sun and an ambient term, lit diffuse and specular apart,
+//!    in B10G11R11 (RGBA16F where the device cannot render B10G11R11).
+//! 3. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
+//!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
+//!    specular into the engine's HDR target. With `--without-lucent` the engine composes
+//!    diffuse + specular itself instead.
+//! 4. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
-//! cargo run --release --example host_engine -- --scene cubes --size 320x240 --frames 6 --out f.png
+//! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
+//! cargo run --release --example host_engine -- --without-lucent --out without.png
 //! ```
 //!
 //! Exits non-zero when anything fails, including any validation error (counted by the
-//! engine's own debug messenger).
+//! engine's own debug messenger; lucent installs none).
 
 use std::ffi::{c_void, CStr};
 use std::path::PathBuf;
@@ -21,43 +33,60 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
 use ash::vk;
+use glam::{Mat4, Vec3};
 use lucent::embed::gpu_allocator::vulkan::{
     Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc,
 };
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
-    requirements, EmbedOptions, HostDevice, HostImage, ImageState, Lucent, OptionalFeatures,
-    SceneRenderer,
+    requirements, DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice,
+    HostImage, IdDesc, ImageState, Lucent, OptionalFeatures, SssEffect, SssEffectDesc, SssFrame,
+    SssImages, SssMaterial, SssProfile,
 };
 
 /// Frames the engine keeps in flight.
 const FRAMES_IN_FLIGHT: usize = 3;
-/// The format of the engine's output images.
-const FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+const NORMAL_FORMAT: vk::Format = vk::Format::R16G16_SNORM;
+const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+const ID_FORMAT: vk::Format = vk::Format::R8_UINT;
+const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+/// The engine's material numbers in its ID target (0: the floor; 5 has no SSS).
+const SKIN_ID: u8 = 17;
+const MARBLE_ID: u8 = 42;
+const PLASTIC_ID: u8 = 5;
+/// The procedural sphere's tessellation (its vertex count is `6 * STACKS * SLICES`).
+const STACKS: u32 = 48;
+const SLICES: u32 = 64;
 
 static VALIDATION_ERRORS: AtomicU32 = AtomicU32::new(0);
 
 struct Args {
-    scene: String,
     width: u32,
     height: u32,
     frames: usize,
     out: PathBuf,
+    with_lucent: bool,
+    blur: String,
 }
+
+const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
+                     [--blur separable|control|burley] [--without-lucent]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
-        scene: "cubes".into(),
         width: 320,
         height: 240,
         frames: 6,
         out: PathBuf::from("host_engine.png"),
+        with_lucent: true,
+        blur: "separable".into(),
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
         let mut value = || it.next().ok_or(format!("{flag} needs a value"));
         match flag.as_str() {
-            "--scene" => args.scene = value()?,
             "--size" => {
                 let v = value()?;
                 let (w, h) = v
@@ -65,6 +94,9 @@ fn parse_args() -> Result<Args, String> {
                     .ok_or(format!("--size {v}: expected WIDTHxHEIGHT"))?;
                 args.width = w.parse().map_err(|_| format!("--size {v}: bad width"))?;
                 args.height = h.parse().map_err(|_| format!("--size {v}: bad height"))?;
+                if args.width == 0 || args.height == 0 || args.width > 8192 || args.height > 8192 {
+                    return Err(format!("--size {v}: 1 to 8192 pixels a side"));
+                }
             }
             "--frames" => {
                 let v = value()?;
@@ -76,14 +108,202 @@ fn parse_args() -> Result<Args, String> {
                 }
             }
             "--out" => args.out = PathBuf::from(value()?),
-            "--help" | "-h" => return Err(
-                "usage: host_engine [--scene NAME|FILE] [--size WxH] [--frames N] [--out F.png]"
-                    .into(),
-            ),
-            other => return Err(format!("unknown argument {other}")),
+            "--blur" => args.blur = value()?,
+            "--without-lucent" => args.with_lucent = false,
+            "--help" | "-h" => return Err(USAGE.into()),
+            other => return Err(format!("unknown argument {other}\n{USAGE}")),
         }
     }
     Ok(args)
+}
+
+/// The engine's shaders (GLSL, compiled at start-up).
+mod shaders {
+    /// A fullscreen triangle.
+    pub const FULLSCREEN_VERT: &str = r#"#version 450
+void main() {
+    vec2 uv = vec2((gl_VertexIndex << 1) & 2, gl_VertexIndex & 2);
+    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+"#;
+
+    /// The push constants every pipeline shares (`m`: the G-buffer's view-projection, the
+    /// lighting's inverse view-projection).
+    const PUSH: &str =
+        "layout(push_constant) uniform Push { mat4 m; vec4 eye; vec4 sun; vec4 params; } pc;\n";
+
+    /// Three spheres (instances 0-2) and a floor (instance 3), generated from the vertex index.
+    pub fn gbuffer_vert() -> String {
+        format!(
+            r#"#version 450
+{PUSH}
+layout(location = 0) out vec3 v_world;
+layout(location = 1) out vec3 v_normal;
+layout(location = 2) flat out uint v_object;
+// Centre (xyz) and radius (w) in metres.
+const vec4 SPHERES[3] = vec4[3](vec4(-0.14, 0.06, 0.0, 0.06), vec4(0.0, 0.06, 0.0, 0.06),
+                                vec4(0.14, 0.06, 0.0, 0.06));
+void main() {{
+    uint object = uint(gl_InstanceIndex);
+    vec3 p;
+    vec3 n;
+    if (object >= 3u) {{
+        const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1),
+                                        vec2(1, 1), vec2(-1, 1));
+        vec2 c = corners[gl_VertexIndex % 6];
+        p = vec3(c.x, 0.0, c.y);
+        n = vec3(0.0, 1.0, 0.0);
+    }} else {{
+        const uvec2 corner[6] = uvec2[6](uvec2(0, 0), uvec2(1, 0), uvec2(1, 1), uvec2(0, 0),
+                                         uvec2(1, 1), uvec2(0, 1));
+        uint quad = uint(gl_VertexIndex) / 6u;
+        uvec2 k = uvec2(quad / {SLICES}u, quad % {SLICES}u) + corner[uint(gl_VertexIndex) % 6u];
+        float theta = float(k.x) / {STACKS}.0 * 3.14159265;
+        float phi = float(k.y) / {SLICES}.0 * 6.28318531;
+        n = vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
+        p = SPHERES[object].xyz + SPHERES[object].w * n;
+    }}
+    v_world = p;
+    v_normal = n;
+    v_object = object;
+    gl_Position = pc.m * vec4(p, 1.0);
+}}
+"#,
+            SLICES = super::SLICES,
+            STACKS = super::STACKS,
+        )
+    }
+
+    pub fn gbuffer_frag() -> String {
+        format!(
+            r#"#version 450
+layout(location = 0) in vec3 v_world;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) flat in uint v_object;
+layout(location = 0) out vec2 o_normal;  // octahedral (RG16_SNORM)
+layout(location = 1) out vec4 o_albedo;  // albedo, a: gloss
+layout(location = 2) out uint o_id;      // the engine's material number (R8_UINT)
+vec2 sign_not_zero(vec2 v) {{ return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }}
+vec2 oct_encode(vec3 n) {{
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
+}}
+void main() {{
+    vec3 albedo;
+    float gloss;
+    uint id;
+    if (v_object == 0u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = 0.5; id = {SKIN}u; }}
+    else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = 0.8; id = {MARBLE}u; }}
+    else if (v_object == 2u) {{ albedo = vec3(0.20, 0.35, 0.75); gloss = 0.6; id = {PLASTIC}u; }}
+    else {{
+        // A floor of 2 cm squares: texture detail the blur must leave sharp.
+        ivec2 cell = ivec2(floor(v_world.xz / 0.02));
+        albedo = ((cell.x + cell.y) & 1) == 0 ? vec3(0.70) : vec3(0.25);
+        gloss = 0.1;
+        id = 0u;
+    }}
+    o_normal = oct_encode(normalize(v_normal));
+    o_albedo = vec4(albedo, gloss);
+    o_id = id;
+}}
+"#,
+            SKIN = super::SKIN_ID,
+            MARBLE = super::MARBLE_ID,
+            PLASTIC = super::PLASTIC_ID,
+        )
+    }
+
+    pub fn lighting_frag() -> String {
+        format!(
+            r#"#version 450
+{PUSH}
+layout(set = 0, binding = 0) uniform sampler2D depth_tex;   // reversed Z, infinite far
+layout(set = 0, binding = 1) uniform sampler2D normal_tex;
+layout(set = 0, binding = 2) uniform sampler2D albedo_tex;
+layout(location = 0) out vec4 o_diffuse;
+layout(location = 1) out vec4 o_specular;
+vec2 sign_not_zero(vec2 v) {{ return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }}
+vec3 oct_decode(vec2 e) {{
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * sign_not_zero(n.xy);
+    return normalize(n);
+}}
+void main() {{
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    float d = texelFetch(depth_tex, px, 0).r;
+    if (d <= 0.0) {{
+        // The far plane at infinity: the sky.
+        o_diffuse = vec4(0.21, 0.27, 0.36, 1.0);
+        o_specular = vec4(0.0);
+        return;
+    }}
+    vec2 ndc = (vec2(px) + 0.5) / vec2(textureSize(depth_tex, 0)) * 2.0 - 1.0;
+    vec4 w = pc.m * vec4(ndc, d, 1.0);
+    vec3 p = w.xyz / w.w;
+    vec3 n = oct_decode(texelFetch(normal_tex, px, 0).rg);
+    vec4 a = texelFetch(albedo_tex, px, 0);
+    vec3 l = normalize(pc.sun.xyz);
+    vec3 v = normalize(pc.eye.xyz - p);
+    vec3 h = normalize(l + v);
+    float nl = max(dot(n, l), 0.0);
+    vec3 sun = vec3(1.0, 0.95, 0.88) * pc.sun.w;
+    vec3 ambient = mix(vec3(0.10, 0.09, 0.08), vec3(0.20, 0.24, 0.30), n.y * 0.5 + 0.5);
+    o_diffuse = vec4(a.rgb * (sun * nl / 3.14159265 + ambient), 1.0);
+    float shininess = exp2(1.0 + 10.0 * a.a);
+    float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
+    float lobe = (shininess + 8.0) / (8.0 * 3.14159265) * pow(max(dot(n, h), 0.0), shininess);
+    o_specular = vec4(sun * fresnel * lobe * nl, 1.0);
+}}
+"#
+        )
+    }
+
+    /// The engine's own composition when lucent is left out: diffuse + specular.
+    pub const COMPOSE_FRAG: &str = r#"#version 450
+layout(set = 0, binding = 0) uniform sampler2D diffuse_tex;
+layout(set = 0, binding = 1) uniform sampler2D specular_tex;
+layout(location = 0) out vec4 o_hdr;
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    o_hdr = vec4(texelFetch(diffuse_tex, px, 0).rgb + texelFetch(specular_tex, px, 0).rgb, 1.0);
+}
+"#;
+
+    pub fn tonemap_frag() -> String {
+        format!(
+            r#"#version 450
+{PUSH}
+layout(set = 0, binding = 0) uniform sampler2D hdr_tex;
+layout(location = 0) out vec4 o_ldr;    // an sRGB target: the hardware encodes
+void main() {{
+    vec3 c = max(texelFetch(hdr_tex, ivec2(gl_FragCoord.xy), 0).rgb, vec3(0.0)) * pc.params.x;
+    o_ldr = vec4(vec3(1.0) - exp(-c), 1.0);
+}}
+"#
+        )
+    }
+}
+
+/// The push constants of every pipeline (`shaders::PUSH`).
+#[repr(C)]
+#[derive(Clone, Copy)]
+struct Push {
+    m: [f32; 16],
+    eye: [f32; 4],
+    sun: [f32; 4],
+    params: [f32; 4],
+}
+
+impl Push {
+    fn bytes(&self) -> &[u8] {
+        // SAFETY: `Push` is plain f32s, repr(C), without padding.
+        unsafe {
+            std::slice::from_raw_parts(
+                (self as *const Self).cast::<u8>(),
+                std::mem::size_of::<Self>(),
+            )
+        }
+    }
 }
 
 unsafe extern "system" fn on_message(
@@ -211,7 +431,9 @@ fn create_engine() -> Result<Engine, String> {
         .shader_storage_image_write_without_format(enabled.storage_image_write_without_format);
     let mut v12 =
         vk::PhysicalDeviceVulkan12Features::default().host_query_reset(enabled.host_query_reset);
-    let mut v13 = needs.vulkan13();
+    // The engine draws with dynamic rendering (its own choice; lucent needs only what
+    // `requirements()` lists).
+    let mut v13 = needs.vulkan13().dynamic_rendering(true);
     let mut features2 = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut v12)
@@ -244,32 +466,513 @@ fn create_engine() -> Result<Engine, String> {
     })
 }
 
-/// One frame in flight: its command pool and buffer, its fence, and the image it renders
-/// into (the engine's stand-in for a swapchain image) with the state the engine tracks.
+fn check(what: &str, r: Result<(), vk::Result>) -> Result<(), String> {
+    r.map_err(|e| format!("{what}: {e}"))
+}
+
+/// One of the engine's images, its memory, and the state the engine tracks it in (the state
+/// it tells lucent, and the one lucent hands back).
+struct Target {
+    image: vk::Image,
+    view: vk::ImageView,
+    memory: Option<Allocation>,
+    format: vk::Format,
+    usage: vk::ImageUsageFlags,
+    aspect: vk::ImageAspectFlags,
+    state: ImageState,
+    name: String,
+}
+
+fn create_target(
+    engine: &Engine,
+    allocator: &Mutex<Allocator>,
+    extent: vk::Extent2D,
+    format: vk::Format,
+    usage: vk::ImageUsageFlags,
+    name: String,
+) -> Result<Target, String> {
+    let device = &engine.device;
+    let aspect = if format == DEPTH_FORMAT {
+        vk::ImageAspectFlags::DEPTH
+    } else {
+        vk::ImageAspectFlags::COLOR
+    };
+    // SAFETY: plain object creation on the engine's device; destroyed in `destroy_target`.
+    unsafe {
+        let image = device
+            .create_image(
+                &vk::ImageCreateInfo::default()
+                    .image_type(vk::ImageType::TYPE_2D)
+                    .format(format)
+                    .extent(vk::Extent3D {
+                        width: extent.width,
+                        height: extent.height,
+                        depth: 1,
+                    })
+                    .mip_levels(1)
+                    .array_layers(1)
+                    .samples(vk::SampleCountFlags::TYPE_1)
+                    .tiling(vk::ImageTiling::OPTIMAL)
+                    .usage(usage),
+                None,
+            )
+            .map_err(|e| format!("vkCreateImage ({name}): {e}"))?;
+        let memory = allocator
+            .lock()
+            .map_err(|_| "allocator lock poisoned".to_string())?
+            .allocate(&AllocationCreateDesc {
+                name: &name,
+                requirements: device.get_image_memory_requirements(image),
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|e| format!("allocate {name}: {e}"))?;
+        check(
+            "vkBindImageMemory",
+            device.bind_image_memory(image, memory.memory(), memory.offset()),
+        )?;
+        let view = device
+            .create_image_view(
+                &vk::ImageViewCreateInfo::default()
+                    .image(image)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(format)
+                    .subresource_range(range(aspect)),
+                None,
+            )
+            .map_err(|e| format!("vkCreateImageView ({name}): {e}"))?;
+        Ok(Target {
+            image,
+            view,
+            memory: Some(memory),
+            format,
+            usage,
+            aspect,
+            state: ImageState::UNDEFINED,
+            name,
+        })
+    }
+}
+
+fn range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+fn destroy_target(engine: &Engine, allocator: &Mutex<Allocator>, mut target: Target) {
+    // SAFETY: the device is idle (the caller waited) and the handles are the target's own.
+    unsafe {
+        engine.device.destroy_image_view(target.view, None);
+        engine.device.destroy_image(target.image, None);
+    }
+    if let (Some(memory), Ok(mut allocator)) = (target.memory.take(), allocator.lock()) {
+        if let Err(e) = allocator.free(memory) {
+            eprintln!("host_engine: freeing {}: {e}", target.name);
+        }
+    }
+}
+
+impl Target {
+    /// Records the barrier from the tracked state to `to` (`discard`: the contents are not
+    /// needed, the old layout is UNDEFINED) and tracks `to`.
+    fn transition(
+        &mut self,
+        device: &ash::Device,
+        cmd: vk::CommandBuffer,
+        to: ImageState,
+        discard: bool,
+    ) {
+        let from = self.state;
+        let barrier = [vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(from.stage)
+            .src_access_mask(from.access)
+            .dst_stage_mask(to.stage)
+            .dst_access_mask(to.access)
+            .old_layout(if discard {
+                vk::ImageLayout::UNDEFINED
+            } else {
+                from.layout
+            })
+            .new_layout(to.layout)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.image)
+            .subresource_range(range(self.aspect))];
+        // SAFETY: `cmd` is recording, outside any rendering.
+        unsafe {
+            device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&barrier),
+            )
+        };
+        self.state = to;
+    }
+
+    /// This image as lucent sees it: in the tracked state, left as lucent leaves it.
+    fn host_image(&self, extent: vk::Extent2D) -> HostImage {
+        HostImage::new(
+            self.name.clone(),
+            self.image,
+            self.view,
+            self.format,
+            extent,
+            self.usage,
+        )
+        .in_state(self.state)
+    }
+}
+
+/// One frame in flight: its command pool and buffer, its fence, its targets and their
+/// descriptor sets.
 struct FrameSlot {
     pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
-    image: vk::Image,
-    view: vk::ImageView,
-    memory: Option<Allocation>,
-    state: ImageState,
+    depth: Target,
+    normal: Target,
+    albedo: Target,
+    ids: Target,
+    diffuse: Target,
+    specular: Target,
+    hdr: Target,
+    ldr: Target,
+    /// Lighting (depth, normals, albedo), compose (diffuse, specular), tonemap (HDR).
+    lighting_set: vk::DescriptorSet,
+    compose_set: vk::DescriptorSet,
+    tonemap_set: vk::DescriptorSet,
 }
 
-fn check(what: &str, r: Result<(), vk::Result>) -> Result<(), String> {
-    r.map_err(|e| format!("{what}: {e}"))
+/// The engine's pipelines and what they share.
+struct Pipelines {
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    sampler: vk::Sampler,
+    pool: vk::DescriptorPool,
+    gbuffer: vk::Pipeline,
+    lighting: vk::Pipeline,
+    compose: vk::Pipeline,
+    tonemap: vk::Pipeline,
+}
+
+fn compile(
+    device: &ash::Device,
+    compiler: &shaderc::Compiler,
+    source: &str,
+    kind: shaderc::ShaderKind,
+    name: &str,
+) -> Result<vk::ShaderModule, String> {
+    let mut options =
+        shaderc::CompileOptions::new().map_err(|e| format!("shaderc options: {e}"))?;
+    options.set_target_env(
+        shaderc::TargetEnv::Vulkan,
+        shaderc::EnvVersion::Vulkan1_3 as u32,
+    );
+    let spirv = compiler
+        .compile_into_spirv(source, kind, name, "main", Some(&options))
+        .map_err(|e| format!("{name}: {e}"))?;
+    // SAFETY: valid SPIR-V words from shaderc.
+    unsafe {
+        device.create_shader_module(
+            &vk::ShaderModuleCreateInfo::default().code(spirv.as_binary()),
+            None,
+        )
+    }
+    .map_err(|e| format!("vkCreateShaderModule ({name}): {e}"))
+}
+
+/// A graphics pipeline of `vert` + `frag` for dynamic rendering into `colours` (and `depth`:
+/// reversed Z, GREATER).
+fn pipeline(
+    device: &ash::Device,
+    cache: vk::PipelineCache,
+    layout: vk::PipelineLayout,
+    (vert, frag): (vk::ShaderModule, vk::ShaderModule),
+    colours: &[vk::Format],
+    depth: Option<vk::Format>,
+) -> Result<vk::Pipeline, String> {
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(vert)
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(frag)
+            .name(c"main"),
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(depth.is_some())
+        .depth_write_enable(depth.is_some())
+        .depth_compare_op(vk::CompareOp::GREATER);
+    let blend: Vec<vk::PipelineColorBlendAttachmentState> = colours
+        .iter()
+        .map(|_| {
+            vk::PipelineColorBlendAttachmentState::default()
+                .color_write_mask(vk::ColorComponentFlags::RGBA)
+        })
+        .collect();
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
+    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(colours)
+        .depth_attachment_format(depth.unwrap_or(vk::Format::UNDEFINED));
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&depth_state)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering);
+    // SAFETY: every pointer in `info` refers to locals that outlive the call.
+    unsafe { device.create_graphics_pipelines(cache, &[info], None) }
+        .map(|p| p[0])
+        .map_err(|(_, e)| format!("vkCreateGraphicsPipelines: {e}"))
+}
+
+fn create_pipelines(
+    engine: &Engine,
+    cache: vk::PipelineCache,
+    light_format: vk::Format,
+) -> Result<Pipelines, String> {
+    let device = &engine.device;
+    let compiler = shaderc::Compiler::new().map_err(|e| format!("shaderc: {e}"))?;
+    use shaderc::ShaderKind::{Fragment, Vertex};
+    let fullscreen = compile(
+        device,
+        &compiler,
+        shaders::FULLSCREEN_VERT,
+        Vertex,
+        "fullscreen.vert",
+    )?;
+    let modules = [
+        fullscreen,
+        compile(
+            device,
+            &compiler,
+            &shaders::gbuffer_vert(),
+            Vertex,
+            "gbuffer.vert",
+        )?,
+        compile(
+            device,
+            &compiler,
+            &shaders::gbuffer_frag(),
+            Fragment,
+            "gbuffer.frag",
+        )?,
+        compile(
+            device,
+            &compiler,
+            &shaders::lighting_frag(),
+            Fragment,
+            "lighting.frag",
+        )?,
+        compile(
+            device,
+            &compiler,
+            shaders::COMPOSE_FRAG,
+            Fragment,
+            "compose.frag",
+        )?,
+        compile(
+            device,
+            &compiler,
+            &shaders::tonemap_frag(),
+            Fragment,
+            "tonemap.frag",
+        )?,
+    ];
+    // SAFETY: plain object creation on the engine's device; destroyed in `destroy_pipelines`.
+    let made = unsafe {
+        let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..3)
+            .map(|b| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+            })
+            .collect();
+        let set_layout = device
+            .create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                None,
+            )
+            .map_err(|e| format!("vkCreateDescriptorSetLayout: {e}"))?;
+        let push = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+            .size(std::mem::size_of::<Push>() as u32)];
+        let set_layouts = [set_layout];
+        let layout = device
+            .create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default()
+                    .set_layouts(&set_layouts)
+                    .push_constant_ranges(&push),
+                None,
+            )
+            .map_err(|e| format!("vkCreatePipelineLayout: {e}"))?;
+        let sampler = device
+            .create_sampler(
+                &vk::SamplerCreateInfo::default()
+                    .mag_filter(vk::Filter::NEAREST)
+                    .min_filter(vk::Filter::NEAREST)
+                    .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE),
+                None,
+            )
+            .map_err(|e| format!("vkCreateSampler: {e}"))?;
+        let sets = 3 * FRAMES_IN_FLIGHT as u32;
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .descriptor_count(3 * sets)];
+        let pool = device
+            .create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(sets)
+                    .pool_sizes(&sizes),
+                None,
+            )
+            .map_err(|e| format!("vkCreateDescriptorPool: {e}"))?;
+        let [_, gbuffer_vert, gbuffer_frag, lighting_frag, compose_frag, tonemap_frag] = modules;
+        let gbuffer = pipeline(
+            device,
+            cache,
+            layout,
+            (gbuffer_vert, gbuffer_frag),
+            &[NORMAL_FORMAT, ALBEDO_FORMAT, ID_FORMAT],
+            Some(DEPTH_FORMAT),
+        )?;
+        let lighting = pipeline(
+            device,
+            cache,
+            layout,
+            (fullscreen, lighting_frag),
+            &[light_format, light_format],
+            None,
+        )?;
+        let compose = pipeline(
+            device,
+            cache,
+            layout,
+            (fullscreen, compose_frag),
+            &[HDR_FORMAT],
+            None,
+        )?;
+        let tonemap = pipeline(
+            device,
+            cache,
+            layout,
+            (fullscreen, tonemap_frag),
+            &[LDR_FORMAT],
+            None,
+        )?;
+        Ok(Pipelines {
+            set_layout,
+            layout,
+            sampler,
+            pool,
+            gbuffer,
+            lighting,
+            compose,
+            tonemap,
+        })
+    };
+    for module in modules {
+        // SAFETY: the pipelines are made (or failed); the modules are no longer needed.
+        unsafe { device.destroy_shader_module(module, None) };
+    }
+    made
+}
+
+fn destroy_pipelines(device: &ash::Device, p: &Pipelines) {
+    // SAFETY: the device is idle; the objects are the engine's own.
+    unsafe {
+        for pipeline in [p.gbuffer, p.lighting, p.compose, p.tonemap] {
+            device.destroy_pipeline(pipeline, None);
+        }
+        device.destroy_descriptor_pool(p.pool, None);
+        device.destroy_sampler(p.sampler, None);
+        device.destroy_pipeline_layout(p.layout, None);
+        device.destroy_descriptor_set_layout(p.set_layout, None);
+    }
+}
+
+/// The lit light's format: B10G11R11 where the device renders to it, else RGBA16F.
+fn light_format(engine: &Engine) -> vk::Format {
+    let wanted = vk::FormatFeatureFlags::COLOR_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE;
+    // SAFETY: plain query of the physical device.
+    let props = unsafe {
+        engine.instance.get_physical_device_format_properties(
+            engine.physical_device,
+            vk::Format::B10G11R11_UFLOAT_PACK32,
+        )
+    };
+    if props.optimal_tiling_features.contains(wanted) {
+        vk::Format::B10G11R11_UFLOAT_PACK32
+    } else {
+        vk::Format::R16G16B16A16_SFLOAT
+    }
 }
 
 fn create_slot(
     engine: &Engine,
     allocator: &Mutex<Allocator>,
-    width: u32,
-    height: u32,
+    pipelines: &Pipelines,
+    extent: vk::Extent2D,
+    light_format: vk::Format,
     index: usize,
 ) -> Result<FrameSlot, String> {
     let device = &engine.device;
-    // SAFETY: plain object creation on the engine's device; every handle is destroyed in
-    // `destroy_slot`.
+    use vk::ImageUsageFlags as U;
+    let target = |format, usage, what: &str| {
+        create_target(
+            engine,
+            allocator,
+            extent,
+            format,
+            usage,
+            format!("{what} {index}"),
+        )
+    };
+    let attachment_sampled = U::COLOR_ATTACHMENT | U::SAMPLED;
+    let depth = target(
+        DEPTH_FORMAT,
+        U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED,
+        "depth",
+    )?;
+    let normal = target(NORMAL_FORMAT, attachment_sampled, "normals")?;
+    let albedo = target(ALBEDO_FORMAT, attachment_sampled, "albedo")?;
+    let ids = target(ID_FORMAT, attachment_sampled, "material IDs")?;
+    let diffuse = target(light_format, attachment_sampled, "lit diffuse")?;
+    let specular = target(light_format, attachment_sampled, "lit specular")?;
+    let hdr = target(HDR_FORMAT, attachment_sampled, "hdr")?;
+    let ldr = target(LDR_FORMAT, U::COLOR_ATTACHMENT | U::TRANSFER_SRC, "ldr")?;
+    // SAFETY: plain object creation on the engine's device; destroyed in `destroy_slot`.
     unsafe {
         let pool = device
             .create_command_pool(
@@ -293,83 +996,173 @@ fn create_slot(
                 None,
             )
             .map_err(|e| format!("vkCreateFence: {e}"))?;
-        let image = device
-            .create_image(
-                &vk::ImageCreateInfo::default()
-                    .image_type(vk::ImageType::TYPE_2D)
-                    .format(FORMAT)
-                    .extent(vk::Extent3D {
-                        width,
-                        height,
-                        depth: 1,
-                    })
-                    .mip_levels(1)
-                    .array_layers(1)
-                    .samples(vk::SampleCountFlags::TYPE_1)
-                    .tiling(vk::ImageTiling::OPTIMAL)
-                    .usage(
-                        vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-                    ),
-                None,
+        let layouts = [pipelines.set_layout; 3];
+        let sets = device
+            .allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pipelines.pool)
+                    .set_layouts(&layouts),
             )
-            .map_err(|e| format!("vkCreateImage: {e}"))?;
-        let requirements = device.get_image_memory_requirements(image);
-        let memory = allocator
-            .lock()
-            .map_err(|_| "allocator lock poisoned".to_string())?
-            .allocate(&AllocationCreateDesc {
-                name: &format!("host output {index}"),
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            .map_err(|e| format!("vkAllocateDescriptorSets: {e}"))?;
+        let sampled = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        let writes: Vec<(vk::DescriptorSet, u32, vk::ImageView, vk::ImageLayout)> = vec![
+            (sets[0], 0, depth.view, ImageState::depth_sampled().layout),
+            (sets[0], 1, normal.view, sampled),
+            (sets[0], 2, albedo.view, sampled),
+            (sets[1], 0, diffuse.view, sampled),
+            (sets[1], 1, specular.view, sampled),
+            (sets[2], 0, hdr.view, sampled),
+            // The bindings a set's shader does not read are written too (with an image of the
+            // same set, never read): lavapipe (Mesa 22.3.6) crashes on its queue thread when a
+            // set with a never-written combined image sampler is bound, draw or no draw.
+            (sets[1], 2, diffuse.view, sampled),
+            (sets[2], 1, hdr.view, sampled),
+            (sets[2], 2, hdr.view, sampled),
+        ];
+        let infos: Vec<[vk::DescriptorImageInfo; 1]> = writes
+            .iter()
+            .map(|&(_, _, view, layout)| {
+                [vk::DescriptorImageInfo::default()
+                    .sampler(pipelines.sampler)
+                    .image_view(view)
+                    .image_layout(layout)]
             })
-            .map_err(|e| format!("allocate output image: {e}"))?;
-        check(
-            "vkBindImageMemory",
-            device.bind_image_memory(image, memory.memory(), memory.offset()),
-        )?;
-        let view = device
-            .create_image_view(
-                &vk::ImageViewCreateInfo::default()
-                    .image(image)
-                    .view_type(vk::ImageViewType::TYPE_2D)
-                    .format(FORMAT)
-                    .subresource_range(vk::ImageSubresourceRange {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        base_mip_level: 0,
-                        level_count: 1,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    }),
-                None,
-            )
-            .map_err(|e| format!("vkCreateImageView: {e}"))?;
+            .collect();
+        let writes: Vec<vk::WriteDescriptorSet> = writes
+            .iter()
+            .zip(&infos)
+            .map(|(&(set, binding, _, _), info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(binding)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .image_info(info)
+            })
+            .collect();
+        device.update_descriptor_sets(&writes, &[]);
         Ok(FrameSlot {
             pool,
             cmd,
             fence,
-            image,
-            view,
-            memory: Some(memory),
-            state: ImageState::UNDEFINED,
+            depth,
+            normal,
+            albedo,
+            ids,
+            diffuse,
+            specular,
+            hdr,
+            ldr,
+            lighting_set: sets[0],
+            compose_set: sets[1],
+            tonemap_set: sets[2],
         })
     }
 }
 
-fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, mut slot: FrameSlot) {
+fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, slot: FrameSlot) {
     // SAFETY: the device is idle (the caller waited) and the handles are the slot's own.
     unsafe {
-        engine.device.destroy_image_view(slot.view, None);
-        engine.device.destroy_image(slot.image, None);
         engine.device.destroy_fence(slot.fence, None);
         engine.device.destroy_command_pool(slot.pool, None);
     }
-    if let (Some(memory), Ok(mut allocator)) = (slot.memory.take(), allocator.lock()) {
-        if let Err(e) = allocator.free(memory) {
-            eprintln!("host_engine: freeing an output image: {e}");
-        }
+    for target in [
+        slot.depth,
+        slot.normal,
+        slot.albedo,
+        slot.ids,
+        slot.diffuse,
+        slot.specular,
+        slot.hdr,
+        slot.ldr,
+    ] {
+        destroy_target(engine, allocator, target);
     }
+}
+
+/// Begins dynamic rendering into `colours` (cleared to 0 when `clear`) and `depth` (cleared
+/// to 0: reversed Z's far plane), with the viewport and scissor of `extent`.
+fn begin_rendering(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    extent: vk::Extent2D,
+    colours: &[vk::ImageView],
+    depth: Option<vk::ImageView>,
+    clear: bool,
+) {
+    let load = if clear {
+        vk::AttachmentLoadOp::CLEAR
+    } else {
+        vk::AttachmentLoadOp::DONT_CARE
+    };
+    let colour_attachments: Vec<vk::RenderingAttachmentInfo> = colours
+        .iter()
+        .map(|&view| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(load)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue::default())
+        })
+        .collect();
+    let depth_attachment = depth.map(|view| {
+        vk::RenderingAttachmentInfo::default()
+            .image_view(view)
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            })
+    });
+    let area = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent,
+    };
+    let mut info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1)
+        .color_attachments(&colour_attachments);
+    if let Some(depth) = &depth_attachment {
+        info = info.depth_attachment(depth);
+    }
+    // SAFETY: `cmd` is recording, outside any rendering; the views are live.
+    unsafe {
+        device.cmd_begin_rendering(cmd, &info);
+        device.cmd_set_viewport(
+            cmd,
+            0,
+            &[vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: extent.width as f32,
+                height: extent.height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            }],
+        );
+        device.cmd_set_scissor(cmd, 0, &[area]);
+    }
+}
+
+/// The engine's camera for frame `frame`: a slow orbit, reversed Z with an infinite far plane,
+/// y down (Vulkan's clip space).
+fn camera(frame: usize, aspect: f32) -> (Mat4, Mat4, Vec3) {
+    let angle = 0.35 + 0.03 * frame as f32;
+    let eye = Vec3::new(0.40 * angle.sin(), 0.15, 0.40 * angle.cos());
+    let view = Mat4::look_at_rh(eye, Vec3::new(0.0, 0.05, 0.0), Vec3::Y);
+    let mut projection = Mat4::perspective_infinite_reverse_rh(35f32.to_radians(), aspect, 0.01);
+    projection.y_axis.y = -projection.y_axis.y;
+    (view, projection, eye)
+}
+
+/// What lucent adds to the engine: the effect, and the `Lucent` it was built from.
+struct Effects {
+    lucent: Lucent,
+    sss: SssEffect,
 }
 
 /// Copies `slot`'s image (in TRANSFER_SRC_OPTIMAL, as lucent left it) to host memory.
@@ -419,7 +1212,7 @@ fn read_back(
         )?;
         device.cmd_copy_image_to_buffer(
             cmd,
-            slot.image,
+            slot.ldr.image,
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             buffer,
             &[vk::BufferImageCopy::default()
@@ -468,9 +1261,300 @@ fn read_back(
     }
 }
 
+/// Records frame `frame` into `slot.cmd`: the engine's G-buffer and lighting, lucent's SSS (or
+/// the engine's own composition), the tonemap; the LDR image left as a copy source.
+fn record_frame(
+    engine: &Engine,
+    pipelines: &Pipelines,
+    effects: Option<&mut Effects>,
+    slot: &mut FrameSlot,
+    slot_index: usize,
+    frame: usize,
+    extent: vk::Extent2D,
+) -> Result<(), String> {
+    let device = &engine.device;
+    let cmd = slot.cmd;
+    let (view, projection, eye) = camera(frame, extent.width as f32 / extent.height as f32);
+    let sun = Vec3::new(0.9, 0.75, -0.35).normalize();
+    let push = |m: Mat4| Push {
+        m: m.to_cols_array(),
+        eye: [eye.x, eye.y, eye.z, 1.0],
+        sun: [sun.x, sun.y, sun.z, 9.0],
+        params: [1.2, 0.0, 0.0, 0.0],
+    };
+    let bind = |pipeline, set: Option<vk::DescriptorSet>, m: Mat4| {
+        // SAFETY: `cmd` is recording inside the pass's rendering; the objects are live.
+        unsafe {
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            if let Some(set) = set {
+                device.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    pipelines.layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+            }
+            device.cmd_push_constants(
+                cmd,
+                pipelines.layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                push(m).bytes(),
+            );
+        }
+    };
+    let fragment_sampled = ImageState::fragment_sampled();
+
+    // 1. The G-buffer.
+    for target in [&mut slot.normal, &mut slot.albedo, &mut slot.ids] {
+        target.transition(device, cmd, ImageState::color_attachment(), true);
+    }
+    let depth_attachment = ImageState {
+        layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        ..ImageState::depth_attachment()
+    };
+    slot.depth.transition(device, cmd, depth_attachment, true);
+    begin_rendering(
+        device,
+        cmd,
+        extent,
+        &[slot.normal.view, slot.albedo.view, slot.ids.view],
+        Some(slot.depth.view),
+        true,
+    );
+    bind(pipelines.gbuffer, None, projection * view);
+    // SAFETY: inside the G-buffer's rendering, its pipeline bound.
+    unsafe {
+        device.cmd_draw(cmd, 6 * STACKS * SLICES, 3, 0, 0);
+        device.cmd_draw(cmd, 6, 1, 0, 3);
+        device.cmd_end_rendering(cmd);
+    }
+    for target in [&mut slot.normal, &mut slot.albedo, &mut slot.ids] {
+        target.transition(device, cmd, fragment_sampled, false);
+    }
+    slot.depth
+        .transition(device, cmd, ImageState::depth_sampled(), false);
+
+    // 2. Lighting.
+    for target in [&mut slot.diffuse, &mut slot.specular] {
+        target.transition(device, cmd, ImageState::color_attachment(), true);
+    }
+    begin_rendering(
+        device,
+        cmd,
+        extent,
+        &[slot.diffuse.view, slot.specular.view],
+        None,
+        false,
+    );
+    bind(
+        pipelines.lighting,
+        Some(slot.lighting_set),
+        (projection * view).inverse(),
+    );
+    // SAFETY: inside the lighting's rendering, its pipeline and set bound.
+    unsafe {
+        device.cmd_draw(cmd, 3, 1, 0, 0);
+        device.cmd_end_rendering(cmd);
+    }
+    for target in [&mut slot.diffuse, &mut slot.specular] {
+        target.transition(device, cmd, fragment_sampled, false);
+    }
+
+    // 3. lucent's SSS into the HDR target, or the engine's own diffuse + specular.
+    match effects {
+        Some(effects) => {
+            let depth = slot.depth.host_image(extent);
+            let diffuse = slot.diffuse.host_image(extent);
+            let specular = slot.specular.host_image(extent);
+            let albedo = slot.albedo.host_image(extent);
+            let ids = slot.ids.host_image(extent);
+            // Every pixel is written: the old contents may be discarded.
+            let output = slot
+                .hdr
+                .host_image(extent)
+                .in_state(ImageState {
+                    layout: vk::ImageLayout::UNDEFINED,
+                    ..slot.hdr.state
+                })
+                .then(fragment_sampled);
+            let frame = SssFrame {
+                slot: slot_index,
+                view: 0,
+                camera: HostCamera::new(view, projection),
+                images: SssImages {
+                    depth: &depth,
+                    diffuse: &diffuse,
+                    specular: Some(&specular),
+                    albedo: Some(&albedo),
+                    material_ids: &ids,
+                },
+                output: &output,
+            };
+            effects
+                .sss
+                .record(&effects.lucent, cmd, &frame)
+                .map_err(|e| format!("lucent: {e}"))?;
+            // lucent left each image in its final state (here: as each came, the output
+            // sampled); the engine tracks what it says.
+            slot.depth.state = depth.left_in();
+            slot.diffuse.state = diffuse.left_in();
+            slot.specular.state = specular.left_in();
+            slot.albedo.state = albedo.left_in();
+            slot.ids.state = ids.left_in();
+            slot.hdr.state = output.left_in();
+        }
+        None => {
+            slot.hdr
+                .transition(device, cmd, ImageState::color_attachment(), true);
+            begin_rendering(device, cmd, extent, &[slot.hdr.view], None, false);
+            bind(pipelines.compose, Some(slot.compose_set), Mat4::IDENTITY);
+            // SAFETY: inside the composition's rendering.
+            unsafe {
+                device.cmd_draw(cmd, 3, 1, 0, 0);
+                device.cmd_end_rendering(cmd);
+            }
+            slot.hdr.transition(device, cmd, fragment_sampled, false);
+        }
+    }
+
+    // 4. Tonemap (lucent left the pipeline, sets and push constants undefined: bound again).
+    slot.ldr
+        .transition(device, cmd, ImageState::color_attachment(), true);
+    begin_rendering(device, cmd, extent, &[slot.ldr.view], None, false);
+    bind(pipelines.tonemap, Some(slot.tonemap_set), Mat4::IDENTITY);
+    // SAFETY: inside the tonemap's rendering.
+    unsafe {
+        device.cmd_draw(cmd, 3, 1, 0, 0);
+        device.cmd_end_rendering(cmd);
+    }
+    slot.ldr
+        .transition(device, cmd, ImageState::transfer_src(), false);
+    Ok(())
+}
+
+/// Submits `cmd` with `fence` (reset first).
+fn submit(engine: &Engine, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<(), String> {
+    let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+    let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
+    // SAFETY: `cmd` is executable; the fence is signalled and unused.
+    unsafe {
+        check("vkResetFences", engine.device.reset_fences(&[fence]))?;
+        check(
+            "vkQueueSubmit2",
+            engine.device.queue_submit2(engine.queue, &[submit], fence),
+        )
+    }
+}
+
+/// Waits for the slot's last submission and begins its command buffer again.
+fn begin_slot(engine: &Engine, slot: &FrameSlot) -> Result<(), String> {
+    let device = &engine.device;
+    // SAFETY: the slot's own objects; the fence wait frees its command buffer (and lucent's
+    // parameters of this slot) for reuse.
+    unsafe {
+        check(
+            "vkWaitForFences",
+            device.wait_for_fences(&[slot.fence], true, u64::MAX),
+        )?;
+        check(
+            "vkResetCommandBuffer",
+            device.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty()),
+        )?;
+        check(
+            "vkBeginCommandBuffer",
+            device.begin_command_buffer(
+                slot.cmd,
+                &vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            ),
+        )
+    }
+}
+
+/// lucent on the engine's device, and its SSS effect for the engine's G-buffer, its uploads
+/// recorded into `slot`'s command buffer (submitted, and waited for here at start-up: the
+/// engine's choice).
+fn create_effects(
+    args: &Args,
+    engine: &Engine,
+    allocator: &Arc<Mutex<Allocator>>,
+    pipeline_cache: vk::PipelineCache,
+    slot: &FrameSlot,
+    light_format: vk::Format,
+) -> Result<Effects, String> {
+    let host = HostDevice {
+        entry: engine.entry.clone(),
+        instance: engine.instance.clone(),
+        physical_device: engine.physical_device,
+        device: engine.device.clone(),
+        queue: engine.queue,
+        queue_family: engine.queue_family,
+        enabled: engine.enabled,
+    };
+    let options = EmbedOptions {
+        frames_in_flight: FRAMES_IN_FLIGHT,
+        pipeline_cache: Some(pipeline_cache),
+        allocator: Some(allocator.clone()),
+        ..EmbedOptions::default()
+    };
+    // SAFETY: the handles are the engine's, created together, and outlive `lucent` (dropped
+    // before the engine is destroyed).
+    let lucent = unsafe { Lucent::new(host, options) }.map_err(|e| e.to_string())?;
+    let profile = |preset: &str| -> Result<SssProfile, String> {
+        let mut profile = SssProfile::preset(preset).map_err(|e| e.to_string())?;
+        profile.blur = Some(args.blur.as_str().into());
+        Ok(profile)
+    };
+    let gbuffer = GBufferDesc::new(
+        args.width,
+        args.height,
+        DepthDesc::device(DEPTH_FORMAT),
+        DiffuseDesc::with_albedo(light_format),
+    )
+    .with_specular(light_format)
+    .with_albedo(ALBEDO_FORMAT)
+    .with_material_ids(IdDesc::value(ID_FORMAT))
+    .with_metres_per_unit(1.0);
+    let desc = SssEffectDesc::new(
+        gbuffer,
+        vec![
+            SssMaterial::new(SKIN_ID, profile("skin")?),
+            SssMaterial::new(MARBLE_ID, profile("marble")?),
+        ],
+        HDR_FORMAT,
+    );
+    begin_slot(engine, slot)?;
+    // SAFETY: the slot's command buffer is recording, outside rendering, on lucent's queue
+    // family; it is submitted below before any frame records the effect.
+    let mut uploads = unsafe { lucent.uploads(slot.cmd) };
+    let sss = SssEffect::new(&lucent, &mut uploads, desc);
+    let device = &engine.device;
+    // SAFETY: the command buffer is recording.
+    check("vkEndCommandBuffer", unsafe {
+        device.end_command_buffer(slot.cmd)
+    })?;
+    submit(engine, slot.cmd, slot.fence)?;
+    // SAFETY: waiting for the submission that holds the uploads.
+    check("vkWaitForFences", unsafe {
+        device.wait_for_fences(&[slot.fence], true, u64::MAX)
+    })?;
+    let staging_bytes = uploads.staging_bytes();
+    // SAFETY: that submission has completed.
+    unsafe { uploads.release(&lucent) }.map_err(|e| e.to_string())?;
+    let sss = sss.map_err(|e| format!("lucent: {e}"))?;
+    eprintln!(
+        "host_engine: lucent effects: sss ({} blur; skin ID {SKIN_ID}, marble ID {MARBLE_ID}; \
+         {} staging bytes uploaded)",
+        args.blur, staging_bytes
+    );
+    Ok(Effects { lucent, sss })
+}
+
 fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     let device = &engine.device;
-    // The engine's allocator, shared with lucent.
     let allocator = Arc::new(Mutex::new(
         Allocator::new(&AllocatorCreateDesc {
             instance: engine.instance.clone(),
@@ -486,100 +1570,62 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     let pipeline_cache =
         unsafe { device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
             .map_err(|e| format!("vkCreatePipelineCache: {e}"))?;
-    let host = HostDevice {
-        entry: engine.entry.clone(),
-        instance: engine.instance.clone(),
-        physical_device: engine.physical_device,
-        device: device.clone(),
-        queue: engine.queue,
-        queue_family: engine.queue_family,
-        enabled: engine.enabled,
-    };
-    let options = EmbedOptions {
-        frames_in_flight: FRAMES_IN_FLIGHT,
-        pipeline_cache: Some(pipeline_cache),
-        allocator: Some(allocator.clone()),
-        cache_dir: None,
-    };
-    // SAFETY: the handles are the engine's, created together above, and outlive `lucent`
-    // (dropped at the end of this function, before the engine is destroyed); nothing else
-    // uses the queue while lucent uploads.
-    let lucent = unsafe { Lucent::new(host, options) }.map_err(|e| e.to_string())?;
-    let scene = lucent.load_scene(&args.scene).map_err(|e| e.to_string())?;
-    let mut renderer = SceneRenderer::new(&lucent, &scene, args.width, args.height, FORMAT)
-        .map_err(|e| e.to_string())?;
-    let mut slots = Vec::with_capacity(FRAMES_IN_FLIGHT);
-    for k in 0..FRAMES_IN_FLIGHT {
-        slots.push(create_slot(engine, &allocator, args.width, args.height, k)?);
-    }
+    let light_format = light_format(engine);
     let extent = vk::Extent2D {
         width: args.width,
         height: args.height,
     };
     let mut result = Ok(());
-    for frame in 0..args.frames {
-        let k = frame % FRAMES_IN_FLIGHT;
-        let slot = &mut slots[k];
-        // SAFETY: the slot's own objects; the fence wait makes its command buffer and lucent's
-        // slot-k parameters free to reuse.
-        let recorded = unsafe {
-            check(
-                "vkWaitForFences",
-                device.wait_for_fences(&[slot.fence], true, u64::MAX),
-            )
-            .and_then(|()| check("vkResetFences", device.reset_fences(&[slot.fence])))
-            .and_then(|()| {
-                check(
-                    "vkResetCommandBuffer",
-                    device.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty()),
-                )
-            })
-            .and_then(|()| {
-                check(
-                    "vkBeginCommandBuffer",
-                    device.begin_command_buffer(
-                        slot.cmd,
-                        &vk::CommandBufferBeginInfo::default()
-                            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                    ),
-                )
-            })
-            .and_then(|()| {
-                let output = HostImage {
-                    name: format!("host output {k}"),
-                    image: slot.image,
-                    view: slot.view,
-                    format: FORMAT,
-                    extent,
-                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT
-                        | vk::ImageUsageFlags::TRANSFER_SRC,
-                    state: slot.state,
-                };
-                renderer
-                    .record(
-                        &lucent,
-                        slot.cmd,
-                        k,
-                        &scene,
-                        &output,
-                        ImageState::transfer_src(),
-                    )
-                    .map(|state| slot.state = state)
-                    .map_err(|e| e.to_string())
-            })
-            .and_then(|()| check("vkEndCommandBuffer", device.end_command_buffer(slot.cmd)))
-            .and_then(|()| {
-                let infos = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
-                let submit = vk::SubmitInfo2::default().command_buffer_infos(&infos);
-                check(
-                    "vkQueueSubmit2",
-                    device.queue_submit2(engine.queue, &[submit], slot.fence),
-                )
-            })
-        };
-        if let Err(e) = recorded {
-            result = Err(format!("frame {frame}: {e}"));
-            break;
+    let mut slots = Vec::with_capacity(FRAMES_IN_FLIGHT);
+    let mut pipelines = None;
+    let mut effects = None;
+    let setup = (|| {
+        let made = create_pipelines(engine, pipeline_cache, light_format)?;
+        let made = pipelines.insert(made);
+        for k in 0..FRAMES_IN_FLIGHT {
+            slots.push(create_slot(
+                engine,
+                &allocator,
+                made,
+                extent,
+                light_format,
+                k,
+            )?);
+        }
+        if args.with_lucent {
+            effects = Some(create_effects(
+                args,
+                engine,
+                &allocator,
+                pipeline_cache,
+                &slots[0],
+                light_format,
+            )?);
+        }
+        Ok::<(), String>(())
+    })();
+    if let Err(e) = setup {
+        result = Err(e);
+    }
+    if let (Ok(()), Some(pipelines)) = (&result, &pipelines) {
+        for frame in 0..args.frames {
+            let k = frame % FRAMES_IN_FLIGHT;
+            let slot = &mut slots[k];
+            let recorded = begin_slot(engine, slot)
+                .and_then(|()| {
+                    record_frame(engine, pipelines, effects.as_mut(), slot, k, frame, extent)
+                })
+                // SAFETY: the command buffer is recording.
+                .and_then(|()| {
+                    check("vkEndCommandBuffer", unsafe {
+                        device.end_command_buffer(slot.cmd)
+                    })
+                })
+                .and_then(|()| submit(engine, slot.cmd, slot.fence));
+            if let Err(e) = recorded {
+                result = Err(format!("frame {frame}: {e}"));
+                break;
+            }
         }
     }
     // SAFETY: waits for every frame the engine submitted.
@@ -592,20 +1638,19 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 .map_err(|e| e.to_string())
         });
     }
-    renderer.destroy(&lucent);
-    let lucent_errors = lucent.gpu().validation_error_count();
-    drop(lucent);
+    if let Some(effects) = effects {
+        effects.sss.destroy(&effects.lucent);
+        drop(effects.lucent);
+    }
     for slot in slots {
         destroy_slot(engine, &allocator, slot);
+    }
+    if let Some(pipelines) = &pipelines {
+        destroy_pipelines(device, pipelines);
     }
     // SAFETY: lucent is gone and the device idle: nothing uses the cache.
     unsafe { device.destroy_pipeline_cache(pipeline_cache, None) };
     drop(allocator);
-    if lucent_errors > 0 {
-        result = result.and(Err(format!(
-            "lucent's messenger counted {lucent_errors} validation error(s)"
-        )));
-    }
     result
 }
 
@@ -635,11 +1680,12 @@ fn main() {
     .map(|n| n.into_owned())
     .unwrap_or_default();
     eprintln!(
-        "host_engine: {} on {name}, {}x{}, {} frames, {FRAMES_IN_FLIGHT} in flight, validation {}",
-        args.scene,
+        "host_engine: {name}, {}x{}, {} frames, {FRAMES_IN_FLIGHT} in flight, lucent {}, \
+         validation {}",
         args.width,
         args.height,
         args.frames,
+        if args.with_lucent { "on" } else { "left out" },
         if engine.validation {
             "on (synchronization validation included)"
         } else {

@@ -79,6 +79,86 @@ pub enum LucentError {
     /// Reading or writing a file failed.
     #[error("{path}: {message}")]
     File { path: PathBuf, message: String },
+    /// A host engine's description or images cannot be used as given (`lucent::embed`),
+    /// refused before anything was recorded.
+    #[error(transparent)]
+    Host(#[from] HostError),
+}
+
+/// What is wrong with what a host engine gave lucent (`lucent::embed`): typed, so a host can
+/// match on the kind of mistake, each naming the input at fault and, where there is a choice,
+/// what lucent would accept. Refused before any command is recorded.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum HostError {
+    /// An input's format (or its encoding: a depth convention, an ID bit field) is not one
+    /// lucent reads for it.
+    #[error("{input}: {found} cannot be used here; lucent accepts {accepted}")]
+    Unsupported {
+        /// The input (`"depth"`, `"material IDs"`, `"output"`, ...).
+        input: String,
+        /// What was given.
+        found: String,
+        /// What would be accepted.
+        accepted: String,
+    },
+    /// An effect needs an input the host did not describe or give.
+    #[error("{input} is missing: {needed_by}")]
+    Missing {
+        /// The input.
+        input: String,
+        /// Who needs it, and why.
+        needed_by: String,
+    },
+    /// A host image cannot be used as declared.
+    #[error("host image '{image}': {problem}")]
+    Image {
+        /// The image's name (`HostImage::name`).
+        image: String,
+        /// Which check it failed.
+        kind: ImageFault,
+        /// What exactly.
+        problem: String,
+    },
+    /// A frame slot or view index outside what the effect was built for.
+    #[error("{what} {index}: the effect was built for {count} (0..{count})")]
+    OutOfRange {
+        /// `"frame slot"` or `"view"`.
+        what: &'static str,
+        /// The index given.
+        index: usize,
+        /// How many there are.
+        count: usize,
+    },
+    /// A description's value out of range (a size, a count, a scale, a camera matrix).
+    #[error("{field}: {problem}")]
+    Description {
+        /// The field.
+        field: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+}
+
+/// Which check a host image failed ([`HostError::Image`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ImageFault {
+    /// A null image or view.
+    Handles,
+    /// Not the size the effect was built for.
+    Size,
+    /// Created without a usage flag lucent's use of it needs.
+    Usage,
+    /// A declared layout the image's usage or aspect does not allow, or one no image can be
+    /// left in.
+    Layout,
+    /// A declared access its stages cannot perform, or its layout cannot hold.
+    Access,
+    /// Not the format the effect was built for, or one the device cannot use in that role.
+    Format,
+    /// The same image as two inputs with different states, or as an input and the output.
+    Aliased,
 }
 
 /// The command that regenerates `glsl/permutations.txt`, the shipped SPIR-V's manifest (named

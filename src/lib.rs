@@ -61,4 +61,4 @@ pub mod reference;
 pub mod report;
 pub mod scene;
 
-pub use error::{LucentError, Result};
+pub use error::{HostError, ImageFault, LucentError, Result};

@@ -27,6 +27,9 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 exposure;        // x: exposure multiplier applied before tonemapping
     ivec4 light_count;    // x
     vec4 camera;          // x: near, y: far, z: focal length in pixels (height / 2 tan(fov / 2))
+    vec4 depth_decode;    // view-space depth from the depth image's value d: (x + y d) / (z + w d),
+                          // from the projection (any near and far, standard or reversed, finite
+                          // or infinite far) or the identity for a linear depth image (embedding)
     ivec4 fault;          // robustness tests (LUCENT_FAULT_INJECTION): x, y pixel; z 1 NaN, 2 +Inf
     Light lights[MAX_LIGHTS];
 } frame;
@@ -60,11 +63,22 @@ vec3 world_position(vec2 frag_coord, float device_depth) {
     return world.xyz / world.w;
 }
 
-// View-space distance along the view axis from a device depth in [0, 1] (glam's right-handed
-// perspective, depth 0 at the near plane). Clamped away from the far plane's singularity.
+// View-space distance along the view axis from the depth image's value (a device depth of the
+// frame's projection, or a host's linear depth). The coefficients are scaled so that the larger
+// of z and w is 1 and the denominator is positive over the depth range: the clamp keeps the far
+// plane of an infinite projection (d = 0 reversed, d = 1 standard) finite instead of Inf.
 float linear_depth(float device_depth) {
-    float n = frame.camera.x, f = frame.camera.y;
-    return n * f / max(f - device_depth * (f - n), 1e-6);
+    vec4 k = frame.depth_decode;
+    return (k.x + k.y * device_depth) / max(k.z + k.w * device_depth, 1e-7);
+}
+
+// Whether a pixel's device depth is a surface's a blur may use: its linear depth positive and
+// finite (a NaN or Inf in a depth image keeps the pixel out of the blur rather than poisoning
+// its neighbours). The background is told by its material ID (0), not by its depth: "1.0 is
+// the far plane" holds for none of a host's reversed, infinite or linear depth images.
+bool depth_is_surface(float device_depth) {
+    float z = linear_depth(device_depth);
+    return z > 0.0 && z < 1e30;
 }
 
 #endif

@@ -32,11 +32,57 @@ layout(std140, set = 0, binding = LUCENT_SSS_PROFILES_BINDING) uniform SssProfil
     // omega) (a: 1 = the profile has a medium), omega / (4 A_1). Read by the lighting pass
     // (sss_medium.glsl, sss_transmission.glsl).
     vec4 medium[MAX_SSS_PROFILES * 6];
+    // A host's material IDs (LUCENT_SSS_HOST_IDS; src/embed/gbuffer.rs `IdEncoding`): x the
+    // channel that holds them, y the bit field's shift, z its mask, w the largest value of a
+    // UNORM channel (its integer is value * w). The field is the host's ID; id_profiles maps
+    // it to a profile number, one byte per ID (ID i: byte i % 4 of id_profiles[i / 16][i / 4 % 4]).
+    uvec4 id_decode;
+    uvec4 id_profiles[16];
 } sss_profiles;
 
 // The profile ID stored at a texel (exact for UNORM8: rounding recovers the integer).
 int sss_profile_id(float stored) {
     return clamp(int(stored * 255.0 + 0.5), 0, MAX_SSS_PROFILES - 1);
+}
+
+// The profile IDs' sampler: lucent's own G-buffer stores R8_UNORM (ID / 255); a host's IDs
+// may be unsigned integers (LUCENT_SSS_IDS_UINT: an R8_UINT target, a stencil aspect, a
+// channel of a UINT target).
+#ifdef LUCENT_SSS_IDS_UINT
+#define SSS_ID_SAMPLER usampler2D
+#else
+#define SSS_ID_SAMPLER sampler2D
+#endif
+
+// The profile number of a host's material ID (0: does not scatter); IDs past 255 have none.
+int sss_host_profile(uint host_id) {
+    if (host_id > 255u) {
+        return 0;
+    }
+    uint word = sss_profiles.id_profiles[host_id / 16u][(host_id / 4u) % 4u];
+    return int((word >> (8u * (host_id % 4u))) & 255u) % MAX_SSS_PROFILES;
+}
+
+// The bit field of a host's ID in its integer channel value.
+uint sss_host_field(uint raw) {
+    return (raw >> sss_profiles.id_decode.y) & sss_profiles.id_decode.z;
+}
+
+// The profile number of the texel `t` of the profile ID image (texelFetch's result).
+int sss_decode_id(vec4 t) {
+#ifdef LUCENT_SSS_HOST_IDS
+    // The channel's integer: exact for UNORM formats, whose values are integers / max.
+    float stored = t[min(sss_profiles.id_decode.x, 3u)];
+    uint raw = uint(clamp(stored, 0.0, 1.0) * float(sss_profiles.id_decode.w) + 0.5);
+    return sss_host_profile(sss_host_field(raw));
+#else
+    return sss_profile_id(t.r);
+#endif
+}
+
+int sss_decode_id(uvec4 t) {
+    // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
+    return sss_host_profile(sss_host_field(t[min(sss_profiles.id_decode.x, 3u)]));
 }
 
 // Whether profile `id` is blurred by chain `chain` (0 never is).

@@ -34,12 +34,12 @@ layout(location = 1) out vec4 out_lean;
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     ivec2 size = textureSize(color_tex, 0);
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     float device_depth = texelFetch(depth_tex, px, 0).r;
 #ifdef LUCENT_SSS_PASSTHROUGH
     bool scatters = false;
 #else
-    bool scatters = in_this_chain(id) && device_depth < 1.0;
+    bool scatters = in_this_chain(id) && depth_is_surface(device_depth);
 #endif
     vec4 center = finite_or(texelFetch(color_tex, px, 0), vec4(0.0));
     float depth_m = linear_depth(device_depth);
@@ -73,7 +73,7 @@ void main() {
                 sss_kernels.inverse_falloff[id * MAX_KERNEL_SAMPLES + k].rgb;
             vec3 w = kernel_tap.rgb * clamp(falloff, vec3(0.0), vec3(1.0));
 #ifdef LUCENT_SSS_PROFILE_EDGES
-            int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
+            int tap_id = sss_decode_id(texelFetch(profile_tex, tap, 0));
             w = tap_id != id && tap_id != 0 ? vec3(0.0) : w;
 #endif
             // A NaN weight (from a NaN depth) would poison the sum: no weight.

@@ -48,7 +48,7 @@ layout(set = 0, binding = 2) uniform usampler2D packed_tex;  // both texels, pac
 layout(set = 0, binding = 2) uniform sampler2D color_tex;    // linear filtering, clamp to edge
 #endif
 layout(set = 0, binding = 3) uniform sampler2D depth_tex;    // device depth, read with texelFetch
-layout(set = 0, binding = 4) uniform sampler2D profile_tex;  // SSS profile ID, 0 = not SSS
+layout(set = 0, binding = 4) uniform SSS_ID_SAMPLER profile_tex;  // SSS profile ID, 0 = not SSS
 #if defined(LUCENT_SSS_LEAN) && !defined(LUCENT_SSS_PACKED_IN)
 layout(set = 0, binding = 5) uniform sampler2D lean_tex;     // slope y, moments (same filter)
 #endif
@@ -109,11 +109,11 @@ void main() {
     vec4 center = finite_or(texelFetch(color_tex, px, 0), vec4(0.0));
 #endif
     float device_depth = texelFetch(depth_tex, px, 0).r;
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     SssStep profile_step = sss_step(id, int(blur.step.z + 0.5));
     // Pixels of other chains' profiles (and of none) are left as they are; sky pixels have no
     // surface to scatter in.
-    float strength = sss_in_chain(id, int(blur.step.w + 0.5)) && device_depth < 1.0 ? 1.0 : 0.0;
+    float strength = sss_in_chain(id, int(blur.step.w + 0.5)) && depth_is_surface(device_depth) ? 1.0 : 0.0;
     float depth_term = profile_step.blur.y;
     float depth_m = linear_depth(device_depth);
     float sigma_px = profile_step.blur.x * frame.camera.z / max(depth_m, 1e-4) * strength;
@@ -146,7 +146,7 @@ void main() {
         float r = sigma > 0.0 ? offset / sigma : 0.0;
         float w = exp(-0.5 * (r * r + dz * dz));
 #ifdef LUCENT_SSS_PROFILE_EDGES
-        int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
+        int tap_id = sss_decode_id(texelFetch(profile_tex, tap, 0));
         w = tap_id != id && tap_id != 0 ? 0.0 : w;
 #endif
         // A NaN depth would poison the sum: such a tap gets no weight.
@@ -196,7 +196,7 @@ void main() {
         // A huge depth difference (another object, the background): back to the centre colour.
         float s = min(depth_term * abs(depth_m - depth), 1.0);
 #ifdef LUCENT_SSS_PROFILE_EDGES
-        int tap_id = sss_profile_id(texelFetch(profile_tex, tap, 0).r);
+        int tap_id = sss_decode_id(texelFetch(profile_tex, tap, 0));
         s = tap_id != id && tap_id != 0 ? 1.0 : s;
 #endif
 #ifdef LUCENT_SSS_LEAN

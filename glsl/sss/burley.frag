@@ -30,7 +30,7 @@ layout(std140, set = 0, binding = 2) uniform SssBurley {
 
 layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;   // lit diffuse (+ depth)
 layout(set = 0, binding = 4) uniform sampler2D depth_tex;     // device depth
-layout(set = 0, binding = 5) uniform sampler2D profile_tex;   // profile IDs
+layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
 
 layout(push_constant) uniform Blur {
     vec4 step;  // w: the chain
@@ -78,7 +78,7 @@ void main() {
     ivec2 texel = px;
 #endif
     vec4 center = finite_or(texelFetch(diffuse_tex, px, 0), vec4(0.0));
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
     vec3 blurred = center.rgb;
     if (scatters) {
@@ -116,7 +116,7 @@ void main() {
                 direction = turn * direction;
                 ivec2 tap_px = clamp(px + ivec2(round(offset)), ivec2(0), size - 1);
                 // Other profiles and pixels that do not scatter are rejected.
-                int tap_id = sss_profile_id(texelFetch(profile_tex, tap_px, 0).r);
+                int tap_id = sss_decode_id(texelFetch(profile_tex, tap_px, 0));
                 if (tap_id != id) {
                     continue;
                 }

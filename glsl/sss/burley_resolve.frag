@@ -32,7 +32,7 @@ layout(std140, set = 0, binding = 2) uniform SssBurley {
 } burley;
 
 layout(set = 0, binding = 3) uniform sampler2D gathered_tex;  // diffused light, depth in alpha
-layout(set = 0, binding = 4) uniform sampler2D profile_tex;   // profile IDs
+layout(set = 0, binding = 4) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
 layout(set = 0, binding = 5) uniform sampler2D diffuse_tex;   // lit diffuse
 layout(set = 0, binding = 6) uniform sampler2D specular_tex;  // lit specular
 #ifdef LUCENT_SSS_BASE
@@ -78,7 +78,7 @@ void main() {
     bool scatters = false;
     int id = 0;
 #else
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
 #endif
     vec3 color;
@@ -123,7 +123,7 @@ void main() {
                 ivec2 q_px = q;
 #endif
 #ifdef LUCENT_SSS_PROFILE_EDGES
-                if (sss_profile_id(texelFetch(profile_tex, q_px, 0).r) != id) {
+                if (sss_decode_id(texelFetch(profile_tex, q_px, 0)) != id) {
                     continue;
                 }
 #endif

@@ -10,7 +10,7 @@
 layout(set = 0, binding = 2) uniform sampler2D sum_tex;
 layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;
 layout(set = 0, binding = 4) uniform sampler2D specular_tex;
-layout(set = 0, binding = 5) uniform sampler2D profile_tex;
+layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;
 #ifdef LUCENT_SSS_BASE
 layout(set = 0, binding = 6) uniform sampler2D base_tex;
 #endif
@@ -32,7 +32,7 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     vec3 color;
     if (sss_in_chain(id, int(chain.step.w + 0.5))) {
         vec3 diffused = texelFetch(sum_tex, px, 0).rgb;

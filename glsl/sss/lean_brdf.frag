@@ -17,7 +17,7 @@ layout(set = 0, binding = 2) uniform sampler2D sum_tex;       // blurred diffuse
 layout(set = 0, binding = 3) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
 layout(set = 0, binding = 4) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
 layout(set = 0, binding = 5) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
-layout(set = 0, binding = 6) uniform sampler2D profile_tex;   // SSS profile ID
+layout(set = 0, binding = 6) uniform SSS_ID_SAMPLER profile_tex;   // SSS profile ID
 layout(set = 0, binding = 7) uniform sampler2D depth_tex;
 layout(set = 0, binding = 8) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
 layout(set = 0, binding = 9) uniform sampler2D normal_tex;    // GB1: a = roughness
@@ -39,7 +39,7 @@ void main() {
     bool scatters = false;
     int id = 0;
 #else
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     bool scatters = sss_in_chain(id, int(chain.step.w + 0.5));
 #endif
     vec3 color;

@@ -58,7 +58,7 @@ void main() {
 #define SCATTER_FROM_ALPHA
     int id = 1;
 #else
-    int id = sss_profile_id(texelFetch(profile_tex, full_px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, full_px, 0));
 #endif
 #if !(defined(LUCENT_SSS_HALF_RES) && !defined(LUCENT_SSS_VERTICAL)) && (defined(LUCENT_SSS_DEPTH_IN_ALPHA) || defined(LUCENT_SSS_VERTICAL))
     // The pixel's linear depth travels with its light (sky: the far plane; its profile ID is
@@ -77,7 +77,7 @@ void main() {
 #elif defined(DEPTH_FROM_ALPHA)
     bool scatters = in_this_chain(id);
 #else
-    bool scatters = in_this_chain(id) && device_depth < 1.0;
+    bool scatters = in_this_chain(id) && depth_is_surface(device_depth);
 #endif
 #if defined(LUCENT_SSS_HALF_RES) && !defined(LUCENT_SSS_VERTICAL)
     // The light at the block's centre: bilinear between its four pixels.
@@ -120,7 +120,7 @@ void main() {
             float s = clamp(abs(depth - depth_m) * info.y, 0.0, 1.0);
 #ifdef LUCENT_SSS_PROFILE_EDGES
             ivec2 tap_px = ivec2(uv * frame.viewport.xy);
-            int tap_id = sss_profile_id(texelFetch(profile_tex, tap_px, 0).r);
+            int tap_id = sss_decode_id(texelFetch(profile_tex, tap_px, 0));
             s = tap_id != id && tap_id != 0 ? 1.0 : s;
 #endif
             sum += tap.rgb * mix(color.rgb, center.rgb, s);

@@ -21,7 +21,7 @@
 #define IMAGE0 3
 layout(set = 0, binding = IMAGE0) uniform sampler2D color_tex;        // light (+ alpha)
 layout(set = 0, binding = IMAGE0 + 1) uniform sampler2D depth_tex;    // device depth, full res
-layout(set = 0, binding = IMAGE0 + 2) uniform sampler2D profile_tex;  // profile IDs, full res
+layout(set = 0, binding = IMAGE0 + 2) uniform SSS_ID_SAMPLER profile_tex;  // profile IDs, full res
 
 layout(push_constant) uniform Blur {
     vec4 step;  // xy: direction (1,0) or (0,1); w: the chain

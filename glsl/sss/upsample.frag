@@ -14,7 +14,7 @@
 
 layout(set = 0, binding = 3) uniform sampler2D blurred_tex;   // half res: rgb, a linear depth
 layout(set = 0, binding = 4) uniform sampler2D depth_tex;
-layout(set = 0, binding = 5) uniform sampler2D profile_tex;
+layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;
 layout(set = 0, binding = 6) uniform sampler2D diffuse_tex;
 layout(set = 0, binding = 7) uniform sampler2D specular_tex;
 #ifdef LUCENT_SSS_BASE
@@ -38,12 +38,12 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    int id = sss_profile_id(texelFetch(profile_tex, px, 0).r);
+    int id = sss_decode_id(texelFetch(profile_tex, px, 0));
     float device_depth = texelFetch(depth_tex, px, 0).r;
 #ifdef LUCENT_SSS_PASSTHROUGH
     bool scatters = false;
 #else
-    bool scatters = sss_in_chain(id, int(chain.step.w + 0.5)) && device_depth < 1.0;
+    bool scatters = sss_in_chain(id, int(chain.step.w + 0.5)) && depth_is_surface(device_depth);
 #endif
     vec3 color;
     if (scatters) {

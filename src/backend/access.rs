@@ -53,6 +53,20 @@ pub struct AccessInfo {
 }
 
 impl Access {
+    /// Whether a pass reads or writes the image through a descriptor (sampled, storage or
+    /// input attachment), not as an attachment or a transfer's image.
+    pub fn through_descriptors(self) -> bool {
+        matches!(
+            self,
+            Access::InputAttachmentRead
+                | Access::DepthInputAttachmentRead
+                | Access::FragmentSampledRead
+                | Access::ComputeSampledRead
+                | Access::ComputeStorageRead
+                | Access::ComputeStorageWrite
+        )
+    }
+
     /// The table. Depth layouts are the combined DEPTH_STENCIL ones, which need no
     /// `separateDepthStencilLayouts` feature. Depth attachments test in both fragment-test stages; load/store ops of
     /// attachments happen in those same stages, so barriers against them cover the ops too.

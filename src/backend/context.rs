@@ -8,8 +8,13 @@
 //!   the features lucent needs and creates a device with one graphics + compute queue. Use this for
 //!   the command-line tool, the benchmark and tests.
 //! - [`GpuContext::wrap`] borrows a host engine's instance, device and queue. lucent then creates
-//!   only its own allocator, a command pool for one-shot submits and (when the host enabled
-//!   `VK_EXT_debug_utils`) a debug messenger, and destroys only those on drop.
+//!   only its own allocator, a command pool for one-shot submits and (when asked, and the host
+//!   enabled `VK_EXT_debug_utils`) a debug messenger, and destroys only those on drop, without
+//!   waiting on the host's device.
+//!
+//! Setup copies (uploads) are submitted and waited for, except on a thread inside
+//! [`GpuContext::record_setup_into`]: there they are recorded into a command buffer the caller
+//! submits, and their staging buffers are handed back to be freed once it has run.
 //!
 //! Failures are values: a missing loader, a missing driver, a device without a required feature
 //! or a missing validation layer each produce their own [`LucentError`] variant; nothing here
@@ -24,6 +29,7 @@ use std::fmt;
 use std::mem::ManuallyDrop;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::ThreadId;
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -35,12 +41,22 @@ use super::desc::{c_string, lock};
 pub use super::desc::{ContextDesc, DeviceInfo};
 use super::device::{create_device, pick_device, probe_device, queue_family_usable};
 use super::instance::{create_instance, messenger_create_info, CreatedInstance, MessengerState};
+use super::resources::GpuBuffer;
 
 /// The command pool, command buffer and fence behind [`GpuContext::submit_and_wait`].
 struct OneShot {
     pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
+}
+
+/// A thread's setup work recorded into a caller's command buffer instead of submitted
+/// ([`GpuContext::record_setup_into`]).
+struct SetupRecording {
+    thread: ThreadId,
+    cmd: vk::CommandBuffer,
+    /// Staging buffers the recorded copies read: freed only after the caller's submission ran.
+    staging: Vec<GpuBuffer>,
 }
 
 /// The Vulkan context every other part of lucent uses (see the module docs).
@@ -71,6 +87,9 @@ pub struct GpuContext {
     owns_handles: bool,
     validation: bool,
     one_shot: Mutex<OneShot>,
+    /// Threads whose setup work goes into a caller's command buffer (usually none, at most a
+    /// few: one per thread building a renderer at the same time).
+    setup_recordings: Mutex<Vec<SetupRecording>>,
 }
 
 impl fmt::Debug for GpuContext {
@@ -180,6 +199,7 @@ impl GpuContext {
             owns_handles: true,
             validation: desc.validation,
             one_shot: Mutex::new(parts.one_shot),
+            setup_recordings: Mutex::new(Vec::new()),
         };
         ctx.name_own_objects();
         Ok(ctx)
@@ -190,8 +210,8 @@ impl GpuContext {
     /// lucent creates only its allocator, a command pool and fence for
     /// [`GpuContext::submit_and_wait`], and a debug messenger when the instance has
     /// `VK_EXT_debug_utils` enabled (so validation errors caused by lucent are logged and counted);
-    /// on drop it waits for the device to be idle and destroys only those. The host's handles are
-    /// never destroyed.
+    /// on drop it destroys only those, without waiting for the device (the host's contract: its
+    /// fences say lucent's work is done). The host's handles are never destroyed.
     ///
     /// The device's support for lucent's requirements (Vulkan 1.3, `synchronization2`,
     /// `maintenance4`, a graphics + compute queue family with timestamps) is checked and a
@@ -227,6 +247,7 @@ impl GpuContext {
                 queue,
                 queue_family,
                 None,
+                true,
             )
         }
     }
@@ -235,10 +256,17 @@ impl GpuContext {
     /// every buffer and image lucent creates is allocated from it and freed back to it;
     /// dropping the context drops only lucent's reference. `None`: lucent creates its own.
     ///
+    /// `debug_messenger`: whether lucent installs a debug messenger of its own on the host's
+    /// instance (when it has `VK_EXT_debug_utils`). A host with its own messenger would see every
+    /// message twice, and lucent would count the host's errors as its own: embedding leaves it
+    /// off unless asked ([`crate::embed::EmbedOptions::debug_messenger`]). Debug names and
+    /// labels need only the extension, not the messenger.
+    ///
     /// # Safety
     ///
     /// As [`GpuContext::wrap`]; a shared allocator must have been created for the same
     /// instance, physical device and device.
+    #[allow(clippy::too_many_arguments)]
     pub unsafe fn wrap_with_allocator(
         entry: ash::Entry,
         instance: ash::Instance,
@@ -247,6 +275,7 @@ impl GpuContext {
         queue: vk::Queue,
         queue_family: u32,
         shared_allocator: Option<Arc<Mutex<Allocator>>>,
+        debug_messenger: bool,
     ) -> Result<Self> {
         let mut probe = probe_device(&instance, physical_device, false)?;
         let families =
@@ -296,7 +325,7 @@ impl GpuContext {
             has_instance_debug.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
         let debug_device = (has_instance_debug && has_device_debug)
             .then(|| ash::ext::debug_utils::Device::new(&instance, &device));
-        let messenger = match &debug_instance {
+        let messenger = match debug_instance.as_ref().filter(|_| debug_messenger) {
             Some(debug) => {
                 let info = messenger_create_info(&messenger_state);
                 // SAFETY: the instance has VK_EXT_debug_utils enabled (checked above) and the
@@ -317,8 +346,10 @@ impl GpuContext {
             Ok(parts) => parts,
             Err(e) => {
                 if let Some(debug) = &debug_instance {
-                    // SAFETY: the messenger was created above and is not used elsewhere.
-                    unsafe { debug.destroy_debug_utils_messenger(messenger, None) };
+                    if messenger != vk::DebugUtilsMessengerEXT::null() {
+                        // SAFETY: the messenger was created above and is not used elsewhere.
+                        unsafe { debug.destroy_debug_utils_messenger(messenger, None) };
+                    }
                 }
                 return Err(e);
             }
@@ -344,6 +375,7 @@ impl GpuContext {
             owns_handles: false,
             validation: false,
             one_shot: Mutex::new(parts.one_shot),
+            setup_recordings: Mutex::new(Vec::new()),
         };
         ctx.name_own_objects();
         Ok(ctx)
@@ -415,7 +447,17 @@ impl GpuContext {
     /// For uploads, readbacks and setup work, not for frames. The command buffer is a primary one
     /// in the recording state; `record` must not call `submit_and_wait` itself (it would
     /// deadlock).
+    ///
+    /// Refused on a thread inside [`GpuContext::record_setup_into`]: work recorded there runs
+    /// when the caller submits it, so nothing can be waited for (a read-back, say).
     pub fn submit_and_wait(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        if self.recording_setup_cmd().is_some() {
+            return Err(LucentError::InvalidInput(
+                "a submission was asked for while setup work is recorded into the caller's \
+                 command buffer (nothing may be submitted or waited for there)"
+                    .into(),
+            ));
+        }
         let one_shot = lock(&self.one_shot);
         let cmd = one_shot.cmd;
         // SAFETY: the pool, command buffer and fence belong to this device and are used only
@@ -453,6 +495,83 @@ impl GpuContext {
         Ok(())
     }
 
+    /// Runs `build` with this thread's setup work (uploads: their copies and barriers)
+    /// recorded into `cmd` instead of submitted and waited for, and returns what `build`
+    /// returned with the staging buffers those copies read. The caller frees them
+    /// ([`GpuContext::destroy_buffer`]) once the submission holding `cmd` has completed, on
+    /// success or failure; on failure `cmd` holds copies into resources `build` destroyed, and
+    /// must be reset rather than submitted.
+    ///
+    /// Each recorded copy ends with a full memory barrier, so every later command in the same
+    /// queue's submission order sees its result. Other threads keep submitting their setup
+    /// work as usual. A nested call on the same thread is refused.
+    ///
+    /// # Safety
+    ///
+    /// `cmd` is a primary command buffer of this device, in the recording state, outside any
+    /// render pass, for a queue of [`GpuContext::queue_family`]; nothing else records into it
+    /// until this returns.
+    pub unsafe fn record_setup_into<T>(
+        &self,
+        cmd: vk::CommandBuffer,
+        build: impl FnOnce() -> Result<T>,
+    ) -> (Result<T>, Vec<GpuBuffer>) {
+        let thread = std::thread::current().id();
+        if self.recording_setup_cmd().is_some() {
+            return (
+                Err(LucentError::InvalidInput(
+                    "setup work is already being recorded on this thread".into(),
+                )),
+                Vec::new(),
+            );
+        }
+        lock(&self.setup_recordings).push(SetupRecording {
+            thread,
+            cmd,
+            staging: Vec::new(),
+        });
+        // A panic in `build` leaves this thread's entry behind; the next call on the thread
+        // would be refused, which is loud rather than wrong.
+        let built = build();
+        let mut recordings = lock(&self.setup_recordings);
+        let staging = match recordings.iter().position(|r| r.thread == thread) {
+            Some(at) => recordings.swap_remove(at).staging,
+            None => Vec::new(),
+        };
+        (built, staging)
+    }
+
+    /// The command buffer this thread's setup work is recorded into, if any.
+    fn recording_setup_cmd(&self) -> Option<vk::CommandBuffer> {
+        let thread = std::thread::current().id();
+        lock(&self.setup_recordings)
+            .iter()
+            .find(|r| r.thread == thread)
+            .map(|r| r.cmd)
+    }
+
+    /// Runs one setup copy reading `staging`: recorded into this thread's setup command buffer
+    /// (the staging buffer kept until the caller's submission ran) or submitted and waited for
+    /// (the staging buffer freed at once).
+    pub(crate) fn setup_copy(
+        &self,
+        staging: GpuBuffer,
+        record: impl FnOnce(vk::CommandBuffer),
+    ) -> Result<()> {
+        let thread = std::thread::current().id();
+        {
+            let mut recordings = lock(&self.setup_recordings);
+            if let Some(recording) = recordings.iter_mut().find(|r| r.thread == thread) {
+                record(recording.cmd);
+                recording.staging.push(staging);
+                return Ok(());
+            }
+        }
+        let copied = self.submit_and_wait(record);
+        self.destroy_buffer(staging);
+        copied
+    }
+
     /// Waits until the device is idle.
     pub fn wait_idle(&self) -> Result<()> {
         // SAFETY: the device is valid for the context's lifetime; vkDeviceWaitIdle requires
@@ -474,13 +593,27 @@ impl GpuContext {
 
 impl Drop for GpuContext {
     fn drop(&mut self) {
-        // SAFETY: after the device is idle nothing lucent created is in use; each object is
-        // destroyed once, children before parents (allocator memory and pool before the device,
-        // messenger before the instance), and the host's handles are left alone when wrapped.
-        // The messenger state box is dropped after this body, i.e. after the messenger is gone.
+        // SAFETY: nothing lucent created is in use: its own device is waited for here, and a
+        // host's fences said its work was done before it dropped the wrapper (the host's
+        // contract; waiting on a host's device would stall its other queues and race its
+        // other threads' submissions). The one-shot fence is only signalled inside
+        // submit_and_wait, which waits for it. Each object is destroyed once, children before
+        // parents (allocator memory and pool before the device, messenger before the
+        // instance), and the host's handles are left alone when wrapped. The messenger state
+        // box is dropped after this body, i.e. after the messenger is gone.
         unsafe {
-            if let Err(e) = self.device.device_wait_idle() {
-                log::error!("vkDeviceWaitIdle failed while dropping the GPU context: {e:?}");
+            if self.owns_handles {
+                if let Err(e) = self.device.device_wait_idle() {
+                    log::error!("vkDeviceWaitIdle failed while dropping the GPU context: {e:?}");
+                }
+            }
+            let recordings = std::mem::take(
+                self.setup_recordings
+                    .get_mut()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner()),
+            );
+            for staging in recordings.into_iter().flat_map(|r| r.staging) {
+                self.destroy_buffer(staging);
             }
             let one_shot = self
                 .one_shot

@@ -45,14 +45,24 @@ pub enum Binding {
     InputAttachment(vk::ImageView, vk::ImageLayout),
     /// A combined image sampler in SHADER_READ_ONLY_OPTIMAL.
     Sampled(vk::ImageView, vk::Sampler),
+    /// A combined image sampler whose view is given per frame slot
+    /// ([`DescriptorSet::write_view`]): a host's image bound when its frame is recorded. The
+    /// set then has one copy per slot.
+    SampledPerSlot(vk::Sampler),
 }
 
-/// A descriptor set with its own pool and layout (passes have one set each).
+/// A descriptor set with its own pool and layout (passes have one set each), or one copy of it
+/// per frame slot when a binding's view is given per slot.
 pub struct DescriptorSet {
     /// Layout, for the pipeline layout.
     pub layout: vk::DescriptorSetLayout,
-    /// The set, to bind.
+    /// The set, to bind (slot 0's copy when there are several).
     pub set: vk::DescriptorSet,
+    /// One copy per frame slot when some binding is [`Binding::SampledPerSlot`] (empty
+    /// otherwise): slot `k` binds `per_slot[k]`.
+    per_slot: Vec<vk::DescriptorSet>,
+    /// The samplers of the per-slot bindings, by binding index.
+    per_slot_samplers: Vec<(u32, vk::Sampler)>,
     pool: vk::DescriptorPool,
     /// Per-frame bindings (dynamic uniform buffers) and their slot stride: each is bound at
     /// `slot * stride`.
@@ -62,18 +72,31 @@ pub struct DescriptorSet {
 
 impl DescriptorSet {
     /// Creates and writes a set; binding `i` of the set is `bindings[i]`, visible to `stages`.
+    /// With a [`Binding::SampledPerSlot`] among them, `slots` copies, each written with the
+    /// other bindings; the per-slot views are written by [`Self::write_view`].
     pub fn new(
         ctx: &impl PipelineTarget,
         bindings: &[Binding],
         stages: vk::ShaderStageFlags,
         name: &str,
+        slots: usize,
     ) -> Result<Self> {
+        let copies = if bindings
+            .iter()
+            .any(|b| matches!(b, Binding::SampledPerSlot(_)))
+        {
+            slots.max(1)
+        } else {
+            1
+        };
         let device = &ctx.gpu().device;
         let kind = |b: &Binding| match b {
             Binding::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
             Binding::PerFrame(_) => vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
             Binding::InputAttachment(..) => vk::DescriptorType::INPUT_ATTACHMENT,
-            Binding::Sampled(..) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            Binding::Sampled(..) | Binding::SampledPerSlot(_) => {
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER
+            }
         };
         let layout_bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
             .iter()
@@ -103,14 +126,14 @@ impl DescriptorSet {
             .iter()
             .map(|b| vk::DescriptorPoolSize {
                 ty: kind(b),
-                descriptor_count: 1,
+                descriptor_count: copies as u32,
             })
             .collect();
         // SAFETY: as above.
         let pool = unsafe {
             device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
+                    .max_sets(copies as u32)
                     .pool_sizes(&sizes),
                 None,
             )
@@ -124,17 +147,34 @@ impl DescriptorSet {
                 return Err(e);
             }
         };
-        let layouts = [layout];
-        // SAFETY: the pool has room for exactly this set.
-        let set = unsafe {
+        let layouts = vec![layout; copies];
+        // SAFETY: the pool has room for exactly these sets.
+        let allocated = unsafe {
             device.allocate_descriptor_sets(
                 &vk::DescriptorSetAllocateInfo::default()
                     .descriptor_pool(pool)
                     .set_layouts(&layouts),
             )
         }
-        .vk("vkAllocateDescriptorSets")?[0];
-        ctx.gpu().set_name(set, name);
+        .vk("vkAllocateDescriptorSets");
+        let sets = match allocated {
+            Ok(sets) => sets,
+            Err(e) => {
+                // SAFETY: created above, unused.
+                unsafe {
+                    device.destroy_descriptor_pool(pool, None);
+                    device.destroy_descriptor_set_layout(layout, None);
+                }
+                return Err(e);
+            }
+        };
+        for (k, &set) in sets.iter().enumerate() {
+            if copies == 1 {
+                ctx.gpu().set_name(set, name);
+            } else {
+                ctx.gpu().set_name(set, &format!("{name} (slot {k})"));
+            }
+        }
         let buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
             .iter()
             .map(|b| match b {
@@ -164,13 +204,22 @@ impl DescriptorSet {
                     image_view: *view,
                     image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 }],
-                Binding::Uniform(_) | Binding::PerFrame(_) => [vk::DescriptorImageInfo::default()],
+                Binding::Uniform(_) | Binding::PerFrame(_) | Binding::SampledPerSlot(_) => {
+                    [vk::DescriptorImageInfo::default()]
+                }
             })
             .collect();
-        let writes: Vec<vk::WriteDescriptorSet> = bindings
+        // Every binding but the per-slot views, into every copy.
+        let writes: Vec<vk::WriteDescriptorSet> = sets
             .iter()
-            .enumerate()
-            .map(|(i, b)| {
+            .flat_map(|&set| {
+                bindings
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, b)| !matches!(b, Binding::SampledPerSlot(_)))
+                    .map(move |(i, b)| (set, i, b))
+            })
+            .map(|(set, i, b)| {
                 let w = vk::WriteDescriptorSet::default()
                     .dst_set(set)
                     .dst_binding(i as u32)
@@ -190,9 +239,19 @@ impl DescriptorSet {
                 _ => None,
             })
             .collect();
+        let per_slot_samplers = bindings
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| match b {
+                Binding::SampledPerSlot(sampler) => Some((i as u32, *sampler)),
+                _ => None,
+            })
+            .collect();
         Ok(Self {
             layout,
-            set,
+            set: sets[0],
+            per_slot: if copies > 1 { sets } else { Vec::new() },
+            per_slot_samplers,
             pool,
             dynamic: per_frame.len() as u32,
             // Every per-frame region lives in the same buffer: one stride.
@@ -200,9 +259,52 @@ impl DescriptorSet {
         })
     }
 
-    /// Binds the set as set `index` of `layout`, its per-frame bindings at the recorded
-    /// frame's slot.
+    /// Writes `view` into the per-slot binding `binding` of slot `slot`'s copy. That copy must
+    /// not be in use by a command buffer still pending (the frame last recorded with the slot
+    /// has completed).
+    pub fn write_view(
+        &self,
+        device: &ash::Device,
+        slot: usize,
+        binding: u32,
+        view: vk::ImageView,
+    ) -> Result<()> {
+        let sampler = self
+            .per_slot_samplers
+            .iter()
+            .find(|(b, _)| *b == binding)
+            .map(|&(_, s)| s);
+        let set = match sampler {
+            // One copy (every slot shares it) when only one slot is recorded.
+            Some(_) if self.per_slot.is_empty() => Some(self.set),
+            Some(_) => self.per_slot.get(slot).copied(),
+            None => None,
+        };
+        let (Some(sampler), Some(set)) = (sampler, set) else {
+            return Err(crate::LucentError::Graph(format!(
+                "descriptor binding {binding} of slot {slot} is not written per slot"
+            )));
+        };
+        let info = [vk::DescriptorImageInfo {
+            sampler,
+            image_view: view,
+            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        }];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(binding)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .image_info(&info);
+        // SAFETY: the set, view and sampler are alive; the caller's contract keeps the set
+        // out of pending command buffers.
+        unsafe { device.update_descriptor_sets(&[write], &[]) };
+        Ok(())
+    }
+
+    /// Binds the set as set `index` of `layout` (the recorded frame's copy when there is one
+    /// per slot), its per-frame bindings at the recorded frame's slot.
     pub fn bind(&self, ctx: &impl Recording, layout: vk::PipelineLayout, index: u32) {
+        let set = self.per_slot.get(ctx.frame()).copied().unwrap_or(self.set);
         // At most MAX_FRAMES_IN_FLIGHT slots of a few tens of kilobytes: fits u32.
         let offset = (self.stride * ctx.frame() as u64) as u32;
         let offsets = vec![offset; self.dynamic as usize];
@@ -213,7 +315,7 @@ impl DescriptorSet {
                 vk::PipelineBindPoint::GRAPHICS,
                 layout,
                 index,
-                &[self.set],
+                &[set],
                 &offsets,
             );
         }

@@ -17,8 +17,9 @@
 //!   an image at an offset in it and [`GpuContext::create_view`] makes its view. Wrap the result
 //!   in [`GpuImage::from_parts`] to use the other functions on it.
 //!
-//! Setup copies go through [`GpuContext::submit_and_wait`] and end with a full barrier, so later
-//! GPU work sees their results without further synchronization.
+//! Setup copies go through [`GpuContext::submit_and_wait`] (or, inside
+//! [`GpuContext::record_setup_into`], into the caller's command buffer) and end with a full
+//! barrier, so later GPU work sees their results without further synchronization.
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
@@ -373,7 +374,8 @@ impl GpuContext {
                 return Err(e);
             }
         };
-        let copied = self.submit_and_wait(|cmd| {
+        let staging_buffer = staging.buffer;
+        let copied = self.setup_copy(staging, |cmd| {
             self.begin_label(cmd, &format!("upload {name}"));
             let region = vk::BufferCopy {
                 src_offset: 0,
@@ -391,7 +393,7 @@ impl GpuContext {
             // were created with TRANSFER_SRC / TRANSFER_DST usage.
             unsafe {
                 self.device
-                    .cmd_copy_buffer(cmd, staging.buffer, buffer.buffer, &[region]);
+                    .cmd_copy_buffer(cmd, staging_buffer, buffer.buffer, &[region]);
                 self.device.cmd_pipeline_barrier2(
                     cmd,
                     &vk::DependencyInfo::default().memory_barriers(&barrier),
@@ -399,7 +401,6 @@ impl GpuContext {
             }
             self.end_label(cmd);
         });
-        self.destroy_buffer(staging);
         match copied {
             Ok(()) => Ok(buffer),
             Err(e) => {
@@ -528,7 +529,8 @@ impl GpuContext {
             offset += bytes;
         }
         let range = desc.subresource_range();
-        let copied = self.submit_and_wait(|cmd| {
+        let staging_buffer = staging.buffer;
+        let copied = self.setup_copy(staging, |cmd| {
             self.begin_label(cmd, &format!("upload {name}"));
             let to_dst = [vk::ImageMemoryBarrier2::default()
                 .src_stage_mask(vk::PipelineStageFlags2::NONE)
@@ -562,7 +564,7 @@ impl GpuContext {
                 );
                 self.device.cmd_copy_buffer_to_image(
                     cmd,
-                    staging.buffer,
+                    staging_buffer,
                     image.image,
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                     &regions,
@@ -574,7 +576,6 @@ impl GpuContext {
             }
             self.end_label(cmd);
         });
-        self.destroy_buffer(staging);
         match copied {
             Ok(()) => Ok(image),
             Err(e) => {

@@ -8,13 +8,15 @@
 //! perform or the declared layout cannot hold, a final layout an image can never be
 //! transitioned to, a format lucent cannot use in that role, a size that is not the frame's.
 //! Each of those would otherwise surface as a validation error (or undefined behaviour) deep
-//! inside a frame; here they are a [`LucentError::InvalidInput`] before the first command.
+//! inside a frame; here they are a [`HostError::Image`] (its [`ImageFault`] says which check)
+//! before the first command.
 
 use ash::vk;
 
 use crate::backend::format::{format_info, format_name, FormatKind};
 use crate::backend::GpuContext;
-use crate::{LucentError, Result};
+use crate::error::{HostError, ImageFault};
+use crate::Result;
 
 /// How an image was last used (or is to be used next): its layout and the pipeline stages and
 /// memory accesses of that use, as in a `VkImageMemoryBarrier2`.
@@ -97,17 +99,63 @@ impl ImageState {
             vk::AccessFlags2::NONE,
         )
     }
+
+    /// A swapchain image just acquired, as the current state of lucent's output: contents
+    /// undefined, and its first use ordered after the acquire. The host submits the command
+    /// buffer waiting on the acquire semaphore at `COLOR_ATTACHMENT_OUTPUT`; lucent's barrier
+    /// out of this state starts at that same stage, so its layout transition happens after the
+    /// presentation engine has released the image (the semaphore wait's second scope and the
+    /// barrier's first scope meet at that stage). [`ImageState::UNDEFINED`], whose stage is
+    /// `NONE`, would let the transition run before the wait.
+    pub const fn acquired() -> Self {
+        Self::new(
+            vk::ImageLayout::UNDEFINED,
+            vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+            vk::AccessFlags2::NONE,
+        )
+    }
+
+    /// Sampled as a depth-stencil image in a fragment shader (the read-only depth-stencil
+    /// layout, which a host may keep its depth buffer in while it also tests against it).
+    pub const fn depth_sampled() -> Self {
+        Self::new(
+            vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::AccessFlags2::SHADER_SAMPLED_READ,
+        )
+    }
 }
 
 /// A host's image handed to lucent for one call: the image, a view of its first mip level
-/// and array layer, and what it was created with. The host keeps owning both handles.
+/// and array layer, what it was created with, the state it is in and the state the host wants
+/// it left in. The host keeps owning both handles. Bound when the call records (never
+/// remembered by handle): a view recreated between frames, even with a reused handle value,
+/// is simply the next frame's view.
+///
+/// ```
+/// # use ash::vk;
+/// # use lucent::embed::{HostImage, ImageState};
+/// let depth = HostImage::new(
+///     "depth",
+///     vk::Image::null(),
+///     vk::ImageView::null(),
+///     vk::Format::D32_SFLOAT,
+///     vk::Extent2D { width: 1280, height: 720 },
+///     vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+/// )
+/// .in_state(ImageState::depth_attachment())
+/// .then(ImageState::depth_sampled());
+/// assert_eq!(depth.final_state, Some(ImageState::depth_sampled()));
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct HostImage {
     /// A name for errors and debug labels (`"scene colour"`).
     pub name: String,
     /// The image.
     pub image: vk::Image,
-    /// A 2-D view of mip 0, layer 0 (a depth-stencil image's view: the depth aspect only).
+    /// A 2-D view of mip 0, layer 0 (a depth-stencil image's view: the aspect lucent reads,
+    /// depth for depth, stencil for material IDs in stencil bits).
     pub view: vk::ImageView,
     /// The format the image (and view) were created with.
     pub format: vk::Format,
@@ -117,6 +165,49 @@ pub struct HostImage {
     pub usage: vk::ImageUsageFlags,
     /// The state it is in when lucent's commands start (the host's last use of it).
     pub state: ImageState,
+    /// The state lucent leaves it in; `None`: the state it came in ([`HostImage::state`]),
+    /// which must then not be UNDEFINED.
+    pub final_state: Option<ImageState>,
+}
+
+impl HostImage {
+    /// An image in [`ImageState::UNDEFINED`], to be left as it came.
+    pub fn new(
+        name: impl Into<String>,
+        image: vk::Image,
+        view: vk::ImageView,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            image,
+            view,
+            format,
+            extent,
+            usage,
+            state: ImageState::UNDEFINED,
+            final_state: None,
+        }
+    }
+
+    /// The state the image is in when lucent's commands start.
+    pub fn in_state(mut self, state: ImageState) -> Self {
+        self.state = state;
+        self
+    }
+
+    /// The state lucent must leave the image in.
+    pub fn then(mut self, state: ImageState) -> Self {
+        self.final_state = Some(state);
+        self
+    }
+
+    /// The state the image is left in: [`HostImage::final_state`], else the one it came in.
+    pub fn left_in(&self) -> ImageState {
+        self.final_state.unwrap_or(self.state)
+    }
 }
 
 /// What lucent does with a host image, which decides the usage, formats and layouts it needs.
@@ -124,9 +215,9 @@ pub struct HostImage {
 pub(crate) enum Role {
     /// Written as a colour attachment (the output).
     Output,
-    /// Sampled colour (lit diffuse, specular, the SSS mask).
+    /// Sampled colour (lit diffuse, specular, albedo, colour material IDs, linear depth).
     SampledColor,
-    /// Sampled depth.
+    /// Sampled depth (or stencil: material IDs in stencil bits) of a depth-stencil image.
     SampledDepth,
 }
 
@@ -162,8 +253,13 @@ impl Role {
     }
 }
 
-fn invalid(image: &str, what: String) -> LucentError {
-    LucentError::InvalidInput(format!("host image '{image}': {what}"))
+fn invalid(image: &str, kind: ImageFault, problem: String) -> crate::LucentError {
+    HostError::Image {
+        image: image.to_string(),
+        kind,
+        problem,
+    }
+    .into()
 }
 
 /// The usage flags an image must have been created with to be in `layout` (the layout
@@ -282,12 +378,14 @@ pub(crate) fn check_state(
     {
         return Err(invalid(
             &image.name,
+            ImageFault::Layout,
             format!("the {what} layout {layout:?} is not one an image can be transitioned to"),
         ));
     }
     let (needs, aspect) = layout_rule(layout).ok_or_else(|| {
         invalid(
             &image.name,
+            ImageFault::Layout,
             format!(
                 "the {what} layout {layout:?} is not one lucent accepts (GENERAL, the attachment, \
                  read-only, transfer and present layouts)"
@@ -297,6 +395,7 @@ pub(crate) fn check_state(
     if !needs.is_empty() && !image.usage.intersects(needs) {
         return Err(invalid(
             &image.name,
+            ImageFault::Layout,
             format!(
                 "the {what} layout {layout:?} needs usage {needs:?}, but the image was declared \
                  with {:?}: the declared layout is wrong or the usage is missing",
@@ -313,6 +412,7 @@ pub(crate) fn check_state(
     if !aspect_ok {
         return Err(invalid(
             &image.name,
+            ImageFault::Layout,
             format!(
                 "the {what} layout {layout:?} is a {} layout, but the image's format {} is a {} \
                  format",
@@ -329,6 +429,7 @@ pub(crate) fn check_state(
             if !declared.intersects(stages) {
                 return Err(invalid(
                     &image.name,
+                    ImageFault::Access,
                     format!(
                         "the {what} access {access:?} cannot be performed by the declared stages \
                          {:?}",
@@ -341,6 +442,7 @@ pub(crate) fn check_state(
             if !layouts.contains(&layout) {
                 return Err(invalid(
                     &image.name,
+                    ImageFault::Access,
                     format!(
                         "the {what} state writes {access:?}, which layout {layout:?} cannot hold: \
                          the declared layout is not the one the image was written in"
@@ -394,23 +496,29 @@ pub(crate) fn is_depth(format: vk::Format) -> bool {
 }
 
 /// Checks everything about `image` lucent's use of it as `role` at `extent` needs, with the
-/// state it is in now and the one the host wants it left in (`final_state`). `formats` says
-/// which formats the role accepts (for the message).
+/// state it is in now and the one it is left in ([`HostImage::left_in`]). `input` names the
+/// input for format errors and `format_ok` says which formats the role accepts, `formats` how
+/// to say so.
 pub(crate) fn check_image(
     gpu: &GpuContext,
     image: &HostImage,
+    input: &str,
     role: Role,
     extent: vk::Extent2D,
-    final_state: &ImageState,
     format_ok: impl Fn(vk::Format) -> bool,
     formats: &str,
 ) -> Result<()> {
     if image.image == vk::Image::null() || image.view == vk::ImageView::null() {
-        return Err(invalid(&image.name, "needs an image and a view".into()));
+        return Err(invalid(
+            &image.name,
+            ImageFault::Handles,
+            "needs an image and a view".into(),
+        ));
     }
     if image.extent != extent {
         return Err(invalid(
             &image.name,
+            ImageFault::Size,
             format!(
                 "is {}x{}, the frame {}x{}",
                 image.extent.width, image.extent.height, extent.width, extent.height
@@ -419,17 +527,20 @@ pub(crate) fn check_image(
     }
     let depth_role = role == Role::SampledDepth;
     if !format_ok(image.format) || is_depth(image.format) != depth_role {
-        return Err(invalid(
-            &image.name,
-            format!(
-                "format {} cannot be used here (lucent accepts {formats})",
-                format_name(image.format)
-            ),
-        ));
+        return Err(HostError::Unsupported {
+            input: format!("{input} ('{}')", image.name),
+            found: format!("format {}", format_name(image.format)),
+            accepted: formats.to_string(),
+        }
+        .into());
     }
     let (usage, flag) = role.usage();
     if !image.usage.contains(usage) {
-        return Err(invalid(&image.name, format!("lacks usage {flag}")));
+        return Err(invalid(
+            &image.name,
+            ImageFault::Usage,
+            format!("lacks usage {flag}"),
+        ));
     }
     let (feature, feature_name) = role.format_feature();
     // SAFETY: the physical device is valid for the context's lifetime.
@@ -440,6 +551,7 @@ pub(crate) fn check_image(
     if !properties.optimal_tiling_features.contains(feature) {
         return Err(invalid(
             &image.name,
+            ImageFault::Format,
             format!(
                 "the device cannot use format {} as {feature_name} with optimal tiling",
                 format_name(image.format)
@@ -450,10 +562,20 @@ pub(crate) fn check_image(
     if role != Role::Output && image.state.layout == vk::ImageLayout::UNDEFINED {
         return Err(invalid(
             &image.name,
+            ImageFault::Layout,
             "is an input but its current layout is UNDEFINED (its contents would be lost)".into(),
         ));
     }
-    check_state(image, final_state, "final", true)
+    if image.final_state.is_none() && image.state.layout == vk::ImageLayout::UNDEFINED {
+        return Err(invalid(
+            &image.name,
+            ImageFault::Layout,
+            "comes in UNDEFINED and says no final state (HostImage::then): lucent cannot \
+             leave it as it came"
+                .into(),
+        ));
+    }
+    check_state(image, &image.left_in(), "final", true)
 }
 
 /// Records one barrier moving `image` from `from` to `to` (the old contents kept unless
@@ -501,18 +623,18 @@ mod tests {
     use super::*;
 
     fn image(format: vk::Format, usage: vk::ImageUsageFlags, state: ImageState) -> HostImage {
-        HostImage {
-            name: "test".into(),
-            image: vk::Image::null(),
-            view: vk::ImageView::null(),
+        HostImage::new(
+            "test",
+            vk::Image::null(),
+            vk::ImageView::null(),
             format,
-            extent: vk::Extent2D {
+            vk::Extent2D {
                 width: 4,
                 height: 4,
             },
             usage,
-            state,
-        }
+        )
+        .in_state(state)
     }
 
     #[test]

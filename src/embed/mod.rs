@@ -1,85 +1,130 @@
-//! lucent inside a host Vulkan engine: the host's device, allocator, images and command
-//! buffers, with frames in flight.
+//! lucent inside a host Vulkan engine: the host's device, allocator, G-buffer, images and
+//! command buffers, with frames in flight.
 //!
-//! The host owns everything Vulkan: instance, device, queue, swapchain, frame loop, fences and
-//! command buffers. lucent borrows the device ([`Lucent::new`]), builds one of two renderers,
-//! and records into the host's command buffer when asked:
+//! The host owns everything Vulkan: instance, device, queues, swapchain, frame loop, fences and
+//! command buffers. lucent borrows the device ([`Lucent::new`]), builds effects and renderers,
+//! and records into the host's command buffers when asked:
 //!
-//! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] — the host's meshes (handed over
-//!   as [`crate::scene::Mesh`]es for lucent to upload), transforms, lucent materials and
-//!   lights — drawn into a host colour image with every feature its materials ask for
-//!   (translucency, screen-space SSS, layered media, shadows), tonemapped.
-//! - [`PostProcessSss`] (*post-process*): screen-space SSS over the host's own lit diffuse,
-//!   depth and per-pixel profile index, written into a host image (how Jimenez's
-//!   `SeparableSSS.h` is integrated into an engine).
+//! - [`SssEffect`]: screen-space SSS (the control, the separable blur, 2-D
+//!   Burley) over the host's **own G-buffer**, described by [`GBufferDesc`]: its depth in any
+//!   depth format, standard or reversed Z, finite or infinite far (decoded through the host's
+//!   projection matrix, [`HostCamera`]) or as linear view depth; its lit diffuse with or
+//!   without the albedo; its specular and albedo when it has them; its material IDs as
+//!   `R8_UINT`/`R8_UNORM`, stencil bits or a bit field of a packed target; its world scale.
+//!   lucent adapts by shader permutation and per-frame constants, not by copying into its own
+//!   layout. Several views per frame (split screen, stereo).
+//! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
+//!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
+//!   colour image with every feature its materials ask for (translucency, screen-space SSS,
+//!   layered media, shadows), tonemapped. This is how GDC 2011 translucency and Li et al.'s
+//!   layered media reach a host today: they have no path on a host's G-buffer yet.
 //!
 //! # The contract
 //!
 //! 1. **Before the device:** [`requirements`] says what lucent needs (Vulkan 1.3 with
-//!    `synchronization2` and `maintenance4`, a queue family with graphics, compute and
-//!    timestamps; no device extension) and which optional features it uses when the host
+//!    `synchronization2` and `maintenance4`, a queue family with graphics and compute; no
+//!    device extension, no timestamps) and which optional features it uses when the host
 //!    enabled them ([`OptionalFeatures`]); [`Requirements::check`] tests a physical device.
 //! 2. **Construction** ([`Lucent::new`]) from the host's instance, physical device, device,
 //!    queue and family, the number of frames in flight, optionally its pipeline cache and its
 //!    `gpu-allocator` ([`EmbedOptions`]). lucent creates its own objects (pipelines, images,
-//!    buffers, descriptor pools, one command pool for uploads) and destroys only those; no
-//!    handle of the host's is ever destroyed.
-//! 3. **Host images** ([`HostImage`]) come with the format, size and usage they were created
-//!    with and the state ([`ImageState`]: layout, stage, access) they are in; the host also
-//!    says the state each must be left in. Everything lucent can check is checked before the
-//!    first command (usage flags, layouts against usage and aspect, accesses against stages and
-//!    layout, formats, sizes): a mistake is an error naming the image, not a validation error.
-//! 4. **Recording** (`record`) goes into the host's primary command buffer, in the recording
+//!    buffers, descriptor pools) and destroys only those; no handle of the host's is ever
+//!    destroyed. No debug messenger is installed unless [`EmbedOptions::debug_messenger`]
+//!    asks for one.
+//! 3. **No waits, no submissions.** Building an effect or renderer records its uploads into a
+//!    command buffer of the host's ([`Lucent::uploads`], [`Uploads`]); the host submits it
+//!    with its own work and frees the staging memory once that submission completed
+//!    ([`Uploads::release`]). Recording a frame submits nothing. No embed path waits on the
+//!    host's device, queues or fences.
+//! 4. **Host images** ([`HostImage`]) come with the format, size and usage they were created
+//!    with, the state ([`ImageState`]: layout, stage, access) they are in, and each its own
+//!    final state ([`HostImage::then`]; by default the state it came in). Everything lucent
+//!    can check is checked before the first command (usage flags, layouts against usage and
+//!    aspect, accesses against stages and layout, formats, sizes): a mistake is a typed
+//!    [`HostError`] naming the input, not a validation error. Images are bound when a frame
+//!    records: any number of different images over time, and a view recreated between frames
+//!    (even one whose handle value is reused) is simply the next frame's.
+//! 5. **Recording** (`record`) goes into the host's primary command buffer, in the recording
 //!    state and outside any render pass the host began. lucent records its barriers from each
-//!    image's declared state, its passes, and barriers to the final states the host asked
-//!    for, and returns those states. Afterwards the bound pipeline, descriptor sets, viewport
-//!    and push constants are undefined: the host binds its own again.
-//! 5. **Frames in flight:** every `record` names a frame slot `0..frames_in_flight`; lucent
-//!    keeps one set of per-frame parameters per slot and writes slot `k`'s when the frame
-//!    for slot `k` is recorded, so the host must have waited for the previous frame recorded
-//!    with slot `k` (its fence) first — the wait it does anyway before reusing that frame's
-//!    command buffer. Transient images are shared by the slots; the frames' barriers order
-//!    them on the queue.
-//! 6. **No hidden submissions:** recording never submits. The one time lucent uses the queue
-//!    is when a renderer is built: [`SceneRenderer::new`] and [`PostProcessSss::new`] upload
-//!    (meshes, textures, tables) with one submission on the host's queue and wait for it.
-//!    Call them where nothing else uses the queue (Vulkan requires external synchronization
-//!    of queue access).
-//! 7. **Teardown:** `destroy` the renderers, then drop the [`Lucent`], once the device is idle
-//!    for lucent's work (the host waits on its frames' fences). Resizing is rebuilding.
+//!    image's declared state, its passes, and barriers to the final states. Afterwards the
+//!    bound pipeline, descriptor sets, viewport and push constants are undefined: the host
+//!    binds its own again.
+//! 6. **Frames in flight:** every `record` names a frame slot `0..frames_in_flight` (and, for
+//!    an effect with several views, a view); lucent keeps one set of per-frame parameters and
+//!    descriptors per slot and view and writes them when that frame records, so the host must
+//!    have waited for the previous frame recorded with that slot (its fence) first — the wait
+//!    it does anyway before reusing that frame's command buffer.
+//! 7. **Threads:** effects and renderers are `Send` (build them on a loader thread, record on
+//!    the render thread); a `&Lucent` is shared by reference. Vulkan's own rules hold: a
+//!    command buffer is recorded by one thread at a time.
+//! 8. **Teardown:** `destroy` the effects and renderers, then drop the [`Lucent`], once the
+//!    GPU is done with lucent's work (the host waits on its frames' fences). One dropped
+//!    without `destroy` is logged as an error and counted ([`leaked`]): never silent.
+//!    Resizing is rebuilding.
 //!
 //! # Example
 //!
 //! ```no_run
-//! use ash::vk;
-//! use lucent::embed::{EmbedOptions, HostDevice, HostImage, ImageState, Lucent, SceneRenderer};
+//! use lucent::embed::ash::vk;
+//! use lucent::embed::glam::Mat4;
+//! use lucent::embed::{
+//!     DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice, HostImage,
+//!     IdDesc, ImageState, Lucent, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
+//!     SssProfile,
+//! };
 //!
-//! # fn host_engine(host: HostDevice, cmd: vk::CommandBuffer, image: vk::Image, view: vk::ImageView)
-//! #     -> lucent::Result<()> {
+//! # fn host_engine(host: HostDevice, setup: vk::CommandBuffer, cmd: vk::CommandBuffer,
+//! #     depth: HostImage, lighting: HostImage, ids: HostImage, output: HostImage,
+//! #     view: Mat4, projection: Mat4) -> lucent::Result<()> {
 //! // (The host created its device after checking lucent::embed::requirements().)
 //! // SAFETY: the host's handles are valid, belong together and outlive `lucent`.
-//! let lucent = unsafe { Lucent::new(host, EmbedOptions { frames_in_flight: 2, ..Default::default() }) }?;
-//! let scene = lucent.load_scene("cubes")?;
-//! let mut renderer = SceneRenderer::new(&lucent, &scene, 320, 240, vk::Format::R8G8B8A8_UNORM)?;
-//! let output = HostImage {
-//!     name: "back buffer".into(),
-//!     image,
-//!     view,
-//!     format: vk::Format::R8G8B8A8_UNORM,
-//!     extent: vk::Extent2D { width: 320, height: 240 },
-//!     usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-//!     state: ImageState::UNDEFINED,
+//! let options = EmbedOptions { frames_in_flight: 2, ..Default::default() };
+//! let lucent = unsafe { Lucent::new(host, options) }?;
+//! // The host's G-buffer: reversed-Z D32 depth, lit diffuse with albedo, R8_UINT IDs, metres.
+//! let gbuffer = GBufferDesc::new(
+//!     1280,
+//!     720,
+//!     DepthDesc::device(vk::Format::D32_SFLOAT),
+//!     DiffuseDesc::with_albedo(vk::Format::B10G11R11_UFLOAT_PACK32),
+//! )
+//! .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+//! // The host's material 3 is skin.
+//! let skin = SssMaterial::new(3, SssProfile::preset("skin")?);
+//! let desc = SssEffectDesc::new(gbuffer, vec![skin], vk::Format::B10G11R11_UFLOAT_PACK32);
+//! // Uploads go into the host's `setup` command buffer (recording); the host submits it.
+//! let mut uploads = unsafe { lucent.uploads(setup) };
+//! let mut sss = SssEffect::new(&lucent, &mut uploads, desc)?;
+//! // ... end `setup`, submit it; once its fence has signalled:
+//! unsafe { uploads.release(&lucent) }?;
+//!
+//! // Each frame: wait for slot k's fence, begin `cmd`, render the G-buffer and lighting, then
+//! // say what state each image is in (and, for the output, the state to leave it in).
+//! let depth = depth.in_state(ImageState::depth_attachment());
+//! let lighting = lighting.in_state(ImageState::color_attachment());
+//! let ids = ids.in_state(ImageState::color_attachment());
+//! let output = output.then(ImageState::fragment_sampled());
+//! let frame = SssFrame {
+//!     slot: 0,
+//!     view: 0,
+//!     camera: HostCamera::new(view, projection),
+//!     images: SssImages {
+//!         depth: &depth,
+//!         diffuse: &lighting,
+//!         specular: None,
+//!         albedo: None,
+//!         material_ids: &ids,
+//!     },
+//!     output: &output,
 //! };
-//! // Each frame: wait for slot k's fence, begin `cmd`, then
-//! let left_in = renderer.record(&lucent, cmd, 0, &scene, &output, ImageState::transfer_src())?;
-//! assert_eq!(left_in, ImageState::transfer_src());
-//! // ... end `cmd`, submit it with the host's semaphores and fence.
-//! # renderer.destroy(&lucent);
+//! sss.record(&lucent, cmd, &frame)?;
+//! // ... the host's tonemap reads `output`; end `cmd`, submit it with its fence.
+//! # sss.destroy(&lucent);
 //! # Ok(()) }
 //! ```
 //!
-//! `examples/host_engine.rs` is a complete small ash engine doing this with three frames in
-//! flight, under the validation layer.
+//! `examples/host_engine.rs` is a complete small ash engine doing this: its own G-buffer pass
+//! in formats lucent does not use itself, its own lighting and tonemap, and the effect between
+//! them, with three frames in flight, under the validation layer.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -94,15 +139,34 @@ use crate::backend::GpuContext;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
+mod gbuffer;
 mod image;
-mod post;
 mod scene;
+mod sss;
+mod uploads;
 
-pub use image::{HostImage, ImageState};
-pub use post::{
-    PostProcessDesc, PostProcessFrame, PostProcessInputs, PostProcessSss, PostProcessStates,
+pub use gbuffer::{
+    DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
+    IdEncoding,
 };
+pub use image::{HostImage, ImageState};
 pub use scene::SceneRenderer;
+pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
+pub use uploads::{leaked, Uploads};
+// The types a host names in its descriptions, and the versions of the crates it must build its
+// handles with.
+pub use crate::error::{HostError, ImageFault};
+pub use crate::features::sss::SssKnobs;
+pub use crate::scene::material::{SssProfile, Texturing};
+pub use ash;
+pub use glam;
+
+/// The embedding API's version: raised whenever a change to `lucent::embed` can break a host
+/// that built against the previous one (the crate's own version says which release). 3: the
+/// host's G-buffer described ([`GBufferDesc`]) and bound per frame ([`SssEffect`], replacing
+/// `PostProcessSss`), uploads recorded into the host's command buffer ([`Uploads`]), typed
+/// errors ([`HostError`]).
+pub const API_VERSION: u32 = 3;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
@@ -118,8 +182,8 @@ pub struct Requirements {
     /// Vulkan 1.3 features to enable: `synchronization2` (every barrier lucent records) and
     /// `maintenance4` (SPIR-V for Vulkan 1.3 needs it).
     pub vulkan13_features: Vec<&'static str>,
-    /// What the queue lucent records for must support: graphics and compute, and
-    /// timestamps (`timestampValidBits > 0`, lucent's per-pass timer).
+    /// What the queue lucent records for must support: graphics and compute. (Timestamps are
+    /// not needed: the effects time nothing unless a host asks lucent's timer to.)
     pub queue_flags: vk::QueueFlags,
     /// Features lucent uses when the host enabled them (and says so in [`OptionalFeatures`]).
     pub optional: Vec<&'static str>,
@@ -133,7 +197,7 @@ pub fn requirements() -> Requirements {
         vulkan13_features: vec!["synchronization2", "maintenance4"],
         queue_flags: vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE,
         optional: vec![
-            "hostQueryReset (Vulkan 1.2): timer queries reset from the CPU",
+            "hostQueryReset (Vulkan 1.2): timer queries reset from the CPU (lucent's timer only)",
             "independentBlend: per-target blend states",
             "shaderStorageImageWriteWithoutFormat: storage writes without a declared format",
         ],
@@ -213,11 +277,17 @@ pub struct EmbedOptions {
     /// ([`crate::files::default_cache_dir`]: `$LUCENT_CACHE_DIR`, else e.g.
     /// `~/.cache/lucent`), never the source tree.
     pub cache_dir: Option<PathBuf>,
+    /// Install lucent's own debug messenger on the host's instance (when it has
+    /// `VK_EXT_debug_utils`), so [`crate::backend::GpuContext::validation_error_count`] counts
+    /// the messages the layers send while lucent is alive. Off by default: a host with its own
+    /// messenger would see every message twice, and lucent's count would include the host's.
+    pub debug_messenger: bool,
 }
 
 /// lucent on a host's device: the wrapped context, the shaders and the pipeline cache every
 /// renderer built from it shares.
 pub struct Lucent {
+    id: u64,
     gpu: GpuContext,
     shaders: ShaderCompiler,
     pipeline_cache: PipelineCache,
@@ -262,6 +332,7 @@ impl Lucent {
                 host.queue,
                 host.queue_family,
                 options.allocator,
+                options.debug_messenger,
             )
         }?;
         gpu.info.host_query_reset = enabled.host_query_reset;
@@ -279,6 +350,7 @@ impl Lucent {
             _ => (PipelineCache::load(&gpu.device, None)?, true),
         };
         Ok(Self {
+            id: uploads::next_lucent_id(),
             gpu,
             shaders,
             pipeline_cache,
@@ -318,6 +390,25 @@ impl Lucent {
         crate::bake::scene::prepare_thickness(scene, &self.cache_dir.join("thickness"))
     }
 
+    /// Begins recording renderers' uploads into the host's command buffer `cmd` (see
+    /// [`Uploads`]): lucent never submits on the host's queue itself.
+    ///
+    /// # Safety
+    ///
+    /// `cmd` is a primary command buffer of the host's device, in the recording state,
+    /// outside any render pass, for a queue of the family lucent was given; nothing else
+    /// records into it while a renderer is built with the returned uploads; the host submits it
+    /// before the first frame that records those renderers (or records them after it, in the
+    /// same command buffer).
+    pub unsafe fn uploads(&self, cmd: vk::CommandBuffer) -> Uploads {
+        // SAFETY: the caller's contract is Uploads::new's.
+        unsafe { Uploads::new(self, cmd) }
+    }
+
+    pub(crate) fn id(&self) -> u64 {
+        self.id
+    }
+
     pub(crate) fn shaders(&self) -> &ShaderCompiler {
         &self.shaders
     }
@@ -331,10 +422,12 @@ impl Lucent {
         if slot < self.frames_in_flight {
             Ok(())
         } else {
-            Err(LucentError::InvalidInput(format!(
-                "frame slot {slot}: lucent was built for {} frame(s) in flight (slots 0..{})",
-                self.frames_in_flight, self.frames_in_flight
-            )))
+            Err(crate::HostError::OutOfRange {
+                what: "frame slot",
+                index: slot,
+                count: self.frames_in_flight,
+            }
+            .into())
         }
     }
 }

@@ -4,11 +4,12 @@
 use ash::vk;
 
 use super::image::{check_image, record_transition, HostImage, ImageState, Role};
-use super::Lucent;
+use super::uploads::LeakGuard;
+use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::frame::{FrameSettings, Renderer, TargetDesc};
 use crate::scene::Scene;
-use crate::{LucentError, Result};
+use crate::Result;
 
 /// A scene's whole frame (G-buffer, lighting and every feature its materials ask for,
 /// tonemapped) rendered into a host image.
@@ -21,6 +22,7 @@ pub struct SceneRenderer {
     renderer: Renderer,
     extent: vk::Extent2D,
     format: vk::Format,
+    guard: LeakGuard,
 }
 
 impl SceneRenderer {
@@ -28,16 +30,25 @@ impl SceneRenderer {
     /// (8-bit UNORM or SRGB RGBA/BGRA — the tonemapped display values, sRGB-encoded — or
     /// RGBA16F/RGBA32F, the same values linear), with lucent's default settings.
     ///
-    /// Uploads the scene: **one submission on the host's queue, waited for** (the only time
-    /// lucent uses the queue; see the module docs).
+    /// The scene's uploads are recorded into `uploads`' command buffer, which the host submits
+    /// before the first frame that records this renderer; nothing is submitted or waited for.
+    /// On an error that command buffer may hold copies into freed resources: reset it rather
+    /// than submit it.
     pub fn new(
         lucent: &Lucent,
+        uploads: &mut Uploads,
         scene: &Scene,
         width: u32,
         height: u32,
         format: vk::Format,
     ) -> Result<Self> {
-        Self::with_settings(lucent, scene, FrameSettings::new(width, height), format)
+        Self::with_settings(
+            lucent,
+            uploads,
+            scene,
+            FrameSettings::new(width, height),
+            format,
+        )
     }
 
     /// [`SceneRenderer::new`] with the caller's frame settings (technique, SSS and layered
@@ -45,6 +56,7 @@ impl SceneRenderer {
     /// lucent's to set (the embedding's frames in flight, the host image).
     pub fn with_settings(
         lucent: &Lucent,
+        uploads: &mut Uploads,
         scene: &Scene,
         settings: FrameSettings,
         format: vk::Format,
@@ -64,17 +76,25 @@ impl SceneRenderer {
             width: settings.width,
             height: settings.height,
         };
-        let renderer = Renderer::new(
-            lucent.gpu(),
-            lucent.shaders(),
-            lucent.pipeline_cache(),
-            scene,
-            settings,
-        )?;
+        let renderer = uploads.record(lucent, "SceneRenderer::new", || {
+            Renderer::new(
+                lucent.gpu(),
+                lucent.shaders(),
+                lucent.pipeline_cache(),
+                scene,
+                settings,
+            )
+        })?;
         Ok(Self {
             renderer,
             extent,
             format,
+            guard: LeakGuard::new(format!(
+                "SceneRenderer ({} objects, {}x{})",
+                scene.objects.len(),
+                extent.width,
+                extent.height
+            )),
         })
     }
 
@@ -84,7 +104,8 @@ impl SceneRenderer {
     }
 
     /// Records the frame of `scene` for frame slot `slot` into `cmd` (recording, outside any
-    /// render pass), drawing into `output` and leaving it in `final_state`, which it returns.
+    /// render pass), drawing into `output` and leaving it in its final state
+    /// ([`HostImage::left_in`]), which it returns.
     ///
     /// Writes slot `slot`'s per-frame parameters from `scene` first (camera, lights, material
     /// values, a deforming scene's vertices at `scene.time`): the frame last recorded with
@@ -97,27 +118,25 @@ impl SceneRenderer {
         slot: usize,
         scene: &Scene,
         output: &HostImage,
-        final_state: ImageState,
     ) -> Result<ImageState> {
         lucent.check_slot(slot)?;
-        if output.format != self.format {
-            return Err(LucentError::InvalidInput(format!(
-                "host image '{}': format {:?}, but the renderer was built for {:?}",
-                output.name, output.format, self.format
-            )));
-        }
+        let format = self.format;
         check_image(
             lucent.gpu(),
             output,
+            "output",
             Role::Output,
             self.extent,
-            &final_state,
-            |_| true,
-            "the renderer's output format",
+            |f| f == format,
+            &format!(
+                "{} (the renderer's)",
+                crate::backend::format::format_name(format)
+            ),
         )?;
         self.renderer.update_slot(scene, slot)?;
         self.renderer
-            .bind_target(lucent.gpu(), output.image, output.view)?;
+            .bind_target(lucent.gpu(), slot, output.image, output.view)?;
+        let final_state = output.left_in();
         let gpu = lucent.gpu();
         let working = Role::Output.working_state();
         record_transition(gpu, cmd, output, &output.state, &working);
@@ -129,6 +148,10 @@ impl SceneRenderer {
     /// Destroys the frame and the scene's GPU data. lucent's work must be complete (the host
     /// waited for every frame it recorded).
     pub fn destroy(self, lucent: &Lucent) {
-        self.renderer.destroy(lucent.gpu());
+        let Self {
+            renderer, guard, ..
+        } = self;
+        renderer.destroy(lucent.gpu());
+        guard.disarm();
     }
 }

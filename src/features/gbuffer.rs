@@ -538,6 +538,7 @@ impl PassExec for GBufferPass {
                 &self.bindings(index),
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 "gbuffer material maps",
+                ctx.slots,
             )?;
             self.map_sets.push(set);
         }

@@ -44,7 +44,7 @@ const NUMBERS: [&str; 24] = [
 ];
 
 /// The rectangles a pass draws in the recorded frame (`None`: the whole screen).
-type Tiles = Box<dyn Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>>>;
+type Tiles = Box<dyn Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>> + Send>;
 
 /// One descriptor binding, as declared.
 #[derive(Clone, Copy, Debug)]
@@ -247,7 +247,7 @@ impl<'g> FullscreenPass<'g> {
     /// if any, in the others.
     pub fn tiles(
         &mut self,
-        tiles: impl Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>> + 'static,
+        tiles: impl Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>> + Send + 'static,
     ) -> &mut Self {
         self.tiles = Some(Box::new(tiles));
         self
@@ -362,7 +362,13 @@ impl PassExec for FullscreenExec {
                     Binding::PerFrame(scene.per_frame.binding(region))
                 }
                 Slot::Sampled(id, filter) => {
-                    Binding::Sampled(views[id], sampler(&mut self.samplers, ctx, filter)?)
+                    let sampler = sampler(&mut self.samplers, ctx, filter)?;
+                    if views[id] == vk::ImageView::null() {
+                        // A host's image bound when its frame is recorded (bind_view).
+                        Binding::SampledPerSlot(sampler)
+                    } else {
+                        Binding::Sampled(views[id], sampler)
+                    }
                 }
                 Slot::Input(id, layout) => Binding::InputAttachment(views[id], layout),
             });
@@ -442,6 +448,26 @@ impl PassExec for FullscreenExec {
                 rects.iter().filter(|r| r.translucent != own_in_marked),
             );
         }
+    }
+
+    fn bind_view(
+        &mut self,
+        gpu: &crate::backend::GpuContext,
+        slot: usize,
+        id: crate::graph::ResourceId,
+        view: vk::ImageView,
+    ) -> Result<()> {
+        let pipeline = self.pipeline.as_ref().ok_or_else(|| {
+            crate::LucentError::Graph(format!("pass '{}' has no descriptor set", self.name))
+        })?;
+        for (binding, s) in self.slots.iter().enumerate() {
+            if matches!(*s, Slot::Sampled(sampled, _) if sampled == id) {
+                pipeline
+                    .set
+                    .write_view(&gpu.device, slot, binding as u32, view)?;
+            }
+        }
+        Ok(())
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {

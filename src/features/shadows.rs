@@ -513,6 +513,7 @@ impl PassExec for ShadowPass {
                 &self.bindings(index),
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 "light-space depth maps",
+                ctx.slots,
             )?;
             self.depth_sets.push(set);
         }

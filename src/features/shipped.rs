@@ -42,6 +42,8 @@ pub fn pipelines() -> Vec<PipelineShaders> {
     for technique in super::registry::TECHNIQUES {
         technique.shader_permutations(&mut out);
     }
+    // The SSS passes over a host's material IDs (lucent::embed).
+    super::sss::host_id_permutations(&mut out);
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
     super::antialias::shader_permutations(&mut out);

@@ -76,6 +76,7 @@ impl PassPipeline {
             bindings,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             desc.name,
+            ctx.slots,
         )?;
         let layouts = [set.layout];
         let desc = GraphicsPipelineDesc {

@@ -126,6 +126,7 @@ pub fn declare_frame(
                 shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
                 albedo: layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: profiles.depth_in_alpha(),
+                id_defines: profiles.id_map.defines(),
             },
             profiles,
             &settings.sss,

@@ -84,7 +84,14 @@ impl Renderer {
         let compiled = graph
             .compile(compile_options(&settings))
             .and_then(|(plan, execs)| {
-                Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)
+                Executable::new(
+                    gpu,
+                    plan,
+                    execs,
+                    shaders,
+                    pipeline_cache.handle,
+                    settings.frames_in_flight,
+                )
             });
         let executable = match compiled {
             Ok(e) => e,
@@ -297,12 +304,14 @@ impl Renderer {
         Ok(bounds_of(&deformed))
     }
 
-    /// Gives the caller's target its image for the frames recorded from now on (frames built
-    /// with [`FrameSettings::target`]): an image of the target's format and the frame's size,
-    /// usable as a colour attachment, and a view of it.
+    /// Gives the caller's target its image for the frame recorded next with slot `slot`
+    /// (frames built with [`FrameSettings::target`]): an image of the target's format and the
+    /// frame's size, usable as a colour attachment, and a view of it. The frame last recorded
+    /// with `slot` must have completed: its framebuffer is replaced.
     pub fn bind_target(
         &mut self,
         gpu: &GpuContext,
+        slot: usize,
         image: vk::Image,
         view: vk::ImageView,
     ) -> Result<()> {
@@ -312,7 +321,7 @@ impl Renderer {
             ));
         }
         self.executable
-            .bind_import(gpu, self.outputs.display, image, view)
+            .bind_imports(gpu, slot, &[(self.outputs.display, image, view)])
     }
 
     /// Records one frame for slot `slot` into `cmd` (in the recording state), with a
@@ -331,7 +340,7 @@ impl Renderer {
                 self.settings.frames_in_flight
             )));
         }
-        if !self.executable.ready() {
+        if !self.executable.ready(slot) {
             return Err(LucentError::InvalidInput(
                 "the frame renders into the caller's target and none is bound (bind_target)".into(),
             ));

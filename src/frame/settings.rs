@@ -129,7 +129,7 @@ pub struct FrameSettings {
     /// Also export the G-buffer (for the CPU reference); otherwise it stays transient.
     pub export_gbuffer: bool,
     /// Frames with SSS: also export the lighting pass's diffuse and specular, apart, before
-    /// the blurs (what a host hands [`crate::embed::PostProcessSss`]; tests compare the two
+    /// the blurs (what a host hands [`crate::embed::SssEffect`]; tests compare the two
     /// paths); otherwise they stay transient.
     pub export_lit: bool,
     /// Precision of the G-buffer's colour targets.

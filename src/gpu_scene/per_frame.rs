@@ -35,6 +35,8 @@ pub struct FrameUniforms {
     exposure: [f32; 4],
     light_count: [i32; 4],
     camera: [f32; 4],
+    /// View-space depth from a depth image's value ([`depth_decode`]).
+    depth_decode: [f32; 4],
     /// Robustness tests (LUCENT_FAULT_INJECTION): x, y pixel; z 1 NaN, 2 +Inf.
     pub fault: [i32; 4],
     lights: [[[f32; 4]; 4]; MAX_LIGHTS],
@@ -44,7 +46,8 @@ impl FrameUniforms {
     /// Fills the uniforms from a scene at a size.
     pub fn new(scene: &Scene, width: u32, height: u32) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
-        let view_proj = scene.camera.projection(aspect) * scene.camera.view();
+        let projection = scene.camera.projection(aspect);
+        let view_proj = projection * scene.camera.view();
         let mut lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
         for (slot, light) in lights.iter_mut().zip(&scene.lights) {
             let radiance = light.radiance();
@@ -100,10 +103,93 @@ impl FrameUniforms {
                 scene.camera.focal_px(height),
                 0.0,
             ],
+            depth_decode: depth_decode(&projection),
             fault: [0; 4],
             lights,
         }
     }
+}
+
+impl FrameUniforms {
+    /// The uniforms of a host's view (embedding): its view and projection matrices, the
+    /// decode of its depth image (`depth_decode`: [`projection_depth_decode`], or the identity
+    /// for a linear depth image) and the image size; no lights, environment or sky (the
+    /// effects that read a scene's fill those in themselves).
+    pub fn for_view(
+        view: glam::Mat4,
+        projection: glam::Mat4,
+        width: u32,
+        height: u32,
+        depth_decode: [f32; 4],
+    ) -> Self {
+        let view_proj = projection * view;
+        let eye = view.inverse().w_axis.truncate();
+        let linear = |d: f32| {
+            let k = depth_decode;
+            let v = (k[0] + k[1] * d) / (k[2] + k[3] * d).max(1e-7);
+            if v.is_finite() {
+                v
+            } else {
+                f32::MAX
+            }
+        };
+        let (a, b) = (linear(0.0), linear(1.0));
+        Self {
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            camera_pos: eye.extend(1.0).to_array(),
+            ambient_sh: [[0.0; 4]; 9],
+            sky: [0.0; 4],
+            viewport: [
+                width as f32,
+                height as f32,
+                1.0 / width.max(1) as f32,
+                1.0 / height.max(1) as f32,
+            ],
+            exposure: [1.0, 0.0, 0.0, 0.0],
+            light_count: [0; 4],
+            // Near and far as the decode reads the depth range's two ends; the focal length
+            // from the projection's vertical scale (its sign is the host's y convention).
+            camera: [
+                a.min(b),
+                a.max(b),
+                projection.y_axis.y.abs() * height as f32 * 0.5,
+                0.0,
+            ],
+            depth_decode,
+            fault: [0; 4],
+            lights: [[[0.0; 4]; 4]; MAX_LIGHTS],
+        }
+    }
+}
+
+/// The coefficients `[x, y, z, w]` of view-space depth `(x + y d) / (z + w d)` from the device
+/// depth `d` that `projection` (view to Vulkan clip space, any perspective: standard or reversed
+/// Z, finite or infinite far) writes: from `clip.z = P22 z + P32`, `clip.w = P23 z + P33` and
+/// view depth `-z`. Scaled so that the larger of |z| and |w| is 1 and the denominator is
+/// positive at mid-range (glsl/common/scene.glsl `linear_depth` clamps it there). `None` when
+/// the matrix has no finite, non-degenerate depth mapping.
+pub fn projection_depth_decode(projection: &glam::Mat4) -> Option<[f32; 4]> {
+    let c = projection.to_cols_array_2d();
+    // c[col][row]: P22 = c[2][2], P32 = c[3][2], P23 = c[2][3], P33 = c[3][3].
+    let mut k = [-c[3][2], c[3][3], -c[2][2], c[2][3]];
+    let scale = k[2].abs().max(k[3].abs());
+    if !(scale.is_finite() && scale > 0.0) || k.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    k.iter_mut().for_each(|v| *v /= scale);
+    if k[2] + 0.5 * k[3] < 0.0 {
+        k.iter_mut().for_each(|v| *v = -*v);
+    }
+    // Both terms zero would be a projection that maps every depth to one value.
+    (k[0] != 0.0 || k[1] != 0.0).then_some(k)
+}
+
+/// [`projection_depth_decode`] for lucent's own cameras (always a finite perspective); the
+/// identity if a degenerate matrix ever reached it.
+fn depth_decode(projection: &glam::Mat4) -> [f32; 4] {
+    projection_depth_decode(projection).unwrap_or([0.0, 1.0, 1.0, 0.0])
 }
 
 /// A region of every slot of the per-frame buffer: one table, declared as a `static` by the
@@ -300,3 +386,64 @@ impl PerFrame {
 
 /// Most frames in flight a renderer takes (engines use 2 or 3).
 pub const MAX_FRAMES_IN_FLIGHT: usize = 4;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Vec4};
+
+    /// The view depth a device depth `d` stands for under `projection`: the f64 twin of
+    /// glsl/common/scene.glsl's `linear_depth` with `projection_depth_decode`'s coefficients.
+    fn decoded(k: [f32; 4], d: f64) -> f64 {
+        let k = k.map(f64::from);
+        (k[0] + k[1] * d) / (k[2] + k[3] * d).max(1e-7)
+    }
+
+    /// The device depth `projection` writes for a point at view depth `z` (> 0, on the axis).
+    fn device_depth(projection: &Mat4, z: f32) -> f64 {
+        let clip = *projection * Vec4::new(0.0, 0.0, -z, 1.0);
+        f64::from(clip.z) / f64::from(clip.w)
+    }
+
+    #[test]
+    fn depth_decodes_for_every_projection_a_host_uses() {
+        let fov = 1.0_f32;
+        let (n, f) = (0.1_f32, 50.0_f32);
+        let mut flipped = Mat4::perspective_rh(fov, 1.5, n, f);
+        flipped.y_axis.y = -flipped.y_axis.y;
+        let projections = [
+            ("standard", Mat4::perspective_rh(fov, 1.5, n, f)),
+            ("standard, y flipped (lucent's own)", flipped),
+            ("reversed", Mat4::perspective_rh(fov, 1.5, f, n)),
+            ("infinite", Mat4::perspective_infinite_rh(fov, 1.5, n)),
+            (
+                "infinite reversed",
+                Mat4::perspective_infinite_reverse_rh(fov, 1.5, n),
+            ),
+        ];
+        for (name, p) in projections {
+            let k = projection_depth_decode(&p).unwrap_or_else(|| panic!("{name}"));
+            for z in [0.1_f32, 0.5, 3.0, 17.0, 49.0] {
+                let got = decoded(k, device_depth(&p, z));
+                // Relative: f32 device depths near the far plane carry little precision.
+                let tolerance = 2e-3 * f64::from(z).max(1.0) * f64::from(z) / f64::from(n).max(1.0);
+                assert!(
+                    (got - f64::from(z)).abs() <= tolerance.max(1e-4),
+                    "{name}: z {z} decoded as {got}"
+                );
+            }
+        }
+        // The far plane of an infinite projection decodes finite, not Inf.
+        let k =
+            projection_depth_decode(&Mat4::perspective_infinite_reverse_rh(fov, 1.5, n)).unwrap();
+        assert!(decoded(k, 0.0).is_finite());
+        let k = projection_depth_decode(&Mat4::perspective_infinite_rh(fov, 1.5, n)).unwrap();
+        assert!(decoded(k, 1.0).is_finite());
+    }
+
+    #[test]
+    fn a_degenerate_projection_has_no_depth_decode() {
+        assert!(projection_depth_decode(&Mat4::ZERO).is_none());
+        assert!(projection_depth_decode(&Mat4::from_cols_array(&[f32::NAN; 16])).is_none());
+    }
+}

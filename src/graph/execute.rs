@@ -38,8 +38,13 @@ pub struct PrepareContext<'a> {
     pub views: &'a [vk::ImageView],
     /// Views for descriptors (input attachments, sampling), by [`ResourceId`]: the same as
     /// `views` except for depth-stencil images, whose descriptor view must name one aspect
-    /// (depth) while the framebuffer's names both.
+    /// (depth) while the framebuffer's names both. Null for an imported image bound at record
+    /// time ([`Executable::bind_imports`]): a pass that samples one keeps a descriptor set per
+    /// frame slot and writes the view into the slot's set when it is bound
+    /// ([`PassExec::bind_view`]).
     pub descriptor_views: &'a [vk::ImageView],
+    /// Frame-in-flight slots the executable records (per-slot descriptor sets have this many).
+    pub slots: usize,
 }
 
 /// What a pass needs to record itself.
@@ -88,25 +93,33 @@ pub struct Executable {
     descriptor_views: Vec<vk::ImageView>,
     blocks: Vec<MemoryBlock>,
     render_passes: Vec<vk::RenderPass>,
-    /// The framebuffer each physical pass records with now (null: an imported attachment
-    /// has no image yet, see [`Executable::bind_import`]).
-    framebuffers: Vec<vk::Framebuffer>,
-    /// Every framebuffer made, by physical pass and attachment views: an import bound again
-    /// (a host's swapchain images in turn) reuses its framebuffer, and frames still in flight
-    /// keep theirs alive until [`Executable::destroy`].
-    framebuffer_cache: Vec<((usize, Vec<vk::ImageView>), vk::Framebuffer)>,
+    /// Per physical pass, its framebuffer per frame slot: one shared by every slot for a pass
+    /// whose attachments are all the executable's own (made at `new`); for a pass with an
+    /// imported attachment, slot `k`'s, made by [`Executable::bind_imports`] for slot `k`
+    /// (null until then) and destroyed when slot `k` is bound again. Bounded: at most one per
+    /// pass and slot, and never matched by handle, so a host view recreated with a reused
+    /// handle value gets a framebuffer of its own.
+    framebuffers: Vec<Vec<vk::Framebuffer>>,
+    /// Per physical pass, the framebuffer made at `new` over views known then (null when an
+    /// attachment had none yet): every slot's until a bind replaces that slot's.
+    shared_framebuffers: Vec<vk::Framebuffer>,
+    /// Frame slots recorded (`record_frame`'s `frame` is below it).
+    slots: usize,
 }
 
 impl Executable {
     /// Creates everything the plan needs and lets every pass prepare its pipelines.
     /// Every surviving pass must have an executor.
+    /// `slots`: the frame-in-flight slots frames are recorded for (1 or more).
     pub fn new(
         gpu: &GpuContext,
         plan: Plan,
         execs: super::compile::PassExecs,
         shaders: &ShaderCompiler,
         pipeline_cache: vk::PipelineCache,
+        slots: usize,
     ) -> Result<Self> {
+        let slots = slots.max(1);
         let execs = execs
             .into_iter()
             .zip(&plan.passes)
@@ -125,7 +138,8 @@ impl Executable {
             blocks: Vec::new(),
             render_passes: Vec::new(),
             framebuffers: Vec::new(),
-            framebuffer_cache: Vec::new(),
+            shared_framebuffers: Vec::new(),
+            slots,
             execs: Vec::new(),
             plan,
         };
@@ -262,115 +276,130 @@ impl Executable {
                 }
                 None => self.render_passes.push(vk::RenderPass::null()),
             }
-            self.framebuffers.push(vk::Framebuffer::null());
-            self.update_framebuffer(gpu, g)?;
+            let shared = if self.attachments_have_views(g) {
+                self.create_group_framebuffer(gpu, g)?
+            } else {
+                // An import without a view yet: made per slot when it is bound.
+                vk::Framebuffer::null()
+            };
+            self.shared_framebuffers.push(shared);
+            self.framebuffers.push(vec![shared; self.slots]);
         }
         Ok(())
     }
 
-    /// Points physical pass `g` at the framebuffer of the current attachment views, making it
-    /// (once per distinct set of views) unless an imported attachment has no view yet.
-    fn update_framebuffer(&mut self, gpu: &GpuContext, g: usize) -> Result<()> {
+    /// Whether every attachment of physical pass `g` has a view now.
+    fn attachments_have_views(&self, g: usize) -> bool {
+        self.plan.physical[g]
+            .render_pass
+            .as_ref()
+            .is_some_and(|rp| {
+                rp.attachments
+                    .iter()
+                    .all(|a| self.views[a.resource] != vk::ImageView::null())
+            })
+    }
+
+    /// A framebuffer of physical pass `g`'s render pass over the current attachment views
+    /// (null when the pass has no render pass).
+    fn create_group_framebuffer(&self, gpu: &GpuContext, g: usize) -> Result<vk::Framebuffer> {
         let phys = &self.plan.physical[g];
         let Some(plan) = &phys.render_pass else {
-            return Ok(());
+            return Ok(vk::Framebuffer::null());
         };
-        let views: Vec<vk::ImageView> = plan
-            .attachments
-            .iter()
-            .map(|a| self.views[a.resource])
-            .collect();
-        if views.contains(&vk::ImageView::null()) {
-            self.framebuffers[g] = vk::Framebuffer::null();
-            return Ok(());
-        }
-        let key = (g, views);
-        let framebuffer = match self.framebuffer_cache.iter().find(|(k, _)| *k == key) {
-            Some(&(_, fb)) => fb,
-            None => {
-                let fb = create_framebuffer(
-                    gpu,
-                    plan,
-                    self.render_passes[g],
-                    &self.views,
-                    phys.extent,
-                    &phys.name,
-                )?;
-                self.framebuffer_cache.push((key, fb));
-                fb
-            }
-        };
-        self.framebuffers[g] = framebuffer;
-        Ok(())
+        create_framebuffer(
+            gpu,
+            plan,
+            self.render_passes[g],
+            &self.views,
+            phys.extent,
+            &phys.name,
+        )
     }
 
-    /// Gives an imported image its image and view for the frames recorded from now on (a
-    /// host's swapchain image, or the next of several targets while earlier frames are still
-    /// in flight). Only images the frame uses as attachments or transfer targets can change
-    /// between frames: a descriptor that samples an import is written once, at `new`.
-    pub fn bind_import(
+    /// Binds imported images for the frame recorded next with slot `slot`: each `(id, image,
+    /// view)` gives import `id` its image and view. Attachments get slot `slot`'s framebuffer
+    /// made anew (its previous one destroyed); images sampled through descriptors are written
+    /// into slot `slot`'s descriptor sets. The frame last recorded with slot `slot` must have
+    /// completed (its framebuffer and sets are replaced), and every import the frame reads or
+    /// writes must be bound before it is recorded ([`Executable::ready`]).
+    pub fn bind_imports(
         &mut self,
         gpu: &GpuContext,
-        id: ResourceId,
-        image: vk::Image,
-        view: vk::ImageView,
+        slot: usize,
+        binds: &[(ResourceId, vk::Image, vk::ImageView)],
     ) -> Result<()> {
-        let resource = self.plan.resources.get(id).ok_or_else(|| {
-            LucentError::Graph(format!("bind_import: no resource {id} in this plan"))
-        })?;
-        if !resource.imported {
+        if slot >= self.slots {
             return Err(LucentError::Graph(format!(
-                "bind_import: '{}' is not an imported image",
-                resource.name
+                "bind_imports: slot {slot}, but the executable records {} slot(s)",
+                self.slots
             )));
         }
-        let through_descriptors = self.plan.passes.iter().any(|p| {
-            p.reads.iter().chain(&p.writes).any(|u| {
-                u.resource == id
-                    && !matches!(
-                        u.access,
-                        Access::ColorAttachmentWrite
-                            | Access::DepthAttachmentWrite
-                            | Access::DepthAttachmentRead
-                            | Access::TransferRead
-                            | Access::TransferWrite
-                    )
-            })
-        });
-        if through_descriptors {
-            return Err(LucentError::Graph(format!(
-                "bind_import: '{}' is read through descriptors, so it cannot change between frames",
-                resource.name
-            )));
+        for &(id, image, view) in binds {
+            let resource = self.plan.resources.get(id).ok_or_else(|| {
+                LucentError::Graph(format!("bind_imports: no resource {id} in this plan"))
+            })?;
+            if !resource.imported {
+                return Err(LucentError::Graph(format!(
+                    "bind_imports: '{}' is not an imported image",
+                    resource.name
+                )));
+            }
+            if image == vk::Image::null() || view == vk::ImageView::null() {
+                return Err(LucentError::Graph(format!(
+                    "bind_imports: '{}' needs an image and a view",
+                    resource.name
+                )));
+            }
+            self.images[id] = image;
+            self.views[id] = view;
         }
-        if image == vk::Image::null() || view == vk::ImageView::null() {
-            return Err(LucentError::Graph(format!(
-                "bind_import: '{}' needs an image and a view",
-                resource.name
-            )));
+        for &(id, _, view) in binds {
+            for p in 0..self.plan.passes.len() {
+                let reads_through_descriptors = self.plan.passes[p]
+                    .reads
+                    .iter()
+                    .any(|u| u.resource == id && u.access.through_descriptors());
+                if reads_through_descriptors {
+                    self.execs[p].bind_view(gpu, slot, id, view)?;
+                }
+            }
         }
-        self.images[id] = image;
-        self.views[id] = view;
-        self.descriptor_views[id] = view;
         for g in 0..self.plan.physical.len() {
-            let uses = self.plan.physical[g]
+            let rebinds = self.plan.physical[g]
                 .render_pass
                 .as_ref()
-                .is_some_and(|rp| rp.attachments.iter().any(|a| a.resource == id));
-            if uses {
-                self.update_framebuffer(gpu, g)?;
+                .is_some_and(|rp| {
+                    rp.attachments
+                        .iter()
+                        .any(|a| binds.iter().any(|&(id, ..)| id == a.resource))
+                });
+            if !rebinds {
+                continue;
+            }
+            let old = std::mem::replace(&mut self.framebuffers[g][slot], vk::Framebuffer::null());
+            if old != vk::Framebuffer::null() && old != self.shared_framebuffers[g] {
+                // SAFETY: made for this slot by an earlier bind; the frame that used it has
+                // completed (the caller's contract).
+                unsafe { gpu.device.destroy_framebuffer(old, None) };
+            }
+            if self.attachments_have_views(g) {
+                self.framebuffers[g][slot] = self.create_group_framebuffer(gpu, g)?;
             }
         }
         Ok(())
     }
 
-    /// Whether every physical pass can be recorded (every imported attachment has an image).
-    pub fn ready(&self) -> bool {
-        self.plan
-            .physical
-            .iter()
-            .zip(&self.framebuffers)
-            .all(|(p, fb)| p.render_pass.is_none() || *fb != vk::Framebuffer::null())
+    /// Whether a frame can be recorded for slot `slot` (every imported attachment bound for it,
+    /// every import with an image).
+    pub fn ready(&self, slot: usize) -> bool {
+        slot < self.slots
+            && self
+                .plan
+                .physical
+                .iter()
+                .zip(&self.framebuffers)
+                .all(|(p, fb)| p.render_pass.is_none() || fb[slot] != vk::Framebuffer::null())
             && self
                 .plan
                 .resources
@@ -401,6 +430,7 @@ impl Executable {
                     extent: extent(phys.extent),
                     views: &self.views,
                     descriptor_views: &self.descriptor_views,
+                    slots: self.slots,
                 };
                 self.execs[p].prepare(&ctx).map_err(|e| match e {
                     LucentError::Graph(m) => {
@@ -477,7 +507,7 @@ impl Executable {
                     .collect();
                 let begin = vk::RenderPassBeginInfo::default()
                     .render_pass(self.render_passes[index])
-                    .framebuffer(self.framebuffers[index])
+                    .framebuffer(self.framebuffers[index][frame])
                     .render_area(vk::Rect2D {
                         offset: vk::Offset2D::default(),
                         extent: area,
@@ -589,9 +619,17 @@ impl Executable {
         self.execs.clear();
         // SAFETY: created by this executable on this device; the caller guarantees idle.
         unsafe {
-            self.framebuffers.clear();
-            for (_, fb) in self.framebuffer_cache.drain(..) {
-                gpu.device.destroy_framebuffer(fb, None);
+            let shared = std::mem::take(&mut self.shared_framebuffers);
+            for fb in self.framebuffers.drain(..).flatten() {
+                // A shared framebuffer is listed once per slot: destroyed once, below.
+                if fb != vk::Framebuffer::null() && !shared.contains(&fb) {
+                    gpu.device.destroy_framebuffer(fb, None);
+                }
+            }
+            for fb in shared {
+                if fb != vk::Framebuffer::null() {
+                    gpu.device.destroy_framebuffer(fb, None);
+                }
             }
             for rp in self.render_passes.drain(..) {
                 if rp != vk::RenderPass::null() {

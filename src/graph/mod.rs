@@ -55,13 +55,27 @@ use crate::backend::GpuContext;
 use crate::Result;
 
 /// The code behind one pass.
-pub trait PassExec {
+pub trait PassExec: Send {
     /// Creates pipelines and descriptor sets, once the plan placed the pass (render pass and
     /// subpass for raster passes) and the physical images exist.
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()>;
     /// Records the pass. The executor has already begun the render pass / subpass and set the
     /// viewport and scissor to the full extent (pipelines use dynamic viewport and scissor).
     fn record(&self, ctx: &RecordContext<'_>);
+    /// Writes `view` as imported image `id` into the descriptors the pass reads it through for
+    /// frame slot `slot` (an import bound at record time, [`Executable::bind_imports`]). Only
+    /// passes that read imports through descriptors are asked; the default refuses.
+    fn bind_view(
+        &mut self,
+        _gpu: &GpuContext,
+        _slot: usize,
+        id: ResourceId,
+        _view: ash::vk::ImageView,
+    ) -> Result<()> {
+        Err(crate::LucentError::Graph(format!(
+            "this pass cannot read imported image {id} bound per frame through its descriptors"
+        )))
+    }
     /// Destroys what `prepare` created.
     fn destroy(&mut self, gpu: &GpuContext);
 }

@@ -337,7 +337,8 @@ impl FloorFrame {
                     .collect()
             })
             .collect();
-        let executable = Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle)?;
+        // One slot: the floors are recorded one at a time, each waited for.
+        let executable = Executable::new(gpu, plan, execs, shaders, pipeline_cache.handle, 1)?;
         let runner = match FrameRunner::new(gpu, executable.plan.physical.len()) {
             Ok(r) => r,
             Err(e) => {

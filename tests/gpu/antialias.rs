@@ -129,7 +129,7 @@ fn fxaa_into_a_hosts_srgb_and_float_targets_matches_lucents_own_display() {
         common::submit_back_to_back(gpu, 1, |slot, cmd| {
             renderer.update_slot(&scene, slot).unwrap();
             renderer
-                .bind_target(gpu, target.image, target.view)
+                .bind_target(gpu, slot, target.image, target.view)
                 .unwrap();
             renderer.record(gpu, cmd, slot, None).unwrap();
         });

@@ -1,28 +1,32 @@
-//! lucent embedded in a host engine (`lucent::embed`): the example engine against `lucent
-//! render`, the post-process SSS path against lucent's own SSS frame, the host's allocator
-//! and pipeline cache in use, and mistakes a host can make refused as errors, not as
-//! validation errors.
+//! lucent embedded in a host engine (`lucent::embed`): the example host, the SSS effect on
+//! host G-buffer layouts against lucent's own SSS frame, several views per frame, the host's
+//! allocator and pipeline cache, no submission or wait on the host's device, the leak
+//! detector, and mistakes a host can make refused as typed errors, not validation errors.
 
 use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
 
 use crate::common::blur;
 use crate::common::{submit_back_to_back, TestGpu};
 use ash::vk;
-use glam::DVec3;
+use glam::{DVec3, Mat4};
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
-    EmbedOptions, HostDevice, HostImage, ImageState, Lucent, OptionalFeatures, PostProcessDesc,
-    PostProcessFrame, PostProcessInputs, PostProcessSss, PostProcessStates, SceneRenderer,
+    DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice, HostError,
+    HostImage, IdDesc, ImageFault, ImageState, Lucent, OptionalFeatures, SceneRenderer, SssEffect,
+    SssEffectDesc, SssFrame, SssImages, SssMaterial, Uploads,
 };
 use lucent::features::sss::SssProfiles;
 use lucent::frame::{FrameSettings, Renderer, Technique};
 use lucent::images::compare::{flip_rgba8, FlipThresholds};
 use lucent::images::output::{read_png_rgba8, write_png_rgba8};
-use lucent::scene::material::Texturing;
+use lucent::scene::material::{SssProfile, Texturing};
 use lucent::LucentError;
 
 /// The example binary `cargo test` built beside this test's (target/<profile>/examples).
@@ -40,14 +44,14 @@ fn example_binary() -> PathBuf {
     path
 }
 
-/// `lucent` for the host's own device: the test context's handles.
-fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
+/// The host's handles of the test context, with `device` as the device lucent calls through.
+fn host_device(test: &TestGpu, device: ash::Device) -> HostDevice {
     let gpu = &test.gpu;
-    let host = HostDevice {
+    HostDevice {
         entry: gpu.entry.clone(),
         instance: gpu.instance.clone(),
         physical_device: gpu.physical_device,
-        device: gpu.device.clone(),
+        device,
         queue: gpu.queue,
         queue_family: gpu.queue_family,
         enabled: OptionalFeatures {
@@ -55,81 +59,70 @@ fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
             independent_blend: gpu.info.independent_blend,
             storage_image_write_without_format: gpu.info.storage_image_write_without_format,
         },
-    };
+    }
+}
+
+/// `lucent` for the host's own device: the test context's handles.
+fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
+    let host = host_device(test, test.gpu.device.clone());
     // SAFETY: the handles are the test context's, created together with lucent's
     // requirements, and outlive the returned value (dropped before `test.finish()`).
     unsafe { Lucent::new(host, options) }.expect("wrap the test's device")
 }
 
-/// Runs the example and `lucent render` on the same scene and size; both under validation
-/// (the example's own messenger fails it on any error).
-fn example_matches_render(scene: &str, size: &str, frames: &str) {
-    let dir = common::temp_dir(&format!("embed-example-{scene}"));
-    let engine_png = dir.join("engine.png");
-    let out = Command::new(example_binary())
-        .args([
-            "--scene", scene, "--size", size, "--frames", frames, "--out",
-        ])
-        .arg(&engine_png)
-        .output()
+fn options(frames_in_flight: usize) -> EmbedOptions {
+    EmbedOptions {
+        frames_in_flight,
+        ..Default::default()
+    }
+}
+
+/// Builds a renderer with its uploads recorded into a command buffer the test (the host)
+/// submits and waits for, then releases the uploads' staging memory.
+fn built<T>(
+    test: &TestGpu,
+    lucent: &Lucent,
+    build: impl FnOnce(&mut Uploads) -> lucent::Result<T>,
+) -> lucent::Result<T> {
+    let mut result = None;
+    let mut recorded = None;
+    test.gpu
+        .submit_and_wait(|cmd| {
+            // SAFETY: the test's one-shot command buffer, recording, on lucent's queue family.
+            let mut uploads = unsafe { lucent.uploads(cmd) };
+            result = Some(build(&mut uploads));
+            recorded = Some(uploads);
+        })
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "host_engine failed:\n{stderr}");
-    assert!(
-        stderr.contains("validation on (synchronization validation included)")
-            && stderr.contains("(0 validation errors)"),
-        "the example must run under validation with no errors:\n{stderr}"
-    );
-    let render_png = dir.join("render.png");
-    common::succeeded(
-        common::lucent_command()
-            .args(["render", "--scene", scene, "--size", size, "--out"])
-            .arg(&render_png),
-    );
-    let (w, h, engine) = read_png_rgba8(&engine_png).unwrap();
-    let (rw, rh, render) = read_png_rgba8(&render_png).unwrap();
-    assert_eq!((w, h), (rw, rh));
-    let flip = flip_rgba8(&render, &engine, w, h).unwrap();
-    assert!(
-        flip.within(&FlipThresholds::default()),
-        "{scene}: the host engine's frame differs from lucent render: mean FLIP {:.4}, {:.3}% \
-         above threshold ({} and {})",
-        flip.mean,
-        flip.fraction_above * 100.0,
-        engine_png.display(),
-        render_png.display()
-    );
-    std::fs::remove_dir_all(&dir).ok();
+    let mut uploads = recorded.unwrap();
+    // SAFETY: submit_and_wait waited for the submission holding the uploads.
+    unsafe { uploads.release(lucent) }.unwrap();
+    result.unwrap()
 }
 
-#[test]
-fn host_engine_example_matches_lucent_render_under_validation() {
-    // The issue's check: cubes, 320x240, 6 frames (three frames in flight, each slot used
-    // twice).
-    example_matches_render("cubes", "320x240", "6");
-    // A frame with every screen-space feature at once (translucency, two SSS profiles,
-    // shadows) at another size, frames not a multiple of the slots.
-    example_matches_render("mixed", "200x150", "4");
+/// Runs `record` into a command buffer the test submits and waits for.
+fn recorded<T>(test: &TestGpu, record: impl FnOnce(vk::CommandBuffer) -> T) -> T {
+    let mut out = None;
+    test.gpu
+        .submit_and_wait(|cmd| out = Some(record(cmd)))
+        .unwrap();
+    out.unwrap()
 }
 
-/// Uploads `texels` (tightly packed) as a sampled host image in SHADER_READ_ONLY_OPTIMAL.
-fn host_input(test: &TestGpu, desc: &ImageDesc, bytes: Vec<u8>, name: &str) -> GpuImage {
-    test.gpu.upload_image(desc, &[bytes], name).unwrap()
-}
-
+/// The host's description of one of its images.
 fn described(image: &GpuImage, name: &str, usage: vk::ImageUsageFlags) -> HostImage {
-    HostImage {
-        name: name.into(),
-        image: image.image,
-        view: image.view,
-        format: image.desc.format,
-        extent: vk::Extent2D {
+    HostImage::new(
+        name,
+        image.image,
+        image.view,
+        image.desc.format,
+        vk::Extent2D {
             width: image.desc.width,
             height: image.desc.height,
         },
         usage,
-        state: ImageState::fragment_sampled(),
-    }
+    )
+    .in_state(ImageState::fragment_sampled())
 }
 
 fn f32_bytes(texels: &[[f32; 4]]) -> Vec<u8> {
@@ -147,8 +140,470 @@ fn tonemapped(hdr: &[f32], exposure: f64) -> Vec<u8> {
         .collect()
 }
 
+/// A host colour image lucent can render into (and the test read back).
+fn output_image(
+    test: &TestGpu,
+    w: u32,
+    h: u32,
+    format: vk::Format,
+    usage: vk::ImageUsageFlags,
+) -> GpuImage {
+    test.gpu
+        .create_image(&ImageDesc::color(w, h, format, usage), "host output")
+        .unwrap()
+}
+
+/// The error a host gets for `result`, which must be a [`HostError`].
+fn host_error<T>(result: lucent::Result<T>) -> HostError {
+    match result {
+        Err(LucentError::Host(e)) => e,
+        Err(other) => panic!("expected a HostError, got {other}"),
+        Ok(_) => panic!("expected a HostError, got Ok"),
+    }
+}
+
+/// `image` changed by `change` (the descriptions cannot be made with struct update syntax
+/// outside lucent: they may grow fields).
+fn changed<T: Clone>(image: &T, change: impl FnOnce(&mut T)) -> T {
+    let mut out = image.clone();
+    change(&mut out);
+    out
+}
+
+/// The example host runs headless under validation, with every effect it inserts, and its
+/// frame shows the scatter: it differs from the same host frame without lucent where the skin
+/// is, and nowhere it has no scattering material.
 #[test]
-fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
+fn host_engine_example_runs_under_validation_and_its_frame_scatters() {
+    let dir = common::temp_dir("embed-example");
+    let run = |png: &Path, extra: &[&str]| {
+        let out = Command::new(example_binary())
+            .args(["--size", "256x192", "--frames", "5", "--out"])
+            .arg(png)
+            .args(extra)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "host_engine failed:\n{stderr}");
+        assert!(
+            stderr.contains("validation on (synchronization validation included)")
+                && stderr.contains("(0 validation errors)"),
+            "the example must run under validation with no errors:\n{stderr}"
+        );
+        stderr.to_string()
+    };
+    let with = dir.join("with.png");
+    let without = dir.join("without.png");
+    let log = run(&with, &[]);
+    assert!(log.contains("lucent effects: sss"), "{log}");
+    run(&without, &["--without-lucent"]);
+    let (w, h, a) = read_png_rgba8(&with).unwrap();
+    let (_, _, b) = read_png_rgba8(&without).unwrap();
+    let differs = |x: &[u8], y: &[u8]| (0..3).any(|c| x[c].abs_diff(y[c]) > 2);
+    let changed = a
+        .chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .filter(|(x, y)| differs(x, y))
+        .count();
+    let share = changed as f64 / f64::from(w * h);
+    println!(
+        "host_engine: lucent's SSS changes {:.2}% of the pixels",
+        share * 100.0
+    );
+    // The engine's spheres are 6 cm across and its profiles physical (skin, marble): the
+    // scatter softens their shadow terminators, 0.49% of the pixels by more than 2/255 at
+    // this size (0.51% at 512x384); a blur that did nothing changes none.
+    assert!(
+        share > 0.002 && share < 0.6,
+        "the host frame with lucent's SSS changed {:.2}% of its pixels ({} and {})",
+        share * 100.0,
+        with.display(),
+        without.display()
+    );
+    // The right of the frame is the blue plastic sphere (the engine's material 5, no profile)
+    // and the floor (0): lucent leaves their light as the engine lit it.
+    let row = 4 * w as usize;
+    let right = (7 * w / 10) as usize;
+    for (y, (ra, rb)) in a.chunks_exact(row).zip(b.chunks_exact(row)).enumerate() {
+        for x in right..w as usize {
+            let (pa, pb) = (&ra[4 * x..4 * x + 4], &rb[4 * x..4 * x + 4]);
+            assert!(
+                !differs(pa, pb),
+                "pixel ({x}, {y}) without a profile changed: {pa:?} against {pb:?} ({} and {})",
+                with.display(),
+                without.display()
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// How a test host stores its depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum HostDepth {
+    /// D32, standard Z (lucent's own).
+    Standard,
+    /// D32, reversed Z with an infinite far plane.
+    ReversedInfinite,
+    /// D24S8, standard Z (its stencil holds the IDs).
+    D24Stencil,
+    /// R32F linear view depth.
+    Linear,
+}
+
+/// How a test host stores its material IDs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum HostIds {
+    /// R8_UNORM, the profile number / 255 (lucent's own).
+    Unorm,
+    /// R8_UINT, the host's own numbers (10 + 3k; 200 where nothing scatters).
+    Uint,
+    /// Bits 4..8 of the depth image's stencil (the low bits hold other data).
+    Stencil,
+    /// Bits 4..8 of the alpha of an RGBA8 target whose other bits and channels hold other
+    /// data.
+    AlphaBits,
+}
+
+/// The host's ID of profile `k` (0: none).
+fn host_id(ids: HostIds, k: u8) -> u8 {
+    match (ids, k) {
+        (HostIds::Uint, 0) => 200,
+        (HostIds::Uint, k) => 10 + 3 * k,
+        (_, k) => k,
+    }
+}
+
+/// A depth-stencil image of `format` (D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT) holding
+/// `depth` and `stencil`, with a view of each aspect, in SHADER_READ_ONLY_OPTIMAL.
+struct DepthStencil {
+    image: GpuImage,
+    depth_view: vk::ImageView,
+    stencil_view: vk::ImageView,
+}
+
+fn depth_stencil_image(
+    test: &TestGpu,
+    w: u32,
+    h: u32,
+    format: vk::Format,
+    depth: &[f32],
+    stencil: &[u8],
+) -> DepthStencil {
+    let gpu = &test.gpu;
+    let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+    let both = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+    let desc = ImageDesc {
+        aspect: both,
+        ..ImageDesc::depth(w, h, format, usage)
+    };
+    let image = gpu.create_image(&desc, "host depth-stencil").unwrap();
+    let view = |aspect| {
+        gpu.create_view(
+            image.image,
+            &ImageDesc { aspect, ..desc },
+            "host aspect view",
+        )
+        .unwrap()
+    };
+    let (depth_view, stencil_view) = (
+        view(vk::ImageAspectFlags::DEPTH),
+        view(vk::ImageAspectFlags::STENCIL),
+    );
+    let depth_bytes: Vec<u8> = match format {
+        // The 24 low bits of each word (buffer copies of D24's depth aspect are 32-bit).
+        vk::Format::D24_UNORM_S8_UINT => depth
+            .iter()
+            .flat_map(|&d| {
+                ((f64::from(d.clamp(0.0, 1.0)) * 16777215.0).round() as u32).to_le_bytes()
+            })
+            .collect(),
+        _ => bytemuck::cast_slice(depth).to_vec(),
+    };
+    let total = (depth_bytes.len() + stencil.len()) as u64;
+    let mut staging = gpu
+        .create_buffer(
+            total,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+            "depth-stencil staging",
+        )
+        .unwrap();
+    {
+        let mapped = staging.mapped_mut().unwrap();
+        mapped[..depth_bytes.len()].copy_from_slice(&depth_bytes);
+        mapped[depth_bytes.len()..total as usize].copy_from_slice(stencil);
+    }
+    let range = vk::ImageSubresourceRange {
+        aspect_mask: both,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let region = |aspect, offset| vk::BufferImageCopy {
+        buffer_offset: offset,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: aspect,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width: w,
+            height: h,
+            depth: 1,
+        },
+    };
+    gpu.submit_and_wait(|cmd| {
+        let barrier = |from, to, src_stage, src, dst_stage, dst| {
+            vk::ImageMemoryBarrier2::default()
+                .old_layout(from)
+                .new_layout(to)
+                .src_stage_mask(src_stage)
+                .src_access_mask(src)
+                .dst_stage_mask(dst_stage)
+                .dst_access_mask(dst)
+                .image(image.image)
+                .subresource_range(range)
+        };
+        let to_dst = [barrier(
+            vk::ImageLayout::UNDEFINED,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::PipelineStageFlags2::NONE,
+            vk::AccessFlags2::NONE,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+        )];
+        let to_read = [barrier(
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::AccessFlags2::SHADER_SAMPLED_READ,
+        )];
+        // SAFETY: the test's recording command buffer; the image and buffer are alive.
+        unsafe {
+            gpu.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_dst),
+            );
+            gpu.device.cmd_copy_buffer_to_image(
+                cmd,
+                staging.buffer,
+                image.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[
+                    region(vk::ImageAspectFlags::DEPTH, 0),
+                    region(vk::ImageAspectFlags::STENCIL, depth_bytes.len() as u64),
+                ],
+            );
+            gpu.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_read),
+            );
+        }
+    })
+    .unwrap();
+    gpu.destroy_buffer(staging);
+    DepthStencil {
+        image,
+        depth_view,
+        stencil_view,
+    }
+}
+
+/// A host layout: its description, its images and its camera, made from lucent's own frame's
+/// depth (standard Z, `depth`) and profile numbers (`ids`).
+struct HostLayout {
+    desc: GBufferDesc,
+    camera: HostCamera,
+    /// The depth image.
+    depth: GpuImage,
+    /// The ID image, unless the IDs are in the depth image's stencil.
+    ids: Option<GpuImage>,
+    /// The depth image's stencil view, when the IDs are there.
+    stencil_ids: Option<vk::ImageView>,
+    /// Views the test made (destroyed with the layout).
+    views: Vec<vk::ImageView>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn host_layout(
+    test: &TestGpu,
+    depth_kind: HostDepth,
+    ids_kind: HostIds,
+    w: u32,
+    h: u32,
+    scene: &lucent::scene::Scene,
+    depth: &[f32],
+    ids: &[u8],
+    metres_per_unit: f32,
+) -> HostLayout {
+    let gpu = &test.gpu;
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let camera = &scene.camera;
+    let (n, f) = (f64::from(camera.near), f64::from(camera.far));
+    let aspect = w as f32 / h as f32;
+    let linear: Vec<f64> = depth
+        .iter()
+        .map(|&d| n * f / (f - f64::from(d) * (f - n)))
+        .collect();
+    let mut projection = camera.projection(aspect);
+    let host_ids: Vec<u8> = ids.iter().map(|&k| host_id(ids_kind, k)).collect();
+    let mut extra_views = Vec::new();
+    let (depth_image, depth_desc, stencil) = match depth_kind {
+        HostDepth::Standard => {
+            let image = gpu
+                .upload_image(
+                    &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage),
+                    &[bytemuck::cast_slice(depth).to_vec()],
+                    "host depth",
+                )
+                .unwrap();
+            (image, DepthDesc::device(vk::Format::D32_SFLOAT), None)
+        }
+        HostDepth::ReversedInfinite => {
+            // Reversed Z, no far plane, the y axis the other way round from lucent's.
+            projection = Mat4::perspective_infinite_reverse_rh(
+                camera.fov_y_degrees.to_radians(),
+                aspect,
+                camera.near,
+            );
+            let reversed: Vec<f32> = linear.iter().map(|&z| (n / z) as f32).collect();
+            let image = gpu
+                .upload_image(
+                    &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage),
+                    &[bytemuck::cast_slice(&reversed).to_vec()],
+                    "host reversed depth",
+                )
+                .unwrap();
+            (image, DepthDesc::device(vk::Format::D32_SFLOAT), None)
+        }
+        HostDepth::D24Stencil => {
+            // Other bits of the stencil hold the host's own data.
+            let stencil: Vec<u8> = host_ids.iter().map(|&id| (id << 4) | 0b0101).collect();
+            let ds =
+                depth_stencil_image(test, w, h, vk::Format::D24_UNORM_S8_UINT, depth, &stencil);
+            extra_views.push(ds.depth_view);
+            extra_views.push(ds.stencil_view);
+            (
+                ds.image,
+                DepthDesc::device(vk::Format::D24_UNORM_S8_UINT),
+                Some(ds.stencil_view),
+            )
+        }
+        HostDepth::Linear => {
+            let z: Vec<f32> = linear.iter().map(|&z| z as f32).collect();
+            let image = gpu
+                .upload_image(
+                    &ImageDesc::color(w, h, vk::Format::R32_SFLOAT, usage),
+                    &[bytemuck::cast_slice(&z).to_vec()],
+                    "host linear depth",
+                )
+                .unwrap();
+            (image, DepthDesc::linear(vk::Format::R32_SFLOAT), None)
+        }
+    };
+    let (id_desc, id_image) = match ids_kind {
+        HostIds::Unorm => (
+            IdDesc::value(vk::Format::R8_UNORM),
+            Some(
+                gpu.upload_image(
+                    &ImageDesc::color(w, h, vk::Format::R8_UNORM, usage),
+                    std::slice::from_ref(&host_ids),
+                    "host IDs",
+                )
+                .unwrap(),
+            ),
+        ),
+        HostIds::Uint => (
+            IdDesc::value(vk::Format::R8_UINT),
+            Some(
+                gpu.upload_image(
+                    &ImageDesc::color(w, h, vk::Format::R8_UINT, usage),
+                    std::slice::from_ref(&host_ids),
+                    "host IDs",
+                )
+                .unwrap(),
+            ),
+        ),
+        HostIds::Stencil => {
+            assert!(stencil.is_some(), "stencil IDs need the D24S8 depth");
+            (IdDesc::stencil(vk::Format::D24_UNORM_S8_UINT, 4, 4), None)
+        }
+        HostIds::AlphaBits => {
+            let packed: Vec<u8> = host_ids
+                .iter()
+                .flat_map(|&id| [17, 200, 3, (id << 4) | 0b0011])
+                .collect();
+            (
+                IdDesc::bits(vk::Format::R8G8B8A8_UNORM, 3, 4, 4),
+                Some(
+                    gpu.upload_image(
+                        &ImageDesc::color(w, h, vk::Format::R8G8B8A8_UNORM, usage),
+                        &[packed],
+                        "host packed target",
+                    )
+                    .unwrap(),
+                ),
+            )
+        }
+    };
+    let desc = GBufferDesc::new(
+        w,
+        h,
+        depth_desc,
+        DiffuseDesc::with_albedo(vk::Format::R32G32B32A32_SFLOAT),
+    )
+    .with_specular(vk::Format::R32G32B32A32_SFLOAT)
+    .with_material_ids(id_desc)
+    .with_metres_per_unit(metres_per_unit);
+    HostLayout {
+        desc,
+        camera: HostCamera::new(camera.view(), projection),
+        depth: depth_image,
+        ids: id_image,
+        stencil_ids: stencil.filter(|_| ids_kind == HostIds::Stencil),
+        views: extra_views,
+    }
+}
+
+impl HostLayout {
+    fn destroy(self, test: &TestGpu) {
+        for view in self.views {
+            // SAFETY: made for this test; the GPU is done with it.
+            unsafe { test.gpu.device.destroy_image_view(view, None) };
+        }
+        test.gpu.destroy_image(self.depth);
+        if let Some(image) = self.ids {
+            test.gpu.destroy_image(image);
+        }
+    }
+}
+
+/// A new view of `image` (a host recreating its views between frames).
+fn fresh_view(
+    test: &TestGpu,
+    image: vk::Image,
+    format: vk::Format,
+    aspect: vk::ImageAspectFlags,
+) -> vk::ImageView {
+    let desc = ImageDesc {
+        aspect,
+        ..ImageDesc::color(1, 1, format, vk::ImageUsageFlags::SAMPLED)
+    };
+    test.gpu
+        .create_view(image, &desc, "recreated view")
+        .unwrap()
+}
+
+#[test]
+fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
     let test = TestGpu::new();
     let gpu = &test.gpu;
     let (w, h) = (240, 180);
@@ -160,30 +615,25 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             p.units_per_mm *= 8.0;
         }
     }
-    for (technique, blur) in [
-        (
-            Technique::Only(&lucent::features::sss::separable::SEPARABLE),
-            blur(&lucent::features::sss::separable::SEPARABLE),
-        ),
-        (
-            Technique::Only(&lucent::features::sss::control::CONTROL),
-            blur(&lucent::features::sss::control::CONTROL),
-        ),
-        (
-            Technique::Only(&lucent::features::sss::burley::BURLEY),
-            blur(&lucent::features::sss::burley::BURLEY),
-        ),
+    let mut worst_report = Vec::new();
+    for technique in [
+        &lucent::features::sss::separable::SEPARABLE
+            as &'static dyn lucent::features::registry::TechniqueModule,
+        &lucent::features::sss::control::CONTROL,
+        &lucent::features::sss::burley::BURLEY,
     ] {
+        // (bilateral blurs lucent's LEAN G-buffer, which a host does not have: refused, in
+        // the typed-error test)
+        let sss_blur = blur(technique);
         // lucent's own frame, keeping what a host's lighting would have made.
-        let settings = FrameSettings {
-            technique,
+        let mut settings = FrameSettings {
+            technique: Technique::Only(technique),
             export_hdr: true,
             export_gbuffer: true,
             export_lit: true,
             ..FrameSettings::new(w, h)
         };
-        // A host's lit diffuse carries its albedo: the post-process blurs it with the light.
-        let mut settings = settings;
+        // A host's lit diffuse carries its albedo: blurred with the light.
         settings.sss.texturing = Some(Texturing::Pre);
         let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
         let images = renderer.render_once(gpu).unwrap();
@@ -193,63 +643,13 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
         renderer.destroy(gpu);
         let expected = images.hdr.unwrap();
         let gb = images.gbuffer.unwrap();
-
-        // The host's images: its lit diffuse and specular, depth buffer and profile IDs.
-        let usage = vk::ImageUsageFlags::SAMPLED;
-        let rgba32 = |t: &[[f32; 4]], name| {
-            host_input(
-                &test,
-                &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, usage),
-                f32_bytes(t),
-                name,
-            )
-        };
-        let diffuse_image = rgba32(&diffuse, "host diffuse");
-        let specular_image = rgba32(&specular, "host specular");
-        let depth_image = host_input(
-            &test,
-            &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage),
-            bytemuck::cast_slice(&gb.depth).to_vec(),
-            "host depth",
-        );
         let ids: Vec<u8> = gb.sss.unwrap().iter().map(|&v| v as u8).collect();
         assert!(ids.iter().any(|&v| v > 0), "the skin scene scatters");
-        let ids_image = host_input(
-            &test,
-            &ImageDesc::color(w, h, vk::Format::R8_UNORM, usage),
-            ids,
-            "host profile ids",
-        );
-        let output_usage =
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-        let output_image = gpu
-            .create_image(
-                &ImageDesc::color(w, h, vk::Format::R16G16B16A16_SFLOAT, output_usage),
-                "host output",
-            )
-            .unwrap();
 
-        let lucent = wrap(
-            &test,
-            EmbedOptions {
-                frames_in_flight: 1,
-                ..Default::default()
-            },
-        );
-        let diffuse_host = described(&diffuse_image, "host diffuse", usage);
-        let specular_host = described(&specular_image, "host specular", usage);
-        let depth_host = described(&depth_image, "host depth", usage);
-        let ids_host = described(&ids_image, "host profile ids", usage);
-        let inputs = PostProcessInputs {
-            diffuse: &diffuse_host,
-            specular: Some(&specular_host),
-            depth: &depth_host,
-            profile_ids: &ids_host,
-        };
-        // The scene's profiles in the frame's ID order.
-        let profiles = SssProfiles::new(
+        // The scene's profiles in the frame's ID order, their scale the host's world scale.
+        let profiles: Vec<SssProfile> = SssProfiles::new(
             &scene,
-            Some(blur),
+            Some(sss_blur),
             None,
             Some(Texturing::Pre),
             &lucent::features::registry::blur_of,
@@ -263,237 +663,251 @@ fn post_process_sss_over_a_hosts_lit_images_matches_lucents_own_sss_frame() {
             p
         })
         .collect();
-        let desc = PostProcessDesc {
-            width: w,
-            height: h,
-            profiles,
-            knobs: settings.sss,
-            output_format: vk::Format::R16G16B16A16_SFLOAT,
-        };
-        let desc_again = desc.clone();
-        let mut post = PostProcessSss::new(&lucent, desc, &[inputs]).unwrap();
-        let output = HostImage {
-            state: ImageState::UNDEFINED,
-            ..described(&output_image, "host output", output_usage)
-        };
-        let finals = PostProcessStates {
-            inputs: ImageState::fragment_sampled(),
-            output: ImageState::transfer_src(),
-        };
-        let mut returned = None;
-        gpu.submit_and_wait(|cmd| {
-            returned = Some(post.record(
-                &lucent,
-                cmd,
-                0,
-                &PostProcessFrame {
-                    camera: &scene.camera,
-                    inputs,
-                    output: &output,
-                    finals,
-                },
-            ));
-        })
-        .unwrap();
-        assert_eq!(returned.unwrap().unwrap(), finals);
-        let got = lucent::images::output::f16_bytes_to_f32(
-            &gpu.read_image(&output_image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .unwrap(),
-        );
-        post.destroy(&lucent);
+        let units_per_mm = profiles[0].units_per_mm;
+        assert!(profiles.iter().all(|p| p.units_per_mm == units_per_mm));
+        let metres_per_unit = 1.0 / (1000.0 * units_per_mm);
 
-        // Without the host's specular lucent adds none: the result is the blurred diffuse
-        // alone (and the frame's minus its specular).
-        let without = PostProcessInputs {
-            specular: None,
-            ..inputs
+        let usage = vk::ImageUsageFlags::SAMPLED;
+        let rgba32 = |t: &[[f32; 4]], name| {
+            gpu.upload_image(
+                &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, usage),
+                &[f32_bytes(t)],
+                name,
+            )
+            .unwrap()
         };
-        let mut post = PostProcessSss::new(&lucent, desc_again, &[without]).unwrap();
-        let mut returned = None;
-        gpu.submit_and_wait(|cmd| {
-            let output = HostImage {
-                state: ImageState::transfer_src(),
-                ..output.clone()
-            };
-            returned = Some(post.record(
-                &lucent,
-                cmd,
-                0,
-                &PostProcessFrame {
-                    camera: &scene.camera,
-                    inputs: without,
-                    output: &output,
-                    finals,
-                },
-            ));
-        })
-        .unwrap();
-        returned.unwrap().unwrap();
-        let diffuse_only = lucent::images::output::f16_bytes_to_f32(
-            &gpu.read_image(&output_image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .unwrap(),
-        );
-        post.destroy(&lucent);
-        drop(lucent);
-        let worst = diffuse_only
-            .chunks_exact(4)
-            .zip(specular.iter())
-            .zip(got.chunks_exact(4))
-            .map(|((d, s), g)| {
-                (0..3)
-                    .map(|c| ((d[c] + s[c]) - g[c]).abs() / g[c].abs().max(0.05))
-                    .fold(0.0f32, f32::max)
-            })
-            .fold(0.0f32, f32::max);
-        assert!(
-            worst < 0.01,
-            "{}: blurred diffuse + specular is not the frame with specular (worst {worst})",
-            technique.name()
-        );
-
-        // The same passes over the same light: equal up to how the taps get their depth
-        // (lucent's separable frame carries linear depth in the diffuse's alpha; the host's
-        // is linearised from its depth buffer).
-        let mean = expected.iter().map(|v| v.abs() as f64).sum::<f64>() / expected.len() as f64;
-        let l1 = expected
-            .iter()
-            .zip(&got)
-            .map(|(a, b)| (a - b).abs() as f64)
-            .sum::<f64>()
-            / expected.len() as f64;
-        let exposure = scene.exposure as f64;
-        let (want, have) = (tonemapped(&expected, exposure), tonemapped(&got, exposure));
-        let flip = flip_rgba8(&want, &have, w, h).unwrap();
-        println!(
-            "{}: post-process vs frame: relative L1 {:.5}, mean FLIP {:.5}",
-            technique.name(),
-            l1 / mean,
-            flip.mean
-        );
-        if !flip.within(&FlipThresholds::default()) || l1 / mean > 0.01 {
-            let dir = common::temp_dir(&format!("embed-post-{}", technique.name()));
-            write_png_rgba8(&dir.join("frame.png"), w, h, &want).unwrap();
-            write_png_rgba8(&dir.join("post.png"), w, h, &have).unwrap();
-            panic!(
-                "{}: post-process SSS differs from the frame's: relative L1 {:.4}, mean FLIP \
-                 {:.4} ({})",
-                technique.name(),
-                l1 / mean,
-                flip.mean,
-                dir.display()
-            );
-        }
-        // And it scattered: the blurred frame differs from the lit light it started from.
-        let lit: Vec<f32> = diffuse
-            .iter()
-            .zip(&specular)
-            .flat_map(|(d, s)| [d[0] + s[0], d[1] + s[1], d[2] + s[2], 1.0])
-            .collect();
-        let changed = lit
-            .chunks_exact(4)
-            .zip(got.chunks_exact(4))
-            .filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 0.01 * a[c].abs().max(0.01)))
-            .count();
-        println!(
-            "{}: {:.1}% of pixels changed by more than 1% by the blur",
-            technique.name(),
-            100.0 * changed as f64 / (w * h) as f64
-        );
-        assert!(
-            changed > (w * h / 100) as usize,
-            "only {changed} pixels blurred"
-        );
-        for image in [
-            diffuse_image,
-            specular_image,
-            depth_image,
-            ids_image,
-            output_image,
+        let diffuse_image = rgba32(&diffuse, "host diffuse");
+        let specular_image = rgba32(&specular, "host specular");
+        let exposure = f64::from(scene.exposure);
+        let want = tonemapped(&expected, exposure);
+        for (name, depth_kind, ids_kind) in [
+            (
+                "D32, R8_UNORM IDs (lucent's own)",
+                HostDepth::Standard,
+                HostIds::Unorm,
+            ),
+            (
+                "reversed-Z infinite D32, R8_UINT IDs",
+                HostDepth::ReversedInfinite,
+                HostIds::Uint,
+            ),
+            (
+                "D24S8, IDs in stencil bits 4-7",
+                HostDepth::D24Stencil,
+                HostIds::Stencil,
+            ),
+            (
+                "linear R32F depth, IDs in RGBA8 alpha bits 4-7",
+                HostDepth::Linear,
+                HostIds::AlphaBits,
+            ),
         ] {
-            gpu.destroy_image(image);
+            let layout = host_layout(
+                &test,
+                depth_kind,
+                ids_kind,
+                w,
+                h,
+                &scene,
+                &gb.depth,
+                &ids,
+                metres_per_unit,
+            );
+            let materials: Vec<SssMaterial> = profiles
+                .iter()
+                .enumerate()
+                .map(|(i, p)| SssMaterial::new(host_id(ids_kind, i as u8 + 1), p.clone()))
+                .collect();
+            let lucent = wrap(&test, options(3));
+            let desc = SssEffectDesc::new(
+                layout.desc.clone(),
+                materials,
+                vk::Format::R16G16B16A16_SFLOAT,
+            )
+            .with_knobs(settings.sss);
+            let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
+            let output_usage =
+                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+            let outputs: Vec<GpuImage> = (0..3)
+                .map(|_| output_image(&test, w, h, vk::Format::R16G16B16A16_SFLOAT, output_usage))
+                .collect();
+            // Three frames in flight, submitted back to back; every frame the host makes its
+            // views anew (a recreated view can reuse a handle value).
+            let mut views = Vec::new();
+            submit_back_to_back(gpu, 3, |k, cmd| {
+                let depth_format = layout.desc.depth.format;
+                let depth_aspect = if depth_kind == HostDepth::Linear {
+                    vk::ImageAspectFlags::COLOR
+                } else {
+                    vk::ImageAspectFlags::DEPTH
+                };
+                let depth_view = fresh_view(&test, layout.depth.image, depth_format, depth_aspect);
+                let diffuse_view = fresh_view(
+                    &test,
+                    diffuse_image.image,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                    vk::ImageAspectFlags::COLOR,
+                );
+                views.extend([depth_view, diffuse_view]);
+                let depth_host = HostImage::new(
+                    "host depth",
+                    layout.depth.image,
+                    depth_view,
+                    depth_format,
+                    layout.desc.extent(),
+                    usage,
+                )
+                .in_state(ImageState::fragment_sampled());
+                let diffuse_host =
+                    changed(&described(&diffuse_image, "host diffuse", usage), |i| {
+                        i.view = diffuse_view
+                    });
+                let specular_host = described(&specular_image, "host specular", usage);
+                let ids_host = match (&layout.ids, layout.stencil_ids) {
+                    (Some(image), _) => HostImage::new(
+                        "host IDs",
+                        image.image,
+                        image.view,
+                        image.desc.format,
+                        layout.desc.extent(),
+                        usage,
+                    ),
+                    (None, Some(view)) => HostImage::new(
+                        "host stencil IDs",
+                        layout.depth.image,
+                        view,
+                        vk::Format::D24_UNORM_S8_UINT,
+                        layout.desc.extent(),
+                        usage,
+                    ),
+                    (None, None) => unreachable!(),
+                }
+                .in_state(ImageState::fragment_sampled());
+                let output = described(&outputs[k], "host output", output_usage)
+                    .in_state(ImageState::UNDEFINED)
+                    .then(ImageState::transfer_src());
+                effect
+                    .record(
+                        &lucent,
+                        cmd,
+                        &SssFrame {
+                            slot: k,
+                            view: 0,
+                            camera: layout.camera,
+                            images: SssImages {
+                                depth: &depth_host,
+                                diffuse: &diffuse_host,
+                                specular: Some(&specular_host),
+                                albedo: None,
+                                material_ids: &ids_host,
+                            },
+                            output: &output,
+                        },
+                    )
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            });
+            for view in views {
+                // SAFETY: the frames that used it completed (submit_back_to_back waited).
+                unsafe { gpu.device.destroy_image_view(view, None) };
+            }
+            for (k, output) in outputs.iter().enumerate() {
+                let got = lucent::images::output::f16_bytes_to_f32(
+                    &gpu.read_image(output, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                        .unwrap(),
+                );
+                let have = tonemapped(&got, exposure);
+                let diffs: Vec<u8> = want
+                    .iter()
+                    .zip(&have)
+                    .map(|(a, b)| a.abs_diff(*b))
+                    .collect();
+                let worst = *diffs.iter().max().unwrap();
+                let over = diffs.iter().filter(|&&d| d > 1).count();
+                let flip = flip_rgba8(&want, &have, w, h).unwrap();
+                worst_report.push(format!(
+                    "{} on {name}, frame {k}: worst {worst}/255, {over} channel values over \
+                     1/255 ({:.3}%), mean FLIP {:.5}",
+                    technique.name(),
+                    100.0 * over as f64 / diffs.len() as f64,
+                    flip.mean
+                ));
+                if over * 1000 > diffs.len() || !flip.within(&FlipThresholds::default()) {
+                    let dir = common::temp_dir(&format!("embed-layout-{}-{k}", technique.name()));
+                    write_png_rgba8(&dir.join("frame.png"), w, h, &want).unwrap();
+                    write_png_rgba8(&dir.join("host.png"), w, h, &have).unwrap();
+                    panic!(
+                        "{} on {name}: the host frame differs from lucent's: worst {worst}/255, \
+                         {over} values over 1/255 ({})",
+                        technique.name(),
+                        dir.display()
+                    );
+                }
+            }
+            effect.destroy(&lucent);
+            drop(lucent);
+            for output in outputs {
+                gpu.destroy_image(output);
+            }
+            layout.destroy(&test);
         }
+        gpu.destroy_image(diffuse_image);
+        gpu.destroy_image(specular_image);
+    }
+    for line in &worst_report {
+        println!("{line}");
     }
     test.finish();
 }
 
-/// A host colour image lucent can render into (and the test read back).
-fn output_image(test: &TestGpu, w: u32, h: u32, usage: vk::ImageUsageFlags) -> GpuImage {
-    test.gpu
-        .create_image(
-            &ImageDesc::color(w, h, vk::Format::R8G8B8A8_UNORM, usage),
-            "host output",
-        )
-        .unwrap()
-}
-
-fn expect_refused(result: lucent::Result<ImageState>, wanted: &[&str]) {
-    match result {
-        Err(LucentError::InvalidInput(message)) => {
-            for w in wanted {
-                assert!(message.contains(w), "'{message}' does not say '{w}'");
-            }
-        }
-        other => panic!("expected a refusal naming {wanted:?}, got {other:?}"),
-    }
-}
-
 #[test]
-fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() {
+fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_errors() {
     let test = TestGpu::new();
     let gpu = &test.gpu;
     let (w, h) = (64, 48);
-    let lucent = wrap(
-        &test,
-        EmbedOptions {
-            frames_in_flight: 2,
-            ..Default::default()
-        },
-    );
+    let lucent = wrap(&test, options(2));
     let scene = lucent.load_scene("smoke").unwrap();
-    let mut renderer =
-        SceneRenderer::new(&lucent, &scene, w, h, vk::Format::R8G8B8A8_UNORM).unwrap();
+    let mut renderer = built(&test, &lucent, |u| {
+        SceneRenderer::new(&lucent, u, &scene, w, h, vk::Format::R8G8B8A8_UNORM)
+    })
+    .unwrap();
     let full = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-    let image = output_image(&test, w, h, full);
-    let good = HostImage {
-        name: "back buffer".into(),
-        image: image.image,
-        view: image.view,
-        format: vk::Format::R8G8B8A8_UNORM,
-        extent: vk::Extent2D {
-            width: w,
-            height: h,
-        },
-        usage: full,
-        state: ImageState::UNDEFINED,
-    };
-    let cmd_result = |renderer: &mut SceneRenderer, output: &HostImage, slot, finals| {
-        let mut result = None;
-        gpu.submit_and_wait(|cmd| {
-            result = Some(renderer.record(&lucent, cmd, slot, &scene, output, finals));
+    let image = output_image(&test, w, h, vk::Format::R8G8B8A8_UNORM, full);
+    let good = described(&image, "back buffer", full)
+        .in_state(ImageState::UNDEFINED)
+        .then(ImageState::transfer_src());
+    let record = |renderer: &mut SceneRenderer, output: &HostImage, slot| {
+        recorded(&test, |cmd| {
+            renderer.record(&lucent, cmd, slot, &scene, output)
         })
-        .unwrap();
-        result.unwrap()
     };
     let with = |change: &dyn Fn(&mut HostImage)| {
         let mut image = good.clone();
         change(&mut image);
         image
     };
-    let transfer = ImageState::transfer_src();
-    // (what is wrong, the image as declared, slot, final state, what the error must say)
-    let cases: Vec<(&str, HostImage, usize, ImageState, Vec<&str>)> = vec![
+    // (what is wrong, the image as declared, slot, the kind of error, what it must say)
+    let image_fault =
+        |kind| move |e: &HostError| matches!(e, HostError::Image { kind: k, .. } if *k == kind);
+    type Case<'a> = (
+        &'a str,
+        HostImage,
+        usize,
+        Box<dyn Fn(&HostError) -> bool>,
+        Vec<&'a str>,
+    );
+    let cases: Vec<Case> = vec![
         (
             "no COLOR_ATTACHMENT usage",
             with(&|i| i.usage = vk::ImageUsageFlags::TRANSFER_SRC),
             0,
-            transfer,
+            Box::new(image_fault(ImageFault::Usage)),
             vec!["'back buffer'", "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT"],
         ),
         (
             "a final layout its usage does not allow (SHADER_READ_ONLY without SAMPLED)",
-            good.clone(),
+            with(&|i| i.final_state = Some(ImageState::fragment_sampled())),
             0,
-            ImageState::fragment_sampled(),
+            Box::new(image_fault(ImageFault::Layout)),
             vec!["'back buffer'", "SHADER_READ_ONLY_OPTIMAL", "SAMPLED"],
         ),
         (
@@ -505,51 +919,75 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() 
                 }
             }),
             0,
-            transfer,
+            Box::new(image_fault(ImageFault::Access)),
             vec!["'back buffer'", "TRANSFER_SRC_OPTIMAL", "cannot hold"],
         ),
         (
             "a depth layout on a colour image",
             with(&|i| i.state = ImageState::depth_attachment()),
             0,
-            transfer,
+            Box::new(image_fault(ImageFault::Layout)),
             vec!["'back buffer'", "DEPTH_STENCIL_ATTACHMENT_OPTIMAL"],
         ),
         (
             "an UNDEFINED final layout",
-            good.clone(),
+            with(&|i| i.final_state = Some(ImageState::UNDEFINED)),
             0,
-            ImageState::UNDEFINED,
+            Box::new(image_fault(ImageFault::Layout)),
             vec!["'back buffer'", "final"],
+        ),
+        (
+            "no final state for an image that comes in UNDEFINED",
+            with(&|i| i.final_state = None),
+            0,
+            Box::new(image_fault(ImageFault::Layout)),
+            vec!["'back buffer'", "HostImage::then"],
         ),
         (
             "half the frame's width",
             with(&|i| i.extent.width = w / 2),
             0,
-            transfer,
+            Box::new(image_fault(ImageFault::Size)),
             vec!["'back buffer'", "32x48"],
         ),
         (
             "another format than the renderer's",
             with(&|i| i.format = vk::Format::R16G16B16A16_SFLOAT),
             0,
-            transfer,
-            vec!["'back buffer'", "format"],
+            Box::new(|e: &HostError| matches!(e, HostError::Unsupported { .. })),
+            vec!["'back buffer'", "RGBA16F", "RGBA8"],
         ),
         (
             "a slot beyond the frames in flight",
             good.clone(),
             2,
-            transfer,
-            vec!["slot 2", "2 frame(s) in flight"],
+            Box::new(|e: &HostError| {
+                matches!(
+                    e,
+                    HostError::OutOfRange {
+                        what: "frame slot",
+                        index: 2,
+                        count: 2
+                    }
+                )
+            }),
+            vec!["frame slot 2"],
         ),
     ];
-    for (what, image, slot, finals, wanted) in cases {
+    for (what, image, slot, kind, wanted) in cases {
         println!("refused: {what}");
-        expect_refused(cmd_result(&mut renderer, &image, slot, finals), &wanted);
+        let e = host_error(record(&mut renderer, &image, slot));
+        assert!(kind(&e), "{what}: the wrong kind of error: {e:?}");
+        let message = e.to_string();
+        for w in wanted {
+            assert!(
+                message.contains(w),
+                "{what}: '{message}' does not say '{w}'"
+            );
+        }
     }
     // After all of that, a correct frame still renders (nothing half-recorded).
-    let state = cmd_result(&mut renderer, &good, 1, ImageState::transfer_src()).unwrap();
+    let state = record(&mut renderer, &good, 1).unwrap();
     assert_eq!(state, ImageState::transfer_src());
     let pixels = gpu
         .read_image(&image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
@@ -557,142 +995,487 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_errors_not_validation_errors() 
     assert!(pixels.chunks_exact(4).any(|p| p[0] != pixels[0]));
     renderer.destroy(&lucent);
 
-    // The post-process path checks its inputs the same way: a depth input without SAMPLED
-    // usage, a profile-ID image of the wrong format, an input set it was not built with.
+    // The SSS effect checks its description when it is built and its images each frame.
     let usage = vk::ImageUsageFlags::SAMPLED;
+    // Filled, so that each is in SHADER_READ_ONLY_OPTIMAL as described below.
+    let texels = (w * h) as usize;
     let colour = gpu
-        .create_image(
+        .upload_image(
             &ImageDesc::color(w, h, vk::Format::R16G16B16A16_SFLOAT, usage),
+            &[vec![0; texels * 8]],
             "c",
         )
         .unwrap();
     let depth = gpu
-        .create_image(&ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage), "d")
+        .upload_image(
+            &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage),
+            &[bytemuck::cast_slice(&vec![0.5f32; texels]).to_vec()],
+            "d",
+        )
         .unwrap();
     let ids = gpu
-        .create_image(&ImageDesc::color(w, h, vk::Format::R8_UNORM, usage), "i")
+        .upload_image(
+            &ImageDesc::color(w, h, vk::Format::R8_UINT, usage),
+            &[vec![7; texels]],
+            "i",
+        )
         .unwrap();
-    let diffuse_host = described(&colour, "lit diffuse", usage);
-    let depth_host = described(&depth, "scene depth", usage);
-    let ids_host = described(&ids, "sss mask", usage);
-    let skin = lucent::scene::material::SssProfile {
+    let skin = SssProfile {
         texturing: Texturing::Pre,
-        ..lucent::scene::material::SssProfile::preset("skin").unwrap()
+        ..SssProfile::preset("skin").unwrap()
     };
-    let desc = PostProcessDesc {
-        width: w,
-        height: h,
-        profiles: vec![skin],
-        knobs: Default::default(),
-        output_format: vk::Format::R16G16B16A16_SFLOAT,
+    let gbuffer = GBufferDesc::new(
+        w,
+        h,
+        DepthDesc::device(vk::Format::D32_SFLOAT),
+        DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+    )
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+    let desc = |gbuffer: GBufferDesc, materials: Vec<SssMaterial>| {
+        SssEffectDesc::new(gbuffer, materials, vk::Format::R8G8B8A8_UNORM)
     };
-    let refused = |inputs: PostProcessInputs<'_>, wanted: &[&str]| match PostProcessSss::new(
-        &lucent,
-        desc.clone(),
-        &[inputs],
-    ) {
-        Err(LucentError::InvalidInput(m)) => {
-            for w in wanted {
-                assert!(m.contains(w), "'{m}' does not say '{w}'");
-            }
-        }
-        Err(other) => panic!("expected InvalidInput, got {other}"),
-        Ok(post) => {
-            post.destroy(&lucent);
-            panic!("expected a refusal naming {wanted:?}");
-        }
+    let refused = |desc: SssEffectDesc| {
+        host_error(built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)))
     };
-    let unsampled_depth = HostImage {
-        usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        state: ImageState::depth_attachment(),
-        ..depth_host.clone()
-    };
-    refused(
-        PostProcessInputs {
-            diffuse: &diffuse_host,
-            specular: None,
-            depth: &unsampled_depth,
-            profile_ids: &ids_host,
-        },
-        &["'scene depth'", "VK_IMAGE_USAGE_SAMPLED_BIT"],
+    let material = |id| SssMaterial::new(id, skin.clone());
+    // No material IDs described.
+    let e = refused(desc(
+        GBufferDesc::new(
+            w,
+            h,
+            DepthDesc::device(vk::Format::D32_SFLOAT),
+            DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+        ),
+        vec![material(1)],
+    ));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input == "material IDs"),
+        "{e}"
     );
-    let colour_as_ids = HostImage {
-        name: "sss mask".into(),
-        ..diffuse_host.clone()
-    };
-    refused(
-        PostProcessInputs {
-            diffuse: &diffuse_host,
-            specular: None,
-            depth: &depth_host,
-            profile_ids: &colour_as_ids,
-        },
-        &["'sss mask'", "R8_UNORM"],
+    // A depth encoding its format cannot have.
+    let e = refused(desc(
+        changed(&gbuffer, |g| {
+            g.depth = DepthDesc::linear(vk::Format::D32_SFLOAT)
+        }),
+        vec![material(1)],
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "depth"),
+        "{e}"
     );
-    let lean = lucent::scene::material::SssProfile {
-        blur: Some(blur(&lucent::features::sss::lbb::LBB).name().into()),
-        ..lucent::scene::material::SssProfile::preset("skin").unwrap()
-    };
-    let good_inputs = PostProcessInputs {
-        diffuse: &diffuse_host,
-        specular: None,
-        depth: &depth_host,
-        profile_ids: &ids_host,
-    };
-    match PostProcessSss::new(
-        &lucent,
-        PostProcessDesc {
-            profiles: vec![lean],
-            ..desc.clone()
-        },
-        &[good_inputs],
-    ) {
-        Err(LucentError::InvalidInput(m)) => assert!(m.contains("LEAN"), "{m}"),
-        Err(other) => panic!("expected InvalidInput, got {other}"),
-        Ok(_) => panic!("a LEAN blur has no post-process path"),
+    // An ID bit field wider than 8 bits, an ID 0, the same ID twice, an ID its field cannot hold.
+    let e = refused(desc(
+        gbuffer
+            .clone()
+            .with_material_ids(IdDesc::bits(vk::Format::R8G8B8A8_UINT, 3, 0, 9)),
+        vec![material(1)],
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "material IDs"),
+        "{e}"
+    );
+    for (materials, says) in [
+        (vec![material(0)], "ID 0"),
+        (vec![material(3), material(3)], "each once"),
+    ] {
+        let e = refused(desc(gbuffer.clone(), materials));
+        assert!(
+            matches!(&e, HostError::Description { .. }) && e.to_string().contains(says),
+            "{e}"
+        );
     }
-    // Built for one set, recorded with another: refused before recording.
-    let mut post = PostProcessSss::new(&lucent, desc.clone(), &[good_inputs]).unwrap();
-    let other_depth = gpu
-        .create_image(&ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage), "d2")
-        .unwrap();
-    let other_depth_host = described(&other_depth, "other depth", usage);
-    let out = output_image(&test, w, h, full);
-    let out_host = HostImage {
-        format: vk::Format::R8G8B8A8_UNORM,
-        ..described(&out, "post output", full)
+    let e = refused(desc(
+        gbuffer
+            .clone()
+            .with_material_ids(IdDesc::bits(vk::Format::R8G8B8A8_UINT, 3, 6, 2)),
+        vec![material(5)],
+    ));
+    assert!(e.to_string().contains("does not fit"), "{e}");
+    // The LEAN blurs (LBB, bilateral), which blur a G-buffer a host does not have.
+    for lean_blur in [
+        &lucent::features::sss::lbb::LBB
+            as &'static dyn lucent::features::registry::TechniqueModule,
+        &lucent::features::sss::bilateral::BILATERAL,
+    ] {
+        let lean = SssProfile {
+            blur: Some(blur(lean_blur).name().into()),
+            ..skin.clone()
+        };
+        let e = refused(desc(gbuffer.clone(), vec![SssMaterial::new(1, lean)]));
+        assert!(
+            matches!(&e, HostError::Unsupported { .. }) && e.to_string().contains("LEAN"),
+            "{e}"
+        );
+    }
+    // Texturing after the scatter without an albedo image.
+    let post = SssProfile {
+        texturing: Texturing::Post,
+        ..skin.clone()
     };
-    let mut result = None;
-    gpu.submit_and_wait(|cmd| {
-        result = Some(post.record(
-            &lucent,
-            cmd,
-            0,
-            &PostProcessFrame {
-                camera: &scene.camera,
-                inputs: PostProcessInputs {
-                    depth: &other_depth_host,
-                    ..good_inputs
-                },
-                output: &out_host,
-                finals: PostProcessStates {
-                    inputs: ImageState::fragment_sampled(),
-                    output: ImageState::transfer_src(),
-                },
-            },
-        ));
+    let e = refused(desc(gbuffer.clone(), vec![SssMaterial::new(1, post)]));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input == "albedo"),
+        "{e}"
+    );
+    // Diffuse light without albedo and no albedo image.
+    let e = refused(desc(
+        changed(&gbuffer, |g| {
+            g.diffuse = DiffuseDesc::without_albedo(vk::Format::R16G16B16A16_SFLOAT)
+        }),
+        vec![material(1)],
+    ));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input == "albedo"),
+        "{e}"
+    );
+
+    // Built correctly, then given wrong images.
+    let mut effect = built(&test, &lucent, |u| {
+        SssEffect::new(&lucent, u, desc(gbuffer.clone(), vec![material(7)]))
     })
     .unwrap();
-    match result.unwrap() {
-        Err(LucentError::InvalidInput(m)) => assert!(m.contains("not one of the 1 set"), "{m}"),
-        other => panic!("expected a refusal, got {other:?}"),
-    }
-    post.destroy(&lucent);
+    let diffuse_host = described(&colour, "lit diffuse", usage);
+    let depth_host = described(&depth, "scene depth", usage);
+    let ids_host = described(&ids, "material IDs", usage);
+    let out = output_image(&test, w, h, vk::Format::R8G8B8A8_UNORM, full);
+    let out_host = described(&out, "sss output", full)
+        .in_state(ImageState::UNDEFINED)
+        .then(ImageState::transfer_src());
+    let camera = HostCamera::new(
+        scene.camera.view(),
+        scene.camera.projection(w as f32 / h as f32),
+    );
+    let mut frame = |images: SssImages<'_>, slot, view| {
+        let frame = SssFrame {
+            slot,
+            view,
+            camera,
+            images,
+            output: &out_host,
+        };
+        recorded(&test, |cmd| effect.record(&lucent, cmd, &frame))
+    };
+    let good_images = SssImages {
+        depth: &depth_host,
+        diffuse: &diffuse_host,
+        specular: None,
+        albedo: None,
+        material_ids: &ids_host,
+    };
+    let unsampled_depth = changed(&depth_host, |i| {
+        i.usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
+        i.state = ImageState::depth_attachment();
+    });
+    let e = host_error(frame(
+        SssImages {
+            depth: &unsampled_depth,
+            ..good_images
+        },
+        0,
+        0,
+    ));
+    assert!(
+        matches!(
+            e,
+            HostError::Image {
+                kind: ImageFault::Usage,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("'scene depth'") && e.to_string().contains("SAMPLED"),
+        "{e}"
+    );
+    let colour_as_ids = changed(&diffuse_host, |i| i.name = "material IDs".into());
+    let e = host_error(frame(
+        SssImages {
+            material_ids: &colour_as_ids,
+            ..good_images
+        },
+        0,
+        0,
+    ));
+    assert!(
+        matches!(e, HostError::Unsupported { .. }) && e.to_string().contains("R8UI"),
+        "{e}"
+    );
+    let e = host_error(frame(
+        SssImages {
+            specular: Some(&diffuse_host),
+            ..good_images
+        },
+        0,
+        0,
+    ));
+    assert!(
+        matches!(
+            e,
+            HostError::Image {
+                kind: ImageFault::Aliased,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = host_error(frame(good_images, 0, 1));
+    assert!(
+        matches!(
+            e,
+            HostError::OutOfRange {
+                what: "view",
+                index: 1,
+                count: 1
+            }
+        ),
+        "{e}"
+    );
+    let e = host_error(frame(good_images, 5, 0));
+    assert!(
+        matches!(
+            e,
+            HostError::OutOfRange {
+                what: "frame slot",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // And a correct frame after all of them.
+    frame(good_images, 1, 0).unwrap();
+    effect.destroy(&lucent);
     drop(lucent);
-    for image in [image, colour, depth, ids, other_depth, out] {
+    for image in [image, colour, depth, ids, out] {
         gpu.destroy_image(image);
     }
     // No validation error anywhere above.
+    test.finish();
+}
+
+/// Every call lucent makes through the host's device, counted where a host would see it.
+static SUBMITS: AtomicUsize = AtomicUsize::new(0);
+static WAITS: AtomicUsize = AtomicUsize::new(0);
+static REAL: OnceLock<(ash::DeviceFnV1_0, ash::DeviceFnV1_3)> = OnceLock::new();
+
+unsafe extern "system" fn counted_queue_submit(
+    queue: vk::Queue,
+    count: u32,
+    submits: *const vk::SubmitInfo<'_>,
+    fence: vk::Fence,
+) -> vk::Result {
+    SUBMITS.fetch_add(1, Ordering::SeqCst);
+    (REAL.get().unwrap().0.queue_submit)(queue, count, submits, fence)
+}
+
+unsafe extern "system" fn counted_queue_submit2(
+    queue: vk::Queue,
+    count: u32,
+    submits: *const vk::SubmitInfo2<'_>,
+    fence: vk::Fence,
+) -> vk::Result {
+    SUBMITS.fetch_add(1, Ordering::SeqCst);
+    (REAL.get().unwrap().1.queue_submit2)(queue, count, submits, fence)
+}
+
+unsafe extern "system" fn counted_queue_wait_idle(queue: vk::Queue) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    (REAL.get().unwrap().0.queue_wait_idle)(queue)
+}
+
+unsafe extern "system" fn counted_device_wait_idle(device: vk::Device) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    (REAL.get().unwrap().0.device_wait_idle)(device)
+}
+
+unsafe extern "system" fn counted_wait_for_fences(
+    device: vk::Device,
+    count: u32,
+    fences: *const vk::Fence,
+    wait_all: vk::Bool32,
+    timeout: u64,
+) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    (REAL.get().unwrap().0.wait_for_fences)(device, count, fences, wait_all, timeout)
+}
+
+/// The test's device with its submits and waits counted.
+fn counting_device(device: &ash::Device) -> ash::Device {
+    let real = REAL.get_or_init(|| (device.fp_v1_0().clone(), device.fp_v1_3().clone()));
+    let mut v1_0 = real.0.clone();
+    v1_0.queue_submit = counted_queue_submit;
+    v1_0.queue_wait_idle = counted_queue_wait_idle;
+    v1_0.device_wait_idle = counted_device_wait_idle;
+    v1_0.wait_for_fences = counted_wait_for_fences;
+    let mut v1_3 = real.1.clone();
+    v1_3.queue_submit2 = counted_queue_submit2;
+    ash::Device::from_parts_1_3(
+        device.handle(),
+        v1_0,
+        device.fp_v1_1().clone(),
+        device.fp_v1_2().clone(),
+        v1_3,
+    )
+}
+
+#[test]
+fn no_embed_path_submits_or_waits_on_the_hosts_device() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (96, 72);
+    let host = host_device(&test, counting_device(&gpu.device));
+    // SAFETY: the test context's handles (the device's functions counted, then forwarded).
+    let lucent = unsafe { Lucent::new(host, options(2)) }.unwrap();
+    let mut scene = lucent.load_scene("mixed").unwrap();
+    scene.name = "counted".into();
+    let before = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+    // A whole frame (translucency, SSS, shadows: every upload a scene has), and the SSS
+    // effect, each built and recorded twice into the test's own command buffers.
+    let mut renderer = built(&test, &lucent, |u| {
+        SceneRenderer::new(&lucent, u, &scene, w, h, vk::Format::R8G8B8A8_UNORM)
+    })
+    .unwrap();
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let image = output_image(&test, w, h, vk::Format::R8G8B8A8_UNORM, usage);
+    for slot in 0..2 {
+        let output = described(&image, "frame", usage)
+            .in_state(ImageState::UNDEFINED)
+            .then(ImageState::transfer_src());
+        recorded(&test, |cmd| {
+            renderer.record(&lucent, cmd, slot, &scene, &output)
+        })
+        .unwrap();
+    }
+    renderer.destroy(&lucent);
+    let sampled = vk::ImageUsageFlags::SAMPLED;
+    let colour = gpu
+        .create_image(
+            &ImageDesc::color(w, h, vk::Format::R16G16B16A16_SFLOAT, sampled),
+            "c",
+        )
+        .unwrap();
+    let depth = gpu
+        .create_image(
+            &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, sampled),
+            "d",
+        )
+        .unwrap();
+    let ids = gpu
+        .create_image(&ImageDesc::color(w, h, vk::Format::R8_UINT, sampled), "i")
+        .unwrap();
+    let out = output_image(&test, w, h, vk::Format::R16G16B16A16_SFLOAT, usage);
+    // Contents undefined is fine here: this test counts calls, not pixels. Each image is
+    // moved into the sampled state once, by the test, so the states declared below are true.
+    recorded(&test, |cmd| {
+        for image in [&colour, &depth, &ids] {
+            let range = image.desc.subresource_range();
+            let barrier = [vk::ImageMemoryBarrier2::default()
+                .old_layout(vk::ImageLayout::UNDEFINED)
+                .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+                .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+                .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
+                .image(image.image)
+                .subresource_range(range)];
+            // SAFETY: the test's recording command buffer and its own images.
+            unsafe {
+                gpu.device.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().image_memory_barriers(&barrier),
+                )
+            };
+        }
+    });
+    let gbuffer = GBufferDesc::new(
+        w,
+        h,
+        DepthDesc::device(vk::Format::D32_SFLOAT),
+        DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+    )
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+    let skin = SssProfile {
+        texturing: Texturing::Pre,
+        ..SssProfile::preset("skin").unwrap()
+    };
+    let mut effect = built(&test, &lucent, |u| {
+        SssEffect::new(
+            &lucent,
+            u,
+            SssEffectDesc::new(
+                gbuffer,
+                vec![SssMaterial::new(1, skin)],
+                vk::Format::R16G16B16A16_SFLOAT,
+            ),
+        )
+    })
+    .unwrap();
+    let camera = HostCamera::new(
+        scene.camera.view(),
+        scene.camera.projection(w as f32 / h as f32),
+    );
+    for slot in 0..2 {
+        let images = SssImages {
+            depth: &described(&depth, "depth", sampled),
+            diffuse: &described(&colour, "diffuse", sampled),
+            specular: None,
+            albedo: None,
+            material_ids: &described(&ids, "ids", sampled),
+        };
+        let output = described(&out, "out", usage)
+            .in_state(ImageState::UNDEFINED)
+            .then(ImageState::transfer_src());
+        recorded(&test, |cmd| {
+            effect.record(
+                &lucent,
+                cmd,
+                &SssFrame {
+                    slot,
+                    view: 0,
+                    camera,
+                    images,
+                    output: &output,
+                },
+            )
+        })
+        .unwrap();
+    }
+    effect.destroy(&lucent);
+    drop(lucent);
+    let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+    assert_eq!(
+        after, before,
+        "lucent submitted or waited on the host's device: (submits, waits) went from {before:?} \
+         to {after:?}"
+    );
+    for image in [image, colour, depth, ids, out] {
+        gpu.destroy_image(image);
+    }
+    test.finish();
+}
+
+#[test]
+fn renderers_move_between_threads_and_destroyed_ones_are_not_counted_as_leaks() {
+    let test = TestGpu::new();
+    let lucent = wrap(&test, options(1));
+    let scene = lucent.load_scene("smoke").unwrap();
+    let before = lucent::embed::leaked();
+    // Renderers can move to another thread (a host's loader thread builds them).
+    fn send<T: Send>(_: &T) {}
+    let renderer = built(&test, &lucent, |u| {
+        SceneRenderer::new(&lucent, u, &scene, 32, 24, vk::Format::R8G8B8A8_UNORM)
+    })
+    .unwrap();
+    send(&renderer);
+    let renderer = std::thread::spawn(move || renderer).join().unwrap();
+    renderer.destroy(&lucent);
+    // (A renderer dropped without `destroy` raises `leaked()` and logs an error naming it:
+    // the unit test in src/embed/uploads.rs; here its allocations would fail the context's
+    // own leak report.)
+    assert_eq!(
+        lucent::embed::leaked(),
+        before,
+        "a destroyed renderer is not a leak"
+    );
+    drop(lucent);
     test.finish();
 }
 
@@ -724,10 +1507,14 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
             pipeline_cache: Some(cache),
             allocator: Some(allocator.clone()),
             cache_dir: Some(common::temp_dir("embed-cache")),
+            ..Default::default()
         },
     );
     let scene = lucent.load_scene("cubes").unwrap();
-    let renderer = SceneRenderer::new(&lucent, &scene, 96, 64, vk::Format::R8G8B8A8_UNORM).unwrap();
+    let renderer = built(&test, &lucent, |u| {
+        SceneRenderer::new(&lucent, u, &scene, 96, 64, vk::Format::R8G8B8A8_UNORM)
+    })
+    .unwrap();
     let while_alive = allocator.lock().unwrap().generate_report();
     assert!(
         while_alive.allocations.len() > 5,
@@ -758,6 +1545,183 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
         gpu.device.destroy_pipeline_cache(cache, None);
     }
     drop(allocator);
+    test.finish();
+}
+
+#[test]
+fn two_views_per_frame_each_equal_their_view_alone() {
+    // Split screen or stereo: two cameras recorded into one frame's command buffer, for the
+    // same slot, each with its own images, each as it would be alone.
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (160, 120);
+    let mut scene = lucent::bake::scene::load_scene_baked("skin").unwrap();
+    for object in &mut scene.objects {
+        if let Some(p) = &mut object.material.sss {
+            p.units_per_mm *= 8.0;
+        }
+    }
+    let views: Vec<lucent::scene::Scene> = (0..2)
+        .map(|k| {
+            let mut s = scene.clone();
+            s.camera.eye.x += 0.6 * (k as f32 * 2.0 - 1.0);
+            s
+        })
+        .collect();
+    // Each view's G-buffer and lit light from lucent's own frame.
+    let mut inputs = Vec::new();
+    for view in &views {
+        let mut settings = FrameSettings {
+            technique: Technique::Only(&lucent::features::sss::separable::SEPARABLE),
+            export_gbuffer: true,
+            export_lit: true,
+            ..FrameSettings::new(w, h)
+        };
+        settings.sss.texturing = Some(Texturing::Pre);
+        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, view, settings).unwrap();
+        let images = renderer.render_once(gpu).unwrap();
+        let lit = renderer.read_lit(gpu).unwrap();
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        inputs.push((images.gbuffer.unwrap(), lit));
+    }
+    let sampled = vk::ImageUsageFlags::SAMPLED;
+    let upload = |format, bytes: Vec<u8>, depth: bool| {
+        let desc = if depth {
+            ImageDesc::depth(w, h, format, sampled)
+        } else {
+            ImageDesc::color(w, h, format, sampled)
+        };
+        gpu.upload_image(&desc, &[bytes], "view input").unwrap()
+    };
+    let images: Vec<[GpuImage; 4]> = inputs
+        .iter()
+        .map(|(gb, lit)| {
+            [
+                upload(
+                    vk::Format::D32_SFLOAT,
+                    bytemuck::cast_slice(&gb.depth).to_vec(),
+                    true,
+                ),
+                upload(
+                    vk::Format::R32G32B32A32_SFLOAT,
+                    f32_bytes(&lit.diffuse),
+                    false,
+                ),
+                upload(
+                    vk::Format::R32G32B32A32_SFLOAT,
+                    f32_bytes(&lit.specular),
+                    false,
+                ),
+                upload(
+                    vk::Format::R8_UINT,
+                    gb.sss.as_ref().unwrap().iter().map(|&v| v as u8).collect(),
+                    false,
+                ),
+            ]
+        })
+        .collect();
+    let profile = SssProfiles::new(
+        &scene,
+        Some(blur(&lucent::features::sss::separable::SEPARABLE)),
+        None,
+        Some(Texturing::Pre),
+        &lucent::features::registry::blur_of,
+    )
+    .unwrap()
+    .unwrap()
+    .profiles;
+    let materials: Vec<SssMaterial> = profile
+        .iter()
+        .enumerate()
+        .map(|(i, (p, b))| {
+            let mut p = p.clone();
+            p.blur = Some(b.name().into());
+            SssMaterial::new(i as u8 + 1, p)
+        })
+        .collect();
+    let gbuffer = GBufferDesc::new(
+        w,
+        h,
+        DepthDesc::device(vk::Format::D32_SFLOAT),
+        DiffuseDesc::with_albedo(vk::Format::R32G32B32A32_SFLOAT),
+    )
+    .with_specular(vk::Format::R32G32B32A32_SFLOAT)
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT))
+    .with_metres_per_unit(1.0 / (1000.0 * profile[0].0.units_per_mm));
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let render = |views_per_frame: usize, which: &[usize]| -> Vec<Vec<u8>> {
+        let lucent = wrap(&test, options(1));
+        let desc = SssEffectDesc::new(
+            gbuffer.clone(),
+            materials.clone(),
+            vk::Format::R16G16B16A16_SFLOAT,
+        )
+        .with_views_per_frame(views_per_frame);
+        let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
+        let outputs: Vec<GpuImage> = which
+            .iter()
+            .map(|_| output_image(&test, w, h, vk::Format::R16G16B16A16_SFLOAT, usage))
+            .collect();
+        recorded(&test, |cmd| {
+            for (index, (&k, output)) in which.iter().zip(&outputs).enumerate() {
+                let [depth, diffuse, specular, ids] = &images[k];
+                let aspect = w as f32 / h as f32;
+                let frame_images = SssImages {
+                    depth: &described(depth, "depth", sampled),
+                    diffuse: &described(diffuse, "diffuse", sampled),
+                    specular: Some(&described(specular, "specular", sampled)),
+                    albedo: None,
+                    material_ids: &described(ids, "ids", sampled),
+                };
+                effect
+                    .record(
+                        &lucent,
+                        cmd,
+                        &SssFrame {
+                            slot: 0,
+                            view: index,
+                            camera: HostCamera::new(
+                                views[k].camera.view(),
+                                views[k].camera.projection(aspect),
+                            ),
+                            images: frame_images,
+                            output: &described(output, "view output", usage)
+                                .in_state(ImageState::UNDEFINED)
+                                .then(ImageState::transfer_src()),
+                        },
+                    )
+                    .unwrap();
+            }
+        });
+        let out: Vec<Vec<u8>> = outputs
+            .iter()
+            .map(|o| {
+                gpu.read_image(o, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                    .unwrap()
+            })
+            .collect();
+        effect.destroy(&lucent);
+        drop(lucent);
+        for o in outputs {
+            gpu.destroy_image(o);
+        }
+        out
+    };
+    let both = render(2, &[0, 1]);
+    let alone = [render(1, &[0]).remove(0), render(1, &[1]).remove(0)];
+    assert_ne!(alone[0], alone[1], "the two views differ");
+    for k in 0..2 {
+        assert_eq!(
+            both[k], alone[k],
+            "view {k} recorded beside the other differs from alone"
+        );
+    }
+    for set in images {
+        for image in set {
+            gpu.destroy_image(image);
+        }
+    }
     test.finish();
 }
 
@@ -841,13 +1805,7 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
     let test = TestGpu::new();
     let gpu = &test.gpu;
     let (w, h) = (120, 90);
-    let lucent = wrap(
-        &test,
-        EmbedOptions {
-            frames_in_flight: 3,
-            ..Default::default()
-        },
-    );
+    let lucent = wrap(&test, options(3));
     let mut scene = host_built_scene();
     lucent.prepare_scene(&mut scene).unwrap();
     assert!(
@@ -878,35 +1836,23 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
         .collect();
     assert_ne!(expected[0], expected[2], "the cameras differ");
 
-    let mut renderer =
-        SceneRenderer::new(&lucent, &scene, w, h, vk::Format::R8G8B8A8_UNORM).unwrap();
+    let mut renderer = built(&test, &lucent, |u| {
+        SceneRenderer::new(&lucent, u, &scene, w, h, vk::Format::R8G8B8A8_UNORM)
+    })
+    .unwrap();
     let desc = &renderer.renderer().desc;
     assert!(desc.sss.is_some() && desc.translucency.is_some() && desc.shadows.is_some());
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-    let images: Vec<GpuImage> = (0..3).map(|_| output_image(&test, w, h, usage)).collect();
+    let images: Vec<GpuImage> = (0..3)
+        .map(|_| output_image(&test, w, h, vk::Format::R8G8B8A8_UNORM, usage))
+        .collect();
     // Recorded into three command buffers, submitted back to back, waited for once.
     submit_back_to_back(gpu, 3, |k, cmd| {
-        let output = HostImage {
-            name: format!("frame {k}"),
-            image: images[k].image,
-            view: images[k].view,
-            format: vk::Format::R8G8B8A8_UNORM,
-            extent: vk::Extent2D {
-                width: w,
-                height: h,
-            },
-            usage,
-            state: ImageState::UNDEFINED,
-        };
+        let output = described(&images[k], &format!("frame {k}"), usage)
+            .in_state(ImageState::UNDEFINED)
+            .then(ImageState::transfer_src());
         renderer
-            .record(
-                &lucent,
-                cmd,
-                k,
-                &scenes[k],
-                &output,
-                ImageState::transfer_src(),
-            )
+            .record(&lucent, cmd, k, &scenes[k], &output)
             .unwrap();
     });
     for (k, image) in images.iter().enumerate() {

@@ -74,7 +74,7 @@ fn run_chain(options: CompileOptions) -> (Vec<u8>, usize) {
     let shared_slots = plan.slots.iter().filter(|s| s.resources.len() > 1).count();
     let shaders = ShaderCompiler::shipped().unwrap();
     let cache = PipelineCache::load(&gpu.device, None).unwrap();
-    let exe = Executable::new(&gpu, plan, execs, &shaders, cache.handle).unwrap();
+    let exe = Executable::new(&gpu, plan, execs, &shaders, cache.handle, 1).unwrap();
     let mut runner = FrameRunner::new(&gpu, exe.plan.physical.len()).unwrap();
     for _ in 0..2 {
         let timing = runner.run_frame(&gpu, &exe).unwrap();

@@ -669,7 +669,7 @@ fn frames_in_flight(
         renderer.update_slot(&scenes[slot], slot).unwrap();
         let target = &targets[slot];
         renderer
-            .bind_target(gpu, target.image, target.view)
+            .bind_target(gpu, slot, target.image, target.view)
             .unwrap();
         renderer.record(gpu, cmd, slot, None).unwrap();
     });

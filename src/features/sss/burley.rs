@@ -316,7 +316,7 @@ impl SssBlurTechnique for BurleyChain {
         };
         let mut gathered = graph.create_image(&chain.image_name("gathered"), gathered_info);
         let name = format!("{}burley", chain.prefix);
-        let mut pass = sss_pass(graph, &name, GATHER_FRAGMENT, scene, constants);
+        let mut pass = sss_pass(graph, inputs, &name, GATHER_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
         for image in [inputs.diffuse, inputs.depth, inputs.profile_ids] {
             pass.sample_with(image, vk::Filter::NEAREST);
@@ -338,7 +338,7 @@ impl SssBlurTechnique for BurleyChain {
 
         // Resolve: the 3x3 average of the nine spiral rotations, composed.
         let name = format!("{}burley resolve", chain.prefix);
-        let mut pass = sss_pass(graph, &name, RESOLVE_FRAGMENT, scene, constants);
+        let mut pass = sss_pass(graph, inputs, &name, RESOLVE_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
         let mut reads = vec![
             &gathered,

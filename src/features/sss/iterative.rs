@@ -188,6 +188,7 @@ pub(super) fn chain_passes(
     };
     let mut pass = sss_pass(
         graph,
+        inputs,
         &format!("{}{name}", chain.prefix),
         fragment,
         scene,
@@ -241,7 +242,7 @@ fn blur_pass<'g>(
     } else {
         vk::Filter::LINEAR
     };
-    let mut pass = sss_pass(graph, name, BLUR_FRAGMENT, scene, constants);
+    let mut pass = sss_pass(graph, inputs, name, BLUR_FRAGMENT, scene, constants);
     pass.sample_with(colors[0], filter);
     for lean in &colors[1..] {
         pass.graph().sample(lean);

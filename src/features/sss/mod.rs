@@ -253,6 +253,75 @@ pub struct SssProfiles {
     pub transmission: Vec<Option<transmission::SssTransmission>>,
     /// Per scene object: its profile ID (0: the object does not scatter).
     pub object_ids: Vec<u8>,
+    /// How the passes read a pixel's profile from the ID image: lucent's own (`R8_UNORM`,
+    /// the profile number / 255) or a host's encoding and ID-to-profile map ([`IdMap`]).
+    pub id_map: IdMap,
+}
+
+/// How the SSS passes find a pixel's profile in the profile ID image.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub enum IdMap {
+    /// lucent's own G-buffer: `R8_UNORM`, the profile number `k` stored as `k / 255`.
+    #[default]
+    Lucent,
+    /// A host's material IDs (`LUCENT_SSS_HOST_IDS`): a bit field of one channel of the
+    /// image, and the profile number of each ID.
+    Host(HostIdMap),
+}
+
+/// A host's material IDs as the SSS passes decode them (built by `lucent::embed` from the
+/// host's description of its ID image).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct HostIdMap {
+    /// The image is read as unsigned integers (a UINT format or a stencil aspect; define
+    /// `LUCENT_SSS_IDS_UINT`), else as UNORM floats turned back into their integers.
+    pub uint: bool,
+    /// The channel holding the IDs (0 = R).
+    pub channel: u32,
+    /// The ID's bit field: `(value >> shift) & mask`.
+    pub shift: u32,
+    /// Its mask (at most 8 bits: IDs 0 to 255).
+    pub mask: u32,
+    /// For UNORM channels, the largest integer (`2^bits - 1`).
+    pub unorm_max: u32,
+    /// The profile number (1 to the number of profiles; 0: none) of each host ID 0 to 255.
+    pub profile_of: Vec<u8>,
+}
+
+impl IdMap {
+    /// The defines the passes reading the ID image are built with.
+    pub fn defines(&self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            IdMap::Lucent => &[],
+            IdMap::Host(h) if h.uint => {
+                &[("LUCENT_SSS_HOST_IDS", "1"), ("LUCENT_SSS_IDS_UINT", "1")]
+            }
+            IdMap::Host(_) => &[("LUCENT_SSS_HOST_IDS", "1")],
+        }
+    }
+
+    /// The profile table's `id_decode` and `id_profiles` rows.
+    fn rows(&self) -> ([u32; 4], [[u32; 4]; 16]) {
+        let mut profiles = [[0u32; 4]; 16];
+        let mut put = |id: usize, profile: u8| {
+            profiles[id / 16][(id / 4) % 4] |= u32::from(profile) << (8 * (id % 4));
+        };
+        match self {
+            IdMap::Lucent => {
+                // Unused by lucent's own passes; the identity, for completeness.
+                for id in 0..MAX_SSS_PROFILES {
+                    put(id, id as u8);
+                }
+                ([0, 0, 0xff, 255], profiles)
+            }
+            IdMap::Host(h) => {
+                for (id, &p) in h.profile_of.iter().enumerate().take(256) {
+                    put(id, p);
+                }
+                ([h.channel, h.shift, h.mask, h.unorm_max], profiles)
+            }
+        }
+    }
 }
 
 impl SssProfiles {
@@ -327,6 +396,7 @@ impl SssProfiles {
             profiles,
             transmission: transmissions,
             object_ids,
+            id_map: IdMap::Lucent,
         }))
     }
 
@@ -386,7 +456,10 @@ impl SssProfiles {
             steps: [[[0.0; 4]; 2]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
             gaussians: [[0.0; 4]; MAX_SSS_PROFILES * MAX_SSS_STEPS],
             medium: [[0.0; 4]; MAX_SSS_PROFILES * transmission::MEDIUM_ROWS],
+            id_decode: [0; 4],
+            id_profiles: [[0; 4]; 16],
         };
+        (table.id_decode, table.id_profiles) = self.id_map.rows();
         for (i, (profile, blur)) in self.profiles.iter().enumerate() {
             let id = i + 1;
             // Rows of zeros: no medium; the transmission's (mm per unit 0) also with
@@ -465,6 +538,10 @@ pub struct ProfileTableGpu {
     /// diffuse transmission ([`transmission::SssTransmission::rows`]) and reflectance
     /// ([`transmission::SssTransmission::reflectance_rows`]); zero where the profile has none.
     pub medium: [[f32; 4]; MAX_SSS_PROFILES * transmission::MEDIUM_ROWS],
+    /// A host's ID decode ([`IdMap::Host`]): channel, shift, mask, UNORM maximum.
+    pub id_decode: [u32; 4],
+    /// A host's ID-to-profile map, a byte per ID 0 to 255.
+    pub id_profiles: [[u32; 4]; 16],
 }
 
 /// Bytes of [`ProfileTableGpu`] (the per-frame buffer's profile region).
@@ -555,6 +632,8 @@ pub struct SssInputs<'a> {
     /// The lit diffuse's alpha holds linear depth for the separable chain's taps (the lighting
     /// pass wrote it: [`SssProfiles::depth_in_alpha`]); otherwise the taps read `depth`.
     pub depth_in_alpha: bool,
+    /// How the passes read `profile_ids` ([`IdMap::defines`] of the profiles' map).
+    pub id_defines: &'static [(&'static str, &'static str)],
 }
 
 /// The G-buffer images LCB's and LBB's chains read besides the lit light.
@@ -647,9 +726,11 @@ struct BlurConstants {
 }
 
 /// Starts an SSS pass: the frame uniforms and the profile table bound first (0: frame, 1:
-/// profiles), `constants` pushed before it draws.
+/// profiles), `constants` pushed before it draws, and the defines that say how its profile
+/// IDs are read ([`IdMap::defines`], from `inputs`).
 fn sss_pass<'g>(
     graph: &'g mut RenderGraph,
+    inputs: &SssInputs<'_>,
     name: &str,
     fragment: &'static str,
     scene: Option<&Arc<SceneGpu>>,
@@ -658,8 +739,111 @@ fn sss_pass<'g>(
     let mut pass = FullscreenPass::new(graph, name, fragment, scene);
     pass.per_frame(&FRAME)
         .per_frame(&tables::PROFILES)
-        .push_constants(&constants);
+        .push_constants(&constants)
+        .defines(inputs.id_defines);
     pass
+}
+
+/// The host albedo pass's shader (lucent::embed).
+const HOST_ALBEDO_FRAGMENT: &str = "sss/host_albedo.frag";
+
+/// The host albedo pass's defines: the ID decode and whether the host's light holds the albedo.
+fn host_albedo_defines(
+    id_defines: &'static [(&'static str, &'static str)],
+    included: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut defines = id_defines.to_vec();
+    if included {
+        defines.push(("LUCENT_SSS_HOST_ALBEDO_INCLUDED", "1"));
+    }
+    defines
+}
+
+/// A host's lit diffuse made into the light the chains expect (lucent::embed): the albedo in it
+/// as each pixel's profile asks before the blur (`glsl/sss/host_albedo.frag`), from a host's
+/// light that holds all of the albedo (`included`) or none. One fullscreen pass, declared only
+/// when the host's light and the profiles' texturing differ; returns its RGBA16F result.
+pub fn host_albedo_pass(
+    graph: &mut RenderGraph,
+    inputs: &SssInputs<'_>,
+    albedo: &Handle<Image>,
+    included: bool,
+    width: u32,
+    height: u32,
+    scene: Option<&Arc<SceneGpu>>,
+) -> Handle<Image> {
+    let mut out = graph.create_image(
+        "sss.host diffuse",
+        crate::graph::ImageInfo {
+            width,
+            height,
+            format: crate::features::lighting::HDR_FORMAT,
+        },
+    );
+    let mut pass = FullscreenPass::new(graph, "sss albedo in", HOST_ALBEDO_FRAGMENT, scene);
+    pass.per_frame(&FRAME)
+        .per_frame(&tables::PROFILES)
+        .sample(inputs.diffuse)
+        .sample(albedo)
+        .sample(inputs.profile_ids)
+        .defines(&host_albedo_defines(inputs.id_defines, included))
+        .color(&mut out, crate::graph::LoadOp::DontCare);
+    pass.finish();
+    out
+}
+
+/// Defines of the permutations a host's frame cannot have: the LEAN G-buffer's, the lighting
+/// pass's linear depth in the diffuse's alpha, shadowed LEAN specular.
+const LUCENT_ONLY_DEFINES: [&str; 3] = [
+    "LUCENT_SSS_LEAN",
+    "LUCENT_SSS_DEPTH_IN_ALPHA",
+    "LUCENT_SHADOWS",
+];
+
+/// Adds, for every SSS pass permutation in `out` a host's frame can have, its two host-ID
+/// variants ([`IdMap::defines`]: UNORM and unsigned IDs), for the shipped SPIR-V.
+pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
+    let host: Vec<crate::backend::shader::PipelineShaders> = out
+        .iter()
+        .filter(|p| p.fragment.starts_with("sss/") && !p.fragment.ends_with("lean_brdf.frag"))
+        .filter(|p| {
+            !p.defines
+                .iter()
+                .any(|(name, _)| LUCENT_ONLY_DEFINES.contains(&name.as_str()))
+        })
+        .cloned()
+        .collect();
+    for uint in [false, true] {
+        let ids: &'static [(&'static str, &'static str)] = if uint {
+            &[("LUCENT_SSS_HOST_IDS", "1"), ("LUCENT_SSS_IDS_UINT", "1")]
+        } else {
+            &[("LUCENT_SSS_HOST_IDS", "1")]
+        };
+        for included in [false, true] {
+            out.push(crate::backend::shader::PipelineShaders::new(
+                "fullscreen.vert",
+                HOST_ALBEDO_FRAGMENT,
+                &host_albedo_defines(ids, included),
+            ));
+        }
+        let map = IdMap::Host(HostIdMap {
+            uint,
+            channel: 0,
+            shift: 0,
+            mask: 0xff,
+            unorm_max: 255,
+            profile_of: Vec::new(),
+        });
+        for p in &host {
+            let mut p = p.clone();
+            p.defines.extend(
+                map.defines()
+                    .iter()
+                    .map(|(n, v)| (n.to_string(), v.to_string())),
+            );
+            out.push(p);
+        }
+    }
 }
 
 /// The tile rectangles of `chain` in the recorded frame (`None`: the whole screen).

@@ -80,6 +80,7 @@ pub(super) fn chain_passes(
     reads.extend(lean.map(|l| l.view_plane));
     let mut pass = blur_pass(
         graph,
+        inputs,
         &format!("{}horizontal blur", chain.prefix),
         scene,
         chain,
@@ -129,6 +130,7 @@ pub(super) fn chain_passes(
     }
     let mut pass = blur_pass(
         graph,
+        inputs,
         &format!("{}vertical blur", chain.prefix),
         scene,
         chain,
@@ -160,6 +162,7 @@ pub(super) fn chain_passes(
     reads.extend(inputs.albedo);
     let mut pass = blur_pass(
         graph,
+        inputs,
         &format!("{}upsample", chain.prefix),
         scene,
         chain,
@@ -177,8 +180,10 @@ pub(super) fn chain_passes(
 /// linear, the rest nearest), pushing the blur `direction`. It draws only where objects of its
 /// chain (and their blur's reach) can be, at half resolution in halved rectangles; a composing
 /// pass draws its pass-through variant on the other rectangles.
+#[allow(clippy::too_many_arguments)]
 fn blur_pass<'g>(
     graph: &'g mut RenderGraph,
+    inputs: &SssInputs<'_>,
     name: &str,
     scene: Option<&Arc<SceneGpu>>,
     chain: &Chain,
@@ -189,7 +194,7 @@ fn blur_pass<'g>(
     let constants = BlurConstants {
         step: [direction[0], direction[1], 0.0, chain.index as f32],
     };
-    let mut pass = sss_pass(graph, name, shape.fragment(), scene, constants);
+    let mut pass = sss_pass(graph, inputs, name, shape.fragment(), scene, constants);
     pass.per_frame(&super::tables::KERNELS);
     for (i, h) in reads.iter().enumerate() {
         let filter = if i == 0 && !chain.blur.bilateral() {

@@ -1,0 +1,773 @@
+//! [`SssEffect`]: lucent's screen-space SSS (the control, the separable blur, 2-D Burley)
+//! inserted into a host's frame, on the host's own G-buffer ([`GBufferDesc`]). The bilateral
+//! blur, LCB and LBB blur lucent's LEAN G-buffer, which a host's does not carry: refused.
+//!
+//! The host renders its G-buffer and lighting as usual, keeping the lit diffuse apart (and,
+//! ideally, the specular), and writes a material ID per pixel. lucent blurs the diffuse of
+//! every pixel whose ID has a profile, following the depth, adds the specular back and
+//! writes the result into a host image; pixels without a profile keep their light. The passes
+//! are the ones lucent's own frames run (`features::sss`): the host's encodings reach them as
+//! shader permutations and per-frame constants (the ID decode, the depth decode of the host's
+//! projection), not as copies into lucent's layout. The one exception: when the host's
+//! diffuse holds its albedo differently from how a profile wants it before the blur
+//! ([`DiffuseAlbedo`] against [`Texturing`]), one fullscreen pass puts it right first
+//! (`sss albedo in`).
+//!
+//! Images are bound when a frame records, into that frame's slot and view: any number of
+//! different images over time, a view recreated between frames (even with a reused handle
+//! value) is simply the next frame's. Several views per frame (split screen, stereo) each
+//! have their own slot of parameters and descriptors ([`SssEffectDesc::views_per_frame`]).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
+use super::image::{check_image, record_transition, HostImage, Role};
+use super::uploads::LeakGuard;
+use super::{Lucent, Uploads};
+use crate::backend::access::Access;
+use crate::backend::format::{format_info, format_name};
+use crate::error::{HostError, ImageFault};
+use crate::features::registry;
+use crate::features::sss::{self, IdMap, SssKnobs, SssProfiles};
+use crate::gpu_scene::{FrameUniforms, SceneGpu, SceneUpload, SlotTiles, FRAME};
+use crate::graph::{
+    Executable, Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
+};
+use crate::scene::material::{SssProfile, Texturing};
+use crate::scene::{Camera, Scene};
+use crate::Result;
+
+/// Most views one frame may record ([`SssEffectDesc::views_per_frame`]).
+pub const MAX_VIEWS_PER_FRAME: usize = 4;
+
+/// One scattering material of the host: its ID in the host's material ID image and the
+/// profile its pixels are blurred with.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SssMaterial {
+    /// The host's ID (1 to 255; 0 is taken to mean "does not scatter" and cannot have one).
+    pub id: u8,
+    /// Its profile: the Gaussians in millimetres (its `units_per_mm` is set from the
+    /// G-buffer's [`GBufferDesc::metres_per_unit`]), the blur ([`SssProfile::blur`]: the
+    /// control, separable or Burley; the bilateral blur, LCB and LBB blur lucent's LEAN
+    /// G-buffer, which a host does not have) and where the albedo goes
+    /// ([`SssProfile::texturing`]).
+    pub profile: SssProfile,
+}
+
+impl SssMaterial {
+    /// Material `id` scattering with `profile`.
+    pub fn new(id: u8, profile: SssProfile) -> Self {
+        Self { id, profile }
+    }
+}
+
+/// What an [`SssEffect`] is built for.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct SssEffectDesc {
+    /// The host's G-buffer (it must describe its material IDs).
+    pub gbuffer: GBufferDesc,
+    /// The scattering materials (1 to 31 of them).
+    pub materials: Vec<SssMaterial>,
+    /// The blurs' knobs (samples, kernel shape, precision, half resolution...).
+    pub knobs: SssKnobs,
+    /// The output's format (an RGB(A) float, UNORM or SRGB colour format).
+    pub output_format: vk::Format,
+    /// Views recorded per frame (1 to [`MAX_VIEWS_PER_FRAME`]): each view of a frame has its
+    /// own camera and images.
+    pub views_per_frame: usize,
+}
+
+impl SssEffectDesc {
+    /// The effect over `gbuffer` for `materials`, writing `output_format`, one view a frame,
+    /// the default knobs.
+    pub fn new(
+        gbuffer: GBufferDesc,
+        materials: Vec<SssMaterial>,
+        output_format: vk::Format,
+    ) -> Self {
+        Self {
+            gbuffer,
+            materials,
+            knobs: SssKnobs::default(),
+            output_format,
+            views_per_frame: 1,
+        }
+    }
+
+    /// With these knobs.
+    pub fn with_knobs(mut self, knobs: SssKnobs) -> Self {
+        self.knobs = knobs;
+        self
+    }
+
+    /// With this many views per frame.
+    pub fn with_views_per_frame(mut self, views: usize) -> Self {
+        self.views_per_frame = views;
+        self
+    }
+}
+
+/// The host's images for one view of one frame, each with its current and final state.
+#[derive(Clone, Copy, Debug)]
+pub struct SssImages<'a> {
+    /// The depth image (a depth format's view of its depth aspect, or linear depth).
+    pub depth: &'a HostImage,
+    /// The lit diffuse light.
+    pub diffuse: &'a HostImage,
+    /// The lit specular, when the description has it.
+    pub specular: Option<&'a HostImage>,
+    /// The albedo, when the description has it.
+    pub albedo: Option<&'a HostImage>,
+    /// The material IDs (for stencil bits: a view of the depth-stencil image's stencil
+    /// aspect; it may be the depth image's image).
+    pub material_ids: &'a HostImage,
+}
+
+/// One view of one frame: what [`SssEffect::record`] reads and writes.
+#[derive(Clone, Copy, Debug)]
+pub struct SssFrame<'a> {
+    /// The frame-in-flight slot (0 to the frames in flight of the [`Lucent`]).
+    pub slot: usize,
+    /// The view within the frame (0 to [`SssEffectDesc::views_per_frame`]).
+    pub view: usize,
+    /// The camera the G-buffer was rendered with.
+    pub camera: HostCamera,
+    /// The G-buffer's images.
+    pub images: SssImages<'a>,
+    /// The image the result is written into (a colour attachment of the output format).
+    pub output: &'a HostImage,
+}
+
+/// The graph's imports, by input.
+#[derive(Clone, Copy, Debug)]
+struct Imports {
+    depth: ResourceId,
+    diffuse: ResourceId,
+    specular: Option<ResourceId>,
+    albedo: Option<ResourceId>,
+    material_ids: ResourceId,
+    output: ResourceId,
+}
+
+/// Screen-space SSS over a host's G-buffer (see the module docs).
+pub struct SssEffect {
+    executable: Option<Executable>,
+    scene_gpu: Option<Arc<SceneGpu>>,
+    imports: Imports,
+    desc: SssEffectDesc,
+    frames_in_flight: usize,
+    guard: Option<LeakGuard>,
+}
+
+/// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
+/// pixel's light must hold a different part of the albedo than the host's light does.
+fn needs_albedo_pass(albedo: DiffuseAlbedo, profiles: &[SssProfile]) -> bool {
+    match albedo {
+        // Pixels that do not scatter need the albedo in their light too.
+        DiffuseAlbedo::Excluded => true,
+        DiffuseAlbedo::Included => profiles.iter().any(|p| p.texturing != Texturing::Pre),
+    }
+}
+
+impl SssEffect {
+    /// Builds the effect for `desc`. The profile tables' upload is recorded into `uploads`
+    /// (the host submits it before the first frame); nothing is submitted or waited for.
+    /// Everything about the description is checked here.
+    pub fn new(lucent: &Lucent, uploads: &mut Uploads, desc: SssEffectDesc) -> Result<Self> {
+        let gbuffer = &desc.gbuffer;
+        gbuffer.check()?;
+        let ids = gbuffer.material_ids.ok_or_else(|| HostError::Missing {
+            input: "material IDs".into(),
+            needed_by: "screen-space SSS picks each pixel's profile by its material ID \
+                        (GBufferDesc::with_material_ids)"
+                .into(),
+        })?;
+        if !(1..=MAX_VIEWS_PER_FRAME).contains(&desc.views_per_frame) {
+            return Err(HostError::Description {
+                field: "views_per_frame".into(),
+                problem: format!(
+                    "{} views; 1 to {MAX_VIEWS_PER_FRAME} are supported",
+                    desc.views_per_frame
+                ),
+            }
+            .into());
+        }
+        if desc.materials.is_empty() || desc.materials.len() >= sss::MAX_SSS_PROFILES {
+            return Err(HostError::Description {
+                field: "materials".into(),
+                problem: format!(
+                    "{} scattering materials; 1 to {} are supported",
+                    desc.materials.len(),
+                    sss::MAX_SSS_PROFILES - 1
+                ),
+            }
+            .into());
+        }
+        check_output_format(desc.output_format)?;
+        let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
+        let mut profile_of = vec![0u8; 256];
+        let mut profiles = Vec::with_capacity(desc.materials.len());
+        for (index, material) in desc.materials.iter().enumerate() {
+            let field = format!("materials[{index}] (ID {})", material.id);
+            if material.id == 0 || profile_of[usize::from(material.id)] != 0 {
+                return Err(HostError::Description {
+                    field,
+                    problem: "IDs are 1 to 255 (0: does not scatter), each once".into(),
+                }
+                .into());
+            }
+            if u32::from(material.id) > ids.decode(Vec::new())?.mask {
+                return Err(HostError::Description {
+                    field,
+                    problem: "the ID does not fit the material ID image's bit field".into(),
+                }
+                .into());
+            }
+            let mut profile = material.profile.clone();
+            profile.units_per_mm = units_per_mm;
+            profile.validate()?;
+            let blur = registry::blur_of(&profile)?;
+            if blur.lean() {
+                let usable: Vec<&str> = registry::sss_blurs()
+                    .filter(|b| !b.lean())
+                    .map(|b| b.name())
+                    .collect();
+                return Err(HostError::Unsupported {
+                    input: field,
+                    found: format!("the {} blur", blur.name()),
+                    accepted: format!(
+                        "a blur of the lit light ({}): {} blurs lucent's LEAN G-buffer, which a \
+                         host's G-buffer does not carry",
+                        usable.join(", "),
+                        blur.name()
+                    ),
+                }
+                .into());
+            }
+            profile_of[usize::from(material.id)] = index as u8 + 1;
+            profiles.push((profile, blur));
+        }
+        let albedo_pass = needs_albedo_pass(
+            gbuffer.diffuse.albedo,
+            &profiles.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>(),
+        );
+        let post_albedo = profiles.iter().any(|(p, _)| p.texturing != Texturing::Pre);
+        if (albedo_pass || post_albedo) && gbuffer.albedo.is_none() {
+            return Err(HostError::Missing {
+                input: "albedo".into(),
+                needed_by: match gbuffer.diffuse.albedo {
+                    DiffuseAlbedo::Excluded => {
+                        "the diffuse light is described without its albedo, so lucent applies it \
+                         (GBufferDesc::with_albedo)"
+                            .into()
+                    }
+                    DiffuseAlbedo::Included => format!(
+                        "a profile applies its albedo after the scatter (texturing '{}'): \
+                         describe the albedo image, or use texturing 'pre'",
+                        profiles
+                            .iter()
+                            .find(|(p, _)| p.texturing != Texturing::Pre)
+                            .map_or("post", |(p, _)| p.texturing.name())
+                    ),
+                },
+            }
+            .into());
+        }
+        let id_map = IdMap::Host(ids.decode(profile_of)?);
+        let profiles = SssProfiles {
+            transmission: vec![None; profiles.len()],
+            profiles,
+            object_ids: Vec::new(),
+            id_map,
+        };
+        let ring = lucent.frames_in_flight() * desc.views_per_frame;
+        let upload = SceneUpload {
+            translucency_ids: None,
+            profile_ids: Some(&[]),
+            normal_maps: false,
+            lean: false,
+            albedo_maps: false,
+            frames_in_flight: ring,
+            tables: sss::tables::regions(&profiles),
+            layered_ids: None,
+            layer_depth_textures: 0,
+        };
+        let no_objects = frame_scene();
+        let scene_gpu = uploads.record(lucent, "SssEffect::new", || {
+            SceneGpu::new(lucent.gpu(), &no_objects, &upload).map(Arc::new)
+        })?;
+        let (graph, imports) = declare(&desc, &profiles, &scene_gpu, albedo_pass, post_albedo);
+        let options = crate::graph::CompileOptions {
+            chained_frames: ring > 1,
+            ..Default::default()
+        };
+        let compiled = graph.compile(options).and_then(|(plan, execs)| {
+            Executable::new(
+                lucent.gpu(),
+                plan,
+                execs,
+                lucent.shaders(),
+                lucent.pipeline_cache().handle,
+                ring,
+            )
+        });
+        let executable = match compiled {
+            Ok(e) => e,
+            Err(e) => {
+                if let Ok(s) = Arc::try_unwrap(scene_gpu) {
+                    s.destroy(lucent.gpu());
+                }
+                return Err(e);
+            }
+        };
+        let out = Self {
+            executable: Some(executable),
+            scene_gpu: Some(scene_gpu),
+            imports,
+            desc,
+            frames_in_flight: lucent.frames_in_flight(),
+            guard: Some(LeakGuard::new("SssEffect")),
+        };
+        // The tables do not change between frames: written once into every slot.
+        for slot in 0..ring {
+            let per_frame = &out.scene_gpu().per_frame;
+            let written = sss::tables::write(per_frame, slot, &profiles, &out.desc.knobs);
+            if let Err(e) = written {
+                out.destroy(lucent);
+                return Err(e);
+            }
+            // No tiles: every chain covers the whole screen (the IDs decide per pixel).
+            *per_frame.tiles(slot) = SlotTiles::default();
+        }
+        Ok(out)
+    }
+
+    fn scene_gpu(&self) -> &Arc<SceneGpu> {
+        self.scene_gpu.as_ref().expect("alive until destroy")
+    }
+
+    fn executable(&self) -> &Executable {
+        self.executable.as_ref().expect("alive until destroy")
+    }
+
+    /// The passes the effect records (their plan, for tables and tests).
+    pub fn plan(&self) -> &crate::graph::Plan {
+        &self.executable().plan
+    }
+
+    /// Records one view of one frame into `cmd` (recording, outside any render pass): the
+    /// frame's images, seen by its camera, blurred into its output; every image then left in
+    /// its final state ([`HostImage::left_in`]). The frame last recorded with the same slot
+    /// and view must have completed (its fence); each (slot, view) is recorded once per frame.
+    /// Everything is checked before anything is recorded.
+    pub fn record(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &SssFrame<'_>,
+    ) -> Result<()> {
+        let views = self.desc.views_per_frame;
+        if frame.slot >= self.frames_in_flight {
+            return Err(HostError::OutOfRange {
+                what: "frame slot",
+                index: frame.slot,
+                count: self.frames_in_flight,
+            }
+            .into());
+        }
+        if frame.view >= views {
+            return Err(HostError::OutOfRange {
+                what: "view",
+                index: frame.view,
+                count: views,
+            }
+            .into());
+        }
+        frame.camera.check()?;
+        let gbuffer = &self.desc.gbuffer;
+        let decode = gbuffer.depth_decode(&frame.camera.projection)?;
+        let inputs = self.check_images(lucent, frame)?;
+        let ring = frame.slot * views + frame.view;
+        let uniforms = FrameUniforms::for_view(
+            frame.camera.view,
+            frame.camera.projection,
+            gbuffer.width,
+            gbuffer.height,
+            decode,
+        );
+        self.scene_gpu()
+            .per_frame
+            .write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        let gpu = lucent.gpu();
+        let mut binds = vec![
+            (self.imports.depth, frame.images.depth),
+            (self.imports.diffuse, frame.images.diffuse),
+            (self.imports.material_ids, frame.images.material_ids),
+            (self.imports.output, frame.output),
+        ];
+        if let (Some(id), Some(image)) = (self.imports.specular, frame.images.specular) {
+            binds.push((id, image));
+        }
+        if let (Some(id), Some(image)) = (self.imports.albedo, frame.images.albedo) {
+            binds.push((id, image));
+        }
+        let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> =
+            binds.iter().map(|(id, i)| (*id, i.image, i.view)).collect();
+        self.executable
+            .as_mut()
+            .expect("alive until destroy")
+            .bind_imports(gpu, ring, &binds)?;
+        let sampled = Role::SampledColor.working_state();
+        let attachment = Role::Output.working_state();
+        for image in &inputs {
+            record_transition(gpu, cmd, image, &image.state, &sampled);
+        }
+        record_transition(gpu, cmd, frame.output, &frame.output.state, &attachment);
+        self.executable().record_frame(gpu, cmd, ring, None);
+        for image in &inputs {
+            record_transition(gpu, cmd, image, &sampled, &image.left_in());
+        }
+        record_transition(gpu, cmd, frame.output, &attachment, &frame.output.left_in());
+        Ok(())
+    }
+
+    /// Checks every image of `frame` against the description; returns the inputs, one per
+    /// distinct Vulkan image (the depth and the stencil IDs may share one: it is transitioned
+    /// once, and both must declare the same states).
+    fn check_images<'a>(
+        &self,
+        lucent: &Lucent,
+        frame: &SssFrame<'a>,
+    ) -> Result<Vec<&'a HostImage>> {
+        let gbuffer = &self.desc.gbuffer;
+        let extent = gbuffer.extent();
+        let gpu = lucent.gpu();
+        let images = &frame.images;
+        let same = |format: vk::Format| move |f: vk::Format| f == format;
+        let named = |format: vk::Format| format!("{} (the description's)", format_name(format));
+        let depth_role = match gbuffer.depth.encoding {
+            super::gbuffer::DepthEncoding::Device => Role::SampledDepth,
+            super::gbuffer::DepthEncoding::LinearView => Role::SampledColor,
+        };
+        check_image(
+            gpu,
+            images.depth,
+            "depth",
+            depth_role,
+            extent,
+            same(gbuffer.depth.format),
+            &named(gbuffer.depth.format),
+        )?;
+        check_image(
+            gpu,
+            images.diffuse,
+            "diffuse",
+            Role::SampledColor,
+            extent,
+            same(gbuffer.diffuse.format),
+            &named(gbuffer.diffuse.format),
+        )?;
+        let ids = gbuffer.material_ids.expect("checked at new");
+        let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
+            Role::SampledDepth
+        } else {
+            Role::SampledColor
+        };
+        check_image(
+            gpu,
+            images.material_ids,
+            "material IDs",
+            id_role,
+            extent,
+            same(ids.format),
+            &named(ids.format),
+        )?;
+        for (input, described, given) in [
+            ("specular", gbuffer.specular, images.specular),
+            ("albedo", gbuffer.albedo, images.albedo),
+        ] {
+            match (described, given) {
+                (Some(format), Some(image)) => check_image(
+                    gpu,
+                    image,
+                    input,
+                    Role::SampledColor,
+                    extent,
+                    same(format),
+                    &named(format),
+                )?,
+                (None, None) => {}
+                (Some(_), None) => {
+                    return Err(HostError::Missing {
+                        input: input.into(),
+                        needed_by: "the G-buffer description has it".into(),
+                    }
+                    .into())
+                }
+                (None, Some(image)) => {
+                    return Err(HostError::Image {
+                        image: image.name.clone(),
+                        kind: ImageFault::Aliased,
+                        problem: format!(
+                            "given as the {input}, which the G-buffer description has none of"
+                        ),
+                    }
+                    .into())
+                }
+            }
+        }
+        check_image(
+            gpu,
+            frame.output,
+            "output",
+            Role::Output,
+            extent,
+            same(self.desc.output_format),
+            &named(self.desc.output_format),
+        )?;
+        let mut inputs: Vec<&HostImage> = Vec::new();
+        let all = [
+            Some(images.depth),
+            Some(images.diffuse),
+            Some(images.material_ids),
+            images.specular,
+            images.albedo,
+        ];
+        for image in all.into_iter().flatten() {
+            if image.image == frame.output.image {
+                return Err(HostError::Image {
+                    image: frame.output.name.clone(),
+                    kind: ImageFault::Aliased,
+                    problem: format!("is both an input ('{}') and the output", image.name),
+                }
+                .into());
+            }
+            match inputs.iter().find(|i| i.image == image.image) {
+                Some(first) if first.state != image.state || first.left_in() != image.left_in() => {
+                    return Err(HostError::Image {
+                        image: image.name.clone(),
+                        kind: ImageFault::Aliased,
+                        problem: format!(
+                            "is the same image as '{}' with other states: one image is in one \
+                             state",
+                            first.name
+                        ),
+                    }
+                    .into())
+                }
+                Some(_) => {}
+                None => inputs.push(image),
+            }
+        }
+        Ok(inputs)
+    }
+
+    /// Destroys the passes and their buffers. The GPU must be done with every frame that
+    /// recorded them (the host's fences).
+    pub fn destroy(mut self, lucent: &Lucent) {
+        if let Some(executable) = self.executable.take() {
+            executable.destroy(lucent.gpu());
+        }
+        if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
+            s.destroy(lucent.gpu());
+        }
+        if let Some(guard) = self.guard.take() {
+            guard.disarm();
+        }
+    }
+}
+
+/// The effect's graph: the host's images imported (bound when each frame records), the
+/// albedo pass where the host's light needs it, the SSS chains into the output.
+fn declare(
+    desc: &SssEffectDesc,
+    profiles: &SssProfiles,
+    scene_gpu: &Arc<SceneGpu>,
+    albedo_pass: bool,
+    post_albedo: bool,
+) -> (RenderGraph, Imports) {
+    let gbuffer = &desc.gbuffer;
+    let (width, height) = (gbuffer.width, gbuffer.height);
+    let mut graph = RenderGraph::new();
+    let import = |graph: &mut RenderGraph, name: &str, format: vk::Format, initial: Access| {
+        graph.import_image(
+            name,
+            ImageInfo {
+                width,
+                height,
+                format,
+            },
+            ImportedImage {
+                image: vk::Image::null(),
+                view: vk::ImageView::null(),
+                initial,
+            },
+        )
+    };
+    let sampled = Access::FragmentSampledRead;
+    let depth = import(&mut graph, "host depth", gbuffer.depth.format, sampled);
+    let diffuse = import(&mut graph, "host diffuse", gbuffer.diffuse.format, sampled);
+    let ids_format = gbuffer.material_ids.expect("checked at new").format;
+    let material_ids = import(&mut graph, "host material IDs", ids_format, sampled);
+    let specular = gbuffer
+        .specular
+        .map(|f| import(&mut graph, "host specular", f, sampled));
+    let albedo = gbuffer
+        .albedo
+        .map(|f| import(&mut graph, "host albedo", f, sampled));
+    let output = import(
+        &mut graph,
+        "host output",
+        desc.output_format,
+        Access::ColorAttachmentWrite,
+    );
+    let imports = Imports {
+        depth: depth.id(),
+        diffuse: diffuse.id(),
+        specular: specular.as_ref().map(Handle::id),
+        albedo: albedo.as_ref().map(Handle::id),
+        material_ids: material_ids.id(),
+        output: output.id(),
+    };
+    let cleared;
+    let specular = match &specular {
+        Some(s) => s,
+        None => {
+            cleared = cleared_image(&mut graph, width, height);
+            &cleared
+        }
+    };
+    let id_defines = profiles.id_map.defines();
+    let mut inputs = sss::SssInputs {
+        diffuse: &diffuse,
+        specular,
+        depth: &depth,
+        profile_ids: &material_ids,
+        lean: None,
+        shadow_depth: None,
+        albedo: None,
+        // The host's alpha is its own: the taps read the depth image.
+        depth_in_alpha: false,
+        id_defines,
+    };
+    let adjusted;
+    if albedo_pass {
+        let albedo = albedo.as_ref().expect("checked at new");
+        let included = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
+        adjusted = sss::host_albedo_pass(
+            &mut graph,
+            &inputs,
+            albedo,
+            included,
+            width,
+            height,
+            Some(scene_gpu),
+        );
+        inputs.diffuse = &adjusted;
+    }
+    if post_albedo {
+        inputs.albedo = albedo.as_ref();
+    }
+    let result = sss::sss_passes(
+        &mut graph,
+        &inputs,
+        profiles,
+        &desc.knobs,
+        Some(scene_gpu),
+        Some(output),
+    );
+    graph.export_image(&result, Access::ColorAttachmentWrite);
+    (graph, imports)
+}
+
+/// The scene the effect's GPU data is created with: no objects, lights or environment (the
+/// passes read the camera, the viewport and the tables only).
+fn frame_scene() -> Scene {
+    Scene {
+        name: "host SSS".into(),
+        meshes: Vec::new(),
+        objects: Vec::new(),
+        lights: Vec::new(),
+        camera: Camera {
+            eye: glam::Vec3::new(0.0, 0.0, 1.0),
+            target: glam::Vec3::ZERO,
+            fov_y_degrees: 45.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
+        sky: glam::Vec3::ZERO,
+        exposure: 1.0,
+        deformation: None,
+        time: 0.0,
+    }
+}
+
+/// The output must be a colour-attachment format the final pass writes floats into.
+fn check_output_format(format: vk::Format) -> Result<()> {
+    if sampled_float(format) && format_info(format).is_some_and(|f| f.channels >= 3) {
+        Ok(())
+    } else {
+        Err(HostError::Unsupported {
+            input: "output".into(),
+            found: format!("format {}", format_name(format)),
+            accepted: "an RGB(A) float, UNORM or SRGB colour format".into(),
+        }
+        .into())
+    }
+}
+
+/// A transient image cleared to black by a pass that draws nothing (the specular a host did
+/// not keep apart).
+fn cleared_image(graph: &mut RenderGraph, width: u32, height: u32) -> Handle<Image> {
+    let mut image = graph.create_image(
+        "specular (none)",
+        ImageInfo {
+            width,
+            height,
+            format: crate::features::lighting::HDR_FORMAT,
+        },
+    );
+    let mut pass = graph.add_pass("clear specular", PassKind::Raster);
+    pass.color(&mut image, LoadOp::Clear([0.0; 4]));
+    pass.clears_only();
+    image
+}
+
+// Renderers move to a loader thread and back.
+const _: () = {
+    const fn send<T: Send>() {}
+    send::<SssEffect>();
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_formats_are_colour_the_final_pass_can_write() {
+        check_output_format(vk::Format::R16G16B16A16_SFLOAT).unwrap();
+        check_output_format(vk::Format::B8G8R8A8_UNORM).unwrap();
+        check_output_format(vk::Format::B10G11R11_UFLOAT_PACK32).unwrap();
+        assert!(check_output_format(vk::Format::R32G32B32A32_UINT).is_err());
+        assert!(check_output_format(vk::Format::D32_SFLOAT).is_err());
+        assert!(check_output_format(vk::Format::R8_UNORM).is_err());
+    }
+
+    #[test]
+    fn the_albedo_pass_runs_only_when_the_hosts_light_and_the_profiles_differ() {
+        let profile = |texturing| SssProfile {
+            texturing,
+            ..SssProfile::preset("skin").expect("a preset")
+        };
+        let pre = [profile(Texturing::Pre)];
+        let post = [profile(Texturing::Post), profile(Texturing::Pre)];
+        assert!(!needs_albedo_pass(DiffuseAlbedo::Included, &pre));
+        assert!(needs_albedo_pass(DiffuseAlbedo::Included, &post));
+        assert!(needs_albedo_pass(DiffuseAlbedo::Excluded, &pre));
+    }
+}

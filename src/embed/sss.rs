@@ -453,39 +453,39 @@ impl SssEffect {
             super::gbuffer::DepthEncoding::Device => Role::SampledDepth,
             super::gbuffer::DepthEncoding::LinearView => Role::SampledColor,
         };
-        check_image(
-            gpu,
-            images.depth,
-            "depth",
-            depth_role,
-            extent,
-            same(gbuffer.depth.format),
-            &named(gbuffer.depth.format),
-        )?;
-        check_image(
-            gpu,
-            images.diffuse,
-            "diffuse",
-            Role::SampledColor,
-            extent,
-            same(gbuffer.diffuse.format),
-            &named(gbuffer.diffuse.format),
-        )?;
         let ids = gbuffer.material_ids.expect("checked at new");
         let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
             Role::SampledDepth
         } else {
             Role::SampledColor
         };
-        check_image(
-            gpu,
-            images.material_ids,
-            "material IDs",
-            id_role,
-            extent,
-            same(ids.format),
-            &named(ids.format),
-        )?;
+        // The inputs every frame has, and the output; the optional ones below.
+        for (image, input, role, format) in [
+            (images.depth, "depth", depth_role, gbuffer.depth.format),
+            (
+                images.diffuse,
+                "diffuse",
+                Role::SampledColor,
+                gbuffer.diffuse.format,
+            ),
+            (images.material_ids, "material IDs", id_role, ids.format),
+            (
+                frame.output,
+                "output",
+                Role::Output,
+                self.desc.output_format,
+            ),
+        ] {
+            check_image(
+                gpu,
+                image,
+                input,
+                role,
+                extent,
+                same(format),
+                &named(format),
+            )?;
+        }
         for (input, described, given) in [
             ("specular", gbuffer.specular, images.specular),
             ("albedo", gbuffer.albedo, images.albedo),
@@ -520,15 +520,6 @@ impl SssEffect {
                 }
             }
         }
-        check_image(
-            gpu,
-            frame.output,
-            "output",
-            Role::Output,
-            extent,
-            same(self.desc.output_format),
-            &named(self.desc.output_format),
-        )?;
         let mut inputs: Vec<&HostImage> = Vec::new();
         let all = [
             Some(images.depth),

@@ -1873,53 +1873,6 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
     test.finish();
 }
 
-/// One command buffer of a pool of its own on `device`'s queue family `family`, recording.
-fn own_command_buffer(device: &ash::Device, family: u32) -> (vk::CommandPool, vk::CommandBuffer) {
-    // SAFETY: plain object creation on the test's device; the caller destroys the pool.
-    unsafe {
-        let pool = device
-            .create_command_pool(
-                &vk::CommandPoolCreateInfo::default().queue_family_index(family),
-                None,
-            )
-            .unwrap();
-        let cmd = device
-            .allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(1),
-            )
-            .unwrap()[0];
-        device
-            .begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
-            .unwrap();
-        (pool, cmd)
-    }
-}
-
-/// Ends `cmd`, submits it on `queue` and waits for it.
-fn submit_own(device: &ash::Device, queue: vk::Queue, cmd: vk::CommandBuffer) {
-    // SAFETY: `cmd` is recording and the caller is the queue's only user now; the fence is
-    // created, waited for and destroyed here.
-    unsafe {
-        device.end_command_buffer(cmd).unwrap();
-        let fence = device
-            .create_fence(&vk::FenceCreateInfo::default(), None)
-            .unwrap();
-        let cmds = [cmd];
-        device
-            .queue_submit(
-                queue,
-                &[vk::SubmitInfo::default().command_buffers(&cmds)],
-                fence,
-            )
-            .unwrap();
-        device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
-        device.destroy_fence(fence, None);
-    }
-}
-
 #[test]
 fn effects_build_while_another_host_thread_submits_to_the_queue() {
     // lavapipe has one queue, so the host's other thread submits to the queue lucent was given:
@@ -1928,7 +1881,6 @@ fn effects_build_while_another_host_thread_submits_to_the_queue() {
     // every test) would report two threads using the queue at once.
     let test = TestGpu::new();
     let gpu = &test.gpu;
-    let (device, queue, family) = (gpu.device.clone(), gpu.queue, gpu.queue_family);
     let lucent = wrap(&test, options(2));
     let scene = lucent.load_scene("mixed").unwrap();
     let (w, h) = (64, 48);
@@ -1948,45 +1900,48 @@ fn effects_build_while_another_host_thread_submits_to_the_queue() {
         vec![SssMaterial::new(3, skin)],
         vk::Format::R16G16B16A16_SFLOAT,
     );
-    let (setup_pool, setup) = own_command_buffer(&device, family);
     let stop = std::sync::atomic::AtomicBool::new(false);
-    let (submissions, mut uploads, renderer, effect) = std::thread::scope(|s| {
+    let mut built = None;
+    std::thread::scope(|s| {
         let other = s.spawn(|| {
             // The host's streaming thread: empty submissions, each waited for, until told to
             // stop (and at least one).
             let mut count = 0usize;
             while count == 0 || !stop.load(Ordering::SeqCst) {
-                let (pool, cmd) = own_command_buffer(&device, family);
-                submit_own(&device, queue, cmd);
-                // SAFETY: its one command buffer completed above.
-                unsafe { device.destroy_command_pool(pool, None) };
+                submit_back_to_back(gpu, 1, |_, _| {});
                 count += 1;
             }
             count
         });
-        // SAFETY: `setup` is this thread's, recording, on lucent's queue family; it is
-        // submitted below, once the other thread has stopped using the queue.
-        let mut uploads = unsafe { lucent.uploads(setup) };
-        let renderer = SceneRenderer::new(
-            &lucent,
-            &mut uploads,
-            &scene,
-            w,
-            h,
-            vk::Format::R8G8B8A8_UNORM,
-        )
-        .unwrap();
-        let effect = SssEffect::new(&lucent, &mut uploads, desc).unwrap();
-        stop.store(true, Ordering::SeqCst);
-        (other.join().unwrap(), uploads, renderer, effect)
+        // The host's setup command buffer, recorded on this thread and submitted once the
+        // other thread has stopped using the queue (submit_back_to_back submits after this).
+        let (mut other, mut desc) = (Some(other), Some(desc));
+        submit_back_to_back(gpu, 1, |_, setup| {
+            let (other, desc) = (other.take().unwrap(), desc.take().unwrap());
+            // SAFETY: `setup` is recording, on lucent's queue family, submitted and waited
+            // for by submit_back_to_back before the uploads are released below.
+            let mut uploads = unsafe { lucent.uploads(setup) };
+            let renderer = SceneRenderer::new(
+                &lucent,
+                &mut uploads,
+                &scene,
+                w,
+                h,
+                vk::Format::R8G8B8A8_UNORM,
+            )
+            .unwrap();
+            let effect = SssEffect::new(&lucent, &mut uploads, desc).unwrap();
+            stop.store(true, Ordering::SeqCst);
+            built = Some((other.join().unwrap(), uploads, renderer, effect));
+        });
     });
+    let (submissions, mut uploads, renderer, effect) = built.unwrap();
     assert!(submissions > 0);
     assert!(
         !uploads.is_empty(),
         "the scene's uploads were recorded into the host's buffer"
     );
-    submit_own(&device, queue, setup);
-    // SAFETY: the submission holding the uploads completed (submit_own waited).
+    // SAFETY: the submission holding the uploads completed.
     unsafe { uploads.release(&lucent) }.unwrap();
     println!(
         "built a SceneRenderer and an SssEffect while another thread made {submissions} \
@@ -1994,8 +1949,6 @@ fn effects_build_while_another_host_thread_submits_to_the_queue() {
     );
     effect.destroy(&lucent);
     renderer.destroy(&lucent);
-    // SAFETY: the pool's command buffer completed.
-    unsafe { device.destroy_command_pool(setup_pool, None) };
     drop(lucent);
     test.finish();
 }

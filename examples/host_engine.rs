@@ -22,7 +22,13 @@
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
 //! cargo run --release --example host_engine -- --without-lucent --out without.png
+//! cargo run --release --example host_engine -- --scene mixed --out mixed.png
 //! ```
+//!
+//! With `--scene NAME` the frame is lucent's whole frame of a built-in scene or scene file
+//! (`SceneRenderer`) drawn into the engine's sRGB target instead: the way GDC 2011
+//! translucency, Li et al.'s layered media and shadows reach a host until they have effects
+//! on the host's own G-buffer. Its PNG equals `lucent render --scene NAME` within 1/255.
 //!
 //! Exits non-zero when anything fails, including any validation error (counted by the
 //! engine's own debug messenger; lucent installs none).
@@ -40,8 +46,8 @@ use lucent::embed::gpu_allocator::vulkan::{
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
     requirements, DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice,
-    HostImage, IdDesc, ImageState, Lucent, OptionalFeatures, SssEffect, SssEffectDesc, SssFrame,
-    SssImages, SssMaterial, SssProfile,
+    HostImage, IdDesc, ImageState, Lucent, OptionalFeatures, SceneRenderer, SssEffect,
+    SssEffectDesc, SssFrame, SssImages, SssMaterial, SssProfile,
 };
 
 /// Frames the engine keeps in flight.
@@ -69,10 +75,13 @@ struct Args {
     out: PathBuf,
     with_lucent: bool,
     blur: String,
+    /// `--scene NAME`: the frame is lucent's whole frame of a built-in scene or scene file
+    /// (`SceneRenderer`) instead of the engine's own.
+    scene: Option<String>,
 }
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
-                     [--blur separable|control|burley] [--without-lucent]";
+                     [--blur separable|control|burley] [--without-lucent] [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -82,6 +91,7 @@ fn parse_args() -> Result<Args, String> {
         out: PathBuf::from("host_engine.png"),
         with_lucent: true,
         blur: "separable".into(),
+        scene: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -110,6 +120,7 @@ fn parse_args() -> Result<Args, String> {
             "--out" => args.out = PathBuf::from(value()?),
             "--blur" => args.blur = value()?,
             "--without-lucent" => args.with_lucent = false,
+            "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
             other => return Err(format!("unknown argument {other}\n{USAGE}")),
         }
@@ -1162,7 +1173,40 @@ fn camera(frame: usize, aspect: f32) -> (Mat4, Mat4, Vec3) {
 /// What lucent adds to the engine: the effect, and the `Lucent` it was built from.
 struct Effects {
     lucent: Lucent,
-    sss: SssEffect,
+    inserted: Inserted,
+}
+
+/// What the engine's frame gets from lucent.
+enum Inserted {
+    /// SSS over the engine's own G-buffer and lighting.
+    Sss(Box<SssEffect>),
+    /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
+    Scene(Box<(lucent::scene::Scene, SceneRenderer)>),
+}
+
+/// `--scene`: the frame is lucent's whole frame of the scene, drawn into the engine's LDR
+/// target and left for the copy out.
+fn record_scene_frame(
+    lucent: &Lucent,
+    renderer: &mut SceneRenderer,
+    scene: &lucent::scene::Scene,
+    slot: &mut FrameSlot,
+    slot_index: usize,
+    extent: vk::Extent2D,
+) -> Result<(), String> {
+    // Every pixel is drawn: the old contents may be discarded.
+    let output = slot
+        .ldr
+        .host_image(extent)
+        .in_state(ImageState {
+            layout: vk::ImageLayout::UNDEFINED,
+            ..slot.ldr.state
+        })
+        .then(ImageState::transfer_src());
+    slot.ldr.state = renderer
+        .record(lucent, slot.cmd, slot_index, scene, &output)
+        .map_err(|e| format!("lucent: {e}"))?;
+    Ok(())
 }
 
 /// Copies `slot`'s image (in TRANSFER_SRC_OPTIMAL, as lucent left it) to host memory.
@@ -1393,9 +1437,10 @@ fn record_frame(
                 },
                 output: &output,
             };
-            effects
-                .sss
-                .record(&effects.lucent, cmd, &frame)
+            let Inserted::Sss(sss) = &mut effects.inserted else {
+                return Err("record_frame is the engine's own frame, not --scene's".into());
+            };
+            sss.record(&effects.lucent, cmd, &frame)
                 .map_err(|e| format!("lucent: {e}"))?;
             // lucent left each image in its final state (here: as each came, the output
             // sampled); the engine tracks what it says.
@@ -1530,7 +1575,21 @@ fn create_effects(
     // SAFETY: the slot's command buffer is recording, outside rendering, on lucent's queue
     // family; it is submitted below before any frame records the effect.
     let mut uploads = unsafe { lucent.uploads(slot.cmd) };
-    let sss = SssEffect::new(&lucent, &mut uploads, desc);
+    let built = match &args.scene {
+        None => SssEffect::new(&lucent, &mut uploads, desc).map(|sss| Inserted::Sss(Box::new(sss))),
+        Some(name) => lucent.load_scene(name).and_then(|scene| {
+            let extent = (args.width, args.height);
+            SceneRenderer::new(
+                &lucent,
+                &mut uploads,
+                &scene,
+                extent.0,
+                extent.1,
+                LDR_FORMAT,
+            )
+            .map(|renderer| Inserted::Scene(Box::new((scene, renderer))))
+        }),
+    };
     let device = &engine.device;
     // SAFETY: the command buffer is recording.
     check("vkEndCommandBuffer", unsafe {
@@ -1544,13 +1603,19 @@ fn create_effects(
     let staging_bytes = uploads.staging_bytes();
     // SAFETY: that submission has completed.
     unsafe { uploads.release(&lucent) }.map_err(|e| e.to_string())?;
-    let sss = sss.map_err(|e| format!("lucent: {e}"))?;
-    eprintln!(
-        "host_engine: lucent effects: sss ({} blur; skin ID {SKIN_ID}, marble ID {MARBLE_ID}; \
-         {} staging bytes uploaded)",
-        args.blur, staging_bytes
-    );
-    Ok(Effects { lucent, sss })
+    let inserted = built.map_err(|e| format!("lucent: {e}"))?;
+    match &args.scene {
+        None => eprintln!(
+            "host_engine: lucent effects: sss ({} blur; skin ID {SKIN_ID}, marble ID \
+             {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            args.blur
+        ),
+        Some(name) => eprintln!(
+            "host_engine: lucent's whole frame of scene '{name}' ({staging_bytes} staging \
+             bytes uploaded)"
+        ),
+    }
+    Ok(Effects { lucent, inserted })
 }
 
 fn run(args: &Args, engine: &Engine) -> Result<(), String> {
@@ -1612,8 +1677,15 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
             let k = frame % FRAMES_IN_FLIGHT;
             let slot = &mut slots[k];
             let recorded = begin_slot(engine, slot)
-                .and_then(|()| {
-                    record_frame(engine, pipelines, effects.as_mut(), slot, k, frame, extent)
+                .and_then(|()| match effects.as_mut() {
+                    Some(Effects {
+                        lucent,
+                        inserted: Inserted::Scene(scene),
+                    }) => {
+                        let (scene, renderer) = &mut **scene;
+                        record_scene_frame(lucent, renderer, scene, slot, k, extent)
+                    }
+                    other => record_frame(engine, pipelines, other, slot, k, frame, extent),
                 })
                 // SAFETY: the command buffer is recording.
                 .and_then(|()| {
@@ -1639,7 +1711,10 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
         });
     }
     if let Some(effects) = effects {
-        effects.sss.destroy(&effects.lucent);
+        match effects.inserted {
+            Inserted::Sss(sss) => (*sss).destroy(&effects.lucent),
+            Inserted::Scene(scene) => (*scene).1.destroy(&effects.lucent),
+        }
         drop(effects.lucent);
     }
     for slot in slots {

@@ -108,9 +108,7 @@ impl FrameUniforms {
             lights,
         }
     }
-}
 
-impl FrameUniforms {
     /// The uniforms of a host's view (embedding): its view and projection matrices, the
     /// decode of its depth image (`depth_decode`: [`projection_depth_decode`], or the identity
     /// for a linear depth image) and the image size; no lights, environment or sky (the
@@ -125,8 +123,7 @@ impl FrameUniforms {
         let view_proj = projection * view;
         let eye = view.inverse().w_axis.truncate();
         let linear = |d: f32| {
-            let k = depth_decode;
-            let v = (k[0] + k[1] * d) / (k[2] + k[3] * d).max(1e-7);
+            let v = decoded_depth(depth_decode, d);
             if v.is_finite() {
                 v
             } else {
@@ -184,6 +181,12 @@ pub fn projection_depth_decode(projection: &glam::Mat4) -> Option<[f32; 4]> {
     }
     // Both terms zero would be a projection that maps every depth to one value.
     (k[0] != 0.0 || k[1] != 0.0).then_some(k)
+}
+
+/// The view depth the decode `k` ([`projection_depth_decode`]) gives a depth image's value `d`:
+/// glsl/common/scene.glsl's `linear_depth`, its denominator clamped the same way.
+fn decoded_depth(k: [f32; 4], d: f32) -> f32 {
+    (k[0] + k[1] * d) / (k[2] + k[3] * d).max(1e-7)
 }
 
 /// [`projection_depth_decode`] for lucent's own cameras (always a finite perspective); the

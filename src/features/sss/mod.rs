@@ -814,18 +814,6 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
         .cloned()
         .collect();
     for uint in [false, true] {
-        let ids: &'static [(&'static str, &'static str)] = if uint {
-            &[("LUCENT_SSS_HOST_IDS", "1"), ("LUCENT_SSS_IDS_UINT", "1")]
-        } else {
-            &[("LUCENT_SSS_HOST_IDS", "1")]
-        };
-        for included in [false, true] {
-            out.push(crate::backend::shader::PipelineShaders::new(
-                "fullscreen.vert",
-                HOST_ALBEDO_FRAGMENT,
-                &host_albedo_defines(ids, included),
-            ));
-        }
         let map = IdMap::Host(HostIdMap {
             uint,
             channel: 0,
@@ -834,13 +822,18 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
             unorm_max: 255,
             profile_of: Vec::new(),
         });
+        let ids = map.defines();
+        for included in [false, true] {
+            out.push(crate::backend::shader::PipelineShaders::new(
+                "fullscreen.vert",
+                HOST_ALBEDO_FRAGMENT,
+                &host_albedo_defines(ids, included),
+            ));
+        }
         for p in &host {
             let mut p = p.clone();
-            p.defines.extend(
-                map.defines()
-                    .iter()
-                    .map(|(n, v)| (n.to_string(), v.to_string())),
-            );
+            p.defines
+                .extend(ids.iter().map(|(n, v)| (n.to_string(), v.to_string())));
             out.push(p);
         }
     }

@@ -1,5 +1,5 @@
-//! A small deferred engine in ash that inserts lucent's screen-space SSS into its own frame, the
-//! way a host engine would.
+//! A small deferred engine in ash that inserts lucent's GDC 2011 translucency and screen-space
+//! SSS into its own frame, the way a host engine would.
 //!
 //! Everything here is the engine's, not lucent's: its instance (with the Khronos validation
 //! layer and synchronization validation when the layer is installed) and debug messenger, its
@@ -8,16 +8,22 @@
 //! compiled with shaderc at start-up), three frames in flight with their own command buffers,
 //! fences and targets, and a frame of its own layout:
 //!
-//! 1. **G-buffer** (raster, procedural spheres and a floor): reversed-Z D32 depth with an
-//!    infinite far plane, octahedral normals in RG16_SNORM, albedo in RGBA8, and the engine's
-//!    own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5, floor 0).
-//! 2. **Lighting** (fullscreen): one sun and an ambient term, lit diffuse and specular apart,
-//!    in B10G11R11 (RGBA16F where the device cannot render B10G11R11).
-//! 3. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
+//! 1. **G-buffer** (raster, procedural spheres, a thin jade leaf and a floor): reversed-Z D32
+//!    depth with an infinite far plane, octahedral normals in RG16_SNORM, albedo in RGBA8, the
+//!    engine's own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5,
+//!    leaf 9, floor 0) and local thickness in R8_UNORM, which the leaf's draw takes from the
+//!    engine's vertex buffer (baked once by `lucent::embed::bake_thickness`).
+//! 2. **Lighting** (fullscreen): a sun, a point light behind the leaf and an ambient term, lit
+//!    diffuse and specular apart, in B10G11R11 (RGBA16F where the device cannot render
+//!    B10G11R11).
+//! 3. **lucent's translucency** (`TranslucencyEffect`): the light of the engine's two lights
+//!    let through the leaf, added to the lit diffuse (the engine's lights, as
+//!    `lucent::embed::Light`s).
+//! 4. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
-//!    diffuse + specular itself instead.
-//! 4. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
+//!    diffuse + specular itself instead (no translucency, no scatter).
+//! 5. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
@@ -26,9 +32,9 @@
 //! ```
 //!
 //! With `--scene NAME` the frame is lucent's whole frame of a built-in scene or scene file
-//! (`SceneRenderer`) drawn into the engine's sRGB target instead: the way GDC 2011
-//! translucency, Li et al.'s layered media and shadows reach a host until they have effects
-//! on the host's own G-buffer. Its PNG equals `lucent render --scene NAME` within 1/255.
+//! (`SceneRenderer`) drawn into the engine's sRGB target instead: the way Li et al.'s layered
+//! media, SSS transmission and lucent's shadows reach a host until they have effects on the
+//! host's own G-buffer. Its PNG equals `lucent render --scene NAME` within 1/255.
 //!
 //! Exits non-zero when anything fails, including any validation error (counted by the
 //! engine's own debug messenger; lucent installs none).
@@ -45,9 +51,11 @@ use lucent::embed::gpu_allocator::vulkan::{
 };
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
-    requirements, DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice,
-    HostImage, IdDesc, ImageState, Lucent, OptionalFeatures, SceneRenderer, SssEffect,
-    SssEffectDesc, SssFrame, SssImages, SssMaterial, SssProfile,
+    capabilities, requirements, DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera,
+    HostDevice, HostImage, IdDesc, ImageState, Light, Lucent, NormalDesc, NormalSpace,
+    OptionalFeatures, SceneRenderer, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
+    SssProfile, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
+    TranslucencyImages, TranslucentMaterial,
 };
 
 /// Frames the engine keeps in flight.
@@ -56,12 +64,25 @@ const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 const NORMAL_FORMAT: vk::Format = vk::Format::R16G16_SNORM;
 const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 const ID_FORMAT: vk::Format = vk::Format::R8_UINT;
+/// Local thickness (GDC 2011): baked per vertex by lucent, carried through the engine's vertex
+/// buffer into this G-buffer target.
+const THICKNESS_FORMAT: vk::Format = vk::Format::R8_UNORM;
 const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// The engine's material numbers in its ID target (0: the floor; 5 has no SSS).
 const SKIN_ID: u8 = 17;
 const MARBLE_ID: u8 = 42;
 const PLASTIC_ID: u8 = 5;
+/// The thin jade leaf, lit through by GDC 2011 translucency.
+const LEAF_ID: u8 = 9;
+/// The leaf: an ellipsoid's centre and radii (metres), thin along z.
+const LEAF_CENTRE: [f32; 3] = [-0.06, 0.15, -0.12];
+const LEAF_RADII: [f32; 3] = [0.06, 0.045, 0.006];
+/// A point light behind the leaf (position, colour times intensity, range): the engine lights
+/// with it, and lucent's translucency lets it through the leaf.
+const BACK_LIGHT: [f32; 3] = [-0.08, 0.17, -0.24];
+const BACK_LIGHT_RADIANCE: [f32; 3] = [0.16, 0.14, 0.11];
+const BACK_LIGHT_RANGE: f32 = 0.6;
 /// The procedural sphere's tessellation (its vertex count is `6 * STACKS * SLICES`).
 const STACKS: u32 = 48;
 const SLICES: u32 = 64;
@@ -148,9 +169,12 @@ void main() {
         format!(
             r#"#version 450
 {PUSH}
+// The leaf's thickness at this vertex (the engine's vertex buffer: lucent's bake).
+layout(location = 0) in float a_thickness;
 layout(location = 0) out vec3 v_world;
 layout(location = 1) out vec3 v_normal;
 layout(location = 2) flat out uint v_object;
+layout(location = 3) out float v_thickness;
 // Centre (xyz) and radius (w) in metres.
 const vec4 SPHERES[3] = vec4[3](vec4(-0.14, 0.06, 0.0, 0.06), vec4(0.0, 0.06, 0.0, 0.06),
                                 vec4(0.14, 0.06, 0.0, 0.06));
@@ -158,7 +182,7 @@ void main() {{
     uint object = uint(gl_InstanceIndex);
     vec3 p;
     vec3 n;
-    if (object >= 3u) {{
+    if (object >= 4u) {{
         const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1),
                                         vec2(1, 1), vec2(-1, 1));
         vec2 c = corners[gl_VertexIndex % 6];
@@ -172,16 +196,29 @@ void main() {{
         float theta = float(k.x) / {STACKS}.0 * 3.14159265;
         float phi = float(k.y) / {SLICES}.0 * 6.28318531;
         n = vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
-        p = SPHERES[object].xyz + SPHERES[object].w * n;
+        if (object == 3u) {{
+            // The leaf: the unit sphere scaled to an ellipsoid (normals by the inverse).
+            p = vec3({LX}, {LY}, {LZ}) + vec3({RX}, {RY}, {RZ}) * n;
+            n = normalize(n / vec3({RX}, {RY}, {RZ}));
+        }} else {{
+            p = SPHERES[object].xyz + SPHERES[object].w * n;
+        }}
     }}
     v_world = p;
     v_normal = n;
     v_object = object;
+    v_thickness = object == 3u ? a_thickness : 0.0;
     gl_Position = pc.m * vec4(p, 1.0);
 }}
 "#,
             SLICES = super::SLICES,
             STACKS = super::STACKS,
+            LX = super::LEAF_CENTRE[0],
+            LY = super::LEAF_CENTRE[1],
+            LZ = super::LEAF_CENTRE[2],
+            RX = super::LEAF_RADII[0],
+            RY = super::LEAF_RADII[1],
+            RZ = super::LEAF_RADII[2],
         )
     }
 
@@ -191,9 +228,11 @@ void main() {{
 layout(location = 0) in vec3 v_world;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) flat in uint v_object;
+layout(location = 3) in float v_thickness;
 layout(location = 0) out vec2 o_normal;  // octahedral (RG16_SNORM)
 layout(location = 1) out vec4 o_albedo;  // albedo, a: gloss
 layout(location = 2) out uint o_id;      // the engine's material number (R8_UINT)
+layout(location = 3) out float o_thickness;  // local thickness (R8_UNORM)
 vec2 sign_not_zero(vec2 v) {{ return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }}
 vec2 oct_encode(vec3 n) {{
     n /= abs(n.x) + abs(n.y) + abs(n.z);
@@ -206,6 +245,7 @@ void main() {{
     if (v_object == 0u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = 0.5; id = {SKIN}u; }}
     else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = 0.8; id = {MARBLE}u; }}
     else if (v_object == 2u) {{ albedo = vec3(0.20, 0.35, 0.75); gloss = 0.6; id = {PLASTIC}u; }}
+    else if (v_object == 3u) {{ albedo = vec3(0.42, 0.78, 0.50); gloss = 0.7; id = {LEAF}u; }}
     else {{
         // A floor of 2 cm squares: texture detail the blur must leave sharp.
         ivec2 cell = ivec2(floor(v_world.xz / 0.02));
@@ -216,8 +256,10 @@ void main() {{
     o_normal = oct_encode(normalize(v_normal));
     o_albedo = vec4(albedo, gloss);
     o_id = id;
+    o_thickness = v_thickness;
 }}
 "#,
+            LEAF = super::LEAF_ID,
             SKIN = super::SKIN_ID,
             MARBLE = super::MARBLE_ID,
             PLASTIC = super::PLASTIC_ID,
@@ -259,13 +301,27 @@ void main() {{
     float nl = max(dot(n, l), 0.0);
     vec3 sun = vec3(1.0, 0.95, 0.88) * pc.sun.w;
     vec3 ambient = mix(vec3(0.10, 0.09, 0.08), vec3(0.20, 0.24, 0.30), n.y * 0.5 + 0.5);
-    o_diffuse = vec4(a.rgb * (sun * nl / 3.14159265 + ambient), 1.0);
+    // The back light, with lucent's point-light falloff (a smooth window to its range).
+    vec3 to_back = vec3({BX}, {BY}, {BZ}) - p;
+    float dist2 = max(dot(to_back, to_back), 1e-4);
+    float ratio = sqrt(dist2) / {BRANGE};
+    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+    vec3 back = vec3({BR}, {BG}, {BB}) * (window * window / dist2);
+    float nb = max(dot(n, to_back * inversesqrt(dist2)), 0.0);
+    o_diffuse = vec4(a.rgb * ((sun * nl + back * nb) / 3.14159265 + ambient), 1.0);
     float shininess = exp2(1.0 + 10.0 * a.a);
     float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
     float lobe = (shininess + 8.0) / (8.0 * 3.14159265) * pow(max(dot(n, h), 0.0), shininess);
     o_specular = vec4(sun * fresnel * lobe * nl, 1.0);
 }}
-"#
+"#,
+            BX = super::BACK_LIGHT[0],
+            BY = super::BACK_LIGHT[1],
+            BZ = super::BACK_LIGHT[2],
+            BR = super::BACK_LIGHT_RADIANCE[0],
+            BG = super::BACK_LIGHT_RADIANCE[1],
+            BB = super::BACK_LIGHT_RADIANCE[2],
+            BRANGE = super::BACK_LIGHT_RANGE,
         )
     }
 
@@ -649,6 +705,7 @@ struct FrameSlot {
     normal: Target,
     albedo: Target,
     ids: Target,
+    thickness: Target,
     diffuse: Target,
     specular: Target,
     hdr: Target,
@@ -706,6 +763,7 @@ fn pipeline(
     (vert, frag): (vk::ShaderModule, vk::ShaderModule),
     colours: &[vk::Format],
     depth: Option<vk::Format>,
+    thickness_attribute: bool,
 ) -> Result<vk::Pipeline, String> {
     let stages = [
         vk::PipelineShaderStageCreateInfo::default()
@@ -717,7 +775,23 @@ fn pipeline(
             .module(frag)
             .name(c"main"),
     ];
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+    // The G-buffer's one vertex attribute: a float of local thickness per vertex drawn.
+    let bindings = [vk::VertexInputBindingDescription::default()
+        .binding(0)
+        .stride(4)
+        .input_rate(vk::VertexInputRate::VERTEX)];
+    let attributes = [vk::VertexInputAttributeDescription::default()
+        .location(0)
+        .binding(0)
+        .format(vk::Format::R32_SFLOAT)
+        .offset(0)];
+    let vertex_input = if thickness_attribute {
+        vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&bindings)
+            .vertex_attribute_descriptions(&attributes)
+    } else {
+        vk::PipelineVertexInputStateCreateInfo::default()
+    };
     let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
         .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default()
@@ -875,8 +949,9 @@ fn create_pipelines(
             cache,
             layout,
             (gbuffer_vert, gbuffer_frag),
-            &[NORMAL_FORMAT, ALBEDO_FORMAT, ID_FORMAT],
+            &[NORMAL_FORMAT, ALBEDO_FORMAT, ID_FORMAT, THICKNESS_FORMAT],
             Some(DEPTH_FORMAT),
+            true,
         )?;
         let lighting = pipeline(
             device,
@@ -885,6 +960,7 @@ fn create_pipelines(
             (fullscreen, lighting_frag),
             &[light_format, light_format],
             None,
+            false,
         )?;
         let compose = pipeline(
             device,
@@ -893,6 +969,7 @@ fn create_pipelines(
             (fullscreen, compose_frag),
             &[HDR_FORMAT],
             None,
+            false,
         )?;
         let tonemap = pipeline(
             device,
@@ -901,6 +978,7 @@ fn create_pipelines(
             (fullscreen, tonemap_frag),
             &[LDR_FORMAT],
             None,
+            false,
         )?;
         Ok(Pipelines {
             set_layout,
@@ -979,6 +1057,7 @@ fn create_slot(
     let normal = target(NORMAL_FORMAT, attachment_sampled, "normals")?;
     let albedo = target(ALBEDO_FORMAT, attachment_sampled, "albedo")?;
     let ids = target(ID_FORMAT, attachment_sampled, "material IDs")?;
+    let thickness = target(THICKNESS_FORMAT, attachment_sampled, "thickness")?;
     let diffuse = target(light_format, attachment_sampled, "lit diffuse")?;
     let specular = target(light_format, attachment_sampled, "lit specular")?;
     let hdr = target(HDR_FORMAT, attachment_sampled, "hdr")?;
@@ -1059,6 +1138,7 @@ fn create_slot(
             normal,
             albedo,
             ids,
+            thickness,
             diffuse,
             specular,
             hdr,
@@ -1081,6 +1161,7 @@ fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, slot: FrameSlot) 
         slot.normal,
         slot.albedo,
         slot.ids,
+        slot.thickness,
         slot.diffuse,
         slot.specular,
         slot.hdr,
@@ -1170,6 +1251,23 @@ fn camera(frame: usize, aspect: f32) -> (Mat4, Mat4, Vec3) {
     (view, projection, eye)
 }
 
+/// The engine's lights as lucent's effects read them: the sun (`sun` points towards it) and
+/// the point light behind the leaf, as the engine's lighting shader has them.
+fn engine_lights(sun: Vec3) -> [Light; 2] {
+    let mut back = Light::point(
+        Vec3::from(BACK_LIGHT),
+        Vec3::from(BACK_LIGHT_RADIANCE),
+        1.0,
+        BACK_LIGHT_RANGE,
+    );
+    // How strongly the back light shines through the leaf (GDC 2011's fLTScale).
+    back.translucency_scale = 1.0;
+    let mut sun = Light::directional(-sun, Vec3::new(1.0, 0.95, 0.88), 9.0);
+    // The sun is high: little of it comes through the leaf towards the camera.
+    sun.translucency_scale = 0.2;
+    [sun, back]
+}
+
 /// What lucent adds to the engine: the effect, and the `Lucent` it was built from.
 struct Effects {
     lucent: Lucent,
@@ -1178,8 +1276,12 @@ struct Effects {
 
 /// What the engine's frame gets from lucent.
 enum Inserted {
-    /// SSS over the engine's own G-buffer and lighting.
-    Sss(Box<SssEffect>),
+    /// Effects over the engine's own G-buffer and lighting: GDC 2011 translucency added to
+    /// its lit diffuse, then SSS.
+    Effects {
+        translucency: Box<TranslucencyEffect>,
+        sss: Box<SssEffect>,
+    },
     /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
     Scene(Box<(lucent::scene::Scene, SceneRenderer)>),
 }
@@ -1315,6 +1417,7 @@ fn record_frame(
     slot_index: usize,
     frame: usize,
     extent: vk::Extent2D,
+    leaf_thickness: vk::Buffer,
 ) -> Result<(), String> {
     let device = &engine.device;
     let cmd = slot.cmd;
@@ -1352,7 +1455,12 @@ fn record_frame(
     let fragment_sampled = ImageState::fragment_sampled();
 
     // 1. The G-buffer.
-    for target in [&mut slot.normal, &mut slot.albedo, &mut slot.ids] {
+    for target in [
+        &mut slot.normal,
+        &mut slot.albedo,
+        &mut slot.ids,
+        &mut slot.thickness,
+    ] {
         target.transition(device, cmd, ImageState::color_attachment(), true);
     }
     let depth_attachment = ImageState {
@@ -1364,18 +1472,31 @@ fn record_frame(
         device,
         cmd,
         extent,
-        &[slot.normal.view, slot.albedo.view, slot.ids.view],
+        &[
+            slot.normal.view,
+            slot.albedo.view,
+            slot.ids.view,
+            slot.thickness.view,
+        ],
         Some(slot.depth.view),
         true,
     );
     bind(pipelines.gbuffer, None, projection * view);
-    // SAFETY: inside the G-buffer's rendering, its pipeline bound.
+    // SAFETY: inside the G-buffer's rendering, its pipeline bound; the thickness buffer holds
+    // one float per vertex of a sphere draw.
     unsafe {
-        device.cmd_draw(cmd, 6 * STACKS * SLICES, 3, 0, 0);
-        device.cmd_draw(cmd, 6, 1, 0, 3);
+        device.cmd_bind_vertex_buffers(cmd, 0, &[leaf_thickness], &[0]);
+        // The three spheres and the leaf, then the floor.
+        device.cmd_draw(cmd, 6 * STACKS * SLICES, 4, 0, 0);
+        device.cmd_draw(cmd, 6, 1, 0, 4);
         device.cmd_end_rendering(cmd);
     }
-    for target in [&mut slot.normal, &mut slot.albedo, &mut slot.ids] {
+    for target in [
+        &mut slot.normal,
+        &mut slot.albedo,
+        &mut slot.ids,
+        &mut slot.thickness,
+    ] {
         target.transition(device, cmd, fragment_sampled, false);
     }
     slot.depth
@@ -1407,14 +1528,44 @@ fn record_frame(
         target.transition(device, cmd, fragment_sampled, false);
     }
 
-    // 3. lucent's SSS into the HDR target, or the engine's own diffuse + specular.
+    // 3. lucent's translucency added to the lit diffuse, then its SSS into the HDR target;
+    // or the engine's own diffuse + specular.
     match effects {
         Some(effects) => {
+            let Inserted::Effects { translucency, sss } = &mut effects.inserted else {
+                return Err("record_frame is the engine's own frame, not --scene's".into());
+            };
             let depth = slot.depth.host_image(extent);
-            let diffuse = slot.diffuse.host_image(extent);
-            let specular = slot.specular.host_image(extent);
+            let normals = slot.normal.host_image(extent);
             let albedo = slot.albedo.host_image(extent);
             let ids = slot.ids.host_image(extent);
+            let thickness = slot.thickness.host_image(extent);
+            let lighting = slot.diffuse.host_image(extent);
+            translucency
+                .record(
+                    &effects.lucent,
+                    cmd,
+                    &TranslucencyFrame {
+                        slot: slot_index,
+                        view: 0,
+                        camera: HostCamera::new(view, projection),
+                        lights: &engine_lights(sun),
+                        images: TranslucencyImages {
+                            depth: &depth,
+                            normals: &normals,
+                            albedo: &albedo,
+                            thickness: &thickness,
+                            material_ids: &ids,
+                        },
+                        lighting: &lighting,
+                    },
+                )
+                .map_err(|e| format!("lucent: {e}"))?;
+            slot.normal.state = normals.left_in();
+            slot.thickness.state = thickness.left_in();
+            // (The other images come back as they came: the SSS reads them below.)
+            let diffuse = slot.diffuse.host_image(extent);
+            let specular = slot.specular.host_image(extent);
             // Every pixel is written: the old contents may be discarded.
             let output = slot
                 .hdr
@@ -1436,9 +1587,6 @@ fn record_frame(
                     material_ids: &ids,
                 },
                 output: &output,
-            };
-            let Inserted::Sss(sss) = &mut effects.inserted else {
-                return Err("record_frame is the engine's own frame, not --scene's".into());
             };
             sss.record(&effects.lucent, cmd, &frame)
                 .map_err(|e| format!("lucent: {e}"))?;
@@ -1562,7 +1710,15 @@ fn create_effects(
     .with_specular(light_format)
     .with_albedo(ALBEDO_FORMAT)
     .with_material_ids(IdDesc::value(ID_FORMAT))
+    .with_normals(NormalDesc::octahedral(NORMAL_FORMAT, NormalSpace::World))
+    .with_thickness(ThicknessDesc::channel(THICKNESS_FORMAT, 0))
     .with_metres_per_unit(1.0);
+    for (effect, support) in capabilities(&gbuffer).map_err(|e| e.to_string())? {
+        eprintln!("host_engine: lucent effect {}: {support:?}", effect.name());
+    }
+    // The leaf: a broad lobe, the talk's distortion, a little light from every angle.
+    let leaf = TranslucentMaterial::new(LEAF_ID, 6.0, 0.25, 0.02);
+    let translucency_desc = TranslucencyEffectDesc::new(gbuffer.clone(), vec![leaf]);
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
@@ -1576,7 +1732,19 @@ fn create_effects(
     // family; it is submitted below before any frame records the effect.
     let mut uploads = unsafe { lucent.uploads(slot.cmd) };
     let built = match &args.scene {
-        None => SssEffect::new(&lucent, &mut uploads, desc).map(|sss| Inserted::Sss(Box::new(sss))),
+        None => TranslucencyEffect::new(&lucent, &mut uploads, translucency_desc).and_then(
+            |translucency| match SssEffect::new(&lucent, &mut uploads, desc) {
+                Ok(sss) => Ok(Inserted::Effects {
+                    translucency: Box::new(translucency),
+                    sss: Box::new(sss),
+                }),
+                Err(e) => {
+                    // Nothing of it was recorded or used yet.
+                    translucency.destroy(&lucent);
+                    Err(e)
+                }
+            },
+        ),
         Some(name) => lucent.load_scene(name).and_then(|scene| {
             let extent = (args.width, args.height);
             SceneRenderer::new(
@@ -1606,8 +1774,8 @@ fn create_effects(
     let inserted = built.map_err(|e| format!("lucent: {e}"))?;
     match &args.scene {
         None => eprintln!(
-            "host_engine: lucent effects: sss ({} blur; skin ID {SKIN_ID}, marble ID \
-             {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            "host_engine: lucent effects: translucency (leaf ID {LEAF_ID}), sss ({} blur; skin \
+             ID {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
             args.blur
         ),
         Some(name) => eprintln!(
@@ -1616,6 +1784,96 @@ fn create_effects(
         ),
     }
     Ok(Effects { lucent, inserted })
+}
+
+/// The engine's vertex buffer of the leaf's local thickness: one float per vertex the sphere
+/// draw emits (6 per quad of the STACKS x SLICES grid), baked by lucent from the leaf's mesh.
+struct VertexBuffer {
+    buffer: vk::Buffer,
+    memory: Allocation,
+}
+
+/// The leaf's mesh as the G-buffer's vertex shader makes it (the grid's vertices, two
+/// triangles a quad), baked with `lucent::embed::bake_thickness` and laid out per vertex drawn.
+fn leaf_thickness_buffer(
+    engine: &Engine,
+    allocator: &Mutex<Allocator>,
+) -> Result<VertexBuffer, String> {
+    let (centre, radii) = (Vec3::from(LEAF_CENTRE), Vec3::from(LEAF_RADII));
+    let columns = SLICES + 1;
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for i in 0..=STACKS {
+        for j in 0..=SLICES {
+            let theta = i as f32 / STACKS as f32 * std::f32::consts::PI;
+            let phi = j as f32 / SLICES as f32 * std::f32::consts::TAU;
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            positions.push(centre + radii * n);
+            normals.push((n / radii).normalize());
+        }
+    }
+    const CORNERS: [(u32, u32); 6] = [(0, 0), (1, 0), (1, 1), (0, 0), (1, 1), (0, 1)];
+    let drawn: Vec<u32> = (0..STACKS * SLICES)
+        .flat_map(|quad| {
+            CORNERS.map(|(di, dj)| (quad / SLICES + di) * columns + quad % SLICES + dj)
+        })
+        .collect();
+    // The bake wants counter-clockwise triangles seen from outside: the grid's are the other
+    // way round, so each triangle's last two corners swap.
+    let indices: Vec<u32> = drawn
+        .chunks_exact(3)
+        .flat_map(|t| [t[0], t[2], t[1]])
+        .collect();
+    // Parts thicker than 1.2 cm read as opaque: the leaf's middle is, its rim lets light
+    // through.
+    let baked = lucent::embed::bake_thickness(&positions, &normals, &indices, Some(0.012))
+        .map_err(|e| format!("bake the leaf's thickness: {e}"))?;
+    let per_vertex: Vec<f32> = drawn.iter().map(|&v| baked[v as usize]).collect();
+    let bytes: Vec<u8> = per_vertex.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let device = &engine.device;
+    // SAFETY: plain object creation on the engine's device; destroyed at the end of `run`.
+    unsafe {
+        let buffer = device
+            .create_buffer(
+                &vk::BufferCreateInfo::default()
+                    .size(bytes.len() as u64)
+                    .usage(vk::BufferUsageFlags::VERTEX_BUFFER),
+                None,
+            )
+            .map_err(|e| format!("vkCreateBuffer: {e}"))?;
+        let mut memory = allocator
+            .lock()
+            .map_err(|_| "allocator lock poisoned".to_string())?
+            .allocate(&AllocationCreateDesc {
+                name: "leaf thickness",
+                requirements: device.get_buffer_memory_requirements(buffer),
+                location: MemoryLocation::CpuToGpu,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .map_err(|e| format!("allocate the leaf's thickness: {e}"))?;
+        check(
+            "vkBindBufferMemory",
+            device.bind_buffer_memory(buffer, memory.memory(), memory.offset()),
+        )?;
+        memory
+            .mapped_slice_mut()
+            .ok_or("the leaf's thickness buffer is not mapped")?[..bytes.len()]
+            .copy_from_slice(&bytes);
+        let (low, high) = baked
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        eprintln!(
+            "host_engine: the leaf's thickness baked by lucent at {} vertices ({low:.2} to \
+             {high:.2})",
+            baked.len()
+        );
+        Ok(VertexBuffer { buffer, memory })
+    }
 }
 
 fn run(args: &Args, engine: &Engine) -> Result<(), String> {
@@ -1640,6 +1898,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
         width: args.width,
         height: args.height,
     };
+    let leaf_thickness = leaf_thickness_buffer(engine, &allocator)?;
     let mut result = Ok(());
     let mut slots = Vec::with_capacity(FRAMES_IN_FLIGHT);
     let mut pipelines = None;
@@ -1685,7 +1944,16 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                         let (scene, renderer) = &mut **scene;
                         record_scene_frame(lucent, renderer, scene, slot, k, extent)
                     }
-                    other => record_frame(engine, pipelines, other, slot, k, frame, extent),
+                    other => record_frame(
+                        engine,
+                        pipelines,
+                        other,
+                        slot,
+                        k,
+                        frame,
+                        extent,
+                        leaf_thickness.buffer,
+                    ),
                 })
                 // SAFETY: the command buffer is recording.
                 .and_then(|()| {
@@ -1712,7 +1980,10 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     }
     if let Some(effects) = effects {
         match effects.inserted {
-            Inserted::Sss(sss) => (*sss).destroy(&effects.lucent),
+            Inserted::Effects { translucency, sss } => {
+                (*translucency).destroy(&effects.lucent);
+                (*sss).destroy(&effects.lucent);
+            }
             Inserted::Scene(scene) => (*scene).1.destroy(&effects.lucent),
         }
         drop(effects.lucent);
@@ -1723,8 +1994,14 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     if let Some(pipelines) = &pipelines {
         destroy_pipelines(device, pipelines);
     }
-    // SAFETY: lucent is gone and the device idle: nothing uses the cache.
-    unsafe { device.destroy_pipeline_cache(pipeline_cache, None) };
+    // SAFETY: lucent is gone and the device idle: nothing uses the cache or the buffer.
+    unsafe {
+        device.destroy_pipeline_cache(pipeline_cache, None);
+        device.destroy_buffer(leaf_thickness.buffer, None);
+    }
+    if let Ok(mut allocator) = allocator.lock() {
+        allocator.free(leaf_thickness.memory).ok();
+    }
     drop(allocator);
     result
 }

@@ -5,6 +5,8 @@
 #ifndef LUCENT_SSS_GLSL
 #define LUCENT_SSS_GLSL
 
+#include "host_ids.glsl"
+
 #define MAX_SSS_PROFILES 32
 #define MAX_SSS_STEPS 8
 
@@ -63,18 +65,10 @@ int sss_host_profile(uint host_id) {
     return int((word >> (8u * (host_id % 4u))) & 255u) % MAX_SSS_PROFILES;
 }
 
-// The bit field of a host's ID in its integer channel value.
-uint sss_host_field(uint raw) {
-    return (raw >> sss_profiles.id_decode.y) & sss_profiles.id_decode.z;
-}
-
 // The profile number of the texel `t` of the profile ID image (texelFetch's result).
 int sss_decode_id(vec4 t) {
 #ifdef LUCENT_SSS_HOST_IDS
-    // The channel's integer: exact for UNORM formats, whose values are integers / max.
-    float stored = t[min(sss_profiles.id_decode.x, 3u)];
-    uint raw = uint(clamp(stored, 0.0, 1.0) * float(sss_profiles.id_decode.w) + 0.5);
-    return sss_host_profile(sss_host_field(raw));
+    return sss_host_profile(host_material_id(t, sss_profiles.id_decode));
 #else
     return sss_profile_id(t.r);
 #endif
@@ -82,7 +76,7 @@ int sss_decode_id(vec4 t) {
 
 int sss_decode_id(uvec4 t) {
     // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
-    return sss_host_profile(sss_host_field(t[min(sss_profiles.id_decode.x, 3u)]));
+    return sss_host_profile(host_material_id(t, sss_profiles.id_decode));
 }
 
 // Whether profile `id` is blurred by chain `chain` (0 never is).

@@ -286,6 +286,168 @@ fn channel_bits(format: vk::Format, channel: u32) -> u32 {
     }
 }
 
+/// How the normal image's values encode a unit normal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum NormalEncoding {
+    /// x, y, z in the first three channels: as stored for float and SNORM formats, `2v - 1`
+    /// for UNORM ones (`RGBA16F`, `RGB10A2`, `RGBA8`).
+    Xyz,
+    /// Octahedral (Cigolle et al. 2014) in the first two channels, in [-1, 1] (float and
+    /// SNORM formats) or mapped to [0, 1] (UNORM: `RG16_UNORM`, `RG8_UNORM`).
+    Octahedral,
+}
+
+/// The space the host's normals are in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum NormalSpace {
+    /// World space.
+    World,
+    /// View space of the frame's [`HostCamera::view`] (turned to world space with its
+    /// inverse).
+    View,
+}
+
+/// The host's per-pixel shading normals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct NormalDesc {
+    /// Its format: a float, SNORM or UNORM colour format with the channels the encoding
+    /// reads (3 for [`NormalEncoding::Xyz`], 2 for [`NormalEncoding::Octahedral`]).
+    pub format: vk::Format,
+    /// How the channels hold the normal.
+    pub encoding: NormalEncoding,
+    /// The space.
+    pub space: NormalSpace,
+}
+
+impl NormalDesc {
+    /// World-space normals as x, y, z.
+    pub fn world(format: vk::Format) -> Self {
+        Self {
+            format,
+            encoding: NormalEncoding::Xyz,
+            space: NormalSpace::World,
+        }
+    }
+
+    /// Octahedral normals in `space`.
+    pub fn octahedral(format: vk::Format, space: NormalSpace) -> Self {
+        Self {
+            format,
+            encoding: NormalEncoding::Octahedral,
+            space,
+        }
+    }
+
+    /// With the normals in `space`.
+    pub fn in_space(mut self, space: NormalSpace) -> Self {
+        self.space = space;
+        self
+    }
+
+    /// Checks the format against the encoding; returns the shader's decode (x: octahedral,
+    /// y: view space, z: UNORM channels mapped from [0, 1]).
+    pub(crate) fn decode(&self) -> Result<[u32; 4]> {
+        let needed = match self.encoding {
+            NormalEncoding::Xyz => 3,
+            NormalEncoding::Octahedral => 2,
+        };
+        let info = format_info(self.format);
+        let kind_ok = info.is_some_and(|f| {
+            matches!(
+                f.kind,
+                FormatKind::Unorm | FormatKind::Snorm | FormatKind::Float
+            )
+        });
+        let channels = info.map_or(0, |f| f.channels);
+        if !kind_ok || channels < needed {
+            return Err(HostError::Unsupported {
+                input: "normals".into(),
+                found: format!(
+                    "format {} with {:?}",
+                    format_name(self.format),
+                    self.encoding
+                ),
+                accepted: format!(
+                    "a float, SNORM or UNORM colour format with at least {needed} channels \
+                     (Xyz: RGBA16F, RGB10A2, RGBA8; Octahedral: RG16_UNORM, RG16F, RG8_SNORM)"
+                ),
+            }
+            .into());
+        }
+        let unorm = info.is_some_and(|f| f.kind == FormatKind::Unorm);
+        Ok([
+            u32::from(self.encoding == NormalEncoding::Octahedral),
+            u32::from(self.space == NormalSpace::View),
+            u32::from(unorm),
+            0,
+        ])
+    }
+}
+
+/// Which channels of the thickness image hold the local thickness.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ThicknessChannels {
+    /// One channel (0 = R .. 3 = A): grayscale thickness, the talk's one G-buffer channel.
+    One(u8),
+    /// R, G and B: coloured thickness (light of each colour let through apart).
+    Rgb,
+}
+
+/// The host's local thickness per pixel, GDC 2011's "inverted ambient occlusion": 0 opaque,
+/// 1 lets all the light through. [`crate::embed::bake_thickness`] bakes it per vertex from
+/// a mesh, for the host to carry through its vertex buffers into this image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ThicknessDesc {
+    /// A float or UNORM colour format (values clamped to [0, 1]).
+    pub format: vk::Format,
+    /// The channels.
+    pub channels: ThicknessChannels,
+}
+
+impl ThicknessDesc {
+    /// Grayscale thickness in channel `channel` of `format`.
+    pub fn channel(format: vk::Format, channel: u8) -> Self {
+        Self {
+            format,
+            channels: ThicknessChannels::One(channel),
+        }
+    }
+
+    /// Coloured thickness in the R, G, B channels of `format`.
+    pub fn rgb(format: vk::Format) -> Self {
+        Self {
+            format,
+            channels: ThicknessChannels::Rgb,
+        }
+    }
+
+    /// Checks the format against the channels; returns the shader's decode (x: the channel,
+    /// 4 for rgb).
+    pub(crate) fn decode(&self) -> Result<[u32; 4]> {
+        let info = format_info(self.format);
+        let channels = info.map_or(0, |f| f.channels);
+        let kind_ok = info.is_some_and(|f| matches!(f.kind, FormatKind::Unorm | FormatKind::Float));
+        let (channel, needed) = match self.channels {
+            ThicknessChannels::One(c) => (u32::from(c), u32::from(c) + 1),
+            ThicknessChannels::Rgb => (4, 3),
+        };
+        if !kind_ok || channels < needed {
+            return Err(HostError::Unsupported {
+                input: "thickness".into(),
+                found: format!("{:?} of format {}", self.channels, format_name(self.format)),
+                accepted: "a float or UNORM colour format that has the channels named".into(),
+            }
+            .into());
+        }
+        Ok([channel, 0, 0, 0])
+    }
+}
+
 /// The host's G-buffer: what each of its images holds and how, its size and its world's scale.
 ///
 /// ```
@@ -321,6 +483,10 @@ pub struct GBufferDesc {
     pub albedo: Option<vk::Format>,
     /// The per-pixel material ID image.
     pub material_ids: Option<IdDesc>,
+    /// The shading normals, when the host has them (GDC 2011 translucency reads them).
+    pub normals: Option<NormalDesc>,
+    /// The local thickness, when the host has it (GDC 2011 translucency reads it).
+    pub thickness: Option<ThicknessDesc>,
     /// The size of the host's world unit in metres (1: metres, 0.01: centimetres): the SSS
     /// profiles' millimetres are converted with it.
     pub metres_per_unit: f32,
@@ -337,6 +503,8 @@ impl GBufferDesc {
             specular: None,
             albedo: None,
             material_ids: None,
+            normals: None,
+            thickness: None,
             metres_per_unit: 1.0,
         }
     }
@@ -356,6 +524,18 @@ impl GBufferDesc {
     /// With the material ID image.
     pub fn with_material_ids(mut self, ids: IdDesc) -> Self {
         self.material_ids = Some(ids);
+        self
+    }
+
+    /// With the normal image.
+    pub fn with_normals(mut self, normals: NormalDesc) -> Self {
+        self.normals = Some(normals);
+        self
+    }
+
+    /// With the thickness image.
+    pub fn with_thickness(mut self, thickness: ThicknessDesc) -> Self {
+        self.thickness = Some(thickness);
         self
     }
 
@@ -445,6 +625,12 @@ impl GBufferDesc {
         }
         if let Some(ids) = &self.material_ids {
             ids.decode(Vec::new())?;
+        }
+        if let Some(normals) = &self.normals {
+            normals.decode()?;
+        }
+        if let Some(thickness) = &self.thickness {
+            thickness.decode()?;
         }
         Ok(())
     }

@@ -215,6 +215,9 @@ impl HostImage {
 pub(crate) enum Role {
     /// Written as a colour attachment (the output).
     Output,
+    /// Added to as a colour attachment, its contents kept and blended with (the light an
+    /// effect adds to the host's lighting).
+    Accumulate,
     /// Sampled colour (lit diffuse, specular, albedo, colour material IDs, linear depth).
     SampledColor,
     /// Sampled depth (or stencil: material IDs in stencil bits) of a depth-stencil image.
@@ -224,7 +227,7 @@ pub(crate) enum Role {
 impl Role {
     fn usage(self) -> (vk::ImageUsageFlags, &'static str) {
         match self {
-            Role::Output => (
+            Role::Output | Role::Accumulate => (
                 vk::ImageUsageFlags::COLOR_ATTACHMENT,
                 "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT (lucent writes it as a colour attachment)",
             ),
@@ -238,6 +241,11 @@ impl Role {
     fn format_feature(self) -> (vk::FormatFeatureFlags, &'static str) {
         match self {
             Role::Output => (vk::FormatFeatureFlags::COLOR_ATTACHMENT, "COLOR_ATTACHMENT"),
+            // Additive blending.
+            Role::Accumulate => (
+                vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND,
+                "COLOR_ATTACHMENT_BLEND",
+            ),
             Role::SampledColor | Role::SampledDepth => {
                 (vk::FormatFeatureFlags::SAMPLED_IMAGE, "SAMPLED_IMAGE")
             }
@@ -247,7 +255,7 @@ impl Role {
     /// The state lucent's own commands use the image in (the graph's import state).
     pub(crate) fn working_state(self) -> ImageState {
         match self {
-            Role::Output => ImageState::color_attachment(),
+            Role::Output | Role::Accumulate => ImageState::color_attachment(),
             Role::SampledColor | Role::SampledDepth => ImageState::fragment_sampled(),
         }
     }
@@ -563,7 +571,13 @@ pub(crate) fn check_image(
         return Err(invalid(
             &image.name,
             ImageFault::Layout,
-            "is an input but its current layout is UNDEFINED (its contents would be lost)".into(),
+            if role == Role::Accumulate {
+                "is added to but its current layout is UNDEFINED (its contents would be lost)"
+                    .into()
+            } else {
+                "is an input but its current layout is UNDEFINED (its contents would be lost)"
+                    .into()
+            },
         ));
     }
     if image.final_state.is_none() && image.state.layout == vk::ImageLayout::UNDEFINED {
@@ -576,6 +590,40 @@ pub(crate) fn check_image(
         ));
     }
     check_state(image, &image.left_in(), "final", true)
+}
+
+/// The inputs of one frame, one per distinct Vulkan image (the depth and stencil IDs of one
+/// depth-stencil image are transitioned once, so both must declare the same states); an input
+/// that is also `output` is refused.
+pub(crate) fn distinct_inputs<'a>(
+    inputs: impl IntoIterator<Item = &'a HostImage>,
+    output: &HostImage,
+) -> Result<Vec<&'a HostImage>> {
+    let mut distinct: Vec<&HostImage> = Vec::new();
+    for image in inputs {
+        if image.image == output.image {
+            return Err(invalid(
+                &output.name,
+                ImageFault::Aliased,
+                format!("is both an input ('{}') and the output", image.name),
+            ));
+        }
+        match distinct.iter().find(|i| i.image == image.image) {
+            Some(first) if first.state != image.state || first.left_in() != image.left_in() => {
+                return Err(invalid(
+                    &image.name,
+                    ImageFault::Aliased,
+                    format!(
+                        "is the same image as '{}' with other states: one image is in one state",
+                        first.name
+                    ),
+                ))
+            }
+            Some(_) => {}
+            None => distinct.push(image),
+        }
+    }
+    Ok(distinct)
 }
 
 /// Records one barrier moving `image` from `from` to `to` (the old contents kept unless

@@ -139,25 +139,34 @@ use crate::backend::GpuContext;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
+mod capabilities;
 mod gbuffer;
 mod image;
 mod scene;
 mod sss;
+mod translucency;
 mod uploads;
 
+pub use capabilities::{capabilities, Effect, Support};
 pub use gbuffer::{
     DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
-    IdEncoding,
+    IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
 };
 pub use image::{HostImage, ImageState};
 pub use scene::SceneRenderer;
 pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
+pub(crate) use translucency::shader_permutations as translucency_permutations;
+pub use translucency::{
+    bake_thickness, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
+    TranslucencyImages, TranslucentMaterial,
+};
 pub use uploads::{leaked, Uploads};
 // The types a host names in its descriptions, and the versions of the crates it must build its
 // handles with.
 pub use crate::error::{HostError, ImageFault};
 pub use crate::features::sss::SssKnobs;
-pub use crate::scene::material::{SssProfile, Texturing};
+pub use crate::scene::material::{PowMode, SssProfile, Texturing, Translucency};
+pub use crate::scene::{Light, LightKind};
 pub use ash;
 pub use glam;
 

@@ -22,8 +22,9 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::capabilities::{missing, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
-use super::image::{check_image, record_transition, HostImage, Role};
+use super::image::{check_image, distinct_inputs, record_transition, HostImage, Role};
 use super::uploads::LeakGuard;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -180,12 +181,12 @@ impl SssEffect {
     pub fn new(lucent: &Lucent, uploads: &mut Uploads, desc: SssEffectDesc) -> Result<Self> {
         let gbuffer = &desc.gbuffer;
         gbuffer.check()?;
-        let ids = gbuffer.material_ids.ok_or_else(|| HostError::Missing {
-            input: "material IDs".into(),
-            needed_by: "screen-space SSS picks each pixel's profile by its material ID \
-                        (GBufferDesc::with_material_ids)"
-                .into(),
-        })?;
+        if let Some(first) = missing(Effect::Sss, gbuffer).into_iter().next() {
+            return Err(first.into());
+        }
+        let ids = gbuffer
+            .material_ids
+            .expect("missing() lists the material IDs");
         if !(1..=MAX_VIEWS_PER_FRAME).contains(&desc.views_per_frame) {
             return Err(HostError::Description {
                 field: "views_per_frame".into(),
@@ -520,7 +521,6 @@ impl SssEffect {
                 }
             }
         }
-        let mut inputs: Vec<&HostImage> = Vec::new();
         let all = [
             Some(images.depth),
             Some(images.diffuse),
@@ -528,33 +528,7 @@ impl SssEffect {
             images.specular,
             images.albedo,
         ];
-        for image in all.into_iter().flatten() {
-            if image.image == frame.output.image {
-                return Err(HostError::Image {
-                    image: frame.output.name.clone(),
-                    kind: ImageFault::Aliased,
-                    problem: format!("is both an input ('{}') and the output", image.name),
-                }
-                .into());
-            }
-            match inputs.iter().find(|i| i.image == image.image) {
-                Some(first) if first.state != image.state || first.left_in() != image.left_in() => {
-                    return Err(HostError::Image {
-                        image: image.name.clone(),
-                        kind: ImageFault::Aliased,
-                        problem: format!(
-                            "is the same image as '{}' with other states: one image is in one \
-                             state",
-                            first.name
-                        ),
-                    }
-                    .into())
-                }
-                Some(_) => {}
-                None => inputs.push(image),
-            }
-        }
-        Ok(inputs)
+        distinct_inputs(all.into_iter().flatten(), frame.output)
     }
 
     /// Destroys the passes and their buffers. The GPU must be done with every frame that
@@ -677,7 +651,7 @@ fn declare(
 
 /// The scene the effect's GPU data is created with: no objects, lights or environment (the
 /// passes read the camera, the viewport and the tables only).
-fn frame_scene() -> Scene {
+pub(super) fn frame_scene() -> Scene {
     Scene {
         name: "host SSS".into(),
         meshes: Vec::new(),

@@ -17,7 +17,7 @@ use glam::Vec3;
 
 use super::tiles::TileRect;
 use crate::backend::{GpuBuffer, GpuContext};
-use crate::scene::{LightKind, Scene, MAX_LIGHTS};
+use crate::scene::{Light, LightKind, Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
 
 /// Frame uniforms, std140 (glsl/common/scene.glsl `Frame`).
@@ -50,37 +50,7 @@ impl FrameUniforms {
         let view_proj = projection * scene.camera.view();
         let mut lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
         for (slot, light) in lights.iter_mut().zip(&scene.lights) {
-            let radiance = light.radiance();
-            let scale = light.translucency_scale;
-            *slot = match light.kind {
-                LightKind::Directional { direction } => [
-                    direction.extend(0.0).to_array(),
-                    radiance.extend(0.0).to_array(),
-                    [0.0; 4],
-                    [1.0, scale, 0.0, 0.0],
-                ],
-                LightKind::Point { position, range } => [
-                    position.extend(1.0).to_array(),
-                    radiance.extend(range).to_array(),
-                    [0.0; 4],
-                    [1.0, scale, 0.0, 0.0],
-                ],
-                LightKind::Spot {
-                    position,
-                    direction,
-                    range,
-                    inner_degrees,
-                    outer_degrees,
-                } => [
-                    position.extend(2.0).to_array(),
-                    radiance.extend(range).to_array(),
-                    direction
-                        .normalize_or(Vec3::NEG_Y)
-                        .extend(outer_degrees.to_radians().cos())
-                        .to_array(),
-                    [inner_degrees.to_radians().cos(), scale, 0.0, 0.0],
-                ],
-            };
+            *slot = light_rows(light);
         }
         Self {
             view_proj: view_proj.to_cols_array_2d(),
@@ -158,6 +128,52 @@ impl FrameUniforms {
             fault: [0; 4],
             lights: [[[0.0; 4]; 4]; MAX_LIGHTS],
         }
+    }
+
+    /// These uniforms with `lights` (at most [`MAX_LIGHTS`]; the rest are dropped: callers
+    /// refuse more) instead of their own.
+    pub fn with_lights(mut self, lights: &[Light]) -> Self {
+        self.lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
+        for (slot, light) in self.lights.iter_mut().zip(lights) {
+            *slot = light_rows(light);
+        }
+        self.light_count = [lights.len().min(MAX_LIGHTS) as i32, 0, 0, 0];
+        self
+    }
+}
+
+/// One light as glsl/common/scene.glsl's `Light` holds it.
+fn light_rows(light: &Light) -> [[f32; 4]; 4] {
+    let radiance = light.radiance();
+    let scale = light.translucency_scale;
+    match light.kind {
+        LightKind::Directional { direction } => [
+            direction.extend(0.0).to_array(),
+            radiance.extend(0.0).to_array(),
+            [0.0; 4],
+            [1.0, scale, 0.0, 0.0],
+        ],
+        LightKind::Point { position, range } => [
+            position.extend(1.0).to_array(),
+            radiance.extend(range).to_array(),
+            [0.0; 4],
+            [1.0, scale, 0.0, 0.0],
+        ],
+        LightKind::Spot {
+            position,
+            direction,
+            range,
+            inner_degrees,
+            outer_degrees,
+        } => [
+            position.extend(2.0).to_array(),
+            radiance.extend(range).to_array(),
+            direction
+                .normalize_or(Vec3::NEG_Y)
+                .extend(outer_degrees.to_radians().cos())
+                .to_array(),
+            [inner_degrees.to_radians().cos(), scale, 0.0, 0.0],
+        ],
     }
 }
 

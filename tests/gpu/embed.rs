@@ -19,8 +19,9 @@ use lucent::embed::gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
     DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice, HostError,
-    HostImage, IdDesc, ImageFault, ImageState, Lucent, OptionalFeatures, SceneRenderer, SssEffect,
-    SssEffectDesc, SssFrame, SssImages, SssMaterial, Uploads,
+    HostImage, IdDesc, ImageFault, ImageState, Lucent, NormalDesc, OptionalFeatures, SceneRenderer,
+    SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect,
+    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial, Uploads,
 };
 use lucent::features::sss::SssProfiles;
 use lucent::frame::{FrameSettings, Renderer, Technique};
@@ -63,14 +64,14 @@ fn host_device(test: &TestGpu, device: ash::Device) -> HostDevice {
 }
 
 /// `lucent` for the host's own device: the test context's handles.
-fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
+pub(crate) fn wrap(test: &TestGpu, options: EmbedOptions) -> Lucent {
     let host = host_device(test, test.gpu.device.clone());
     // SAFETY: the handles are the test context's, created together with lucent's
     // requirements, and outlive the returned value (dropped before `test.finish()`).
     unsafe { Lucent::new(host, options) }.expect("wrap the test's device")
 }
 
-fn options(frames_in_flight: usize) -> EmbedOptions {
+pub(crate) fn options(frames_in_flight: usize) -> EmbedOptions {
     EmbedOptions {
         frames_in_flight,
         ..Default::default()
@@ -79,7 +80,7 @@ fn options(frames_in_flight: usize) -> EmbedOptions {
 
 /// Builds a renderer with its uploads recorded into a command buffer the test (the host)
 /// submits and waits for, then releases the uploads' staging memory.
-fn built<T>(
+pub(crate) fn built<T>(
     test: &TestGpu,
     lucent: &Lucent,
     build: impl FnOnce(&mut Uploads) -> lucent::Result<T>,
@@ -110,7 +111,7 @@ fn recorded<T>(test: &TestGpu, record: impl FnOnce(vk::CommandBuffer) -> T) -> T
 }
 
 /// The host's description of one of its images.
-fn described(image: &GpuImage, name: &str, usage: vk::ImageUsageFlags) -> HostImage {
+pub(crate) fn described(image: &GpuImage, name: &str, usage: vk::ImageUsageFlags) -> HostImage {
     HostImage::new(
         name,
         image.image,
@@ -125,11 +126,11 @@ fn described(image: &GpuImage, name: &str, usage: vk::ImageUsageFlags) -> HostIm
     .in_state(ImageState::fragment_sampled())
 }
 
-fn f32_bytes(texels: &[[f32; 4]]) -> Vec<u8> {
+pub(crate) fn f32_bytes(texels: &[[f32; 4]]) -> Vec<u8> {
     bytemuck::cast_slice(texels).to_vec()
 }
 
-fn tonemapped(hdr: &[f32], exposure: f64) -> Vec<u8> {
+pub(crate) fn tonemapped(hdr: &[f32], exposure: f64) -> Vec<u8> {
     hdr.chunks_exact(4)
         .flat_map(|t| {
             lucent::reference::tonemap::display_rgba8(
@@ -154,7 +155,7 @@ fn output_image(
 }
 
 /// The error a host gets for `result`, which must be a [`HostError`].
-fn host_error<T>(result: lucent::Result<T>) -> HostError {
+pub(crate) fn host_error<T>(result: lucent::Result<T>) -> HostError {
     match result {
         Err(LucentError::Host(e)) => e,
         Err(other) => panic!("expected a HostError, got {other}"),
@@ -164,17 +165,18 @@ fn host_error<T>(result: lucent::Result<T>) -> HostError {
 
 /// `image` changed by `change` (the descriptions cannot be made with struct update syntax
 /// outside lucent: they may grow fields).
-fn changed<T: Clone>(image: &T, change: impl FnOnce(&mut T)) -> T {
+pub(crate) fn changed<T: Clone>(image: &T, change: impl FnOnce(&mut T)) -> T {
     let mut out = image.clone();
     change(&mut out);
     out
 }
 
 /// The example host runs headless under validation, with every effect it inserts, and its
-/// frame shows the scatter: it differs from the same host frame without lucent where the skin
-/// is, and nowhere it has no scattering material.
+/// frame shows them: it differs from the same host frame without lucent where the skin is
+/// (the scatter) and where the leaf is (the light let through), and nowhere it has no
+/// material of lucent's.
 #[test]
-fn host_engine_example_runs_under_validation_and_its_frame_scatters() {
+fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_light_through() {
     let dir = common::temp_dir("embed-example");
     let run = |png: &Path, extra: &[&str]| {
         let out = Command::new(example_binary())
@@ -195,7 +197,10 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters() {
     let with = dir.join("with.png");
     let without = dir.join("without.png");
     let log = run(&with, &[]);
-    assert!(log.contains("lucent effects: sss"), "{log}");
+    assert!(
+        log.contains("lucent effects: translucency") && log.contains("sss (separable blur"),
+        "{log}"
+    );
     run(&without, &["--without-lucent"]);
     let (w, h, a) = read_png_rgba8(&with).unwrap();
     let (_, _, b) = read_png_rgba8(&without).unwrap();
@@ -207,7 +212,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters() {
         .count();
     let share = changed as f64 / f64::from(w * h);
     println!(
-        "host_engine: lucent's SSS changes {:.2}% of the pixels",
+        "host_engine: lucent's effects change {:.2}% of the pixels",
         share * 100.0
     );
     // The engine's spheres are 6 cm across and its profiles physical (skin, marble): the
@@ -220,9 +225,22 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters() {
         with.display(),
         without.display()
     );
+    // The jade leaf above the spheres (top third, the middle of the frame) is lit through by
+    // the light behind it: GDC 2011 translucency brightens it.
+    let row = 4 * w as usize;
+    let lit_through = (0..h as usize / 3)
+        .flat_map(|y| (w as usize / 3..2 * w as usize / 3).map(move |x| y * row + 4 * x))
+        .filter(|&i| a[i + 1] > b[i + 1].saturating_add(8))
+        .count();
+    println!("host_engine: lucent's translucency brightens {lit_through} pixels of the leaf");
+    assert!(
+        lit_through > 150,
+        "translucency brightened only {lit_through} pixels of the leaf ({} and {})",
+        with.display(),
+        without.display()
+    );
     // The right of the frame is the blue plastic sphere (the engine's material 5, no profile)
     // and the floor (0): lucent leaves their light as the engine lit it.
-    let row = 4 * w as usize;
     let right = (7 * w / 10) as usize;
     for (y, (ra, rb)) in a.chunks_exact(row).zip(b.chunks_exact(row)).enumerate() {
         for x in right..w as usize {
@@ -299,7 +317,7 @@ fn host_engine_scene_mode_matches_lucent_render_under_validation() {
 
 /// How a test host stores its depth.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum HostDepth {
+pub(crate) enum HostDepth {
     /// D32, standard Z (lucent's own).
     Standard,
     /// D32, reversed Z with an infinite far plane.
@@ -312,7 +330,7 @@ enum HostDepth {
 
 /// How a test host stores its material IDs.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum HostIds {
+pub(crate) enum HostIds {
     /// R8_UNORM, the profile number / 255 (lucent's own).
     Unorm,
     /// R8_UINT, the host's own numbers (10 + 3k; 200 where nothing scatters).
@@ -325,7 +343,7 @@ enum HostIds {
 }
 
 /// The host's ID of profile `k` (0: none).
-fn host_id(ids: HostIds, k: u8) -> u8 {
+pub(crate) fn host_id(ids: HostIds, k: u8) -> u8 {
     match (ids, k) {
         (HostIds::Uint, 0) => 200,
         (HostIds::Uint, k) => 10 + 3 * k,
@@ -478,21 +496,21 @@ fn depth_stencil_image(
 
 /// A host layout: its description, its images and its camera, made from lucent's own frame's
 /// depth (standard Z, `depth`) and profile numbers (`ids`).
-struct HostLayout {
-    desc: GBufferDesc,
-    camera: HostCamera,
+pub(crate) struct HostLayout {
+    pub(crate) desc: GBufferDesc,
+    pub(crate) camera: HostCamera,
     /// The depth image.
-    depth: GpuImage,
+    pub(crate) depth: GpuImage,
     /// The ID image, unless the IDs are in the depth image's stencil.
-    ids: Option<GpuImage>,
+    pub(crate) ids: Option<GpuImage>,
     /// The depth image's stencil view, when the IDs are there.
-    stencil_ids: Option<vk::ImageView>,
+    pub(crate) stencil_ids: Option<vk::ImageView>,
     /// Views the test made (destroyed with the layout).
-    views: Vec<vk::ImageView>,
+    pub(crate) views: Vec<vk::ImageView>,
 }
 
 #[allow(clippy::too_many_arguments)]
-fn host_layout(
+pub(crate) fn host_layout(
     test: &TestGpu,
     depth_kind: HostDepth,
     ids_kind: HostIds,
@@ -633,7 +651,7 @@ fn host_layout(
 }
 
 impl HostLayout {
-    fn destroy(self, test: &TestGpu) {
+    pub(crate) fn destroy(self, test: &TestGpu) {
         for view in self.views {
             // SAFETY: made for this test; the GPU is done with it.
             unsafe { test.gpu.device.destroy_image_view(view, None) };
@@ -646,7 +664,7 @@ impl HostLayout {
 }
 
 /// A new view of `image` (a host recreating its views between frames).
-fn fresh_view(
+pub(crate) fn fresh_view(
     test: &TestGpu,
     image: vk::Image,
     format: vk::Format,
@@ -1450,17 +1468,32 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
         DepthDesc::device(vk::Format::D32_SFLOAT),
         DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
     )
-    .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT))
+    .with_normals(NormalDesc::world(vk::Format::R16G16B16A16_SFLOAT))
+    .with_albedo(vk::Format::R16G16B16A16_SFLOAT)
+    .with_thickness(ThicknessDesc::channel(vk::Format::R16G16B16A16_SFLOAT, 0));
     let skin = SssProfile {
         texturing: Texturing::Pre,
         ..SssProfile::preset("skin").unwrap()
     };
+    let mut translucency = built(&test, &lucent, |u| {
+        TranslucencyEffect::new(
+            &lucent,
+            u,
+            TranslucencyEffectDesc::new(
+                gbuffer.clone(),
+                vec![TranslucentMaterial::new(2, 12.0, 0.2, 0.0)],
+            ),
+        )
+    })
+    .unwrap();
     let mut effect = built(&test, &lucent, |u| {
         SssEffect::new(
             &lucent,
             u,
             SssEffectDesc::new(
-                gbuffer,
+                // (The albedo is the translucency's: the SSS is given none.)
+                changed(&gbuffer, |g| g.albedo = None),
                 vec![SssMaterial::new(1, skin)],
                 vk::Format::R16G16B16A16_SFLOAT,
             ),
@@ -1496,8 +1529,33 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
             )
         })
         .unwrap();
+        // The translucency adds to what the SSS wrote (left in TRANSFER_SRC_OPTIMAL).
+        let colour_in = described(&colour, "colour", sampled);
+        let lighting = described(&out, "out", usage).in_state(ImageState::transfer_src());
+        recorded(&test, |cmd| {
+            translucency.record(
+                &lucent,
+                cmd,
+                &TranslucencyFrame {
+                    slot,
+                    view: 0,
+                    camera,
+                    lights: &scene.lights,
+                    images: TranslucencyImages {
+                        depth: images.depth,
+                        normals: &colour_in,
+                        albedo: &colour_in,
+                        thickness: &colour_in,
+                        material_ids: images.material_ids,
+                    },
+                    lighting: &lighting,
+                },
+            )
+        })
+        .unwrap();
     }
     effect.destroy(&lucent);
+    translucency.destroy(&lucent);
     drop(lucent);
     let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
     assert_eq!(

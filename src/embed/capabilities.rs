@@ -1,0 +1,215 @@
+//! Which of lucent's effects a host's G-buffer can run, and what each lacks
+//! ([`capabilities`]): asked before building anything, answered from the description alone.
+//! The effects' own constructors refuse with the same errors.
+
+use super::gbuffer::GBufferDesc;
+use crate::error::HostError;
+use crate::Result;
+
+/// One of the techniques lucent can add to a host's frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Effect {
+    /// Screen-space SSS on the host's lit diffuse ([`super::SssEffect`]: the control, the
+    /// separable blur, 2-D Burley).
+    Sss,
+    /// GDC 2011 thickness-based translucency added to the host's light
+    /// ([`super::TranslucencyEffect`]).
+    Translucency,
+    /// Screen-space SSS's transmission through thin parts (a medium's diffusion through the
+    /// thickness lucent's light-space maps measure).
+    SssTransmission,
+    /// Li et al.'s multi-layer single + dipole multiple scattering.
+    LayeredMedia,
+    /// The SH environment's diffuse light.
+    Environment,
+}
+
+impl Effect {
+    /// Every effect, in the order [`capabilities`] reports them.
+    pub const ALL: [Effect; 5] = [
+        Effect::Sss,
+        Effect::Translucency,
+        Effect::SssTransmission,
+        Effect::LayeredMedia,
+        Effect::Environment,
+    ];
+
+    /// A short name (`sss`, `translucency`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Sss => "sss",
+            Effect::Translucency => "translucency",
+            Effect::SssTransmission => "sss-transmission",
+            Effect::LayeredMedia => "layered-media",
+            Effect::Environment => "environment",
+        }
+    }
+}
+
+/// Whether a host's G-buffer can run an effect.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Support {
+    /// The description has every input the effect reads.
+    Runs,
+    /// Inputs the description lacks, each a [`HostError::Missing`] naming the input and why
+    /// the effect needs it (what the effect's constructor would refuse with).
+    Lacks(Vec<HostError>),
+    /// The effect has no path on a host's G-buffer yet: it reaches a host only inside
+    /// lucent's whole frame ([`super::SceneRenderer`]). Says what it would need.
+    NotEmbedded(&'static str),
+}
+
+impl Support {
+    /// Whether the effect can be built on the description.
+    pub fn runs(&self) -> bool {
+        matches!(self, Support::Runs)
+    }
+}
+
+/// For a host's G-buffer `gbuffer`, every effect ([`Effect::ALL`]) and whether it can run on
+/// it. An invalid description (a format that cannot hold its input, a size out of range) is
+/// the error [`GBufferDesc::check`] gives.
+///
+/// ```
+/// # use ash::vk;
+/// use lucent::embed::{capabilities, DepthDesc, DiffuseDesc, Effect, GBufferDesc, IdDesc};
+/// let gbuffer = GBufferDesc::new(
+///     1280,
+///     720,
+///     DepthDesc::device(vk::Format::D32_SFLOAT),
+///     DiffuseDesc::with_albedo(vk::Format::B10G11R11_UFLOAT_PACK32),
+/// )
+/// .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+/// let support = capabilities(&gbuffer).unwrap();
+/// assert!(support[0].1.runs()); // screen-space SSS: depth, diffuse and IDs are enough
+/// assert_eq!(support[1].0, Effect::Translucency); // ...which lacks normals, albedo, thickness
+/// assert!(!support[1].1.runs());
+/// ```
+pub fn capabilities(gbuffer: &GBufferDesc) -> Result<Vec<(Effect, Support)>> {
+    gbuffer.check()?;
+    Ok(Effect::ALL
+        .iter()
+        .map(|&effect| (effect, support(effect, gbuffer)))
+        .collect())
+}
+
+/// Whether `effect` can run on `gbuffer` (already checked).
+pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
+    let lacks = missing(effect, gbuffer);
+    match effect {
+        Effect::Sss | Effect::Translucency if lacks.is_empty() => Support::Runs,
+        Effect::Sss | Effect::Translucency => Support::Lacks(lacks),
+        Effect::SssTransmission => Support::NotEmbedded(
+            "the thickness along each light's direction, which lucent measures in its own \
+             light-space maps of the scene's meshes",
+        ),
+        Effect::LayeredMedia => Support::NotEmbedded(
+            "light-space depth maps of each layered object drawn from the host's vertex and \
+             index buffers",
+        ),
+        Effect::Environment => Support::NotEmbedded(
+            "the host's ambient light is its own; lucent's SH environment lights lucent's \
+             scenes",
+        ),
+    }
+}
+
+/// The inputs `effect` reads that `gbuffer` lacks, as the errors its constructor gives.
+pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
+    let lack = |input: &str, needed_by: &str| HostError::Missing {
+        input: input.into(),
+        needed_by: needed_by.into(),
+    };
+    let mut out = Vec::new();
+    match effect {
+        Effect::Sss => {
+            if gbuffer.material_ids.is_none() {
+                out.push(lack(
+                    "material IDs",
+                    "screen-space SSS picks each pixel's profile by its material ID \
+                     (GBufferDesc::with_material_ids)",
+                ));
+            }
+        }
+        Effect::Translucency => {
+            if gbuffer.material_ids.is_none() {
+                out.push(lack(
+                    "material IDs",
+                    "GDC 2011 translucency picks each pixel's material by its ID \
+                     (GBufferDesc::with_material_ids)",
+                ));
+            }
+            if gbuffer.normals.is_none() {
+                out.push(lack(
+                    "normals",
+                    "GDC 2011 translucency bends the light through the surface by its normal \
+                     (GBufferDesc::with_normals)",
+                ));
+            }
+            if gbuffer.albedo.is_none() {
+                out.push(lack(
+                    "albedo",
+                    "GDC 2011 translucency tints the light let through by the surface albedo \
+                     (GBufferDesc::with_albedo)",
+                ));
+            }
+            if gbuffer.thickness.is_none() {
+                out.push(lack(
+                    "thickness",
+                    "GDC 2011 translucency lets light through in proportion to the local \
+                     thickness (GBufferDesc::with_thickness; lucent::embed::bake_thickness \
+                     bakes it per vertex)",
+                ));
+            }
+        }
+        Effect::SssTransmission | Effect::LayeredMedia | Effect::Environment => {}
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embed::{DepthDesc, DiffuseDesc, IdDesc, NormalDesc, ThicknessDesc};
+    use ash::vk;
+
+    #[test]
+    fn each_effect_says_what_the_description_lacks() {
+        let bare = GBufferDesc::new(
+            64,
+            64,
+            DepthDesc::device(vk::Format::D24_UNORM_S8_UINT),
+            DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+        );
+        let support = capabilities(&bare).unwrap();
+        assert_eq!(support.len(), Effect::ALL.len());
+        let Support::Lacks(sss) = &support[0].1 else {
+            panic!("{:?}", support[0])
+        };
+        assert_eq!(sss.len(), 1);
+        let Support::Lacks(translucency) = &support[1].1 else {
+            panic!("{:?}", support[1])
+        };
+        let inputs: Vec<String> = translucency
+            .iter()
+            .map(|e| match e {
+                HostError::Missing { input, .. } => input.clone(),
+                other => panic!("{other}"),
+            })
+            .collect();
+        assert_eq!(inputs, ["material IDs", "normals", "albedo", "thickness"]);
+        assert!(matches!(support[3].1, Support::NotEmbedded(_)));
+
+        let full = bare
+            .with_material_ids(IdDesc::stencil(vk::Format::D24_UNORM_S8_UINT, 0, 8))
+            .with_normals(NormalDesc::world(vk::Format::A2B10G10R10_UNORM_PACK32))
+            .with_albedo(vk::Format::R8G8B8A8_SRGB)
+            .with_thickness(ThicknessDesc::channel(vk::Format::R8_UNORM, 0));
+        let support = capabilities(&full).unwrap();
+        assert!(support[0].1.runs() && support[1].1.runs());
+        // An invalid description is its own error, not a list.
+        assert!(capabilities(&full.with_metres_per_unit(-1.0)).is_err());
+    }
+}

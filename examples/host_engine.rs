@@ -1414,13 +1414,14 @@ fn record_frame(
     pipelines: &Pipelines,
     effects: Option<&mut Effects>,
     slot: &mut FrameSlot,
-    slot_index: usize,
     frame: usize,
     extent: vk::Extent2D,
     leaf_thickness: vk::Buffer,
 ) -> Result<(), String> {
     let device = &engine.device;
     let cmd = slot.cmd;
+    // The frame-in-flight slot (`slot` is the engine's for it).
+    let slot_index = frame % FRAMES_IN_FLIGHT;
     let (view, projection, eye) = camera(frame, extent.width as f32 / extent.height as f32);
     let sun = Vec3::new(0.9, 0.75, -0.35).normalize();
     let push = |m: Mat4| Push {
@@ -1949,7 +1950,6 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                         pipelines,
                         other,
                         slot,
-                        k,
                         frame,
                         extent,
                         leaf_thickness.buffer,

@@ -73,6 +73,12 @@ const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 const SKIN_ID: u8 = 17;
 const MARBLE_ID: u8 = 42;
 const PLASTIC_ID: u8 = 5;
+/// The spheres (skin, marble, plastic): centre and radius in metres.
+const SPHERES: [[f32; 4]; 3] = [
+    [-0.14, 0.06, 0.0, 0.06],
+    [0.0, 0.06, 0.0, 0.06],
+    [0.14, 0.06, 0.0, 0.06],
+];
 /// The thin jade leaf, lit through by GDC 2011 translucency.
 const LEAF_ID: u8 = 9;
 /// The leaf: an ellipsoid's centre and radii (metres), thin along z.
@@ -96,13 +102,17 @@ struct Args {
     out: PathBuf,
     with_lucent: bool,
     blur: String,
+    /// `--whole-screen`: the effects draw over the whole screen, not only over the objects'
+    /// screen regions (the same picture; a check of the regions).
+    whole_screen: bool,
     /// `--scene NAME`: the frame is lucent's whole frame of a built-in scene or scene file
     /// (`SceneRenderer`) instead of the engine's own.
     scene: Option<String>,
 }
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
-                     [--blur separable|control|burley] [--without-lucent] [--scene NAME]";
+                     [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
+                     [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -112,6 +122,7 @@ fn parse_args() -> Result<Args, String> {
         out: PathBuf::from("host_engine.png"),
         with_lucent: true,
         blur: "separable".into(),
+        whole_screen: false,
         scene: None,
     };
     let mut it = std::env::args().skip(1);
@@ -141,6 +152,7 @@ fn parse_args() -> Result<Args, String> {
             "--out" => args.out = PathBuf::from(value()?),
             "--blur" => args.blur = value()?,
             "--without-lucent" => args.with_lucent = false,
+            "--whole-screen" => args.whole_screen = true,
             "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
             other => return Err(format!("unknown argument {other}\n{USAGE}")),
@@ -176,8 +188,7 @@ layout(location = 1) out vec3 v_normal;
 layout(location = 2) flat out uint v_object;
 layout(location = 3) out float v_thickness;
 // Centre (xyz) and radius (w) in metres.
-const vec4 SPHERES[3] = vec4[3](vec4(-0.14, 0.06, 0.0, 0.06), vec4(0.0, 0.06, 0.0, 0.06),
-                                vec4(0.14, 0.06, 0.0, 0.06));
+const vec4 SPHERES[3] = vec4[3]({SPHERES});
 void main() {{
     uint object = uint(gl_InstanceIndex);
     vec3 p;
@@ -213,6 +224,9 @@ void main() {{
 "#,
             SLICES = super::SLICES,
             STACKS = super::STACKS,
+            SPHERES = super::SPHERES
+                .map(|[x, y, z, r]| format!("vec4({x:?}, {y:?}, {z:?}, {r:?})"))
+                .join(", "),
             LX = super::LEAF_CENTRE[0],
             LY = super::LEAF_CENTRE[1],
             LZ = super::LEAF_CENTRE[2],
@@ -1268,10 +1282,52 @@ fn engine_lights(sun: Vec3) -> [Light; 2] {
     [sun, back]
 }
 
+/// The eight corners of a box (centre, half extents).
+fn corners(centre: Vec3, half: Vec3) -> Vec<Vec3> {
+    (0..8)
+        .map(|i| {
+            let sign = Vec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            centre + sign * half
+        })
+        .collect()
+}
+
+/// The screen rectangle the leaf covers: where the translucency pass draws (none, the whole
+/// screen, when the engine asks for it or the leaf crosses the eye's plane).
+fn leaf_region(camera: &HostCamera, extent: vk::Extent2D, whole_screen: bool) -> Vec<vk::Rect2D> {
+    let leaf = corners(Vec3::from(LEAF_CENTRE), Vec3::from(LEAF_RADII));
+    let region = lucent::embed::screen_region(&leaf, camera, extent, 0.0);
+    region.filter(|_| !whole_screen).into_iter().collect()
+}
+
+/// The screen rectangles of the skin and marble spheres widened by the blurs' `reach`: where
+/// the SSS blurs run (a pass-through elsewhere).
+fn scattering_region(
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    reach: f32,
+    whole_screen: bool,
+) -> Vec<vk::Rect2D> {
+    let regions: Option<Vec<vk::Rect2D>> = SPHERES[..2]
+        .iter()
+        .map(|&[x, y, z, r]| {
+            let sphere = corners(Vec3::new(x, y, z), Vec3::splat(r));
+            lucent::embed::screen_region(&sphere, camera, extent, reach)
+        })
+        .collect();
+    regions.filter(|_| !whole_screen).unwrap_or_default()
+}
+
 /// What lucent adds to the engine: the effect, and the `Lucent` it was built from.
 struct Effects {
     lucent: Lucent,
     inserted: Inserted,
+    /// `--whole-screen`: no regions.
+    whole_screen: bool,
 }
 
 /// What the engine's frame gets from lucent.
@@ -1536,6 +1592,7 @@ fn record_frame(
             let Inserted::Effects { translucency, sss } = &mut effects.inserted else {
                 return Err("record_frame is the engine's own frame, not --scene's".into());
             };
+            let camera = HostCamera::new(view, projection);
             let depth = slot.depth.host_image(extent);
             let normals = slot.normal.host_image(extent);
             let albedo = slot.albedo.host_image(extent);
@@ -1549,7 +1606,7 @@ fn record_frame(
                     &TranslucencyFrame {
                         slot: slot_index,
                         view: 0,
-                        camera: HostCamera::new(view, projection),
+                        camera,
                         lights: &engine_lights(sun),
                         images: TranslucencyImages {
                             depth: &depth,
@@ -1558,6 +1615,8 @@ fn record_frame(
                             thickness: &thickness,
                             material_ids: &ids,
                         },
+                        // The leaf's projected bounds: the pass draws nothing elsewhere.
+                        regions: &leaf_region(&camera, extent, effects.whole_screen),
                         lighting: &lighting,
                     },
                 )
@@ -1579,7 +1638,7 @@ fn record_frame(
             let frame = SssFrame {
                 slot: slot_index,
                 view: 0,
-                camera: HostCamera::new(view, projection),
+                camera,
                 images: SssImages {
                     depth: &depth,
                     diffuse: &diffuse,
@@ -1587,6 +1646,8 @@ fn record_frame(
                     albedo: Some(&albedo),
                     material_ids: &ids,
                 },
+                // The skin's and the marble's projected bounds: elsewhere a pass-through.
+                regions: &scattering_region(&camera, extent, sss.reach(), effects.whole_screen),
                 output: &output,
             };
             sss.record(&effects.lucent, cmd, &frame)
@@ -1784,7 +1845,11 @@ fn create_effects(
              bytes uploaded)"
         ),
     }
-    Ok(Effects { lucent, inserted })
+    Ok(Effects {
+        lucent,
+        inserted,
+        whole_screen: args.whole_screen,
+    })
 }
 
 /// The engine's vertex buffer of the leaf's local thickness: one float per vertex the sphere
@@ -1941,6 +2006,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                     Some(Effects {
                         lucent,
                         inserted: Inserted::Scene(scene),
+                        ..
                     }) => {
                         let (scene, renderer) = &mut **scene;
                         record_scene_frame(lucent, renderer, scene, slot, k, extent)

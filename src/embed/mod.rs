@@ -114,6 +114,7 @@
 //!         albedo: None,
 //!         material_ids: &ids,
 //!     },
+//!     regions: &[], // the whole screen (or the skin's projected bounds)
 //!     output: &output,
 //! };
 //! sss.record(&lucent, cmd, &frame)?;
@@ -142,8 +143,10 @@ use crate::{LucentError, Result};
 mod capabilities;
 mod gbuffer;
 mod image;
+mod regions;
 mod scene;
 mod sss;
+mod timing;
 mod translucency;
 mod uploads;
 
@@ -153,8 +156,10 @@ pub use gbuffer::{
     IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
 };
 pub use image::{HostImage, ImageState};
+pub use regions::screen_region;
 pub use scene::SceneRenderer;
 pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
+pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;
 pub use translucency::{
     bake_thickness, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
@@ -174,8 +179,9 @@ pub use glam;
 /// that built against the previous one (the crate's own version says which release). 3: the
 /// host's G-buffer described ([`GBufferDesc`]) and bound per frame ([`SssEffect`], replacing
 /// `PostProcessSss`), uploads recorded into the host's command buffer ([`Uploads`]), typed
-/// errors ([`HostError`]).
-pub const API_VERSION: u32 = 3;
+/// errors ([`HostError`]). 4: [`SssFrame::regions`] (the blurs' screen regions),
+/// [`TranslucencyEffect`], [`capabilities`], [`EffectTimer`] and `record_timed`.
+pub const API_VERSION: u32 = 4;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -25,6 +25,7 @@ use ash::vk;
 use super::capabilities::{missing, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, record_transition, HostImage, Role};
+use super::regions::marked_tiles;
 use super::uploads::LeakGuard;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -139,6 +140,12 @@ pub struct SssFrame<'a> {
     pub camera: HostCamera,
     /// The G-buffer's images.
     pub images: SssImages<'a>,
+    /// Screen rectangles the scattering materials' light may reach this frame: their
+    /// objects' projected bounds widened by the blurs' reach ([`SssEffect::reach`];
+    /// [`super::screen_region`] computes both). The blurs run on the 64-pixel tiles these
+    /// touch and a pass-through elsewhere, as in lucent's own frames; a region that leaves
+    /// out the reach changes the result near its edge. Empty: the whole screen.
+    pub regions: &'a [vk::Rect2D],
     /// The image the result is written into (a colour attachment of the output format).
     pub output: &'a HostImage,
 }
@@ -160,6 +167,10 @@ pub struct SssEffect {
     scene_gpu: Option<Arc<SceneGpu>>,
     imports: Imports,
     desc: SssEffectDesc,
+    /// The blur chains the profiles use (each draws in the frame's tiles).
+    chains: usize,
+    /// The widest profile's reach, world units ([`Self::reach`]).
+    reach: f32,
     frames_in_flight: usize,
     guard: Option<LeakGuard>,
 }
@@ -330,6 +341,12 @@ impl SssEffect {
             scene_gpu: Some(scene_gpu),
             imports,
             desc,
+            chains: profiles.chains().len(),
+            reach: profiles
+                .profiles
+                .iter()
+                .map(|(p, _)| sss::profile_reach(p))
+                .fold(0.0, f32::max),
             frames_in_flight: lucent.frames_in_flight(),
             guard: Some(LeakGuard::new("SssEffect")),
         };
@@ -355,6 +372,14 @@ impl SssEffect {
         self.executable.as_ref().expect("alive until destroy")
     }
 
+    /// How far, in the host's world units, the blurs spread light beyond an object (3 sigma
+    /// of the widest profile's widest Gaussian): widen each object's screen bounds by it
+    /// projected at the object's depth for [`SssFrame::regions`] ([`super::screen_region`]
+    /// does).
+    pub fn reach(&self) -> f32 {
+        self.reach
+    }
+
     /// The passes the effect records (their plan, for tables and tests).
     pub fn plan(&self) -> &crate::graph::Plan {
         &self.executable().plan
@@ -370,6 +395,29 @@ impl SssEffect {
         lucent: &Lucent,
         cmd: vk::CommandBuffer,
         frame: &SssFrame<'_>,
+    ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, None)
+    }
+
+    /// [`Self::record`] with a timestamp pair around each pass, written into `timer` (reset in
+    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
+    /// fence has signalled.
+    pub fn record_timed(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &SssFrame<'_>,
+        timer: &mut super::EffectTimer,
+    ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, Some(timer))
+    }
+
+    fn record_with(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &SssFrame<'_>,
+        timer: Option<&mut super::EffectTimer>,
     ) -> Result<()> {
         let views = self.desc.views_per_frame;
         if frame.slot >= self.frames_in_flight {
@@ -400,9 +448,13 @@ impl SssEffect {
             gbuffer.height,
             decode,
         );
-        self.scene_gpu()
-            .per_frame
-            .write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        let per_frame = &self.scene_gpu().per_frame;
+        per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        // Each chain's tiles (none: the whole screen).
+        per_frame.tiles(ring).sss = match marked_tiles(frame.regions, gbuffer.extent()) {
+            Some(tiles) => vec![Some(tiles); self.chains],
+            None => Vec::new(),
+        };
         let gpu = lucent.gpu();
         let mut binds = vec![
             (self.imports.depth, frame.images.depth),
@@ -428,7 +480,12 @@ impl SssEffect {
             record_transition(gpu, cmd, image, &image.state, &sampled);
         }
         record_transition(gpu, cmd, frame.output, &frame.output.state, &attachment);
-        self.executable().record_frame(gpu, cmd, ring, None);
+        let timer = timer.map(|t| {
+            let timer = t.timer_mut();
+            timer.reset(gpu, cmd);
+            timer
+        });
+        self.executable().record_frame(gpu, cmd, ring, timer);
         for image in &inputs {
             record_transition(gpu, cmd, image, &sampled, &image.left_in());
         }

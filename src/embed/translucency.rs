@@ -27,6 +27,7 @@ use glam::Vec3;
 use super::capabilities::{missing, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, record_transition, HostImage, Role};
+use super::regions::clipped;
 use super::sss::frame_scene;
 use super::uploads::LeakGuard;
 use super::{Lucent, Uploads};
@@ -215,6 +216,11 @@ pub struct TranslucencyFrame<'a> {
     pub lights: &'a [Light],
     /// The G-buffer's images.
     pub images: TranslucencyImages<'a>,
+    /// Screen rectangles the translucent materials may cover this frame (say, their
+    /// objects' projected bounds): the pass draws only inside them, as lucent's own lighting
+    /// pass runs the term only on the tiles translucent objects cover. Empty: the whole
+    /// screen. Clipped to the G-buffer.
+    pub regions: &'a [vk::Rect2D],
     /// The host's lit diffuse light, which the term is added to (a colour attachment of the
     /// description's diffuse format that can be blended; its contents are kept, so it cannot
     /// come in UNDEFINED).
@@ -436,6 +442,29 @@ impl TranslucencyEffect {
         cmd: vk::CommandBuffer,
         frame: &TranslucencyFrame<'_>,
     ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, None)
+    }
+
+    /// [`Self::record`] with a timestamp pair around each pass, written into `timer` (reset in
+    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
+    /// fence has signalled.
+    pub fn record_timed(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &TranslucencyFrame<'_>,
+        timer: &mut super::EffectTimer,
+    ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, Some(timer))
+    }
+
+    fn record_with(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &TranslucencyFrame<'_>,
+        timer: Option<&mut super::EffectTimer>,
+    ) -> Result<()> {
         let views = self.desc.views_per_frame;
         if frame.slot >= self.frames_in_flight {
             return Err(HostError::OutOfRange {
@@ -474,6 +503,8 @@ impl TranslucencyEffect {
         let per_frame = &self.scene_gpu().per_frame;
         per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
         per_frame.write(ring, &HOST_TRANSLUCENCY, bytemuck::bytes_of(&constants))?;
+        // The pass draws in the `lighting` tiles of the slot (none: the whole screen).
+        per_frame.tiles(ring).lighting = clipped(frame.regions, gbuffer.extent());
         let gpu = lucent.gpu();
         let images = &frame.images;
         let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> = [
@@ -497,7 +528,12 @@ impl TranslucencyEffect {
             record_transition(gpu, cmd, image, &image.state, &sampled);
         }
         record_transition(gpu, cmd, frame.lighting, &frame.lighting.state, &attachment);
-        self.executable().record_frame(gpu, cmd, ring, None);
+        let timer = timer.map(|t| {
+            let timer = t.timer_mut();
+            timer.reset(gpu, cmd);
+            timer
+        });
+        self.executable().record_frame(gpu, cmd, ring, timer);
         for image in &inputs {
             record_transition(gpu, cmd, image, &sampled, &image.left_in());
         }
@@ -713,6 +749,10 @@ fn declare(
         .sample(&thickness)
         .sample(&material_ids)
         .defines(defines(uint_ids))
+        .tiles(|scene, ctx| {
+            let regions = &scene.per_frame.tiles(ctx.frame).lighting;
+            (!regions.is_empty()).then(|| regions.clone())
+        })
         .color_add(&mut lighting, LoadOp::Load);
     pass.finish();
     graph.export_image(&lighting, Access::ColorAttachmentWrite);

@@ -19,6 +19,7 @@
 //! - [`truth`]: a frame against the path-traced truth (error, energy per channel, FLIP).
 
 pub mod bench;
+pub mod embed_cost;
 pub mod gallery;
 pub mod gate;
 pub mod layered_error;

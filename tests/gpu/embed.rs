@@ -196,7 +196,18 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     };
     let with = dir.join("with.png");
     let without = dir.join("without.png");
+    let whole = dir.join("whole-screen.png");
     let log = run(&with, &[]);
+    // The effects drawn only over the objects' screen regions (the default: tiles left out,
+    // the blurs' pass-through there) change nothing against the whole screen.
+    run(&whole, &["--whole-screen"]);
+    assert_eq!(
+        read_png_rgba8(&with).unwrap(),
+        read_png_rgba8(&whole).unwrap(),
+        "the effects over their regions differ from the whole screen ({} and {})",
+        with.display(),
+        whole.display()
+    );
     assert!(
         log.contains("lucent effects: translucency") && log.contains("sss (separable blur"),
         "{log}"
@@ -663,6 +674,38 @@ impl HostLayout {
     }
 }
 
+/// The screen regions of `scene`'s scattering objects (their boxes' corners in the world)
+/// seen by `camera`, widened by `reach`: what a host passes as `SssFrame::regions`. None (the
+/// whole screen) when one crosses the eye's plane.
+fn sss_regions(
+    scene: &lucent::scene::Scene,
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    reach: f32,
+) -> Vec<vk::Rect2D> {
+    let bounds = lucent::gpu_scene::tiles::mesh_bounds(scene);
+    let regions: Option<Vec<vk::Rect2D>> = scene
+        .objects
+        .iter()
+        .filter(|o| o.material.sss.is_some())
+        .map(|o| {
+            let (lo, hi) = bounds[o.mesh];
+            let corners: Vec<glam::Vec3> = (0..8)
+                .map(|i| {
+                    let p = glam::Vec3::new(
+                        if i & 1 == 0 { lo.x } else { hi.x },
+                        if i & 2 == 0 { lo.y } else { hi.y },
+                        if i & 4 == 0 { lo.z } else { hi.z },
+                    );
+                    o.transform.transform_point3(p)
+                })
+                .collect();
+            lucent::embed::screen_region(&corners, camera, extent, reach)
+        })
+        .collect();
+    regions.unwrap_or_default()
+}
+
 /// A new view of `image` (a host recreating its views between frames).
 pub(crate) fn fresh_view(
     test: &TestGpu,
@@ -808,6 +851,15 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
             let outputs: Vec<GpuImage> = (0..3)
                 .map(|_| output_image(&test, w, h, vk::Format::R16G16B16A16_SFLOAT, output_usage))
                 .collect();
+            // One layout blurs only on the tiles its scattering objects' screen bounds
+            // (widened by the blurs' reach) touch, as a host computes them; the others on the
+            // whole screen. (At this size and the widened profiles' reach the regions touch
+            // every tile: the example's test covers regions that leave tiles out.)
+            let regions: Vec<vk::Rect2D> = if depth_kind == HostDepth::D24Stencil {
+                sss_regions(&scene, &layout.camera, layout.desc.extent(), effect.reach())
+            } else {
+                Vec::new()
+            };
             // Three frames in flight, submitted back to back; every frame the host makes its
             // views anew (a recreated view can reuse a handle value).
             let mut views = Vec::new();
@@ -878,6 +930,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                                 albedo: None,
                                 material_ids: &ids_host,
                             },
+                            regions: &regions,
                             output: &output,
                         },
                     )
@@ -1228,6 +1281,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
             view,
             camera,
             images,
+            regions: &[],
             output: &out_host,
         };
         recorded(&test, |cmd| effect.record(&lucent, cmd, &frame))
@@ -1524,6 +1578,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                     view: 0,
                     camera,
                     images,
+                    regions: &[],
                     output: &output,
                 },
             )
@@ -1548,6 +1603,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                         thickness: &colour_in,
                         material_ids: images.material_ids,
                     },
+                    regions: &[],
                     lighting: &lighting,
                 },
             )
@@ -1803,6 +1859,7 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                                 views[k].camera.projection(aspect),
                             ),
                             images: frame_images,
+                            regions: &[],
                             output: &described(output, "view output", usage)
                                 .in_state(ImageState::UNDEFINED)
                                 .then(ImageState::transfer_src()),

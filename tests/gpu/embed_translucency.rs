@@ -127,6 +127,32 @@ fn normal_image(
     (image, desc)
 }
 
+/// The smallest rectangle holding every pixel whose ID is not 0, widened by one pixel.
+pub(crate) fn bounds(w: u32, h: u32, ids: &[u8]) -> vk::Rect2D {
+    let inside: Vec<(u32, u32)> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| ids[(y * w + x) as usize] > 0)
+        .collect();
+    let x0 = inside.iter().map(|p| p.0).min().unwrap().saturating_sub(1);
+    let y0 = inside.iter().map(|p| p.1).min().unwrap().saturating_sub(1);
+    let x1 = (inside.iter().map(|p| p.0).max().unwrap() + 2).min(w);
+    let y1 = (inside.iter().map(|p| p.1).max().unwrap() + 2).min(h);
+    assert!(
+        (x1 - x0) * (y1 - y0) < w * h * 9 / 10,
+        "the bounds must leave part of the screen out"
+    );
+    vk::Rect2D {
+        offset: vk::Offset2D {
+            x: x0 as i32,
+            y: y0 as i32,
+        },
+        extent: vk::Extent2D {
+            width: x1 - x0,
+            height: y1 - y0,
+        },
+    }
+}
+
 fn rgba8(texels: &[[f32; 4]]) -> Vec<u8> {
     texels
         .iter()
@@ -280,6 +306,13 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
                 .unwrap()
             })
             .collect();
+        // One layout draws over the translucent pixels' bounds only (a host's projected
+        // object bounds), the others over the whole screen.
+        let regions: Vec<vk::Rect2D> = if depth_kind == HostDepth::ReversedInfinite {
+            vec![bounds(w, h, &ids)]
+        } else {
+            Vec::new()
+        };
         let mut views = Vec::new();
         submit_back_to_back(gpu, 3, |k, cmd| {
             let depth_aspect = if depth_kind == HostDepth::Linear {
@@ -334,6 +367,7 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
                             thickness: &thickness_image,
                             material_ids: &ids,
                         },
+                        regions: &regions,
                         lighting: &lighting,
                     },
                 )

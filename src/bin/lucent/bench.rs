@@ -71,6 +71,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
             "--compare-thesis prints Markdown tables; use it with --format markdown".into(),
         ));
     }
+    if format != Format::Markdown && args.embed {
+        return Err(LucentError::InvalidInput(
+            "--embed prints a Markdown table; use it with --format markdown".into(),
+        ));
+    }
     if format == Format::Csv && against.is_some() {
         return Err(LucentError::InvalidInput(
             "--against prints a Markdown table (or an `against` object with --format json); \
@@ -114,6 +119,19 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     println!("{line}");
                 }
             }
+        }
+        if args.embed {
+            let cost = lucent::measure::embed_cost::embed_cost(
+                &session.gpu,
+                &session.shaders,
+                &session.pipeline_cache,
+                scene,
+                &args.frame.scene,
+                technique,
+                (renderer.settings.width, renderer.settings.height),
+                (options.frames, options.warmup),
+            )?;
+            println!("{}", cost.markdown());
         }
         write_outputs(session, renderer, &args, format, &report)?;
         trusted(&report, &options)

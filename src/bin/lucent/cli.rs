@@ -121,6 +121,11 @@ pub struct BenchArgs {
     /// 1 nearest its triangle count. Alias: --compare-seeds.
     #[arg(long, alias = "compare-seeds")]
     pub compare_thesis: bool,
+    /// Also measure the technique as an effect on a host's G-buffer (`lucent::embed`: an SSS
+    /// blur a host can run, or `translucency`) against the same work in lucent's own frame,
+    /// frames alternating, and print both with their ratio (Markdown).
+    #[arg(long)]
+    pub embed: bool,
     /// Run the speed-of-light gate instead of one benchmark: every built-in scene's passes
     /// against their floors and the techniques that add to shared passes against `none`,
     /// each held under its limit (docs/performance.md); prints each pass, its ratio and its

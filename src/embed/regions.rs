@@ -1,0 +1,179 @@
+//! Screen regions a host gives with a frame (its objects' projected bounds), as the tiles
+//! lucent's passes draw in: an effect then runs its expensive shader only where its materials
+//! may be, as lucent's own frames do with the tiles they project from their objects' bounds
+//! (`crate::gpu_scene::tiles`).
+
+use ash::vk;
+
+use glam::Vec3;
+
+use super::HostCamera;
+use crate::gpu_scene::tiles::{tile_rects, TILE_SIZE};
+use crate::gpu_scene::TileRect;
+
+/// The screen rectangle of the world-space points `corners` (an object's bounding box's eight
+/// corners, say) seen by `camera` at `extent`, widened by `reach` world units projected at
+/// the points' nearest view depth (for an [`super::SssEffect`], [`super::SssEffect::reach`]:
+/// the blurs spread light that far beyond an object; 0 for translucency), as lucent widens
+/// its own objects' tiles: what an effect's `regions` want. The widening is at most a quarter
+/// of the screen's larger side. `None` when a point is behind the eye (give no region: the
+/// whole screen); an empty rectangle when the points are off screen (the effect draws
+/// nothing there).
+pub fn screen_region(
+    corners: &[Vec3],
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    reach: f32,
+) -> Option<vk::Rect2D> {
+    let view_projection = camera.projection * camera.view;
+    let size = glam::Vec2::new(extent.width as f32, extent.height as f32);
+    let (mut low, mut high) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+    let mut nearest = f32::MAX;
+    for &corner in corners {
+        let clip = view_projection * corner.extend(1.0);
+        // Clip-space w is the view depth for a perspective projection: <= 0 is behind the eye.
+        if !clip.is_finite() || clip.w <= 1e-6 {
+            return None;
+        }
+        nearest = nearest.min(clip.w);
+        let pixel = (glam::Vec2::new(clip.x, clip.y) / clip.w * 0.5 + 0.5) * size;
+        (low, high) = (low.min(pixel), high.max(pixel));
+    }
+    if corners.is_empty() {
+        return Some(vk::Rect2D::default());
+    }
+    // The reach on screen: world units times the focal length in pixels over the depth,
+    // clamped (as lucent's own tiles are) so a huge or non-finite reach stays bounded.
+    let focal_px = camera.projection.y_axis.y.abs() * size.y * 0.5;
+    let quarter = 0.25 * size.x.max(size.y);
+    let margin = (reach.max(0.0) * focal_px / nearest).min(quarter);
+    let margin = if margin.is_finite() { margin } else { quarter } + 1.0;
+    let low = (low - margin).floor().max(glam::Vec2::ZERO);
+    let high = (high + margin).ceil().min(size);
+    if high.x <= low.x || high.y <= low.y {
+        return Some(vk::Rect2D::default());
+    }
+    Some(vk::Rect2D {
+        offset: vk::Offset2D {
+            x: low.x as i32,
+            y: low.y as i32,
+        },
+        extent: vk::Extent2D {
+            width: (high.x - low.x) as u32,
+            height: (high.y - low.y) as u32,
+        },
+    })
+}
+
+/// The host's regions as tiles the pass draws (all marked), clipped to `extent`; empty ones
+/// dropped. No region at all stays no tile (the whole screen); regions that all fall outside
+/// the screen become one empty tile, which draws nothing.
+pub(crate) fn clipped(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Vec<TileRect> {
+    let mut tiles: Vec<TileRect> = regions
+        .iter()
+        .filter_map(|r| {
+            let x0 = i64::from(r.offset.x).clamp(0, i64::from(extent.width));
+            let y0 = i64::from(r.offset.y).clamp(0, i64::from(extent.height));
+            let x1 = (i64::from(r.offset.x) + i64::from(r.extent.width))
+                .clamp(0, i64::from(extent.width));
+            let y1 = (i64::from(r.offset.y) + i64::from(r.extent.height))
+                .clamp(0, i64::from(extent.height));
+            (x1 > x0 && y1 > y0).then(|| TileRect {
+                x: x0 as u32,
+                y: y0 as u32,
+                width: (x1 - x0) as u32,
+                height: (y1 - y0) as u32,
+                translucent: true,
+            })
+        })
+        .collect();
+    if tiles.is_empty() && !regions.is_empty() {
+        tiles.push(TileRect {
+            x: 0,
+            y: 0,
+            width: 0,
+            height: 0,
+            translucent: true,
+        });
+    }
+    tiles
+}
+
+/// The screen as tiles of [`TILE_SIZE`] (merged into rectangles), marked where a region
+/// touches them, for passes that draw their own shader in the marked tiles and a pass-through
+/// variant elsewhere (the SSS chains). `None` (no region): the whole screen with their own
+/// shader.
+pub(crate) fn marked_tiles(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Option<Vec<TileRect>> {
+    if regions.is_empty() {
+        return None;
+    }
+    let columns = extent.width.div_ceil(TILE_SIZE);
+    let rows = extent.height.div_ceil(TILE_SIZE);
+    let mut marked = vec![false; (columns * rows) as usize];
+    for r in clipped(regions, extent)
+        .iter()
+        .filter(|r| r.width * r.height > 0)
+    {
+        for row in r.y / TILE_SIZE..(r.y + r.height).div_ceil(TILE_SIZE) {
+            for column in r.x / TILE_SIZE..(r.x + r.width).div_ceil(TILE_SIZE) {
+                marked[(row * columns + column) as usize] = true;
+            }
+        }
+    }
+    Some(tile_rects(columns, &marked, extent.width, extent.height))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regions_are_clipped_to_the_screen_and_none_means_the_whole_screen() {
+        let extent = vk::Extent2D {
+            width: 100,
+            height: 50,
+        };
+        let rect = |x, y, w, h| vk::Rect2D {
+            offset: vk::Offset2D { x, y },
+            extent: vk::Extent2D {
+                width: w,
+                height: h,
+            },
+        };
+        assert!(clipped(&[], extent).is_empty());
+        let tiles = clipped(&[rect(-10, 40, 30, 30), rect(90, 0, u32::MAX, 5)], extent);
+        assert_eq!(
+            tiles
+                .iter()
+                .map(|t| (t.x, t.y, t.width, t.height))
+                .collect::<Vec<_>>(),
+            [(0, 40, 20, 10), (90, 0, 10, 5)]
+        );
+        // Regions all off screen draw nothing (one empty tile), not the whole screen.
+        let off = clipped(&[rect(200, 0, 10, 10)], extent);
+        assert_eq!(off.len(), 1);
+        assert_eq!(off[0].width * off[0].height, 0);
+    }
+
+    #[test]
+    fn marked_tiles_cover_the_screen_and_mark_what_the_regions_touch() {
+        let extent = vk::Extent2D {
+            width: 200,
+            height: 100,
+        };
+        assert!(marked_tiles(&[], extent).is_none());
+        let region = vk::Rect2D {
+            offset: vk::Offset2D { x: 70, y: 10 },
+            extent: vk::Extent2D {
+                width: 10,
+                height: 10,
+            },
+        };
+        let tiles = marked_tiles(&[region], extent).unwrap();
+        let area: u32 = tiles.iter().map(|t| t.width * t.height).sum();
+        assert_eq!(area, 200 * 100, "every pixel in exactly one rectangle");
+        let marked: Vec<_> = tiles.iter().filter(|t| t.translucent).collect();
+        assert_eq!(marked.len(), 1);
+        assert_eq!((marked[0].x, marked[0].y, marked[0].width), (64, 0, 64));
+    }
+}

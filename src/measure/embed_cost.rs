@@ -1,0 +1,729 @@
+//! `lucent bench --embed`: what an effect costs in a host's frame against the same work in
+//! lucent's own frame, measured in one run with frames alternating.
+//!
+//! lucent's own frame of the scene is rendered once to export what a host's G-buffer would
+//! hold (depth, lit diffuse and specular, albedo, normals, thickness, material IDs); those
+//! become host images in a host's formats, and the effect (`lucent::embed`) is built on the
+//! same device through the public API. Then, frame by frame, lucent's own frame and the
+//! host's effect alone are each submitted and timed with GPU timestamps; the table gives each
+//! pass's median in both and their ratio.
+//!
+//! - **Screen-space SSS** (`--technique separable|control|burley`): each pass of the
+//!   `SssEffect` (its regions the scattering objects' screen bounds widened by the blurs'
+//!   reach) against lucent's pass of the same name (the host's diffuse and
+//!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM).
+//! - **GDC 2011 translucency** (`--technique translucency`): lucent adds the term inside its
+//!   lighting pass, so its cost there is the lighting pass with translucency minus the
+//!   lighting pass without (`none`, a third frame in the rotation, lighting unmerged as
+//!   `report`'s GDC table measures it), against the `TranslucencyEffect`'s one pass, drawn
+//!   over the translucent objects' screen bounds (`TranslucencyFrame::regions`, from
+//!   `embed::screen_region`, as a host gives them).
+
+use std::collections::BTreeMap;
+
+use ash::vk;
+
+use crate::backend::shader::{PipelineCache, ShaderCompiler};
+use crate::backend::{GpuContext, GpuImage, ImageDesc};
+use crate::embed::{
+    DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, GBufferDesc, HostCamera, HostDevice,
+    HostImage, IdDesc, ImageState, Lucent, NormalDesc, OptionalFeatures, SssEffect, SssEffectDesc,
+    SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
+    TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
+};
+use crate::features::registry;
+use crate::features::sss::SssProfiles;
+use crate::features::technique::TechniqueModule;
+use crate::frame::{FrameSettings, Renderer, Technique};
+use crate::measure::stats::Stats;
+use crate::scene::material::Texturing;
+use crate::scene::Scene;
+use crate::{LucentError, Result};
+
+/// One pass: its median in lucent's frame and in the host's.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EmbedCostRow {
+    /// The pass (for translucency: the term, and the lighting passes it is measured from).
+    pub pass: String,
+    /// Median milliseconds in lucent's own frame (`None`: the pass is not in it).
+    pub lucent_ms: Option<f64>,
+    /// Median milliseconds as the host's effect (`None`: the effect has no such pass).
+    pub host_ms: Option<f64>,
+}
+
+/// What `lucent bench --embed` prints.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EmbedCost {
+    /// The device.
+    pub device: String,
+    /// Scene, size, effect, frames.
+    pub setup: String,
+    /// Per pass.
+    pub rows: Vec<EmbedCostRow>,
+}
+
+impl EmbedCost {
+    /// A Markdown table: pass, lucent's frame, the host's effect, host / lucent.
+    pub fn markdown(&self) -> String {
+        let mut out = format!(
+            "**The effect in a host's frame against lucent's own** ({}; {}; GPU timestamps, \
+             medians)\n\n| pass | lucent's frame (ms) | host effect (ms) | host / lucent |\n\
+             |---|---:|---:|---:|\n",
+            self.device, self.setup
+        );
+        let ms = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+        for row in &self.rows {
+            let ratio = match (row.lucent_ms, row.host_ms) {
+                (Some(a), Some(b)) if a > 0.0 => format!("{:.3}", b / a),
+                _ => "-".into(),
+            };
+            out.push_str(&format!(
+                "| {} | {} | {} | {ratio} |\n",
+                row.pass,
+                ms(row.lucent_ms),
+                ms(row.host_ms)
+            ));
+        }
+        out
+    }
+}
+
+/// The host's handles of `gpu`: lucent borrows its own device as a host's.
+fn host_device(gpu: &GpuContext) -> HostDevice {
+    HostDevice {
+        entry: gpu.entry.clone(),
+        instance: gpu.instance.clone(),
+        physical_device: gpu.physical_device,
+        device: gpu.device.clone(),
+        queue: gpu.queue,
+        queue_family: gpu.queue_family,
+        enabled: OptionalFeatures {
+            host_query_reset: gpu.info.host_query_reset,
+            independent_blend: gpu.info.independent_blend,
+            storage_image_write_without_format: gpu.info.storage_image_write_without_format,
+        },
+    }
+}
+
+/// Medians of named samples.
+#[derive(Default)]
+struct Samples(BTreeMap<String, Vec<f64>>);
+
+impl Samples {
+    fn push(&mut self, name: &str, ms: f64) {
+        self.0.entry(name.to_string()).or_default().push(ms);
+    }
+
+    fn median(&self, name: &str) -> Option<f64> {
+        self.0.get(name).map(|v| Stats::of(v).median)
+    }
+}
+
+/// Measures the effect of `technique` (an SSS blur a host can run, or `translucency`) on
+/// `scene` at `width` x `height`: `warmup` rounds discarded, `frames` measured.
+#[allow(clippy::too_many_arguments)]
+pub fn embed_cost(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    scene: &Scene,
+    scene_label: &str,
+    technique: Technique,
+    (width, height): (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<EmbedCost> {
+    let module = technique.module();
+    let translucency =
+        module.is_some_and(|m| m.name() == crate::features::translucency::TRANSLUCENCY.name());
+    let blur =
+        module.and_then(|m| registry::sss_blurs().find(|b| b.name() == m.name() && !b.lean()));
+    if !translucency && blur.is_none() {
+        let blurs: Vec<&str> = registry::sss_blurs()
+            .filter(|b| !b.lean())
+            .map(|b| b.name())
+            .collect();
+        return Err(LucentError::InvalidInput(format!(
+            "--embed measures an effect a host can insert: --technique {} or translucency \
+             (not '{}')",
+            blurs.join(", "),
+            technique.name()
+        )));
+    }
+    // SAFETY: the handles are `gpu`'s own, valid until it is dropped, after `lucent`.
+    let lucent = unsafe {
+        Lucent::new(
+            host_device(gpu),
+            EmbedOptions {
+                frames_in_flight: 1,
+                ..Default::default()
+            },
+        )
+    }?;
+    let setup = format!(
+        "`{scene_label}`, {width}x{height}, {} as `{}`, {frames} frames after {warmup}, \
+         alternating",
+        if translucency {
+            "TranslucencyEffect"
+        } else {
+            "SssEffect"
+        },
+        technique.name()
+    );
+    let rows = if translucency {
+        measure_translucency(
+            gpu,
+            shaders,
+            pipeline_cache,
+            &lucent,
+            scene,
+            (width, height),
+            (frames, warmup),
+        )
+    } else {
+        measure_sss(
+            gpu,
+            shaders,
+            pipeline_cache,
+            &lucent,
+            scene,
+            technique,
+            (width, height),
+            (frames, warmup),
+        )
+    };
+    let idle = gpu.wait_idle();
+    drop(lucent);
+    idle?;
+    Ok(EmbedCost {
+        device: gpu.info.describe(),
+        setup,
+        rows: rows?,
+    })
+}
+
+/// The images of one measurement, destroyed together.
+#[derive(Default)]
+struct Images(Vec<GpuImage>);
+
+impl Images {
+    fn upload(
+        &mut self,
+        gpu: &GpuContext,
+        desc: &ImageDesc,
+        bytes: Vec<u8>,
+        name: &str,
+    ) -> Result<(vk::Image, vk::ImageView)> {
+        let image = gpu.upload_image(desc, &[bytes], name)?;
+        let handles = (image.image, image.view);
+        self.0.push(image);
+        Ok(handles)
+    }
+
+    fn destroy(self, gpu: &GpuContext) {
+        for image in self.0 {
+            gpu.destroy_image(image);
+        }
+    }
+}
+
+fn rgba8(texels: &[[f32; 4]]) -> Vec<u8> {
+    texels
+        .iter()
+        .flat_map(|t| t.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8))
+        .collect()
+}
+
+fn rgba16f(texels: &[[f32; 4]]) -> Vec<u8> {
+    texels
+        .iter()
+        .flat_map(|t| t.map(|v| half::f16::from_f32(v).to_le_bytes()))
+        .flatten()
+        .collect()
+}
+
+fn host_image(
+    (image, view): (vk::Image, vk::ImageView),
+    name: &str,
+    format: vk::Format,
+    (width, height): (u32, u32),
+    usage: vk::ImageUsageFlags,
+) -> HostImage {
+    HostImage::new(
+        name,
+        image,
+        view,
+        format,
+        vk::Extent2D { width, height },
+        usage,
+    )
+    .in_state(ImageState::fragment_sampled())
+}
+
+/// Records `record` into a command buffer, submits it and waits: the host's frame.
+fn host_frame(
+    gpu: &GpuContext,
+    record: impl FnOnce(vk::CommandBuffer) -> Result<()>,
+) -> Result<()> {
+    let mut recorded = Ok(());
+    gpu.submit_and_wait(|cmd| recorded = record(cmd))?;
+    recorded
+}
+
+#[allow(clippy::too_many_arguments)]
+fn measure_sss(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    lucent: &Lucent,
+    scene: &Scene,
+    technique: Technique,
+    (width, height): (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<Vec<EmbedCostRow>> {
+    let module = technique.module().expect("checked by the caller");
+    let blur = registry::sss_blur(module.name())?;
+    let mut settings = FrameSettings {
+        technique,
+        export_gbuffer: true,
+        export_lit: true,
+        ..FrameSettings::new(width, height)
+    };
+    // A host's lit diffuse carries its albedo: blurred with the light.
+    settings.sss.texturing = Some(Texturing::Pre);
+    let renderer = Renderer::new(gpu, shaders, pipeline_cache, scene, settings)?;
+    let mut images = Images::default();
+    let measured = (|| {
+        renderer.render_once(gpu)?;
+        let gb = renderer.read_gbuffer(gpu)?;
+        let lit = renderer.read_lit(gpu)?;
+        let ids: Vec<u8> = gb
+            .sss
+            .as_ref()
+            .ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "--embed with --technique {}: the scene has no screen-space SSS material",
+                    module.name()
+                ))
+            })?
+            .iter()
+            .map(|&v| v as u8)
+            .collect();
+        let profiles: Vec<_> = SssProfiles::new(
+            scene,
+            Some(blur),
+            None,
+            Some(Texturing::Pre),
+            &registry::blur_of,
+        )?
+        .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?
+        .profiles
+        .into_iter()
+        .map(|(mut p, b)| {
+            p.blur = Some(b.name().into());
+            p
+        })
+        .collect();
+        let units_per_mm = profiles[0].units_per_mm;
+        if profiles.iter().any(|p| p.units_per_mm != units_per_mm) {
+            return Err(LucentError::InvalidInput(
+                "--embed: the scene's SSS profiles have different scales; a host's G-buffer \
+                 has one world scale"
+                    .into(),
+            ));
+        }
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let size = (width, height);
+        let hdr = vk::Format::R16G16B16A16_SFLOAT;
+        let depth = images.upload(
+            gpu,
+            &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
+            bytemuck::cast_slice(&gb.depth).to_vec(),
+            "host depth",
+        )?;
+        let id_image = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, vk::Format::R8_UNORM, sampled),
+            ids,
+            "host IDs",
+        )?;
+        let colour = ImageDesc::color(width, height, hdr, sampled);
+        let diffuse = images.upload(gpu, &colour, rgba16f(&lit.diffuse), "host diffuse")?;
+        let specular = images.upload(gpu, &colour, rgba16f(&lit.specular), "host specular")?;
+        let output_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let output = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, hdr, output_usage),
+            rgba16f(&lit.diffuse),
+            "host output",
+        )?;
+        let gbuffer = GBufferDesc::new(
+            width,
+            height,
+            DepthDesc::device(vk::Format::D32_SFLOAT),
+            DiffuseDesc::with_albedo(hdr),
+        )
+        .with_specular(hdr)
+        .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
+        .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        let materials = profiles
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| SssMaterial::new(i as u8 + 1, p))
+            .collect();
+        let mut effect = build(gpu, lucent, |u| {
+            SssEffect::new(
+                lucent,
+                u,
+                SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss),
+            )
+        })?;
+        let mut timer = EffectTimer::new(lucent, 64)?;
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(width as f32 / height as f32),
+        );
+        // The host blurs over its scattering objects' screen bounds widened by the reach, as
+        // lucent's own frame does over its tiles.
+        let regions = object_regions(scene, &camera, (width, height), effect.reach(), |o| {
+            o.material.sss.is_some() || o.material.medium.is_some()
+        });
+        let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
+        let diffuse = host_image(diffuse, "host diffuse", hdr, size, sampled);
+        let specular = host_image(specular, "host specular", hdr, size, sampled);
+        let id_image = host_image(id_image, "host IDs", vk::Format::R8_UNORM, size, sampled);
+        let output = host_image(output, "host output", hdr, size, output_usage)
+            .in_state(ImageState::UNDEFINED)
+            .then(ImageState::fragment_sampled());
+        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
+        let mut run = || -> Result<()> {
+            for round in 0..warmup + frames {
+                let frame = renderer.render_once(gpu)?;
+                host_frame(gpu, |cmd| {
+                    effect.record_timed(
+                        lucent,
+                        cmd,
+                        &SssFrame {
+                            slot: 0,
+                            view: 0,
+                            camera,
+                            images: SssImages {
+                                depth: &depth,
+                                diffuse: &diffuse,
+                                specular: Some(&specular),
+                                albedo: None,
+                                material_ids: &id_image,
+                            },
+                            regions: &regions,
+                            output: &output,
+                        },
+                        &mut timer,
+                    )
+                })?;
+                if round < warmup {
+                    continue;
+                }
+                for pass in &frame.timing.passes {
+                    ours.push(&pass.name, pass.ms);
+                }
+                for pass in timer.results(lucent)?.unwrap_or_default() {
+                    theirs.push(&pass.name, pass.ms);
+                }
+            }
+            Ok(())
+        };
+        let result = run();
+        timer.destroy(lucent);
+        effect.destroy(lucent);
+        result?;
+        // The effect's passes, each beside lucent's pass of the same name.
+        let names: Vec<String> = theirs.0.keys().cloned().collect();
+        Ok(names
+            .into_iter()
+            .map(|name| EmbedCostRow {
+                lucent_ms: ours.median(&name),
+                host_ms: theirs.median(&name),
+                pass: name,
+            })
+            .collect())
+    })();
+    let idle = gpu.wait_idle();
+    images.destroy(gpu);
+    renderer.destroy(gpu);
+    idle?;
+    measured
+}
+
+fn measure_translucency(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    lucent: &Lucent,
+    scene: &Scene,
+    (width, height): (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<Vec<EmbedCostRow>> {
+    let with = Technique::Only(&crate::features::translucency::TRANSLUCENCY);
+    let settings = |technique| FrameSettings {
+        export_gbuffer: true,
+        ..crate::measure::scaling::settings(technique, width, height)
+    };
+    let lit = Renderer::new(gpu, shaders, pipeline_cache, scene, settings(with))?;
+    let plain = match Renderer::new(
+        gpu,
+        shaders,
+        pipeline_cache,
+        scene,
+        settings(Technique::None),
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            lit.destroy(gpu);
+            return Err(e);
+        }
+    };
+    let mut images = Images::default();
+    let measured = (|| {
+        lit.render_once(gpu)?;
+        let gb = lit.read_gbuffer(gpu)?;
+        let gb2 = gb.gb2.clone().ok_or_else(|| {
+            LucentError::InvalidInput(
+                "--embed with --technique translucency: the scene has no translucent material"
+                    .into(),
+            )
+        })?;
+        let coloured = gb.layout.gb2_format().is_some_and(|f| {
+            crate::backend::format::format_info(f).is_some_and(|i| i.channels == 4)
+        });
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let size = (width, height);
+        let depth = images.upload(
+            gpu,
+            &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
+            bytemuck::cast_slice(&gb.depth).to_vec(),
+            "host depth",
+        )?;
+        let rgba8_desc = ImageDesc::color(width, height, vk::Format::R8G8B8A8_UNORM, sampled);
+        let albedo = images.upload(gpu, &rgba8_desc, rgba8(&gb.gb0), "host albedo")?;
+        let hdr = vk::Format::R16G16B16A16_SFLOAT;
+        let normals = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, hdr, sampled),
+            rgba16f(&gb.gb1),
+            "host normals",
+        )?;
+        // lucent's own GB2 layout: thickness and the ID in one RGBA8 (or RG8) target.
+        let (gb2_format, thickness_desc, id_desc, gb2_bytes) = if coloured {
+            (
+                vk::Format::R8G8B8A8_UNORM,
+                ThicknessDesc::rgb(vk::Format::R8G8B8A8_UNORM),
+                IdDesc::bits(vk::Format::R8G8B8A8_UNORM, 3, 0, 8),
+                rgba8(&gb2),
+            )
+        } else {
+            let bytes = rgba8(&gb2)
+                .chunks_exact(4)
+                .flat_map(|t| [t[0], t[1]])
+                .collect();
+            (
+                vk::Format::R8G8_UNORM,
+                ThicknessDesc::channel(vk::Format::R8G8_UNORM, 0),
+                IdDesc::bits(vk::Format::R8G8_UNORM, 1, 0, 8),
+                bytes,
+            )
+        };
+        let gb2_image = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, gb2_format, sampled),
+            gb2_bytes,
+            "host thickness and IDs",
+        )?;
+        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let lighting = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, hdr, lighting_usage),
+            rgba16f(&gb.gb1),
+            "host lighting",
+        )?;
+        let gbuffer = GBufferDesc::new(
+            width,
+            height,
+            DepthDesc::device(vk::Format::D32_SFLOAT),
+            DiffuseDesc::with_albedo(hdr),
+        )
+        .with_albedo(vk::Format::R8G8B8A8_UNORM)
+        .with_normals(NormalDesc::world(hdr))
+        .with_thickness(thickness_desc)
+        .with_material_ids(id_desc);
+        let table = crate::features::translucency::MaterialTable::new(scene, true)?;
+        let parameters: Vec<&crate::scene::material::Translucency> = scene
+            .objects
+            .iter()
+            .filter_map(|o| o.material.translucency_under(true))
+            .collect();
+        let materials = table
+            .rows
+            .iter()
+            .enumerate()
+            .map(|(i, row)| {
+                let t = parameters
+                    .iter()
+                    .find(|t| crate::features::translucency::material_row(t) == *row)
+                    .expect("each row is a material's");
+                TranslucentMaterial::from_translucency(i as u8 + 1, t)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let mut effect = build(gpu, lucent, |u| {
+            TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
+        })?;
+        let mut timer = EffectTimer::new(lucent, 8)?;
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(width as f32 / height as f32),
+        );
+        // The host draws the effect over its translucent objects' screen bounds, as lucent's
+        // lighting pass runs the term over the tiles they touch.
+        let regions = object_regions(scene, &camera, (width, height), 0.0, |o| {
+            o.material.translucency_under(true).is_some()
+        });
+        let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
+        let albedo = host_image(
+            albedo,
+            "host albedo",
+            vk::Format::R8G8B8A8_UNORM,
+            size,
+            sampled,
+        );
+        let normals = host_image(normals, "host normals", hdr, size, sampled);
+        let gb2_image = host_image(
+            gb2_image,
+            "host thickness and IDs",
+            gb2_format,
+            size,
+            sampled,
+        );
+        let lighting = host_image(lighting, "host lighting", hdr, size, lighting_usage);
+        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
+        let mut run = || -> Result<()> {
+            for round in 0..warmup + frames {
+                let with_term = lit.render_once(gpu)?;
+                let without = plain.render_once(gpu)?;
+                host_frame(gpu, |cmd| {
+                    effect.record_timed(
+                        lucent,
+                        cmd,
+                        &TranslucencyFrame {
+                            slot: 0,
+                            view: 0,
+                            camera,
+                            lights: &scene.lights,
+                            images: TranslucencyImages {
+                                depth: &depth,
+                                normals: &normals,
+                                albedo: &albedo,
+                                thickness: &gb2_image,
+                                material_ids: &gb2_image,
+                            },
+                            regions: &regions,
+                            lighting: &lighting,
+                        },
+                        &mut timer,
+                    )
+                })?;
+                if round < warmup {
+                    continue;
+                }
+                let lighting_ms = |frame: &crate::frame::FrameImages| {
+                    frame
+                        .timing
+                        .passes
+                        .iter()
+                        .find(|p| p.name == "lighting")
+                        .map(|p| p.ms)
+                };
+                if let (Some(a), Some(b)) = (lighting_ms(&with_term), lighting_ms(&without)) {
+                    ours.push("lighting (translucency)", a);
+                    ours.push("lighting (none)", b);
+                    ours.push("the term", a - b);
+                }
+                for pass in timer.results(lucent)?.unwrap_or_default() {
+                    theirs.push("the term", pass.ms);
+                    theirs.push(&pass.name, pass.ms);
+                }
+            }
+            Ok(())
+        };
+        let result = run();
+        timer.destroy(lucent);
+        effect.destroy(lucent);
+        result?;
+        Ok(["lighting (none)", "lighting (translucency)", "the term"]
+            .iter()
+            .map(|name| EmbedCostRow {
+                pass: name.to_string(),
+                lucent_ms: ours.median(name),
+                host_ms: theirs.median(name),
+            })
+            .collect())
+    })();
+    let idle = gpu.wait_idle();
+    images.destroy(gpu);
+    lit.destroy(gpu);
+    plain.destroy(gpu);
+    idle?;
+    measured
+}
+
+/// The screen regions of the objects `pick` selects, widened by `reach` (the whole screen,
+/// no region, when one crosses the eye's plane).
+fn object_regions(
+    scene: &Scene,
+    camera: &HostCamera,
+    (width, height): (u32, u32),
+    reach: f32,
+    pick: impl Fn(&crate::scene::Object) -> bool,
+) -> Vec<vk::Rect2D> {
+    let bounds = crate::gpu_scene::tiles::mesh_bounds(scene);
+    let extent = vk::Extent2D { width, height };
+    let regions: Option<Vec<vk::Rect2D>> = scene
+        .objects
+        .iter()
+        .filter(|o| pick(o))
+        .map(|o| {
+            let (lo, hi) = bounds[o.mesh];
+            let corners: Vec<glam::Vec3> = (0..8)
+                .map(|i| {
+                    let p = glam::Vec3::new(
+                        if i & 1 == 0 { lo.x } else { hi.x },
+                        if i & 2 == 0 { lo.y } else { hi.y },
+                        if i & 4 == 0 { lo.z } else { hi.z },
+                    );
+                    o.transform.transform_point3(p)
+                })
+                .collect();
+            crate::embed::screen_region(&corners, camera, extent, reach)
+        })
+        .collect();
+    regions.unwrap_or_default()
+}
+
+/// Builds an effect with its uploads recorded into one command buffer, submitted and waited
+/// for here (the benchmark is the host), then released.
+fn build<T>(
+    gpu: &GpuContext,
+    lucent: &Lucent,
+    make: impl FnOnce(&mut crate::embed::Uploads) -> Result<T>,
+) -> Result<T> {
+    let mut made = None;
+    let mut uploads = None;
+    gpu.submit_and_wait(|cmd| {
+        // SAFETY: `cmd` is recording, on lucent's queue family, submitted by submit_and_wait.
+        let mut u = unsafe { lucent.uploads(cmd) };
+        made = Some(make(&mut u));
+        uploads = Some(u);
+    })?;
+    if let Some(mut u) = uploads {
+        // SAFETY: submit_and_wait waited for the submission holding the uploads.
+        unsafe { u.release(lucent) }?;
+    }
+    made.expect("the closure ran")
+}

@@ -1282,25 +1282,12 @@ fn engine_lights(sun: Vec3) -> [Light; 2] {
     [sun, back]
 }
 
-/// The eight corners of a box (centre, half extents).
-fn corners(centre: Vec3, half: Vec3) -> Vec<Vec3> {
-    (0..8)
-        .map(|i| {
-            let sign = Vec3::new(
-                if i & 1 == 0 { -1.0 } else { 1.0 },
-                if i & 2 == 0 { -1.0 } else { 1.0 },
-                if i & 4 == 0 { -1.0 } else { 1.0 },
-            );
-            centre + sign * half
-        })
-        .collect()
-}
-
 /// The screen rectangle the leaf covers: where the translucency pass draws (none, the whole
 /// screen, when the engine asks for it or the leaf crosses the eye's plane).
 fn leaf_region(camera: &HostCamera, extent: vk::Extent2D, whole_screen: bool) -> Vec<vk::Rect2D> {
-    let leaf = corners(Vec3::from(LEAF_CENTRE), Vec3::from(LEAF_RADII));
-    let region = lucent::embed::screen_region(&leaf, camera, extent, 0.0);
+    let (centre, half) = (Vec3::from(LEAF_CENTRE), Vec3::from(LEAF_RADII));
+    let leaf = (centre - half, centre + half);
+    let region = lucent::embed::box_screen_region(leaf, Mat4::IDENTITY, camera, extent, 0.0);
     region.filter(|_| !whole_screen).into_iter().collect()
 }
 
@@ -1315,8 +1302,9 @@ fn scattering_region(
     let regions: Option<Vec<vk::Rect2D>> = SPHERES[..2]
         .iter()
         .map(|&[x, y, z, r]| {
-            let sphere = corners(Vec3::new(x, y, z), Vec3::splat(r));
-            lucent::embed::screen_region(&sphere, camera, extent, reach)
+            let (centre, half) = (Vec3::new(x, y, z), Vec3::splat(r));
+            let sphere = (centre - half, centre + half);
+            lucent::embed::box_screen_region(sphere, Mat4::IDENTITY, camera, extent, reach)
         })
         .collect();
     regions.filter(|_| !whole_screen).unwrap_or_default()

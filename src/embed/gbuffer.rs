@@ -635,6 +635,23 @@ impl GBufferDesc {
         Ok(())
     }
 
+    /// The frame uniforms of a view of this G-buffer seen by `camera` (checked): its
+    /// matrices, size and depth decode; no lights.
+    pub(crate) fn view_uniforms(
+        &self,
+        camera: &HostCamera,
+    ) -> Result<crate::gpu_scene::FrameUniforms> {
+        camera.check()?;
+        let decode = self.depth_decode(&camera.projection)?;
+        Ok(crate::gpu_scene::FrameUniforms::for_view(
+            camera.view,
+            camera.projection,
+            self.width,
+            self.height,
+            decode,
+        ))
+    }
+
     /// The depth decode coefficients for a frame seen through `projection`
     /// ([`crate::gpu_scene::projection_depth_decode`]; the identity for linear depth).
     pub(crate) fn depth_decode(&self, projection: &Mat4) -> Result<[f32; 4]> {

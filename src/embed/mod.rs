@@ -13,11 +13,20 @@
 //!   `R8_UINT`/`R8_UNORM`, stencil bits or a bit field of a packed target; its world scale.
 //!   lucent adapts by shader permutation and per-frame constants, not by copying into its own
 //!   layout. Several views per frame (split screen, stereo).
+//! - [`TranslucencyEffect`]: GDC 2011 thickness-based translucency added to the host's lit
+//!   diffuse, lit by the host's lights ([`Light`]), on the same G-buffer with its normals
+//!   ([`NormalDesc`]: world or view space, xyz or octahedral), albedo and local thickness
+//!   ([`ThicknessDesc`]; [`bake_thickness`] bakes it per vertex of the host's mesh).
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
-//!   layered media, shadows), tonemapped. This is how GDC 2011 translucency and Li et al.'s
-//!   layered media reach a host today: they have no path on a host's G-buffer yet.
+//!   SSS transmission, layered media, shadows, the SH environment), tonemapped. This is how
+//!   SSS transmission, Li et al.'s layered media and the SH environment reach a host today:
+//!   they have no path on a host's G-buffer yet ([`capabilities`] says so per description).
+//!
+//! Effects draw over the screen regions a host gives each frame ([`screen_region`] projects an
+//! object's box), and time their passes only when recorded with `record_timed` and an
+//! [`EffectTimer`].
 //!
 //! # The contract
 //!
@@ -143,6 +152,7 @@ use crate::{LucentError, Result};
 mod capabilities;
 mod gbuffer;
 mod image;
+mod passes;
 mod regions;
 mod scene;
 mod sss;
@@ -156,7 +166,7 @@ pub use gbuffer::{
     IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
 };
 pub use image::{HostImage, ImageState};
-pub use regions::screen_region;
+pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
 pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
 pub use timing::{EffectTimer, PassTime};

@@ -11,6 +11,28 @@ use super::HostCamera;
 use crate::gpu_scene::tiles::{tile_rects, TILE_SIZE};
 use crate::gpu_scene::TileRect;
 
+/// [`screen_region`] of the box `lo..hi` (an object's bounds in its own space) placed in the
+/// world by `transform`.
+pub fn box_screen_region(
+    (lo, hi): (Vec3, Vec3),
+    transform: glam::Mat4,
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    reach: f32,
+) -> Option<vk::Rect2D> {
+    let corners: Vec<Vec3> = (0..8)
+        .map(|i| {
+            let p = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            transform.transform_point3(p)
+        })
+        .collect();
+    screen_region(&corners, camera, extent, reach)
+}
+
 /// The screen rectangle of the world-space points `corners` (an object's bounding box's eight
 /// corners, say) seen by `camera` at `extent`, widened by `reach` world units projected at
 /// the points' nearest view depth (for an [`super::SssEffect`], [`super::SssEffect::reach`]:

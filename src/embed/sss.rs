@@ -24,18 +24,18 @@ use ash::vk;
 
 use super::capabilities::{missing, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
-use super::image::{check_image, distinct_inputs, record_transition, HostImage, Role};
+use super::image::{check_image, distinct_inputs, HostImage, Role};
+use super::passes::EffectPasses;
 use super::regions::marked_tiles;
-use super::uploads::LeakGuard;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
 use crate::features::registry;
 use crate::features::sss::{self, IdMap, SssKnobs, SssProfiles};
-use crate::gpu_scene::{FrameUniforms, SceneGpu, SceneUpload, SlotTiles, FRAME};
+use crate::gpu_scene::{SceneGpu, SceneUpload, SlotTiles, FRAME};
 use crate::graph::{
-    Executable, Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
+    Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
 use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::{Camera, Scene};
@@ -163,16 +163,13 @@ struct Imports {
 
 /// Screen-space SSS over a host's G-buffer (see the module docs).
 pub struct SssEffect {
-    executable: Option<Executable>,
-    scene_gpu: Option<Arc<SceneGpu>>,
+    passes: EffectPasses,
     imports: Imports,
     desc: SssEffectDesc,
     /// The blur chains the profiles use (each draws in the frame's tiles).
     chains: usize,
     /// The widest profile's reach, world units ([`Self::reach`]).
     reach: f32,
-    frames_in_flight: usize,
-    guard: Option<LeakGuard>,
 }
 
 /// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
@@ -296,80 +293,48 @@ impl SssEffect {
             object_ids: Vec::new(),
             id_map,
         };
-        let ring = lucent.frames_in_flight() * desc.views_per_frame;
         let upload = SceneUpload {
             translucency_ids: None,
             profile_ids: Some(&[]),
             normal_maps: false,
             lean: false,
             albedo_maps: false,
-            frames_in_flight: ring,
+            frames_in_flight: 1,
             tables: sss::tables::regions(&profiles),
             layered_ids: None,
             layer_depth_textures: 0,
         };
-        let no_objects = frame_scene();
-        let scene_gpu = uploads.record(lucent, "SssEffect::new", || {
-            SceneGpu::new(lucent.gpu(), &no_objects, &upload).map(Arc::new)
-        })?;
-        let (graph, imports) = declare(&desc, &profiles, &scene_gpu, albedo_pass, post_albedo);
-        let options = crate::graph::CompileOptions {
-            chained_frames: ring > 1,
-            ..Default::default()
-        };
-        let compiled = graph.compile(options).and_then(|(plan, execs)| {
-            Executable::new(
-                lucent.gpu(),
-                plan,
-                execs,
-                lucent.shaders(),
-                lucent.pipeline_cache().handle,
-                ring,
-            )
-        });
-        let executable = match compiled {
-            Ok(e) => e,
-            Err(e) => {
-                if let Ok(s) = Arc::try_unwrap(scene_gpu) {
-                    s.destroy(lucent.gpu());
-                }
-                return Err(e);
-            }
-        };
+        let (passes, imports) = EffectPasses::new(
+            lucent,
+            uploads,
+            "SssEffect",
+            upload,
+            desc.views_per_frame,
+            |scene_gpu| declare(&desc, &profiles, scene_gpu, albedo_pass, post_albedo),
+        )?;
         let out = Self {
-            executable: Some(executable),
-            scene_gpu: Some(scene_gpu),
+            passes,
             imports,
-            desc,
             chains: profiles.chains().len(),
             reach: profiles
                 .profiles
                 .iter()
                 .map(|(p, _)| sss::profile_reach(p))
                 .fold(0.0, f32::max),
-            frames_in_flight: lucent.frames_in_flight(),
-            guard: Some(LeakGuard::new("SssEffect")),
+            desc,
         };
         // The tables do not change between frames: written once into every slot.
-        for slot in 0..ring {
-            let per_frame = &out.scene_gpu().per_frame;
+        for slot in 0..out.passes.slots() {
+            let per_frame = out.passes.per_frame();
             let written = sss::tables::write(per_frame, slot, &profiles, &out.desc.knobs);
             if let Err(e) = written {
                 out.destroy(lucent);
                 return Err(e);
             }
-            // No tiles: every chain covers the whole screen (the IDs decide per pixel).
+            // No tiles until a frame gives regions: every chain covers the whole screen.
             *per_frame.tiles(slot) = SlotTiles::default();
         }
         Ok(out)
-    }
-
-    fn scene_gpu(&self) -> &Arc<SceneGpu> {
-        self.scene_gpu.as_ref().expect("alive until destroy")
-    }
-
-    fn executable(&self) -> &Executable {
-        self.executable.as_ref().expect("alive until destroy")
     }
 
     /// How far, in the host's world units, the blurs spread light beyond an object (3 sigma
@@ -382,7 +347,7 @@ impl SssEffect {
 
     /// The passes the effect records (their plan, for tables and tests).
     pub fn plan(&self) -> &crate::graph::Plan {
-        &self.executable().plan
+        self.passes.plan()
     }
 
     /// Records one view of one frame into `cmd` (recording, outside any render pass): the
@@ -419,43 +384,17 @@ impl SssEffect {
         frame: &SssFrame<'_>,
         timer: Option<&mut super::EffectTimer>,
     ) -> Result<()> {
-        let views = self.desc.views_per_frame;
-        if frame.slot >= self.frames_in_flight {
-            return Err(HostError::OutOfRange {
-                what: "frame slot",
-                index: frame.slot,
-                count: self.frames_in_flight,
-            }
-            .into());
-        }
-        if frame.view >= views {
-            return Err(HostError::OutOfRange {
-                what: "view",
-                index: frame.view,
-                count: views,
-            }
-            .into());
-        }
-        frame.camera.check()?;
+        let ring = self.passes.slot(frame.slot, frame.view)?;
         let gbuffer = &self.desc.gbuffer;
-        let decode = gbuffer.depth_decode(&frame.camera.projection)?;
+        let uniforms = gbuffer.view_uniforms(&frame.camera)?;
         let inputs = self.check_images(lucent, frame)?;
-        let ring = frame.slot * views + frame.view;
-        let uniforms = FrameUniforms::for_view(
-            frame.camera.view,
-            frame.camera.projection,
-            gbuffer.width,
-            gbuffer.height,
-            decode,
-        );
-        let per_frame = &self.scene_gpu().per_frame;
+        let per_frame = self.passes.per_frame();
         per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
         // Each chain's tiles (none: the whole screen).
         per_frame.tiles(ring).sss = match marked_tiles(frame.regions, gbuffer.extent()) {
             Some(tiles) => vec![Some(tiles); self.chains],
             None => Vec::new(),
         };
-        let gpu = lucent.gpu();
         let mut binds = vec![
             (self.imports.depth, frame.images.depth),
             (self.imports.diffuse, frame.images.diffuse),
@@ -468,29 +407,15 @@ impl SssEffect {
         if let (Some(id), Some(image)) = (self.imports.albedo, frame.images.albedo) {
             binds.push((id, image));
         }
-        let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> =
-            binds.iter().map(|(id, i)| (*id, i.image, i.view)).collect();
-        self.executable
-            .as_mut()
-            .expect("alive until destroy")
-            .bind_imports(gpu, ring, &binds)?;
-        let sampled = Role::SampledColor.working_state();
-        let attachment = Role::Output.working_state();
-        for image in &inputs {
-            record_transition(gpu, cmd, image, &image.state, &sampled);
-        }
-        record_transition(gpu, cmd, frame.output, &frame.output.state, &attachment);
-        let timer = timer.map(|t| {
-            let timer = t.timer_mut();
-            timer.reset(gpu, cmd);
-            timer
-        });
-        self.executable().record_frame(gpu, cmd, ring, timer);
-        for image in &inputs {
-            record_transition(gpu, cmd, image, &sampled, &image.left_in());
-        }
-        record_transition(gpu, cmd, frame.output, &attachment, &frame.output.left_in());
-        Ok(())
+        self.passes.record(
+            lucent,
+            cmd,
+            ring,
+            &binds,
+            &inputs,
+            (frame.output, Role::Output),
+            timer,
+        )
     }
 
     /// Checks every image of `frame` against the description; returns the inputs, one per
@@ -590,16 +515,8 @@ impl SssEffect {
 
     /// Destroys the passes and their buffers. The GPU must be done with every frame that
     /// recorded them (the host's fences).
-    pub fn destroy(mut self, lucent: &Lucent) {
-        if let Some(executable) = self.executable.take() {
-            executable.destroy(lucent.gpu());
-        }
-        if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
-            s.destroy(lucent.gpu());
-        }
-        if let Some(guard) = self.guard.take() {
-            guard.disarm();
-        }
+    pub fn destroy(self, lucent: &Lucent) {
+        self.passes.destroy(lucent);
     }
 }
 

@@ -26,10 +26,9 @@ use glam::Vec3;
 
 use super::capabilities::{missing, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera, IdEncoding};
-use super::image::{check_image, distinct_inputs, record_transition, HostImage, Role};
+use super::image::{check_image, distinct_inputs, HostImage, Role};
+use super::passes::EffectPasses;
 use super::regions::clipped;
-use super::sss::frame_scene;
-use super::uploads::LeakGuard;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::format_name;
@@ -37,10 +36,8 @@ use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
 use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION};
-use crate::gpu_scene::{
-    FrameUniforms, Region, SceneGpu, SceneUpload, SlotTiles, TableRegion, FRAME,
-};
-use crate::graph::{Executable, ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
+use crate::gpu_scene::{Region, SceneGpu, SceneUpload, SlotTiles, TableRegion, FRAME};
+use crate::graph::{ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::{Light, Mesh, MAX_LIGHTS};
 use crate::Result;
@@ -256,14 +253,11 @@ struct Imports {
 
 /// GDC 2011 translucency on a host's G-buffer (see the module docs).
 pub struct TranslucencyEffect {
-    executable: Option<Executable>,
-    scene_gpu: Option<Arc<SceneGpu>>,
+    passes: EffectPasses,
     imports: Imports,
     desc: TranslucencyEffectDesc,
     /// The constants every frame shares; each frame adds its view.
     constants: HostTranslucencyGpu,
-    frames_in_flight: usize,
-    guard: Option<LeakGuard>,
 }
 
 /// The shader defines of a host's ID image (unsigned or UNORM).
@@ -351,14 +345,13 @@ impl TranslucencyEffect {
             translucent,
             view_to_world: glam::Mat4::IDENTITY.to_cols_array_2d(),
         };
-        let ring = lucent.frames_in_flight() * desc.views_per_frame;
         let upload = SceneUpload {
             translucency_ids: None,
             profile_ids: None,
             normal_maps: false,
             lean: false,
             albedo_maps: false,
-            frames_in_flight: ring,
+            frames_in_flight: 1,
             tables: vec![
                 crate::features::translucency::table_region(),
                 TableRegion {
@@ -369,46 +362,23 @@ impl TranslucencyEffect {
             layered_ids: None,
             layer_depth_textures: 0,
         };
-        let no_objects = frame_scene();
-        let scene_gpu = uploads.record(lucent, "TranslucencyEffect::new", || {
-            SceneGpu::new(lucent.gpu(), &no_objects, &upload).map(Arc::new)
-        })?;
-        let (graph, imports) = declare(&desc, id_map.uint, &scene_gpu);
-        let options = crate::graph::CompileOptions {
-            chained_frames: ring > 1,
-            ..Default::default()
-        };
-        let compiled = graph.compile(options).and_then(|(plan, execs)| {
-            Executable::new(
-                lucent.gpu(),
-                plan,
-                execs,
-                lucent.shaders(),
-                lucent.pipeline_cache().handle,
-                ring,
-            )
-        });
-        let executable = match compiled {
-            Ok(e) => e,
-            Err(e) => {
-                if let Ok(s) = Arc::try_unwrap(scene_gpu) {
-                    s.destroy(lucent.gpu());
-                }
-                return Err(e);
-            }
-        };
+        let (passes, imports) = EffectPasses::new(
+            lucent,
+            uploads,
+            "TranslucencyEffect",
+            upload,
+            desc.views_per_frame,
+            |scene_gpu| declare(&desc, id_map.uint, scene_gpu),
+        )?;
         let out = Self {
-            executable: Some(executable),
-            scene_gpu: Some(scene_gpu),
+            passes,
             imports,
             desc,
             constants,
-            frames_in_flight: lucent.frames_in_flight(),
-            guard: Some(LeakGuard::new("TranslucencyEffect")),
         };
         // The material table does not change between frames: written once into every slot.
-        for slot in 0..ring {
-            let per_frame = &out.scene_gpu().per_frame;
+        for slot in 0..out.passes.slots() {
+            let per_frame = out.passes.per_frame();
             let written = per_frame.write(slot, &TABLE_REGION, bytemuck::bytes_of(&table));
             if let Err(e) = written {
                 out.destroy(lucent);
@@ -419,17 +389,9 @@ impl TranslucencyEffect {
         Ok(out)
     }
 
-    fn scene_gpu(&self) -> &Arc<SceneGpu> {
-        self.scene_gpu.as_ref().expect("alive until destroy")
-    }
-
-    fn executable(&self) -> &Executable {
-        self.executable.as_ref().expect("alive until destroy")
-    }
-
     /// The passes the effect records (its plan, for tables and tests).
     pub fn plan(&self) -> &crate::graph::Plan {
-        &self.executable().plan
+        self.passes.plan()
     }
 
     /// Records one view of one frame into `cmd` (recording, outside any render pass): the
@@ -465,86 +427,40 @@ impl TranslucencyEffect {
         frame: &TranslucencyFrame<'_>,
         timer: Option<&mut super::EffectTimer>,
     ) -> Result<()> {
-        let views = self.desc.views_per_frame;
-        if frame.slot >= self.frames_in_flight {
-            return Err(HostError::OutOfRange {
-                what: "frame slot",
-                index: frame.slot,
-                count: self.frames_in_flight,
-            }
-            .into());
-        }
-        if frame.view >= views {
-            return Err(HostError::OutOfRange {
-                what: "view",
-                index: frame.view,
-                count: views,
-            }
-            .into());
-        }
-        frame.camera.check()?;
+        let ring = self.passes.slot(frame.slot, frame.view)?;
         check_lights(frame.lights)?;
         let gbuffer = &self.desc.gbuffer;
-        let decode = gbuffer.depth_decode(&frame.camera.projection)?;
+        let uniforms = gbuffer
+            .view_uniforms(&frame.camera)?
+            .with_lights(frame.lights);
         let inputs = self.check_images(lucent, frame)?;
-        let ring = frame.slot * views + frame.view;
-        let uniforms = FrameUniforms::for_view(
-            frame.camera.view,
-            frame.camera.projection,
-            gbuffer.width,
-            gbuffer.height,
-            decode,
-        )
-        .with_lights(frame.lights);
         let constants = HostTranslucencyGpu {
             view_to_world: frame.camera.view.inverse().to_cols_array_2d(),
             ..self.constants
         };
-        let per_frame = &self.scene_gpu().per_frame;
+        let per_frame = self.passes.per_frame();
         per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
         per_frame.write(ring, &HOST_TRANSLUCENCY, bytemuck::bytes_of(&constants))?;
         // The pass draws in the `lighting` tiles of the slot (none: the whole screen).
         per_frame.tiles(ring).lighting = clipped(frame.regions, gbuffer.extent());
-        let gpu = lucent.gpu();
         let images = &frame.images;
-        let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> = [
+        let binds = [
             (self.imports.depth, images.depth),
             (self.imports.normals, images.normals),
             (self.imports.albedo, images.albedo),
             (self.imports.thickness, images.thickness),
             (self.imports.material_ids, images.material_ids),
             (self.imports.lighting, frame.lighting),
-        ]
-        .iter()
-        .map(|(id, i)| (*id, i.image, i.view))
-        .collect();
-        self.executable
-            .as_mut()
-            .expect("alive until destroy")
-            .bind_imports(gpu, ring, &binds)?;
-        let sampled = Role::SampledColor.working_state();
-        let attachment = Role::Accumulate.working_state();
-        for image in &inputs {
-            record_transition(gpu, cmd, image, &image.state, &sampled);
-        }
-        record_transition(gpu, cmd, frame.lighting, &frame.lighting.state, &attachment);
-        let timer = timer.map(|t| {
-            let timer = t.timer_mut();
-            timer.reset(gpu, cmd);
-            timer
-        });
-        self.executable().record_frame(gpu, cmd, ring, timer);
-        for image in &inputs {
-            record_transition(gpu, cmd, image, &sampled, &image.left_in());
-        }
-        record_transition(
-            gpu,
+        ];
+        self.passes.record(
+            lucent,
             cmd,
-            frame.lighting,
-            &attachment,
-            &frame.lighting.left_in(),
-        );
-        Ok(())
+            ring,
+            &binds,
+            &inputs,
+            (frame.lighting, Role::Accumulate),
+            timer,
+        )
     }
 
     /// Checks every image of `frame` against the description; returns the inputs, one per
@@ -619,16 +535,8 @@ impl TranslucencyEffect {
 
     /// Destroys the pass and its buffers. The GPU must be done with every frame that
     /// recorded it (the host's fences).
-    pub fn destroy(mut self, lucent: &Lucent) {
-        if let Some(executable) = self.executable.take() {
-            executable.destroy(lucent.gpu());
-        }
-        if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
-            s.destroy(lucent.gpu());
-        }
-        if let Some(guard) = self.guard.take() {
-            guard.disarm();
-        }
+    pub fn destroy(self, lucent: &Lucent) {
+        self.passes.destroy(lucent);
     }
 }
 

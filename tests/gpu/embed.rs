@@ -689,18 +689,7 @@ fn sss_regions(
         .iter()
         .filter(|o| o.material.sss.is_some())
         .map(|o| {
-            let (lo, hi) = bounds[o.mesh];
-            let corners: Vec<glam::Vec3> = (0..8)
-                .map(|i| {
-                    let p = glam::Vec3::new(
-                        if i & 1 == 0 { lo.x } else { hi.x },
-                        if i & 2 == 0 { lo.y } else { hi.y },
-                        if i & 4 == 0 { lo.z } else { hi.z },
-                    );
-                    o.transform.transform_point3(p)
-                })
-                .collect();
-            lucent::embed::screen_region(&corners, camera, extent, reach)
+            lucent::embed::box_screen_region(bounds[o.mesh], o.transform, camera, extent, reach)
         })
         .collect();
     regions.unwrap_or_default()

@@ -1,0 +1,175 @@
+//! What every effect on a host's G-buffer is made of ([`EffectPasses`]): its compiled passes
+//! with the host's images imported, its per-frame buffer with one slot per frame in flight and
+//! view, and the leak guard; building it, checking a frame's slot and view, and recording a
+//! frame (the host's images bound, moved into the states the passes use and back, timestamps
+//! when asked). The effects ([`super::SssEffect`], [`super::TranslucencyEffect`]) add what
+//! their technique needs: their description, tables and per-frame constants.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::image::{record_transition, HostImage, Role};
+use super::sss::frame_scene;
+use super::uploads::LeakGuard;
+use super::{EffectTimer, Lucent, Uploads};
+use crate::error::HostError;
+use crate::gpu_scene::{PerFrame, SceneGpu, SceneUpload};
+use crate::graph::{CompileOptions, Executable, RenderGraph, ResourceId};
+use crate::Result;
+
+/// An effect's passes and per-frame data (see the module docs).
+pub(crate) struct EffectPasses {
+    executable: Option<Executable>,
+    scene_gpu: Option<Arc<SceneGpu>>,
+    frames_in_flight: usize,
+    views: usize,
+    guard: Option<LeakGuard>,
+}
+
+impl EffectPasses {
+    /// Builds the passes `declare` declares over a per-frame buffer of `upload`'s tables,
+    /// one slot per frame in flight and view (`upload.frames_in_flight` is set here). The
+    /// buffer's creation is recorded into `uploads` under `what` (the effect's name).
+    pub(crate) fn new<I>(
+        lucent: &Lucent,
+        uploads: &mut Uploads,
+        what: &'static str,
+        mut upload: SceneUpload<'_>,
+        views: usize,
+        declare: impl FnOnce(&Arc<SceneGpu>) -> (RenderGraph, I),
+    ) -> Result<(Self, I)> {
+        let ring = lucent.frames_in_flight() * views;
+        upload.frames_in_flight = ring;
+        let no_objects = frame_scene();
+        let scene_gpu = uploads.record(lucent, what, || {
+            SceneGpu::new(lucent.gpu(), &no_objects, &upload).map(Arc::new)
+        })?;
+        let (graph, imports) = declare(&scene_gpu);
+        let options = CompileOptions {
+            chained_frames: ring > 1,
+            ..Default::default()
+        };
+        let compiled = graph.compile(options).and_then(|(plan, execs)| {
+            Executable::new(
+                lucent.gpu(),
+                plan,
+                execs,
+                lucent.shaders(),
+                lucent.pipeline_cache().handle,
+                ring,
+            )
+        });
+        match compiled {
+            Ok(executable) => Ok((
+                Self {
+                    executable: Some(executable),
+                    scene_gpu: Some(scene_gpu),
+                    frames_in_flight: lucent.frames_in_flight(),
+                    views,
+                    guard: Some(LeakGuard::new(what)),
+                },
+                imports,
+            )),
+            Err(e) => {
+                if let Ok(s) = Arc::try_unwrap(scene_gpu) {
+                    s.destroy(lucent.gpu());
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// The per-frame buffer and tiles.
+    pub(crate) fn per_frame(&self) -> &PerFrame {
+        &self
+            .scene_gpu
+            .as_ref()
+            .expect("alive until destroy")
+            .per_frame
+    }
+
+    /// Every slot of the per-frame buffer (frames in flight times views).
+    pub(crate) fn slots(&self) -> usize {
+        self.frames_in_flight * self.views
+    }
+
+    /// The passes (their plan).
+    pub(crate) fn plan(&self) -> &crate::graph::Plan {
+        &self.executable.as_ref().expect("alive until destroy").plan
+    }
+
+    /// The per-frame slot of frame slot `slot`, view `view`, or the error naming which is out
+    /// of range.
+    pub(crate) fn slot(&self, slot: usize, view: usize) -> Result<usize> {
+        if slot >= self.frames_in_flight {
+            return Err(HostError::OutOfRange {
+                what: "frame slot",
+                index: slot,
+                count: self.frames_in_flight,
+            }
+            .into());
+        }
+        if view >= self.views {
+            return Err(HostError::OutOfRange {
+                what: "view",
+                index: view,
+                count: self.views,
+            }
+            .into());
+        }
+        Ok(slot * self.views + view)
+    }
+
+    /// Records per-frame slot `ring`'s passes into `cmd`: `binds` (each import's host image)
+    /// bound, the `inputs` (distinct images, checked) moved to the sampled state and `output`
+    /// to `output_role`'s, the passes (timed into `timer` when given), then each image to its
+    /// final state.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn record(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        ring: usize,
+        binds: &[(ResourceId, &HostImage)],
+        inputs: &[&HostImage],
+        (output, output_role): (&HostImage, Role),
+        timer: Option<&mut EffectTimer>,
+    ) -> Result<()> {
+        let gpu = lucent.gpu();
+        let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> =
+            binds.iter().map(|(id, i)| (*id, i.image, i.view)).collect();
+        let executable = self.executable.as_mut().expect("alive until destroy");
+        executable.bind_imports(gpu, ring, &binds)?;
+        let sampled = Role::SampledColor.working_state();
+        let attachment = output_role.working_state();
+        for image in inputs {
+            record_transition(gpu, cmd, image, &image.state, &sampled);
+        }
+        record_transition(gpu, cmd, output, &output.state, &attachment);
+        let timer = timer.map(|t| {
+            let timer = t.timer_mut();
+            timer.reset(gpu, cmd);
+            timer
+        });
+        executable.record_frame(gpu, cmd, ring, timer);
+        for image in inputs {
+            record_transition(gpu, cmd, image, &sampled, &image.left_in());
+        }
+        record_transition(gpu, cmd, output, &attachment, &output.left_in());
+        Ok(())
+    }
+
+    /// Destroys the passes and their buffers; the GPU must be done with them.
+    pub(crate) fn destroy(mut self, lucent: &Lucent) {
+        if let Some(executable) = self.executable.take() {
+            executable.destroy(lucent.gpu());
+        }
+        if let Some(s) = self.scene_gpu.take().and_then(|s| Arc::try_unwrap(s).ok()) {
+            s.destroy(lucent.gpu());
+        }
+        if let Some(guard) = self.guard.take() {
+            guard.disarm();
+        }
+    }
+}

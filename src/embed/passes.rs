@@ -10,12 +10,12 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::image::{record_transition, HostImage, Role};
-use super::sss::frame_scene;
 use super::uploads::LeakGuard;
 use super::{EffectTimer, Lucent, Uploads};
 use crate::error::HostError;
 use crate::gpu_scene::{PerFrame, SceneGpu, SceneUpload};
 use crate::graph::{CompileOptions, Executable, RenderGraph, ResourceId};
+use crate::scene::{Camera, Scene};
 use crate::Result;
 
 /// An effect's passes and per-frame data (see the module docs).
@@ -171,5 +171,28 @@ impl EffectPasses {
         if let Some(guard) = self.guard.take() {
             guard.disarm();
         }
+    }
+}
+
+/// The scene the effect's GPU data is created with: no objects, lights or environment (the
+/// passes read the camera, the viewport and the tables only).
+fn frame_scene() -> Scene {
+    Scene {
+        name: "host effect".into(),
+        meshes: Vec::new(),
+        objects: Vec::new(),
+        lights: Vec::new(),
+        camera: Camera {
+            eye: glam::Vec3::new(0.0, 0.0, 1.0),
+            target: glam::Vec3::ZERO,
+            fov_y_degrees: 45.0,
+            near: 0.1,
+            far: 100.0,
+        },
+        environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
+        sky: glam::Vec3::ZERO,
+        exposure: 1.0,
+        deformation: None,
+        time: 0.0,
     }
 }

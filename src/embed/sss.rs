@@ -38,7 +38,6 @@ use crate::graph::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
 use crate::scene::material::{SssProfile, Texturing};
-use crate::scene::{Camera, Scene};
 use crate::Result;
 
 /// Most views one frame may record ([`SssEffectDesc::views_per_frame`]).
@@ -621,29 +620,6 @@ fn declare(
     );
     graph.export_image(&result, Access::ColorAttachmentWrite);
     (graph, imports)
-}
-
-/// The scene the effect's GPU data is created with: no objects, lights or environment (the
-/// passes read the camera, the viewport and the tables only).
-pub(super) fn frame_scene() -> Scene {
-    Scene {
-        name: "host SSS".into(),
-        meshes: Vec::new(),
-        objects: Vec::new(),
-        lights: Vec::new(),
-        camera: Camera {
-            eye: glam::Vec3::new(0.0, 0.0, 1.0),
-            target: glam::Vec3::ZERO,
-            fov_y_degrees: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
-        sky: glam::Vec3::ZERO,
-        exposure: 1.0,
-        deformation: None,
-        time: 0.0,
-    }
 }
 
 /// The output must be a colour-attachment format the final pass writes floats into.

@@ -336,7 +336,7 @@ fn upload_format(layout: UploadLayout) -> vk::Format {
 
 /// Creates a sampled `width x height` image in `layout` with its whole mip chain, which
 /// `fill` writes into the staging buffer ([`upload::write_chain`] or
-/// [`upload::write_texture_chain`]).
+/// [`crate::scene::texture::write_texture_chain`]).
 fn upload_chain(
     gpu: &GpuContext,
     width: u32,
@@ -372,7 +372,7 @@ pub fn upload_texture_file(
     warn_non_finite(path, &decoded);
     let (width, height, layout) = (decoded.width, decoded.height, decoded.upload_layout());
     upload_chain(gpu, width, height, layout, name, move |out| {
-        upload::write_texture_chain(decoded, out)
+        crate::scene::texture::write_texture_chain(decoded, out)
     })
 }
 

@@ -4,7 +4,9 @@
 //! changes, so does its twin. [`raytrace`] renders a whole scene from the analytic shapes its
 //! meshes approximate, as an independent end-to-end reference.
 
-pub mod albedo;
+/// The medium's albedo is CPU math of the materials (`crate::scene::albedo`); the f64
+/// references name it here too.
+pub use crate::scene::albedo;
 pub mod dipole;
 pub mod fxaa;
 pub mod layered;

@@ -41,8 +41,7 @@
 
 use glam::Vec3;
 
-use super::material::TextureSource;
-use super::texture::{load_texture, Texture, TextureUsage};
+use super::texture::{load_texture, Texture, TextureSource, TextureUsage};
 use crate::{LucentError, Result};
 
 /// Most layers a medium may have (two RGBA depth textures).
@@ -324,7 +323,7 @@ impl LayeredMedium {
     /// The white-sky albedo of the first layer, taken as semi-infinite, at the medium's `eta`,
     /// per channel: the fraction of the light falling on a flat surface of it from every
     /// direction that leaves again, single and multiple scattering together
-    /// ([`crate::reference::albedo`]; exact for isotropic scattering behind an index-matched
+    /// ([`crate::scene::albedo`]; exact for isotropic scattering behind an index-matched
     /// boundary). The albedo a Lambertian surface of this medium has: what `[material.medium]`
     /// gives a material that writes none. Above [`LayeredMedium::total_diffuse_reflectance`]
     /// (the dipole's, which misses single scattering and underestimates diffusion at moderate
@@ -338,7 +337,7 @@ impl LayeredMedium {
     pub fn white_sky_albedo_at(&self, eta: f32) -> Vec3 {
         let r = self.first_layer_reduced();
         Vec3::from_array(std::array::from_fn(|c| {
-            crate::reference::albedo::white_sky_albedo(
+            crate::scene::albedo::white_sky_albedo(
                 f64::from(r.sigma_s_prime[c]),
                 f64::from(r.sigma_a[c]),
                 f64::from(eta),

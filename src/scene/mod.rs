@@ -4,6 +4,7 @@
 //! reference in [`crate::reference`] can ray-trace the exact surface the GPU rasterises an
 //! approximation of.
 
+pub mod albedo;
 mod build;
 pub mod builtin;
 pub mod environment;
@@ -20,6 +21,7 @@ pub mod polygon;
 pub mod profile;
 pub mod showcase;
 pub mod texture;
+pub mod transmittance;
 pub mod upload;
 
 use glam::{Mat4, Vec3};

@@ -6,12 +6,264 @@
 //! to it). CPU math of the materials; the f64 reference and the frame both use it.
 
 use std::f64::consts::PI;
+use std::path::PathBuf;
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 use super::layered::{dipole_constants, LayeredMedium};
-use super::material::{BurleyDistance, Gaussian, SssProfile, Texturing};
-use crate::Result;
+use crate::{LucentError, Result};
+
+/// One Gaussian of a diffusion profile: variance in mm² and its RGB weight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gaussian {
+    /// Variance v (the Gaussian is exp(-r²/2v) / 2πv), mm².
+    pub variance: f32,
+    /// Weight per colour channel.
+    pub weight: Vec3,
+}
+
+/// A diffusion profile as a sum of Gaussians (d'Eon and Luebke), used by screen-space SSS.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SssProfile {
+    /// Preset name or "custom".
+    pub name: String,
+    /// The Gaussians, narrowest first.
+    pub gaussians: Vec<Gaussian>,
+    /// World units per millimetre of the profile (scene scale).
+    pub units_per_mm: f32,
+    /// The screen-space blur the material asks for (`[material.sss] blur`, a registered SSS
+    /// technique's name); `None`: the registry's default blur.
+    pub blur: Option<TechniqueName>,
+    /// Christensen and Burley's normalized diffusion, for the 2-D Burley blur
+    /// (`[material.sss] scattering_distance` or `mean_free_path`); `None`: the Burley blur
+    /// matches the Gaussians' second moment (the other blurs always read the Gaussians).
+    pub burley: Option<BurleyDistance>,
+    /// Where the surface albedo meets the scattered light (`[material.sss] texturing`).
+    pub texturing: Texturing,
+}
+
+/// Where a screen-space SSS material's albedo (its texture included) is applied relative to
+/// the blur. Light that scatters under a surface crosses it on the way in and on the way out,
+/// so a texture's detail belongs outside the blur, not smeared by it (HDRP's "post-scatter"
+/// and "pre- and post-scatter" texturing modes; UE and EEVEE multiply after).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Texturing {
+    /// The albedo is in the light the blur diffuses (lucent's behaviour before this mode
+    /// existed; kept to measure what the other two change): textures are blurred away.
+    Pre,
+    /// The blur diffuses light without albedo; the pixel's own albedo multiplies the result:
+    /// textures stay as sharp as under plain lighting. The default: the only mode that keeps
+    /// `showcase-marble`'s veins at the contrast plain lighting gives them (docs/sss.md,
+    /// "Albedo after the scatter", has the measurements).
+    #[default]
+    Post,
+    /// The square root of the albedo before the blur and after it (HDRP's default): some of
+    /// the neighbours' colour bleeds in (light entered through them), half the pixel's own
+    /// detail stays.
+    PrePost,
+}
+
+impl Texturing {
+    /// Every mode with its scene-file and command-line name.
+    pub const ALL: [(&'static str, Texturing); 3] = [
+        ("pre", Texturing::Pre),
+        ("post", Texturing::Post),
+        ("pre-post", Texturing::PrePost),
+    ];
+
+    /// The mode named `name` (scene files, `--sss-texturing`).
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    }
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, t)| *t == self)
+            .map_or("post", |(n, _)| n)
+    }
+
+    /// The shaders' code for it (glsl/common/sss.glsl `sss_albedo_*`): 0 pre, 1 post,
+    /// 2 pre-post.
+    pub fn code(self) -> f32 {
+        match self {
+            Texturing::Pre => 0.0,
+            Texturing::Post => 1.0,
+            Texturing::PrePost => 2.0,
+        }
+    }
+
+    /// The factor of the albedo `a` in the light the blur diffuses.
+    pub fn before(self, a: f64) -> f64 {
+        match self {
+            Texturing::Pre => a,
+            Texturing::Post => 1.0,
+            Texturing::PrePost => a.max(0.0).sqrt(),
+        }
+    }
+
+    /// The factor of the albedo `a` that multiplies the blurred light.
+    pub fn after(self, a: f64) -> f64 {
+        match self {
+            Texturing::Pre => 1.0,
+            Texturing::Post => a,
+            Texturing::PrePost => a.max(0.0).sqrt(),
+        }
+    }
+}
+
+/// How a material gives Burley's per-channel shape parameter `d` (mm): directly, as HDRP's
+/// "scattering distance", or as a diffuse mean free path `l` with the surface albedo `A`,
+/// `d = l / s(A)` by one of Christensen and Burley's fits (chosen per frame: `--burley-fit`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BurleyDistance {
+    /// `d` per channel, mm.
+    Scattering(Vec3),
+    /// The diffuse mean free path per channel (mm) and the albedo the fit reads.
+    MeanFreePath {
+        /// `l` per channel, mm.
+        mfp: Vec3,
+        /// Surface albedo `A` per channel, in [0, 1].
+        albedo: Vec3,
+    },
+}
+
+/// A technique a scene names (`[material.sss] blur`), kept as written. The scene knows no
+/// techniques: the technique registry (`lucent::features::registry`), a layer above, resolves
+/// the name, and [`TechniqueName::error`] words its complaint with the file, line and key the
+/// name came from. Two names are equal when they are spelled the same.
+#[derive(Clone, Debug)]
+pub struct TechniqueName {
+    /// The name as written.
+    pub name: String,
+    /// Where it was written: the scene file and ``line N, key `...` ``.
+    origin: Option<(PathBuf, String)>,
+}
+
+impl TechniqueName {
+    /// A name given in code (no file to point at).
+    pub fn new(name: impl Into<String>) -> Self {
+        Self {
+            name: name.into(),
+            origin: None,
+        }
+    }
+
+    /// A name read from `path` at `location` (``line N, key `material[i].blur` ``).
+    pub fn written_at(name: impl Into<String>, path: &std::path::Path, location: String) -> Self {
+        Self {
+            name: name.into(),
+            origin: Some((path.to_path_buf(), location)),
+        }
+    }
+
+    /// `message` about this name, naming where it was written when it came from a file.
+    pub fn error(&self, message: impl std::fmt::Display) -> LucentError {
+        match &self.origin {
+            Some((path, location)) => LucentError::file(path, format!("{location}: {message}")),
+            None => LucentError::InvalidInput(message.to_string()),
+        }
+    }
+}
+
+impl PartialEq for TechniqueName {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+impl From<&str> for TechniqueName {
+    fn from(name: &str) -> Self {
+        Self::new(name)
+    }
+}
+
+/// d'Eon's six-Gaussian fit of human skin (the thesis, Figure 17): (variance mm², R, G, B).
+pub const SKIN_GAUSSIANS: [(f32, [f32; 3]); 6] = [
+    (0.0064, [0.233, 0.455, 0.649]),
+    (0.0484, [0.100, 0.336, 0.344]),
+    (0.187, [0.118, 0.198, 0.0]),
+    (0.567, [0.113, 0.007, 0.007]),
+    (1.99, [0.358, 0.004, 0.0]),
+    (7.41, [0.078, 0.0, 0.0]),
+];
+
+/// Marble: the variances of the skin fit with weights fitted (non-negative least squares, in
+/// `lucent::reference::dipole`) to Jensen et al.'s dipole profile of marble
+/// (σs' = 2.19, 2.62, 3.00 /mm; σa = 0.0021, 0.0041, 0.0071 /mm; η = 1.5), each channel
+/// normalised to sum to 1, fitted over 0 to 10 mm. The fit's relative L2 error is 1.8%, 1.2%
+/// and 2.0% (R, G, B). Checked by the test `marble_preset_matches_its_fit`.
+pub const MARBLE_GAUSSIANS: [(f32, [f32; 3]); 6] = [
+    (0.0064, [0.0001, 0.0027, 0.0074]),
+    (0.0484, [0.0857, 0.1409, 0.1943]),
+    (0.187, [0.2174, 0.2054, 0.1755]),
+    (0.567, [0.1421, 0.1372, 0.1612]),
+    (1.99, [0.1675, 0.2001, 0.2098]),
+    (7.41, [0.3873, 0.3138, 0.2519]),
+];
+
+impl SssProfile {
+    /// A preset by name: `skin` (d'Eon, thesis Figure 17) or `marble`.
+    pub fn preset(name: &str) -> Result<Self> {
+        let table = match name {
+            "skin" => &SKIN_GAUSSIANS,
+            "marble" => &MARBLE_GAUSSIANS,
+            _ => {
+                return Err(LucentError::InvalidInput(format!(
+                    "unknown SSS profile '{name}'; presets: skin, marble"
+                )))
+            }
+        };
+        Ok(Self {
+            name: name.to_string(),
+            gaussians: table
+                .iter()
+                .map(|&(variance, w)| Gaussian {
+                    variance,
+                    weight: Vec3::from(w),
+                })
+                .collect(),
+            units_per_mm: 0.01,
+            blur: None,
+            burley: None,
+            texturing: Texturing::default(),
+        })
+    }
+
+    /// Checks the profile can be blurred safely: 1 to 8 Gaussians, finite positive variances,
+    /// finite non-negative weights.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.gaussians.len();
+        if !(1..=8).contains(&n) {
+            return Err(LucentError::InvalidInput(format!(
+                "SSS profile '{}' has {n} Gaussians; 1 to 8 are supported",
+                self.name
+            )));
+        }
+        for (i, g) in self.gaussians.iter().enumerate() {
+            if !(g.variance.is_finite() && g.variance > 0.0) {
+                return Err(LucentError::InvalidInput(format!(
+                    "SSS profile '{}' Gaussian {i}: variance {} must be finite and > 0",
+                    self.name, g.variance
+                )));
+            }
+            if !(g.weight.is_finite() && g.weight.min_element() >= 0.0) {
+                return Err(LucentError::InvalidInput(format!(
+                    "SSS profile '{}' Gaussian {i}: weights must be finite and >= 0",
+                    self.name
+                )));
+            }
+        }
+        if !(self.units_per_mm.is_finite() && self.units_per_mm > 0.0) {
+            return Err(LucentError::InvalidInput(format!(
+                "SSS profile '{}': units_per_mm must be finite and > 0",
+                self.name
+            )));
+        }
+        Ok(())
+    }
+}
 
 /// Each Gaussian's weight, normalised per channel so the weights sum to 1 (as the blurs
 /// normalise them); a channel whose weights are all 0 keeps its light where it is, which the

@@ -24,13 +24,48 @@
 //! mips while loading). [`decode_texture`] keeps the image as stored (its decoded size, no
 //! `f32` copy) for what samples it on the CPU: thickness maps, `lucent inspect`, the upload.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use image::{DynamicImage, ImageReader, Limits};
 use rayon::prelude::*;
 
+use super::upload::{axis_weights, make_mips, split_level0, UploadLayout};
+pub use super::upload::{mip_levels, srgb_to_linear};
 use crate::files::Capped;
 use crate::{LucentError, Result};
+
+/// Where a texture comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureSource {
+    /// A file (PNG, JPEG, TGA, EXR, HDR), relative paths resolved against the scene file.
+    File(PathBuf),
+    /// Made in code, so built-in scenes need no file from outside the repository.
+    Procedural(ProceduralTexture),
+}
+
+/// Textures lucent can make itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProceduralTexture {
+    /// A tangent-space normal map of marble-like veins: the height field
+    /// `sin(frequency * (x + turbulence(x, y)))`, differentiated.
+    MarbleNormal {
+        /// Vein frequency across the texture.
+        frequency: f32,
+        /// Bump strength (slope scale).
+        strength: f32,
+    },
+    /// A veined marble albedo (linear RGB, multiplied with the material's albedo): white
+    /// crossed by thin `vein_color` veins along the zero crossings of the same height field as
+    /// `MarbleNormal` at the same `frequency`, so veins and bumps line up, and a fainter,
+    /// finer second net.
+    MarbleAlbedo {
+        /// Vein frequency across the texture (as `MarbleNormal`'s).
+        frequency: f32,
+        /// Colour at the centre of a vein (linear, each channel in [0, 1]).
+        vein_color: Vec3,
+    },
+}
 
 /// Largest width or height accepted (the minimum `maxImageDimension2D` Vulkan devices commonly
 /// offer, and already 4 GiB of `f32` RGBA texels).
@@ -180,17 +215,14 @@ fn marble_height(frequency: f32, n: usize, x: usize, y: usize) -> f32 {
 /// field crosses zero) and by a third of that of a field at 2.7 times the frequency (rounded)
 /// turned
 /// across it (the finer net); linear RGB.
-pub fn procedural_texture(
-    texture: &super::material::ProceduralTexture,
-    size: u32,
-) -> Result<Texture> {
+pub fn procedural_texture(texture: &ProceduralTexture, size: u32) -> Result<Texture> {
     let n = size.max(1) as usize;
     let (frequency, strength) = match *texture {
-        super::material::ProceduralTexture::MarbleNormal {
+        ProceduralTexture::MarbleNormal {
             frequency,
             strength,
         } => (frequency, strength),
-        super::material::ProceduralTexture::MarbleAlbedo {
+        ProceduralTexture::MarbleAlbedo {
             frequency,
             vein_color,
         } => {
@@ -252,11 +284,6 @@ pub const MAX_TEXTURE_FILE_BYTES: u64 = 2 << 30;
 /// makes two more of the same size; so the limit is on the texel count, checked from the
 /// file's header before anything is decoded.
 pub const MAX_TEXTURE_TEXELS: u64 = 8192 * 8192;
-
-/// Mip levels of a `width x height` texture down to 1x1 (`floor(log2(max side)) + 1`).
-pub fn mip_levels(width: u32, height: u32) -> u32 {
-    32 - width.max(height).max(1).leading_zeros()
-}
 
 /// Host bytes of a loaded `width x height` texture: linear RGBA `f32` texels of every mip
 /// level. Checked arithmetic: `None` only beyond `u64`, which no accepted size reaches.
@@ -365,7 +392,7 @@ pub fn scene_texture_sizes(
         let m = &object.material;
         let maps = [(&m.normal_texture, true), (&m.albedo_texture, false)];
         for (source, normal) in maps {
-            let Some(super::material::TextureSource::File(path)) = source else {
+            let Some(TextureSource::File(path)) = source else {
                 continue;
             };
             if sizes.iter().any(|(p, _, _, n)| p == path && *n == normal) {
@@ -586,6 +613,33 @@ impl DecodedImage {
     }
 }
 
+/// Writes `image`'s whole mip chain into `out` (its [`level_bytes`](super::upload::level_bytes) for
+/// [`DecodedImage::upload_layout`], packed, level 0 first). Level 0 is the file's texels in
+/// that layout; `image` is dropped before the mips are made, so the decoded file and the mips
+/// never share memory.
+pub fn write_texture_chain(image: DecodedImage, out: &mut [u8]) -> Result<()> {
+    let (width, height) = (image.width, image.height);
+    let layout = image.upload_layout();
+    let (level0, rest) = split_level0(width, height, layout, out)?;
+    let w = width as usize;
+    let row_bytes = w * layout.texel_bytes();
+    let eight_bit = matches!(layout, UploadLayout::Unorm8 | UploadLayout::Srgb8);
+    level0
+        .par_chunks_mut(row_bytes)
+        .enumerate()
+        .for_each(|(y, row)| {
+            // 8-bit files are copied as stored (exact); anything else is converted.
+            if !(eight_bit && image.write_rgba8_row(y, row)) {
+                for (x, texel) in row.chunks_exact_mut(layout.texel_bytes()).enumerate() {
+                    layout.encode(image.texel(x, y), texel);
+                }
+            }
+        });
+    drop(image);
+    make_mips(width, height, layout, level0, rest);
+    Ok(())
+}
+
 /// Decodes an image file ([`load_texture`]'s checks and limits) into a [`DecodedImage`].
 pub fn decode_texture(path: &Path, usage: TextureUsage) -> Result<DecodedImage> {
     // Read the header alone first, so an absurd size is refused before anything is allocated.
@@ -637,15 +691,6 @@ fn decode(path: &Path, usage: TextureUsage) -> Result<(u32, u32, Vec<[f32; 4]>)>
     Ok((decoded.width, decoded.height, texels))
 }
 
-/// The sRGB electro-optical transfer function (IEC 61966-2-1), encoded [0, 1] to linear.
-pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// Replaces every NaN or infinite component by 0; returns how many were replaced.
 ///
 /// This happens at load, before filtering, because one NaN poisons every filter tap that touches
@@ -660,24 +705,6 @@ fn sanitize(texels: &mut [[f32; 4]]) -> usize {
         }
     }
     replaced
-}
-
-/// For each texel of a `m`-texel axis downsampled from `n` texels: the source texels it covers
-/// and their weights (overlap / footprint), summing to 1.
-pub(super) fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
-    (0..m)
-        .map(|i| {
-            let start = i as f64 * n as f64 / m as f64;
-            let end = (i + 1) as f64 * n as f64 / m as f64;
-            let width = end - start; // >= 1 because m <= n
-            (start.floor() as usize..(end.ceil() as usize).min(n))
-                .filter_map(|j| {
-                    let overlap = end.min(j as f64 + 1.0) - start.max(j as f64);
-                    (overlap > 0.0).then(|| (j, (overlap / width) as f32))
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// One mip step: `w x h` to `max(1, w/2) x max(1, h/2)` with an area-weighted box filter.
@@ -718,7 +745,7 @@ mod tests {
 
     #[test]
     fn procedural_marble_normals_are_unit_tangent_space_and_tile() {
-        let p = crate::scene::material::ProceduralTexture::MarbleNormal {
+        let p = ProceduralTexture::MarbleNormal {
             frequency: 18.0,
             strength: 0.35,
         };

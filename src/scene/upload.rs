@@ -4,8 +4,8 @@
 //!
 //! [`load_texture`](super::texture::load_texture) makes linear `f32` texels with mips (about
 //! 21 bytes a texel) for what computes with a texture on the CPU. A texture bound for the GPU
-//! needs none of that: [`write_texture_chain`] takes the file decoded as it is stored
-//! ([`DecodedImage`]), writes level 0 into the caller's buffer (the staging buffer of the
+//! needs none of that: [`write_texture_chain`](super::texture::write_texture_chain) takes the file decoded as it is stored
+//! ([`DecodedImage`](super::texture::DecodedImage)), writes level 0 into the caller's buffer (the staging buffer of the
 //! upload) in the smallest [`UploadLayout`] that keeps what the file holds, drops the decoded
 //! file, and makes every next mip level from the one before it inside that buffer:
 //!
@@ -30,7 +30,6 @@
 
 use rayon::prelude::*;
 
-use super::texture::{mip_levels, srgb_to_linear, DecodedImage};
 use crate::{LucentError, Result};
 
 /// The texel layout a texture is uploaded in (see the module docs for which file gets which).
@@ -75,7 +74,7 @@ impl UploadLayout {
 
     /// Writes linear RGBA `t` into `out` (one texel). Values are clamped to what the layout
     /// holds (`[0, 1]` for 8 bits, fp16's finite range), so nothing overflows to infinity.
-    fn encode(self, t: [f32; 4], out: &mut [u8]) {
+    pub(super) fn encode(self, t: [f32; 4], out: &mut [u8]) {
         let unorm = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
         let half = |v: f32| half::f16::from_f32(v.clamp(-65504.0, 65504.0)).to_le_bytes();
         match self {
@@ -100,6 +99,38 @@ impl UploadLayout {
     }
 }
 
+/// Mip levels of a `width x height` texture down to 1x1 (`floor(log2(max side)) + 1`).
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1), encoded [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// For each texel of a `m`-texel axis downsampled from `n` texels: the source texels it covers
+/// and their weights (overlap / footprint), summing to 1.
+pub(super) fn axis_weights(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
+    (0..m)
+        .map(|i| {
+            let start = i as f64 * n as f64 / m as f64;
+            let end = (i + 1) as f64 * n as f64 / m as f64;
+            let width = end - start; // >= 1 because m <= n
+            (start.floor() as usize..(end.ceil() as usize).min(n))
+                .filter_map(|j| {
+                    let overlap = end.min(j as f64 + 1.0) - start.max(j as f64);
+                    (overlap > 0.0).then(|| (j, (overlap / width) as f32))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Bytes of each mip level of a `width x height` texture in `layout`, level 0 first, down to
 /// 1x1 (`max(1, size >> level)` per side).
 pub fn level_bytes(width: u32, height: u32, layout: UploadLayout) -> Vec<u64> {
@@ -109,33 +140,6 @@ pub fn level_bytes(width: u32, height: u32, layout: UploadLayout) -> Vec<u64> {
             u64::from(w) * u64::from(h) * layout.texel_bytes() as u64
         })
         .collect()
-}
-
-/// Writes `image`'s whole mip chain into `out` (its [`level_bytes`] for
-/// [`DecodedImage::upload_layout`], packed, level 0 first). Level 0 is the file's texels in
-/// that layout; `image` is dropped before the mips are made, so the decoded file and the mips
-/// never share memory.
-pub fn write_texture_chain(image: DecodedImage, out: &mut [u8]) -> Result<()> {
-    let (width, height) = (image.width, image.height);
-    let layout = image.upload_layout();
-    let (level0, rest) = split_level0(width, height, layout, out)?;
-    let w = width as usize;
-    let row_bytes = w * layout.texel_bytes();
-    let eight_bit = matches!(layout, UploadLayout::Unorm8 | UploadLayout::Srgb8);
-    level0
-        .par_chunks_mut(row_bytes)
-        .enumerate()
-        .for_each(|(y, row)| {
-            // 8-bit files are copied as stored (exact); anything else is converted.
-            if !(eight_bit && image.write_rgba8_row(y, row)) {
-                for (x, texel) in row.chunks_exact_mut(layout.texel_bytes()).enumerate() {
-                    layout.encode(image.texel(x, y), texel);
-                }
-            }
-        });
-    drop(image);
-    make_mips(width, height, layout, level0, rest);
-    Ok(())
 }
 
 /// Writes a whole mip chain of a `width x height` texture into `out` (its [`level_bytes`] for
@@ -163,7 +167,7 @@ pub fn write_chain(
 }
 
 /// `out` split into level 0 and the levels after it, checked against [`level_bytes`].
-fn split_level0(
+pub(super) fn split_level0(
     width: u32,
     height: u32,
     layout: UploadLayout,
@@ -181,7 +185,13 @@ fn split_level0(
 
 /// Makes every level after `level0` (a `width x height` image in `layout`) into `rest`, each
 /// from the level before it.
-fn make_mips(width: u32, height: u32, layout: UploadLayout, level0: &[u8], rest: &mut [u8]) {
+pub(super) fn make_mips(
+    width: u32,
+    height: u32,
+    layout: UploadLayout,
+    level0: &[u8],
+    rest: &mut [u8],
+) {
     let srgb: [f32; 256] = std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0));
     let tb = layout.texel_bytes();
     let (mut w, mut h) = (width as usize, height as usize);
@@ -216,8 +226,8 @@ fn downsample(
     nh: usize,
 ) {
     let tb = layout.texel_bytes();
-    let wx = super::texture::axis_weights(w, nw);
-    let wy = super::texture::axis_weights(h, nh);
+    let wx = axis_weights(w, nw);
+    let wy = axis_weights(h, nh);
     dst.par_chunks_mut(nw * tb)
         .enumerate()
         .for_each(|(y, row)| {

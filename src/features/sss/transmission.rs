@@ -54,7 +54,7 @@ pub struct SssTransmission {
     pub medium_albedo: [f64; 3],
     /// Its reduced single-scattering albedo `sigma_s' / (sigma_s' + sigma_a)` per channel
     /// and its white-sky albedo behind an index-matched boundary: what its reflectance
-    /// relative to Lambert's takes ([`crate::reference::albedo::medium_reflectance`]).
+    /// relative to Lambert's takes ([`crate::scene::albedo::medium_reflectance`]).
     pub reflectance: [(f64, f64); 3],
 }
 
@@ -80,10 +80,10 @@ impl SssTransmission {
     }
 
     /// The transmittance per channel through `a` scene units, relative to the medium's albedo
-    /// ([`crate::reference::transmission::transmittance_over_albedo`]).
+    /// ([`crate::scene::transmittance::transmittance_over_albedo`]).
     pub fn transmittance(&self, a: f64) -> [f64; 3] {
         std::array::from_fn(|c| {
-            crate::reference::transmission::transmittance_over_albedo(
+            crate::scene::transmittance::transmittance_over_albedo(
                 &self.dipoles[c],
                 a * self.mm_per_unit,
                 self.medium_albedo[c],

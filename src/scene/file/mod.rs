@@ -560,7 +560,7 @@ units_per_mm = 0.05
         );
         // The f64 twin, channel by channel.
         for c in 0..3 {
-            let a = crate::reference::albedo::white_sky_albedo(
+            let a = crate::scene::albedo::white_sky_albedo(
                 [0.74, 0.88, 1.01][c],
                 [0.032, 0.17, 0.48][c],
                 1.0,

@@ -83,6 +83,11 @@ pub struct DiffuseDesc {
     pub format: vk::Format,
     /// Whether the albedo is in it.
     pub albedo: DiffuseAlbedo,
+    /// Whether its alpha holds the pixel's linear view depth (world units along the view
+    /// axis, positive in front of the camera), as lucent's own lighting pass writes it and
+    /// Jimenez et al.'s separable SSS reads it: the separable and Burley blurs then read each
+    /// tap's depth with its light, one fetch instead of two. Needs a float format with alpha.
+    pub depth_in_alpha: bool,
 }
 
 impl DiffuseDesc {
@@ -91,6 +96,7 @@ impl DiffuseDesc {
         Self {
             format,
             albedo: DiffuseAlbedo::Included,
+            depth_in_alpha: false,
         }
     }
 
@@ -99,7 +105,14 @@ impl DiffuseDesc {
         Self {
             format,
             albedo: DiffuseAlbedo::Excluded,
+            depth_in_alpha: false,
         }
+    }
+
+    /// With linear view depth in the alpha channel ([`Self::depth_in_alpha`]).
+    pub fn with_depth_in_alpha(mut self) -> Self {
+        self.depth_in_alpha = true;
+        self
     }
 }
 
@@ -626,6 +639,21 @@ impl GBufferDesc {
         if let Some(ids) = &self.material_ids {
             ids.decode(Vec::new())?;
         }
+        let float_alpha = format_info(self.diffuse.format)
+            .is_some_and(|f| f.kind == FormatKind::Float && f.channels == 4);
+        if self.diffuse.depth_in_alpha && !float_alpha {
+            return Err(HostError::Unsupported {
+                input: "diffuse".into(),
+                found: format!(
+                    "format {} with depth in alpha",
+                    format_name(self.diffuse.format)
+                ),
+                accepted: "a float format with alpha (R16G16B16A16_SFLOAT, R32G32B32A32_SFLOAT) \
+                           for linear depth in the alpha"
+                    .into(),
+            }
+            .into());
+        }
         if let Some(normals) = &self.normals {
             normals.decode()?;
         }
@@ -809,6 +837,23 @@ mod tests {
                 matches!(&e, crate::LucentError::Host(HostError::Unsupported { input, .. }) if input == "material IDs"),
                 "{bad:?}: {e}"
             );
+        }
+    }
+
+    #[test]
+    fn depth_in_the_diffuses_alpha_needs_a_float_format_with_alpha() {
+        let with_depth = |format| GBufferDesc {
+            diffuse: DiffuseDesc::with_albedo(format).with_depth_in_alpha(),
+            ..gbuffer()
+        };
+        with_depth(vk::Format::R16G16B16A16_SFLOAT).check().unwrap();
+        with_depth(vk::Format::R32G32B32A32_SFLOAT).check().unwrap();
+        for format in [
+            vk::Format::R8G8B8A8_UNORM,
+            vk::Format::B10G11R11_UFLOAT_PACK32,
+        ] {
+            let e = with_depth(format).check().unwrap_err();
+            assert!(e.to_string().contains("depth in alpha"), "{e}");
         }
     }
 

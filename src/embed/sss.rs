@@ -588,8 +588,9 @@ fn declare(
         lean: None,
         shadow_depth: None,
         albedo: None,
-        // The host's alpha is its own: the taps read the depth image.
-        depth_in_alpha: false,
+        // The host's alpha is its own unless it holds linear depth: then the taps read it
+        // there, as in lucent's own frames; otherwise they read the depth image.
+        depth_in_alpha: gbuffer.diffuse.depth_in_alpha,
         id_defines,
     };
     let adjusted;

@@ -10,7 +10,8 @@
 //!
 //! - **Screen-space SSS** (`--technique separable|control|burley`): each pass of the
 //!   `SssEffect` (its regions the scattering objects' screen bounds widened by the blurs'
-//!   reach) against lucent's pass of the same name (the host's diffuse and
+//!   reach; its diffuse with linear depth in the alpha where lucent's own frame has it)
+//!   against lucent's pass of the same name (the host's diffuse and
 //!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM).
 //! - **GDC 2011 translucency** (`--technique translucency`): lucent adds the term inside its
 //!   lighting pass, so its cost there is the lighting pass with translucency minus the
@@ -308,21 +309,25 @@ fn measure_sss(
             .iter()
             .map(|&v| v as u8)
             .collect();
-        let profiles: Vec<_> = SssProfiles::new(
+        let frame_profiles = SssProfiles::new(
             scene,
             Some(blur),
             None,
             Some(Texturing::Pre),
             &registry::blur_of,
         )?
-        .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?
-        .profiles
-        .into_iter()
-        .map(|(mut p, b)| {
-            p.blur = Some(b.name().into());
-            p
-        })
-        .collect();
+        .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?;
+        // lucent's lighting pass writes linear depth in the diffuse's alpha for the blurs
+        // that read it there; the host's light then holds it too (the export keeps it).
+        let depth_in_alpha = frame_profiles.depth_in_alpha();
+        let profiles: Vec<_> = frame_profiles
+            .profiles
+            .into_iter()
+            .map(|(mut p, b)| {
+                p.blur = Some(b.name().into());
+                p
+            })
+            .collect();
         let units_per_mm = profiles[0].units_per_mm;
         if profiles.iter().any(|p| p.units_per_mm != units_per_mm) {
             return Err(LucentError::InvalidInput(
@@ -360,7 +365,11 @@ fn measure_sss(
             width,
             height,
             DepthDesc::device(vk::Format::D32_SFLOAT),
-            DiffuseDesc::with_albedo(hdr),
+            if depth_in_alpha {
+                DiffuseDesc::with_albedo(hdr).with_depth_in_alpha()
+            } else {
+                DiffuseDesc::with_albedo(hdr)
+            },
         )
         .with_specular(hdr)
         .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))

@@ -786,32 +786,53 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
             .unwrap()
         };
         let diffuse_image = rgba32(&diffuse, "host diffuse");
+        // The same light with linear view depth in its alpha, as lucent's own lighting pass
+        // writes it for the separable blur (DiffuseDesc::with_depth_in_alpha).
+        let (near, far) = (f64::from(scene.camera.near), f64::from(scene.camera.far));
+        let with_depth: Vec<[f32; 4]> = diffuse
+            .iter()
+            .zip(&gb.depth)
+            .map(|(t, &d)| {
+                let z = near * far / (far - f64::from(d) * (far - near));
+                [t[0], t[1], t[2], z as f32]
+            })
+            .collect();
+        let diffuse_depth_image = rgba32(&with_depth, "host diffuse with depth");
         let specular_image = rgba32(&specular, "host specular");
         let exposure = f64::from(scene.exposure);
         let want = tonemapped(&expected, exposure);
-        for (name, depth_kind, ids_kind) in [
+        for (name, depth_kind, ids_kind, depth_in_alpha) in [
             (
-                "D32, R8_UNORM IDs (lucent's own)",
+                "D32, R8_UNORM IDs, linear depth in the diffuse's alpha (lucent's own)",
                 HostDepth::Standard,
                 HostIds::Unorm,
+                true,
             ),
             (
                 "reversed-Z infinite D32, R8_UINT IDs",
                 HostDepth::ReversedInfinite,
                 HostIds::Uint,
+                false,
             ),
             (
                 "D24S8, IDs in stencil bits 4-7",
                 HostDepth::D24Stencil,
                 HostIds::Stencil,
+                false,
             ),
             (
                 "linear R32F depth, IDs in RGBA8 alpha bits 4-7",
                 HostDepth::Linear,
                 HostIds::AlphaBits,
+                false,
             ),
         ] {
-            let layout = host_layout(
+            let diffuse_image = if depth_in_alpha {
+                &diffuse_depth_image
+            } else {
+                &diffuse_image
+            };
+            let mut layout = host_layout(
                 &test,
                 depth_kind,
                 ids_kind,
@@ -822,6 +843,9 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                 &ids,
                 metres_per_unit,
             );
+            if depth_in_alpha {
+                layout.desc.diffuse = layout.desc.diffuse.with_depth_in_alpha();
+            }
             let materials: Vec<SssMaterial> = profiles
                 .iter()
                 .enumerate()
@@ -877,7 +901,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                 )
                 .in_state(ImageState::fragment_sampled());
                 let diffuse_host =
-                    changed(&described(&diffuse_image, "host diffuse", usage), |i| {
+                    changed(&described(diffuse_image, "host diffuse", usage), |i| {
                         i.view = diffuse_view
                     });
                 let specular_host = described(&specular_image, "host specular", usage);
@@ -970,6 +994,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
             layout.destroy(&test);
         }
         gpu.destroy_image(diffuse_image);
+        gpu.destroy_image(diffuse_depth_image);
         gpu.destroy_image(specular_image);
     }
     for line in &worst_report {

@@ -792,13 +792,10 @@ pub fn host_albedo_pass(
     out
 }
 
-/// Defines of the permutations a host's frame cannot have: the LEAN G-buffer's, the lighting
-/// pass's linear depth in the diffuse's alpha, shadowed LEAN specular.
-const LUCENT_ONLY_DEFINES: [&str; 3] = [
-    "LUCENT_SSS_LEAN",
-    "LUCENT_SSS_DEPTH_IN_ALPHA",
-    "LUCENT_SHADOWS",
-];
+/// Defines of the permutations a host's frame cannot have: the LEAN G-buffer's and shadowed
+/// LEAN specular. (Linear depth in the diffuse's alpha a host can have:
+/// `embed::DiffuseDesc::with_depth_in_alpha`.)
+const LUCENT_ONLY_DEFINES: [&str; 2] = ["LUCENT_SSS_LEAN", "LUCENT_SHADOWS"];
 
 /// Adds, for every SSS pass permutation in `out` a host's frame can have, its two host-ID
 /// variants ([`IdMap::defines`]: UNORM and unsigned IDs), for the shipped SPIR-V.

@@ -695,6 +695,45 @@ fn sss_regions(
     regions.unwrap_or_default()
 }
 
+/// How many channel values of a frame may differ by more than 1/255: 0.1% (Burley's random
+/// taps round differently now and then).
+fn over_allowed(frame: &[u8]) -> usize {
+    frame.len() / 1000
+}
+
+/// Compares a host frame (`have`, RGBA8 after tonemapping) with lucent's own (`want`): at most
+/// `over` channel values more than 1/255 apart and within FLIP's thresholds, or it writes both
+/// PNGs under `dir` (a temporary directory's name) and fails naming `what`. Returns the report
+/// line.
+pub(crate) fn compare_host_frame(
+    want: &[u8],
+    have: &[u8],
+    (w, h): (u32, u32),
+    over: usize,
+    what: &str,
+    dir: &str,
+) -> String {
+    let diffs: Vec<u8> = want.iter().zip(have).map(|(a, b)| a.abs_diff(*b)).collect();
+    let worst = *diffs.iter().max().unwrap();
+    let count = diffs.iter().filter(|&&d| d > 1).count();
+    let flip = flip_rgba8(want, have, w, h).unwrap();
+    if count > over || !flip.within(&FlipThresholds::default()) {
+        let dir = common::temp_dir(dir);
+        write_png_rgba8(&dir.join("frame.png"), w, h, want).unwrap();
+        write_png_rgba8(&dir.join("host.png"), w, h, have).unwrap();
+        panic!(
+            "{what}: the host frame differs from lucent's: worst {worst}/255, {count} values \
+             over 1/255 ({})",
+            dir.display()
+        );
+    }
+    format!(
+        "{what}: worst {worst}/255, {count} channel values over 1/255 ({:.3}%), mean FLIP {:.5}",
+        100.0 * count as f64 / diffs.len() as f64,
+        flip.mean
+    )
+}
+
 /// A new view of `image` (a host recreating its views between frames).
 pub(crate) fn fresh_view(
     test: &TestGpu,
@@ -900,10 +939,9 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                     usage,
                 )
                 .in_state(ImageState::fragment_sampled());
-                let diffuse_host =
-                    changed(&described(diffuse_image, "host diffuse", usage), |i| {
-                        i.view = diffuse_view
-                    });
+                let diffuse_host = changed(&described(diffuse_image, "host diffuse", usage), |i| {
+                    i.view = diffuse_view
+                });
                 let specular_host = described(&specular_image, "host specular", usage);
                 let ids_host = match (&layout.ids, layout.stencil_ids) {
                     (Some(image), _) => HostImage::new(
@@ -959,32 +997,15 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                         .unwrap(),
                 );
                 let have = tonemapped(&got, exposure);
-                let diffs: Vec<u8> = want
-                    .iter()
-                    .zip(&have)
-                    .map(|(a, b)| a.abs_diff(*b))
-                    .collect();
-                let worst = *diffs.iter().max().unwrap();
-                let over = diffs.iter().filter(|&&d| d > 1).count();
-                let flip = flip_rgba8(&want, &have, w, h).unwrap();
-                worst_report.push(format!(
-                    "{} on {name}, frame {k}: worst {worst}/255, {over} channel values over \
-                     1/255 ({:.3}%), mean FLIP {:.5}",
-                    technique.name(),
-                    100.0 * over as f64 / diffs.len() as f64,
-                    flip.mean
-                ));
-                if over * 1000 > diffs.len() || !flip.within(&FlipThresholds::default()) {
-                    let dir = common::temp_dir(&format!("embed-layout-{}-{k}", technique.name()));
-                    write_png_rgba8(&dir.join("frame.png"), w, h, &want).unwrap();
-                    write_png_rgba8(&dir.join("host.png"), w, h, &have).unwrap();
-                    panic!(
-                        "{} on {name}: the host frame differs from lucent's: worst {worst}/255, \
-                         {over} values over 1/255 ({})",
-                        technique.name(),
-                        dir.display()
-                    );
-                }
+                let line = compare_host_frame(
+                    &want,
+                    &have,
+                    (w, h),
+                    over_allowed(&want),
+                    &format!("{} on {name}, frame {k}", technique.name()),
+                    &format!("embed-layout-{}-{k}", technique.name()),
+                );
+                worst_report.push(line);
             }
             effect.destroy(&lucent);
             drop(lucent);

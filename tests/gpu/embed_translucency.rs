@@ -5,11 +5,10 @@
 //! or UNORM; IDs in a packed target's alpha, R8_UINT, stencil bits, R8_UNORM), and the effect
 //! must add what lucent's lighting pass adds.
 
-use crate::common;
 use crate::common::{submit_back_to_back, TestGpu};
 use crate::embed::{
-    built, changed, described, fresh_view, host_error, host_id, host_layout, options, tonemapped,
-    wrap, HostDepth, HostIds,
+    built, changed, compare_host_frame, described, fresh_view, host_error, host_id, host_layout,
+    options, tonemapped, wrap, HostDepth, HostIds,
 };
 
 use ash::vk;
@@ -21,8 +20,6 @@ use lucent::embed::{
     TranslucentMaterial,
 };
 use lucent::frame::{FrameSettings, Renderer, Technique};
-use lucent::images::compare::{flip_rgba8, FlipThresholds};
-use lucent::images::output::write_png_rgba8;
 
 /// How a test host stores its normals.
 #[derive(Clone, Copy, Debug)]
@@ -382,30 +379,14 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
                 .read_image(lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
                 .unwrap();
             let have = tonemapped(bytemuck::cast_slice(&bytes), exposure);
-            let diffs: Vec<u8> = want
-                .iter()
-                .zip(&have)
-                .map(|(a, b)| a.abs_diff(*b))
-                .collect();
-            let worst = *diffs.iter().max().unwrap();
-            let over = diffs.iter().filter(|&&d| d > 1).count();
-            let flip = flip_rgba8(&want, &have, w, h).unwrap();
-            report.push(format!(
-                "{name}, frame {k}: worst {worst}/255, {over} channel values over 1/255, mean \
-                 FLIP {:.5}",
-                flip.mean
+            report.push(compare_host_frame(
+                &want,
+                &have,
+                (w, h),
+                0,
+                &format!("{name}, frame {k}"),
+                &format!("embed-translucency-{k}"),
             ));
-            if over > 0 || !flip.within(&FlipThresholds::default()) {
-                let dir = common::temp_dir(&format!("embed-translucency-{k}"));
-                write_png_rgba8(&dir.join("frame.png"), w, h, &want).unwrap();
-                write_png_rgba8(&dir.join("host.png"), w, h, &have).unwrap();
-                write_png_rgba8(&dir.join("plain.png"), w, h, &plain).unwrap();
-                panic!(
-                    "{name}: the host frame differs from lucent's: worst {worst}/255, {over} \
-                     values over 1/255 ({})",
-                    dir.display()
-                );
-            }
         }
         effect.destroy(&lucent);
         drop(lucent);

@@ -28,6 +28,7 @@
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
 //! cargo run --release --example host_engine -- --without-lucent --out without.png
+//! cargo run --release --example host_engine -- --timing     # lucent's passes, GPU timestamps
 //! cargo run --release --example host_engine -- --scene mixed --out mixed.png
 //! ```
 //!
@@ -51,8 +52,8 @@ use lucent::embed::gpu_allocator::vulkan::{
 };
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
-    capabilities, requirements, DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera,
-    HostDevice, HostImage, IdDesc, ImageState, Light, Lucent, NormalDesc, NormalSpace,
+    capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, GBufferDesc,
+    HostCamera, HostDevice, HostImage, IdDesc, ImageState, Light, Lucent, NormalDesc, NormalSpace,
     OptionalFeatures, SceneRenderer, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
     SssProfile, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
     TranslucencyImages, TranslucentMaterial,
@@ -105,6 +106,9 @@ struct Args {
     /// `--whole-screen`: the effects draw over the whole screen, not only over the objects'
     /// screen regions (the same picture; a check of the regions).
     whole_screen: bool,
+    /// `--timing`: time lucent's passes with GPU timestamps (`record_timed`) and print each
+    /// pass's median over the frames.
+    timing: bool,
     /// `--scene NAME`: the frame is lucent's whole frame of a built-in scene or scene file
     /// (`SceneRenderer`) instead of the engine's own.
     scene: Option<String>,
@@ -112,7 +116,7 @@ struct Args {
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
                      [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
-                     [--scene NAME]";
+                     [--timing] [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -123,6 +127,7 @@ fn parse_args() -> Result<Args, String> {
         with_lucent: true,
         blur: "separable".into(),
         whole_screen: false,
+        timing: false,
         scene: None,
     };
     let mut it = std::env::args().skip(1);
@@ -153,6 +158,7 @@ fn parse_args() -> Result<Args, String> {
             "--blur" => args.blur = value()?,
             "--without-lucent" => args.with_lucent = false,
             "--whole-screen" => args.whole_screen = true,
+            "--timing" => args.timing = true,
             "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
             other => return Err(format!("unknown argument {other}\n{USAGE}")),
@@ -1316,6 +1322,42 @@ struct Effects {
     inserted: Inserted,
     /// `--whole-screen`: no regions.
     whole_screen: bool,
+    /// `--timing`: per frame slot, the translucency's and the SSS's timers.
+    timers: Vec<[EffectTimer; 2]>,
+    /// Each timed pass's milliseconds, frame by frame (`effect: pass`).
+    times: std::collections::BTreeMap<String, Vec<f64>>,
+}
+
+impl Effects {
+    /// Reads the times of the frame slot `k` last recorded (its fence has signalled: the
+    /// engine waited for it before reusing the slot, or for the device at the end).
+    fn collect_times(&mut self, k: usize) -> Result<(), String> {
+        let Some(timers) = self.timers.get(k) else {
+            return Ok(());
+        };
+        for (effect, timer) in ["translucency", "sss"].into_iter().zip(timers) {
+            let passes = timer.results(&self.lucent).map_err(|e| e.to_string())?;
+            for pass in passes.unwrap_or_default() {
+                let key = format!("{effect}: {}", pass.name);
+                self.times.entry(key).or_default().push(pass.ms);
+            }
+        }
+        Ok(())
+    }
+
+    /// Each timed pass's median, one line.
+    fn timing_report(&self) -> String {
+        let median = |v: &[f64]| {
+            let mut v = v.to_vec();
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        self.times
+            .iter()
+            .map(|(pass, ms)| format!("{pass} {:.3} ms", median(ms)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 /// What the engine's frame gets from lucent.
@@ -1587,28 +1629,29 @@ fn record_frame(
             let ids = slot.ids.host_image(extent);
             let thickness = slot.thickness.host_image(extent);
             let lighting = slot.diffuse.host_image(extent);
-            translucency
-                .record(
-                    &effects.lucent,
-                    cmd,
-                    &TranslucencyFrame {
-                        slot: slot_index,
-                        view: 0,
-                        camera,
-                        lights: &engine_lights(sun),
-                        images: TranslucencyImages {
-                            depth: &depth,
-                            normals: &normals,
-                            albedo: &albedo,
-                            thickness: &thickness,
-                            material_ids: &ids,
-                        },
-                        // The leaf's projected bounds: the pass draws nothing elsewhere.
-                        regions: &leaf_region(&camera, extent, effects.whole_screen),
-                        lighting: &lighting,
-                    },
-                )
-                .map_err(|e| format!("lucent: {e}"))?;
+            let translucency_frame = TranslucencyFrame {
+                slot: slot_index,
+                view: 0,
+                camera,
+                lights: &engine_lights(sun),
+                images: TranslucencyImages {
+                    depth: &depth,
+                    normals: &normals,
+                    albedo: &albedo,
+                    thickness: &thickness,
+                    material_ids: &ids,
+                },
+                // The leaf's projected bounds: the pass draws nothing elsewhere.
+                regions: &leaf_region(&camera, extent, effects.whole_screen),
+                lighting: &lighting,
+            };
+            match effects.timers.get_mut(slot_index) {
+                Some([timer, _]) => {
+                    translucency.record_timed(&effects.lucent, cmd, &translucency_frame, timer)
+                }
+                None => translucency.record(&effects.lucent, cmd, &translucency_frame),
+            }
+            .map_err(|e| format!("lucent: {e}"))?;
             slot.normal.state = normals.left_in();
             slot.thickness.state = thickness.left_in();
             // (The other images come back as they came: the SSS reads them below.)
@@ -1638,8 +1681,11 @@ fn record_frame(
                 regions: &scattering_region(&camera, extent, sss.reach(), effects.whole_screen),
                 output: &output,
             };
-            sss.record(&effects.lucent, cmd, &frame)
-                .map_err(|e| format!("lucent: {e}"))?;
+            match effects.timers.get_mut(slot_index) {
+                Some([_, timer]) => sss.record_timed(&effects.lucent, cmd, &frame, timer),
+                None => sss.record(&effects.lucent, cmd, &frame),
+            }
+            .map_err(|e| format!("lucent: {e}"))?;
             // lucent left each image in its final state (here: as each came, the output
             // sampled); the engine tracks what it says.
             slot.depth.state = depth.left_in();
@@ -1833,10 +1879,23 @@ fn create_effects(
              bytes uploaded)"
         ),
     }
+    let timers = if args.timing && args.scene.is_none() {
+        let made: Result<Vec<[EffectTimer; 2]>, String> = (0..FRAMES_IN_FLIGHT)
+            .map(|_| {
+                let timer = || EffectTimer::new(&lucent, 32).map_err(|e| e.to_string());
+                Ok([timer()?, timer()?])
+            })
+            .collect();
+        made?
+    } else {
+        Vec::new()
+    };
     Ok(Effects {
         lucent,
         inserted,
         whole_screen: args.whole_screen,
+        timers,
+        times: Default::default(),
     })
 }
 
@@ -1991,6 +2050,11 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
             let slot = &mut slots[k];
             let recorded = begin_slot(engine, slot)
                 .and_then(|()| match effects.as_mut() {
+                    // The slot's previous frame has completed: its times are there.
+                    Some(effects) if frame >= FRAMES_IN_FLIGHT => effects.collect_times(k),
+                    _ => Ok(()),
+                })
+                .and_then(|()| match effects.as_mut() {
                     Some(Effects {
                         lucent,
                         inserted: Inserted::Scene(scene),
@@ -2032,7 +2096,23 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 .map_err(|e| e.to_string())
         });
     }
+    if let (Ok(()), Some(effects)) = (&result, effects.as_mut()) {
+        // The last frame of each slot (the device is idle).
+        let first = args.frames.saturating_sub(FRAMES_IN_FLIGHT);
+        result = (first..args.frames)
+            .try_for_each(|frame| effects.collect_times(frame % FRAMES_IN_FLIGHT));
+        if !effects.timers.is_empty() && result.is_ok() {
+            eprintln!(
+                "host_engine: lucent's passes (GPU timestamps, medians of {} frames): {}",
+                args.frames,
+                effects.timing_report()
+            );
+        }
+    }
     if let Some(effects) = effects {
+        for timer in effects.timers.into_iter().flatten() {
+            timer.destroy(&effects.lucent);
+        }
         match effects.inserted {
             Inserted::Effects { translucency, sss } => {
                 (*translucency).destroy(&effects.lucent);

@@ -197,7 +197,15 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     let with = dir.join("with.png");
     let without = dir.join("without.png");
     let whole = dir.join("whole-screen.png");
-    let log = run(&with, &[]);
+    // Timed (record_timed, the engine's own EffectTimers): the same frame, and each pass's
+    // time printed.
+    let log = run(&with, &["--timing"]);
+    assert!(
+        log.contains("lucent's passes (GPU timestamps")
+            && log.contains("translucency: host translucency")
+            && log.contains("sss: horizontal blur"),
+        "{log}"
+    );
     // The effects drawn only over the objects' screen regions (the default: tiles left out,
     // the blurs' pass-through there) change nothing against the whole screen.
     run(&whole, &["--whole-screen"]);

@@ -116,6 +116,14 @@ pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
     }
 }
 
+/// The first input `effect` reads that `gbuffer` lacks, as the error its constructor gives.
+pub(crate) fn require(effect: Effect, gbuffer: &GBufferDesc) -> Result<()> {
+    match missing(effect, gbuffer).into_iter().next() {
+        Some(first) => Err(first.into()),
+        None => Ok(()),
+    }
+}
+
 /// The inputs `effect` reads that `gbuffer` lacks, as the errors its constructor gives.
 pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
     let lack = |input: &str, needed_by: &str| HostError::Missing {

@@ -18,6 +18,21 @@ use crate::graph::{CompileOptions, Executable, RenderGraph, ResourceId};
 use crate::scene::{Camera, Scene};
 use crate::Result;
 
+/// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
+pub(crate) fn check_views(views: usize) -> Result<()> {
+    if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {
+        return Ok(());
+    }
+    Err(HostError::Description {
+        field: "views_per_frame".into(),
+        problem: format!(
+            "{views} views; 1 to {} are supported",
+            super::MAX_VIEWS_PER_FRAME
+        ),
+    }
+    .into())
+}
+
 /// An effect's passes and per-frame data (see the module docs).
 pub(crate) struct EffectPasses {
     executable: Option<Executable>,

@@ -22,10 +22,10 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::capabilities::{missing, Effect};
+use super::capabilities::{require, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::EffectPasses;
+use super::passes::{check_views, EffectPasses};
 use super::regions::marked_tiles;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -33,7 +33,7 @@ use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
 use crate::features::registry;
 use crate::features::sss::{self, IdMap, SssKnobs, SssProfiles};
-use crate::gpu_scene::{SceneGpu, SceneUpload, SlotTiles, FRAME};
+use crate::gpu_scene::{SceneGpu, SceneUpload, FRAME};
 use crate::graph::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
@@ -188,22 +188,11 @@ impl SssEffect {
     pub fn new(lucent: &Lucent, uploads: &mut Uploads, desc: SssEffectDesc) -> Result<Self> {
         let gbuffer = &desc.gbuffer;
         gbuffer.check()?;
-        if let Some(first) = missing(Effect::Sss, gbuffer).into_iter().next() {
-            return Err(first.into());
-        }
+        require(Effect::Sss, gbuffer)?;
         let ids = gbuffer
             .material_ids
             .expect("missing() lists the material IDs");
-        if !(1..=MAX_VIEWS_PER_FRAME).contains(&desc.views_per_frame) {
-            return Err(HostError::Description {
-                field: "views_per_frame".into(),
-                problem: format!(
-                    "{} views; 1 to {MAX_VIEWS_PER_FRAME} are supported",
-                    desc.views_per_frame
-                ),
-            }
-            .into());
-        }
+        check_views(desc.views_per_frame)?;
         if desc.materials.is_empty() || desc.materials.len() >= sss::MAX_SSS_PROFILES {
             return Err(HostError::Description {
                 field: "materials".into(),
@@ -330,8 +319,6 @@ impl SssEffect {
                 out.destroy(lucent);
                 return Err(e);
             }
-            // No tiles until a frame gives regions: every chain covers the whole screen.
-            *per_frame.tiles(slot) = SlotTiles::default();
         }
         Ok(out)
     }

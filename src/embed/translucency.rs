@@ -24,10 +24,10 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
-use super::capabilities::{missing, Effect};
+use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::EffectPasses;
+use super::passes::{check_views, EffectPasses};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -36,7 +36,7 @@ use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
 use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION};
-use crate::gpu_scene::{Region, SceneGpu, SceneUpload, SlotTiles, TableRegion, FRAME};
+use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::{Light, Mesh, MAX_LIGHTS};
@@ -287,25 +287,13 @@ impl TranslucencyEffect {
     ) -> Result<Self> {
         let gbuffer = &desc.gbuffer;
         gbuffer.check()?;
-        if let Some(first) = missing(Effect::Translucency, gbuffer).into_iter().next() {
-            return Err(first.into());
-        }
+        require(Effect::Translucency, gbuffer)?;
         let (Some(ids), Some(normals), Some(thickness)) =
             (gbuffer.material_ids, gbuffer.normals, gbuffer.thickness)
         else {
             unreachable!("missing() lists each input the effect reads");
         };
-        if !(1..=super::MAX_VIEWS_PER_FRAME).contains(&desc.views_per_frame) {
-            return Err(HostError::Description {
-                field: "views_per_frame".into(),
-                problem: format!(
-                    "{} views; 1 to {} are supported",
-                    desc.views_per_frame,
-                    super::MAX_VIEWS_PER_FRAME
-                ),
-            }
-            .into());
-        }
+        check_views(desc.views_per_frame)?;
         if desc.materials.is_empty() {
             return Err(HostError::Description {
                 field: "materials".into(),
@@ -384,7 +372,6 @@ impl TranslucencyEffect {
                 out.destroy(lucent);
                 return Err(e);
             }
-            *per_frame.tiles(slot) = SlotTiles::default();
         }
         Ok(out)
     }

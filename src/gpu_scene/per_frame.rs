@@ -48,10 +48,6 @@ impl FrameUniforms {
         let aspect = width as f32 / height.max(1) as f32;
         let projection = scene.camera.projection(aspect);
         let view_proj = projection * scene.camera.view();
-        let mut lights = [[[0.0; 4]; 4]; MAX_LIGHTS];
-        for (slot, light) in lights.iter_mut().zip(&scene.lights) {
-            *slot = light_rows(light);
-        }
         Self {
             view_proj: view_proj.to_cols_array_2d(),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
@@ -66,7 +62,7 @@ impl FrameUniforms {
                 1.0 / height as f32,
             ],
             exposure: [scene.exposure, 0.0, 0.0, 0.0],
-            light_count: [scene.lights.len().min(MAX_LIGHTS) as i32, 0, 0, 0],
+            light_count: [0; 4],
             camera: [
                 scene.camera.near,
                 scene.camera.far,
@@ -75,8 +71,9 @@ impl FrameUniforms {
             ],
             depth_decode: depth_decode(&projection),
             fault: [0; 4],
-            lights,
+            lights: [[[0.0; 4]; 4]; MAX_LIGHTS],
         }
+        .with_lights(&scene.lights)
     }
 
     /// The uniforms of a host's view (embedding): its view and projection matrices, the

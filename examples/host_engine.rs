@@ -13,17 +13,21 @@
 //!    engine's own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5,
 //!    leaf 9, floor 0) and local thickness in R8_UNORM, which the leaf's draw takes from the
 //!    engine's vertex buffer (baked once by `lucent::embed::bake_thickness`).
-//! 2. **Lighting** (fullscreen): a sun, a point light behind the leaf and an ambient term, lit
-//!    diffuse and specular apart, in B10G11R11 (RGBA16F where the device cannot render
-//!    B10G11R11).
-//! 3. **lucent's translucency** (`TranslucencyEffect`): the light of the engine's two lights
+//! 2. **Lighting** (fullscreen): a sun and a point light behind the leaf (and, without lucent
+//!    or with `--engine-ambient`, the engine's own sky-over-ground ambient term), lit diffuse
+//!    and specular apart, in B10G11R11 (RGBA16F where the device cannot render B10G11R11).
+//! 3. **lucent's environment** (`EnvironmentEffect`): the same sky-over-ground light as an SH
+//!    environment (`lucent::embed::Environment::hemisphere`), added to the lit diffuse at the
+//!    engine's normals times its albedo; the frame equals the engine's own ambient within the
+//!    B10G11R11 target's rounding.
+//! 4. **lucent's translucency** (`TranslucencyEffect`): the light of the engine's two lights
 //!    let through the leaf, added to the lit diffuse (the engine's lights, as
 //!    `lucent::embed::Light`s).
-//! 4. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
+//! 5. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
-//!    diffuse + specular itself instead (no translucency, no scatter).
-//! 5. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
+//!    diffuse + specular itself instead (its own ambient, no translucency, no scatter).
+//! 6. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
@@ -52,13 +56,19 @@ use lucent::embed::gpu_allocator::vulkan::{
 };
 use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
-    capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, GBufferDesc,
+    capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, Environment,
+    EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc,
     HostCamera, HostDevice, HostImage, IdDesc, ImageState, Light, Lucent, NormalDesc, NormalSpace,
     OptionalFeatures, SceneRenderer, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
     SssProfile, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
     TranslucencyImages, TranslucentMaterial,
 };
 
+/// The engine's ambient light: a sky radiance above the horizon and a ground radiance below,
+/// blended by the normal's height (its lighting shader's own term, or lucent's
+/// `Environment::hemisphere` of the same two, which is that blend exactly).
+const AMBIENT_SKY: [f32; 3] = [0.20, 0.24, 0.30];
+const AMBIENT_GROUND: [f32; 3] = [0.10, 0.09, 0.08];
 /// Frames the engine keeps in flight.
 const FRAMES_IN_FLIGHT: usize = 3;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -106,6 +116,9 @@ struct Args {
     /// `--whole-screen`: the effects draw over the whole screen, not only over the objects'
     /// screen regions (the same picture; a check of the regions).
     whole_screen: bool,
+    /// `--engine-ambient`: the engine's lighting adds its own ambient term instead of lucent's
+    /// `EnvironmentEffect` adding the same light (a check of the effect).
+    engine_ambient: bool,
     /// `--timing`: time lucent's passes with GPU timestamps (`record_timed`) and print each
     /// pass's median over the frames.
     timing: bool,
@@ -116,7 +129,7 @@ struct Args {
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
                      [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
-                     [--timing] [--scene NAME]";
+                     [--engine-ambient] [--timing] [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -127,6 +140,7 @@ fn parse_args() -> Result<Args, String> {
         with_lucent: true,
         blur: "separable".into(),
         whole_screen: false,
+        engine_ambient: false,
         timing: false,
         scene: None,
     };
@@ -158,6 +172,7 @@ fn parse_args() -> Result<Args, String> {
             "--blur" => args.blur = value()?,
             "--without-lucent" => args.with_lucent = false,
             "--whole-screen" => args.whole_screen = true,
+            "--engine-ambient" => args.engine_ambient = true,
             "--timing" => args.timing = true,
             "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
@@ -320,7 +335,10 @@ void main() {{
     vec3 h = normalize(l + v);
     float nl = max(dot(n, l), 0.0);
     vec3 sun = vec3(1.0, 0.95, 0.88) * pc.sun.w;
-    vec3 ambient = mix(vec3(0.10, 0.09, 0.08), vec3(0.20, 0.24, 0.30), n.y * 0.5 + 0.5);
+    // The engine's own ambient (pc.params.y 1), or none where lucent's EnvironmentEffect adds
+    // the same light (0).
+    vec3 ground = vec3({GR}, {GG}, {GB}), sky = vec3({SR}, {SG}, {SB});
+    vec3 ambient = mix(ground, sky, n.y * 0.5 + 0.5) * pc.params.y;
     // The back light, with lucent's point-light falloff (a smooth window to its range).
     vec3 to_back = vec3({BX}, {BY}, {BZ}) - p;
     float dist2 = max(dot(to_back, to_back), 1e-4);
@@ -342,6 +360,12 @@ void main() {{
             BG = super::BACK_LIGHT_RADIANCE[1],
             BB = super::BACK_LIGHT_RADIANCE[2],
             BRANGE = super::BACK_LIGHT_RANGE,
+            GR = super::AMBIENT_GROUND[0],
+            GG = super::AMBIENT_GROUND[1],
+            GB = super::AMBIENT_GROUND[2],
+            SR = super::AMBIENT_SKY[0],
+            SG = super::AMBIENT_SKY[1],
+            SB = super::AMBIENT_SKY[2],
         )
     }
 
@@ -1271,6 +1295,11 @@ fn camera(frame: usize, aspect: f32) -> (Mat4, Mat4, Vec3) {
     (view, projection, eye)
 }
 
+/// The engine's ambient light as lucent's SH environment: the same sky and ground.
+fn engine_environment() -> Environment {
+    Environment::hemisphere(Vec3::from(AMBIENT_SKY), Vec3::from(AMBIENT_GROUND))
+}
+
 /// The engine's lights as lucent's effects read them: the sun (`sun` points towards it) and
 /// the point light behind the leaf, as the engine's lighting shader has them.
 fn engine_lights(sun: Vec3) -> [Light; 2] {
@@ -1316,14 +1345,21 @@ fn scattering_region(
     regions.filter(|_| !whole_screen).unwrap_or_default()
 }
 
+/// One frame slot's timers, one per effect (`--timing`).
+struct Timers {
+    environment: Option<EffectTimer>,
+    translucency: EffectTimer,
+    sss: EffectTimer,
+}
+
 /// What lucent adds to the engine: the effect, and the `Lucent` it was built from.
 struct Effects {
     lucent: Lucent,
     inserted: Inserted,
     /// `--whole-screen`: no regions.
     whole_screen: bool,
-    /// `--timing`: per frame slot, the translucency's and the SSS's timers.
-    timers: Vec<[EffectTimer; 2]>,
+    /// `--timing`: per frame slot, the effects' timers.
+    timers: Vec<Timers>,
     /// Each timed pass's milliseconds, frame by frame (`effect: pass`).
     times: std::collections::BTreeMap<String, Vec<f64>>,
 }
@@ -1335,7 +1371,13 @@ impl Effects {
         let Some(timers) = self.timers.get(k) else {
             return Ok(());
         };
-        for (effect, timer) in ["translucency", "sss"].into_iter().zip(timers) {
+        let named = [
+            ("environment", timers.environment.as_ref()),
+            ("translucency", Some(&timers.translucency)),
+            ("sss", Some(&timers.sss)),
+        ];
+        for (effect, timer) in named {
+            let Some(timer) = timer else { continue };
             let passes = timer.results(&self.lucent).map_err(|e| e.to_string())?;
             for pass in passes.unwrap_or_default() {
                 let key = format!("{effect}: {}", pass.name);
@@ -1362,14 +1404,53 @@ impl Effects {
 
 /// What the engine's frame gets from lucent.
 enum Inserted {
-    /// Effects over the engine's own G-buffer and lighting: GDC 2011 translucency added to
-    /// its lit diffuse, then SSS.
+    /// Effects over the engine's own G-buffer and lighting: the SH environment and GDC 2011
+    /// translucency added to its lit diffuse, then SSS.
     Effects {
+        /// The engine's ambient as lucent's SH environment (none with `--engine-ambient`).
+        environment: Option<Box<EnvironmentEffect>>,
         translucency: Box<TranslucencyEffect>,
         sss: Box<SssEffect>,
     },
     /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
     Scene(Box<(lucent::scene::Scene, SceneRenderer)>),
+}
+
+/// Builds the effects over the engine's G-buffer; on an error, destroys those already built
+/// (nothing of them was recorded or used yet).
+fn build_effects(
+    lucent: &Lucent,
+    uploads: &mut lucent::embed::Uploads,
+    environment: Option<EnvironmentEffectDesc>,
+    translucency: TranslucencyEffectDesc,
+    sss: SssEffectDesc,
+) -> lucent::Result<Inserted> {
+    let environment = environment
+        .map(|desc| EnvironmentEffect::new(lucent, uploads, desc))
+        .transpose()?;
+    let translucency = match TranslucencyEffect::new(lucent, uploads, translucency) {
+        Ok(t) => t,
+        Err(e) => {
+            if let Some(environment) = environment {
+                environment.destroy(lucent);
+            }
+            return Err(e);
+        }
+    };
+    match SssEffect::new(lucent, uploads, sss) {
+        Ok(sss) => Ok(Inserted::Effects {
+            environment: environment.map(Box::new),
+            translucency: Box::new(translucency),
+            sss: Box::new(sss),
+        }),
+        Err(e) => {
+            if let Some(environment) = environment {
+                environment.destroy(lucent);
+            }
+            translucency.destroy(lucent);
+            Err(e)
+        }
+    }
 }
 
 /// `--scene`: the frame is lucent's whole frame of the scene, drawn into the engine's LDR
@@ -1510,11 +1591,19 @@ fn record_frame(
     let slot_index = frame % FRAMES_IN_FLIGHT;
     let (view, projection, eye) = camera(frame, extent.width as f32 / extent.height as f32);
     let sun = Vec3::new(0.9, 0.75, -0.35).normalize();
+    // The engine adds its own ambient unless lucent's environment effect adds it.
+    let engine_ambient = match effects.as_deref() {
+        Some(Effects {
+            inserted: Inserted::Effects { environment, .. },
+            ..
+        }) => environment.is_none(),
+        _ => true,
+    };
     let push = |m: Mat4| Push {
         m: m.to_cols_array(),
         eye: [eye.x, eye.y, eye.z, 1.0],
         sun: [sun.x, sun.y, sun.z, 9.0],
-        params: [1.2, 0.0, 0.0, 0.0],
+        params: [1.2, if engine_ambient { 1.0 } else { 0.0 }, 0.0, 0.0],
     };
     let bind = |pipeline, set: Option<vk::DescriptorSet>, m: Mat4| {
         // SAFETY: `cmd` is recording inside the pass's rendering; the objects are live.
@@ -1619,7 +1708,12 @@ fn record_frame(
     // or the engine's own diffuse + specular.
     match effects {
         Some(effects) => {
-            let Inserted::Effects { translucency, sss } = &mut effects.inserted else {
+            let Inserted::Effects {
+                environment,
+                translucency,
+                sss,
+            } = &mut effects.inserted
+            else {
                 return Err("record_frame is the engine's own frame, not --scene's".into());
             };
             let camera = HostCamera::new(view, projection);
@@ -1629,6 +1723,31 @@ fn record_frame(
             let ids = slot.ids.host_image(extent);
             let thickness = slot.thickness.host_image(extent);
             let lighting = slot.diffuse.host_image(extent);
+            if let Some(environment) = environment {
+                let frame = EnvironmentFrame {
+                    slot: slot_index,
+                    view: 0,
+                    camera,
+                    environment: &engine_environment(),
+                    images: EnvironmentImages {
+                        depth: &depth,
+                        normals: &normals,
+                        albedo: Some(&albedo),
+                    },
+                    // Every surface has the ambient: the whole screen.
+                    regions: &[],
+                    lighting: &lighting,
+                };
+                let timer = effects
+                    .timers
+                    .get_mut(slot_index)
+                    .and_then(|t| t.environment.as_mut());
+                match timer {
+                    Some(timer) => environment.record_timed(&effects.lucent, cmd, &frame, timer),
+                    None => environment.record(&effects.lucent, cmd, &frame),
+                }
+                .map_err(|e| format!("lucent: {e}"))?;
+            }
             let translucency_frame = TranslucencyFrame {
                 slot: slot_index,
                 view: 0,
@@ -1646,9 +1765,12 @@ fn record_frame(
                 lighting: &lighting,
             };
             match effects.timers.get_mut(slot_index) {
-                Some([timer, _]) => {
-                    translucency.record_timed(&effects.lucent, cmd, &translucency_frame, timer)
-                }
+                Some(t) => translucency.record_timed(
+                    &effects.lucent,
+                    cmd,
+                    &translucency_frame,
+                    &mut t.translucency,
+                ),
                 None => translucency.record(&effects.lucent, cmd, &translucency_frame),
             }
             .map_err(|e| format!("lucent: {e}"))?;
@@ -1682,7 +1804,7 @@ fn record_frame(
                 output: &output,
             };
             match effects.timers.get_mut(slot_index) {
-                Some([_, timer]) => sss.record_timed(&effects.lucent, cmd, &frame, timer),
+                Some(t) => sss.record_timed(&effects.lucent, cmd, &frame, &mut t.sss),
                 None => sss.record(&effects.lucent, cmd, &frame),
             }
             .map_err(|e| format!("lucent: {e}"))?;
@@ -1815,6 +1937,8 @@ fn create_effects(
     // The leaf: a broad lobe, the talk's distortion, a little light from every angle.
     let leaf = TranslucentMaterial::new(LEAF_ID, 6.0, 0.25, 0.02);
     let translucency_desc = TranslucencyEffectDesc::new(gbuffer.clone(), vec![leaf]);
+    let environment_desc =
+        (!args.engine_ambient).then(|| EnvironmentEffectDesc::new(gbuffer.clone()));
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
@@ -1828,18 +1952,12 @@ fn create_effects(
     // family; it is submitted below before any frame records the effect.
     let mut uploads = unsafe { lucent.uploads(slot.cmd) };
     let built = match &args.scene {
-        None => TranslucencyEffect::new(&lucent, &mut uploads, translucency_desc).and_then(
-            |translucency| match SssEffect::new(&lucent, &mut uploads, desc) {
-                Ok(sss) => Ok(Inserted::Effects {
-                    translucency: Box::new(translucency),
-                    sss: Box::new(sss),
-                }),
-                Err(e) => {
-                    // Nothing of it was recorded or used yet.
-                    translucency.destroy(&lucent);
-                    Err(e)
-                }
-            },
+        None => build_effects(
+            &lucent,
+            &mut uploads,
+            environment_desc,
+            translucency_desc,
+            desc,
         ),
         Some(name) => lucent.load_scene(name).and_then(|scene| {
             let extent = (args.width, args.height);
@@ -1870,8 +1988,13 @@ fn create_effects(
     let inserted = built.map_err(|e| format!("lucent: {e}"))?;
     match &args.scene {
         None => eprintln!(
-            "host_engine: lucent effects: translucency (leaf ID {LEAF_ID}), sss ({} blur; skin \
-             ID {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            "host_engine: lucent effects: {}translucency (leaf ID {LEAF_ID}), sss ({} blur; \
+             skin ID {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            if args.engine_ambient {
+                ""
+            } else {
+                "environment (the engine's sky and ground), "
+            },
             args.blur
         ),
         Some(name) => eprintln!(
@@ -1880,10 +2003,18 @@ fn create_effects(
         ),
     }
     let timers = if args.timing && args.scene.is_none() {
-        let made: Result<Vec<[EffectTimer; 2]>, String> = (0..FRAMES_IN_FLIGHT)
+        let made: Result<Vec<Timers>, String> = (0..FRAMES_IN_FLIGHT)
             .map(|_| {
                 let timer = || EffectTimer::new(&lucent, 32).map_err(|e| e.to_string());
-                Ok([timer()?, timer()?])
+                Ok(Timers {
+                    environment: if args.engine_ambient {
+                        None
+                    } else {
+                        Some(timer()?)
+                    },
+                    translucency: timer()?,
+                    sss: timer()?,
+                })
             })
             .collect();
         made?
@@ -2110,11 +2241,22 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
         }
     }
     if let Some(effects) = effects {
-        for timer in effects.timers.into_iter().flatten() {
-            timer.destroy(&effects.lucent);
+        for timers in effects.timers {
+            for timer in timers.environment.into_iter() {
+                timer.destroy(&effects.lucent);
+            }
+            timers.translucency.destroy(&effects.lucent);
+            timers.sss.destroy(&effects.lucent);
         }
         match effects.inserted {
-            Inserted::Effects { translucency, sss } => {
+            Inserted::Effects {
+                environment,
+                translucency,
+                sss,
+            } => {
+                if let Some(environment) = environment {
+                    (*environment).destroy(&effects.lucent);
+                }
                 (*translucency).destroy(&effects.lucent);
                 (*sss).destroy(&effects.lucent);
             }

@@ -16,6 +16,7 @@
 #define LUCENT_TRANSLUCENCY_TABLE_BINDING 1
 #include "../common/translucency.glsl"
 #include "../common/host_ids.glsl"
+#include "../common/host_normals.glsl"
 
 // The host's encodings (src/embed/translucency.rs `HostTranslucencyGpu`).
 layout(std140, set = 0, binding = 2) uniform HostTranslucency {
@@ -48,30 +49,6 @@ bool has_material(uint id) {
     return ((word >> (id % 32u)) & 1u) != 0u;
 }
 
-// Octahedral decode (Cigolle et al. 2014, z the folded axis), e in [-1, 1]^2.
-vec3 octahedral_decode(vec2 e) {
-    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-    float fold = max(-n.z, 0.0);
-    n.x += n.x >= 0.0 ? -fold : fold;
-    n.y += n.y >= 0.0 ? -fold : fold;
-    return n;
-}
-
-vec3 host_normal(vec4 t) {
-    vec3 n;
-    if (host.normals.x != 0u) {
-        vec2 e = host.normals.z != 0u ? t.xy * 2.0 - 1.0 : t.xy;
-        n = octahedral_decode(clamp(e, -1.0, 1.0));
-    } else {
-        n = host.normals.z != 0u ? t.xyz * 2.0 - 1.0 : t.xyz;
-    }
-    if (host.normals.y != 0u) {
-        n = mat3(host.view_to_world) * n;
-    }
-    // A NaN, Inf or zero normal in the host's image falls back to +Y (sanitize_normal).
-    return sanitize_normal(n);
-}
-
 // The world position at this pixel with linear view depth `z`: along the pixel's ray through
 // the frame's inverse view-projection, at view depth z (the ray's point at device depth 0.5
 // is finite for standard, reversed and infinite projections alike).
@@ -98,7 +75,7 @@ void main() {
     Surface s;
     s.albedo = clamp(texelFetch(albedo_image, px, 0).rgb, 0.0, 1.0);
     s.specular = 0.0;
-    s.normal = host_normal(texelFetch(normal_image, px, 0));
+    s.normal = host_normal(texelFetch(normal_image, px, 0), host.normals, host.view_to_world);
     s.roughness = 1.0;
     vec4 t = texelFetch(thickness_image, px, 0);
     vec3 thickness = host.thickness.x >= 4u ? t.rgb : vec3(t[host.thickness.x]);

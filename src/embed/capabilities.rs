@@ -2,7 +2,7 @@
 //! ([`capabilities`]): asked before building anything, answered from the description alone.
 //! The effects' own constructors refuse with the same errors.
 
-use super::gbuffer::GBufferDesc;
+use super::gbuffer::{DiffuseAlbedo, GBufferDesc};
 use crate::error::HostError;
 use crate::Result;
 
@@ -21,7 +21,8 @@ pub enum Effect {
     SssTransmission,
     /// Li et al.'s multi-layer single + dipole multiple scattering.
     LayeredMedia,
-    /// The SH environment's diffuse light.
+    /// The SH environment's diffuse light added to the host's light
+    /// ([`super::EnvironmentEffect`]).
     Environment,
 }
 
@@ -99,8 +100,10 @@ pub fn capabilities(gbuffer: &GBufferDesc) -> Result<Vec<(Effect, Support)>> {
 pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
     let lacks = missing(effect, gbuffer);
     match effect {
-        Effect::Sss | Effect::Translucency if lacks.is_empty() => Support::Runs,
-        Effect::Sss | Effect::Translucency => Support::Lacks(lacks),
+        Effect::Sss | Effect::Translucency | Effect::Environment if lacks.is_empty() => {
+            Support::Runs
+        }
+        Effect::Sss | Effect::Translucency | Effect::Environment => Support::Lacks(lacks),
         Effect::SssTransmission => Support::NotEmbedded(
             "the thickness along each light's direction, which lucent measures in its own \
              light-space maps of the scene's meshes",
@@ -108,10 +111,6 @@ pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
         Effect::LayeredMedia => Support::NotEmbedded(
             "light-space depth maps of each layered object drawn from the host's vertex and \
              index buffers",
-        ),
-        Effect::Environment => Support::NotEmbedded(
-            "the host's ambient light is its own; lucent's SH environment lights lucent's \
-             scenes",
         ),
     }
 }
@@ -172,7 +171,24 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                 ));
             }
         }
-        Effect::SssTransmission | Effect::LayeredMedia | Effect::Environment => {}
+        Effect::Environment => {
+            if gbuffer.normals.is_none() {
+                out.push(lack(
+                    "normals",
+                    "the SH environment's irradiance is evaluated at each pixel's normal \
+                     (GBufferDesc::with_normals)",
+                ));
+            }
+            if gbuffer.diffuse.albedo == DiffuseAlbedo::Included && gbuffer.albedo.is_none() {
+                out.push(lack(
+                    "albedo",
+                    "the host's diffuse light has the albedo multiplied in, so the \
+                     environment's light needs it too (GBufferDesc::with_albedo, or a diffuse \
+                     light without the albedo: DiffuseDesc::without_albedo)",
+                ));
+            }
+        }
+        Effect::SssTransmission | Effect::LayeredMedia => {}
     }
     out
 }
@@ -209,6 +225,17 @@ mod tests {
             .collect();
         assert_eq!(inputs, ["material IDs", "normals", "albedo", "thickness"]);
         assert!(matches!(support[3].1, Support::NotEmbedded(_)));
+        // The environment: normals and, with the albedo in the diffuse light, the albedo.
+        let Support::Lacks(environment) = &support[4].1 else {
+            panic!("{:?}", support[4])
+        };
+        assert_eq!(environment.len(), 2);
+        let without_albedo = GBufferDesc {
+            diffuse: DiffuseDesc::without_albedo(vk::Format::R16G16B16A16_SFLOAT),
+            ..bare.clone()
+        }
+        .with_normals(NormalDesc::world(vk::Format::R16G16B16A16_SFLOAT));
+        assert!(capabilities(&without_albedo).unwrap()[4].1.runs());
 
         let full = bare
             .with_material_ids(IdDesc::stencil(vk::Format::D24_UNORM_S8_UINT, 0, 8))
@@ -216,7 +243,7 @@ mod tests {
             .with_albedo(vk::Format::R8G8B8A8_SRGB)
             .with_thickness(ThicknessDesc::channel(vk::Format::R8_UNORM, 0));
         let support = capabilities(&full).unwrap();
-        assert!(support[0].1.runs() && support[1].1.runs());
+        assert!(support[0].1.runs() && support[1].1.runs() && support[4].1.runs());
         // An invalid description is its own error, not a list.
         assert!(capabilities(&full.with_metres_per_unit(-1.0)).is_err());
     }

@@ -17,12 +17,15 @@
 //!   diffuse, lit by the host's lights ([`Light`]), on the same G-buffer with its normals
 //!   ([`NormalDesc`]: world or view space, xyz or octahedral), albedo and local thickness
 //!   ([`ThicknessDesc`]; [`bake_thickness`] bakes it per vertex of the host's mesh).
+//! - [`EnvironmentEffect`]: lucent's SH environment light ([`Environment`]: constant,
+//!   hemisphere, the built-in sky or a radiance map) added to the host's lit diffuse at each
+//!   surface pixel's normal, times the albedo when the host's diffuse light has it.
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
 //!   SSS transmission, layered media, shadows, the SH environment), tonemapped. This is how
-//!   SSS transmission, Li et al.'s layered media and the SH environment reach a host today:
-//!   they have no path on a host's G-buffer yet ([`capabilities`] says so per description).
+//!   SSS transmission and Li et al.'s layered media reach a host today: they have no path on
+//!   a host's G-buffer yet ([`capabilities`] says so per description).
 //!
 //! Effects draw over the screen regions a host gives each frame ([`screen_region`] projects an
 //! object's box), and time their passes only when recorded with `record_timed` and an
@@ -150,6 +153,7 @@ use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 mod capabilities;
+mod environment;
 mod gbuffer;
 mod image;
 mod passes;
@@ -161,6 +165,10 @@ mod translucency;
 mod uploads;
 
 pub use capabilities::{capabilities, Effect, Support};
+pub(crate) use environment::shader_permutations as environment_permutations;
+pub use environment::{
+    EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages,
+};
 pub use gbuffer::{
     DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
     IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
@@ -181,7 +189,7 @@ pub use uploads::{leaked, Uploads};
 pub use crate::error::{HostError, ImageFault};
 pub use crate::features::sss::SssKnobs;
 pub use crate::scene::material::{PowMode, SssProfile, Texturing, Translucency};
-pub use crate::scene::{Light, LightKind};
+pub use crate::scene::{Environment, Light, LightKind};
 pub use ash;
 pub use glam;
 

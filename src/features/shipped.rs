@@ -46,6 +46,8 @@ pub fn pipelines() -> Vec<PipelineShaders> {
     super::sss::host_id_permutations(&mut out);
     // GDC 2011 translucency on a host's G-buffer (lucent::embed::TranslucencyEffect).
     crate::embed::translucency_permutations(&mut out);
+    // The SH environment on a host's G-buffer (lucent::embed::EnvironmentEffect).
+    crate::embed::environment_permutations(&mut out);
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
     super::antialias::shader_permutations(&mut out);

@@ -127,6 +127,13 @@ impl FrameUniforms {
         }
     }
 
+    /// These uniforms with an environment's nine SH coefficients
+    /// ([`crate::scene::Environment::coefficients`]) instead of their own.
+    pub fn with_environment(mut self, coefficients: [[f32; 4]; 9]) -> Self {
+        self.ambient_sh = coefficients;
+        self
+    }
+
     /// These uniforms with `lights` (at most [`MAX_LIGHTS`]; the rest are dropped: callers
     /// refuse more) instead of their own.
     pub fn with_lights(mut self, lights: &[Light]) -> Self {

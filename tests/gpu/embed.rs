@@ -202,6 +202,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     let log = run(&with, &["--timing"]);
     assert!(
         log.contains("lucent's passes (GPU timestamps")
+            && log.contains("environment: host environment")
             && log.contains("translucency: host translucency")
             && log.contains("sss: horizontal blur"),
         "{log}"
@@ -217,8 +218,32 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
         whole.display()
     );
     assert!(
-        log.contains("lucent effects: translucency") && log.contains("sss (separable blur"),
+        log.contains("lucent effects: environment")
+            && log.contains("translucency (leaf")
+            && log.contains("sss (separable blur"),
         "{log}"
+    );
+    // lucent's EnvironmentEffect adds the engine's own sky-over-ground ambient (the engine's
+    // lighting leaves it out): the frame equals the one with the engine's own term within
+    // the rounding of its B10G11R11 light (one sum rounded twice: 2/255 at most, measured).
+    let engine_ambient = dir.join("engine-ambient.png");
+    let ambient_log = run(&engine_ambient, &["--engine-ambient"]);
+    assert!(
+        !ambient_log.contains("environment ("),
+        "{log}\n{ambient_log}"
+    );
+    let (_, _, x) = read_png_rgba8(&with).unwrap();
+    let (_, _, y) = read_png_rgba8(&engine_ambient).unwrap();
+    let diffs: Vec<u8> = x.iter().zip(&y).map(|(p, q)| p.abs_diff(*q)).collect();
+    let worst = diffs.iter().copied().max().unwrap();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    println!("host_engine: lucent's environment against the engine's ambient: worst {worst}/255, mean {mean:.3}");
+    assert!(
+        worst <= 2 && mean < 0.5,
+        "lucent's environment differs from the engine's own ambient: worst {worst}/255, mean \
+         {mean} ({} and {})",
+        with.display(),
+        engine_ambient.display()
     );
     run(&without, &["--without-lucent"]);
     let (w, h, a) = read_png_rgba8(&with).unwrap();

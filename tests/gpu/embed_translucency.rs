@@ -23,7 +23,7 @@ use lucent::frame::{FrameSettings, Renderer, Technique};
 
 /// How a test host stores its normals.
 #[derive(Clone, Copy, Debug)]
-enum HostNormals {
+pub(crate) enum HostNormals {
     /// World xyz in RGBA16F (lucent's own GB1).
     WorldHalf,
     /// View-space octahedral in RG16_UNORM.
@@ -50,7 +50,7 @@ fn unorm16(v: f32) -> [u8; 2] {
 }
 
 /// The normal image of `kind` from lucent's world normals, seen through `view`.
-fn normal_image(
+pub(crate) fn normal_image(
     test: &TestGpu,
     kind: HostNormals,
     w: u32,
@@ -150,7 +150,7 @@ pub(crate) fn bounds(w: u32, h: u32, ids: &[u8]) -> vk::Rect2D {
     }
 }
 
-fn rgba8(texels: &[[f32; 4]]) -> Vec<u8> {
+pub(crate) fn rgba8(texels: &[[f32; 4]]) -> Vec<u8> {
     texels
         .iter()
         .flat_map(|t| t.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8))

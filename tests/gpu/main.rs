@@ -13,6 +13,7 @@ mod context;
 mod debug_view;
 mod deformation;
 mod embed;
+mod embed_environment;
 mod embed_translucency;
 mod environment;
 mod graph_gpu;

@@ -27,12 +27,19 @@
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
 //!    diffuse + specular itself instead (its own ambient, no translucency, no scatter).
+//!
+//!    With `--fused` the engine adds the environment and the translucency inside its own
+//!    lighting pass instead, with lucent's GLSL (`lucent::embed::glsl::TERMS`:
+//!    `lucent_sh_ambient`, `lucent_translucency`) and lucent's data (the environment's
+//!    coefficients, the leaf's material row, the lights' translucency scales): no pass of
+//!    lucent's but the SSS, the same picture within the target's rounding.
 //! 6. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
 //! cargo run --release --example host_engine -- --without-lucent --out without.png
 //! cargo run --release --example host_engine -- --timing     # lucent's passes, GPU timestamps
+//! cargo run --release --example host_engine -- --fused      # lucent's terms in its lighting
 //! cargo run --release --example host_engine -- --scene mixed --out mixed.png
 //! ```
 //!
@@ -119,6 +126,9 @@ struct Args {
     /// `--engine-ambient`: the engine's lighting adds its own ambient term instead of lucent's
     /// `EnvironmentEffect` adding the same light (a check of the effect).
     engine_ambient: bool,
+    /// `--fused`: the engine's lighting pass adds lucent's environment and translucency terms
+    /// itself (`lucent::embed::glsl::TERMS`) instead of lucent's effects adding them after it.
+    fused: bool,
     /// `--timing`: time lucent's passes with GPU timestamps (`record_timed`) and print each
     /// pass's median over the frames.
     timing: bool,
@@ -129,7 +139,7 @@ struct Args {
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
                      [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
-                     [--engine-ambient] [--timing] [--scene NAME]";
+                     [--engine-ambient] [--fused] [--timing] [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -141,6 +151,7 @@ fn parse_args() -> Result<Args, String> {
         blur: "separable".into(),
         whole_screen: false,
         engine_ambient: false,
+        fused: false,
         timing: false,
         scene: None,
     };
@@ -173,6 +184,7 @@ fn parse_args() -> Result<Args, String> {
             "--without-lucent" => args.with_lucent = false,
             "--whole-screen" => args.whole_screen = true,
             "--engine-ambient" => args.engine_ambient = true,
+            "--fused" => args.fused = true,
             "--timing" => args.timing = true,
             "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
@@ -301,13 +313,66 @@ void main() {{
         )
     }
 
-    pub fn lighting_frag() -> String {
+    /// What the engine's lighting shader needs to add lucent's terms itself (`--fused`).
+    pub struct Fused {
+        /// The environment's coefficients (`Environment::coefficients`).
+        pub sh: [[f32; 4]; 9],
+        /// The leaf's translucency row (`TranslucentMaterial::row`).
+        pub leaf_row: [f32; 4],
+        /// The sun's and the back light's translucency scales.
+        pub scales: [f32; 2],
+    }
+
+    /// The lighting shader; with `fused`, lucent's GLSL terms and the constants they read
+    /// (the engine's own data, compiled in), called where it shades each light.
+    pub fn lighting_frag(fused: Option<&Fused>) -> String {
+        let vec4 = |v: [f32; 4]| format!("vec4({:?}, {:?}, {:?}, {:?})", v[0], v[1], v[2], v[3]);
+        let (terms, ambient, transmitted) = match fused {
+            None => (
+                String::new(),
+                // The engine's own ambient (pc.params.y 1), or none where lucent's
+                // EnvironmentEffect adds the same light (0).
+                "mix(ground, sky, n.y * 0.5 + 0.5) * pc.params.y".to_string(),
+                String::new(),
+            ),
+            Some(f) => (
+                format!(
+                    "{}\nconst vec4 LUCENT_SH[9] = vec4[9]({});\nconst vec4 LEAF_ROW = {};\n",
+                    lucent::embed::glsl::TERMS,
+                    f.sh.iter().map(|&c| vec4(c)).collect::<Vec<_>>().join(", "),
+                    vec4(f.leaf_row)
+                ),
+                "lucent_sh_ambient(LUCENT_SH, n)".to_string(),
+                format!(
+                    r#"
+    // GDC 2011 translucency through the leaf, from both lights: lucent's term.
+    if (texelFetch(id_tex, px, 0).r == {LEAF}u) {{
+        vec3 thickness = vec3(texelFetch(thickness_tex, px, 0).r);
+        float v_dot_n = dot(v, n);
+        diffuse += lucent_translucency(a.rgb, thickness, LEAF_ROW, v, v_dot_n, l, sun, 1.0,
+                                       {SUN_SCALE:?});
+        diffuse += lucent_translucency(a.rgb, thickness, LEAF_ROW, v, v_dot_n,
+                                       to_back * inversesqrt(dist2), vec3({BR}, {BG}, {BB}),
+                                       window * window / dist2, {BACK_SCALE:?});
+    }}"#,
+                    LEAF = super::LEAF_ID,
+                    SUN_SCALE = f.scales[0],
+                    BACK_SCALE = f.scales[1],
+                    BR = super::BACK_LIGHT_RADIANCE[0],
+                    BG = super::BACK_LIGHT_RADIANCE[1],
+                    BB = super::BACK_LIGHT_RADIANCE[2],
+                ),
+            ),
+        };
         format!(
             r#"#version 450
 {PUSH}
+{terms}
 layout(set = 0, binding = 0) uniform sampler2D depth_tex;   // reversed Z, infinite far
 layout(set = 0, binding = 1) uniform sampler2D normal_tex;
 layout(set = 0, binding = 2) uniform sampler2D albedo_tex;
+layout(set = 0, binding = 3) uniform usampler2D id_tex;
+layout(set = 0, binding = 4) uniform sampler2D thickness_tex;
 layout(location = 0) out vec4 o_diffuse;
 layout(location = 1) out vec4 o_specular;
 vec2 sign_not_zero(vec2 v) {{ return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }}
@@ -335,10 +400,8 @@ void main() {{
     vec3 h = normalize(l + v);
     float nl = max(dot(n, l), 0.0);
     vec3 sun = vec3(1.0, 0.95, 0.88) * pc.sun.w;
-    // The engine's own ambient (pc.params.y 1), or none where lucent's EnvironmentEffect adds
-    // the same light (0).
     vec3 ground = vec3({GR}, {GG}, {GB}), sky = vec3({SR}, {SG}, {SB});
-    vec3 ambient = mix(ground, sky, n.y * 0.5 + 0.5) * pc.params.y;
+    vec3 ambient = {ambient};
     // The back light, with lucent's point-light falloff (a smooth window to its range).
     vec3 to_back = vec3({BX}, {BY}, {BZ}) - p;
     float dist2 = max(dot(to_back, to_back), 1e-4);
@@ -346,7 +409,8 @@ void main() {{
     float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
     vec3 back = vec3({BR}, {BG}, {BB}) * (window * window / dist2);
     float nb = max(dot(n, to_back * inversesqrt(dist2)), 0.0);
-    o_diffuse = vec4(a.rgb * ((sun * nl + back * nb) / 3.14159265 + ambient), 1.0);
+    vec3 diffuse = a.rgb * ((sun * nl + back * nb) / 3.14159265 + ambient);{transmitted}
+    o_diffuse = vec4(diffuse, 1.0);
     float shininess = exp2(1.0 + 10.0 * a.a);
     float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
     float lobe = (shininess + 8.0) / (8.0 * 3.14159265) * pow(max(dot(n, h), 0.0), shininess);
@@ -758,6 +822,9 @@ struct FrameSlot {
     lighting_set: vk::DescriptorSet,
     compose_set: vk::DescriptorSet,
     tonemap_set: vk::DescriptorSet,
+    /// `--timing`: the engine's own two timestamps around its lighting pass (what lucent's
+    /// terms cost inside it with `--fused`).
+    lighting_queries: Option<vk::QueryPool>,
 }
 
 /// The engine's pipelines and what they share.
@@ -886,6 +953,7 @@ fn create_pipelines(
     engine: &Engine,
     cache: vk::PipelineCache,
     light_format: vk::Format,
+    fused: Option<&shaders::Fused>,
 ) -> Result<Pipelines, String> {
     let device = &engine.device;
     let compiler = shaderc::Compiler::new().map_err(|e| format!("shaderc: {e}"))?;
@@ -916,7 +984,7 @@ fn create_pipelines(
         compile(
             device,
             &compiler,
-            &shaders::lighting_frag(),
+            &shaders::lighting_frag(fused),
             Fragment,
             "lighting.frag",
         )?,
@@ -937,7 +1005,7 @@ fn create_pipelines(
     ];
     // SAFETY: plain object creation on the engine's device; destroyed in `destroy_pipelines`.
     let made = unsafe {
-        let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..3)
+        let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..5)
             .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
@@ -978,7 +1046,7 @@ fn create_pipelines(
         let sets = 3 * FRAMES_IN_FLIGHT as u32;
         let sizes = [vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(3 * sets)];
+            .descriptor_count(5 * sets)];
         let pool = device
             .create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
@@ -1079,6 +1147,7 @@ fn create_slot(
     extent: vk::Extent2D,
     light_format: vk::Format,
     index: usize,
+    timing: bool,
 ) -> Result<FrameSlot, String> {
     let device = &engine.device;
     use vk::ImageUsageFlags as U;
@@ -1152,6 +1221,14 @@ fn create_slot(
             (sets[1], 2, diffuse.view, sampled),
             (sets[2], 1, hdr.view, sampled),
             (sets[2], 2, hdr.view, sampled),
+            // The IDs and the thickness: the lighting reads them to add lucent's translucency
+            // itself (--fused); the other sets' never-read bindings as above.
+            (sets[0], 3, ids.view, sampled),
+            (sets[0], 4, thickness.view, sampled),
+            (sets[1], 3, ids.view, sampled),
+            (sets[1], 4, diffuse.view, sampled),
+            (sets[2], 3, ids.view, sampled),
+            (sets[2], 4, hdr.view, sampled),
         ];
         let infos: Vec<[vk::DescriptorImageInfo; 1]> = writes
             .iter()
@@ -1190,6 +1267,20 @@ fn create_slot(
             lighting_set: sets[0],
             compose_set: sets[1],
             tonemap_set: sets[2],
+            lighting_queries: if timing {
+                Some(
+                    device
+                        .create_query_pool(
+                            &vk::QueryPoolCreateInfo::default()
+                                .query_type(vk::QueryType::TIMESTAMP)
+                                .query_count(2),
+                            None,
+                        )
+                        .map_err(|e| format!("vkCreateQueryPool: {e}"))?,
+                )
+            } else {
+                None
+            },
         })
     }
 }
@@ -1199,6 +1290,9 @@ fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, slot: FrameSlot) 
     unsafe {
         engine.device.destroy_fence(slot.fence, None);
         engine.device.destroy_command_pool(slot.pool, None);
+        if let Some(pool) = slot.lighting_queries {
+            engine.device.destroy_query_pool(pool, None);
+        }
     }
     for target in [
         slot.depth,
@@ -1295,6 +1389,12 @@ fn camera(frame: usize, aspect: f32) -> (Mat4, Mat4, Vec3) {
     (view, projection, eye)
 }
 
+/// The leaf's GDC 2011 material: a broad lobe, the talk's distortion, a little light from
+/// every angle.
+fn leaf_material() -> TranslucentMaterial {
+    TranslucentMaterial::new(LEAF_ID, 6.0, 0.25, 0.02)
+}
+
 /// The engine's ambient light as lucent's SH environment: the same sky and ground.
 fn engine_environment() -> Environment {
     Environment::hemisphere(Vec3::from(AMBIENT_SKY), Vec3::from(AMBIENT_GROUND))
@@ -1348,7 +1448,7 @@ fn scattering_region(
 /// One frame slot's timers, one per effect (`--timing`).
 struct Timers {
     environment: Option<EffectTimer>,
-    translucency: EffectTimer,
+    translucency: Option<EffectTimer>,
     sss: EffectTimer,
 }
 
@@ -1367,13 +1467,17 @@ struct Effects {
 impl Effects {
     /// Reads the times of the frame slot `k` last recorded (its fence has signalled: the
     /// engine waited for it before reusing the slot, or for the device at the end).
-    fn collect_times(&mut self, k: usize) -> Result<(), String> {
+    fn collect_times(&mut self, k: usize, engine_lighting_ms: Option<f64>) -> Result<(), String> {
+        if let Some(ms) = engine_lighting_ms {
+            let key = "engine: lighting".to_string();
+            self.times.entry(key).or_default().push(ms);
+        }
         let Some(timers) = self.timers.get(k) else {
             return Ok(());
         };
         let named = [
             ("environment", timers.environment.as_ref()),
-            ("translucency", Some(&timers.translucency)),
+            ("translucency", timers.translucency.as_ref()),
             ("sss", Some(&timers.sss)),
         ];
         for (effect, timer) in named {
@@ -1409,7 +1513,8 @@ enum Inserted {
     Effects {
         /// The engine's ambient as lucent's SH environment (none with `--engine-ambient`).
         environment: Option<Box<EnvironmentEffect>>,
-        translucency: Box<TranslucencyEffect>,
+        /// The leaf's translucency (none with `--fused`).
+        translucency: Option<Box<TranslucencyEffect>>,
         sss: Box<SssEffect>,
     },
     /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
@@ -1422,13 +1527,16 @@ fn build_effects(
     lucent: &Lucent,
     uploads: &mut lucent::embed::Uploads,
     environment: Option<EnvironmentEffectDesc>,
-    translucency: TranslucencyEffectDesc,
+    translucency: Option<TranslucencyEffectDesc>,
     sss: SssEffectDesc,
 ) -> lucent::Result<Inserted> {
     let environment = environment
         .map(|desc| EnvironmentEffect::new(lucent, uploads, desc))
         .transpose()?;
-    let translucency = match TranslucencyEffect::new(lucent, uploads, translucency) {
+    let translucency = match translucency
+        .map(|desc| TranslucencyEffect::new(lucent, uploads, desc))
+        .transpose()
+    {
         Ok(t) => t,
         Err(e) => {
             if let Some(environment) = environment {
@@ -1440,14 +1548,16 @@ fn build_effects(
     match SssEffect::new(lucent, uploads, sss) {
         Ok(sss) => Ok(Inserted::Effects {
             environment: environment.map(Box::new),
-            translucency: Box::new(translucency),
+            translucency: translucency.map(Box::new),
             sss: Box::new(sss),
         }),
         Err(e) => {
             if let Some(environment) = environment {
                 environment.destroy(lucent);
             }
-            translucency.destroy(lucent);
+            if let Some(translucency) = translucency {
+                translucency.destroy(lucent);
+            }
             Err(e)
         }
     }
@@ -1678,9 +1788,17 @@ fn record_frame(
     slot.depth
         .transition(device, cmd, ImageState::depth_sampled(), false);
 
-    // 2. Lighting.
+    // 2. Lighting (timed by the engine itself with --timing).
     for target in [&mut slot.diffuse, &mut slot.specular] {
         target.transition(device, cmd, ImageState::color_attachment(), true);
+    }
+    if let Some(pool) = slot.lighting_queries {
+        // SAFETY: `cmd` is recording outside rendering; the pool is the slot's, its last use
+        // completed (the slot's fence).
+        unsafe {
+            device.cmd_reset_query_pool(cmd, pool, 0, 2);
+            device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, 0);
+        }
     }
     begin_rendering(
         device,
@@ -1699,6 +1817,9 @@ fn record_frame(
     unsafe {
         device.cmd_draw(cmd, 3, 1, 0, 0);
         device.cmd_end_rendering(cmd);
+        if let Some(pool) = slot.lighting_queries {
+            device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, 1);
+        }
     }
     for target in [&mut slot.diffuse, &mut slot.specular] {
         target.transition(device, cmd, fragment_sampled, false);
@@ -1748,32 +1869,35 @@ fn record_frame(
                 }
                 .map_err(|e| format!("lucent: {e}"))?;
             }
-            let translucency_frame = TranslucencyFrame {
-                slot: slot_index,
-                view: 0,
-                camera,
-                lights: &engine_lights(sun),
-                images: TranslucencyImages {
-                    depth: &depth,
-                    normals: &normals,
-                    albedo: &albedo,
-                    thickness: &thickness,
-                    material_ids: &ids,
-                },
-                // The leaf's projected bounds: the pass draws nothing elsewhere.
-                regions: &leaf_region(&camera, extent, effects.whole_screen),
-                lighting: &lighting,
-            };
-            match effects.timers.get_mut(slot_index) {
-                Some(t) => translucency.record_timed(
-                    &effects.lucent,
-                    cmd,
-                    &translucency_frame,
-                    &mut t.translucency,
-                ),
-                None => translucency.record(&effects.lucent, cmd, &translucency_frame),
+            if let Some(translucency) = translucency {
+                let translucency_frame = TranslucencyFrame {
+                    slot: slot_index,
+                    view: 0,
+                    camera,
+                    lights: &engine_lights(sun),
+                    images: TranslucencyImages {
+                        depth: &depth,
+                        normals: &normals,
+                        albedo: &albedo,
+                        thickness: &thickness,
+                        material_ids: &ids,
+                    },
+                    // The leaf's projected bounds: the pass draws nothing elsewhere.
+                    regions: &leaf_region(&camera, extent, effects.whole_screen),
+                    lighting: &lighting,
+                };
+                let timer = effects
+                    .timers
+                    .get_mut(slot_index)
+                    .and_then(|t| t.translucency.as_mut());
+                match timer {
+                    Some(timer) => {
+                        translucency.record_timed(&effects.lucent, cmd, &translucency_frame, timer)
+                    }
+                    None => translucency.record(&effects.lucent, cmd, &translucency_frame),
+                }
+                .map_err(|e| format!("lucent: {e}"))?;
             }
-            .map_err(|e| format!("lucent: {e}"))?;
             slot.normal.state = normals.left_in();
             slot.thickness.state = thickness.left_in();
             // (The other images come back as they came: the SSS reads them below.)
@@ -1861,6 +1985,28 @@ fn submit(engine: &Engine, cmd: vk::CommandBuffer, fence: vk::Fence) -> Result<(
 }
 
 /// Waits for the slot's last submission and begins its command buffer again.
+/// The milliseconds of the engine's lighting pass in the frame `slot` last recorded (its fence
+/// has signalled), when it is timed.
+fn lighting_ms(engine: &Engine, slot: &FrameSlot) -> Option<f64> {
+    let pool = slot.lighting_queries?;
+    let mut stamps = [0u64; 2];
+    // SAFETY: the pool is live; the frame that wrote it completed (no wait is asked for).
+    unsafe {
+        engine
+            .device
+            .get_query_pool_results(pool, 0, &mut stamps, vk::QueryResultFlags::TYPE_64)
+            .ok()?;
+    }
+    // SAFETY: a plain query of the engine's physical device.
+    let properties = unsafe {
+        engine
+            .instance
+            .get_physical_device_properties(engine.physical_device)
+    };
+    let ticks = stamps[1].wrapping_sub(stamps[0]) as f64;
+    Some(ticks * f64::from(properties.limits.timestamp_period) / 1e6)
+}
+
 fn begin_slot(engine: &Engine, slot: &FrameSlot) -> Result<(), String> {
     let device = &engine.device;
     // SAFETY: the slot's own objects; the fence wait frees its command buffer (and lucent's
@@ -1934,11 +2080,11 @@ fn create_effects(
     for (effect, support) in capabilities(&gbuffer).map_err(|e| e.to_string())? {
         eprintln!("host_engine: lucent effect {}: {support:?}", effect.name());
     }
-    // The leaf: a broad lobe, the talk's distortion, a little light from every angle.
-    let leaf = TranslucentMaterial::new(LEAF_ID, 6.0, 0.25, 0.02);
-    let translucency_desc = TranslucencyEffectDesc::new(gbuffer.clone(), vec![leaf]);
+    // With --fused the engine's lighting adds both terms itself.
+    let translucency_desc =
+        (!args.fused).then(|| TranslucencyEffectDesc::new(gbuffer.clone(), vec![leaf_material()]));
     let environment_desc =
-        (!args.engine_ambient).then(|| EnvironmentEffectDesc::new(gbuffer.clone()));
+        (!args.engine_ambient && !args.fused).then(|| EnvironmentEffectDesc::new(gbuffer.clone()));
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
@@ -1988,12 +2134,17 @@ fn create_effects(
     let inserted = built.map_err(|e| format!("lucent: {e}"))?;
     match &args.scene {
         None => eprintln!(
-            "host_engine: lucent effects: {}translucency (leaf ID {LEAF_ID}), sss ({} blur; \
-             skin ID {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
-            if args.engine_ambient {
-                ""
-            } else {
-                "environment (the engine's sky and ground), "
+            "host_engine: lucent effects: {}sss ({} blur; skin ID {SKIN_ID}, marble ID \
+             {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            match (args.fused, args.engine_ambient) {
+                (true, _) => "environment and translucency (the leaf) in the engine's \
+                              lighting pass (lucent::embed::glsl::TERMS), "
+                    .to_string(),
+                (false, true) => format!("translucency (leaf ID {LEAF_ID}), "),
+                (false, false) => format!(
+                    "environment (the engine's sky and ground), translucency (leaf ID \
+                     {LEAF_ID}), "
+                ),
             },
             args.blur
         ),
@@ -2012,7 +2163,7 @@ fn create_effects(
                     } else {
                         Some(timer()?)
                     },
-                    translucency: timer()?,
+                    translucency: if args.fused { None } else { Some(timer()?) },
                     sss: timer()?,
                 })
             })
@@ -2148,7 +2299,12 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     let mut pipelines = None;
     let mut effects = None;
     let setup = (|| {
-        let made = create_pipelines(engine, pipeline_cache, light_format)?;
+        let fused = (args.fused && args.with_lucent).then(|| shaders::Fused {
+            sh: engine_environment().coefficients(),
+            leaf_row: leaf_material().row(),
+            scales: engine_lights(Vec3::Y).map(|l| l.translucency_scale),
+        });
+        let made = create_pipelines(engine, pipeline_cache, light_format, fused.as_ref())?;
         let made = pipelines.insert(made);
         for k in 0..FRAMES_IN_FLIGHT {
             slots.push(create_slot(
@@ -2158,6 +2314,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 extent,
                 light_format,
                 k,
+                args.timing && args.with_lucent && args.scene.is_none(),
             )?);
         }
         if args.with_lucent {
@@ -2182,7 +2339,9 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
             let recorded = begin_slot(engine, slot)
                 .and_then(|()| match effects.as_mut() {
                     // The slot's previous frame has completed: its times are there.
-                    Some(effects) if frame >= FRAMES_IN_FLIGHT => effects.collect_times(k),
+                    Some(effects) if frame >= FRAMES_IN_FLIGHT => {
+                        effects.collect_times(k, lighting_ms(engine, slot))
+                    }
                     _ => Ok(()),
                 })
                 .and_then(|()| match effects.as_mut() {
@@ -2230,8 +2389,10 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     if let (Ok(()), Some(effects)) = (&result, effects.as_mut()) {
         // The last frame of each slot (the device is idle).
         let first = args.frames.saturating_sub(FRAMES_IN_FLIGHT);
-        result = (first..args.frames)
-            .try_for_each(|frame| effects.collect_times(frame % FRAMES_IN_FLIGHT));
+        result = (first..args.frames).try_for_each(|frame| {
+            let k = frame % FRAMES_IN_FLIGHT;
+            effects.collect_times(k, lighting_ms(engine, &slots[k]))
+        });
         if !effects.timers.is_empty() && result.is_ok() {
             eprintln!(
                 "host_engine: lucent's passes (GPU timestamps, medians of {} frames): {}",
@@ -2245,7 +2406,9 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
             for timer in timers.environment.into_iter() {
                 timer.destroy(&effects.lucent);
             }
-            timers.translucency.destroy(&effects.lucent);
+            for timer in timers.translucency.into_iter() {
+                timer.destroy(&effects.lucent);
+            }
             timers.sss.destroy(&effects.lucent);
         }
         match effects.inserted {
@@ -2257,7 +2420,9 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 if let Some(environment) = environment {
                     (*environment).destroy(&effects.lucent);
                 }
-                (*translucency).destroy(&effects.lucent);
+                if let Some(translucency) = translucency {
+                    (*translucency).destroy(&effects.lucent);
+                }
                 (*sss).destroy(&effects.lucent);
             }
             Inserted::Scene(scene) => (*scene).1.destroy(&effects.lucent),

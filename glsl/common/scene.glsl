@@ -3,6 +3,8 @@
 #ifndef LUCENT_SCENE_GLSL
 #define LUCENT_SCENE_GLSL
 
+#include "../embed/lucent_terms.glsl"
+
 #define MAX_LIGHTS 64
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_POINT 1
@@ -35,24 +37,9 @@ layout(std140, set = 0, binding = 0) uniform Frame {
 } frame;
 
 // The environment's diffuse light at unit normal n: E(n) / pi, the radiance a Lambertian
-// albedo multiplies (src/scene/environment.rs: nine SH coefficients with the clamped cosine
-// convolved in and the basis constants folded in). Clamped at 0: the series of a map with a
-// small bright sun rings below zero opposite it, and irradiance cannot be negative. Only the
-// bands in use are evaluated (a uniform branch): a constant environment is one read.
+// albedo multiplies (glsl/embed/lucent_terms.glsl, which a host's lighting pass includes too).
 vec3 ambient_radiance(vec3 n) {
-    vec3 e = frame.ambient_sh[0].rgb;
-    float bands = frame.ambient_sh[0].w;
-    if (bands > 1.5) {
-        e += frame.ambient_sh[1].rgb * n.y + frame.ambient_sh[2].rgb * n.z
-           + frame.ambient_sh[3].rgb * n.x;
-    }
-    if (bands > 2.5) {
-        e += frame.ambient_sh[4].rgb * (n.x * n.y) + frame.ambient_sh[5].rgb * (n.y * n.z)
-           + frame.ambient_sh[6].rgb * (3.0 * n.z * n.z - 1.0)
-           + frame.ambient_sh[7].rgb * (n.x * n.z)
-           + frame.ambient_sh[8].rgb * (n.x * n.x - n.y * n.y);
-    }
-    return max(e, vec3(0.0));
+    return lucent_sh_ambient(frame.ambient_sh, n);
 }
 
 // World position of the surface at window position `frag_coord` (gl_FragCoord.xy) with device

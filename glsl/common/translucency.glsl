@@ -8,6 +8,7 @@
 
 #include "gbuffer.glsl"
 #include "lighting.glsl"
+#include "../embed/lucent_terms.glsl"
 
 #define POW_EXACT 0
 #define POW_SPHERICAL_GAUSSIAN 1
@@ -26,25 +27,11 @@ layout(std140, set = 0, binding = LUCENT_TRANSLUCENCY_TABLE_BINDING) uniform Tra
     vec4 rows[256];
 } translucency_materials;
 
-// x^n for x in [0, 1], n >= 0. pow(0, 0) is undefined in GLSL (and pow(x, y) for x <= 0 in
-// general): the base is clamped to a tiny positive value, so n = 0 gives exactly 1 and large n
-// underflow to 0 instead of NaN.
-// LUCENT_POW_MODES says which forms the frame's materials use (1 exact, 2 exp2, 3 both): a
-// frame compiles only its forms, because a SIMD CPU driver evaluates both sides of a branch.
-// exp2(n*x - n) = exp2(n (x - 1)) <= 1: no overflow for any n >= 0.
+// x^n for x in [0, 1], n >= 0, in a row's pow form (glsl/embed/lucent_terms.glsl: the talk's
+// lobe as a host's lighting pass includes it). LUCENT_POW_MODES says which forms the frame's
+// materials use (1 exact, 2 exp2, 3 both): a frame compiles only its forms.
 float translucency_lobe(float x, float n, float mode) {
-    x = clamp(x, 0.0, 1.0);
-    // The row's w carries the shadowed flag above the pow mode.
-    mode = mode >= TRANSLUCENCY_SHADOWED ? mode - TRANSLUCENCY_SHADOWED : mode;
-#if LUCENT_POW_MODES == 1
-    return pow(max(x, 1e-30), n);
-#elif LUCENT_POW_MODES == 2
-    return exp2(n * (x - 1.0));
-#else
-    // Both forms are exp2 of n times an exponent: choose the exponent, not the function.
-    float e = mode == float(POW_SPHERICAL_GAUSSIAN) ? x - 1.0 : log2(max(x, 1e-30));
-    return exp2(n * e);
-#endif
+    return lucent_translucency_lobe(x, n, mode);
 }
 
 // Diffuse + specular + the talk's per-light term from one light:
@@ -82,9 +69,8 @@ bool translucency_shadowed(vec4 material) {
 // diffuses the light coming through thin parts (transmission plus diffusion on one skin).
 vec3 translucency_transmitted(Surface s, vec3 to_eye, float v_dot_n, vec3 to_light,
                               float attenuation, Light light, vec4 material, vec3 thickness) {
-    float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
-    float lobe = translucency_lobe(back, material.x, material.w) * light.params.y;
-    return s.albedo * (lobe + material.z) * thickness * light.radiance_range.rgb * attenuation;
+    return lucent_translucency(s.albedo, thickness, material, to_eye, v_dot_n, to_light,
+                               light.radiance_range.rgb, attenuation, light.params.y);
 }
 
 #endif

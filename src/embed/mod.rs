@@ -155,6 +155,7 @@ use crate::{LucentError, Result};
 mod capabilities;
 mod environment;
 mod gbuffer;
+pub mod glsl;
 mod image;
 mod passes;
 mod regions;

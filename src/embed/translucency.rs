@@ -108,8 +108,10 @@ impl TranslucentMaterial {
         })
     }
 
-    /// The material table row (`features::translucency::material_row`).
-    fn row(&self) -> [f32; 4] {
+    /// The material's row as the shaders read it (x power, y distortion, z ambient, w the pow
+    /// form: 0 exact, 1 exp2): what a host passes to `lucent_translucency` in its own
+    /// lighting pass ([`super::glsl::TERMS`]), lucent's `features::translucency::material_row`.
+    pub fn row(&self) -> [f32; 4] {
         material_row(&Translucency {
             power: self.power,
             distortion: self.distortion,

@@ -202,6 +202,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     let log = run(&with, &["--timing"]);
     assert!(
         log.contains("lucent's passes (GPU timestamps")
+            && log.contains("engine: lighting")
             && log.contains("environment: host environment")
             && log.contains("translucency: host translucency")
             && log.contains("sss: horizontal blur"),
@@ -244,6 +245,30 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
          {mean} ({} and {})",
         with.display(),
         engine_ambient.display()
+    );
+    // The engine's lighting pass adds lucent's environment and translucency terms itself
+    // (lucent::embed::glsl::TERMS): the same frame within its B10G11R11 light's rounding,
+    // with no pass of lucent's but the SSS.
+    let fused = dir.join("fused.png");
+    let fused_log = run(&fused, &["--fused", "--timing"]);
+    assert!(
+        fused_log.contains("lucent::embed::glsl::TERMS")
+            && fused_log.contains("engine: lighting")
+            && !fused_log.contains("host translucency")
+            && !fused_log.contains("host environment"),
+        "{fused_log}"
+    );
+    let (_, _, z) = read_png_rgba8(&fused).unwrap();
+    let diffs: Vec<u8> = x.iter().zip(&z).map(|(p, q)| p.abs_diff(*q)).collect();
+    let worst = diffs.iter().copied().max().unwrap();
+    let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+    println!("host_engine: lucent's terms in the engine's lighting against lucent's effects: worst {worst}/255, mean {mean:.3}");
+    assert!(
+        worst <= 2 && mean < 0.5,
+        "lucent's fused terms differ from its effects: worst {worst}/255, mean {mean} ({} and \
+         {})",
+        with.display(),
+        fused.display()
     );
     run(&without, &["--without-lucent"]);
     let (w, h, a) = read_png_rgba8(&with).unwrap();

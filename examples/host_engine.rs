@@ -324,8 +324,11 @@ void main() {{
     }
 
     /// The lighting shader; with `fused`, lucent's GLSL terms and the constants they read
-    /// (the engine's own data, compiled in), called where it shades each light.
-    pub fn lighting_frag(fused: Option<&Fused>) -> String {
+    /// (the engine's own data, compiled in), called where it shades each light: the SH
+    /// ambient everywhere, the translucency in the `leaf` variant only (drawn over the leaf's
+    /// screen rectangle, the plain one elsewhere: a CPU driver runs both sides of a branch,
+    /// so a branch on the ID would cost the whole screen the term).
+    pub fn lighting_frag(fused: Option<&Fused>, leaf: bool) -> String {
         let vec4 = |v: [f32; 4]| format!("vec4({:?}, {:?}, {:?}, {:?})", v[0], v[1], v[2], v[3]);
         let (terms, ambient, transmitted) = match fused {
             None => (
@@ -333,6 +336,15 @@ void main() {{
                 // The engine's own ambient (pc.params.y 1), or none where lucent's
                 // EnvironmentEffect adds the same light (0).
                 "mix(ground, sky, n.y * 0.5 + 0.5) * pc.params.y".to_string(),
+                String::new(),
+            ),
+            Some(f) if !leaf => (
+                format!(
+                    "{}\nconst vec4 LUCENT_SH[9] = vec4[9]({});\n",
+                    lucent::embed::glsl::TERMS,
+                    f.sh.iter().map(|&c| vec4(c)).collect::<Vec<_>>().join(", "),
+                ),
+                "lucent_sh_ambient(LUCENT_SH, n)".to_string(),
                 String::new(),
             ),
             Some(f) => (
@@ -835,6 +847,8 @@ struct Pipelines {
     pool: vk::DescriptorPool,
     gbuffer: vk::Pipeline,
     lighting: vk::Pipeline,
+    /// `--fused`: the lighting with lucent's translucency, drawn over the leaf's rectangle.
+    lighting_leaf: Option<vk::Pipeline>,
     compose: vk::Pipeline,
     tonemap: vk::Pipeline,
 }
@@ -852,6 +866,8 @@ fn compile(
         shaderc::TargetEnv::Vulkan,
         shaderc::EnvVersion::Vulkan1_3 as u32,
     );
+    // Optimized, as an engine ships its shaders (and as lucent compiles its own).
+    options.set_optimization_level(shaderc::OptimizationLevel::Performance);
     let spirv = compiler
         .compile_into_spirv(source, kind, name, "main", Some(&options))
         .map_err(|e| format!("{name}: {e}"))?;
@@ -984,7 +1000,7 @@ fn create_pipelines(
         compile(
             device,
             &compiler,
-            &shaders::lighting_frag(fused),
+            &shaders::lighting_frag(fused, false),
             Fragment,
             "lighting.frag",
         )?,
@@ -1003,6 +1019,17 @@ fn create_pipelines(
             "tonemap.frag",
         )?,
     ];
+    // --fused: the lighting's variant with lucent's translucency, for the leaf's rectangle.
+    let leaf_module = match fused {
+        Some(_) => Some(compile(
+            device,
+            &compiler,
+            &shaders::lighting_frag(fused, true),
+            Fragment,
+            "lighting_leaf.frag",
+        )?),
+        None => None,
+    };
     // SAFETY: plain object creation on the engine's device; destroyed in `destroy_pipelines`.
     let made = unsafe {
         let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..5)
@@ -1074,6 +1101,18 @@ fn create_pipelines(
             None,
             false,
         )?;
+        let lighting_leaf = match leaf_module {
+            Some(module) => Some(pipeline(
+                device,
+                cache,
+                layout,
+                (fullscreen, module),
+                &[light_format, light_format],
+                None,
+                false,
+            )?),
+            None => None,
+        };
         let compose = pipeline(
             device,
             cache,
@@ -1099,11 +1138,12 @@ fn create_pipelines(
             pool,
             gbuffer,
             lighting,
+            lighting_leaf,
             compose,
             tonemap,
         })
     };
-    for module in modules {
+    for module in modules.into_iter().chain(leaf_module) {
         // SAFETY: the pipelines are made (or failed); the modules are no longer needed.
         unsafe { device.destroy_shader_module(module, None) };
     }
@@ -1113,7 +1153,8 @@ fn create_pipelines(
 fn destroy_pipelines(device: &ash::Device, p: &Pipelines) {
     // SAFETY: the device is idle; the objects are the engine's own.
     unsafe {
-        for pipeline in [p.gbuffer, p.lighting, p.compose, p.tonemap] {
+        let pipelines = [p.gbuffer, p.lighting, p.compose, p.tonemap];
+        for pipeline in pipelines.into_iter().chain(p.lighting_leaf) {
             device.destroy_pipeline(pipeline, None);
         }
         device.destroy_descriptor_pool(p.pool, None);
@@ -1415,6 +1456,32 @@ fn engine_lights(sun: Vec3) -> [Light; 2] {
     // The sun is high: little of it comes through the leaf towards the camera.
     sun.translucency_scale = 0.2;
     [sun, back]
+}
+
+/// The parts of `whole` outside `inner` (inside it): up to four rectangles, none empty.
+fn around(whole: vk::Rect2D, inner: vk::Rect2D) -> Vec<vk::Rect2D> {
+    let (x0, y0) = (inner.offset.x, inner.offset.y);
+    let (x1, y1) = (
+        x0 + inner.extent.width as i32,
+        y0 + inner.extent.height as i32,
+    );
+    let (w, h) = (whole.extent.width as i32, whole.extent.height as i32);
+    let rect = |x: i32, y: i32, right: i32, bottom: i32| vk::Rect2D {
+        offset: vk::Offset2D { x, y },
+        extent: vk::Extent2D {
+            width: (right - x).max(0) as u32,
+            height: (bottom - y).max(0) as u32,
+        },
+    };
+    [
+        rect(0, 0, w, y0),
+        rect(0, y1, w, h),
+        rect(0, y0, x0, y1),
+        rect(x1, y0, w, y1),
+    ]
+    .into_iter()
+    .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+    .collect()
 }
 
 /// The screen rectangle the leaf covers: where the translucency pass draws (none, the whole
@@ -1808,14 +1875,44 @@ fn record_frame(
         None,
         false,
     );
-    bind(
-        pipelines.lighting,
-        Some(slot.lighting_set),
-        (projection * view).inverse(),
-    );
-    // SAFETY: inside the lighting's rendering, its pipeline and set bound.
+    let inverse = (projection * view).inverse();
+    match pipelines.lighting_leaf {
+        // --fused: lucent's translucency in the leaf's rectangle only, the plain lighting
+        // around it (as lucent's own lighting pass draws its translucency variant on the
+        // tiles translucent objects cover).
+        Some(leaf_pipeline) => {
+            let whole = vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent,
+            };
+            let leaf = leaf_region(&HostCamera::new(view, projection), extent, false)
+                .first()
+                .copied()
+                .unwrap_or(whole);
+            bind(pipelines.lighting, Some(slot.lighting_set), inverse);
+            for rect in around(whole, leaf) {
+                // SAFETY: inside the lighting's rendering, its pipeline and set bound.
+                unsafe {
+                    device.cmd_set_scissor(cmd, 0, &[rect]);
+                    device.cmd_draw(cmd, 3, 1, 0, 0);
+                }
+            }
+            bind(leaf_pipeline, Some(slot.lighting_set), inverse);
+            // SAFETY: as above; the scissor is set back to the whole target after.
+            unsafe {
+                device.cmd_set_scissor(cmd, 0, &[leaf]);
+                device.cmd_draw(cmd, 3, 1, 0, 0);
+                device.cmd_set_scissor(cmd, 0, &[whole]);
+            }
+        }
+        None => {
+            bind(pipelines.lighting, Some(slot.lighting_set), inverse);
+            // SAFETY: inside the lighting's rendering, its pipeline and set bound.
+            unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) };
+        }
+    }
+    // SAFETY: inside the lighting's rendering.
     unsafe {
-        device.cmd_draw(cmd, 3, 1, 0, 0);
         device.cmd_end_rendering(cmd);
         if let Some(pool) = slot.lighting_queries {
             device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, 1);

@@ -13,6 +13,10 @@
 //!   reach; its diffuse with linear depth in the alpha where lucent's own frame has it)
 //!   against lucent's pass of the same name (the host's diffuse and
 //!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM).
+//! - **The SH environment** (`--technique none`, plain lighting, whose ambient term is what a
+//!   host inserts of it): lucent's ambient inside its lighting pass is the lighting pass with
+//!   the scene's environment minus the lighting pass with none, against the
+//!   `EnvironmentEffect`'s one pass over the whole screen.
 //! - **GDC 2011 translucency** (`--technique translucency`): lucent adds the term inside its
 //!   lighting pass, so its cost there is the lighting pass with translucency minus the
 //!   lighting pass without (`none`, a third frame in the rotation, lighting unmerged as
@@ -27,9 +31,10 @@ use ash::vk;
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{GpuContext, GpuImage, ImageDesc};
 use crate::embed::{
-    DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, GBufferDesc, HostCamera, HostDevice,
-    HostImage, IdDesc, ImageState, Lucent, NormalDesc, OptionalFeatures, SssEffect, SssEffectDesc,
-    SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
+    DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, EnvironmentEffect, EnvironmentEffectDesc,
+    EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
+    ImageState, Lucent, NormalDesc, OptionalFeatures, SssEffect, SssEffectDesc, SssFrame,
+    SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
     TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
 };
 use crate::features::registry;
@@ -136,16 +141,18 @@ pub fn embed_cost(
     let module = technique.module();
     let translucency =
         module.is_some_and(|m| m.name() == crate::features::translucency::TRANSLUCENCY.name());
+    // `none`, plain lighting: what a host inserts of it is the SH environment's light.
+    let environment = matches!(technique, Technique::None);
     let blur =
         module.and_then(|m| registry::sss_blurs().find(|b| b.name() == m.name() && !b.lean()));
-    if !translucency && blur.is_none() {
+    if !translucency && !environment && blur.is_none() {
         let blurs: Vec<&str> = registry::sss_blurs()
             .filter(|b| !b.lean())
             .map(|b| b.name())
             .collect();
         return Err(LucentError::InvalidInput(format!(
-            "--embed measures an effect a host can insert: --technique {} or translucency \
-             (not '{}')",
+            "--embed measures an effect a host can insert: --technique {}, translucency or \
+             none (the SH environment) (not '{}')",
             blurs.join(", "),
             technique.name()
         )));
@@ -165,12 +172,24 @@ pub fn embed_cost(
          alternating",
         if translucency {
             "TranslucencyEffect"
+        } else if environment {
+            "EnvironmentEffect"
         } else {
             "SssEffect"
         },
         technique.name()
     );
-    let rows = if translucency {
+    let rows = if environment {
+        measure_environment(
+            gpu,
+            shaders,
+            pipeline_cache,
+            &lucent,
+            scene,
+            (width, height),
+            (frames, warmup),
+        )
+    } else if translucency {
         measure_translucency(
             gpu,
             shaders,
@@ -584,7 +603,6 @@ fn measure_translucency(
         let mut effect = build(gpu, lucent, |u| {
             TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
         })?;
-        let mut timer = EffectTimer::new(lucent, 8)?;
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -611,68 +629,37 @@ fn measure_translucency(
             sampled,
         );
         let lighting = host_image(lighting, "host lighting", hdr, size, lighting_usage);
-        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
-        let mut run = || -> Result<()> {
-            for round in 0..warmup + frames {
-                let with_term = lit.render_once(gpu)?;
-                let without = plain.render_once(gpu)?;
-                host_frame(gpu, |cmd| {
-                    effect.record_timed(
-                        lucent,
-                        cmd,
-                        &TranslucencyFrame {
-                            slot: 0,
-                            view: 0,
-                            camera,
-                            lights: &scene.lights,
-                            images: TranslucencyImages {
-                                depth: &depth,
-                                normals: &normals,
-                                albedo: &albedo,
-                                thickness: &gb2_image,
-                                material_ids: &gb2_image,
-                            },
-                            regions: &regions,
-                            lighting: &lighting,
+        let rows = time_term(
+            gpu,
+            lucent,
+            (&lit, &plain),
+            ("translucency", "none"),
+            (frames, warmup),
+            |cmd, timer| {
+                effect.record_timed(
+                    lucent,
+                    cmd,
+                    &TranslucencyFrame {
+                        slot: 0,
+                        view: 0,
+                        camera,
+                        lights: &scene.lights,
+                        images: TranslucencyImages {
+                            depth: &depth,
+                            normals: &normals,
+                            albedo: &albedo,
+                            thickness: &gb2_image,
+                            material_ids: &gb2_image,
                         },
-                        &mut timer,
-                    )
-                })?;
-                if round < warmup {
-                    continue;
-                }
-                let lighting_ms = |frame: &crate::frame::FrameImages| {
-                    frame
-                        .timing
-                        .passes
-                        .iter()
-                        .find(|p| p.name == "lighting")
-                        .map(|p| p.ms)
-                };
-                if let (Some(a), Some(b)) = (lighting_ms(&with_term), lighting_ms(&without)) {
-                    ours.push("lighting (translucency)", a);
-                    ours.push("lighting (none)", b);
-                    ours.push("the term", a - b);
-                }
-                for pass in timer.results(lucent)?.unwrap_or_default() {
-                    theirs.push("the term", pass.ms);
-                    theirs.push(&pass.name, pass.ms);
-                }
-            }
-            Ok(())
-        };
-        let result = run();
-        timer.destroy(lucent);
+                        regions: &regions,
+                        lighting: &lighting,
+                    },
+                    timer,
+                )
+            },
+        );
         effect.destroy(lucent);
-        result?;
-        Ok(["lighting (none)", "lighting (translucency)", "the term"]
-            .iter()
-            .map(|name| EmbedCostRow {
-                pass: name.to_string(),
-                lucent_ms: ours.median(name),
-                host_ms: theirs.median(name),
-            })
-            .collect())
+        rows
     })();
     let idle = gpu.wait_idle();
     images.destroy(gpu);
@@ -680,6 +667,190 @@ fn measure_translucency(
     plain.destroy(gpu);
     idle?;
     measured
+}
+
+/// The SH environment: lucent's ambient term inside its lighting pass (the scene's lighting
+/// with its environment minus with none) against the `EnvironmentEffect`'s pass over the
+/// whole screen (every surface has the ambient), on a host G-buffer of lucent's own frame
+/// (D32, world RGBA16F normals, RGBA8 albedo, RGBA16F light with the albedo).
+fn measure_environment(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    lucent: &Lucent,
+    scene: &Scene,
+    (width, height): (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<Vec<EmbedCostRow>> {
+    let settings = || FrameSettings {
+        export_gbuffer: true,
+        ..crate::measure::scaling::settings(Technique::None, width, height)
+    };
+    let dark = Scene {
+        environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
+        ..scene.clone()
+    };
+    let lit = Renderer::new(gpu, shaders, pipeline_cache, scene, settings())?;
+    let plain = match Renderer::new(gpu, shaders, pipeline_cache, &dark, settings()) {
+        Ok(r) => r,
+        Err(e) => {
+            lit.destroy(gpu);
+            return Err(e);
+        }
+    };
+    let mut images = Images::default();
+    let measured = (|| {
+        lit.render_once(gpu)?;
+        let gb = lit.read_gbuffer(gpu)?;
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let size = (width, height);
+        let hdr = vk::Format::R16G16B16A16_SFLOAT;
+        let depth = images.upload(
+            gpu,
+            &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
+            bytemuck::cast_slice(&gb.depth).to_vec(),
+            "host depth",
+        )?;
+        let albedo = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, vk::Format::R8G8B8A8_UNORM, sampled),
+            rgba8(&gb.gb0),
+            "host albedo",
+        )?;
+        let normals = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, hdr, sampled),
+            rgba16f(&gb.gb1),
+            "host normals",
+        )?;
+        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let lighting = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, hdr, lighting_usage),
+            rgba16f(&gb.gb1),
+            "host lighting",
+        )?;
+        let gbuffer = GBufferDesc::new(
+            width,
+            height,
+            DepthDesc::device(vk::Format::D32_SFLOAT),
+            DiffuseDesc::with_albedo(hdr),
+        )
+        .with_albedo(vk::Format::R8G8B8A8_UNORM)
+        .with_normals(NormalDesc::world(hdr));
+        let mut effect = build(gpu, lucent, |u| {
+            EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(gbuffer))
+        })?;
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(width as f32 / height as f32),
+        );
+        let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
+        let albedo = host_image(
+            albedo,
+            "host albedo",
+            vk::Format::R8G8B8A8_UNORM,
+            size,
+            sampled,
+        );
+        let normals = host_image(normals, "host normals", hdr, size, sampled);
+        let lighting = host_image(lighting, "host lighting", hdr, size, lighting_usage);
+        let rows = time_term(
+            gpu,
+            lucent,
+            (&lit, &plain),
+            ("environment", "no environment"),
+            (frames, warmup),
+            |cmd, timer| {
+                effect.record_timed(
+                    lucent,
+                    cmd,
+                    &EnvironmentFrame {
+                        slot: 0,
+                        view: 0,
+                        camera,
+                        environment: &scene.environment,
+                        images: EnvironmentImages {
+                            depth: &depth,
+                            normals: &normals,
+                            albedo: Some(&albedo),
+                        },
+                        regions: &[],
+                        lighting: &lighting,
+                    },
+                    timer,
+                )
+            },
+        );
+        effect.destroy(lucent);
+        rows
+    })();
+    let idle = gpu.wait_idle();
+    images.destroy(gpu);
+    lit.destroy(gpu);
+    plain.destroy(gpu);
+    idle?;
+    measured
+}
+
+/// Times a lighting term lucent adds inside its lighting pass against the effect a host
+/// records for it: lucent's cost is the lighting pass of `lit` (with the term, labelled
+/// `labels.0`) minus that of `plain` (without it, `labels.1`), frame by frame; the host's is
+/// each pass `record` times (into the timer it is given, reset in its command buffer). The
+/// three frames alternate; `warmup` rounds are discarded, `frames` measured.
+fn time_term(
+    gpu: &GpuContext,
+    lucent: &Lucent,
+    (lit, plain): (&Renderer, &Renderer),
+    labels: (&str, &str),
+    (frames, warmup): (usize, usize),
+    mut record: impl FnMut(vk::CommandBuffer, &mut EffectTimer) -> Result<()>,
+) -> Result<Vec<EmbedCostRow>> {
+    let mut timer = EffectTimer::new(lucent, 8)?;
+    let (with_label, without_label) = (
+        format!("lighting ({})", labels.0),
+        format!("lighting ({})", labels.1),
+    );
+    let (mut ours, mut theirs) = (Samples::default(), Samples::default());
+    let mut run = || -> Result<()> {
+        for round in 0..warmup + frames {
+            let with_term = lit.render_once(gpu)?;
+            let without = plain.render_once(gpu)?;
+            host_frame(gpu, |cmd| record(cmd, &mut timer))?;
+            if round < warmup {
+                continue;
+            }
+            let lighting_ms = |frame: &crate::frame::FrameImages| {
+                frame
+                    .timing
+                    .passes
+                    .iter()
+                    .find(|p| p.name == "lighting")
+                    .map(|p| p.ms)
+            };
+            if let (Some(a), Some(b)) = (lighting_ms(&with_term), lighting_ms(&without)) {
+                ours.push(&with_label, a);
+                ours.push(&without_label, b);
+                ours.push("the term", a - b);
+            }
+            for pass in timer.results(lucent)?.unwrap_or_default() {
+                theirs.push("the term", pass.ms);
+                theirs.push(&pass.name, pass.ms);
+            }
+        }
+        Ok(())
+    };
+    let result = run();
+    timer.destroy(lucent);
+    result?;
+    Ok([without_label.as_str(), with_label.as_str(), "the term"]
+        .iter()
+        .map(|name| EmbedCostRow {
+            pass: name.to_string(),
+            lucent_ms: ours.median(name),
+            host_ms: theirs.median(name),
+        })
+        .collect())
 }
 
 /// The screen regions of the objects `pick` selects, widened by `reach` (the whole screen,

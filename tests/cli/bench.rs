@@ -333,3 +333,46 @@ fn the_gate_refuses_the_flags_it_sets_itself_naming_them() {
     let out = common::lucent(&["bench", "--gate", "--gate-baseline", "1"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
+    // The SH environment (--technique none), GDC 2011 translucency and an SSS blur, each
+    // as a host's effect against lucent's own frame: a table with both columns filled.
+    for (scene, technique, effect, row) in [
+        ("cubes", "none", "EnvironmentEffect", "| the term |"),
+        (
+            "cubes",
+            "translucency",
+            "TranslucencyEffect",
+            "| the term |",
+        ),
+        ("skin", "separable", "SssEffect", "| horizontal blur |"),
+    ] {
+        let text = run_bench(&format!(
+            "bench --validation --scene {scene} --technique {technique} --size 96x64 \
+             --frames 2 --warmup 1 --embed"
+        ));
+        assert!(
+            text.contains("The effect in a host's frame against lucent's own")
+                && text.contains(effect),
+            "{technique}: {text}"
+        );
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(row))
+            .unwrap_or_else(|| panic!("{technique}: no row {row}: {text}"));
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        assert!(
+            cells[2].parse::<f64>().is_ok() && cells[3].parse::<f64>().is_ok_and(|v| v > 0.0),
+            "{technique}: {line}"
+        );
+    }
+    let out = common::lucent(&common::words(
+        "bench --scene skin --technique lcb --size 96x64 --frames 2 --embed",
+    ));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("translucency or none (the SH environment)"),
+        "{stderr}"
+    );
+}

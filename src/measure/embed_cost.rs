@@ -487,32 +487,22 @@ fn measure_translucency(
     pipeline_cache: &PipelineCache,
     lucent: &Lucent,
     scene: &Scene,
-    (width, height): (u32, u32),
-    (frames, warmup): (usize, usize),
+    size: (u32, u32),
+    frames: (usize, usize),
 ) -> Result<Vec<EmbedCostRow>> {
     let with = Technique::Only(&crate::features::translucency::TRANSLUCENCY);
-    let settings = |technique| FrameSettings {
-        export_gbuffer: true,
-        ..crate::measure::scaling::settings(technique, width, height)
-    };
-    let lit = Renderer::new(gpu, shaders, pipeline_cache, scene, settings(with))?;
-    let plain = match Renderer::new(
+    let pair = RendererPair::new(
         gpu,
         shaders,
         pipeline_cache,
-        scene,
-        settings(Technique::None),
-    ) {
-        Ok(r) => r,
-        Err(e) => {
-            lit.destroy(gpu);
-            return Err(e);
-        }
-    };
+        (scene, with),
+        (scene, Technique::None),
+        size,
+    )?;
     let mut images = Images::default();
     let measured = (|| {
-        lit.render_once(gpu)?;
-        let gb = lit.read_gbuffer(gpu)?;
+        let (width, height) = size;
+        let (host, gb) = HostGBuffer::of(gpu, &pair.lit, &mut images, size)?;
         let gb2 = gb.gb2.clone().ok_or_else(|| {
             LucentError::InvalidInput(
                 "--embed with --technique translucency: the scene has no translucent material"
@@ -523,22 +513,6 @@ fn measure_translucency(
             crate::backend::format::format_info(f).is_some_and(|i| i.channels == 4)
         });
         let sampled = vk::ImageUsageFlags::SAMPLED;
-        let size = (width, height);
-        let depth = images.upload(
-            gpu,
-            &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
-            bytemuck::cast_slice(&gb.depth).to_vec(),
-            "host depth",
-        )?;
-        let rgba8_desc = ImageDesc::color(width, height, vk::Format::R8G8B8A8_UNORM, sampled);
-        let albedo = images.upload(gpu, &rgba8_desc, rgba8(&gb.gb0), "host albedo")?;
-        let hdr = vk::Format::R16G16B16A16_SFLOAT;
-        let normals = images.upload(
-            gpu,
-            &ImageDesc::color(width, height, hdr, sampled),
-            rgba16f(&gb.gb1),
-            "host normals",
-        )?;
         // lucent's own GB2 layout: thickness and the ID in one RGBA8 (or RG8) target.
         let (gb2_format, thickness_desc, id_desc, gb2_bytes) = if coloured {
             (
@@ -565,23 +539,11 @@ fn measure_translucency(
             gb2_bytes,
             "host thickness and IDs",
         )?;
-        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
-        let lighting = images.upload(
-            gpu,
-            &ImageDesc::color(width, height, hdr, lighting_usage),
-            rgba16f(&gb.gb1),
-            "host lighting",
-        )?;
-        let gbuffer = GBufferDesc::new(
-            width,
-            height,
-            DepthDesc::device(vk::Format::D32_SFLOAT),
-            DiffuseDesc::with_albedo(hdr),
-        )
-        .with_albedo(vk::Format::R8G8B8A8_UNORM)
-        .with_normals(NormalDesc::world(hdr))
-        .with_thickness(thickness_desc)
-        .with_material_ids(id_desc);
+        let gbuffer = host
+            .desc
+            .clone()
+            .with_thickness(thickness_desc)
+            .with_material_ids(id_desc);
         let table = crate::features::translucency::MaterialTable::new(scene, true)?;
         let parameters: Vec<&crate::scene::material::Translucency> = scene
             .objects
@@ -612,15 +574,6 @@ fn measure_translucency(
         let regions = object_regions(scene, &camera, (width, height), 0.0, |o| {
             o.material.translucency_under(true).is_some()
         });
-        let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
-        let albedo = host_image(
-            albedo,
-            "host albedo",
-            vk::Format::R8G8B8A8_UNORM,
-            size,
-            sampled,
-        );
-        let normals = host_image(normals, "host normals", hdr, size, sampled);
         let gb2_image = host_image(
             gb2_image,
             "host thickness and IDs",
@@ -628,13 +581,12 @@ fn measure_translucency(
             size,
             sampled,
         );
-        let lighting = host_image(lighting, "host lighting", hdr, size, lighting_usage);
         let rows = time_term(
             gpu,
             lucent,
-            (&lit, &plain),
+            (&pair.lit, &pair.plain),
             ("translucency", "none"),
-            (frames, warmup),
+            frames,
             |cmd, timer| {
                 effect.record_timed(
                     lucent,
@@ -645,14 +597,14 @@ fn measure_translucency(
                         camera,
                         lights: &scene.lights,
                         images: TranslucencyImages {
-                            depth: &depth,
-                            normals: &normals,
-                            albedo: &albedo,
+                            depth: &host.depth,
+                            normals: &host.normals,
+                            albedo: &host.albedo,
                             thickness: &gb2_image,
                             material_ids: &gb2_image,
                         },
                         regions: &regions,
-                        lighting: &lighting,
+                        lighting: &host.lighting,
                     },
                     timer,
                 )
@@ -661,12 +613,7 @@ fn measure_translucency(
         effect.destroy(lucent);
         rows
     })();
-    let idle = gpu.wait_idle();
-    images.destroy(gpu);
-    lit.destroy(gpu);
-    plain.destroy(gpu);
-    idle?;
-    measured
+    pair.finish(gpu, images, measured)
 }
 
 /// The SH environment: lucent's ambient term inside its lighting pass (the scene's lighting
@@ -679,32 +626,133 @@ fn measure_environment(
     pipeline_cache: &PipelineCache,
     lucent: &Lucent,
     scene: &Scene,
-    (width, height): (u32, u32),
-    (frames, warmup): (usize, usize),
+    size: (u32, u32),
+    frames: (usize, usize),
 ) -> Result<Vec<EmbedCostRow>> {
-    let settings = || FrameSettings {
-        export_gbuffer: true,
-        ..crate::measure::scaling::settings(Technique::None, width, height)
-    };
     let dark = Scene {
         environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
         ..scene.clone()
     };
-    let lit = Renderer::new(gpu, shaders, pipeline_cache, scene, settings())?;
-    let plain = match Renderer::new(gpu, shaders, pipeline_cache, &dark, settings()) {
-        Ok(r) => r,
-        Err(e) => {
-            lit.destroy(gpu);
-            return Err(e);
-        }
-    };
+    let pair = RendererPair::new(
+        gpu,
+        shaders,
+        pipeline_cache,
+        (scene, Technique::None),
+        (&dark, Technique::None),
+        size,
+    )?;
     let mut images = Images::default();
     let measured = (|| {
-        lit.render_once(gpu)?;
-        let gb = lit.read_gbuffer(gpu)?;
+        let (host, _) = HostGBuffer::of(gpu, &pair.lit, &mut images, size)?;
+        let mut effect = build(gpu, lucent, |u| {
+            EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(host.desc.clone()))
+        })?;
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(size.0 as f32 / size.1 as f32),
+        );
+        let rows = time_term(
+            gpu,
+            lucent,
+            (&pair.lit, &pair.plain),
+            ("environment", "no environment"),
+            frames,
+            |cmd, timer| {
+                effect.record_timed(
+                    lucent,
+                    cmd,
+                    &EnvironmentFrame {
+                        slot: 0,
+                        view: 0,
+                        camera,
+                        environment: &scene.environment,
+                        images: EnvironmentImages {
+                            depth: &host.depth,
+                            normals: &host.normals,
+                            albedo: Some(&host.albedo),
+                        },
+                        regions: &[],
+                        lighting: &host.lighting,
+                    },
+                    timer,
+                )
+            },
+        );
+        effect.destroy(lucent);
+        rows
+    })();
+    pair.finish(gpu, images, measured)
+}
+
+/// lucent's frame of a scene with a lighting term (`lit`) and without (`plain`), each
+/// exporting its G-buffer, destroyed together.
+struct RendererPair {
+    lit: Renderer,
+    plain: Renderer,
+}
+
+impl RendererPair {
+    fn new(
+        gpu: &GpuContext,
+        shaders: &ShaderCompiler,
+        pipeline_cache: &PipelineCache,
+        lit: (&Scene, Technique),
+        plain: (&Scene, Technique),
+        (width, height): (u32, u32),
+    ) -> Result<Self> {
+        let make = |(scene, technique): (&Scene, Technique)| {
+            let settings = FrameSettings {
+                export_gbuffer: true,
+                ..crate::measure::scaling::settings(technique, width, height)
+            };
+            Renderer::new(gpu, shaders, pipeline_cache, scene, settings)
+        };
+        let lit = make(lit)?;
+        match make(plain) {
+            Ok(plain) => Ok(Self { lit, plain }),
+            Err(e) => {
+                lit.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+
+    /// Waits for the GPU, destroys the renderers and `images`, and returns `measured`.
+    fn finish<T>(self, gpu: &GpuContext, images: Images, measured: Result<T>) -> Result<T> {
+        let idle = gpu.wait_idle();
+        images.destroy(gpu);
+        self.lit.destroy(gpu);
+        self.plain.destroy(gpu);
+        idle?;
+        measured
+    }
+}
+
+/// A host G-buffer made from lucent's own frame: depth (D32), albedo (RGBA8), world normals
+/// and the lit light (RGBA16F, the albedo in it), described and ready to bind.
+struct HostGBuffer {
+    desc: GBufferDesc,
+    depth: HostImage,
+    albedo: HostImage,
+    normals: HostImage,
+    lighting: HostImage,
+}
+
+impl HostGBuffer {
+    /// Renders `renderer` once and uploads its G-buffer into `images` as a host's; returns it
+    /// with lucent's G-buffer as read back.
+    fn of(
+        gpu: &GpuContext,
+        renderer: &Renderer,
+        images: &mut Images,
+        size: (u32, u32),
+    ) -> Result<(Self, crate::frame::GBufferReadback)> {
+        let (width, height) = size;
+        renderer.render_once(gpu)?;
+        let gb = renderer.read_gbuffer(gpu)?;
         let sampled = vk::ImageUsageFlags::SAMPLED;
-        let size = (width, height);
         let hdr = vk::Format::R16G16B16A16_SFLOAT;
+        let rgba8_format = vk::Format::R8G8B8A8_UNORM;
         let depth = images.upload(
             gpu,
             &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
@@ -713,7 +761,7 @@ fn measure_environment(
         )?;
         let albedo = images.upload(
             gpu,
-            &ImageDesc::color(width, height, vk::Format::R8G8B8A8_UNORM, sampled),
+            &ImageDesc::color(width, height, rgba8_format, sampled),
             rgba8(&gb.gb0),
             "host albedo",
         )?;
@@ -730,67 +778,23 @@ fn measure_environment(
             rgba16f(&gb.gb1),
             "host lighting",
         )?;
-        let gbuffer = GBufferDesc::new(
+        let desc = GBufferDesc::new(
             width,
             height,
             DepthDesc::device(vk::Format::D32_SFLOAT),
             DiffuseDesc::with_albedo(hdr),
         )
-        .with_albedo(vk::Format::R8G8B8A8_UNORM)
+        .with_albedo(rgba8_format)
         .with_normals(NormalDesc::world(hdr));
-        let mut effect = build(gpu, lucent, |u| {
-            EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(gbuffer))
-        })?;
-        let camera = HostCamera::new(
-            scene.camera.view(),
-            scene.camera.projection(width as f32 / height as f32),
-        );
-        let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
-        let albedo = host_image(
-            albedo,
-            "host albedo",
-            vk::Format::R8G8B8A8_UNORM,
-            size,
-            sampled,
-        );
-        let normals = host_image(normals, "host normals", hdr, size, sampled);
-        let lighting = host_image(lighting, "host lighting", hdr, size, lighting_usage);
-        let rows = time_term(
-            gpu,
-            lucent,
-            (&lit, &plain),
-            ("environment", "no environment"),
-            (frames, warmup),
-            |cmd, timer| {
-                effect.record_timed(
-                    lucent,
-                    cmd,
-                    &EnvironmentFrame {
-                        slot: 0,
-                        view: 0,
-                        camera,
-                        environment: &scene.environment,
-                        images: EnvironmentImages {
-                            depth: &depth,
-                            normals: &normals,
-                            albedo: Some(&albedo),
-                        },
-                        regions: &[],
-                        lighting: &lighting,
-                    },
-                    timer,
-                )
-            },
-        );
-        effect.destroy(lucent);
-        rows
-    })();
-    let idle = gpu.wait_idle();
-    images.destroy(gpu);
-    lit.destroy(gpu);
-    plain.destroy(gpu);
-    idle?;
-    measured
+        let host = Self {
+            desc,
+            depth: host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled),
+            albedo: host_image(albedo, "host albedo", rgba8_format, size, sampled),
+            normals: host_image(normals, "host normals", hdr, size, sampled),
+            lighting: host_image(lighting, "host lighting", hdr, size, lighting_usage),
+        };
+        Ok((host, gb))
+    }
 }
 
 /// Times a lighting term lucent adds inside its lighting pass against the effect a host

@@ -16,8 +16,8 @@ pub enum Effect {
     /// GDC 2011 thickness-based translucency added to the host's light
     /// ([`super::TranslucencyEffect`]).
     Translucency,
-    /// Screen-space SSS's transmission through thin parts (a medium's diffusion through the
-    /// thickness lucent's light-space maps measure).
+    /// Screen-space SSS's transmission through thin parts: a medium's diffusion through the
+    /// thickness the host's shadow maps measure ([`super::TransmissionEffect`]).
     SssTransmission,
     /// Li et al.'s multi-layer single + dipole multiple scattering.
     LayeredMedia,
@@ -100,18 +100,12 @@ pub fn capabilities(gbuffer: &GBufferDesc) -> Result<Vec<(Effect, Support)>> {
 pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
     let lacks = missing(effect, gbuffer);
     match effect {
-        Effect::Sss | Effect::Translucency | Effect::Environment if lacks.is_empty() => {
-            Support::Runs
-        }
-        Effect::Sss | Effect::Translucency | Effect::Environment => Support::Lacks(lacks),
-        Effect::SssTransmission => Support::NotEmbedded(
-            "the thickness along each light's direction, which lucent measures in its own \
-             light-space maps of the scene's meshes",
-        ),
         Effect::LayeredMedia => Support::NotEmbedded(
             "light-space depth maps of each layered object drawn from the host's vertex and \
              index buffers",
         ),
+        _ if lacks.is_empty() => Support::Runs,
+        _ => Support::Lacks(lacks),
     }
 }
 
@@ -188,7 +182,31 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                 ));
             }
         }
-        Effect::SssTransmission | Effect::LayeredMedia => {}
+        Effect::SssTransmission => {
+            if gbuffer.material_ids.is_none() {
+                out.push(lack(
+                    "material IDs",
+                    "SSS transmission picks each pixel's medium by its material ID \
+                     (GBufferDesc::with_material_ids)",
+                ));
+            }
+            if gbuffer.normals.is_none() {
+                out.push(lack(
+                    "normals",
+                    "SSS transmission moves each point inside along its normal and lets light \
+                     through the back-facing cosine (GBufferDesc::with_normals)",
+                ));
+            }
+            if gbuffer.diffuse.albedo == DiffuseAlbedo::Included && gbuffer.albedo.is_none() {
+                out.push(lack(
+                    "albedo",
+                    "the host's diffuse light has the albedo multiplied in, so the \
+                     transmitted light needs it too (GBufferDesc::with_albedo, or \
+                     DiffuseDesc::without_albedo)",
+                ));
+            }
+        }
+        Effect::LayeredMedia => {}
     }
     out
 }
@@ -225,6 +243,11 @@ mod tests {
             .collect();
         assert_eq!(inputs, ["material IDs", "normals", "albedo", "thickness"]);
         assert!(matches!(support[3].1, Support::NotEmbedded(_)));
+        // SSS transmission: IDs, normals and (the albedo in the light) the albedo.
+        let Support::Lacks(transmission) = &support[2].1 else {
+            panic!("{:?}", support[2])
+        };
+        assert_eq!(transmission.len(), 3);
         // The environment: normals and, with the albedo in the diffuse light, the albedo.
         let Support::Lacks(environment) = &support[4].1 else {
             panic!("{:?}", support[4])
@@ -243,7 +266,7 @@ mod tests {
             .with_albedo(vk::Format::R8G8B8A8_SRGB)
             .with_thickness(ThicknessDesc::channel(vk::Format::R8_UNORM, 0));
         let support = capabilities(&full).unwrap();
-        assert!(support[0].1.runs() && support[1].1.runs() && support[4].1.runs());
+        assert!(support.iter().filter(|(_, s)| s.runs()).count() == 4);
         // An invalid description is its own error, not a list.
         assert!(capabilities(&full.with_metres_per_unit(-1.0)).is_err());
     }

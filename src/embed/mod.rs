@@ -163,6 +163,7 @@ mod scene;
 mod sss;
 mod timing;
 mod translucency;
+mod transmission;
 mod uploads;
 
 pub use capabilities::{capabilities, Effect, Support};
@@ -184,12 +185,17 @@ pub use translucency::{
     bake_thickness, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
     TranslucencyImages, TranslucentMaterial,
 };
+pub(crate) use transmission::shader_permutations as transmission_permutations;
+pub use transmission::{
+    ShadowFace, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
+    TransmissionMaterial,
+};
 pub use uploads::{leaked, Uploads};
 // The types a host names in its descriptions, and the versions of the crates it must build its
 // handles with.
 pub use crate::error::{HostError, ImageFault};
 pub use crate::features::sss::SssKnobs;
-pub use crate::scene::material::{PowMode, SssProfile, Texturing, Translucency};
+pub use crate::scene::material::{Medium, PowMode, SssProfile, Texturing, Translucency};
 pub use crate::scene::{Environment, Light, LightKind};
 pub use ash;
 pub use glam;

@@ -531,7 +531,7 @@ impl TranslucencyEffect {
 
 /// The host's lights: at most [`MAX_LIGHTS`], each finite, with a finite translucency scale
 /// and, for point and spot lights, a positive range (the shader divides by it).
-fn check_lights(lights: &[Light]) -> Result<()> {
+pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
     if lights.len() > MAX_LIGHTS {
         return Err(HostError::Description {
             field: "lights".into(),

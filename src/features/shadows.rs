@@ -184,10 +184,10 @@ impl ShadowDesc {
                 continue;
             }
             u.lights[i] = [face as i32, count as i32, 0, 0];
-            for (view_proj, texel) in light_faces(light.kind, center, radius, self.tile) {
+            for (view, proj, texel) in light_faces(light.kind, center, radius, self.tile) {
                 let (x, y) = self.tile_origin(face);
                 u.faces[face as usize] = ShadowFaceGpu {
-                    view_proj: view_proj.to_cols_array_2d(),
+                    view_proj: (proj * view).to_cols_array_2d(),
                     rect: [x as f32, y as f32, self.tile as f32, 0.0],
                     params: texel.to_array(),
                 };
@@ -195,6 +195,45 @@ impl ShadowDesc {
             }
         }
         u
+    }
+}
+
+/// One face of the atlas as a host describes its own shadow maps
+/// ([`crate::embed::ShadowFace`]): what tests hand an embedded effect to compare it with
+/// lucent's own frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceMatrices {
+    /// The light's index in the scene.
+    pub light: usize,
+    /// World to the face's view space.
+    pub view: Mat4,
+    /// The face's projection (standard Z).
+    pub projection: Mat4,
+    /// Its tile's top-left texel and edge in the atlas.
+    pub tile: (u32, u32, u32),
+}
+
+impl ShadowDesc {
+    /// Each casting light's faces in atlas order, with their matrices and tiles (what
+    /// [`Self::uniforms`] writes, before the matrices are multiplied).
+    pub fn face_matrices(&self, scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> Vec<FaceMatrices> {
+        let (center, radius) = world_sphere(scene, mesh_bounds);
+        let mut out = Vec::new();
+        for (i, (light, &count)) in scene.lights.iter().zip(&self.light_faces).enumerate() {
+            if count == 0 {
+                continue;
+            }
+            for (view, projection, _) in light_faces(light.kind, center, radius, self.tile) {
+                let (x, y) = self.tile_origin(out.len() as u32);
+                out.push(FaceMatrices {
+                    light: i,
+                    view,
+                    projection,
+                    tile: (x, y, self.tile),
+                });
+            }
+        }
+        out
     }
 }
 
@@ -275,8 +314,8 @@ fn world_sphere(scene: &Scene, mesh_bounds: &[(Vec3, Vec3)]) -> (Vec3, f32) {
     (center, ((hi - lo).length() * 0.5).max(1e-3))
 }
 
-/// The view-projection and texel-size parameters of each face of a light.
-fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Mat4, Vec4)> {
+/// The view and projection matrices and texel-size parameters of each face of a light.
+fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Mat4, Mat4, Vec4)> {
     let tile = tile as f32;
     // Perspective faces: far at the light's range or the scene's farthest point from the
     // light, whichever is nearer, and near at 1/200 of that, which keeps fp32 depth resolution
@@ -292,7 +331,8 @@ fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Ma
         let view = Mat4::look_to_rh(position, forward, up);
         let proj = Mat4::perspective_rh(fov, 1.0, near, far);
         (
-            proj * view,
+            view,
+            proj,
             Vec4::new(2.0 * (fov * 0.5).tan() / tile, 0.0, near, far),
         )
     };
@@ -312,7 +352,8 @@ fn light_faces(kind: LightKind, center: Vec3, radius: f32, tile: u32) -> Vec<(Ma
                 Mat4::orthographic_rh(-radius, radius, -radius, radius, radius, 3.0 * radius);
             // Negative near marks the orthographic face (depth is linear in distance).
             vec![(
-                proj * view,
+                view,
+                proj,
                 Vec4::new(0.0, 2.0 * radius / tile, -radius, 3.0 * radius),
             )]
         }
@@ -711,7 +752,7 @@ mod tests {
                 2
             };
             let face = axis * 2 + usize::from(d[axis] < 0.0);
-            let clip = faces[face].0 * (Vec3::new(0.5, 2.0, -1.0) + d).extend(1.0);
+            let clip = (faces[face].1 * faces[face].0) * (Vec3::new(0.5, 2.0, -1.0) + d).extend(1.0);
             let ndc = clip.truncate() / clip.w;
             assert!(clip.w > 0.0, "{d}");
             assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{d}: {ndc}");
@@ -728,7 +769,7 @@ mod tests {
         let (center, radius) = (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.1).length());
         for range in [10.0, 1000.0, 1e7] {
             let faces = light_faces(LightKind::Point { position, range }, center, radius, 512);
-            let plus_z = faces[4].0; // +Z: from the light towards the slab
+            let plus_z = faces[4].1 * faces[4].0; // +Z: from the light towards the slab
             for p in [Vec3::new(0.0, 0.0, -0.1), Vec3::new(0.0, 0.0, 0.1)] {
                 let clip = plus_z * p.extend(1.0);
                 let ndc = clip.truncate() / clip.w;
@@ -739,9 +780,9 @@ mod tests {
             }
             // Far follows the scene, not the range: depth precision is spent on what is there.
             assert!(
-                faces[4].1.w <= 1.1 * (1.0 + radius) + 1e-4,
+                faces[4].2.w <= 1.1 * (1.0 + radius) + 1e-4,
                 "range {range}: {}",
-                faces[4].1
+                faces[4].2
             );
         }
     }
@@ -763,7 +804,7 @@ mod tests {
             let (a, b) = bounds[object.mesh];
             for p in [a, b] {
                 let w = object.transform.transform_point3(p);
-                let clip = faces[0].0 * w.extend(1.0);
+                let clip = (faces[0].1 * faces[0].0) * w.extend(1.0);
                 let ndc = clip.truncate() / clip.w;
                 assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{ndc}");
                 assert!((0.0..=1.0).contains(&ndc.z), "{ndc}");

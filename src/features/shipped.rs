@@ -48,6 +48,8 @@ pub fn pipelines() -> Vec<PipelineShaders> {
     crate::embed::translucency_permutations(&mut out);
     // The SH environment on a host's G-buffer (lucent::embed::EnvironmentEffect).
     crate::embed::environment_permutations(&mut out);
+    // SSS transmission through a host's shadow maps (lucent::embed::TransmissionEffect).
+    crate::embed::transmission_permutations(&mut out);
     super::debug_view::shader_permutations(&mut out);
     super::tonemap::shader_permutations(&mut out);
     super::antialias::shader_permutations(&mut out);

@@ -52,6 +52,9 @@ pub struct FrameOutputs {
     /// The tonemapped image the anti-aliasing reads (sRGB RGBA8, luma in alpha), when
     /// exported (`export_ldr` in a frame with anti-aliasing).
     pub ldr: Option<ResourceId>,
+    /// The light-space maps' depth atlas, when exported (`export_shadows` in a frame with
+    /// them).
+    pub shadows: Option<ResourceId>,
 }
 
 /// Declares every pass of a frame. `scene_gpu` is `None` for plan-only graphs.
@@ -211,6 +214,13 @@ pub fn declare_frame(
             layout,
         }
     });
+    let shadows = shadow_maps
+        .as_ref()
+        .filter(|_| settings.export_shadows)
+        .map(|maps| {
+            graph.export_image(&maps.depth, Access::TransferRead);
+            maps.depth.id()
+        });
     FrameOutputs {
         display: display.id(),
         target: settings.target.is_some(),
@@ -218,6 +228,7 @@ pub fn declare_frame(
         lit: lit_ids,
         ldr: ldr_id,
         gbuffer,
+        shadows,
     }
 }
 

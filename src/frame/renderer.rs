@@ -409,6 +409,25 @@ impl Renderer {
         })
     }
 
+    /// Reads the light-space maps' depth atlas of the last frame: its width, height and
+    /// depths (needs `export_shadows` and a frame with light-space maps).
+    pub fn read_shadow_map(&self, gpu: &GpuContext) -> Result<(u32, u32, Vec<f32>)> {
+        let id = self.outputs.shadows.ok_or_else(|| {
+            LucentError::InvalidInput(
+                "the light-space maps are not exported in this frame (export_shadows, frames \
+                 with shadows)"
+                    .into(),
+            )
+        })?;
+        let info = self.executable.plan.resources[id].info;
+        let texels = decode_texels(&self.read_export(gpu, id)?, info.format)?;
+        Ok((
+            info.width,
+            info.height,
+            texels.into_iter().map(|t| t[0]).collect(),
+        ))
+    }
+
     /// Runs one frame in one command buffer and reads back everything it exports.
     pub fn render_once(&self, gpu: &GpuContext) -> Result<FrameImages> {
         let mut runner = FrameRunner::new(gpu, self.executable.plan.physical.len())?;

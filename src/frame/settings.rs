@@ -168,6 +168,9 @@ pub struct FrameSettings {
     /// Frames with anti-aliasing: also export the tonemapped image before it (sRGB-encoded,
     /// luma in alpha) for the CPU reference of the pass ([`crate::reference::fxaa`]).
     pub export_ldr: bool,
+    /// Frames with light-space maps: also export the depth atlas (what a host hands
+    /// [`crate::embed::TransmissionEffect`] as its shadow map; tests compare the two).
+    pub export_shadows: bool,
 }
 
 /// An image the caller renders into: its format, the state it is in when the frame starts
@@ -223,6 +226,7 @@ impl FrameSettings {
             layered: LayeredKnobs::default(),
             antialias: Antialias::Off,
             export_ldr: false,
+            export_shadows: false,
         }
     }
 

@@ -495,6 +495,7 @@ impl FrameArgs {
             },
             antialias: Antialias::parse(&self.aa)?,
             export_ldr: false,
+            export_shadows: false,
             layered: LayeredKnobs::default(),
         };
         for &(knob, value) in &self.knobs.given {

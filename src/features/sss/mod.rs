@@ -301,7 +301,7 @@ impl IdMap {
     }
 
     /// The profile table's `id_decode` and `id_profiles` rows.
-    fn rows(&self) -> ([u32; 4], [[u32; 4]; 16]) {
+    pub(crate) fn rows(&self) -> ([u32; 4], [[u32; 4]; 16]) {
         let mut profiles = [[0u32; 4]; 16];
         let mut put = |id: usize, profile: u8| {
             profiles[id / 16][(id / 4) % 4] |= u32::from(profile) << (8 * (id % 4));

@@ -1,0 +1,866 @@
+//! [`TransmissionEffect`]: screen-space SSS's transmission through thin parts (HDRP's "thick"
+//! mode, from a material's medium) added to a host's lit diffuse, measured through the host's
+//! own shadow maps.
+//!
+//! For each pixel whose material has a medium ([`TransmissionMaterial`]: lucent's
+//! `[material.medium]`), and each of the host's lights with a shadow map, the light that
+//! entered on the far side of the object diffuses through the thickness the map measures and
+//! leaves here: the same GLSL (`sss_transmitted` in `glsl/common/sss_transmission.glsl`) that
+//! lucent's own lighting pass adds, with its f64 twin in `src/reference/transmission.rs`. The
+//! thickness is the light's path through the object: from this pixel (moved one map texel
+//! inside) towards the light, to the first surface the map holds, bilinearly over the map's
+//! four texels around it. Recorded before an [`super::SssEffect`] on the same light, the blur
+//! spreads the transmitted light, as lucent's own frames do.
+//!
+//! The host describes the maps it already renders for its shadows ([`ShadowFace`]): one depth
+//! image (an atlas: each face a square rectangle of it), and per face its light, its view and
+//! projection matrices (standard Z: depth 0 at the near plane, 1 at the far; perspective or
+//! orthographic) and its rectangle, with which it rendered the map. A point light has six
+//! faces, +X, -X, +Y, -Y, +Z, -Z in that order (checked from their view matrices); a spot or
+//! directional light one. Lights without faces transmit nothing (nothing measures the
+//! thickness), as in lucent's own frames.
+//!
+//! The host's encodings reach one shader (`glsl/deferred/host_transmission.frag`) as
+//! permutations (unsigned or UNORM IDs; whether the albedo is read) and per-frame constants
+//! (the ID bit field and the ID-to-medium table, the normal encoding, the depth decode, the
+//! shadow table lucent's own light-space maps fill): no copy into lucent's layout.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use super::capabilities::{require, Effect};
+use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
+use super::image::{check_image, distinct_inputs, HostImage, Role};
+use super::passes::{check_views, EffectPasses};
+use super::regions::clipped;
+use super::{Lucent, Uploads};
+use crate::backend::access::Access;
+use crate::backend::format::{format_info, format_name, FormatKind};
+use crate::backend::shader::PipelineShaders;
+use crate::error::HostError;
+use crate::features::pass::FullscreenPass;
+use crate::features::shadows::{ShadowFaceGpu, ShadowUniforms, MAX_SHADOW_FACES};
+use crate::features::sss::transmission::{SssTransmission, MEDIUM_ROWS};
+use crate::features::sss::{IdMap, ProfileTableGpu, MAX_SSS_PROFILES};
+use crate::gpu_scene::{
+    projection_depth_decode, Region, SceneGpu, SceneUpload, TableRegion, FRAME,
+};
+use crate::graph::{ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
+use crate::scene::material::Medium;
+use crate::scene::{Light, LightKind};
+use crate::Result;
+
+/// The effect's fragment shader.
+const FRAGMENT: &str = "deferred/host_transmission.frag";
+
+/// One material of the host whose light diffuses through its thickness: its ID in the host's
+/// material ID image and its medium (lucent's `[material.medium]`,
+/// [`crate::scene::material::Medium::new`]). Its lengths are scaled by the G-buffer's
+/// [`GBufferDesc::metres_per_unit`], not by the medium's own `units_per_mm`.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct TransmissionMaterial {
+    /// The host's ID (1 to 255; 0 is taken to mean "no medium").
+    pub id: u8,
+    /// The medium.
+    pub medium: Medium,
+}
+
+impl TransmissionMaterial {
+    /// Material `id` with `medium`.
+    pub fn new(id: u8, medium: Medium) -> Self {
+        Self { id, medium }
+    }
+}
+
+/// What a [`TransmissionEffect`] is built for.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct TransmissionEffectDesc {
+    /// The host's G-buffer: it must describe its normals and material IDs, and its albedo
+    /// when its diffuse light has the albedo multiplied in.
+    pub gbuffer: GBufferDesc,
+    /// The materials with a medium (1 to 31 of them).
+    pub materials: Vec<TransmissionMaterial>,
+    /// The format of the host's shadow map (a depth format: `D32_SFLOAT`, `D16_UNORM`,
+    /// `D24_UNORM_S8_UINT`, `D32_SFLOAT_S8_UINT`, `X8_D24_UNORM_PACK32`).
+    pub shadow_format: vk::Format,
+    /// Views recorded per frame (1 to [`super::MAX_VIEWS_PER_FRAME`]).
+    pub views_per_frame: usize,
+}
+
+impl TransmissionEffectDesc {
+    /// The effect over `gbuffer` for `materials`, reading shadow maps of `shadow_format`, one
+    /// view a frame.
+    pub fn new(
+        gbuffer: GBufferDesc,
+        materials: Vec<TransmissionMaterial>,
+        shadow_format: vk::Format,
+    ) -> Self {
+        Self {
+            gbuffer,
+            materials,
+            shadow_format,
+            views_per_frame: 1,
+        }
+    }
+
+    /// With this many views per frame.
+    pub fn with_views_per_frame(mut self, views: usize) -> Self {
+        self.views_per_frame = views;
+        self
+    }
+}
+
+/// One face of a host's shadow map: the light it belongs to, the matrices the host rendered
+/// it with and where it lies in the shadow map image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ShadowFace {
+    /// Index of its light in [`TransmissionFrame::lights`].
+    pub light: usize,
+    /// World to the face's view space (looking down -z).
+    pub view: Mat4,
+    /// The face's view to clip space: standard Z (0 near, 1 far, finite planes), perspective
+    /// (a spot light's cone, a point light's 90-degree faces) or orthographic (a directional
+    /// light), either y convention.
+    pub projection: Mat4,
+    /// Its square rectangle in the shadow map image, in texels, which the host's viewport
+    /// covered when it rendered the face.
+    pub rect: vk::Rect2D,
+}
+
+impl ShadowFace {
+    /// Face `rect` of light `light`, rendered with `view` and `projection`.
+    pub fn new(light: usize, view: Mat4, projection: Mat4, rect: vk::Rect2D) -> Self {
+        Self {
+            light,
+            view,
+            projection,
+            rect,
+        }
+    }
+}
+
+/// The host's images for one view of one frame, each with its current and final state.
+#[derive(Clone, Copy, Debug)]
+pub struct TransmissionImages<'a> {
+    /// The depth image (a depth format's view of its depth aspect, or linear depth).
+    pub depth: &'a HostImage,
+    /// The normals.
+    pub normals: &'a HostImage,
+    /// The material IDs (for stencil bits: a view of the depth-stencil image's stencil
+    /// aspect).
+    pub material_ids: &'a HostImage,
+    /// The albedo: required when the description's diffuse light has the albedo multiplied
+    /// in, refused when it is kept apart.
+    pub albedo: Option<&'a HostImage>,
+    /// The shadow map holding every [`TransmissionFrame::shadow_faces`] face (a view of its
+    /// depth aspect, sampled).
+    pub shadow_map: &'a HostImage,
+}
+
+/// One view of one frame: what [`TransmissionEffect::record`] reads and adds to.
+#[derive(Clone, Copy, Debug)]
+pub struct TransmissionFrame<'a> {
+    /// The frame-in-flight slot (0 to the frames in flight of the [`Lucent`]).
+    pub slot: usize,
+    /// The view within the frame.
+    pub view: usize,
+    /// The camera the G-buffer was rendered with.
+    pub camera: HostCamera,
+    /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
+    pub lights: &'a [Light],
+    /// The faces of the lights' shadow maps this frame (at most [`MAX_SHADOW_FACES`]), each
+    /// light's together and in order.
+    pub shadow_faces: &'a [ShadowFace],
+    /// The images.
+    pub images: TransmissionImages<'a>,
+    /// Screen rectangles the materials with a medium may cover this frame; empty: the whole
+    /// screen. Clipped to the G-buffer.
+    pub regions: &'a [vk::Rect2D],
+    /// The host's lit diffuse light, which the transmitted light is added to (a colour
+    /// attachment of the description's diffuse format that can be blended; its contents are
+    /// kept, so it cannot come in UNDEFINED).
+    pub lighting: &'a HostImage,
+}
+
+/// The effect's per-frame constants (glsl/deferred/host_transmission.frag
+/// `HostTransmission`, std140).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct HostTransmissionGpu {
+    normals: [u32; 4],
+    depth: [u32; 4],
+    view_to_world: [[f32; 4]; 4],
+}
+
+/// The effect's constants, its profile table (the media) and its shadow table in the
+/// per-frame buffer.
+static HOST_TRANSMISSION: Region = Region::new("host transmission decode");
+static MEDIA: Region = Region::new("host transmission media");
+static SHADOWS: Region = Region::new("host shadow maps' table");
+
+/// The graph's imports, by input.
+#[derive(Clone, Copy, Debug)]
+struct Imports {
+    depth: ResourceId,
+    normals: ResourceId,
+    material_ids: ResourceId,
+    albedo: Option<ResourceId>,
+    shadow_map: ResourceId,
+    lighting: ResourceId,
+}
+
+/// Screen-space SSS's transmission on a host's G-buffer (see the module docs).
+pub struct TransmissionEffect {
+    passes: EffectPasses,
+    imports: Imports,
+    desc: TransmissionEffectDesc,
+    /// The normal decode every frame shares; each frame adds its view.
+    normals: [u32; 4],
+}
+
+/// The shader defines of a host's ID image (unsigned or UNORM) and whether the albedo is read.
+fn defines(uint_ids: bool, albedo: bool) -> &'static [(&'static str, &'static str)] {
+    match (uint_ids, albedo) {
+        (false, false) => &[],
+        (true, false) => &[("LUCENT_HOST_IDS_UINT", "1")],
+        (false, true) => &[("LUCENT_HOST_ALBEDO", "1")],
+        (true, true) => &[("LUCENT_HOST_ALBEDO", "1"), ("LUCENT_HOST_IDS_UINT", "1")],
+    }
+}
+
+/// Every pipeline the effect may build, for the shipped SPIR-V.
+pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
+    for uint in [false, true] {
+        for albedo in [false, true] {
+            out.push(PipelineShaders::fullscreen(FRAGMENT, defines(uint, albedo)));
+        }
+    }
+}
+
+impl TransmissionEffect {
+    /// Builds the effect for `desc`, checking all of it first. Its media table is written
+    /// into lucent's own host-visible per-frame buffer: nothing is recorded into `uploads`,
+    /// submitted or waited for (`uploads` is taken so that every effect is built alike).
+    pub fn new(
+        lucent: &Lucent,
+        uploads: &mut Uploads,
+        desc: TransmissionEffectDesc,
+    ) -> Result<Self> {
+        let gbuffer = &desc.gbuffer;
+        gbuffer.check()?;
+        require(Effect::SssTransmission, gbuffer)?;
+        let (Some(ids), Some(normals)) = (gbuffer.material_ids, gbuffer.normals) else {
+            unreachable!("missing() lists each input the effect reads");
+        };
+        check_views(desc.views_per_frame)?;
+        let is_depth = format_info(desc.shadow_format).is_some_and(|f| f.kind == FormatKind::Depth);
+        if !is_depth {
+            return Err(HostError::Unsupported {
+                input: "shadow map".into(),
+                found: format!("format {}", format_name(desc.shadow_format)),
+                accepted: "a depth format (D32_SFLOAT, D16_UNORM, D24_UNORM_S8_UINT, \
+                           D32_SFLOAT_S8_UINT, X8_D24_UNORM_PACK32)"
+                    .into(),
+            }
+            .into());
+        }
+        if desc.materials.is_empty() || desc.materials.len() >= MAX_SSS_PROFILES {
+            return Err(HostError::Description {
+                field: "materials".into(),
+                problem: format!(
+                    "{} materials with a medium; 1 to {} are supported",
+                    desc.materials.len(),
+                    MAX_SSS_PROFILES - 1
+                ),
+            }
+            .into());
+        }
+        let mask = ids.decode(Vec::new())?.mask;
+        let mut profile_of = vec![0u8; 256];
+        let mut table: ProfileTableGpu = bytemuck::Zeroable::zeroed();
+        let mm_per_unit = 1000.0 * f64::from(gbuffer.metres_per_unit);
+        for (index, material) in desc.materials.iter().enumerate() {
+            let id = usize::from(material.id);
+            if id == 0 || profile_of[id] != 0 || u32::from(material.id) > mask {
+                return Err(HostError::Description {
+                    field: format!("materials[{index}] (ID {id})"),
+                    problem: "IDs are 1 to 255, each once, within the material ID image's bit \
+                              field"
+                        .into(),
+                }
+                .into());
+            }
+            let profile = index + 1;
+            profile_of[id] = profile as u8;
+            let transmission = SssTransmission {
+                mm_per_unit,
+                ..SssTransmission::of(&material.medium)
+            };
+            let rows = &mut table.medium[profile * MEDIUM_ROWS..];
+            rows[..4].copy_from_slice(&transmission.rows());
+            rows[4..MEDIUM_ROWS].copy_from_slice(&transmission.reflectance_rows());
+        }
+        let id_map = ids.decode(profile_of)?;
+        let uint_ids = id_map.uint;
+        (table.id_decode, table.id_profiles) = IdMap::Host(id_map).rows();
+        let normals = normals.decode()?;
+        let region = |region: &'static Region, bytes: usize| TableRegion {
+            region,
+            bytes: bytes as u64,
+        };
+        let upload = SceneUpload {
+            translucency_ids: None,
+            profile_ids: None,
+            normal_maps: false,
+            lean: false,
+            albedo_maps: false,
+            frames_in_flight: 1,
+            tables: vec![
+                region(&MEDIA, std::mem::size_of::<ProfileTableGpu>()),
+                region(
+                    &HOST_TRANSMISSION,
+                    std::mem::size_of::<HostTransmissionGpu>(),
+                ),
+                region(&SHADOWS, std::mem::size_of::<ShadowUniforms>()),
+            ],
+            layered_ids: None,
+            layer_depth_textures: 0,
+        };
+        let (passes, imports) = EffectPasses::new(
+            lucent,
+            uploads,
+            "TransmissionEffect",
+            upload,
+            desc.views_per_frame,
+            |scene_gpu| declare(&desc, uint_ids, scene_gpu),
+        )?;
+        let out = Self {
+            passes,
+            imports,
+            desc,
+            normals,
+        };
+        // The media do not change between frames: written once into every slot.
+        for slot in 0..out.passes.slots() {
+            let per_frame = out.passes.per_frame();
+            if let Err(e) = per_frame.write(slot, &MEDIA, bytemuck::bytes_of(&table)) {
+                out.destroy(lucent);
+                return Err(e);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The passes the effect records (its plan, for tables and tests).
+    pub fn plan(&self) -> &crate::graph::Plan {
+        self.passes.plan()
+    }
+
+    /// Records one view of one frame into `cmd` (recording, outside any render pass): the
+    /// light of `frame.lights` diffused through the thickness their shadow maps measure,
+    /// added to `frame.lighting`; every image then left in its final state. The frame last
+    /// recorded with the same slot and view must have completed. Everything is checked
+    /// before anything is recorded.
+    pub fn record(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &TransmissionFrame<'_>,
+    ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, None)
+    }
+
+    /// [`Self::record`] with a timestamp pair around the pass, written into `timer` (reset in
+    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
+    /// fence has signalled.
+    pub fn record_timed(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &TransmissionFrame<'_>,
+        timer: &mut super::EffectTimer,
+    ) -> Result<()> {
+        self.record_with(lucent, cmd, frame, Some(timer))
+    }
+
+    fn record_with(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &TransmissionFrame<'_>,
+        timer: Option<&mut super::EffectTimer>,
+    ) -> Result<()> {
+        let ring = self.passes.slot(frame.slot, frame.view)?;
+        super::translucency::check_lights(frame.lights)?;
+        let inputs = self.check_images(lucent, frame)?;
+        let shadows = shadow_table(
+            frame.lights,
+            frame.shadow_faces,
+            frame.images.shadow_map.extent,
+        )?;
+        let gbuffer = &self.desc.gbuffer;
+        let uniforms = gbuffer
+            .view_uniforms(&frame.camera)?
+            .with_lights(frame.lights);
+        let constants = HostTransmissionGpu {
+            normals: self.normals,
+            depth: [
+                u32::from(gbuffer.depth.encoding == DepthEncoding::LinearView),
+                0,
+                0,
+                0,
+            ],
+            view_to_world: frame.camera.view.inverse().to_cols_array_2d(),
+        };
+        let per_frame = self.passes.per_frame();
+        per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        per_frame.write(ring, &HOST_TRANSMISSION, bytemuck::bytes_of(&constants))?;
+        per_frame.write(ring, &SHADOWS, bytemuck::bytes_of(&shadows))?;
+        // The pass draws in the `lighting` tiles of the slot (none: the whole screen).
+        per_frame.tiles(ring).lighting = clipped(frame.regions, gbuffer.extent());
+        let images = &frame.images;
+        let mut binds = vec![
+            (self.imports.depth, images.depth),
+            (self.imports.normals, images.normals),
+            (self.imports.material_ids, images.material_ids),
+            (self.imports.shadow_map, images.shadow_map),
+            (self.imports.lighting, frame.lighting),
+        ];
+        if let (Some(id), Some(albedo)) = (self.imports.albedo, images.albedo) {
+            binds.push((id, albedo));
+        }
+        self.passes.record(
+            lucent,
+            cmd,
+            ring,
+            &binds,
+            &inputs,
+            (frame.lighting, Role::Accumulate),
+            timer,
+        )
+    }
+
+    /// Checks every image of `frame` against the description; returns the inputs, one per
+    /// distinct Vulkan image.
+    fn check_images<'a>(
+        &self,
+        lucent: &Lucent,
+        frame: &TransmissionFrame<'a>,
+    ) -> Result<Vec<&'a HostImage>> {
+        let gbuffer = &self.desc.gbuffer;
+        let images = &frame.images;
+        let ids = gbuffer.material_ids.expect("checked at new");
+        let depth_role = match gbuffer.depth.encoding {
+            DepthEncoding::Device => Role::SampledDepth,
+            DepthEncoding::LinearView => Role::SampledColor,
+        };
+        let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
+            Role::SampledDepth
+        } else {
+            Role::SampledColor
+        };
+        let albedo = match (self.imports.albedo.is_some(), images.albedo) {
+            (true, Some(albedo)) => Some(albedo),
+            (false, None) => None,
+            (true, None) => {
+                return Err(HostError::Missing {
+                    input: "albedo".into(),
+                    needed_by: "the transmitted light is multiplied by the albedo, as the \
+                                host's diffuse light has it (TransmissionImages::albedo)"
+                        .into(),
+                }
+                .into())
+            }
+            (false, Some(_)) => {
+                return Err(HostError::Description {
+                    field: "albedo".into(),
+                    problem: "given, but the description's diffuse light is kept without the \
+                              albedo, so the transmitted light is too: pass None"
+                        .into(),
+                }
+                .into())
+            }
+        };
+        let normal_format = gbuffer.normals.expect("checked at new").format;
+        let mut checks = vec![
+            (images.depth, "depth", depth_role, gbuffer.depth.format),
+            (images.normals, "normals", Role::SampledColor, normal_format),
+            (images.material_ids, "material IDs", id_role, ids.format),
+            (
+                frame.lighting,
+                "lighting",
+                Role::Accumulate,
+                gbuffer.diffuse.format,
+            ),
+        ];
+        if let Some(albedo) = albedo {
+            let format = gbuffer.albedo.expect("checked at new");
+            checks.push((albedo, "albedo", Role::SampledColor, format));
+        }
+        for (image, input, role, format) in checks {
+            check_image(
+                lucent.gpu(),
+                image,
+                input,
+                role,
+                gbuffer.extent(),
+                |f| f == format,
+                &format!("{} (the description's)", format_name(format)),
+            )?;
+        }
+        // The shadow map has a size of its own.
+        let shadow_format = self.desc.shadow_format;
+        check_image(
+            lucent.gpu(),
+            images.shadow_map,
+            "shadow map",
+            Role::SampledDepth,
+            images.shadow_map.extent,
+            |f| f == shadow_format,
+            &format!("{} (the description's)", format_name(shadow_format)),
+        )?;
+        distinct_inputs(
+            [
+                images.depth,
+                images.normals,
+                images.material_ids,
+                images.shadow_map,
+            ]
+            .into_iter()
+            .chain(albedo),
+            frame.lighting,
+        )
+    }
+
+    /// Destroys the pass and its buffers. The GPU must be done with every frame that
+    /// recorded it (the host's fences).
+    pub fn destroy(self, lucent: &Lucent) {
+        self.passes.destroy(lucent);
+    }
+}
+
+/// The unit axes a point light's six faces look along, in order.
+const CUBE_AXES: [Vec3; 6] = [
+    Vec3::X,
+    Vec3::NEG_X,
+    Vec3::Y,
+    Vec3::NEG_Y,
+    Vec3::Z,
+    Vec3::NEG_Z,
+];
+
+/// The shadow table (glsl/common/shadows.glsl `Shadows`, what lucent's own light-space maps
+/// fill) of the host's faces in a shadow map of `extent`, each checked: its light exists and
+/// has one face (six for a point light, in [`CUBE_AXES`] order, together), its matrices are
+/// finite with a standard-Z projection, its rectangle square and inside the map.
+fn shadow_table(
+    lights: &[Light],
+    faces: &[ShadowFace],
+    extent: vk::Extent2D,
+) -> Result<ShadowUniforms> {
+    let bad = |index: usize, problem: String| -> crate::LucentError {
+        HostError::Description {
+            field: format!("shadow_faces[{index}]"),
+            problem,
+        }
+        .into()
+    };
+    if faces.len() > MAX_SHADOW_FACES {
+        return Err(HostError::Description {
+            field: "shadow_faces".into(),
+            problem: format!("{} faces; at most {MAX_SHADOW_FACES}", faces.len()),
+        }
+        .into());
+    }
+    let mut table: ShadowUniforms = bytemuck::Zeroable::zeroed();
+    let (w, h) = (extent.width.max(1) as f32, extent.height.max(1) as f32);
+    table.atlas = [w, h, 1.0 / w, 1.0 / h];
+    for light in table.lights.iter_mut() {
+        *light = [-1, 0, 0, 0];
+    }
+    let mut index = 0;
+    while index < faces.len() {
+        let light = faces[index].light;
+        let Some(kind) = lights.get(light).map(|l| l.kind) else {
+            return Err(bad(
+                index,
+                format!("light {light}: the frame has {} lights", lights.len()),
+            ));
+        };
+        if table.lights[light][0] >= 0 {
+            return Err(bad(
+                index,
+                format!("light {light}'s faces must come together, once"),
+            ));
+        }
+        let count = match kind {
+            LightKind::Point { .. } => 6,
+            _ => 1,
+        };
+        if index + count > faces.len()
+            || faces[index..index + count].iter().any(|f| f.light != light)
+        {
+            return Err(bad(
+                index,
+                format!(
+                    "light {light} needs {count} face{} in a row ({})",
+                    if count == 1 { "" } else { "s" },
+                    if count == 6 {
+                        "a point light: +X, -X, +Y, -Y, +Z, -Z"
+                    } else {
+                        "a spot or directional light"
+                    }
+                ),
+            ));
+        }
+        table.lights[light] = [index as i32, count as i32, 0, 0];
+        for k in 0..count {
+            let face = &faces[index + k];
+            table.faces[index + k] =
+                face_row(face, extent).map_err(|problem| bad(index + k, problem))?;
+            if count == 6 {
+                // The face's view axis in the world: -z of its view space.
+                let forward = face
+                    .view
+                    .inverse()
+                    .transform_vector3(Vec3::NEG_Z)
+                    .normalize();
+                if forward.dot(CUBE_AXES[k]) < 0.999 {
+                    return Err(bad(
+                        index + k,
+                        format!(
+                            "face {k} of point light {light} looks along {forward}; the six \
+                             faces look along +X, -X, +Y, -Y, +Z, -Z in that order"
+                        ),
+                    ));
+                }
+            }
+        }
+        index += count;
+    }
+    Ok(table)
+}
+
+/// A face's row of the shadow table: its view-projection, rectangle and the parameters
+/// glsl/common/shadows.glsl reads (a map texel's world size at a point, near and far: see
+/// [`ShadowFaceGpu::params`]), or what is wrong with it.
+fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<ShadowFaceGpu, String> {
+    let (view, projection) = (face.view, face.projection);
+    if !(view.is_finite() && projection.is_finite()) || view.determinant().abs() < 1e-12 {
+        return Err("its view and projection must be finite, the view invertible".into());
+    }
+    let r = face.rect;
+    let inside = r.offset.x >= 0
+        && r.offset.y >= 0
+        && r.extent.width > 0
+        && u64::from(r.offset.x as u32) + u64::from(r.extent.width) <= u64::from(extent.width)
+        && u64::from(r.offset.y as u32) + u64::from(r.extent.height) <= u64::from(extent.height);
+    if !inside || r.extent.width != r.extent.height {
+        return Err(format!(
+            "its rectangle {r:?} must be square and inside the {}x{} shadow map",
+            extent.width, extent.height
+        ));
+    }
+    let edge = r.extent.width as f32;
+    let standard = || {
+        "a perspective or orthographic projection with standard Z (depth 0 at a \
+                       finite near plane, 1 at a finite far one)"
+            .to_string()
+    };
+    let k = projection_depth_decode(&projection).ok_or_else(standard)?;
+    let distance = |d: f32| {
+        let denominator = k[2] + k[3] * d;
+        (denominator > 1e-9 * k[2].abs().max(k[3].abs())).then(|| (k[0] + k[1] * d) / denominator)
+    };
+    let (Some(near), Some(far)) = (distance(0.0), distance(1.0)) else {
+        return Err(standard());
+    };
+    if !(near > 0.0 && far > near && far.is_finite()) {
+        return Err(standard());
+    }
+    let scale = projection.y_axis.y.abs();
+    if scale.is_nan() || scale <= 0.0 {
+        return Err(standard());
+    }
+    let orthographic = projection.w_axis.w != 0.0;
+    // A map texel's world size at a point: x * clip.w + y (glsl map_texel_size).
+    let texel = 2.0 / (scale * edge);
+    let params = if orthographic {
+        [0.0, texel, -near, far]
+    } else {
+        [texel, 0.0, near, far]
+    };
+    Ok(ShadowFaceGpu {
+        view_proj: (projection * view).to_cols_array_2d(),
+        rect: [r.offset.x as f32, r.offset.y as f32, edge, 0.0],
+        params,
+    })
+}
+
+/// The effect's graph: the host's images imported (bound when each frame records) and one
+/// fullscreen pass adding the transmitted light to the host's.
+fn declare(
+    desc: &TransmissionEffectDesc,
+    uint_ids: bool,
+    scene_gpu: &Arc<SceneGpu>,
+) -> (RenderGraph, Imports) {
+    let gbuffer = &desc.gbuffer;
+    let reads_albedo = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
+    let mut graph = RenderGraph::new();
+    let mut import = |name: &str, format: vk::Format, initial: Access| {
+        graph.import_image(
+            name,
+            ImageInfo {
+                width: gbuffer.width,
+                height: gbuffer.height,
+                format,
+            },
+            ImportedImage {
+                image: vk::Image::null(),
+                view: vk::ImageView::null(),
+                initial,
+            },
+        )
+    };
+    let sampled = Access::FragmentSampledRead;
+    let shadow_map = import("host shadow map", desc.shadow_format, sampled);
+    let depth = import("host depth", gbuffer.depth.format, sampled);
+    let normal_format = gbuffer.normals.expect("checked at new").format;
+    let normals = import("host normals", normal_format, sampled);
+    let ids_format = gbuffer.material_ids.expect("checked at new").format;
+    let material_ids = import("host material IDs", ids_format, sampled);
+    let albedo = reads_albedo.then(|| {
+        import(
+            "host albedo",
+            gbuffer.albedo.expect("checked at new"),
+            sampled,
+        )
+    });
+    let mut lighting = import(
+        "host lighting",
+        gbuffer.diffuse.format,
+        Access::ColorAttachmentWrite,
+    );
+    let imports = Imports {
+        depth: depth.id(),
+        normals: normals.id(),
+        material_ids: material_ids.id(),
+        albedo: albedo.as_ref().map(|a| a.id()),
+        shadow_map: shadow_map.id(),
+        lighting: lighting.id(),
+    };
+    let mut pass = FullscreenPass::new(&mut graph, "host transmission", FRAGMENT, Some(scene_gpu));
+    // Bindings in the shader's order: the frame (0), the media (1), the decode (2), the
+    // shadow table (3) and map (4, glsl/common/shadows.glsl's LUCENT_SHADOW_BINDING + 1),
+    // then the G-buffer.
+    pass.per_frame(&FRAME)
+        .per_frame(&MEDIA)
+        .per_frame(&HOST_TRANSMISSION)
+        .per_frame(&SHADOWS)
+        .sample(&shadow_map)
+        .sample(&depth)
+        .sample(&normals)
+        .sample(&material_ids);
+    if let Some(albedo) = &albedo {
+        pass.sample(albedo);
+    }
+    pass.defines(defines(uint_ids, reads_albedo))
+        .tiles(|scene, ctx| {
+            let regions = &scene.per_frame.tiles(ctx.frame).lighting;
+            (!regions.is_empty()).then(|| regions.clone())
+        })
+        .color_add(&mut lighting, LoadOp::Load);
+    pass.finish();
+    graph.export_image(&lighting, Access::ColorAttachmentWrite);
+    (graph, imports)
+}
+
+// Effects move to a loader thread and back.
+const _: () = {
+    const fn send<T: Send>() {}
+    send::<TransmissionEffect>();
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rect(x: i32, y: i32, edge: u32) -> vk::Rect2D {
+        vk::Rect2D {
+            offset: vk::Offset2D { x, y },
+            extent: vk::Extent2D {
+                width: edge,
+                height: edge,
+            },
+        }
+    }
+
+    #[test]
+    fn a_spot_face_becomes_lucents_row_and_bad_faces_are_named() {
+        let extent = vk::Extent2D {
+            width: 512,
+            height: 256,
+        };
+        let view = Mat4::look_at_rh(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, Vec3::Z);
+        let projection = Mat4::perspective_rh(1.0, 1.0, 0.1, 20.0);
+        let spot = Light {
+            kind: LightKind::Spot {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                direction: Vec3::NEG_Y,
+                range: 10.0,
+                inner_degrees: 20.0,
+                outer_degrees: 30.0,
+            },
+            ..Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 1.0)
+        };
+        let face = ShadowFace::new(0, view, projection, rect(256, 0, 256));
+        let table = shadow_table(&[spot], &[face], extent).unwrap();
+        assert_eq!(table.lights[0], [0, 1, 0, 0]);
+        assert_eq!(table.lights[1][0], -1);
+        let row = table.faces[0];
+        assert_eq!(row.rect, [256.0, 0.0, 256.0, 0.0]);
+        assert!((row.params[2] - 0.1).abs() < 1e-4 && (row.params[3] - 20.0).abs() < 0.05);
+        // x = 2 tan(fov / 2) / edge.
+        assert!(
+            (row.params[0] - 2.0 * 0.5f32.tan() / 256.0).abs() < 1e-6,
+            "{row:?}"
+        );
+        for bad in [
+            ShadowFace::new(1, view, projection, rect(0, 0, 256)), // no such light
+            ShadowFace::new(0, view, projection, rect(300, 0, 256)), // outside the map
+            ShadowFace::new(0, view, projection, rect(-1, 0, 64)),
+            ShadowFace::new(
+                0,
+                view,
+                Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.1),
+                rect(0, 0, 64),
+            ),
+            ShadowFace::new(0, Mat4::ZERO, projection, rect(0, 0, 64)),
+        ] {
+            assert!(shadow_table(&[spot], &[bad], extent).is_err(), "{bad:?}");
+        }
+        // A point light needs its six faces, in order.
+        let point = Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 5.0);
+        let cube: Vec<ShadowFace> = CUBE_AXES
+            .iter()
+            .enumerate()
+            .map(|(k, &axis)| {
+                let up = if axis.y.abs() > 0.5 { Vec3::Z } else { Vec3::Y };
+                let view = Mat4::look_at_rh(Vec3::ZERO, axis, up);
+                let projection = Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.05, 5.0);
+                ShadowFace::new(0, view, projection, rect(64 * k as i32, 0, 64))
+            })
+            .collect();
+        let table = shadow_table(&[point], &cube, extent).unwrap();
+        assert_eq!(table.lights[0], [0, 6, 0, 0]);
+        let mut swapped = cube.clone();
+        swapped.swap(0, 1);
+        assert!(shadow_table(&[point], &swapped, extent).is_err());
+        assert!(shadow_table(&[point], &cube[..3], extent).is_err());
+    }
+}

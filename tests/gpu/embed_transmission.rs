@@ -1,0 +1,453 @@
+//! Screen-space SSS's transmission as an effect on a host's G-buffer
+//! (`lucent::embed::TransmissionEffect`) against lucent's own frame of the same scene: the
+//! host's lighting is lucent's lit diffuse (before the blur) without transmission, its
+//! shadow map lucent's own light-space atlas with each face's matrices as a host describes
+//! them, its G-buffer lucent's own re-encoded in host layouts (standard, reversed-Z infinite,
+//! D24S8 and linear depth; normals world or view space, xyz or octahedral, float or UNORM; IDs
+//! R8_UNORM, R8_UINT, stencil bits, bits of a packed target), and the effect must add what
+//! lucent's lighting pass adds: a point light's six faces, a spot light's and a directional
+//! light's one.
+
+use std::path::Path;
+
+use crate::common::{submit_back_to_back, TestGpu};
+use crate::embed::{
+    built, changed, compare_host_frame, described, fresh_view, host_error, host_id, host_layout,
+    options, tonemapped, wrap, HostDepth, HostIds,
+};
+use crate::embed_translucency::{normal_image, rgba8, HostNormals};
+
+use ash::vk;
+use lucent::backend::{GpuImage, ImageDesc};
+use lucent::embed::{
+    capabilities, DiffuseDesc, Effect, GBufferDesc, HostError, HostImage, IdDesc, ImageState,
+    NormalDesc, ShadowFace, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame,
+    TransmissionImages, TransmissionMaterial,
+};
+use lucent::features::registry;
+use lucent::features::shadows::ShadowDesc;
+use lucent::features::sss::SssProfiles;
+use lucent::frame::{FrameSettings, Renderer, Technique};
+use lucent::scene::material::Texturing;
+
+/// A thin slab of skin and a ball of marble (1 unit = 20 mm), lit from behind by a point
+/// light (six faces), a spot light and a directional light, all casting.
+fn scene() -> lucent::scene::Scene {
+    let source = r#"name = "host-transmission"
+ambient = [0.02, 0.02, 0.02]
+sky = [0.0, 0.0, 0.0]
+[camera]
+eye = [0.0, 0.4, 4.0]
+target = [0.0, 0.0, 0.0]
+fov_y_degrees = 40.0
+[[mesh]]
+name = "slab"
+generator = "cube"
+level = 3
+[[mesh]]
+name = "ball"
+generator = "icosphere"
+level = 3
+[[material]]
+name = "skin"
+specular = 0.0
+[material.medium]
+preset = "skin1"
+units_per_mm = 0.05
+[[material]]
+name = "marble"
+specular = 0.0
+[material.medium]
+preset = "marble"
+units_per_mm = 0.05
+[[object]]
+mesh = "slab"
+material = "skin"
+translate = [-0.7, 0.0, 0.0]
+scale = [0.6, 0.6, 0.08]
+[[object]]
+mesh = "ball"
+material = "marble"
+translate = [0.7, 0.0, 0.0]
+scale = [0.4, 0.4, 0.4]
+[[light]]
+type = "point"
+position = [-0.7, 0.1, -1.0]
+intensity = 12.0
+range = 100.0
+[[light]]
+type = "spot"
+position = [0.7, 0.3, -1.6]
+direction = [0.0, -0.15, 1.0]
+inner_degrees = 20.0
+outer_degrees = 30.0
+intensity = 30.0
+range = 100.0
+[[light]]
+type = "directional"
+direction = [0.3, -0.2, 1.0]
+intensity = 1.5
+"#;
+    lucent::scene::file::parse_scene(Path::new("host-transmission.toml"), source)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (200, 150);
+    let scene = scene();
+    let technique = Technique::parse("separable").unwrap();
+    let settings = |transmission: bool| {
+        let mut s = FrameSettings {
+            technique,
+            export_gbuffer: true,
+            export_lit: true,
+            export_shadows: true,
+            ..FrameSettings::new(w, h)
+        };
+        // The host's diffuse carries the whole albedo (profiles blurred as they are).
+        s.sss.texturing = Some(Texturing::Pre);
+        s.sss.transmission = transmission;
+        s
+    };
+    let render = |transmission: bool| {
+        let renderer = Renderer::new(
+            gpu,
+            &test.shaders,
+            &test.cache,
+            &scene,
+            settings(transmission),
+        )
+        .unwrap();
+        renderer.render_once(gpu).unwrap();
+        let gb = renderer.read_gbuffer(gpu).unwrap();
+        let lit = renderer.read_lit(gpu).unwrap();
+        let shadow_map = renderer.read_shadow_map(gpu).unwrap();
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        (gb, lit, shadow_map)
+    };
+    let (gb, with, (sw, sh, depths)) = render(true);
+    let (_, without, _) = render(false);
+    let exposure = f64::from(scene.exposure);
+    let flat = |t: &[[f32; 4]]| -> Vec<f32> { t.iter().flatten().copied().collect() };
+    let want = tonemapped(&flat(&with.diffuse), exposure);
+    let plain = tonemapped(&flat(&without.diffuse), exposure);
+    // The transmitted light must be visible, or the comparison below proves nothing.
+    let lit_through = want
+        .chunks_exact(4)
+        .zip(plain.chunks_exact(4))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(
+        lit_through * 50 > (w * h) as usize,
+        "transmission changes only {lit_through} pixels"
+    );
+    // lucent's profile numbers (the G-buffer's IDs) and each one's medium.
+    let ids: Vec<u8> = gb.sss.as_ref().unwrap().iter().map(|&v| v as u8).collect();
+    let profiles = SssProfiles::new(
+        &scene,
+        Some(registry::sss_blur("separable").unwrap()),
+        None,
+        Some(Texturing::Pre),
+        &registry::blur_of,
+    )
+    .unwrap()
+    .unwrap();
+    let medium_of = |k: u8| {
+        let object = profiles
+            .object_ids
+            .iter()
+            .position(|&id| id == k)
+            .expect("each profile is an object's");
+        scene.objects[object].material.medium.clone().unwrap()
+    };
+    let profile_count = ids.iter().copied().max().unwrap();
+    assert_eq!(profile_count, 2, "two media");
+    // The host's shadow map: lucent's atlas, each face with its matrices and tile.
+    let faces: Vec<ShadowFace> = ShadowDesc::new(&scene, &settings(true).shadows, false)
+        .unwrap()
+        .face_matrices(&scene, &lucent::gpu_scene::tiles::mesh_bounds(&scene))
+        .into_iter()
+        .map(|f| {
+            let (x, y, edge) = f.tile;
+            ShadowFace::new(
+                f.light,
+                f.view,
+                f.projection,
+                vk::Rect2D {
+                    offset: vk::Offset2D {
+                        x: x as i32,
+                        y: y as i32,
+                    },
+                    extent: vk::Extent2D {
+                        width: edge,
+                        height: edge,
+                    },
+                },
+            )
+        })
+        .collect();
+    assert_eq!(
+        faces.len(),
+        8,
+        "a point light's six faces, a spot's and a sun's"
+    );
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let shadow_map = gpu
+        .upload_image(
+            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+            &[bytemuck::cast_slice(&depths).to_vec()],
+            "host shadow map",
+        )
+        .unwrap();
+    let albedo = gpu
+        .upload_image(
+            &ImageDesc::color(w, h, vk::Format::R8G8B8A8_UNORM, usage),
+            &[rgba8(&gb.gb0)],
+            "host albedo",
+        )
+        .unwrap();
+    let mut report = Vec::new();
+    for (name, depth_kind, ids_kind, normals_kind) in [
+        (
+            "D32, world RGBA16F normals, R8_UNORM IDs",
+            HostDepth::Standard,
+            HostIds::Unorm,
+            HostNormals::WorldHalf,
+        ),
+        (
+            "reversed-Z infinite D32, view-space octahedral RG16 normals, R8_UINT IDs",
+            HostDepth::ReversedInfinite,
+            HostIds::Uint,
+            HostNormals::ViewOctahedralUnorm,
+        ),
+        (
+            "D24S8 with IDs in stencil bits 4-7, world RGBA16_UNORM normals",
+            HostDepth::D24Stencil,
+            HostIds::Stencil,
+            HostNormals::WorldUnorm,
+        ),
+        (
+            "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
+             normals",
+            HostDepth::Linear,
+            HostIds::AlphaBits,
+            HostNormals::WorldOctahedralFloat,
+        ),
+    ] {
+        let mut layout = host_layout(
+            &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
+        );
+        if depth_kind == HostDepth::ReversedInfinite {
+            // The same pixels as lucent's frame: its clip-space y convention.
+            let mut projection = layout.camera.projection;
+            projection.y_axis.y = -projection.y_axis.y;
+            layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
+        }
+        let (normals, normal_desc) =
+            normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
+        let desc = layout
+            .desc
+            .clone()
+            .with_normals(normal_desc)
+            .with_albedo(vk::Format::R8G8B8A8_UNORM);
+        assert!(capabilities(&desc).unwrap()[2].1.runs());
+        let materials: Vec<TransmissionMaterial> = (1..=profile_count)
+            .map(|k| TransmissionMaterial::new(host_id(ids_kind, k), medium_of(k)))
+            .collect();
+        let lucent = wrap(&test, options(3));
+        let mut effect = built(&test, &lucent, |u| {
+            TransmissionEffect::new(
+                &lucent,
+                u,
+                TransmissionEffectDesc::new(desc.clone(), materials, vk::Format::D32_SFLOAT),
+            )
+        })
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(effect.plan().passes.len(), 1, "one pass");
+        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let lightings: Vec<GpuImage> = (0..3)
+            .map(|_| {
+                gpu.upload_image(
+                    &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, lighting_usage),
+                    &[bytemuck::cast_slice(&without.diffuse).to_vec()],
+                    "host lighting",
+                )
+                .unwrap()
+            })
+            .collect();
+        let mut views = Vec::new();
+        submit_back_to_back(gpu, 3, |k, cmd| {
+            let depth_aspect = if depth_kind == HostDepth::Linear {
+                vk::ImageAspectFlags::COLOR
+            } else {
+                vk::ImageAspectFlags::DEPTH
+            };
+            // Views made anew every frame (a recreated view can reuse a handle value).
+            let depth_view = fresh_view(&test, layout.depth.image, desc.depth.format, depth_aspect);
+            views.push(depth_view);
+            let depth = HostImage::new(
+                "host depth",
+                layout.depth.image,
+                depth_view,
+                desc.depth.format,
+                desc.extent(),
+                usage,
+            )
+            .in_state(ImageState::fragment_sampled());
+            let normals = described(&normals, "host normals", usage);
+            let albedo = described(&albedo, "host albedo", usage);
+            let shadows = HostImage::new(
+                "host shadow map",
+                shadow_map.image,
+                shadow_map.view,
+                vk::Format::D32_SFLOAT,
+                vk::Extent2D {
+                    width: sw,
+                    height: sh,
+                },
+                usage,
+            )
+            .in_state(ImageState::fragment_sampled());
+            let ids = match (&layout.ids, layout.stencil_ids) {
+                (Some(image), _) => described(image, "host IDs", usage),
+                (None, Some(view)) => HostImage::new(
+                    "host stencil IDs",
+                    layout.depth.image,
+                    view,
+                    vk::Format::D24_UNORM_S8_UINT,
+                    desc.extent(),
+                    usage,
+                )
+                .in_state(ImageState::fragment_sampled()),
+                (None, None) => unreachable!(),
+            };
+            let lighting = described(&lightings[k], "host lighting", lighting_usage)
+                .then(ImageState::transfer_src());
+            effect
+                .record(
+                    &lucent,
+                    cmd,
+                    &TransmissionFrame {
+                        slot: k,
+                        view: 0,
+                        camera: layout.camera,
+                        lights: &scene.lights,
+                        shadow_faces: &faces,
+                        images: TransmissionImages {
+                            depth: &depth,
+                            normals: &normals,
+                            material_ids: &ids,
+                            albedo: Some(&albedo),
+                            shadow_map: &shadows,
+                        },
+                        regions: &[],
+                        lighting: &lighting,
+                    },
+                )
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        });
+        for view in views {
+            // SAFETY: the frames that used it completed (submit_back_to_back waited).
+            unsafe { gpu.device.destroy_image_view(view, None) };
+        }
+        for (k, lighting) in lightings.iter().enumerate() {
+            let bytes = gpu
+                .read_image(lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                .unwrap();
+            let have = tonemapped(bytemuck::cast_slice(&bytes), exposure);
+            // A position or normal the host encodes otherwise (reversed or linear depth,
+            // octahedral normals) moves the point the map is read from (one texel inside along
+            // the normal) by a hair: where that crosses to another map texel on a silhouette,
+            // the thickness jumps (measured: 2 channel values of 120,000, one pixel). At most
+            // 0.05% of the channel values may differ by more than 1/255.
+            report.push(compare_host_frame(
+                &want,
+                &have,
+                (w, h),
+                want.len() / 2000,
+                &format!("{name}, frame {k}"),
+                &format!("embed-transmission-{k}"),
+            ));
+        }
+        effect.destroy(&lucent);
+        drop(lucent);
+        for image in lightings.into_iter().chain([normals]) {
+            gpu.destroy_image(image);
+        }
+        layout.destroy(&test);
+    }
+    gpu.destroy_image(albedo);
+    gpu.destroy_image(shadow_map);
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
+#[test]
+fn a_transmission_description_missing_an_input_or_with_bad_faces_is_a_typed_error() {
+    let test = TestGpu::new();
+    let lucent = wrap(&test, options(2));
+    let gbuffer = GBufferDesc::new(
+        64,
+        48,
+        lucent::embed::DepthDesc::device(vk::Format::D32_SFLOAT),
+        DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+    )
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT))
+    .with_normals(NormalDesc::world(vk::Format::R16G16B16A16_SFLOAT))
+    .with_albedo(vk::Format::R8G8B8A8_UNORM);
+    let medium = scene().objects[0].material.medium.clone().unwrap();
+    let material = TransmissionMaterial::new(7, medium);
+    let build = |gbuffer: GBufferDesc, materials: Vec<TransmissionMaterial>, format| {
+        built(&test, &lucent, |u| {
+            TransmissionEffect::new(
+                &lucent,
+                u,
+                TransmissionEffectDesc::new(gbuffer, materials, format),
+            )
+        })
+    };
+    let d32 = vk::Format::D32_SFLOAT;
+    for (input, gbuffer) in [
+        ("material IDs", changed(&gbuffer, |g| g.material_ids = None)),
+        ("normals", changed(&gbuffer, |g| g.normals = None)),
+        ("albedo", changed(&gbuffer, |g| g.albedo = None)),
+    ] {
+        let e = host_error(build(gbuffer, vec![material.clone()], d32));
+        assert!(
+            matches!(&e, HostError::Missing { input: i, .. } if i == input),
+            "{input}: {e}"
+        );
+    }
+    assert!(
+        !capabilities(&changed(&gbuffer, |g| g.normals = None)).unwrap()[2]
+            .1
+            .runs()
+    );
+    assert_eq!(Effect::ALL[2], Effect::SssTransmission);
+    // A shadow map that is not a depth format; no material; an ID twice.
+    let e = host_error(build(
+        gbuffer.clone(),
+        vec![material.clone()],
+        vk::Format::R32_SFLOAT,
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "shadow map"),
+        "{e}"
+    );
+    for materials in [vec![], vec![material.clone(), material.clone()]] {
+        let e = host_error(build(gbuffer.clone(), materials, d32));
+        assert!(matches!(&e, HostError::Description { .. }), "{e}");
+    }
+    let effect = build(gbuffer, vec![material], d32).unwrap();
+    effect.destroy(&lucent);
+    drop(lucent);
+    test.finish();
+}

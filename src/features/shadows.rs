@@ -752,7 +752,8 @@ mod tests {
                 2
             };
             let face = axis * 2 + usize::from(d[axis] < 0.0);
-            let clip = (faces[face].1 * faces[face].0) * (Vec3::new(0.5, 2.0, -1.0) + d).extend(1.0);
+            let clip =
+                (faces[face].1 * faces[face].0) * (Vec3::new(0.5, 2.0, -1.0) + d).extend(1.0);
             let ndc = clip.truncate() / clip.w;
             assert!(clip.w > 0.0, "{d}");
             assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{d}: {ndc}");

@@ -1647,6 +1647,52 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
         )
     })
     .unwrap();
+    let mut environment = built(&test, &lucent, |u| {
+        lucent::embed::EnvironmentEffect::new(
+            &lucent,
+            u,
+            lucent::embed::EnvironmentEffectDesc::new(gbuffer.clone()),
+        )
+    })
+    .unwrap();
+    let skin1 = lucent::scene::material::Medium::new(
+        lucent::scene::layered::LayeredMedium::preset("skin1").unwrap(),
+    );
+    let mut transmission = built(&test, &lucent, |u| {
+        lucent::embed::TransmissionEffect::new(
+            &lucent,
+            u,
+            lucent::embed::TransmissionEffectDesc::new(
+                gbuffer.clone(),
+                vec![lucent::embed::TransmissionMaterial::new(1, skin1)],
+                vk::Format::D32_SFLOAT,
+            ),
+        )
+    })
+    .unwrap();
+    // A sun whose shadow map is the depth image's top-left square (its contents do not
+    // matter: this test counts calls).
+    let sun = [lucent::embed::Light::directional(
+        glam::Vec3::new(0.2, -1.0, 0.3),
+        glam::Vec3::ONE,
+        3.0,
+    )];
+    let sun_face = [lucent::embed::ShadowFace::new(
+        0,
+        glam::Mat4::look_to_rh(
+            glam::Vec3::new(0.0, 5.0, 0.0),
+            glam::Vec3::new(0.2, -1.0, 0.3),
+            glam::Vec3::Z,
+        ),
+        glam::Mat4::orthographic_rh(-2.0, 2.0, -2.0, 2.0, 0.5, 10.0),
+        vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: h,
+                height: h,
+            },
+        },
+    )];
     let camera = HostCamera::new(
         scene.camera.view(),
         scene.camera.projection(w as f32 / h as f32),
@@ -1702,9 +1748,56 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
             )
         })
         .unwrap();
+        // The environment and the transmission add to it too.
+        recorded(&test, |cmd| {
+            environment.record(
+                &lucent,
+                cmd,
+                &lucent::embed::EnvironmentFrame {
+                    slot,
+                    view: 0,
+                    camera,
+                    environment: &scene.environment,
+                    images: lucent::embed::EnvironmentImages {
+                        depth: images.depth,
+                        normals: &colour_in,
+                        albedo: Some(&colour_in),
+                    },
+                    regions: &[],
+                    lighting: &lighting,
+                },
+            )
+        })
+        .unwrap();
+        let shadow_map = described(&depth, "shadow map", sampled);
+        recorded(&test, |cmd| {
+            transmission.record(
+                &lucent,
+                cmd,
+                &lucent::embed::TransmissionFrame {
+                    slot,
+                    view: 0,
+                    camera,
+                    lights: &sun,
+                    shadow_faces: &sun_face,
+                    images: lucent::embed::TransmissionImages {
+                        depth: images.depth,
+                        normals: &colour_in,
+                        material_ids: images.material_ids,
+                        albedo: Some(&colour_in),
+                        shadow_map: &shadow_map,
+                    },
+                    regions: &[],
+                    lighting: &lighting,
+                },
+            )
+        })
+        .unwrap();
     }
     effect.destroy(&lucent);
     translucency.destroy(&lucent);
+    environment.destroy(&lucent);
+    transmission.destroy(&lucent);
     drop(lucent);
     let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
     assert_eq!(

@@ -20,12 +20,17 @@
 //! - [`EnvironmentEffect`]: lucent's SH environment light ([`Environment`]: constant,
 //!   hemisphere, the built-in sky or a radiance map) added to the host's lit diffuse at each
 //!   surface pixel's normal, times the albedo when the host's diffuse light has it.
+//! - [`TransmissionEffect`]: screen-space SSS's transmission through thin parts of the
+//!   materials with a medium ([`TransmissionMaterial`]), measured through the host's own
+//!   shadow maps ([`ShadowFace`]).
+//! - [`glsl::TERMS`]: the environment's and GDC 2011's terms as GLSL for the host's own
+//!   lighting pass, where they cost what they cost in lucent's.
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
 //!   SSS transmission, layered media, shadows, the SH environment), tonemapped. This is how
-//!   SSS transmission and Li et al.'s layered media reach a host today: they have no path on
-//!   a host's G-buffer yet ([`capabilities`] says so per description).
+//!   Li et al.'s layered media reach a host today: they have no path on a host's G-buffer yet
+//!   ([`capabilities`] says so per description).
 //!
 //! Effects draw over the screen regions a host gives each frame ([`screen_region`] projects an
 //! object's box), and time their passes only when recorded with `record_timed` and an
@@ -205,8 +210,10 @@ pub use glam;
 /// host's G-buffer described ([`GBufferDesc`]) and bound per frame ([`SssEffect`], replacing
 /// `PostProcessSss`), uploads recorded into the host's command buffer ([`Uploads`]), typed
 /// errors ([`HostError`]). 4: [`SssFrame::regions`] (the blurs' screen regions),
-/// [`TranslucencyEffect`], [`capabilities`], [`EffectTimer`] and `record_timed`.
-pub const API_VERSION: u32 = 4;
+/// [`TranslucencyEffect`], [`capabilities`], [`EffectTimer`] and `record_timed`. 5:
+/// [`EnvironmentEffect`], [`TransmissionEffect`] (with [`ShadowFace`]), [`glsl::TERMS`];
+/// [`capabilities`] reports SSS transmission and the environment as effects that run.
+pub const API_VERSION: u32 = 5;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

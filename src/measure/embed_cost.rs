@@ -13,6 +13,11 @@
 //!   reach; its diffuse with linear depth in the alpha where lucent's own frame has it)
 //!   against lucent's pass of the same name (the host's diffuse and
 //!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM).
+//! - **SSS transmission** (with an SSS blur, on a scene with a `[material.medium]` and a
+//!   light casting shadows): lucent's term inside its lighting pass (the lighting with
+//!   transmission minus without) against the `TransmissionEffect`'s pass over the media's
+//!   screen bounds, its shadow map lucent's own atlas with each face as a host describes it;
+//!   rows `transmission: ...` after the blur's.
 //! - **The SH environment** (`--technique none`, plain lighting, whose ambient term is what a
 //!   host inserts of it): lucent's ambient inside its lighting pass is the lighting pass with
 //!   the scene's environment minus the lighting pass with none, against the
@@ -33,9 +38,10 @@ use crate::backend::{GpuContext, GpuImage, ImageDesc};
 use crate::embed::{
     DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, EnvironmentEffect, EnvironmentEffectDesc,
     EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
-    ImageState, Lucent, NormalDesc, OptionalFeatures, SssEffect, SssEffectDesc, SssFrame,
-    SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
-    TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
+    ImageState, Lucent, NormalDesc, OptionalFeatures, ShadowFace, SssEffect, SssEffectDesc,
+    SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
+    TranslucencyFrame, TranslucencyImages, TranslucentMaterial, TransmissionEffect,
+    TransmissionEffectDesc, TransmissionFrame, TransmissionImages, TransmissionMaterial,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -210,6 +216,24 @@ pub fn embed_cost(
             (width, height),
             (frames, warmup),
         )
+    };
+    // An SSS blur on a scene with media also times their transmission.
+    let rows = match (rows, blur.is_some()) {
+        (Ok(mut rows), true) => measure_transmission(
+            gpu,
+            shaders,
+            pipeline_cache,
+            &lucent,
+            scene,
+            technique,
+            (width, height),
+            (frames, warmup),
+        )
+        .map(|more| {
+            rows.extend(more.unwrap_or_default());
+            rows
+        }),
+        (rows, _) => rows,
     };
     let idle = gpu.wait_idle();
     drop(lucent);
@@ -495,9 +519,8 @@ fn measure_translucency(
         gpu,
         shaders,
         pipeline_cache,
-        (scene, with),
-        (scene, Technique::None),
-        size,
+        (scene, term_settings(with, size)),
+        (scene, term_settings(Technique::None, size)),
     )?;
     let mut images = Images::default();
     let measured = (|| {
@@ -637,9 +660,8 @@ fn measure_environment(
         gpu,
         shaders,
         pipeline_cache,
-        (scene, Technique::None),
-        (&dark, Technique::None),
-        size,
+        (scene, term_settings(Technique::None, size)),
+        (&dark, term_settings(Technique::None, size)),
     )?;
     let mut images = Images::default();
     let measured = (|| {
@@ -684,6 +706,197 @@ fn measure_environment(
     pair.finish(gpu, images, measured)
 }
 
+/// A frame of `technique` for timing a term of its lighting pass: the pass unmerged (timed
+/// alone), the G-buffer exported.
+fn term_settings(technique: Technique, (width, height): (u32, u32)) -> FrameSettings {
+    FrameSettings {
+        export_gbuffer: true,
+        ..crate::measure::scaling::settings(technique, width, height)
+    }
+}
+
+/// SSS transmission: lucent's term inside its lighting pass (the lighting with
+/// transmission minus without) against the `TransmissionEffect`'s pass over the scattering
+/// objects' screen bounds, on a host G-buffer of lucent's own frame whose shadow map is
+/// lucent's own light-space atlas with each face's matrices
+/// ([`crate::features::shadows::ShadowDesc::face_matrices`]). `None` when the scene has no
+/// material with a medium or no light casting shadows.
+fn measure_transmission(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    lucent: &Lucent,
+    scene: &Scene,
+    technique: Technique,
+    size: (u32, u32),
+    frames: (usize, usize),
+) -> Result<Option<Vec<EmbedCostRow>>> {
+    let settings = |transmission: bool| {
+        let mut s = FrameSettings {
+            export_shadows: true,
+            ..term_settings(technique, size)
+        };
+        s.sss.texturing = Some(Texturing::Pre);
+        s.sss.transmission = transmission;
+        s
+    };
+    let Some(shadows) =
+        crate::features::shadows::ShadowDesc::new(scene, &settings(true).shadows, false)
+    else {
+        return Ok(None);
+    };
+    let media: Vec<&crate::scene::material::Medium> = scene
+        .objects
+        .iter()
+        .filter_map(|o| o.material.medium.as_ref())
+        .collect();
+    if media.is_empty() {
+        return Ok(None);
+    }
+    let pair = RendererPair::new(
+        gpu,
+        shaders,
+        pipeline_cache,
+        (scene, settings(true)),
+        (scene, settings(false)),
+    )?;
+    let mut images = Images::default();
+    let measured = (|| {
+        let (width, height) = size;
+        let (host, gb) = HostGBuffer::of(gpu, &pair.lit, &mut images, size)?;
+        let (sw, sh, depths) = pair.lit.read_shadow_map(gpu)?;
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let shadow_map = images.upload(
+            gpu,
+            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, sampled),
+            bytemuck::cast_slice(&depths).to_vec(),
+            "host shadow map",
+        )?;
+        let shadow_map = host_image(
+            shadow_map,
+            "host shadow map",
+            vk::Format::D32_SFLOAT,
+            (sw, sh),
+            sampled,
+        );
+        // lucent's profile numbers as the host's IDs, each with its object's medium.
+        let ids: Vec<u8> = gb
+            .sss
+            .as_ref()
+            .map(|v| v.iter().map(|&k| k as u8).collect())
+            .unwrap_or_default();
+        let id_image = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, vk::Format::R8_UNORM, sampled),
+            ids,
+            "host IDs",
+        )?;
+        let id_image = host_image(id_image, "host IDs", vk::Format::R8_UNORM, size, sampled);
+        let profiles = SssProfiles::new(
+            scene,
+            technique
+                .module()
+                .and_then(|m| registry::sss_blur(m.name()).ok()),
+            None,
+            Some(Texturing::Pre),
+            &registry::blur_of,
+        )?
+        .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?;
+        let materials = (1..=profiles.profiles.len())
+            .filter_map(|k| {
+                let object = profiles
+                    .object_ids
+                    .iter()
+                    .position(|&id| usize::from(id) == k)?;
+                let medium = scene.objects[object].material.medium.clone()?;
+                Some(TransmissionMaterial::new(k as u8, medium))
+            })
+            .collect::<Vec<_>>();
+        let units_per_mm = media[0].layered.units_per_mm;
+        let gbuffer = host
+            .desc
+            .clone()
+            .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
+            .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        let mut effect = build(gpu, lucent, |u| {
+            TransmissionEffect::new(
+                lucent,
+                u,
+                TransmissionEffectDesc::new(gbuffer, materials, vk::Format::D32_SFLOAT),
+            )
+        })?;
+        let faces: Vec<ShadowFace> = shadows
+            .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
+            .into_iter()
+            .map(|f| {
+                let (x, y, edge) = f.tile;
+                ShadowFace::new(
+                    f.light,
+                    f.view,
+                    f.projection,
+                    vk::Rect2D {
+                        offset: vk::Offset2D {
+                            x: x as i32,
+                            y: y as i32,
+                        },
+                        extent: vk::Extent2D {
+                            width: edge,
+                            height: edge,
+                        },
+                    },
+                )
+            })
+            .collect();
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(width as f32 / height as f32),
+        );
+        let regions = object_regions(scene, &camera, size, 0.0, |o| o.material.medium.is_some());
+        let rows = time_term(
+            gpu,
+            lucent,
+            (&pair.lit, &pair.plain),
+            ("transmission", "no transmission"),
+            frames,
+            |cmd, timer| {
+                effect.record_timed(
+                    lucent,
+                    cmd,
+                    &TransmissionFrame {
+                        slot: 0,
+                        view: 0,
+                        camera,
+                        lights: &scene.lights,
+                        shadow_faces: &faces,
+                        images: TransmissionImages {
+                            depth: &host.depth,
+                            normals: &host.normals,
+                            material_ids: &id_image,
+                            albedo: Some(&host.albedo),
+                            shadow_map: &shadow_map,
+                        },
+                        regions: &regions,
+                        lighting: &host.lighting,
+                    },
+                    timer,
+                )
+            },
+        );
+        effect.destroy(lucent);
+        rows
+    })();
+    pair.finish(gpu, images, measured).map(|rows| {
+        Some(
+            rows.into_iter()
+                .map(|row| EmbedCostRow {
+                    pass: format!("transmission: {}", row.pass),
+                    ..row
+                })
+                .collect(),
+        )
+    })
+}
+
 /// lucent's frame of a scene with a lighting term (`lit`) and without (`plain`), each
 /// exporting its G-buffer, destroyed together.
 struct RendererPair {
@@ -696,15 +909,10 @@ impl RendererPair {
         gpu: &GpuContext,
         shaders: &ShaderCompiler,
         pipeline_cache: &PipelineCache,
-        lit: (&Scene, Technique),
-        plain: (&Scene, Technique),
-        (width, height): (u32, u32),
+        lit: (&Scene, FrameSettings),
+        plain: (&Scene, FrameSettings),
     ) -> Result<Self> {
-        let make = |(scene, technique): (&Scene, Technique)| {
-            let settings = FrameSettings {
-                export_gbuffer: true,
-                ..crate::measure::scaling::settings(technique, width, height)
-            };
+        let make = |(scene, settings): (&Scene, FrameSettings)| {
             Renderer::new(gpu, shaders, pipeline_cache, scene, settings)
         };
         let lit = make(lit)?;

@@ -336,8 +336,9 @@ fn the_gate_refuses_the_flags_it_sets_itself_naming_them() {
 
 #[test]
 fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
-    // The SH environment (--technique none), GDC 2011 translucency and an SSS blur, each
-    // as a host's effect against lucent's own frame: a table with both columns filled.
+    // The SH environment (--technique none), GDC 2011 translucency, an SSS blur and SSS
+    // transmission, each as a host's effect against lucent's own frame: a table with both
+    // columns filled.
     for (scene, technique, effect, row) in [
         ("cubes", "none", "EnvironmentEffect", "| the term |"),
         (
@@ -347,6 +348,13 @@ fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
             "| the term |",
         ),
         ("skin", "separable", "SssEffect", "| horizontal blur |"),
+        // A medium back-lit by a shadowed light: its transmission is timed too.
+        (
+            "tools/truth/scenes/skin1-slab-backlit.toml",
+            "separable",
+            "SssEffect",
+            "| transmission: the term |",
+        ),
     ] {
         let text = run_bench(&format!(
             "bench --validation --scene {scene} --technique {technique} --size 96x64 \

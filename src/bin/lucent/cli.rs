@@ -122,9 +122,10 @@ pub struct BenchArgs {
     #[arg(long, alias = "compare-seeds")]
     pub compare_thesis: bool,
     /// Also measure the technique as an effect on a host's G-buffer (`lucent::embed`: an SSS
-    /// blur a host can run, `translucency`, or `none` for the SH environment's light)
-    /// against the same work in lucent's own frame, frames alternating, and print both with
-    /// their ratio (Markdown).
+    /// blur a host can run, `translucency`, or `none` for the SH environment's light; with a
+    /// blur, on a scene with media and shadows, their transmission too) against the same
+    /// work in lucent's own frame, frames alternating, and print both with their ratio
+    /// (Markdown).
     #[arg(long)]
     pub embed: bool,
     /// Run the speed-of-light gate instead of one benchmark: every built-in scene's passes

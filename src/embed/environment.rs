@@ -27,7 +27,7 @@ use ash::vk;
 use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, EffectPasses};
+use super::passes::{check_views, frame_albedo, import_host_image, EffectPasses};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -38,7 +38,7 @@ use crate::features::pass::FullscreenPass;
 use crate::gpu_scene::{
     projection_depth_decode, Region, SceneGpu, SceneUpload, TableRegion, FRAME,
 };
-use crate::graph::{ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
+use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::Environment;
 use crate::Result;
 
@@ -244,36 +244,10 @@ impl EnvironmentEffect {
         })
     }
 
-    /// The passes the effect records (its plan, for tables and tests).
-    pub fn plan(&self) -> &crate::graph::Plan {
-        self.passes.plan()
-    }
-
-    /// Records one view of one frame into `cmd` (recording, outside any render pass):
-    /// `frame.environment`'s diffuse light added to `frame.lighting`; every image then left
-    /// in its final state. The frame last recorded with the same slot and view must have
-    /// completed. Everything is checked before anything is recorded.
-    pub fn record(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &EnvironmentFrame<'_>,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, None)
-    }
-
-    /// [`Self::record`] with a timestamp pair around the pass, written into `timer` (reset in
-    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
-    /// fence has signalled.
-    pub fn record_timed(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &EnvironmentFrame<'_>,
-        timer: &mut super::EffectTimer,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, Some(timer))
-    }
+    super::passes::effect_methods!(
+        EnvironmentFrame,
+        "`frame.environment`'s diffuse light added to `frame.lighting`"
+    );
 
     fn record_with(
         &mut self,
@@ -350,29 +324,11 @@ impl EnvironmentEffect {
             DepthEncoding::Device => Role::SampledDepth,
             DepthEncoding::LinearView => Role::SampledColor,
         };
-        let reads_albedo = self.imports.albedo.is_some();
-        let albedo = match (reads_albedo, images.albedo) {
-            (true, Some(albedo)) => Some(albedo),
-            (false, None) => None,
-            (true, None) => {
-                return Err(HostError::Missing {
-                    input: "albedo".into(),
-                    needed_by: "the environment's light is multiplied by the albedo, as the \
-                                host's diffuse light has it (EnvironmentImages::albedo)"
-                        .into(),
-                }
-                .into())
-            }
-            (false, Some(_)) => {
-                return Err(HostError::Description {
-                    field: "albedo".into(),
-                    problem: "given, but the description's diffuse light is kept without the \
-                              albedo, so the environment's light is too: pass None"
-                        .into(),
-                }
-                .into())
-            }
-        };
+        let albedo = frame_albedo(
+            self.imports.albedo.is_some(),
+            images.albedo,
+            "the environment's light",
+        )?;
         let normal_format = gbuffer.normals.expect("checked at new").format;
         let mut checks = vec![
             (images.depth, "depth", depth_role, gbuffer.depth.format),
@@ -404,12 +360,6 @@ impl EnvironmentEffect {
             frame.lighting,
         )
     }
-
-    /// Destroys the pass and its buffers. The GPU must be done with every frame that
-    /// recorded it (the host's fences).
-    pub fn destroy(self, lucent: &Lucent) {
-        self.passes.destroy(lucent);
-    }
 }
 
 /// The effect's graph: the host's images imported (bound when each frame records) and one
@@ -419,19 +369,7 @@ fn declare(desc: &EnvironmentEffectDesc, scene_gpu: &Arc<SceneGpu>) -> (RenderGr
     let reads_albedo = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
     let mut graph = RenderGraph::new();
     let mut import = |name: &str, format: vk::Format, initial: Access| {
-        graph.import_image(
-            name,
-            ImageInfo {
-                width: gbuffer.width,
-                height: gbuffer.height,
-                format,
-            },
-            ImportedImage {
-                image: vk::Image::null(),
-                view: vk::ImageView::null(),
-                initial,
-            },
-        )
+        import_host_image(&mut graph, gbuffer, name, format, initial)
     };
     let sampled = Access::FragmentSampledRead;
     let depth = import("host depth", gbuffer.depth.format, sampled);

@@ -18,6 +18,109 @@ use crate::graph::{CompileOptions, Executable, RenderGraph, ResourceId};
 use crate::scene::{Camera, Scene};
 use crate::Result;
 
+/// The public methods every effect has alike, over its `passes` ([`EffectPasses`]) and its
+/// own `record_with(lucent, cmd, frame, timer)`: `plan`, `record` (documented with `$does`,
+/// what one frame's recording does), `record_timed` and `destroy`.
+macro_rules! effect_methods {
+    ($frame:ident, $does:literal) => {
+        /// The passes the effect records (their plan, for tables and tests).
+        pub fn plan(&self) -> &crate::graph::Plan {
+            self.passes.plan()
+        }
+
+        #[doc = concat!(
+            "Records one view of one frame into `cmd` (recording, outside any render pass): ",
+            $does,
+            "; every image then left in its final state ([`HostImage::left_in`]). The frame \
+             last recorded with the same slot and view must have completed (its fence); each \
+             (slot, view) is recorded once per frame. Everything is checked before anything \
+             is recorded."
+        )]
+        pub fn record(
+            &mut self,
+            lucent: &Lucent,
+            cmd: vk::CommandBuffer,
+            frame: &$frame<'_>,
+        ) -> Result<()> {
+            self.record_with(lucent, cmd, frame, None)
+        }
+
+        /// [`Self::record`] with a timestamp pair around each pass, written into `timer`
+        /// (reset in `cmd` first): read the times with [`super::EffectTimer::results`] once
+        /// the frame's fence has signalled.
+        pub fn record_timed(
+            &mut self,
+            lucent: &Lucent,
+            cmd: vk::CommandBuffer,
+            frame: &$frame<'_>,
+            timer: &mut super::EffectTimer,
+        ) -> Result<()> {
+            self.record_with(lucent, cmd, frame, Some(timer))
+        }
+
+        /// Destroys the passes and their buffers. The GPU must be done with every frame that
+        /// recorded them (the host's fences).
+        pub fn destroy(self, lucent: &Lucent) {
+            self.passes.destroy(lucent);
+        }
+    };
+}
+pub(crate) use effect_methods;
+
+/// A host image of `gbuffer`'s size imported into `graph` as `name` (bound to the host's
+/// image when each frame records), first used as `initial`.
+pub(crate) fn import_host_image(
+    graph: &mut RenderGraph,
+    gbuffer: &super::GBufferDesc,
+    name: &str,
+    format: vk::Format,
+    initial: crate::backend::access::Access,
+) -> crate::graph::Handle<crate::graph::Image> {
+    graph.import_image(
+        name,
+        crate::graph::ImageInfo {
+            width: gbuffer.width,
+            height: gbuffer.height,
+            format,
+        },
+        crate::graph::ImportedImage {
+            image: vk::Image::null(),
+            view: vk::ImageView::null(),
+            initial,
+        },
+    )
+}
+
+/// The albedo image a frame gives, against whether the effect reads it (`reads`: the host's
+/// diffuse light has the albedo multiplied in): required then, refused otherwise; `term`
+/// names the light the effect adds, for the errors.
+pub(crate) fn frame_albedo<'a>(
+    reads: bool,
+    given: Option<&'a HostImage>,
+    term: &str,
+) -> Result<Option<&'a HostImage>> {
+    match (reads, given) {
+        (true, Some(albedo)) => Ok(Some(albedo)),
+        (false, None) => Ok(None),
+        (true, None) => Err(HostError::Missing {
+            input: "albedo".into(),
+            needed_by: format!(
+                "{term} is multiplied by the albedo, as the host's diffuse light has it (the \
+                 frame's albedo image)"
+            ),
+        }
+        .into()),
+        (false, Some(_)) => Err(HostError::Description {
+            field: "albedo".into(),
+            problem: format!(
+                "given, but the description's diffuse light is kept without the albedo, so \
+                 {term} is too: pass None"
+            ),
+        }
+        .into()),
+    }
+}
+
 /// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
 pub(crate) fn check_views(views: usize) -> Result<()> {
     if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {

@@ -331,37 +331,10 @@ impl SssEffect {
         self.reach
     }
 
-    /// The passes the effect records (their plan, for tables and tests).
-    pub fn plan(&self) -> &crate::graph::Plan {
-        self.passes.plan()
-    }
-
-    /// Records one view of one frame into `cmd` (recording, outside any render pass): the
-    /// frame's images, seen by its camera, blurred into its output; every image then left in
-    /// its final state ([`HostImage::left_in`]). The frame last recorded with the same slot
-    /// and view must have completed (its fence); each (slot, view) is recorded once per frame.
-    /// Everything is checked before anything is recorded.
-    pub fn record(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &SssFrame<'_>,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, None)
-    }
-
-    /// [`Self::record`] with a timestamp pair around each pass, written into `timer` (reset in
-    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
-    /// fence has signalled.
-    pub fn record_timed(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &SssFrame<'_>,
-        timer: &mut super::EffectTimer,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, Some(timer))
-    }
+    super::passes::effect_methods!(
+        SssFrame,
+        "the frame's images, seen by its camera, blurred into its output"
+    );
 
     fn record_with(
         &mut self,
@@ -497,12 +470,6 @@ impl SssEffect {
             images.albedo,
         ];
         distinct_inputs(all.into_iter().flatten(), frame.output)
-    }
-
-    /// Destroys the passes and their buffers. The GPU must be done with every frame that
-    /// recorded them (the host's fences).
-    pub fn destroy(self, lucent: &Lucent) {
-        self.passes.destroy(lucent);
     }
 }
 

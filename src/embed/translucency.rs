@@ -27,7 +27,7 @@ use glam::Vec3;
 use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, EffectPasses};
+use super::passes::{check_views, import_host_image, EffectPasses};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -37,7 +37,7 @@ use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
 use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION};
 use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
-use crate::graph::{ImageInfo, ImportedImage, LoadOp, RenderGraph, ResourceId};
+use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::{Light, Mesh, MAX_LIGHTS};
 use crate::Result;
@@ -378,36 +378,10 @@ impl TranslucencyEffect {
         Ok(out)
     }
 
-    /// The passes the effect records (its plan, for tables and tests).
-    pub fn plan(&self) -> &crate::graph::Plan {
-        self.passes.plan()
-    }
-
-    /// Records one view of one frame into `cmd` (recording, outside any render pass): the
-    /// talk's term from `frame.lights` added to `frame.lighting`; every image then left in its
-    /// final state. The frame last recorded with the same slot and view must have completed.
-    /// Everything is checked before anything is recorded.
-    pub fn record(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &TranslucencyFrame<'_>,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, None)
-    }
-
-    /// [`Self::record`] with a timestamp pair around each pass, written into `timer` (reset in
-    /// `cmd` first): read the times with [`super::EffectTimer::results`] once the frame's
-    /// fence has signalled.
-    pub fn record_timed(
-        &mut self,
-        lucent: &Lucent,
-        cmd: vk::CommandBuffer,
-        frame: &TranslucencyFrame<'_>,
-        timer: &mut super::EffectTimer,
-    ) -> Result<()> {
-        self.record_with(lucent, cmd, frame, Some(timer))
-    }
+    super::passes::effect_methods!(
+        TranslucencyFrame,
+        "the talk's term from `frame.lights` added to `frame.lighting`"
+    );
 
     fn record_with(
         &mut self,
@@ -521,12 +495,6 @@ impl TranslucencyEffect {
             frame.lighting,
         )
     }
-
-    /// Destroys the pass and its buffers. The GPU must be done with every frame that
-    /// recorded it (the host's fences).
-    pub fn destroy(self, lucent: &Lucent) {
-        self.passes.destroy(lucent);
-    }
 }
 
 /// The host's lights: at most [`MAX_LIGHTS`], each finite, with a finite translucency scale
@@ -593,19 +561,7 @@ fn declare(
     let gbuffer = &desc.gbuffer;
     let mut graph = RenderGraph::new();
     let mut import = |name: &str, format: vk::Format, initial: Access| {
-        graph.import_image(
-            name,
-            ImageInfo {
-                width: gbuffer.width,
-                height: gbuffer.height,
-                format,
-            },
-            ImportedImage {
-                image: vk::Image::null(),
-                view: vk::ImageView::null(),
-                initial,
-            },
-        )
+        import_host_image(&mut graph, gbuffer, name, format, initial)
     };
     let sampled = Access::FragmentSampledRead;
     let described = |f: Option<vk::Format>| f.expect("checked at new");

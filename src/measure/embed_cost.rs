@@ -721,6 +721,7 @@ fn term_settings(technique: Technique, (width, height): (u32, u32)) -> FrameSett
 /// lucent's own light-space atlas with each face's matrices
 /// ([`crate::features::shadows::ShadowDesc::face_matrices`]). `None` when the scene has no
 /// material with a medium or no light casting shadows.
+#[allow(clippy::too_many_arguments)]
 fn measure_transmission(
     gpu: &GpuContext,
     shaders: &ShaderCompiler,

@@ -26,12 +26,13 @@ use ash::vk;
 
 use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
-use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, frame_albedo, import_host_image, EffectPasses};
+use super::image::{distinct_inputs, HostImage, Role};
+use super::passes::{
+    check_described, check_views, depth_role, frame_albedo, import_host_image, EffectPasses,
+};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
-use crate::backend::format::format_name;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
@@ -320,10 +321,7 @@ impl EnvironmentEffect {
     ) -> Result<Vec<&'a HostImage>> {
         let gbuffer = &self.desc.gbuffer;
         let images = &frame.images;
-        let depth_role = match gbuffer.depth.encoding {
-            DepthEncoding::Device => Role::SampledDepth,
-            DepthEncoding::LinearView => Role::SampledColor,
-        };
+        let depth_role = depth_role(gbuffer);
         let albedo = frame_albedo(
             self.imports.albedo.is_some(),
             images.albedo,
@@ -344,17 +342,7 @@ impl EnvironmentEffect {
             let format = gbuffer.albedo.expect("checked at new");
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
-        for (image, input, role, format) in checks {
-            check_image(
-                lucent.gpu(),
-                image,
-                input,
-                role,
-                gbuffer.extent(),
-                |f| f == format,
-                &format!("{} (the description's)", format_name(format)),
-            )?;
-        }
+        check_described(lucent, gbuffer.extent(), &checks)?;
         distinct_inputs(
             [images.depth, images.normals].into_iter().chain(albedo),
             frame.lighting,

@@ -121,6 +121,49 @@ pub(crate) fn frame_albedo<'a>(
     }
 }
 
+/// How an effect samples the host's depth image: as depth (a depth format's depth aspect) or
+/// as a colour image (linear view depth).
+pub(crate) fn depth_role(gbuffer: &super::GBufferDesc) -> Role {
+    match gbuffer.depth.encoding {
+        super::DepthEncoding::Device => Role::SampledDepth,
+        super::DepthEncoding::LinearView => Role::SampledColor,
+    }
+}
+
+/// How an effect samples the host's material IDs: a stencil aspect as a depth-stencil
+/// image's, any other as a colour image.
+pub(crate) fn id_role(ids: &super::IdDesc) -> Role {
+    if matches!(ids.encoding, super::IdEncoding::Stencil { .. }) {
+        Role::SampledDepth
+    } else {
+        Role::SampledColor
+    }
+}
+
+/// Checks each of a frame's images (image, input name, role, the format its description
+/// names) at the G-buffer's size: the first mistake as its typed error.
+pub(crate) fn check_described(
+    lucent: &Lucent,
+    extent: vk::Extent2D,
+    checks: &[(&HostImage, &str, Role, vk::Format)],
+) -> Result<()> {
+    for &(image, input, role, format) in checks {
+        super::image::check_image(
+            lucent.gpu(),
+            image,
+            input,
+            role,
+            extent,
+            |f| f == format,
+            &format!(
+                "{} (the description's)",
+                crate::backend::format::format_name(format)
+            ),
+        )?;
+    }
+    Ok(())
+}
+
 /// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
 pub(crate) fn check_views(views: usize) -> Result<()> {
     if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {

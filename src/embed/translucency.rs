@@ -25,13 +25,14 @@ use ash::vk;
 use glam::Vec3;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera, IdEncoding};
-use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, import_host_image, EffectPasses};
+use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera};
+use super::image::{distinct_inputs, HostImage, Role};
+use super::passes::{
+    check_described, check_views, depth_role, id_role, import_host_image, EffectPasses,
+};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
-use crate::backend::format::format_name;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
@@ -436,54 +437,41 @@ impl TranslucencyEffect {
         let gbuffer = &self.desc.gbuffer;
         let images = &frame.images;
         let ids = gbuffer.material_ids.expect("checked at new");
-        let depth_role = match gbuffer.depth.encoding {
-            DepthEncoding::Device => Role::SampledDepth,
-            DepthEncoding::LinearView => Role::SampledColor,
-        };
-        let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
-            Role::SampledDepth
-        } else {
-            Role::SampledColor
-        };
+        let depth_role = depth_role(gbuffer);
+        let id_role = id_role(&ids);
         let described = |f: Option<vk::Format>| f.expect("checked at new");
-        for (image, input, role, format) in [
-            (images.depth, "depth", depth_role, gbuffer.depth.format),
-            (
-                images.normals,
-                "normals",
-                Role::SampledColor,
-                described(gbuffer.normals.map(|n| n.format)),
-            ),
-            (
-                images.albedo,
-                "albedo",
-                Role::SampledColor,
-                described(gbuffer.albedo),
-            ),
-            (
-                images.thickness,
-                "thickness",
-                Role::SampledColor,
-                described(gbuffer.thickness.map(|t| t.format)),
-            ),
-            (images.material_ids, "material IDs", id_role, ids.format),
-            (
-                frame.lighting,
-                "lighting",
-                Role::Accumulate,
-                gbuffer.diffuse.format,
-            ),
-        ] {
-            check_image(
-                lucent.gpu(),
-                image,
-                input,
-                role,
-                gbuffer.extent(),
-                |f| f == format,
-                &format!("{} (the description's)", format_name(format)),
-            )?;
-        }
+        check_described(
+            lucent,
+            gbuffer.extent(),
+            &[
+                (images.depth, "depth", depth_role, gbuffer.depth.format),
+                (
+                    images.normals,
+                    "normals",
+                    Role::SampledColor,
+                    described(gbuffer.normals.map(|n| n.format)),
+                ),
+                (
+                    images.albedo,
+                    "albedo",
+                    Role::SampledColor,
+                    described(gbuffer.albedo),
+                ),
+                (
+                    images.thickness,
+                    "thickness",
+                    Role::SampledColor,
+                    described(gbuffer.thickness.map(|t| t.format)),
+                ),
+                (images.material_ids, "material IDs", id_role, ids.format),
+                (
+                    frame.lighting,
+                    "lighting",
+                    Role::Accumulate,
+                    gbuffer.diffuse.format,
+                ),
+            ],
+        )?;
         distinct_inputs(
             [
                 images.depth,

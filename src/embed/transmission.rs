@@ -31,9 +31,12 @@ use ash::vk;
 use glam::{Mat4, Vec3};
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
+use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, frame_albedo, import_host_image, EffectPasses};
+use super::passes::{
+    check_described, check_views, depth_role, frame_albedo, id_role, import_host_image,
+    EffectPasses,
+};
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -428,15 +431,8 @@ impl TransmissionEffect {
         let gbuffer = &self.desc.gbuffer;
         let images = &frame.images;
         let ids = gbuffer.material_ids.expect("checked at new");
-        let depth_role = match gbuffer.depth.encoding {
-            DepthEncoding::Device => Role::SampledDepth,
-            DepthEncoding::LinearView => Role::SampledColor,
-        };
-        let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
-            Role::SampledDepth
-        } else {
-            Role::SampledColor
-        };
+        let depth_role = depth_role(gbuffer);
+        let id_role = id_role(&ids);
         let albedo = frame_albedo(
             self.imports.albedo.is_some(),
             images.albedo,
@@ -458,17 +454,7 @@ impl TransmissionEffect {
             let format = gbuffer.albedo.expect("checked at new");
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
-        for (image, input, role, format) in checks {
-            check_image(
-                lucent.gpu(),
-                image,
-                input,
-                role,
-                gbuffer.extent(),
-                |f| f == format,
-                &format!("{} (the description's)", format_name(format)),
-            )?;
-        }
+        check_described(lucent, gbuffer.extent(), &checks)?;
         // The shadow map has a size of its own.
         let shadow_format = self.desc.shadow_format;
         check_image(

@@ -140,8 +140,9 @@ pub struct SssFrame<'a> {
     /// The G-buffer's images.
     pub images: SssImages<'a>,
     /// Screen rectangles the scattering materials' light may reach this frame: their
-    /// objects' projected bounds widened by the blurs' reach ([`SssEffect::reach`];
-    /// [`super::screen_region`] computes both). The blurs run on the 64-pixel tiles these
+    /// objects' projected bounds widened by the blurs' reach ([`SssEffect::reach_of`] each
+    /// object's material's, or [`SssEffect::reach`] the widest; [`super::screen_region`]
+    /// computes both). The blurs run on the 64-pixel tiles these
     /// touch and a pass-through elsewhere, as in lucent's own frames; a region that leaves
     /// out the reach changes the result near its edge. Empty: the whole screen.
     pub regions: &'a [vk::Rect2D],
@@ -167,8 +168,8 @@ pub struct SssEffect {
     desc: SssEffectDesc,
     /// The blur chains the profiles use (each draws in the frame's tiles).
     chains: usize,
-    /// The widest profile's reach, world units ([`Self::reach`]).
-    reach: f32,
+    /// Each material's reach, world units, by its host ID ([`Self::reach_of`]).
+    reaches: Vec<(u8, f32)>,
 }
 
 /// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
@@ -304,11 +305,13 @@ impl SssEffect {
             passes,
             imports,
             chains: profiles.chains().len(),
-            reach: profiles
-                .profiles
+            // Material i has profile i + 1 (profile_of above).
+            reaches: desc
+                .materials
                 .iter()
-                .map(|(p, _)| sss::profile_reach(p))
-                .fold(0.0, f32::max),
+                .zip(&profiles.profiles)
+                .map(|(m, (p, _))| (m.id, sss::profile_reach(p)))
+                .collect(),
             desc,
         };
         // The tables do not change between frames: written once into every slot.
@@ -328,7 +331,17 @@ impl SssEffect {
     /// projected at the object's depth for [`SssFrame::regions`] ([`super::screen_region`]
     /// does).
     pub fn reach(&self) -> f32 {
-        self.reach
+        self.reaches.iter().map(|&(_, r)| r).fold(0.0, f32::max)
+    }
+
+    /// The reach of the material with host ID `id` alone (`None`: no material has it): widen
+    /// each object's bounds by its own material's reach and the regions cover no more than
+    /// the blurs need, as lucent's own frames widen each object's tiles by its own profile's.
+    pub fn reach_of(&self, id: u8) -> Option<f32> {
+        self.reaches
+            .iter()
+            .find(|&&(i, _)| i == id)
+            .map(|&(_, r)| r)
     }
 
     super::passes::effect_methods!(

@@ -436,8 +436,11 @@ fn measure_sss(
         );
         // The host blurs over its scattering objects' screen bounds widened by the reach, as
         // lucent's own frame does over its tiles.
-        let regions = object_regions(scene, &camera, (width, height), effect.reach(), |o| {
-            o.material.sss.is_some() || o.material.medium.is_some()
+        // Each scattering object's bounds widened by its own profile's reach (its host ID is
+        // its profile number), as lucent's own frame widens its tiles.
+        let regions = object_regions(scene, &camera, (width, height), |i, _| {
+            let id = frame_profiles.object_ids.get(i).copied().unwrap_or(0);
+            effect.reach_of(id).filter(|_| id > 0)
         });
         let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
         let diffuse = host_image(diffuse, "host diffuse", hdr, size, sampled);
@@ -594,8 +597,8 @@ fn measure_translucency(
         );
         // The host draws the effect over its translucent objects' screen bounds, as lucent's
         // lighting pass runs the term over the tiles they touch.
-        let regions = object_regions(scene, &camera, (width, height), 0.0, |o| {
-            o.material.translucency_under(true).is_some()
+        let regions = object_regions(scene, &camera, (width, height), |_, o| {
+            o.material.translucency_under(true).map(|_| 0.0)
         });
         let gb2_image = host_image(
             gb2_image,
@@ -852,7 +855,9 @@ fn measure_transmission(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
         );
-        let regions = object_regions(scene, &camera, size, 0.0, |o| o.material.medium.is_some());
+        let regions = object_regions(scene, &camera, size, |_, o| {
+            o.material.medium.as_ref().map(|_| 0.0)
+        });
         let rows = time_term(
             gpu,
             lucent,
@@ -1066,23 +1071,23 @@ fn time_term(
         .collect())
 }
 
-/// The screen regions of the objects `pick` selects, widened by `reach` (the whole screen,
-/// no region, when one crosses the eye's plane).
+/// The screen regions of the objects `reach` selects, each widened by the reach it gives (the
+/// whole screen, no region, when one crosses the eye's plane).
 fn object_regions(
     scene: &Scene,
     camera: &HostCamera,
     (width, height): (u32, u32),
-    reach: f32,
-    pick: impl Fn(&crate::scene::Object) -> bool,
+    reach: impl Fn(usize, &crate::scene::Object) -> Option<f32>,
 ) -> Vec<vk::Rect2D> {
     let bounds = crate::gpu_scene::tiles::mesh_bounds(scene);
     let extent = vk::Extent2D { width, height };
     let regions: Option<Vec<vk::Rect2D>> = scene
         .objects
         .iter()
-        .filter(|o| pick(o))
-        .map(|o| {
-            crate::embed::box_screen_region(bounds[o.mesh], o.transform, camera, extent, reach)
+        .enumerate()
+        .filter_map(|(i, o)| reach(i, o).map(|r| (o, r)))
+        .map(|(o, r)| {
+            crate::embed::box_screen_region(bounds[o.mesh], o.transform, camera, extent, r)
         })
         .collect();
     regions.unwrap_or_default()

@@ -207,6 +207,7 @@ impl SssEffect {
         }
         check_output_format(desc.output_format)?;
         let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
+        let mut id_map = ids.decode(Vec::new())?;
         let mut profile_of = vec![0u8; 256];
         let mut profiles = Vec::with_capacity(desc.materials.len());
         for (index, material) in desc.materials.iter().enumerate() {
@@ -218,7 +219,7 @@ impl SssEffect {
                 }
                 .into());
             }
-            if u32::from(material.id) > ids.decode(Vec::new())?.mask {
+            if u32::from(material.id) > id_map.mask {
                 return Err(HostError::Description {
                     field,
                     problem: "the ID does not fit the material ID image's bit field".into(),
@@ -275,7 +276,8 @@ impl SssEffect {
             }
             .into());
         }
-        let id_map = IdMap::Host(ids.decode(profile_of)?);
+        id_map.profile_of = profile_of;
+        let id_map = IdMap::Host(id_map);
         let profiles = SssProfiles {
             transmission: vec![None; profiles.len()],
             profiles,

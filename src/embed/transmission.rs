@@ -283,13 +283,13 @@ impl TransmissionEffect {
             }
             .into());
         }
-        let mask = ids.decode(Vec::new())?.mask;
+        let mut id_map = ids.decode(Vec::new())?;
         let mut profile_of = vec![0u8; 256];
         let mut table: ProfileTableGpu = bytemuck::Zeroable::zeroed();
         let mm_per_unit = 1000.0 * f64::from(gbuffer.metres_per_unit);
         for (index, material) in desc.materials.iter().enumerate() {
             let id = usize::from(material.id);
-            if id == 0 || profile_of[id] != 0 || u32::from(material.id) > mask {
+            if id == 0 || profile_of[id] != 0 || u32::from(material.id) > id_map.mask {
                 return Err(HostError::Description {
                     field: format!("materials[{index}] (ID {id})"),
                     problem: "IDs are 1 to 255, each once, within the material ID image's bit \
@@ -308,7 +308,7 @@ impl TransmissionEffect {
             rows[..4].copy_from_slice(&transmission.rows());
             rows[4..MEDIUM_ROWS].copy_from_slice(&transmission.reflectance_rows());
         }
-        let id_map = ids.decode(profile_of)?;
+        id_map.profile_of = profile_of;
         let uint_ids = id_map.uint;
         (table.id_decode, table.id_profiles) = IdMap::Host(id_map).rows();
         let normals = normals.decode()?;

@@ -36,9 +36,7 @@ use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
-use crate::gpu_scene::{
-    projection_depth_decode, Region, SceneGpu, SceneUpload, TableRegion, FRAME,
-};
+use crate::gpu_scene::{projection_depth_ends, Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::Environment;
 use crate::Result;
@@ -170,29 +168,15 @@ pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
 /// (refused for device depth by [`GBufferDesc::view_uniforms`]) gives standard Z with an
 /// infinite far plane, which leaves the background to the depth image's own values.
 fn far_end(projection: &glam::Mat4) -> (bool, f32) {
-    let Some(k) = projection_depth_decode(projection) else {
+    let Some((at_zero, at_one)) = projection_depth_ends(projection) else {
         return (true, INFINITE_FAR);
     };
-    // The decode is (k0 + k1 d) / (k2 + k3 d), its denominator positive over the range and
-    // vanishing at an end whose far plane is at infinity. Evaluated in f64: near the far end
-    // the denominator is a difference of nearly equal terms.
-    let k = k.map(f64::from);
-    let view_depth = |d: f64| {
-        let denominator = k[2] + k[3] * d;
-        let depth = (k[0] + k[1] * d) / denominator;
-        if denominator <= 1e-9 * k[2].abs().max(k[3].abs()) || !depth.is_finite() {
-            f64::INFINITY
-        } else {
-            depth
-        }
-    };
-    let (at_zero, at_one) = (view_depth(0.0), view_depth(1.0));
     let (near, far) = (at_zero.min(at_one), at_zero.max(at_one));
     if !far.is_finite() || far >= f64::from(INFINITE_FAR) {
         return (at_one >= at_zero, INFINITE_FAR);
     }
-    // The matrix's f32 entries put the far plane's distance f32 epsilon times far / near
-    // off (the cancellation above), and a host's linear depth image holds the far plane
+    // The matrix's f32 entries put the far plane's distance f32 epsilon times far / near off
+    // (the decode's cancellation there), and a host's linear depth image holds the far plane
     // rounded to f32: within a few of those of the far plane is the background.
     let tolerance = (8.0 * f64::from(f32::EPSILON) * far / near.max(1e-30)).clamp(1e-6, 1e-2);
     (at_one >= at_zero, (far * (1.0 - tolerance)) as f32)

@@ -164,6 +164,64 @@ pub(crate) fn check_described(
     Ok(())
 }
 
+/// The host's lights: at most [`crate::scene::MAX_LIGHTS`], each finite, with a finite translucency scale
+/// and, for point and spot lights, a positive range (the shader divides by it).
+pub(crate) fn check_lights(lights: &[crate::scene::Light]) -> Result<()> {
+    if lights.len() > crate::scene::MAX_LIGHTS {
+        return Err(HostError::Description {
+            field: "lights".into(),
+            problem: format!(
+                "{} lights; at most {}",
+                lights.len(),
+                crate::scene::MAX_LIGHTS
+            ),
+        }
+        .into());
+    }
+    for (index, light) in lights.iter().enumerate() {
+        let radiance = light.radiance();
+        let geometry_ok = match light.kind {
+            crate::scene::LightKind::Directional { direction } => {
+                direction.is_finite() && direction.length_squared() > 0.0
+            }
+            crate::scene::LightKind::Point { position, range } => {
+                position.is_finite() && range.is_finite() && range > 0.0
+            }
+            crate::scene::LightKind::Spot {
+                position,
+                direction,
+                range,
+                inner_degrees,
+                outer_degrees,
+            } => {
+                position.is_finite()
+                    && direction.is_finite()
+                    && direction.length_squared() > 0.0
+                    && range.is_finite()
+                    && range > 0.0
+                    && inner_degrees.is_finite()
+                    && outer_degrees.is_finite()
+            }
+        };
+        if !(geometry_ok
+            && radiance.is_finite()
+            && radiance.min_element() >= 0.0
+            && light.translucency_scale.is_finite()
+            && light.translucency_scale >= 0.0)
+        {
+            return Err(HostError::Description {
+                field: format!("lights[{index}]"),
+                problem: format!(
+                    "{light:?}: positions, directions (non-zero), ranges (> 0), colours and \
+                     intensities (>= 0) and the translucency scale (>= 0) must be finite"
+                ),
+            }
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
 pub(crate) fn check_views(views: usize) -> Result<()> {
     if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {
@@ -355,5 +413,24 @@ fn frame_scene() -> Scene {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Light;
+    use glam::Vec3;
+
+    #[test]
+    fn lights_that_are_not_finite_or_too_many_are_refused() {
+        let good = Light::point(Vec3::ONE, Vec3::ONE, 2.0, 5.0);
+        check_lights(&[good]).unwrap();
+        let mut bad = good;
+        bad.intensity = f32::NAN;
+        assert!(check_lights(&[bad]).is_err());
+        let zero_range = Light::point(Vec3::ONE, Vec3::ONE, 2.0, 0.0);
+        assert!(check_lights(&[zero_range]).is_err());
+        assert!(check_lights(&vec![good; crate::scene::MAX_LIGHTS + 1]).is_err());
     }
 }

@@ -28,7 +28,8 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
-    check_described, check_views, depth_role, id_role, import_host_image, EffectPasses,
+    check_described, check_lights, check_views, depth_role, id_role, import_host_image,
+    EffectPasses,
 };
 use super::regions::clipped;
 use super::{Lucent, Uploads};
@@ -40,7 +41,7 @@ use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION
 use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::{PowMode, Translucency};
-use crate::scene::{Light, Mesh, MAX_LIGHTS};
+use crate::scene::{Light, Mesh};
 use crate::Result;
 
 /// The effect's fragment shader.
@@ -211,7 +212,7 @@ pub struct TranslucencyFrame<'a> {
     pub view: usize,
     /// The camera the G-buffer was rendered with.
     pub camera: HostCamera,
-    /// The host's lights this frame, in its world (at most [`MAX_LIGHTS`]). Their
+    /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]). Their
     /// `shadows` flag does not apply: the talk's term is unshadowed.
     pub lights: &'a [Light],
     /// The G-buffer's images.
@@ -485,60 +486,6 @@ impl TranslucencyEffect {
     }
 }
 
-/// The host's lights: at most [`MAX_LIGHTS`], each finite, with a finite translucency scale
-/// and, for point and spot lights, a positive range (the shader divides by it).
-pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
-    if lights.len() > MAX_LIGHTS {
-        return Err(HostError::Description {
-            field: "lights".into(),
-            problem: format!("{} lights; at most {MAX_LIGHTS}", lights.len()),
-        }
-        .into());
-    }
-    for (index, light) in lights.iter().enumerate() {
-        let radiance = light.radiance();
-        let geometry_ok = match light.kind {
-            crate::scene::LightKind::Directional { direction } => {
-                direction.is_finite() && direction.length_squared() > 0.0
-            }
-            crate::scene::LightKind::Point { position, range } => {
-                position.is_finite() && range.is_finite() && range > 0.0
-            }
-            crate::scene::LightKind::Spot {
-                position,
-                direction,
-                range,
-                inner_degrees,
-                outer_degrees,
-            } => {
-                position.is_finite()
-                    && direction.is_finite()
-                    && direction.length_squared() > 0.0
-                    && range.is_finite()
-                    && range > 0.0
-                    && inner_degrees.is_finite()
-                    && outer_degrees.is_finite()
-            }
-        };
-        if !(geometry_ok
-            && radiance.is_finite()
-            && radiance.min_element() >= 0.0
-            && light.translucency_scale.is_finite()
-            && light.translucency_scale >= 0.0)
-        {
-            return Err(HostError::Description {
-                field: format!("lights[{index}]"),
-                problem: format!(
-                    "{light:?}: positions, directions (non-zero), ranges (> 0), colours and \
-                     intensities (>= 0) and the translucency scale (>= 0) must be finite"
-                ),
-            }
-            .into());
-        }
-    }
-    Ok(())
-}
-
 /// The effect's graph: the host's images imported (bound when each frame records) and one
 /// fullscreen pass adding the term to the host's light.
 fn declare(
@@ -687,18 +634,6 @@ mod tests {
         };
         let m = TranslucentMaterial::from_translucency(9, &t).unwrap();
         assert_eq!(m.row(), material_row(&t));
-    }
-
-    #[test]
-    fn lights_that_are_not_finite_or_too_many_are_refused() {
-        let good = Light::point(Vec3::ONE, Vec3::ONE, 2.0, 5.0);
-        check_lights(&[good]).unwrap();
-        let mut bad = good;
-        bad.intensity = f32::NAN;
-        assert!(check_lights(&[bad]).is_err());
-        let zero_range = Light::point(Vec3::ONE, Vec3::ONE, 2.0, 0.0);
-        assert!(check_lights(&[zero_range]).is_err());
-        assert!(check_lights(&vec![good; MAX_LIGHTS + 1]).is_err());
     }
 
     #[test]

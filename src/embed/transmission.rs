@@ -34,8 +34,8 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{
-    check_described, check_views, depth_role, frame_albedo, id_role, import_host_image,
-    EffectPasses,
+    check_described, check_lights, check_views, depth_role, frame_albedo, id_role,
+    import_host_image, EffectPasses,
 };
 use super::regions::clipped;
 use super::{Lucent, Uploads};
@@ -47,9 +47,7 @@ use crate::features::pass::FullscreenPass;
 use crate::features::shadows::{ShadowFaceGpu, ShadowUniforms, MAX_SHADOW_FACES};
 use crate::features::sss::transmission::{SssTransmission, MEDIUM_ROWS};
 use crate::features::sss::{IdMap, ProfileTableGpu, MAX_SSS_PROFILES};
-use crate::gpu_scene::{
-    projection_depth_decode, Region, SceneGpu, SceneUpload, TableRegion, FRAME,
-};
+use crate::gpu_scene::{projection_depth_ends, Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::Medium;
 use crate::scene::{Light, LightKind};
@@ -144,6 +142,30 @@ impl ShadowFace {
             projection,
             rect,
         }
+    }
+}
+
+/// A face of lucent's own light-space atlas as a host describes it
+/// ([`crate::features::shadows::ShadowDesc::face_matrices`]): what tests and `lucent bench
+/// --embed` hand the effect to compare it with lucent's own frame.
+impl From<crate::features::shadows::FaceMatrices> for ShadowFace {
+    fn from(face: crate::features::shadows::FaceMatrices) -> Self {
+        let (x, y, edge) = face.tile;
+        Self::new(
+            face.light,
+            face.view,
+            face.projection,
+            vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x as i32,
+                    y: y as i32,
+                },
+                extent: vk::Extent2D {
+                    width: edge,
+                    height: edge,
+                },
+            },
+        )
     }
 }
 
@@ -372,7 +394,7 @@ impl TransmissionEffect {
         timer: Option<&mut super::EffectTimer>,
     ) -> Result<()> {
         let ring = self.passes.slot(frame.slot, frame.view)?;
-        super::translucency::check_lights(frame.lights)?;
+        check_lights(frame.lights)?;
         let inputs = self.check_images(lucent, frame)?;
         let shadows = shadow_table(
             frame.lights,
@@ -608,17 +630,11 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
                        finite near plane, 1 at a finite far one)"
             .to_string()
     };
-    let k = projection_depth_decode(&projection).ok_or_else(standard)?;
-    let distance = |d: f32| {
-        let denominator = k[2] + k[3] * d;
-        (denominator > 1e-9 * k[2].abs().max(k[3].abs())).then(|| (k[0] + k[1] * d) / denominator)
-    };
-    let (Some(near), Some(far)) = (distance(0.0), distance(1.0)) else {
-        return Err(standard());
-    };
+    let (near, far) = projection_depth_ends(&projection).ok_or_else(standard)?;
     if !(near > 0.0 && far > near && far.is_finite()) {
         return Err(standard());
     }
+    let (near, far) = (near as f32, far as f32);
     let scale = projection.y_axis.y.abs();
     if scale.is_nan() || scale <= 0.0 {
         return Err(standard());

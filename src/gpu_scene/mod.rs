@@ -26,8 +26,8 @@ use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 pub use per_frame::{
-    projection_depth_decode, FrameUniforms, PerFrame, PerFrameBinding, Region, SlotTiles,
-    TableRegion, FRAME,
+    projection_depth_decode, projection_depth_ends, FrameUniforms, PerFrame, PerFrameBinding,
+    Region, SlotTiles, TableRegion, FRAME,
 };
 pub use tiles::TileRect;
 

@@ -203,6 +203,24 @@ pub fn projection_depth_decode(projection: &glam::Mat4) -> Option<[f32; 4]> {
     (k[0] != 0.0 || k[1] != 0.0).then_some(k)
 }
 
+/// The view depths `projection` puts at the two ends of the device depth range (depth 0, depth
+/// 1), from [`projection_depth_decode`] evaluated in f64 (near an end the decode's denominator
+/// is a difference of nearly equal terms): +infinity at an end where the denominator vanishes
+/// (an infinite far plane). `None` where the matrix has no depth mapping.
+pub fn projection_depth_ends(projection: &glam::Mat4) -> Option<(f64, f64)> {
+    let k = projection_depth_decode(projection)?.map(f64::from);
+    let at = |d: f64| {
+        let denominator = k[2] + k[3] * d;
+        let depth = (k[0] + k[1] * d) / denominator;
+        if denominator <= 1e-9 * k[2].abs().max(k[3].abs()) || !depth.is_finite() {
+            f64::INFINITY
+        } else {
+            depth
+        }
+    };
+    Some((at(0.0), at(1.0)))
+}
+
 /// The view depth the decode `k` ([`projection_depth_decode`]) gives a depth image's value `d`:
 /// glsl/common/scene.glsl's `linear_depth`, its denominator clamped the same way.
 fn decoded_depth(k: [f32; 4], d: f32) -> f32 {

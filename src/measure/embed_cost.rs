@@ -832,24 +832,7 @@ fn measure_transmission(
         let faces: Vec<ShadowFace> = shadows
             .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
             .into_iter()
-            .map(|f| {
-                let (x, y, edge) = f.tile;
-                ShadowFace::new(
-                    f.light,
-                    f.view,
-                    f.projection,
-                    vk::Rect2D {
-                        offset: vk::Offset2D {
-                            x: x as i32,
-                            y: y as i32,
-                        },
-                        extent: vk::Extent2D {
-                            width: edge,
-                            height: edge,
-                        },
-                    },
-                )
-            })
+            .map(ShadowFace::from)
             .collect();
         let camera = HostCamera::new(
             scene.camera.view(),

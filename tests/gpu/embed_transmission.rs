@@ -171,24 +171,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         .unwrap()
         .face_matrices(&scene, &lucent::gpu_scene::tiles::mesh_bounds(&scene))
         .into_iter()
-        .map(|f| {
-            let (x, y, edge) = f.tile;
-            ShadowFace::new(
-                f.light,
-                f.view,
-                f.projection,
-                vk::Rect2D {
-                    offset: vk::Offset2D {
-                        x: x as i32,
-                        y: y as i32,
-                    },
-                    extent: vk::Extent2D {
-                        width: edge,
-                        height: edge,
-                    },
-                },
-            )
-        })
+        .map(ShadowFace::from)
         .collect();
     assert_eq!(
         faces.len(),

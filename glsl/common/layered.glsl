@@ -4,7 +4,14 @@
 // src/reference/dipole.rs): change both together.
 //
 // Set 0: 0 the frame uniforms, 1 the layered table, 2 depth, 3 GB1 (normal), 4 the layered IDs;
-// then the pass's own bindings.
+// then the pass's own bindings. With LUCENT_HOST_GBUFFER (src/embed/layered.rs
+// `LayeredEffect`) bindings 2 to 4 are a host's depth, normals and material IDs, decoded as
+// the host describes them (the table's host fields: the ID bit field, the normal encoding
+// and each host ID's layered material); LUCENT_HOST_IDS_UINT when the IDs are an
+// unsigned-integer image, LUCENT_HOST_LINEAR_DEPTH when the depth is linear view depth (a
+// define, not a constant: a CPU driver runs both sides of a branch, and the gather rebuilds a
+// position per sample). Every pass reads the G-buffer through layered_id_at,
+// layered_position_at, layered_normal_at and layered_view_depth_at.
 #ifndef LUCENT_LAYERED_GLSL
 #define LUCENT_LAYERED_GLSL
 
@@ -14,6 +21,11 @@
 #include "dipole.glsl"
 #ifdef LUCENT_SHADOWS
 #include "shadows.glsl"
+#endif
+#ifdef LUCENT_HOST_GBUFFER
+#include "host_ids.glsl"
+#include "host_normals.glsl"
+#include "host_depth.glsl"
 #endif
 
 #define MAX_LAYERED_MATERIALS 16
@@ -39,15 +51,56 @@ struct LayeredMaterial {
 layout(std140, set = 0, binding = 1) uniform Layered {
     ivec4 knobs;  // x march steps, y pixel lights, z phase (0 HG, 1 Schlick), w downscale
     LayeredMaterial materials[MAX_LAYERED_MATERIALS];
+#ifdef LUCENT_HOST_GBUFFER
+    uvec4 host_ids;        // host_ids.glsl's decode of the host's material IDs
+    uvec4 host_normals;    // host_normals.glsl's encoding
+    mat4 view_to_world;    // the inverse of the frame's view matrix
+    uvec4 host_materials[64];  // host ID k's layered material at [k / 4][k % 4] (0: none)
+#endif
 } layered;
 
 layout(set = 0, binding = 2) uniform sampler2D gbuffer_depth;
 layout(set = 0, binding = 3) uniform sampler2D gbuffer_normal;
+#if defined(LUCENT_HOST_GBUFFER) && defined(LUCENT_HOST_IDS_UINT)
+layout(set = 0, binding = 4) uniform usampler2D gbuffer_layered;
+#else
 layout(set = 0, binding = 4) uniform sampler2D gbuffer_layered;
+#endif
 
 // The layered material ID at a full-resolution pixel (0: not layered).
 int layered_id_at(ivec2 px) {
+#ifdef LUCENT_HOST_GBUFFER
+    // The host's ID (at most 255 after its bit field: the table has 256 entries).
+    uint host = min(host_material_id(texelFetch(gbuffer_layered, px, 0), layered.host_ids), 255u);
+    return int(layered.host_materials[host >> 2u][host & 3u]);
+#else
     return int(texelFetch(gbuffer_layered, px, 0).r * 255.0 + 0.5);
+#endif
+}
+
+// The view depth (along the view axis) of the surface at a full-resolution pixel.
+float layered_view_depth_at(ivec2 px) {
+    return linear_depth(texelFetch(gbuffer_depth, px, 0).r);
+}
+
+// The world position of the surface at a full-resolution pixel.
+vec3 layered_position_at(ivec2 px) {
+    float depth = texelFetch(gbuffer_depth, px, 0).r;
+#ifdef LUCENT_HOST_LINEAR_DEPTH
+    return position_at_view_depth(vec2(px) + 0.5, linear_depth(depth), layered.view_to_world);
+#else
+    return world_position(vec2(px) + 0.5, depth);
+#endif
+}
+
+// The unit world normal at a full-resolution pixel (a NaN, Inf or zero normal: +Y).
+vec3 layered_normal_at(ivec2 px) {
+#ifdef LUCENT_HOST_GBUFFER
+    return host_normal(texelFetch(gbuffer_normal, px, 0), layered.host_normals,
+                       layered.view_to_world);
+#else
+    return sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+#endif
 }
 
 // The table row of material `id` (read fields through it: copying a row into a local

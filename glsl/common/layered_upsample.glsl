@@ -23,14 +23,14 @@ layout(set = 0, binding = LUCENT_HALF_TERM_BINDING) uniform sampler2D half_term;
 // that material within ~1% of its depth (the pixel itself always counts).
 vec3 upsampled_multiple(ivec2 px, int id) {
     ivec2 size = textureSize(half_term, 0);
-    float here = linear_depth(texelFetch(gbuffer_depth, px, 0).r);
+    float here = layered_view_depth_at(px);
     vec3 sum = vec3(0.0);
     float count = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(px + ivec2(dx, dy), ivec2(0), size - 1);
             vec4 texel = texelFetch(half_term, q, 0);
-            float d = linear_depth(texelFetch(gbuffer_depth, q, 0).r);
+            float d = layered_view_depth_at(q);
             float keep = int(texel.a + 0.5) == id && abs(d - here) <= 0.01 * here ? 1.0 : 0.0;
             sum += keep * texel.rgb;
             count += keep;
@@ -44,7 +44,7 @@ vec3 upsampled_multiple(ivec2 px, int id) {
 vec3 upsampled_multiple(ivec2 px, int id) {
     ivec2 size = ivec2(frame.viewport.xy);
     ivec2 half_size = textureSize(half_term, 0);
-    float here = linear_depth(texelFetch(gbuffer_depth, px, 0).r);
+    float here = layered_view_depth_at(px);
     // Texel k samples pixel 2k: pixel px lies at px / 2 in texel units.
     vec2 t = vec2(px) * 0.5;
     ivec2 base = ivec2(floor(t));
@@ -60,7 +60,7 @@ vec3 upsampled_multiple(ivec2 px, int id) {
         if (int(texel.a + 0.5) != id) {
             continue;
         }
-        float d = linear_depth(texelFetch(gbuffer_depth, min(q * 2, size - 1), 0).r);
+        float d = layered_view_depth_at(min(q * 2, size - 1));
         // Depth agreement within ~1% of the depth: a texel across a fold of the same object
         // (or behind it) gets no say.
         float rel = abs(d - here) / max(0.01 * here, 1e-6);

@@ -17,6 +17,7 @@
 #include "../common/translucency.glsl"
 #include "../common/host_ids.glsl"
 #include "../common/host_normals.glsl"
+#include "../common/host_depth.glsl"
 
 // The host's encodings (src/embed/translucency.rs `HostTranslucencyGpu`).
 layout(std140, set = 0, binding = 2) uniform HostTranslucency {
@@ -49,16 +50,6 @@ bool has_material(uint id) {
     return ((word >> (id % 32u)) & 1u) != 0u;
 }
 
-// The world position at this pixel with linear view depth `z`: along the pixel's ray through
-// the frame's inverse view-projection, at view depth z (the ray's point at device depth 0.5
-// is finite for standard, reversed and infinite projections alike).
-vec3 position_at_view_depth(vec2 frag_coord, float z) {
-    vec3 on_ray = world_position(frag_coord, 0.5);
-    vec3 view = (frame.view * vec4(on_ray, 1.0)).xyz;
-    vec3 at = view * (z / max(-view.z, 1e-30));
-    return (host.view_to_world * vec4(at, 1.0)).xyz;
-}
-
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     uint id = host_material_id(texelFetch(id_image, px, 0), host.ids);
@@ -70,8 +61,7 @@ void main() {
         out_color = vec4(0.0);
         return;
     }
-    vec3 pos = host.depth.x != 0u ? position_at_view_depth(gl_FragCoord.xy, z)
-                                  : world_position(gl_FragCoord.xy, d);
+    vec3 pos = host_world_position(gl_FragCoord.xy, d, host.depth.x != 0u, host.view_to_world);
     Surface s;
     s.albedo = clamp(texelFetch(albedo_image, px, 0).rgb, 0.0, 1.0);
     s.specular = 0.0;

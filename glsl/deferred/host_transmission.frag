@@ -22,6 +22,7 @@
 #include "../common/sss_transmission.glsl"
 #include "../common/host_ids.glsl"
 #include "../common/host_normals.glsl"
+#include "../common/host_depth.glsl"
 
 // The host's encodings (src/embed/transmission.rs `HostTransmissionGpu`).
 layout(std140, set = 0, binding = 2) uniform HostTransmission {
@@ -44,14 +45,6 @@ layout(set = 0, binding = 8) uniform sampler2D albedo_image;
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;
 
-// The world position at this pixel with linear view depth `z` (as host_translucency.frag).
-vec3 position_at_view_depth(vec2 frag_coord, float z) {
-    vec3 on_ray = world_position(frag_coord, 0.5);
-    vec3 view = (frame.view * vec4(on_ray, 1.0)).xyz;
-    vec3 at = view * (z / max(-view.z, 1e-30));
-    return (host.view_to_world * vec4(at, 1.0)).xyz;
-}
-
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
     int id = sss_host_profile(host_material_id(texelFetch(id_image, px, 0),
@@ -64,8 +57,7 @@ void main() {
         out_color = vec4(0.0);
         return;
     }
-    vec3 pos = host.depth.x != 0u ? position_at_view_depth(gl_FragCoord.xy, z)
-                                  : world_position(gl_FragCoord.xy, d);
+    vec3 pos = host_world_position(gl_FragCoord.xy, d, host.depth.x != 0u, host.view_to_world);
     vec3 n = host_normal(texelFetch(normal_image, px, 0), host.normals, host.view_to_world);
     vec3 color = vec3(0.0);
     int count = clamp(frame.light_count.x, 0, MAX_LIGHTS);

@@ -23,9 +23,8 @@ void main() {
         return;
     }
     int mat = layered_row(id);
-    float depth = texelFetch(gbuffer_depth, px, 0).r;
-    vec3 pos = world_position(vec2(px) + 0.5, depth);
-    vec3 n = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+    vec3 pos = layered_position_at(px);
+    vec3 n = layered_normal_at(px);
     // Alpha: the layered material ID, so the gather reads a pixel light's material with it.
     out_irradiance = vec4(finite_term(transmitted_irradiance(pos, n, MAT.info.y, MAT.weights.w)), float(id));
 }

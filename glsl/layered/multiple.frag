@@ -36,9 +36,8 @@ void main() {
     }
     int mat = layered_row(id);
     float eta = MAT.info.y;
-    float depth = texelFetch(gbuffer_depth, px, 0).r;
-    vec3 x_o = world_position(vec2(px) + 0.5, depth);
-    vec3 n_o = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+    vec3 x_o = layered_position_at(px);
+    vec3 n_o = layered_normal_at(px);
     vec3 view = x_o - frame.camera_pos.xyz;
     float view_len2 = dot(view, view);
     vec3 view_dir = view_len2 > 1e-20 ? view * inversesqrt(view_len2) : -n_o;
@@ -81,7 +80,7 @@ void main() {
         if (int(light.a + 0.5) != id) {
             continue; // another object or material: rejected
         }
-        vec3 p = world_position(vec2(qp) + 0.5, texelFetch(gbuffer_depth, qp, 0).r);
+        vec3 p = layered_position_at(qp);
         float r = length(p - x_o);
         vec3 e = light.rgb;
         vec3 rd = dipole_rd(mat, r) * area;

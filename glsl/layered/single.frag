@@ -320,9 +320,8 @@ void main() {
     }
     int mat = layered_row(id);
     float eta = MAT.info.y;
-    float depth = texelFetch(gbuffer_depth, px, 0).r;
-    vec3 x_o = world_position(vec2(px) + 0.5, depth);
-    vec3 n_o = sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
+    vec3 x_o = layered_position_at(px);
+    vec3 n_o = layered_normal_at(px);
     uvec4 texels_o = uvec4(0);
 #ifdef LUCENT_LAYER_DEPTHS
     texels_o = texelFetch(gbuffer_layer_depths, px, 0);

@@ -50,7 +50,7 @@ void main() {
         return;
     }
     int mat = layered_row(id);
-    float here = linear_depth(texelFetch(gbuffer_depth, term_pixel(t), 0).r);
+    float here = layered_view_depth_at(term_pixel(t));
     // Pixels per scene unit at this depth (the focal length in pixels over the depth), and
     // the narrowest channel's diffusion length on screen.
     float px_per_unit = frame.camera.z / max(here, 1e-6);
@@ -69,7 +69,7 @@ void main() {
             continue;
         }
         vec4 texel = texelFetch(term_tex, q, 0);
-        float d = linear_depth(texelFetch(gbuffer_depth, term_pixel(q), 0).r);
+        float d = layered_view_depth_at(term_pixel(q));
         // Same material, within ~1% of the depth (the resolve's rule): no term crosses a
         // silhouette or a fold of the same object.
         if (int(texel.a + 0.5) == id && abs(d - here) <= 0.01 * here) {

@@ -60,6 +60,22 @@ pub enum VertexInput {
     },
     /// A mesh's positions only (binding 0, location 0: depth-only passes).
     Positions,
+    /// A host's mesh streams as the host lays them out (`lucent::embed::VertexLayout`):
+    /// position at location 0 and normal at location 1, each from one of two vertex
+    /// buffer bindings with the host's strides, offsets and formats.
+    Host(HostVertexInput),
+}
+
+/// A host's vertex layout as pipelines take it: two bindings (their strides; 0: the binding is
+/// unused) and the position and normal attributes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HostVertexInput {
+    /// Bytes between consecutive vertices of bindings 0 and 1.
+    pub strides: [u32; 2],
+    /// The position: its binding, format and byte offset in a vertex.
+    pub position: (u32, vk::Format, u32),
+    /// The normal: its binding, format and byte offset in a vertex.
+    pub normal: (u32, vk::Format, u32),
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -202,6 +218,18 @@ impl GraphicsPipeline {
                 vertex_bindings.push(binding(2, 24));
                 vertex_attributes.push(attribute(3, 2, vec2, 0));
                 vertex_attributes.push(attribute(4, 2, vec4, 8));
+            }
+        }
+        if let VertexInput::Host(host) = desc.vertex_input {
+            for (index, stride) in host.strides.into_iter().enumerate() {
+                if stride > 0 {
+                    vertex_bindings.push(binding(index as u32, stride));
+                }
+            }
+            for (location, (stream, format, offset)) in
+                [host.position, host.normal].into_iter().enumerate()
+            {
+                vertex_attributes.push(attribute(location as u32, stream, format, offset));
             }
         }
         if let VertexInput::Positions = desc.vertex_input {

@@ -19,7 +19,8 @@ pub enum Effect {
     /// Screen-space SSS's transmission through thin parts: a medium's diffusion through the
     /// thickness the host's shadow maps measure ([`super::TransmissionEffect`]).
     SssTransmission,
-    /// Li et al.'s multi-layer single + dipole multiple scattering.
+    /// Li et al.'s multi-layer single + dipole multiple scattering, drawn from the host's
+    /// meshes ([`super::LayeredEffect`]).
     LayeredMedia,
     /// The SH environment's diffuse light added to the host's light
     /// ([`super::EnvironmentEffect`]).
@@ -57,9 +58,6 @@ pub enum Support {
     /// Inputs the description lacks, each a [`HostError::Missing`] naming the input and why
     /// the effect needs it (what the effect's constructor would refuse with).
     Lacks(Vec<HostError>),
-    /// The effect has no path on a host's G-buffer yet: it reaches a host only inside
-    /// lucent's whole frame ([`super::SceneRenderer`]). Says what it would need.
-    NotEmbedded(&'static str),
 }
 
 impl Support {
@@ -99,13 +97,10 @@ pub fn capabilities(gbuffer: &GBufferDesc) -> Result<Vec<(Effect, Support)>> {
 /// Whether `effect` can run on `gbuffer` (already checked).
 pub(crate) fn support(effect: Effect, gbuffer: &GBufferDesc) -> Support {
     let lacks = missing(effect, gbuffer);
-    match effect {
-        Effect::LayeredMedia => Support::NotEmbedded(
-            "light-space depth maps of each layered object drawn from the host's vertex and \
-             index buffers",
-        ),
-        _ if lacks.is_empty() => Support::Runs,
-        _ => Support::Lacks(lacks),
+    if lacks.is_empty() {
+        Support::Runs
+    } else {
+        Support::Lacks(lacks)
     }
 }
 
@@ -206,7 +201,22 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                 ));
             }
         }
-        Effect::LayeredMedia => {}
+        Effect::LayeredMedia => {
+            if gbuffer.material_ids.is_none() {
+                out.push(lack(
+                    "material IDs",
+                    "Li et al.'s layered media picks each pixel's medium by its material ID \
+                     (GBufferDesc::with_material_ids)",
+                ));
+            }
+            if gbuffer.normals.is_none() {
+                out.push(lack(
+                    "normals",
+                    "Li et al.'s layered media refracts the view ray and lets light in through \
+                     each pixel's normal (GBufferDesc::with_normals)",
+                ));
+            }
+        }
     }
     out
 }
@@ -242,7 +252,11 @@ mod tests {
             })
             .collect();
         assert_eq!(inputs, ["material IDs", "normals", "albedo", "thickness"]);
-        assert!(matches!(support[3].1, Support::NotEmbedded(_)));
+        // Layered media: IDs and normals.
+        let Support::Lacks(layered) = &support[3].1 else {
+            panic!("{:?}", support[3])
+        };
+        assert_eq!(layered.len(), 2);
         // SSS transmission: IDs, normals and (the albedo in the light) the albedo.
         let Support::Lacks(transmission) = &support[2].1 else {
             panic!("{:?}", support[2])
@@ -266,7 +280,7 @@ mod tests {
             .with_albedo(vk::Format::R8G8B8A8_SRGB)
             .with_thickness(ThicknessDesc::channel(vk::Format::R8_UNORM, 0));
         let support = capabilities(&full).unwrap();
-        assert!(support.iter().filter(|(_, s)| s.runs()).count() == 4);
+        assert!(support.iter().all(|(_, s)| s.runs()));
         // An invalid description is its own error, not a list.
         assert!(capabilities(&full.with_metres_per_unit(-1.0)).is_err());
     }

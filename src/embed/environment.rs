@@ -28,13 +28,13 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
-    check_described, check_views, depth_role, frame_albedo, import_host_image, EffectPasses,
+    check_described, check_environment, check_views, depth_role, frame_albedo, import_host_image,
+    EffectPasses,
 };
 use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
-use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
 use crate::gpu_scene::{projection_depth_ends, Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{LoadOp, RenderGraph, ResourceId};
@@ -242,18 +242,7 @@ impl EnvironmentEffect {
         timer: Option<&mut super::EffectTimer>,
     ) -> Result<()> {
         let ring = self.passes.slot(frame.slot, frame.view)?;
-        let coefficients = frame.environment.coefficients();
-        // A NaN or Inf coefficient would light every pixel with it: refused where it enters.
-        if coefficients.iter().flatten().any(|c| !c.is_finite()) {
-            return Err(HostError::Description {
-                field: "environment".into(),
-                problem: format!(
-                    "{}: its SH coefficients must be finite",
-                    frame.environment.describe()
-                ),
-            }
-            .into());
-        }
+        let coefficients = check_environment(frame.environment)?;
         let gbuffer = &self.desc.gbuffer;
         let uniforms = gbuffer
             .view_uniforms(&frame.camera)?

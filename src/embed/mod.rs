@@ -23,14 +23,16 @@
 //! - [`TransmissionEffect`]: screen-space SSS's transmission through thin parts of the
 //!   materials with a medium ([`TransmissionMaterial`]), measured through the host's own
 //!   shadow maps ([`ShadowFace`]).
+//! - [`LayeredEffect`]: Li et al.'s layered media (transmitted light, single scattering along
+//!   the refracted view ray, the dipole's multiple scattering) added to the host's lit
+//!   diffuse; lucent draws its light-space maps from the host's own vertex and index buffers
+//!   ([`VertexLayout`], [`MeshDraw`]) with the faces the host gives ([`ShadowFace`]).
 //! - [`glsl::TERMS`]: the environment's and GDC 2011's terms as GLSL for the host's own
 //!   lighting pass, where they cost what they cost in lucent's.
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
-//!   SSS transmission, layered media, shadows, the SH environment), tonemapped. This is how
-//!   Li et al.'s layered media reach a host today: they have no path on a host's G-buffer yet
-//!   ([`capabilities`] says so per description).
+//!   SSS transmission, layered media, shadows, the SH environment), tonemapped.
 //!
 //! Effects draw over the screen regions a host gives each frame ([`screen_region`] projects an
 //! object's box), and time their passes only when recorded with `record_timed` and an
@@ -162,9 +164,11 @@ mod environment;
 mod gbuffer;
 pub mod glsl;
 mod image;
+mod layered;
 mod passes;
 mod regions;
 mod scene;
+mod shadow_faces;
 mod sss;
 mod timing;
 mod translucency;
@@ -181,8 +185,13 @@ pub use gbuffer::{
     IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
 };
 pub use image::{HostImage, ImageState};
+pub use layered::{
+    IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages, LayeredMaterial,
+    MeshDraw, VertexAttribute, VertexLayout,
+};
 pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
+pub use shadow_faces::ShadowFace;
 pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
 pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;
@@ -192,14 +201,16 @@ pub use translucency::{
 };
 pub(crate) use transmission::shader_permutations as transmission_permutations;
 pub use transmission::{
-    ShadowFace, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
+    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
     TransmissionMaterial,
 };
 pub use uploads::{leaked, Uploads};
 // The types a host names in its descriptions, and the versions of the crates it must build its
 // handles with.
 pub use crate::error::{HostError, ImageFault};
+pub use crate::features::layered::{LayeredKnobs, PhaseForm};
 pub use crate::features::sss::SssKnobs;
+pub use crate::scene::layered::{Layer, LayeredMedium, Thickness};
 pub use crate::scene::material::{Medium, PowMode, SssProfile, Texturing, Translucency};
 pub use crate::scene::{Environment, Light, LightKind};
 pub use ash;
@@ -212,8 +223,10 @@ pub use glam;
 /// errors ([`HostError`]). 4: [`SssFrame::regions`] (the blurs' screen regions),
 /// [`TranslucencyEffect`], [`capabilities`], [`EffectTimer`] and `record_timed`. 5:
 /// [`EnvironmentEffect`], [`TransmissionEffect`] (with [`ShadowFace`]), [`glsl::TERMS`];
-/// [`capabilities`] reports SSS transmission and the environment as effects that run.
-pub const API_VERSION: u32 = 5;
+/// [`capabilities`] reports SSS transmission and the environment as effects that run. 6:
+/// [`LayeredEffect`] (with [`VertexLayout`] and [`MeshDraw`]); `Support::NotEmbedded` is gone
+/// (every effect of [`Effect::ALL`] has a path on a host's G-buffer).
+pub const API_VERSION: u32 = 6;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -222,6 +222,23 @@ pub(crate) fn check_lights(lights: &[crate::scene::Light]) -> Result<()> {
     Ok(())
 }
 
+/// An environment's nine SH coefficients, refused unless finite (a NaN or Inf coefficient
+/// would light every pixel with it: refused where it enters).
+pub(crate) fn check_environment(environment: &crate::scene::Environment) -> Result<[[f32; 4]; 9]> {
+    let coefficients = environment.coefficients();
+    if coefficients.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(HostError::Description {
+            field: "environment".into(),
+            problem: format!(
+                "{}: its SH coefficients must be finite",
+                environment.describe()
+            ),
+        }
+        .into());
+    }
+    Ok(coefficients)
+}
+
 /// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
 pub(crate) fn check_views(views: usize) -> Result<()> {
     if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {

@@ -621,6 +621,164 @@ impl PassExec for ShadowPass {
     }
 }
 
+/// One draw of a host's mesh into the light-space maps ([`host_shadow_pass`]): its vertex
+/// buffers (bindings 0 and 1 of the host's layout, each with its byte offset), its index
+/// buffer (with offset and type; `None`: a non-indexed draw), how many indices (or vertices)
+/// from which first one, the model matrix and its layered material ID (0: it only casts).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HostShadowDraw {
+    pub vertex_buffers: [(vk::Buffer, vk::DeviceSize); 2],
+    pub indices: Option<(vk::Buffer, vk::DeviceSize, vk::IndexType)>,
+    pub count: u32,
+    pub first: u32,
+    pub vertex_offset: i32,
+    pub model: Mat4,
+    pub layered_id: u8,
+}
+
+/// What [`host_shadow_pass`] draws in the frame being recorded: each face's square tile
+/// (origin and edge, in face order) and the draws, every draw into every face. The effect
+/// fills it just before it records the frame.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct HostShadowFrame {
+    pub tiles: Vec<((u32, u32), u32)>,
+    pub draws: Vec<HostShadowDraw>,
+}
+
+/// Declares the `light-space maps` pass of a host's meshes (`lucent::embed::LayeredEffect`):
+/// a depth atlas of `extent` and its entry target (each texel's first surface's normal and
+/// layered material), drawn with the same shaders as lucent's own maps from the host's vertex
+/// and index buffers laid out as `input` says, the draws and faces `frame` holds when the
+/// pass records. Its table is the shadow table region, as lucent's own.
+pub(crate) fn host_shadow_pass(
+    graph: &mut RenderGraph,
+    (width, height): (u32, u32),
+    input: crate::backend::pipeline::HostVertexInput,
+    frame: Arc<std::sync::Mutex<HostShadowFrame>>,
+    scene: &Arc<SceneGpu>,
+) -> ShadowMaps {
+    let info = |format| ImageInfo {
+        width,
+        height,
+        format,
+    };
+    let mut maps = ShadowMaps {
+        depth: graph.create_image("light-space.depth", info(SHADOW_DEPTH_FORMAT)),
+        ids: None,
+        entry: Some(graph.create_image("light-space.entry", info(ENTRY_FORMAT))),
+        layer_depths: None,
+    };
+    let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
+    if let Some(entry) = &mut maps.entry {
+        // Not cleared, as lucent's own: readers trust an entry only where the depth says a
+        // surface was drawn.
+        pass.color(entry, LoadOp::DontCare);
+    }
+    pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
+    pass.execute(HostShadowPass {
+        scene: scene.clone(),
+        input,
+        frame,
+        pipeline: None,
+    });
+    maps
+}
+
+struct HostShadowPass {
+    scene: Arc<SceneGpu>,
+    input: crate::backend::pipeline::HostVertexInput,
+    frame: Arc<std::sync::Mutex<HostShadowFrame>>,
+    pipeline: Option<PassPipeline>,
+}
+
+impl PassExec for HostShadowPass {
+    fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        let defines = shadow_map_defines(false, true, 0);
+        self.pipeline = Some(PassPipeline::new(
+            ctx,
+            &[Binding::PerFrame(
+                self.scene.per_frame.binding(&TABLE_REGION),
+            )],
+            &GraphicsPipelineDesc {
+                vertex: SHADOW_VERTEX,
+                fragment: SHADOW_FRAGMENT,
+                defines: &defines,
+                vertex_input: VertexInput::Host(self.input),
+                depth_test: true,
+                // Open meshes cast from both sides, as in lucent's own maps.
+                cull_back: false,
+                additive_attachments: 0,
+                set_layouts: &[],
+                push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+                name: "light-space maps",
+            },
+        )?);
+        Ok(())
+    }
+
+    fn record(&self, ctx: &RecordContext<'_>) {
+        let Some(pipeline) = &self.pipeline else {
+            return;
+        };
+        // A poisoned lock means a panic elsewhere while filling it: draw nothing rather than
+        // half a frame.
+        let Ok(frame) = self.frame.lock() else {
+            return;
+        };
+        pipeline.bind(ctx);
+        let device = &ctx.gpu.device;
+        let streams = 1 + usize::from(self.input.strides[1] > 0);
+        for (face, &(origin, edge)) in frame.tiles.iter().enumerate() {
+            super::util::set_tile_viewport(ctx, origin, edge);
+            for draw in &frame.draws {
+                let constants = ShadowConstants {
+                    model: draw.model.to_cols_array_2d(),
+                    face_id: [face as i32, 0, i32::from(draw.layered_id), 0],
+                };
+                let buffers = draw.vertex_buffers.map(|(buffer, _)| buffer);
+                let offsets = draw.vertex_buffers.map(|(_, offset)| offset);
+                // SAFETY: recording inside the pass's render pass with its pipeline bound; the
+                // host's buffers are valid for the frame (its contract, checked non-null).
+                unsafe {
+                    device.cmd_push_constants(
+                        ctx.cmd,
+                        pipeline.pipeline.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&constants),
+                    );
+                    device.cmd_bind_vertex_buffers(
+                        ctx.cmd,
+                        0,
+                        &buffers[..streams],
+                        &offsets[..streams],
+                    );
+                    match draw.indices {
+                        Some((buffer, offset, index_type)) => {
+                            device.cmd_bind_index_buffer(ctx.cmd, buffer, offset, index_type);
+                            device.cmd_draw_indexed(
+                                ctx.cmd,
+                                draw.count,
+                                1,
+                                draw.first,
+                                draw.vertex_offset,
+                                0,
+                            );
+                        }
+                        None => device.cmd_draw(ctx.cmd, draw.count, 1, draw.first, 0),
+                    }
+                }
+            }
+        }
+    }
+
+    fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
+        if let Some(mut p) = self.pipeline.take() {
+            p.destroy(&gpu.device);
+        }
+    }
+}
+
 /// The light-space maps pass's shaders.
 const SHADOW_VERTEX: &str = "shadow/depth.vert";
 const SHADOW_FRAGMENT: &str = "shadow/depth.frag";

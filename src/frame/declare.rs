@@ -29,6 +29,8 @@ pub struct GBufferOutputs {
     pub sss: Option<ResourceId>,
     /// View-plane LEAN slope y and second moments (LCB and LBB frames).
     pub lean: Option<ResourceId>,
+    /// Li et al.'s layered material IDs (frames with layered media).
+    pub layered: Option<ResourceId>,
     /// Depth.
     pub depth: ResourceId,
     /// Its layout.
@@ -152,6 +154,7 @@ pub fn declare_frame(
                 layer_depth_textures: gb.layout.layer_depth_textures,
                 shadows: shadow_maps.as_ref(),
                 film: gb.layout.layered_film,
+                host: None,
             },
             &settings.layered,
             scene_gpu,
@@ -201,6 +204,7 @@ pub fn declare_frame(
             .chain(gb.gb2.as_ref())
             .chain(gb.sss.as_ref())
             .chain(gb.lean.as_ref())
+            .chain(gb.layered.as_ref())
         {
             graph.export_image(image, Access::TransferRead);
         }
@@ -210,6 +214,7 @@ pub fn declare_frame(
             gb2: gb.gb2.as_ref().map(|h| h.id()),
             sss: gb.sss.as_ref().map(|h| h.id()),
             lean: gb.lean.as_ref().map(|h| h.id()),
+            layered: gb.layered.as_ref().map(|h| h.id()),
             depth: gb.depth.id(),
             layout,
         }

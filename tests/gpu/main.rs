@@ -14,6 +14,7 @@ mod debug_view;
 mod deformation;
 mod embed;
 mod embed_environment;
+mod embed_layered;
 mod embed_translucency;
 mod embed_transmission;
 mod environment;

@@ -312,6 +312,52 @@ pub struct LayeredInputs<'a> {
     pub shadows: Option<&'a ShadowMaps>,
     /// The ID target holds each pixel's albedo texel too ([`LayeredDesc::film`]).
     pub film: bool,
+    /// `None`: lucent's own G-buffer. `Some`: a host's (`lucent::embed::LayeredEffect`), its
+    /// depth, normals and material IDs decoded as the table's host fields and these say.
+    pub host: Option<LayeredHost>,
+}
+
+/// What a host's G-buffer changes in the layered passes' shaders (their permutation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LayeredHost {
+    /// The material IDs are an unsigned-integer image (`LUCENT_HOST_IDS_UINT`).
+    pub uint_ids: bool,
+    /// The depth is linear view depth (`LUCENT_HOST_LINEAR_DEPTH`), else a device depth.
+    pub linear_depth: bool,
+}
+
+impl LayeredHost {
+    /// Every host permutation.
+    const ALL: [LayeredHost; 4] = [
+        LayeredHost {
+            uint_ids: false,
+            linear_depth: false,
+        },
+        LayeredHost {
+            uint_ids: true,
+            linear_depth: false,
+        },
+        LayeredHost {
+            uint_ids: false,
+            linear_depth: true,
+        },
+        LayeredHost {
+            uint_ids: true,
+            linear_depth: true,
+        },
+    ];
+
+    /// Its defines.
+    fn defines(self) -> Vec<(&'static str, &'static str)> {
+        let mut defines = vec![("LUCENT_HOST_GBUFFER", "1")];
+        if self.uint_ids {
+            defines.push(("LUCENT_HOST_IDS_UINT", "1"));
+        }
+        if self.linear_depth {
+            defines.push(("LUCENT_HOST_LINEAR_DEPTH", "1"));
+        }
+        defines
+    }
 }
 
 /// Declares `layered irradiance`, `single scattering` and `multiple scattering`; both
@@ -474,6 +520,9 @@ fn layered_pass<'g>(
         graph.resources()[h.id()].info.width != graph.resources()[inputs.depth.id()].info.width
     });
     let mut pass = FullscreenPass::new(graph, kind.name(), kind.fragment(), scene);
+    if let Some(host) = inputs.host {
+        pass.defines(&host.defines());
+    }
     pass.per_frame(&FRAME)
         .per_frame(&TABLE_REGION)
         .sample(inputs.depth)
@@ -628,6 +677,8 @@ struct LayeredShape {
     entry_depths: bool,
     /// The ID target carries the albedo film (single scattering applies it).
     film: bool,
+    /// A host's G-buffer.
+    host: Option<LayeredHost>,
 }
 
 impl LayeredShape {
@@ -636,6 +687,9 @@ impl LayeredShape {
     /// GB1, 4 IDs, then the pass's own in this order).
     fn defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut defines: Vec<(&str, &str)> = Vec::new();
+        if let Some(host) = self.host {
+            defines.extend(host.defines());
+        }
         let mut next = 5;
         let single = self.kind == Kind::Single;
         next += usize::from(self.irradiance);
@@ -692,22 +746,31 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
                 continue;
             }
             for layer_depths in [None, Some(1), Some(2)] {
-                let shape = LayeredShape {
-                    kind,
-                    half_res: bit(0),
-                    irradiance: bit(1),
-                    half_term: bit(2),
-                    full_res_term: bit(6),
-                    layer_depths,
-                    shadows: bit(3),
-                    entry: bit(4),
-                    entry_depths: bit(5),
-                    film: bit(7),
-                };
-                out.push(crate::backend::shader::PipelineShaders::fullscreen(
-                    kind.fragment(),
-                    &shape.defines(),
-                ));
+                for host in std::iter::once(None).chain(LayeredHost::ALL.map(Some)) {
+                    // A host's G-buffer: lucent draws the maps with their entry target, and
+                    // neither depth textures nor the film are embedded.
+                    let embedded = layer_depths.is_none() && bit(3) && bit(4) && !bit(5) && !bit(7);
+                    if host.is_some() && !embedded {
+                        continue;
+                    }
+                    let shape = LayeredShape {
+                        kind,
+                        half_res: bit(0),
+                        irradiance: bit(1),
+                        half_term: bit(2),
+                        full_res_term: bit(6),
+                        layer_depths,
+                        shadows: bit(3),
+                        entry: bit(4),
+                        entry_depths: bit(5),
+                        film: bit(7),
+                        host,
+                    };
+                    out.push(crate::backend::shader::PipelineShaders::fullscreen(
+                        kind.fragment(),
+                        &shape.defines(),
+                    ));
+                }
             }
         }
     }
@@ -789,7 +852,10 @@ mod tests {
         for kind in Kind::ALL {
             for flags in 0u32..1 << 8 {
                 let bit = |i: u32| flags & (1 << i) != 0;
-                for textures in 0..=2 {
+                for (textures, host) in (0..=2)
+                    .map(|t| (t, None))
+                    .chain(LayeredHost::ALL.map(|h| (0, Some(h))))
+                {
                     let mut graph = RenderGraph::new();
                     let mut image = |name: &str| graph.create_image(name, info);
                     let (depth, gb1, ids) = (image("depth"), image("gb1"), image("ids"));
@@ -815,6 +881,7 @@ mod tests {
                         layer_depth_textures: textures,
                         shadows: maps.as_ref(),
                         film: bit(7),
+                        host,
                     };
                     let scale = if bit(0) { 2 } else { 1 };
                     let pass = layered_pass(
@@ -837,6 +904,7 @@ mod tests {
                         entry: bit(4),
                         entry_depths: bit(5),
                         film: bit(7),
+                        host,
                     };
                     assert_eq!(pass.shader_defines(), shape.defines(), "{shape:?}");
                 }

@@ -1,0 +1,783 @@
+//! [`LayeredEffect`]: Li et al.'s layered media (single scattering along the refracted view
+//! ray, light transmitted through the object, and the dipole's multiple scattering) added to a
+//! host's lit diffuse, on the host's own G-buffer and drawn from the host's own meshes.
+//!
+//! The host describes, for each of its materials that is a layered medium, its ID in the
+//! host's material ID image and its medium ([`LayeredMaterial`]: lucent's `[material.layers]`,
+//! a [`LayeredMedium`]). Each frame it hands over its lights, its environment, its G-buffer
+//! (depth, normals, material IDs) and the meshes it drew ([`MeshDraw`]: its own vertex and
+//! index buffers, laid out as the description's [`VertexLayout`] says, each with its model
+//! matrix and material ID). lucent then records, into the host's command buffer:
+//!
+//! 1. `light-space maps`: every mesh drawn into each face of the frame's [`ShadowFace`]s, into
+//!    lucent's own depth atlas (of the description's size) and its entry target (the first
+//!    surface's normal and layered material: where light enters an object). The same shaders
+//!    as lucent's own maps; the faces' matrices are the host's (a host that renders shadow
+//!    maps already passes the same faces).
+//! 2. The passes of lucent's own frame (src/features/layered): the transmitted irradiance,
+//!    the dipole's gather over it, its blur, and single scattering, which adds
+//!    `λ3 L_t + λ4 L_ss + λ5 L_ms` into the host's lit diffuse. The same GLSL, reading the
+//!    host's G-buffer as it is encoded (`LUCENT_HOST_GBUFFER`: the ID bit field, the normal
+//!    encoding and the depth encoding are per-frame constants in the layered table).
+//!
+//! Eq. 3's `λ1 L_d + λ2 L_s` is the host's own lighting: a host weights its diffuse and
+//! specular light of a layered material by the medium's `weights[0]` and `weights[1]`, as
+//! lucent's G-buffer does. The medium's lengths are scaled by the G-buffer's
+//! [`GBufferDesc::metres_per_unit`], not by its own `units_per_mm`.
+//!
+//! Not embedded (refused by name): layers whose thickness is read from a depth texture
+//! (`TexDep`), and the albedo film (`post` texturing of a layered material).
+
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use glam::Mat4;
+
+use super::capabilities::{require, Effect};
+use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera};
+use super::image::{distinct_inputs, HostImage, Role};
+use super::passes::{
+    check_described, check_environment, check_lights, check_views, depth_role, id_role,
+    import_host_image, EffectPasses,
+};
+use super::regions::clipped;
+use super::shadow_faces::{shadow_table, ShadowFace};
+use super::{Lucent, Uploads};
+use crate::backend::access::Access;
+use crate::backend::format::format_name;
+use crate::backend::pipeline::HostVertexInput;
+use crate::error::HostError;
+use crate::features::layered::{
+    layered_passes, LayeredDesc, LayeredHost, LayeredInputs, LayeredKnobs, LayeredTableGpu,
+    MAX_LAYERED_MATERIALS, TABLE_REGION,
+};
+use crate::features::shadows::{
+    self, host_shadow_pass, HostShadowDraw, HostShadowFrame, ShadowUniforms, MAX_ATLAS_EXTENT,
+};
+use crate::gpu_scene::{SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
+use crate::graph::{RenderGraph, ResourceId};
+use crate::scene::layered::LayeredMedium;
+use crate::scene::{Environment, Light};
+use crate::Result;
+
+/// One material of the host that is a layered medium: its ID in the host's material ID image
+/// and its medium.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct LayeredMaterial {
+    /// The host's ID (1 to 255; 0 is taken to mean "not layered").
+    pub id: u8,
+    /// The medium (its layers, index and eq. 3's weights; its `units_per_mm` is replaced by
+    /// the G-buffer's world scale).
+    pub medium: LayeredMedium,
+}
+
+impl LayeredMaterial {
+    /// Material `id` with `medium`.
+    pub fn new(id: u8, medium: LayeredMedium) -> Self {
+        Self { id, medium }
+    }
+}
+
+/// One attribute of the host's vertices: the vertex buffer binding it is read from (0 or 1),
+/// its format and its byte offset within a vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct VertexAttribute {
+    /// The binding (0 or 1: [`MeshDraw::vertex_buffers`]).
+    pub binding: u32,
+    /// Its format: positions `R32G32B32_SFLOAT`, `R32G32B32A32_SFLOAT` or
+    /// `R16G16B16A16_SFLOAT`; normals those or `R8G8B8A8_SNORM`, `R16G16B16A16_SNORM`,
+    /// `A2B10G10R10_SNORM_PACK32` (each where the device reads it from vertex buffers).
+    pub format: vk::Format,
+    /// Byte offset within a vertex.
+    pub offset: u32,
+}
+
+impl VertexAttribute {
+    /// An attribute of `format` at `offset` in binding `binding`.
+    pub fn new(binding: u32, format: vk::Format, offset: u32) -> Self {
+        Self {
+            binding,
+            format,
+            offset,
+        }
+    }
+}
+
+/// How the host's vertex buffers hold the positions and normals lucent draws its light-space
+/// maps with: up to two bindings (a stride each; 0: unused) and where each attribute is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct VertexLayout {
+    /// Bytes between consecutive vertices of bindings 0 and 1 (0: the binding is unused).
+    pub strides: [u32; 2],
+    /// The object-space position.
+    pub position: VertexAttribute,
+    /// The object-space normal (outward; it need not be unit length).
+    pub normal: VertexAttribute,
+}
+
+impl VertexLayout {
+    /// One interleaved stream of `stride` bytes: an `f32` position at `position_offset` and an
+    /// `f32` normal at `normal_offset`.
+    pub fn interleaved(stride: u32, position_offset: u32, normal_offset: u32) -> Self {
+        let vec3 = vk::Format::R32G32B32_SFLOAT;
+        Self {
+            strides: [stride, 0],
+            position: VertexAttribute::new(0, vec3, position_offset),
+            normal: VertexAttribute::new(0, vec3, normal_offset),
+        }
+    }
+
+    /// Any layout: the bindings' strides and the two attributes.
+    pub fn new(strides: [u32; 2], position: VertexAttribute, normal: VertexAttribute) -> Self {
+        Self {
+            strides,
+            position,
+            normal,
+        }
+    }
+
+    /// The layout as the pipeline takes it, each attribute checked: in a used binding, within
+    /// its stride, in a format the device reads from vertex buffers.
+    fn check(&self, gpu: &crate::backend::GpuContext) -> Result<HostVertexInput> {
+        // Vulkan's guaranteed minimums of maxVertexInputBindingStride and
+        // maxVertexInputAttributeOffset.
+        const MAX_STRIDE: u32 = 2048;
+        const MAX_OFFSET: u32 = 2047;
+        if self.strides.iter().any(|&s| s > MAX_STRIDE) || self.strides[0] == 0 {
+            return Err(HostError::Description {
+                field: "vertices.strides".into(),
+                problem: format!(
+                    "{:?}: binding 0 is used (stride > 0), and strides are at most {MAX_STRIDE}",
+                    self.strides
+                ),
+            }
+            .into());
+        }
+        let vec3 = vk::Format::R32G32B32_SFLOAT;
+        let vec4 = vk::Format::R32G32B32A32_SFLOAT;
+        let half4 = vk::Format::R16G16B16A16_SFLOAT;
+        // Each accepted format with its bytes.
+        let positions = [(vec3, 12), (vec4, 16), (half4, 8)];
+        let normals = [
+            (vec3, 12),
+            (vec4, 16),
+            (half4, 8),
+            (vk::Format::R8G8B8A8_SNORM, 4),
+            (vk::Format::R16G16B16A16_SNORM, 8),
+            (vk::Format::A2B10G10R10_SNORM_PACK32, 4),
+        ];
+        let mut attributes = [(0, vec3, 0); 2];
+        for (k, (name, attribute, accepted)) in [
+            ("vertices.position", self.position, &positions[..]),
+            ("vertices.normal", self.normal, &normals[..]),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let names: Vec<String> = accepted.iter().map(|&(f, _)| format_name(f)).collect();
+            let bytes = accepted
+                .iter()
+                .find(|(f, _)| *f == attribute.format)
+                .map(|&(_, bytes)| bytes);
+            let readable = bytes.is_some() && {
+                // SAFETY: a query of the host's physical device.
+                let properties = unsafe {
+                    gpu.instance.get_physical_device_format_properties(
+                        gpu.physical_device,
+                        attribute.format,
+                    )
+                };
+                properties
+                    .buffer_features
+                    .contains(vk::FormatFeatureFlags::VERTEX_BUFFER)
+            };
+            if !readable {
+                return Err(HostError::Unsupported {
+                    input: name.into(),
+                    found: format!("format {}", format_name(attribute.format)),
+                    accepted: format!("{} (read from vertex buffers)", names.join(", ")),
+                }
+                .into());
+            }
+            let bytes = bytes.unwrap_or(0);
+            let stride = self
+                .strides
+                .get(attribute.binding as usize)
+                .copied()
+                .unwrap_or(0);
+            if stride == 0 || attribute.offset > MAX_OFFSET || attribute.offset + bytes > stride {
+                return Err(HostError::Description {
+                    field: name.into(),
+                    problem: format!(
+                        "{attribute:?}: its binding must be 0 or 1 with a stride, and its {bytes} \
+                         bytes at its offset (at most {MAX_OFFSET}) within that stride \
+                         ({stride})"
+                    ),
+                }
+                .into());
+            }
+            attributes[k] = (attribute.binding, attribute.format, attribute.offset);
+        }
+        Ok(HostVertexInput {
+            strides: self.strides,
+            position: attributes[0],
+            normal: attributes[1],
+        })
+    }
+}
+
+/// What a [`LayeredEffect`] is built for.
+#[derive(Clone, Debug)]
+#[non_exhaustive]
+pub struct LayeredEffectDesc {
+    /// The host's G-buffer: it must describe its normals and material IDs.
+    pub gbuffer: GBufferDesc,
+    /// The layered materials (1 to 16 of them).
+    pub materials: Vec<LayeredMaterial>,
+    /// How the host's vertex buffers hold positions and normals.
+    pub vertices: VertexLayout,
+    /// The size of lucent's light-space atlas (each side 16 to 8192 texels), which every
+    /// frame's [`LayeredFrame::light_faces`] lie in.
+    pub light_space: vk::Extent2D,
+    /// Li et al.'s knobs (march steps, pixel lights, phase function, resolutions).
+    pub knobs: LayeredKnobs,
+    /// Views recorded per frame (1 to [`super::MAX_VIEWS_PER_FRAME`]).
+    pub views_per_frame: usize,
+}
+
+impl LayeredEffectDesc {
+    /// The effect over `gbuffer` for `materials`, drawing meshes laid out as `vertices` into a
+    /// light-space atlas of `light_space`, with the default knobs, one view a frame.
+    pub fn new(
+        gbuffer: GBufferDesc,
+        materials: Vec<LayeredMaterial>,
+        vertices: VertexLayout,
+        light_space: vk::Extent2D,
+    ) -> Self {
+        Self {
+            gbuffer,
+            materials,
+            vertices,
+            light_space,
+            knobs: LayeredKnobs::default(),
+            views_per_frame: 1,
+        }
+    }
+
+    /// With these knobs.
+    pub fn with_knobs(mut self, knobs: LayeredKnobs) -> Self {
+        self.knobs = knobs;
+        self
+    }
+
+    /// With this many views per frame.
+    pub fn with_views_per_frame(mut self, views: usize) -> Self {
+        self.views_per_frame = views;
+        self
+    }
+}
+
+/// A host's index buffer: the buffer, the byte offset of index 0 and the index type
+/// (`UINT16` or `UINT32`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IndexBuffer {
+    /// The buffer (with `INDEX_BUFFER` usage).
+    pub buffer: vk::Buffer,
+    /// Byte offset of index 0.
+    pub offset: vk::DeviceSize,
+    /// `UINT16` or `UINT32`.
+    pub index_type: vk::IndexType,
+}
+
+/// One mesh the host drew this frame, as lucent draws it into its light-space maps: the
+/// host's buffers (valid until the frame completes), the range drawn, its model matrix and
+/// its material ID (the host's; an ID without a [`LayeredMaterial`] casts shadows only).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct MeshDraw {
+    /// The vertex buffers of bindings 0 and 1 (with `VERTEX_BUFFER` usage), each with the
+    /// byte offset of vertex 0; binding 1's is ignored when the layout does not use it.
+    pub vertex_buffers: [(vk::Buffer, vk::DeviceSize); 2],
+    /// The index buffer; `None`: the vertices are drawn in order.
+    pub indices: Option<IndexBuffer>,
+    /// Indices (or, without an index buffer, vertices) drawn: a multiple of 3 (triangles).
+    pub count: u32,
+    /// The first index (or vertex).
+    pub first: u32,
+    /// Added to each index before the vertex is fetched.
+    pub vertex_offset: i32,
+    /// Object to world.
+    pub transform: Mat4,
+    /// The host's material ID of the mesh.
+    pub material_id: u8,
+}
+
+impl MeshDraw {
+    /// `count` vertices of `vertex_buffer` (binding 0, offset 0) in order, three per
+    /// triangle, placed by `transform`, of material `material_id`.
+    pub fn new(vertex_buffer: vk::Buffer, count: u32, transform: Mat4, material_id: u8) -> Self {
+        Self {
+            vertex_buffers: [(vertex_buffer, 0), (vk::Buffer::null(), 0)],
+            indices: None,
+            count,
+            first: 0,
+            vertex_offset: 0,
+            transform,
+            material_id,
+        }
+    }
+
+    /// This draw through `indices` (`count` then counts indices).
+    pub fn with_indices(mut self, indices: IndexBuffer) -> Self {
+        self.indices = Some(indices);
+        self
+    }
+
+    /// This draw with binding 1's vertex buffer (for layouts with two bindings).
+    pub fn with_second_binding(mut self, buffer: vk::Buffer, offset: vk::DeviceSize) -> Self {
+        self.vertex_buffers[1] = (buffer, offset);
+        self
+    }
+}
+
+/// The host's images for one view of one frame, each with its current and final state.
+#[derive(Clone, Copy, Debug)]
+pub struct LayeredImages<'a> {
+    /// The depth image (a depth format's view of its depth aspect, or linear depth).
+    pub depth: &'a HostImage,
+    /// The normals.
+    pub normals: &'a HostImage,
+    /// The material IDs (for stencil bits: a view of the depth-stencil image's stencil
+    /// aspect).
+    pub material_ids: &'a HostImage,
+}
+
+/// One view of one frame: what [`LayeredEffect::record`] reads and adds to.
+#[derive(Clone, Copy, Debug)]
+pub struct LayeredFrame<'a> {
+    /// The frame-in-flight slot (0 to the frames in flight of the [`Lucent`]).
+    pub slot: usize,
+    /// The view within the frame.
+    pub view: usize,
+    /// The camera the G-buffer was rendered with.
+    pub camera: HostCamera,
+    /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
+    pub lights: &'a [Light],
+    /// The environment whose light enters the media (Li et al.'s ambient term; `None`: none).
+    pub environment: Option<&'a Environment>,
+    /// The faces lucent draws its light-space maps with (at most
+    /// [`crate::features::shadows::MAX_SHADOW_FACES`]), each light's together and in order,
+    /// their rectangles inside [`LayeredEffectDesc::light_space`]. A light without faces
+    /// lights the media unshadowed, and its entry points are the shaded surface's plane.
+    pub light_faces: &'a [ShadowFace],
+    /// The meshes drawn into the maps: every object that casts, layered or not.
+    pub meshes: &'a [MeshDraw],
+    /// The images.
+    pub images: LayeredImages<'a>,
+    /// Screen rectangles the layered materials may cover this frame; empty: the whole
+    /// screen. Clipped to the G-buffer.
+    pub regions: &'a [vk::Rect2D],
+    /// The host's lit diffuse light, which the terms are added to (a colour attachment of the
+    /// description's diffuse format that can be blended; its contents are kept, so it cannot
+    /// come in UNDEFINED).
+    pub lighting: &'a HostImage,
+}
+
+/// The layered table with the host's decode (glsl/common/layered.glsl `Layered` under
+/// `LUCENT_HOST_GBUFFER`, std140).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct HostLayeredTableGpu {
+    table: LayeredTableGpu,
+    host_ids: [u32; 4],
+    host_normals: [u32; 4],
+    view_to_world: [[f32; 4]; 4],
+    /// Host ID k's layered material at `[k / 4][k % 4]`.
+    host_materials: [[u32; 4]; 64],
+}
+
+/// The graph's imports, by input.
+#[derive(Clone, Copy, Debug)]
+struct Imports {
+    depth: ResourceId,
+    normals: ResourceId,
+    material_ids: ResourceId,
+    lighting: ResourceId,
+}
+
+/// Li et al.'s layered media on a host's G-buffer (see the module docs).
+pub struct LayeredEffect {
+    passes: EffectPasses,
+    imports: Imports,
+    desc: LayeredEffectDesc,
+    /// The table every frame shares; each frame adds its view.
+    table: HostLayeredTableGpu,
+    /// What the light-space maps pass draws: filled just before each frame records.
+    shadow_frame: Arc<Mutex<HostShadowFrame>>,
+}
+
+impl LayeredEffect {
+    /// Builds the effect for `desc`, checking all of it first. Its tables are written into
+    /// lucent's own host-visible per-frame buffer: nothing is recorded into `uploads`,
+    /// submitted or waited for (`uploads` is taken so that every effect is built alike).
+    pub fn new(lucent: &Lucent, uploads: &mut Uploads, desc: LayeredEffectDesc) -> Result<Self> {
+        let gbuffer = &desc.gbuffer;
+        gbuffer.check()?;
+        require(Effect::LayeredMedia, gbuffer)?;
+        let (Some(ids), Some(normals)) = (gbuffer.material_ids, gbuffer.normals) else {
+            unreachable!("missing() lists each input the effect reads");
+        };
+        check_views(desc.views_per_frame)?;
+        let input = desc.vertices.check(lucent.gpu())?;
+        let extent = desc.light_space;
+        let sides = 16..=MAX_ATLAS_EXTENT;
+        if !(sides.contains(&extent.width) && sides.contains(&extent.height)) {
+            return Err(HostError::Description {
+                field: "light_space".into(),
+                problem: format!(
+                    "{}x{}: each side 16 to {MAX_ATLAS_EXTENT} texels",
+                    extent.width, extent.height
+                ),
+            }
+            .into());
+        }
+        if desc.materials.is_empty() || desc.materials.len() > MAX_LAYERED_MATERIALS {
+            return Err(HostError::Description {
+                field: "materials".into(),
+                problem: format!(
+                    "{} layered materials; 1 to {MAX_LAYERED_MATERIALS} are supported",
+                    desc.materials.len()
+                ),
+            }
+            .into());
+        }
+        let id_map = ids.decode(Vec::new())?;
+        let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
+        let mut host_materials = [[0u32; 4]; 64];
+        let mut media = Vec::with_capacity(desc.materials.len());
+        for (index, material) in desc.materials.iter().enumerate() {
+            let field = format!("materials[{index}] (ID {})", material.id);
+            let id = usize::from(material.id);
+            if id == 0
+                || host_materials[id / 4][id % 4] != 0
+                || u32::from(material.id) > id_map.mask
+            {
+                return Err(HostError::Description {
+                    field,
+                    problem: "IDs are 1 to 255, each once, within the material ID image's bit \
+                              field"
+                        .into(),
+                }
+                .into());
+            }
+            let medium = LayeredMedium {
+                units_per_mm,
+                ..material.medium.clone()
+            };
+            if medium.depth_textures_needed() > 0 {
+                return Err(HostError::Unsupported {
+                    input: field,
+                    found: "a layer whose thickness is read from a depth texture (TexDep)".into(),
+                    accepted: "layers of a constant thickness in mm, and the rest of the object"
+                        .into(),
+                }
+                .into());
+            }
+            medium.validate().map_err(|e| HostError::Description {
+                field: field.clone(),
+                problem: e.to_string(),
+            })?;
+            host_materials[id / 4][id % 4] = index as u32 + 1;
+            media.push(medium);
+        }
+        let uint_ids = id_map.uint;
+        let (host_ids, _) = crate::features::sss::IdMap::Host(id_map).rows();
+        let layered = LayeredDesc {
+            materials: media,
+            object_ids: Vec::new(),
+            film: false,
+        };
+        let table = HostLayeredTableGpu {
+            table: layered.table(&desc.knobs),
+            host_ids,
+            host_normals: normals.decode()?,
+            view_to_world: Mat4::IDENTITY.to_cols_array_2d(),
+            host_materials,
+        };
+        let upload = SceneUpload {
+            translucency_ids: None,
+            profile_ids: None,
+            normal_maps: false,
+            lean: false,
+            albedo_maps: false,
+            frames_in_flight: 1,
+            tables: vec![
+                TableRegion {
+                    region: &TABLE_REGION,
+                    bytes: std::mem::size_of::<HostLayeredTableGpu>() as u64,
+                },
+                shadows::table_region(),
+            ],
+            layered_ids: None,
+            layer_depth_textures: 0,
+        };
+        let shadow_frame = Arc::new(Mutex::new(HostShadowFrame::default()));
+        let (passes, imports) = EffectPasses::new(
+            lucent,
+            uploads,
+            "LayeredEffect",
+            upload,
+            desc.views_per_frame,
+            |scene_gpu| declare(&desc, uint_ids, input, shadow_frame.clone(), scene_gpu),
+        )?;
+        Ok(Self {
+            passes,
+            imports,
+            desc,
+            table,
+            shadow_frame,
+        })
+    }
+
+    super::passes::effect_methods!(
+        LayeredFrame,
+        "`frame.meshes` drawn into lucent's light-space maps with `frame.light_faces`, then Li et al.'s transmitted, single and multiple scattering terms of the layered materials added to `frame.lighting`"
+    );
+
+    fn record_with(
+        &mut self,
+        lucent: &Lucent,
+        cmd: vk::CommandBuffer,
+        frame: &LayeredFrame<'_>,
+        timer: Option<&mut super::EffectTimer>,
+    ) -> Result<()> {
+        let ring = self.passes.slot(frame.slot, frame.view)?;
+        check_lights(frame.lights)?;
+        let coefficients = frame
+            .environment
+            .map(check_environment)
+            .transpose()?
+            .unwrap_or([[0.0; 4]; 9]);
+        let inputs = self.check_images(lucent, frame)?;
+        let light_table = shadow_table(frame.lights, frame.light_faces, self.desc.light_space)?;
+        let draws = self.draws(frame.meshes)?;
+        let gbuffer = &self.desc.gbuffer;
+        let uniforms = gbuffer
+            .view_uniforms(&frame.camera)?
+            .with_lights(frame.lights)
+            .with_environment(coefficients);
+        let table = HostLayeredTableGpu {
+            view_to_world: frame.camera.view.inverse().to_cols_array_2d(),
+            ..self.table
+        };
+        let per_frame = self.passes.per_frame();
+        per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        per_frame.write(ring, &TABLE_REGION, bytemuck::bytes_of(&table))?;
+        per_frame.write(
+            ring,
+            &shadows::TABLE_REGION,
+            bytemuck::bytes_of(&light_table),
+        )?;
+        // The layered passes draw in the slot's `layered` tiles, the term's blur in its
+        // `layered_blur` ones (which the blur's shader narrows per texel).
+        let rects = if frame.regions.is_empty() {
+            vec![TileRect {
+                x: 0,
+                y: 0,
+                width: gbuffer.width,
+                height: gbuffer.height,
+                translucent: true,
+            }]
+        } else {
+            clipped(frame.regions, gbuffer.extent())
+        };
+        {
+            let mut tiles = per_frame.tiles(ring);
+            tiles.layered_blur = rects.clone();
+            tiles.layered = rects;
+        }
+        *self.shadow_frame.lock().unwrap_or_else(|e| e.into_inner()) = HostShadowFrame {
+            tiles: face_tiles(&light_table, frame.light_faces.len()),
+            draws,
+        };
+        let images = &frame.images;
+        let binds = [
+            (self.imports.depth, images.depth),
+            (self.imports.normals, images.normals),
+            (self.imports.material_ids, images.material_ids),
+            (self.imports.lighting, frame.lighting),
+        ];
+        self.passes.record(
+            lucent,
+            cmd,
+            ring,
+            &binds,
+            &inputs,
+            (frame.lighting, Role::Accumulate),
+            timer,
+        )
+    }
+
+    /// The frame's meshes as the light-space pass draws them, each checked: its buffers given,
+    /// whole triangles, a finite model matrix, a 16- or 32-bit index type.
+    fn draws(&self, meshes: &[MeshDraw]) -> Result<Vec<HostShadowDraw>> {
+        let two_bindings = self.desc.vertices.strides[1] > 0;
+        meshes
+            .iter()
+            .enumerate()
+            .map(|(index, mesh)| {
+                let bad = |problem: &str| -> crate::LucentError {
+                    HostError::Description {
+                        field: format!("meshes[{index}]"),
+                        problem: problem.into(),
+                    }
+                    .into()
+                };
+                if mesh.vertex_buffers[0].0 == vk::Buffer::null()
+                    || (two_bindings && mesh.vertex_buffers[1].0 == vk::Buffer::null())
+                {
+                    return Err(bad("a vertex buffer of a binding the layout uses is null"));
+                }
+                if mesh.count % 3 != 0 {
+                    return Err(bad("its count is not whole triangles (a multiple of 3)"));
+                }
+                if !mesh.transform.is_finite() {
+                    return Err(bad("its transform is not finite"));
+                }
+                let indices = match mesh.indices {
+                    None => None,
+                    Some(i) if i.buffer == vk::Buffer::null() => {
+                        return Err(bad("its index buffer is null"))
+                    }
+                    Some(i)
+                        if i.index_type != vk::IndexType::UINT16
+                            && i.index_type != vk::IndexType::UINT32 =>
+                    {
+                        return Err(bad("its index type is neither UINT16 nor UINT32"))
+                    }
+                    Some(i) => Some((i.buffer, i.offset, i.index_type)),
+                };
+                let id = usize::from(mesh.material_id);
+                Ok(HostShadowDraw {
+                    vertex_buffers: mesh.vertex_buffers,
+                    indices,
+                    count: mesh.count,
+                    first: mesh.first,
+                    vertex_offset: mesh.vertex_offset,
+                    model: mesh.transform,
+                    layered_id: self.table.host_materials[id / 4][id % 4] as u8,
+                })
+            })
+            .collect()
+    }
+
+    /// Checks every image of `frame` against the description; returns the inputs, one per
+    /// distinct Vulkan image.
+    fn check_images<'a>(
+        &self,
+        lucent: &Lucent,
+        frame: &LayeredFrame<'a>,
+    ) -> Result<Vec<&'a HostImage>> {
+        let gbuffer = &self.desc.gbuffer;
+        let images = &frame.images;
+        let ids = gbuffer.material_ids.expect("checked at new");
+        let normal_format = gbuffer.normals.expect("checked at new").format;
+        check_described(
+            lucent,
+            gbuffer.extent(),
+            &[
+                (
+                    images.depth,
+                    "depth",
+                    depth_role(gbuffer),
+                    gbuffer.depth.format,
+                ),
+                (images.normals, "normals", Role::SampledColor, normal_format),
+                (
+                    images.material_ids,
+                    "material IDs",
+                    id_role(&ids),
+                    ids.format,
+                ),
+                (
+                    frame.lighting,
+                    "lighting",
+                    Role::Accumulate,
+                    gbuffer.diffuse.format,
+                ),
+            ],
+        )?;
+        distinct_inputs(
+            [images.depth, images.normals, images.material_ids],
+            frame.lighting,
+        )
+    }
+}
+
+/// Each face's tile (origin, edge) in face order, from the checked shadow table.
+fn face_tiles(table: &ShadowUniforms, faces: usize) -> Vec<((u32, u32), u32)> {
+    table.faces[..faces]
+        .iter()
+        .map(|f| ((f.rect[0] as u32, f.rect[1] as u32), f.rect[2] as u32))
+        .collect()
+}
+
+/// The effect's graph: the host's images imported (bound when each frame records), lucent's
+/// light-space maps of the host's meshes, and the layered passes adding into the host's light.
+fn declare(
+    desc: &LayeredEffectDesc,
+    uint_ids: bool,
+    input: HostVertexInput,
+    shadow_frame: Arc<Mutex<HostShadowFrame>>,
+    scene_gpu: &Arc<SceneGpu>,
+) -> (RenderGraph, Imports) {
+    let gbuffer = &desc.gbuffer;
+    let mut graph = RenderGraph::new();
+    let mut import = |name: &str, format: vk::Format, initial: Access| {
+        import_host_image(&mut graph, gbuffer, name, format, initial)
+    };
+    let sampled = Access::FragmentSampledRead;
+    let depth = import("host depth", gbuffer.depth.format, sampled);
+    let normal_format = gbuffer.normals.expect("checked at new").format;
+    let normals = import("host normals", normal_format, sampled);
+    let ids_format = gbuffer.material_ids.expect("checked at new").format;
+    let material_ids = import("host material IDs", ids_format, sampled);
+    let lighting = import(
+        "host lighting",
+        gbuffer.diffuse.format,
+        Access::ColorAttachmentWrite,
+    );
+    let imports = Imports {
+        depth: depth.id(),
+        normals: normals.id(),
+        material_ids: material_ids.id(),
+        lighting: lighting.id(),
+    };
+    let extent = (desc.light_space.width, desc.light_space.height);
+    let maps = host_shadow_pass(&mut graph, extent, input, shadow_frame, scene_gpu);
+    let inputs = LayeredInputs {
+        depth: &depth,
+        gb1: &normals,
+        ids: &material_ids,
+        layer_depths: None,
+        layer_depth_textures: 0,
+        shadows: Some(&maps),
+        film: false,
+        host: Some(LayeredHost {
+            uint_ids,
+            linear_depth: gbuffer.depth.encoding == DepthEncoding::LinearView,
+        }),
+    };
+    let lighting = layered_passes(&mut graph, lighting, &inputs, &desc.knobs, Some(scene_gpu));
+    graph.export_image(&lighting, Access::ColorAttachmentWrite);
+    (graph, imports)
+}
+
+// Effects move to a loader thread and back.
+const _: () = {
+    const fn send<T: Send>() {}
+    send::<LayeredEffect>();
+};

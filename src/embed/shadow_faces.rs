@@ -1,0 +1,300 @@
+//! [`ShadowFace`]: one face of a light's depth map as a host describes it (its light, its view
+//! and projection matrices, its square rectangle in one depth atlas), and the shadow table
+//! lucent's shaders read (glsl/common/shadows.glsl `Shadows`) made from a frame's faces, each
+//! checked. [`super::TransmissionEffect`] reads the host's own maps through it;
+//! [`super::LayeredEffect`] draws lucent's light-space maps of the host's meshes with the
+//! faces' matrices into its own atlas.
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use crate::error::HostError;
+use crate::features::shadows::{ShadowFaceGpu, ShadowUniforms, MAX_SHADOW_FACES};
+use crate::gpu_scene::projection_depth_ends;
+use crate::scene::{Light, LightKind};
+use crate::Result;
+
+/// One face of a host's shadow map: the light it belongs to, the matrices the host rendered
+/// it with and where it lies in the shadow map image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ShadowFace {
+    /// Index of its light in the frame's lights.
+    pub light: usize,
+    /// World to the face's view space (looking down -z).
+    pub view: Mat4,
+    /// The face's view to clip space: standard Z (0 near, 1 far, finite planes), perspective
+    /// (a spot light's cone, a point light's 90-degree faces) or orthographic (a directional
+    /// light), either y convention.
+    pub projection: Mat4,
+    /// Its square rectangle in the shadow map image, in texels, which the host's viewport
+    /// covered when it rendered the face.
+    pub rect: vk::Rect2D,
+}
+
+impl ShadowFace {
+    /// Face `rect` of light `light`, rendered with `view` and `projection`.
+    pub fn new(light: usize, view: Mat4, projection: Mat4, rect: vk::Rect2D) -> Self {
+        Self {
+            light,
+            view,
+            projection,
+            rect,
+        }
+    }
+}
+
+/// A face of lucent's own light-space atlas as a host describes it
+/// ([`crate::features::shadows::ShadowDesc::face_matrices`]): what tests and `lucent bench
+/// --embed` hand the effect to compare it with lucent's own frame.
+impl From<crate::features::shadows::FaceMatrices> for ShadowFace {
+    fn from(face: crate::features::shadows::FaceMatrices) -> Self {
+        let (x, y, edge) = face.tile;
+        Self::new(
+            face.light,
+            face.view,
+            face.projection,
+            vk::Rect2D {
+                offset: vk::Offset2D {
+                    x: x as i32,
+                    y: y as i32,
+                },
+                extent: vk::Extent2D {
+                    width: edge,
+                    height: edge,
+                },
+            },
+        )
+    }
+}
+
+/// The unit axes a point light's six faces look along, in order.
+const CUBE_AXES: [Vec3; 6] = [
+    Vec3::X,
+    Vec3::NEG_X,
+    Vec3::Y,
+    Vec3::NEG_Y,
+    Vec3::Z,
+    Vec3::NEG_Z,
+];
+
+/// The shadow table (glsl/common/shadows.glsl `Shadows`, what lucent's own light-space maps
+/// fill) of the host's faces in a shadow map of `extent`, each checked: its light exists and
+/// has one face (six for a point light, in [`CUBE_AXES`] order, together), its matrices are
+/// finite with a standard-Z projection, its rectangle square and inside the map.
+pub(crate) fn shadow_table(
+    lights: &[Light],
+    faces: &[ShadowFace],
+    extent: vk::Extent2D,
+) -> Result<ShadowUniforms> {
+    let bad = |index: usize, problem: String| -> crate::LucentError {
+        HostError::Description {
+            field: format!("shadow_faces[{index}]"),
+            problem,
+        }
+        .into()
+    };
+    if faces.len() > MAX_SHADOW_FACES {
+        return Err(HostError::Description {
+            field: "shadow_faces".into(),
+            problem: format!("{} faces; at most {MAX_SHADOW_FACES}", faces.len()),
+        }
+        .into());
+    }
+    let mut table: ShadowUniforms = bytemuck::Zeroable::zeroed();
+    let (w, h) = (extent.width.max(1) as f32, extent.height.max(1) as f32);
+    table.atlas = [w, h, 1.0 / w, 1.0 / h];
+    for light in table.lights.iter_mut() {
+        *light = [-1, 0, 0, 0];
+    }
+    let mut index = 0;
+    while index < faces.len() {
+        let light = faces[index].light;
+        let Some(kind) = lights.get(light).map(|l| l.kind) else {
+            return Err(bad(
+                index,
+                format!("light {light}: the frame has {} lights", lights.len()),
+            ));
+        };
+        if table.lights[light][0] >= 0 {
+            return Err(bad(
+                index,
+                format!("light {light}'s faces must come together, once"),
+            ));
+        }
+        let count = match kind {
+            LightKind::Point { .. } => 6,
+            _ => 1,
+        };
+        if index + count > faces.len()
+            || faces[index..index + count].iter().any(|f| f.light != light)
+        {
+            return Err(bad(
+                index,
+                format!(
+                    "light {light} needs {count} face{} in a row ({})",
+                    if count == 1 { "" } else { "s" },
+                    if count == 6 {
+                        "a point light: +X, -X, +Y, -Y, +Z, -Z"
+                    } else {
+                        "a spot or directional light"
+                    }
+                ),
+            ));
+        }
+        table.lights[light] = [index as i32, count as i32, 0, 0];
+        for k in 0..count {
+            let face = &faces[index + k];
+            table.faces[index + k] =
+                face_row(face, extent).map_err(|problem| bad(index + k, problem))?;
+            if count == 6 {
+                // The face's view axis in the world: -z of its view space.
+                let forward = face
+                    .view
+                    .inverse()
+                    .transform_vector3(Vec3::NEG_Z)
+                    .normalize();
+                if forward.dot(CUBE_AXES[k]) < 0.999 {
+                    return Err(bad(
+                        index + k,
+                        format!(
+                            "face {k} of point light {light} looks along {forward}; the six \
+                             faces look along +X, -X, +Y, -Y, +Z, -Z in that order"
+                        ),
+                    ));
+                }
+            }
+        }
+        index += count;
+    }
+    Ok(table)
+}
+
+/// A face's row of the shadow table: its view-projection, rectangle and the parameters
+/// glsl/common/shadows.glsl reads (a map texel's world size at a point, near and far: see
+/// [`ShadowFaceGpu::params`]), or what is wrong with it.
+fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<ShadowFaceGpu, String> {
+    let (view, projection) = (face.view, face.projection);
+    if !(view.is_finite() && projection.is_finite()) || view.determinant().abs() < 1e-12 {
+        return Err("its view and projection must be finite, the view invertible".into());
+    }
+    let r = face.rect;
+    let inside = r.offset.x >= 0
+        && r.offset.y >= 0
+        && r.extent.width > 0
+        && u64::from(r.offset.x as u32) + u64::from(r.extent.width) <= u64::from(extent.width)
+        && u64::from(r.offset.y as u32) + u64::from(r.extent.height) <= u64::from(extent.height);
+    if !inside || r.extent.width != r.extent.height {
+        return Err(format!(
+            "its rectangle {r:?} must be square and inside the {}x{} shadow map",
+            extent.width, extent.height
+        ));
+    }
+    let edge = r.extent.width as f32;
+    let standard = || {
+        "a perspective or orthographic projection with standard Z (depth 0 at a \
+                       finite near plane, 1 at a finite far one)"
+            .to_string()
+    };
+    let (near, far) = projection_depth_ends(&projection).ok_or_else(standard)?;
+    if !(near > 0.0 && far > near && far.is_finite()) {
+        return Err(standard());
+    }
+    let (near, far) = (near as f32, far as f32);
+    let scale = projection.y_axis.y.abs();
+    if scale.is_nan() || scale <= 0.0 {
+        return Err(standard());
+    }
+    let orthographic = projection.w_axis.w != 0.0;
+    // A map texel's world size at a point: x * clip.w + y (glsl map_texel_size).
+    let texel = 2.0 / (scale * edge);
+    let params = if orthographic {
+        [0.0, texel, -near, far]
+    } else {
+        [texel, 0.0, near, far]
+    };
+    Ok(ShadowFaceGpu {
+        view_proj: (projection * view).to_cols_array_2d(),
+        rect: [r.offset.x as f32, r.offset.y as f32, edge, 0.0],
+        params,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rect(x: i32, y: i32, edge: u32) -> vk::Rect2D {
+        vk::Rect2D {
+            offset: vk::Offset2D { x, y },
+            extent: vk::Extent2D {
+                width: edge,
+                height: edge,
+            },
+        }
+    }
+
+    #[test]
+    fn a_spot_face_becomes_lucents_row_and_bad_faces_are_named() {
+        let extent = vk::Extent2D {
+            width: 512,
+            height: 256,
+        };
+        let view = Mat4::look_at_rh(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, Vec3::Z);
+        let projection = Mat4::perspective_rh(1.0, 1.0, 0.1, 20.0);
+        let spot = Light {
+            kind: LightKind::Spot {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                direction: Vec3::NEG_Y,
+                range: 10.0,
+                inner_degrees: 20.0,
+                outer_degrees: 30.0,
+            },
+            ..Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 1.0)
+        };
+        let face = ShadowFace::new(0, view, projection, rect(256, 0, 256));
+        let table = shadow_table(&[spot], &[face], extent).unwrap();
+        assert_eq!(table.lights[0], [0, 1, 0, 0]);
+        assert_eq!(table.lights[1][0], -1);
+        let row = table.faces[0];
+        assert_eq!(row.rect, [256.0, 0.0, 256.0, 0.0]);
+        assert!((row.params[2] - 0.1).abs() < 1e-4 && (row.params[3] - 20.0).abs() < 0.05);
+        // x = 2 tan(fov / 2) / edge.
+        assert!(
+            (row.params[0] - 2.0 * 0.5f32.tan() / 256.0).abs() < 1e-6,
+            "{row:?}"
+        );
+        for bad in [
+            ShadowFace::new(1, view, projection, rect(0, 0, 256)), // no such light
+            ShadowFace::new(0, view, projection, rect(300, 0, 256)), // outside the map
+            ShadowFace::new(0, view, projection, rect(-1, 0, 64)),
+            ShadowFace::new(
+                0,
+                view,
+                Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.1),
+                rect(0, 0, 64),
+            ),
+            ShadowFace::new(0, Mat4::ZERO, projection, rect(0, 0, 64)),
+        ] {
+            assert!(shadow_table(&[spot], &[bad], extent).is_err(), "{bad:?}");
+        }
+        // A point light needs its six faces, in order.
+        let point = Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 5.0);
+        let cube: Vec<ShadowFace> = CUBE_AXES
+            .iter()
+            .enumerate()
+            .map(|(k, &axis)| {
+                let up = if axis.y.abs() > 0.5 { Vec3::Z } else { Vec3::Y };
+                let view = Mat4::look_at_rh(Vec3::ZERO, axis, up);
+                let projection = Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.05, 5.0);
+                ShadowFace::new(0, view, projection, rect(64 * k as i32, 0, 64))
+            })
+            .collect();
+        let table = shadow_table(&[point], &cube, extent).unwrap();
+        assert_eq!(table.lights[0], [0, 6, 0, 0]);
+        let mut swapped = cube.clone();
+        swapped.swap(0, 1);
+        assert!(shadow_table(&[point], &swapped, extent).is_err());
+        assert!(shadow_table(&[point], &cube[..3], extent).is_err());
+    }
+}

@@ -22,6 +22,10 @@
 //!   host inserts of it): lucent's ambient inside its lighting pass is the lighting pass with
 //!   the scene's environment minus the lighting pass with none, against the
 //!   `EnvironmentEffect`'s one pass over the whole screen.
+//! - **Li et al.'s layered media** (`--technique layered`): each pass of the `LayeredEffect`
+//!   (its light-space maps drawn from the scene's meshes in host vertex and index buffers, its
+//!   regions the layered objects' screen bounds, its faces lucent's own) against lucent's pass
+//!   of the same name.
 //! - **GDC 2011 translucency** (`--technique translucency`): lucent adds the term inside its
 //!   lighting pass, so its cost there is the lighting pass with translucency minus the
 //!   lighting pass without (`none`, a third frame in the rotation, lighting unmerged as
@@ -38,10 +42,12 @@ use crate::backend::{GpuContext, GpuImage, ImageDesc};
 use crate::embed::{
     DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, EnvironmentEffect, EnvironmentEffectDesc,
     EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
-    ImageState, Lucent, NormalDesc, OptionalFeatures, ShadowFace, SssEffect, SssEffectDesc,
-    SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
-    TranslucencyFrame, TranslucencyImages, TranslucentMaterial, TransmissionEffect,
-    TransmissionEffectDesc, TransmissionFrame, TransmissionImages, TransmissionMaterial,
+    ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages,
+    LayeredMaterial, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace, SssEffect,
+    SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect,
+    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
+    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
+    TransmissionMaterial, VertexLayout,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -149,16 +155,17 @@ pub fn embed_cost(
         module.is_some_and(|m| m.name() == crate::features::translucency::TRANSLUCENCY.name());
     // `none`, plain lighting: what a host inserts of it is the SH environment's light.
     let environment = matches!(technique, Technique::None);
+    let layered = module.is_some_and(|m| m.name() == crate::features::layered::LAYERED.name());
     let blur =
         module.and_then(|m| registry::sss_blurs().find(|b| b.name() == m.name() && !b.lean()));
-    if !translucency && !environment && blur.is_none() {
+    if !translucency && !environment && !layered && blur.is_none() {
         let blurs: Vec<&str> = registry::sss_blurs()
             .filter(|b| !b.lean())
             .map(|b| b.name())
             .collect();
         return Err(LucentError::InvalidInput(format!(
-            "--embed measures an effect a host can insert: --technique {}, translucency or \
-             none (the SH environment) (not '{}')",
+            "--embed measures an effect a host can insert: --technique {}, translucency, \
+             layered or none (the SH environment) (not '{}')",
             blurs.join(", "),
             technique.name()
         )));
@@ -180,12 +187,25 @@ pub fn embed_cost(
             "TranslucencyEffect"
         } else if environment {
             "EnvironmentEffect"
+        } else if layered {
+            "LayeredEffect"
         } else {
             "SssEffect"
         },
         technique.name()
     );
-    let rows = if environment {
+    let rows = if layered {
+        measure_layered(
+            gpu,
+            shaders,
+            pipeline_cache,
+            &lucent,
+            scene,
+            technique,
+            (width, height),
+            (frames, warmup),
+        )
+    } else if environment {
         measure_environment(
             gpu,
             shaders,
@@ -884,6 +904,221 @@ fn measure_transmission(
                 .collect(),
         )
     })
+}
+
+/// Li et al.'s layered media: each pass of the `LayeredEffect` against lucent's pass of the
+/// same name, on a host G-buffer of lucent's own frame (its layered material numbers as the
+/// host's R8_UNORM IDs), the scene's meshes in host buffers (interleaved f32 positions and
+/// normals, 32-bit indices), lucent's own light-space faces, the layered objects' screen
+/// bounds as the regions.
+#[allow(clippy::too_many_arguments)]
+fn measure_layered(
+    gpu: &GpuContext,
+    shaders: &ShaderCompiler,
+    pipeline_cache: &PipelineCache,
+    lucent: &Lucent,
+    scene: &Scene,
+    technique: Technique,
+    size: (u32, u32),
+    (frames, warmup): (usize, usize),
+) -> Result<Vec<EmbedCostRow>> {
+    let settings = FrameSettings {
+        export_shadows: true,
+        ..term_settings(technique, size)
+    };
+    let desc = crate::features::layered::LayeredDesc::new(scene)?
+        .ok_or_else(|| LucentError::InvalidInput("the scene has no layered material".into()))?;
+    let shadows = crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false);
+    let renderer = Renderer::new(gpu, shaders, pipeline_cache, scene, settings)?;
+    let mut images = Images::default();
+    let mut buffers: Vec<crate::backend::GpuBuffer> = Vec::new();
+    let measured = (|| {
+        let (width, height) = size;
+        let (host, gb) = HostGBuffer::of(gpu, &renderer, &mut images, size)?;
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let ids: Vec<u8> = gb
+            .layered
+            .as_ref()
+            .map(|v| v.iter().map(|&k| k as u8).collect())
+            .unwrap_or_default();
+        let id_image = images.upload(
+            gpu,
+            &ImageDesc::color(width, height, vk::Format::R8_UNORM, sampled),
+            ids,
+            "host IDs",
+        )?;
+        let id_image = host_image(id_image, "host IDs", vk::Format::R8_UNORM, size, sampled);
+        // Every mesh in a host vertex buffer and index buffer of its own.
+        let mut meshes = Vec::with_capacity(scene.meshes.len());
+        for mesh in &scene.meshes {
+            let vertices: Vec<f32> = mesh
+                .positions
+                .iter()
+                .zip(&mesh.normals)
+                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+                .collect();
+            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+            buffers.push(gpu.upload_buffer(&vertices, usage, "host vertices")?);
+            let usage = vk::BufferUsageFlags::INDEX_BUFFER;
+            buffers.push(gpu.upload_buffer(&mesh.indices, usage, "host indices")?);
+            let n = buffers.len();
+            meshes.push((
+                buffers[n - 2].buffer,
+                buffers[n - 1].buffer,
+                mesh.indices.len(),
+            ));
+        }
+        let draws: Vec<MeshDraw> = scene
+            .objects
+            .iter()
+            .zip(&desc.object_ids)
+            .map(|(o, &id)| {
+                let (vertices, indices, count) = meshes[o.mesh];
+                MeshDraw::new(vertices, count as u32, o.transform, id).with_indices(IndexBuffer {
+                    buffer: indices,
+                    offset: 0,
+                    index_type: vk::IndexType::UINT32,
+                })
+            })
+            .collect();
+        let (faces, atlas) = match &shadows {
+            Some(s) => (
+                s.face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
+                    .into_iter()
+                    .map(ShadowFace::from)
+                    .collect(),
+                s.extent(),
+            ),
+            None => (Vec::new(), (64, 64)),
+        };
+        let units_per_mm = desc.materials[0].units_per_mm;
+        let gbuffer = host
+            .desc
+            .clone()
+            .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
+            .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        let materials = desc
+            .materials
+            .iter()
+            .enumerate()
+            .map(|(k, m)| LayeredMaterial::new(k as u8 + 1, m.clone()))
+            .collect();
+        let mut effect = build(gpu, lucent, |u| {
+            LayeredEffect::new(
+                lucent,
+                u,
+                LayeredEffectDesc::new(
+                    gbuffer,
+                    materials,
+                    VertexLayout::interleaved(24, 0, 12),
+                    vk::Extent2D {
+                        width: atlas.0,
+                        height: atlas.1,
+                    },
+                )
+                .with_knobs(renderer.settings.layered),
+            )
+        })?;
+        let mut timer = EffectTimer::new(lucent, 16)?;
+        let camera = HostCamera::new(
+            scene.camera.view(),
+            scene.camera.projection(width as f32 / height as f32),
+        );
+        let regions = object_regions(scene, &camera, size, |i, _| {
+            (desc.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)
+        });
+        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
+        let mut run = || -> Result<()> {
+            for round in 0..warmup + frames {
+                let frame = renderer.render_once(gpu)?;
+                host_frame(gpu, |cmd| {
+                    effect.record_timed(
+                        lucent,
+                        cmd,
+                        &LayeredFrame {
+                            slot: 0,
+                            view: 0,
+                            camera,
+                            lights: &scene.lights,
+                            environment: Some(&scene.environment),
+                            light_faces: &faces,
+                            meshes: &draws,
+                            images: LayeredImages {
+                                depth: &host.depth,
+                                normals: &host.normals,
+                                material_ids: &id_image,
+                            },
+                            regions: &regions,
+                            lighting: &host.lighting,
+                        },
+                        &mut timer,
+                    )
+                })?;
+                if round < warmup {
+                    continue;
+                }
+                for pass in &frame.timing.passes {
+                    ours.push(&pass.name, pass.ms);
+                }
+                for pass in timer.results(lucent)?.unwrap_or_default() {
+                    theirs.push(&pass.name, pass.ms);
+                }
+            }
+            Ok(())
+        };
+        let result = run();
+        timer.destroy(lucent);
+        effect.destroy(lucent);
+        result?;
+        // The effect's passes in their order, each beside lucent's pass of the same name.
+        let mut names: Vec<String> = Vec::new();
+        for pass in effect_pass_order(&theirs) {
+            if !names.contains(&pass) {
+                names.push(pass);
+            }
+        }
+        Ok(names
+            .into_iter()
+            .map(|name| EmbedCostRow {
+                lucent_ms: ours.median(&name),
+                host_ms: theirs.median(&name),
+                pass: name,
+            })
+            .collect())
+    })();
+    let idle = gpu.wait_idle();
+    for buffer in buffers {
+        gpu.destroy_buffer(buffer);
+    }
+    images.destroy(gpu);
+    renderer.destroy(gpu);
+    idle?;
+    measured
+}
+
+/// The passes timed, by name (the layered effect's names are its passes in order: maps,
+/// irradiance, multiple scattering, its blur, single scattering).
+fn effect_pass_order(samples: &Samples) -> Vec<String> {
+    const ORDER: [&str; 5] = [
+        "light-space maps",
+        "layered irradiance",
+        "multiple scattering",
+        "multiple scattering blur",
+        "single scattering",
+    ];
+    let mut names: Vec<String> = ORDER
+        .iter()
+        .filter(|n| samples.0.contains_key(**n))
+        .map(|n| n.to_string())
+        .collect();
+    names.extend(
+        samples
+            .0
+            .keys()
+            .filter(|k| !ORDER.contains(&k.as_str()))
+            .cloned(),
+    );
+    names
 }
 
 /// lucent's frame of a scene with a lighting term (`lit`) and without (`plain`), each

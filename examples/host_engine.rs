@@ -11,8 +11,9 @@
 //! 1. **G-buffer** (raster, procedural spheres, a thin jade leaf and a floor): reversed-Z D32
 //!    depth with an infinite far plane, octahedral normals in RG16_SNORM, albedo in RGBA8, the
 //!    engine's own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5,
-//!    leaf 9, floor 0) and local thickness in R8_UNORM, which the leaf's draw takes from the
-//!    engine's vertex buffer (baked once by `lucent::embed::bake_thickness`).
+//!    leaf 9, an apple-flesh ball 23, floor 0) and local thickness in R8_UNORM, which the
+//!    leaf's draw takes from the engine's vertex buffer (baked once by
+//!    `lucent::embed::bake_thickness`).
 //! 2. **Lighting** (fullscreen): a sun and a point light behind the leaf (and, without lucent
 //!    or with `--engine-ambient`, the engine's own sky-over-ground ambient term), lit diffuse
 //!    and specular apart, in B10G11R11 (RGBA16F where the device cannot render B10G11R11).
@@ -23,7 +24,14 @@
 //! 4. **lucent's translucency** (`TranslucencyEffect`): the light of the engine's two lights
 //!    let through the leaf, added to the lit diffuse (the engine's lights, as
 //!    `lucent::embed::Light`s).
-//! 5. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
+//! 5. **lucent's layered media** (`LayeredEffect`): Li et al.'s transmitted, single and
+//!    multiple scattering of the apple-flesh ball (a `LayeredMedium` with eq. 3's physical
+//!    weights: the engine's G-buffer gives the ball no Lambert albedo, `λ1 = 0`), added to the
+//!    lit diffuse. lucent draws its light-space maps from the engine's own vertex buffer (a
+//!    sphere and a floor quad, f32 positions and R16G16B16A16_SNORM normals, 20 bytes a
+//!    vertex, not indexed), each object placed by its model matrix, with the faces the engine
+//!    gives: the sun's orthographic one and the back light's six.
+//! 6. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
 //!    diffuse + specular itself instead (its own ambient, no translucency, no scatter).
@@ -33,7 +41,7 @@
 //!    `lucent_sh_ambient`, `lucent_translucency`) and lucent's data (the environment's
 //!    coefficients, the leaf's material row, the lights' translucency scales): no pass of
 //!    lucent's but the SSS, the same picture within the target's rounding.
-//! 6. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
+//! 7. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
@@ -44,9 +52,9 @@
 //! ```
 //!
 //! With `--scene NAME` the frame is lucent's whole frame of a built-in scene or scene file
-//! (`SceneRenderer`) drawn into the engine's sRGB target instead: the way Li et al.'s layered
-//! media, SSS transmission and lucent's shadows reach a host until they have effects on the
-//! host's own G-buffer. Its PNG equals `lucent render --scene NAME` within 1/255.
+//! (`SceneRenderer`) drawn into the engine's sRGB target instead (lucent's shadows, SSS
+//! transmission, every technique of a lucent scene). Its PNG equals `lucent render --scene
+//! NAME` within 1/255.
 //!
 //! Exits non-zero when anything fails, including any validation error (counted by the
 //! engine's own debug messenger; lucent installs none).
@@ -65,10 +73,11 @@ use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
     capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, Environment,
     EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc,
-    HostCamera, HostDevice, HostImage, IdDesc, ImageState, Light, Lucent, NormalDesc, NormalSpace,
-    OptionalFeatures, SceneRenderer, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
-    SssProfile, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
-    TranslucencyImages, TranslucentMaterial,
+    HostCamera, HostDevice, HostImage, IdDesc, ImageState, LayeredEffect, LayeredEffectDesc,
+    LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, Light, Lucent, MeshDraw,
+    NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace, SssEffect, SssEffectDesc,
+    SssFrame, SssImages, SssMaterial, SssProfile, ThicknessDesc, TranslucencyEffect,
+    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
 };
 
 /// The engine's ambient light: a sky radiance above the horizon and a ground radiance below,
@@ -107,6 +116,20 @@ const LEAF_RADII: [f32; 3] = [0.06, 0.045, 0.006];
 const BACK_LIGHT: [f32; 3] = [-0.08, 0.17, -0.24];
 const BACK_LIGHT_RADIANCE: [f32; 3] = [0.16, 0.14, 0.11];
 const BACK_LIGHT_RANGE: f32 = 0.6;
+/// The ball of Li et al.'s layered medium (an apple's flesh): its material number, and its
+/// centre and radius in metres.
+const LAYERED_ID: u8 = 23;
+const LAYERED_SPHERE: [f32; 4] = [-0.07, 0.03, 0.09, 0.03];
+/// lucent's light-space atlas for the layered medium: the sun's 512-texel face on the left,
+/// the back light's six 256-texel faces two a row on the right (single scattering finds where
+/// light entered the ball per map texel: a coarser sun face shows its texels along the
+/// marble's shadow).
+const LIGHT_SPACE: vk::Extent2D = vk::Extent2D {
+    width: 1024,
+    height: 768,
+};
+const SUN_FACE_EDGE: u32 = 512;
+const POINT_FACE_EDGE: u32 = 256;
 /// The procedural sphere's tessellation (its vertex count is `6 * STACKS * SLICES`).
 const STACKS: u32 = 48;
 const SLICES: u32 = 64;
@@ -209,7 +232,8 @@ void main() {
     const PUSH: &str =
         "layout(push_constant) uniform Push { mat4 m; vec4 eye; vec4 sun; vec4 params; } pc;\n";
 
-    /// Three spheres (instances 0-2) and a floor (instance 3), generated from the vertex index.
+    /// Three spheres (instances 0-2), the leaf (3), a floor (4) and the layered ball (5),
+    /// generated from the vertex index.
     pub fn gbuffer_vert() -> String {
         format!(
             r#"#version 450
@@ -220,13 +244,13 @@ layout(location = 0) out vec3 v_world;
 layout(location = 1) out vec3 v_normal;
 layout(location = 2) flat out uint v_object;
 layout(location = 3) out float v_thickness;
-// Centre (xyz) and radius (w) in metres.
-const vec4 SPHERES[3] = vec4[3]({SPHERES});
+// Centre (xyz) and radius (w) in metres: the three spheres, then the layered ball.
+const vec4 SPHERES[4] = vec4[4]({SPHERES});
 void main() {{
     uint object = uint(gl_InstanceIndex);
     vec3 p;
     vec3 n;
-    if (object >= 4u) {{
+    if (object == 4u) {{
         const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1),
                                         vec2(1, 1), vec2(-1, 1));
         vec2 c = corners[gl_VertexIndex % 6];
@@ -245,7 +269,8 @@ void main() {{
             p = vec3({LX}, {LY}, {LZ}) + vec3({RX}, {RY}, {RZ}) * n;
             n = normalize(n / vec3({RX}, {RY}, {RZ}));
         }} else {{
-            p = SPHERES[object].xyz + SPHERES[object].w * n;
+            vec4 s = SPHERES[object == 5u ? 3u : object];
+            p = s.xyz + s.w * n;
         }}
     }}
     v_world = p;
@@ -258,7 +283,10 @@ void main() {{
             SLICES = super::SLICES,
             STACKS = super::STACKS,
             SPHERES = super::SPHERES
-                .map(|[x, y, z, r]| format!("vec4({x:?}, {y:?}, {z:?}, {r:?})"))
+                .iter()
+                .chain([&super::LAYERED_SPHERE])
+                .map(|&[x, y, z, r]| format!("vec4({x:?}, {y:?}, {z:?}, {r:?})"))
+                .collect::<Vec<_>>()
                 .join(", "),
             LX = super::LEAF_CENTRE[0],
             LY = super::LEAF_CENTRE[1],
@@ -293,6 +321,9 @@ void main() {{
     else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = 0.8; id = {MARBLE}u; }}
     else if (v_object == 2u) {{ albedo = vec3(0.20, 0.35, 0.75); gloss = 0.6; id = {PLASTIC}u; }}
     else if (v_object == 3u) {{ albedo = vec3(0.42, 0.78, 0.50); gloss = 0.7; id = {LEAF}u; }}
+    // Li et al.'s eq. 3 with physical weights: no Lambert term (λ1 = 0; the dipole is the
+    // medium's diffuse light, which lucent adds), the specular at its own radiance (λ2 = 1).
+    else if (v_object == 5u) {{ albedo = vec3(0.0); gloss = 0.6; id = {LAYERED}u; }}
     else {{
         // A floor of 2 cm squares: texture detail the blur must leave sharp.
         ivec2 cell = ivec2(floor(v_world.xz / 0.02));
@@ -307,6 +338,7 @@ void main() {{
 }}
 "#,
             LEAF = super::LEAF_ID,
+            LAYERED = super::LAYERED_ID,
             SKIN = super::SKIN_ID,
             MARBLE = super::MARBLE_ID,
             PLASTIC = super::PLASTIC_ID,
@@ -1458,6 +1490,147 @@ fn engine_lights(sun: Vec3) -> [Light; 2] {
     [sun, back]
 }
 
+/// The layered ball's medium: Jensen's apple with eq. 3's physical weights.
+fn layered_medium() -> Result<LayeredMedium, String> {
+    let mut medium = LayeredMedium::preset("apple").map_err(|e| e.to_string())?;
+    medium.weights = lucent::scene::layered::PHYSICAL_WEIGHTS;
+    Ok(medium)
+}
+
+/// Vertices of the sphere the G-buffer's vertex shader makes (6 per quad of the STACKS x
+/// SLICES grid, unit radius), then the floor's quad: the engine's vertex buffer for lucent's
+/// light-space maps, each vertex an f32 position and an R16G16B16A16_SNORM normal (20 bytes).
+fn mesh_vertices() -> Vec<u8> {
+    const CORNERS: [(u32, u32); 6] = [(0, 0), (1, 0), (1, 1), (0, 0), (1, 1), (0, 1)];
+    let snorm = |v: f32| ((v.clamp(-1.0, 1.0) * 32767.0).round() as i16).to_le_bytes();
+    let vertex = |p: Vec3, n: Vec3| -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(MESH_STRIDE as usize);
+        for c in p.to_array() {
+            bytes.extend(c.to_le_bytes());
+        }
+        for c in [n.x, n.y, n.z, 0.0] {
+            bytes.extend(snorm(c));
+        }
+        bytes
+    };
+    let sphere = (0..STACKS * SLICES).flat_map(|quad| {
+        CORNERS.map(|(di, dj)| {
+            let (i, j) = (quad / SLICES + di, quad % SLICES + dj);
+            let theta = i as f32 / STACKS as f32 * std::f32::consts::PI;
+            let phi = j as f32 / SLICES as f32 * std::f32::consts::TAU;
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            vertex(n, n)
+        })
+    });
+    let floor = [
+        (-1.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+    ]
+    .map(|(x, z)| vertex(Vec3::new(x, 0.0, z), Vec3::Y));
+    sphere.chain(floor).flatten().collect()
+}
+
+/// Bytes of one vertex of [`mesh_vertices`].
+const MESH_STRIDE: u32 = 20;
+
+/// The engine's objects as lucent draws them into its light-space maps: the sphere mesh
+/// placed and scaled per object (the leaf an ellipsoid), then the floor, each with its
+/// material number.
+fn mesh_draws(buffer: vk::Buffer) -> Vec<MeshDraw> {
+    let sphere_vertices = 6 * STACKS * SLICES;
+    let ball = |[x, y, z, r]: [f32; 4]| {
+        Mat4::from_translation(Vec3::new(x, y, z)) * Mat4::from_scale(Vec3::splat(r))
+    };
+    let ids = [SKIN_ID, MARBLE_ID, PLASTIC_ID];
+    let mut draws: Vec<MeshDraw> = SPHERES
+        .iter()
+        .zip(ids)
+        .map(|(&s, id)| MeshDraw::new(buffer, sphere_vertices, ball(s), id))
+        .collect();
+    let leaf =
+        Mat4::from_translation(Vec3::from(LEAF_CENTRE)) * Mat4::from_scale(Vec3::from(LEAF_RADII));
+    draws.push(MeshDraw::new(buffer, sphere_vertices, leaf, LEAF_ID));
+    draws.push(MeshDraw::new(
+        buffer,
+        sphere_vertices,
+        ball(LAYERED_SPHERE),
+        LAYERED_ID,
+    ));
+    let mut floor = MeshDraw::new(buffer, 6, Mat4::IDENTITY, 0);
+    floor.first = sphere_vertices;
+    draws.push(floor);
+    draws
+}
+
+/// The faces lucent draws its light-space maps with, as the engine gives them: the sun's
+/// orthographic face over the objects (light 0), then the back light's six (light 1, +X, -X,
+/// +Y, -Y, +Z, -Z), standard Z, each a square tile of the atlas ([`LIGHT_SPACE`]).
+fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
+    let square = |x: u32, y: u32, edge: u32| vk::Rect2D {
+        offset: vk::Offset2D {
+            x: x as i32,
+            y: y as i32,
+        },
+        extent: vk::Extent2D {
+            width: edge,
+            height: edge,
+        },
+    };
+    let tile = |k: u32| {
+        square(
+            SUN_FACE_EDGE + (k % 2) * POINT_FACE_EDGE,
+            (k / 2) * POINT_FACE_EDGE,
+            POINT_FACE_EDGE,
+        )
+    };
+    let centre = Vec3::new(0.0, 0.05, 0.0);
+    let mut faces = vec![ShadowFace::new(
+        0,
+        Mat4::look_to_rh(centre + sun, -sun, Vec3::Y),
+        Mat4::orthographic_rh(-0.35, 0.35, -0.35, 0.35, 0.05, 2.0),
+        square(0, 0, SUN_FACE_EDGE),
+    )];
+    let axes = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ];
+    for (k, axis) in axes.into_iter().enumerate() {
+        let up = if axis.y != 0.0 { Vec3::Z } else { Vec3::Y };
+        faces.push(ShadowFace::new(
+            1,
+            Mat4::look_to_rh(Vec3::from(BACK_LIGHT), axis, up),
+            Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.005, BACK_LIGHT_RANGE),
+            tile(k as u32),
+        ));
+    }
+    faces
+}
+
+/// The screen rectangle the layered ball covers: where Li et al.'s passes draw.
+fn layered_region(
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    whole_screen: bool,
+) -> Vec<vk::Rect2D> {
+    let [x, y, z, r] = LAYERED_SPHERE;
+    let (centre, half) = (Vec3::new(x, y, z), Vec3::splat(r));
+    let ball = (centre - half, centre + half);
+    let region = lucent::embed::box_screen_region(ball, Mat4::IDENTITY, camera, extent, 0.0);
+    region.filter(|_| !whole_screen).into_iter().collect()
+}
+
 /// The parts of `whole` outside `inner` (inside it): up to four rectangles, none empty.
 fn around(whole: vk::Rect2D, inner: vk::Rect2D) -> Vec<vk::Rect2D> {
     let (x0, y0) = (inner.offset.x, inner.offset.y);
@@ -1516,6 +1689,7 @@ fn scattering_region(
 struct Timers {
     environment: Option<EffectTimer>,
     translucency: Option<EffectTimer>,
+    layered: EffectTimer,
     sss: EffectTimer,
 }
 
@@ -1545,6 +1719,7 @@ impl Effects {
         let named = [
             ("environment", timers.environment.as_ref()),
             ("translucency", timers.translucency.as_ref()),
+            ("layered", Some(&timers.layered)),
             ("sss", Some(&timers.sss)),
         ];
         for (effect, timer) in named {
@@ -1575,13 +1750,15 @@ impl Effects {
 
 /// What the engine's frame gets from lucent.
 enum Inserted {
-    /// Effects over the engine's own G-buffer and lighting: the SH environment and GDC 2011
-    /// translucency added to its lit diffuse, then SSS.
+    /// Effects over the engine's own G-buffer and lighting: the SH environment, GDC 2011
+    /// translucency and Li et al.'s layered media added to its lit diffuse, then SSS.
     Effects {
         /// The engine's ambient as lucent's SH environment (none with `--engine-ambient`).
         environment: Option<Box<EnvironmentEffect>>,
         /// The leaf's translucency (none with `--fused`).
         translucency: Option<Box<TranslucencyEffect>>,
+        /// The apple-flesh ball's layered medium.
+        layered: Box<LayeredEffect>,
         sss: Box<SssEffect>,
     },
     /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
@@ -1595,6 +1772,7 @@ fn build_effects(
     uploads: &mut lucent::embed::Uploads,
     environment: Option<EnvironmentEffectDesc>,
     translucency: Option<TranslucencyEffectDesc>,
+    layered: LayeredEffectDesc,
     sss: SssEffectDesc,
 ) -> lucent::Result<Inserted> {
     let environment = environment
@@ -1612,10 +1790,21 @@ fn build_effects(
             return Err(e);
         }
     };
-    match SssEffect::new(lucent, uploads, sss) {
-        Ok(sss) => Ok(Inserted::Effects {
+    let built =
+        LayeredEffect::new(lucent, uploads, layered).and_then(|layered| {
+            match SssEffect::new(lucent, uploads, sss) {
+                Ok(sss) => Ok((layered, sss)),
+                Err(e) => {
+                    layered.destroy(lucent);
+                    Err(e)
+                }
+            }
+        });
+    match built {
+        Ok((layered, sss)) => Ok(Inserted::Effects {
             environment: environment.map(Box::new),
             translucency: translucency.map(Box::new),
+            layered: Box::new(layered),
             sss: Box::new(sss),
         }),
         Err(e) => {
@@ -1760,7 +1949,7 @@ fn record_frame(
     slot: &mut FrameSlot,
     frame: usize,
     extent: vk::Extent2D,
-    leaf_thickness: vk::Buffer,
+    (leaf_thickness, meshes): (vk::Buffer, vk::Buffer),
 ) -> Result<(), String> {
     let device = &engine.device;
     let cmd = slot.cmd;
@@ -1839,9 +2028,10 @@ fn record_frame(
     // one float per vertex of a sphere draw.
     unsafe {
         device.cmd_bind_vertex_buffers(cmd, 0, &[leaf_thickness], &[0]);
-        // The three spheres and the leaf, then the floor.
+        // The three spheres and the leaf, the floor, then the layered ball.
         device.cmd_draw(cmd, 6 * STACKS * SLICES, 4, 0, 0);
         device.cmd_draw(cmd, 6, 1, 0, 4);
+        device.cmd_draw(cmd, 6 * STACKS * SLICES, 1, 0, 5);
         device.cmd_end_rendering(cmd);
     }
     for target in [
@@ -1929,6 +2119,7 @@ fn record_frame(
             let Inserted::Effects {
                 environment,
                 translucency,
+                layered,
                 sss,
             } = &mut effects.inserted
             else {
@@ -1995,6 +2186,34 @@ fn record_frame(
                 }
                 .map_err(|e| format!("lucent: {e}"))?;
             }
+            // Li et al.'s terms of the layered ball, its light-space maps drawn from the
+            // engine's vertex buffer.
+            let lights = engine_lights(sun);
+            let faces = light_faces(sun);
+            let draws = mesh_draws(meshes);
+            let layered_frame = LayeredFrame {
+                slot: slot_index,
+                view: 0,
+                camera,
+                lights: &lights,
+                environment: Some(&engine_environment()),
+                light_faces: &faces,
+                meshes: &draws,
+                images: LayeredImages {
+                    depth: &depth,
+                    normals: &normals,
+                    material_ids: &ids,
+                },
+                regions: &layered_region(&camera, extent, effects.whole_screen),
+                lighting: &lighting,
+            };
+            match effects.timers.get_mut(slot_index) {
+                Some(t) => {
+                    layered.record_timed(&effects.lucent, cmd, &layered_frame, &mut t.layered)
+                }
+                None => layered.record(&effects.lucent, cmd, &layered_frame),
+            }
+            .map_err(|e| format!("lucent: {e}"))?;
             slot.normal.state = normals.left_in();
             slot.thickness.state = thickness.left_in();
             // (The other images come back as they came: the SSS reads them below.)
@@ -2182,6 +2401,16 @@ fn create_effects(
         (!args.fused).then(|| TranslucencyEffectDesc::new(gbuffer.clone(), vec![leaf_material()]));
     let environment_desc =
         (!args.engine_ambient && !args.fused).then(|| EnvironmentEffectDesc::new(gbuffer.clone()));
+    let layered_desc = LayeredEffectDesc::new(
+        gbuffer.clone(),
+        vec![LayeredMaterial::new(LAYERED_ID, layered_medium()?)],
+        lucent::embed::VertexLayout::new(
+            [MESH_STRIDE, 0],
+            lucent::embed::VertexAttribute::new(0, vk::Format::R32G32B32_SFLOAT, 0),
+            lucent::embed::VertexAttribute::new(0, vk::Format::R16G16B16A16_SNORM, 12),
+        ),
+        LIGHT_SPACE,
+    );
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
@@ -2200,6 +2429,7 @@ fn create_effects(
             &mut uploads,
             environment_desc,
             translucency_desc,
+            layered_desc,
             desc,
         ),
         Some(name) => lucent.load_scene(name).and_then(|scene| {
@@ -2231,8 +2461,9 @@ fn create_effects(
     let inserted = built.map_err(|e| format!("lucent: {e}"))?;
     match &args.scene {
         None => eprintln!(
-            "host_engine: lucent effects: {}sss ({} blur; skin ID {SKIN_ID}, marble ID \
-             {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+            "host_engine: lucent effects: {}layered media (apple flesh, ID {LAYERED_ID}; its \
+             light-space maps drawn from the engine's vertex buffer), sss ({} blur; skin ID \
+             {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
             match (args.fused, args.engine_ambient) {
                 (true, _) => "environment and translucency (the leaf) in the engine's \
                               lighting pass (lucent::embed::glsl::TERMS), "
@@ -2261,6 +2492,7 @@ fn create_effects(
                         Some(timer()?)
                     },
                     translucency: if args.fused { None } else { Some(timer()?) },
+                    layered: timer()?,
                     sss: timer()?,
                 })
             })
@@ -2326,6 +2558,24 @@ fn leaf_thickness_buffer(
         .map_err(|e| format!("bake the leaf's thickness: {e}"))?;
     let per_vertex: Vec<f32> = drawn.iter().map(|&v| baked[v as usize]).collect();
     let bytes: Vec<u8> = per_vertex.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let (low, high) = baked
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    eprintln!(
+        "host_engine: the leaf's thickness baked by lucent at {} vertices ({low:.2} to \
+         {high:.2})",
+        baked.len()
+    );
+    host_buffer(engine, allocator, &bytes, "leaf thickness")
+}
+
+/// A host-visible vertex buffer of the engine's holding `bytes`.
+fn host_buffer(
+    engine: &Engine,
+    allocator: &Mutex<Allocator>,
+    bytes: &[u8],
+    name: &str,
+) -> Result<VertexBuffer, String> {
     let device = &engine.device;
     // SAFETY: plain object creation on the engine's device; destroyed at the end of `run`.
     unsafe {
@@ -2337,33 +2587,44 @@ fn leaf_thickness_buffer(
                 None,
             )
             .map_err(|e| format!("vkCreateBuffer: {e}"))?;
-        let mut memory = allocator
+        let allocated = allocator
             .lock()
-            .map_err(|_| "allocator lock poisoned".to_string())?
-            .allocate(&AllocationCreateDesc {
-                name: "leaf thickness",
-                requirements: device.get_buffer_memory_requirements(buffer),
-                location: MemoryLocation::CpuToGpu,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            })
-            .map_err(|e| format!("allocate the leaf's thickness: {e}"))?;
-        check(
+            .map_err(|_| "allocator lock poisoned".to_string())
+            .and_then(|mut allocator| {
+                allocator
+                    .allocate(&AllocationCreateDesc {
+                        name,
+                        requirements: device.get_buffer_memory_requirements(buffer),
+                        location: MemoryLocation::CpuToGpu,
+                        linear: true,
+                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                    })
+                    .map_err(|e| format!("allocate {name}: {e}"))
+            });
+        let mut memory = match allocated {
+            Ok(memory) => memory,
+            Err(e) => {
+                device.destroy_buffer(buffer, None);
+                return Err(e);
+            }
+        };
+        let filled = check(
             "vkBindBufferMemory",
             device.bind_buffer_memory(buffer, memory.memory(), memory.offset()),
-        )?;
-        memory
-            .mapped_slice_mut()
-            .ok_or("the leaf's thickness buffer is not mapped")?[..bytes.len()]
-            .copy_from_slice(&bytes);
-        let (low, high) = baked
-            .iter()
-            .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-        eprintln!(
-            "host_engine: the leaf's thickness baked by lucent at {} vertices ({low:.2} to \
-             {high:.2})",
-            baked.len()
-        );
+        )
+        .and_then(|()| {
+            memory
+                .mapped_slice_mut()
+                .ok_or(format!("{name}: the buffer is not mapped"))
+                .map(|mapped| mapped[..bytes.len()].copy_from_slice(bytes))
+        });
+        if let Err(e) = filled {
+            device.destroy_buffer(buffer, None);
+            if let Ok(mut allocator) = allocator.lock() {
+                allocator.free(memory).ok();
+            }
+            return Err(e);
+        }
         Ok(VertexBuffer { buffer, memory })
     }
 }
@@ -2391,6 +2652,17 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
         height: args.height,
     };
     let leaf_thickness = leaf_thickness_buffer(engine, &allocator)?;
+    let meshes = match host_buffer(engine, &allocator, &mesh_vertices(), "meshes") {
+        Ok(buffer) => buffer,
+        Err(e) => {
+            // SAFETY: nothing used the buffer yet.
+            unsafe { device.destroy_buffer(leaf_thickness.buffer, None) };
+            if let Ok(mut allocator) = allocator.lock() {
+                allocator.free(leaf_thickness.memory).ok();
+            }
+            return Err(e);
+        }
+    };
     let mut result = Ok(());
     let mut slots = Vec::with_capacity(FRAMES_IN_FLIGHT);
     let mut pipelines = None;
@@ -2457,7 +2729,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                         slot,
                         frame,
                         extent,
-                        leaf_thickness.buffer,
+                        (leaf_thickness.buffer, meshes.buffer),
                     ),
                 })
                 // SAFETY: the command buffer is recording.
@@ -2506,12 +2778,14 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
             for timer in timers.translucency.into_iter() {
                 timer.destroy(&effects.lucent);
             }
+            timers.layered.destroy(&effects.lucent);
             timers.sss.destroy(&effects.lucent);
         }
         match effects.inserted {
             Inserted::Effects {
                 environment,
                 translucency,
+                layered,
                 sss,
             } => {
                 if let Some(environment) = environment {
@@ -2520,6 +2794,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 if let Some(translucency) = translucency {
                     (*translucency).destroy(&effects.lucent);
                 }
+                (*layered).destroy(&effects.lucent);
                 (*sss).destroy(&effects.lucent);
             }
             Inserted::Scene(scene) => (*scene).1.destroy(&effects.lucent),
@@ -2536,9 +2811,11 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     unsafe {
         device.destroy_pipeline_cache(pipeline_cache, None);
         device.destroy_buffer(leaf_thickness.buffer, None);
+        device.destroy_buffer(meshes.buffer, None);
     }
     if let Ok(mut allocator) = allocator.lock() {
         allocator.free(leaf_thickness.memory).ok();
+        allocator.free(meshes.memory).ok();
     }
     drop(allocator);
     result

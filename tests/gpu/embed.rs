@@ -173,8 +173,8 @@ pub(crate) fn changed<T: Clone>(image: &T, change: impl FnOnce(&mut T)) -> T {
 
 /// The example host runs headless under validation, with every effect it inserts, and its
 /// frame shows them: it differs from the same host frame without lucent where the skin is
-/// (the scatter) and where the leaf is (the light let through), and nowhere it has no
-/// material of lucent's.
+/// (the scatter), where the leaf is (the light let through) and where the layered ball is
+/// (Li et al.'s terms), and nowhere it has no material of lucent's.
 #[test]
 fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_light_through() {
     let dir = common::temp_dir("embed-example");
@@ -205,6 +205,8 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
             && log.contains("engine: lighting")
             && log.contains("environment: host environment")
             && log.contains("translucency: host translucency")
+            && log.contains("layered: light-space maps")
+            && log.contains("layered: single scattering")
             && log.contains("sss: horizontal blur"),
         "{log}"
     );
@@ -221,6 +223,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     assert!(
         log.contains("lucent effects: environment")
             && log.contains("translucency (leaf")
+            && log.contains("layered media (apple flesh")
             && log.contains("sss (separable blur"),
         "{log}"
     );
@@ -305,6 +308,20 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     assert!(
         lit_through > 150,
         "translucency brightened only {lit_through} pixels of the leaf ({} and {})",
+        with.display(),
+        without.display()
+    );
+    // The apple-flesh ball in front (lower left of the middle) has no Lambert term of the
+    // engine's (eq. 3's physical weights): without lucent it is black but for its highlight;
+    // Li et al.'s terms light it.
+    let ball = (h as usize / 2..3 * h as usize / 4)
+        .flat_map(|y| (w as usize / 16..w as usize / 4).map(move |x| y * row + 4 * x))
+        .filter(|&i| a[i + 1] > b[i + 1].saturating_add(40))
+        .count();
+    println!("host_engine: lucent's layered media light {ball} pixels of the ball");
+    assert!(
+        ball > 600,
+        "the layered media lit only {ball} pixels of the ball ({} and {})",
         with.display(),
         without.display()
     );
@@ -1670,6 +1687,42 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
         )
     })
     .unwrap();
+    // Li et al.'s layered media, drawing one triangle of a host vertex buffer into its maps.
+    let mut layered = built(&test, &lucent, |u| {
+        lucent::embed::LayeredEffect::new(
+            &lucent,
+            u,
+            lucent::embed::LayeredEffectDesc::new(
+                gbuffer.clone(),
+                vec![lucent::embed::LayeredMaterial::new(
+                    1,
+                    lucent::embed::LayeredMedium::preset("apple").unwrap(),
+                )],
+                lucent::embed::VertexLayout::interleaved(24, 0, 12),
+                vk::Extent2D {
+                    width: 64,
+                    height: 64,
+                },
+            ),
+        )
+    })
+    .unwrap();
+    let triangle = gpu
+        .upload_buffer(
+            &[
+                0.0f32, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+                1.0, 0.0,
+            ],
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            "triangle",
+        )
+        .unwrap();
+    let meshes = [lucent::embed::MeshDraw::new(
+        triangle.buffer,
+        3,
+        glam::Mat4::IDENTITY,
+        1,
+    )];
     // A sun whose shadow map is the depth image's top-left square (its contents do not
     // matter: this test counts calls).
     let sun = [lucent::embed::Light::directional(
@@ -1793,11 +1846,41 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
             )
         })
         .unwrap();
+        let mut light_face = sun_face;
+        light_face[0].rect.extent = vk::Extent2D {
+            width: 64,
+            height: 64,
+        };
+        recorded(&test, |cmd| {
+            layered.record(
+                &lucent,
+                cmd,
+                &lucent::embed::LayeredFrame {
+                    slot,
+                    view: 0,
+                    camera,
+                    lights: &sun,
+                    environment: Some(&scene.environment),
+                    light_faces: &light_face,
+                    meshes: &meshes,
+                    images: lucent::embed::LayeredImages {
+                        depth: images.depth,
+                        normals: &colour_in,
+                        material_ids: images.material_ids,
+                    },
+                    regions: &[],
+                    lighting: &lighting,
+                },
+            )
+        })
+        .unwrap();
     }
     effect.destroy(&lucent);
     translucency.destroy(&lucent);
     environment.destroy(&lucent);
     transmission.destroy(&lucent);
+    layered.destroy(&lucent);
+    gpu.destroy_buffer(triangle);
     drop(lucent);
     let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
     assert_eq!(

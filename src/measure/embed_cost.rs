@@ -137,7 +137,8 @@ impl Samples {
     }
 }
 
-/// Measures the effect of `technique` (an SSS blur a host can run, or `translucency`) on
+/// Measures the effect of `technique` (an SSS blur a host can run, `translucency`, `layered`,
+/// or `none` for the SH environment) on
 /// `scene` at `width` x `height`: `warmup` rounds discarded, `frames` measured.
 #[allow(clippy::too_many_arguments)]
 pub fn embed_cost(

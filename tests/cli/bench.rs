@@ -336,9 +336,9 @@ fn the_gate_refuses_the_flags_it_sets_itself_naming_them() {
 
 #[test]
 fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
-    // The SH environment (--technique none), GDC 2011 translucency, an SSS blur and SSS
-    // transmission, each as a host's effect against lucent's own frame: a table with both
-    // columns filled.
+    // The SH environment (--technique none), GDC 2011 translucency, an SSS blur, SSS
+    // transmission and Li et al.'s layered media, each as a host's effect against lucent's own
+    // frame: a table with both columns filled.
     for (scene, technique, effect, row) in [
         ("cubes", "none", "EnvironmentEffect", "| the term |"),
         (
@@ -355,6 +355,8 @@ fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
             "SssEffect",
             "| transmission: the term |",
         ),
+        // Its light-space maps drawn from host vertex buffers, then the four layered passes.
+        ("layered", "layered", "LayeredEffect", "| single scattering |"),
     ] {
         let text = run_bench(&format!(
             "bench --validation --scene {scene} --technique {technique} --size 96x64 \
@@ -380,7 +382,7 @@ fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
     ));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && stderr.contains("translucency or none (the SH environment)"),
+        !out.status.success() && stderr.contains("layered or none (the SH environment)"),
         "{stderr}"
     );
 }

@@ -122,7 +122,7 @@ pub struct BenchArgs {
     #[arg(long, alias = "compare-seeds")]
     pub compare_thesis: bool,
     /// Also measure the technique as an effect on a host's G-buffer (`lucent::embed`: an SSS
-    /// blur a host can run, `translucency`, or `none` for the SH environment's light; with a
+    /// blur a host can run, `translucency`, `layered`, or `none` for the SH environment's light; with a
     /// blur, on a scene with media and shadows, their transmission too) against the same
     /// work in lucent's own frame, frames alternating, and print both with their ratio
     /// (Markdown).

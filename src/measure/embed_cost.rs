@@ -450,7 +450,6 @@ fn measure_sss(
                 SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss),
             )
         })?;
-        let mut timer = EffectTimer::new(lucent, 64)?;
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -470,57 +469,29 @@ fn measure_sss(
         let output = host_image(output, "host output", hdr, size, output_usage)
             .in_state(ImageState::UNDEFINED)
             .then(ImageState::fragment_sampled());
-        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
-        let mut run = || -> Result<()> {
-            for round in 0..warmup + frames {
-                let frame = renderer.render_once(gpu)?;
-                host_frame(gpu, |cmd| {
-                    effect.record_timed(
-                        lucent,
-                        cmd,
-                        &SssFrame {
-                            slot: 0,
-                            view: 0,
-                            camera,
-                            images: SssImages {
-                                depth: &depth,
-                                diffuse: &diffuse,
-                                specular: Some(&specular),
-                                albedo: None,
-                                material_ids: &id_image,
-                            },
-                            regions: &regions,
-                            output: &output,
-                        },
-                        &mut timer,
-                    )
-                })?;
-                if round < warmup {
-                    continue;
-                }
-                for pass in &frame.timing.passes {
-                    ours.push(&pass.name, pass.ms);
-                }
-                for pass in timer.results(lucent)?.unwrap_or_default() {
-                    theirs.push(&pass.name, pass.ms);
-                }
-            }
-            Ok(())
-        };
-        let result = run();
-        timer.destroy(lucent);
+        let rows = time_passes(gpu, lucent, &renderer, (frames, warmup), |cmd, timer| {
+            effect.record_timed(
+                lucent,
+                cmd,
+                &SssFrame {
+                    slot: 0,
+                    view: 0,
+                    camera,
+                    images: SssImages {
+                        depth: &depth,
+                        diffuse: &diffuse,
+                        specular: Some(&specular),
+                        albedo: None,
+                        material_ids: &id_image,
+                    },
+                    regions: &regions,
+                    output: &output,
+                },
+                timer,
+            )
+        });
         effect.destroy(lucent);
-        result?;
-        // The effect's passes, each beside lucent's pass of the same name.
-        let names: Vec<String> = theirs.0.keys().cloned().collect();
-        Ok(names
-            .into_iter()
-            .map(|name| EmbedCostRow {
-                lucent_ms: ours.median(&name),
-                host_ms: theirs.median(&name),
-                pass: name,
-            })
-            .collect())
+        rows
     })();
     let idle = gpu.wait_idle();
     images.destroy(gpu);
@@ -1020,7 +991,6 @@ fn measure_layered(
                 .with_knobs(renderer.settings.layered),
             )
         })?;
-        let mut timer = EffectTimer::new(lucent, 16)?;
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -1028,64 +998,31 @@ fn measure_layered(
         let regions = object_regions(scene, &camera, size, |i, _| {
             (desc.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)
         });
-        let (mut ours, mut theirs) = (Samples::default(), Samples::default());
-        let mut run = || -> Result<()> {
-            for round in 0..warmup + frames {
-                let frame = renderer.render_once(gpu)?;
-                host_frame(gpu, |cmd| {
-                    effect.record_timed(
-                        lucent,
-                        cmd,
-                        &LayeredFrame {
-                            slot: 0,
-                            view: 0,
-                            camera,
-                            lights: &scene.lights,
-                            environment: Some(&scene.environment),
-                            light_faces: &faces,
-                            meshes: &draws,
-                            images: LayeredImages {
-                                depth: &host.depth,
-                                normals: &host.normals,
-                                material_ids: &id_image,
-                            },
-                            regions: &regions,
-                            lighting: &host.lighting,
-                        },
-                        &mut timer,
-                    )
-                })?;
-                if round < warmup {
-                    continue;
-                }
-                for pass in &frame.timing.passes {
-                    ours.push(&pass.name, pass.ms);
-                }
-                for pass in timer.results(lucent)?.unwrap_or_default() {
-                    theirs.push(&pass.name, pass.ms);
-                }
-            }
-            Ok(())
-        };
-        let result = run();
-        timer.destroy(lucent);
+        let rows = time_passes(gpu, lucent, &renderer, (frames, warmup), |cmd, timer| {
+            effect.record_timed(
+                lucent,
+                cmd,
+                &LayeredFrame {
+                    slot: 0,
+                    view: 0,
+                    camera,
+                    lights: &scene.lights,
+                    environment: Some(&scene.environment),
+                    light_faces: &faces,
+                    meshes: &draws,
+                    images: LayeredImages {
+                        depth: &host.depth,
+                        normals: &host.normals,
+                        material_ids: &id_image,
+                    },
+                    regions: &regions,
+                    lighting: &host.lighting,
+                },
+                timer,
+            )
+        });
         effect.destroy(lucent);
-        result?;
-        // The effect's passes in their order, each beside lucent's pass of the same name.
-        let mut names: Vec<String> = Vec::new();
-        for pass in effect_pass_order(&theirs) {
-            if !names.contains(&pass) {
-                names.push(pass);
-            }
-        }
-        Ok(names
-            .into_iter()
-            .map(|name| EmbedCostRow {
-                lucent_ms: ours.median(&name),
-                host_ms: theirs.median(&name),
-                pass: name,
-            })
-            .collect())
+        rows
     })();
     let idle = gpu.wait_idle();
     for buffer in buffers {
@@ -1095,31 +1032,6 @@ fn measure_layered(
     renderer.destroy(gpu);
     idle?;
     measured
-}
-
-/// The passes timed, by name (the layered effect's names are its passes in order: maps,
-/// irradiance, multiple scattering, its blur, single scattering).
-fn effect_pass_order(samples: &Samples) -> Vec<String> {
-    const ORDER: [&str; 5] = [
-        "light-space maps",
-        "layered irradiance",
-        "multiple scattering",
-        "multiple scattering blur",
-        "single scattering",
-    ];
-    let mut names: Vec<String> = ORDER
-        .iter()
-        .filter(|n| samples.0.contains_key(**n))
-        .map(|n| n.to_string())
-        .collect();
-    names.extend(
-        samples
-            .0
-            .keys()
-            .filter(|k| !ORDER.contains(&k.as_str()))
-            .cloned(),
-    );
-    names
 }
 
 /// lucent's frame of a scene with a lighting term (`lit`) and without (`plain`), each
@@ -1228,6 +1140,52 @@ impl HostGBuffer {
         };
         Ok((host, gb))
     }
+}
+
+/// Times lucent's frame of `renderer` against the passes `record` records (into the timer it
+/// is given, reset in its command buffer), frames alternating; `warmup` rounds are discarded,
+/// `frames` measured. A row per pass of the effect, in the order it records them, beside
+/// lucent's pass of the same name.
+fn time_passes(
+    gpu: &GpuContext,
+    lucent: &Lucent,
+    renderer: &Renderer,
+    (frames, warmup): (usize, usize),
+    mut record: impl FnMut(vk::CommandBuffer, &mut EffectTimer) -> Result<()>,
+) -> Result<Vec<EmbedCostRow>> {
+    let mut timer = EffectTimer::new(lucent, 64)?;
+    let (mut ours, mut theirs) = (Samples::default(), Samples::default());
+    let mut order: Vec<String> = Vec::new();
+    let mut run = || -> Result<()> {
+        for round in 0..warmup + frames {
+            let frame = renderer.render_once(gpu)?;
+            host_frame(gpu, |cmd| record(cmd, &mut timer))?;
+            if round < warmup {
+                continue;
+            }
+            for pass in &frame.timing.passes {
+                ours.push(&pass.name, pass.ms);
+            }
+            for pass in timer.results(lucent)?.unwrap_or_default() {
+                if !order.contains(&pass.name) {
+                    order.push(pass.name.clone());
+                }
+                theirs.push(&pass.name, pass.ms);
+            }
+        }
+        Ok(())
+    };
+    let result = run();
+    timer.destroy(lucent);
+    result?;
+    Ok(order
+        .into_iter()
+        .map(|name| EmbedCostRow {
+            lucent_ms: ours.median(&name),
+            host_ms: theirs.median(&name),
+            pass: name,
+        })
+        .collect())
 }
 
 /// Times a lighting term lucent adds inside its lighting pass against the effect a host

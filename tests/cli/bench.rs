@@ -356,7 +356,12 @@ fn embed_times_each_kind_of_effect_under_validation_and_refuses_a_lean_blur() {
             "| transmission: the term |",
         ),
         // Its light-space maps drawn from host vertex buffers, then the four layered passes.
-        ("layered", "layered", "LayeredEffect", "| single scattering |"),
+        (
+            "layered",
+            "layered",
+            "LayeredEffect",
+            "| single scattering |",
+        ),
     ] {
         let text = run_bench(&format!(
             "bench --validation --scene {scene} --technique {technique} --size 96x64 \

@@ -736,6 +736,103 @@ pub(crate) fn host_layout(
     }
 }
 
+/// One host frame's images of a [`HostLayout`]: its depth (through a view made for the frame),
+/// its material IDs (none when the layout keeps them in a target of the test's own) and the
+/// frame's lighting image, which the effect adds to.
+pub(crate) struct FrameImages<'a> {
+    pub(crate) depth: &'a HostImage,
+    pub(crate) ids: Option<&'a HostImage>,
+    pub(crate) lighting: &'a HostImage,
+}
+
+/// Records three frames of a host's effect on `layout` (described by `desc`) back to back,
+/// three frames in flight, as a host would: each frame's depth view made anew (a recreated
+/// view can reuse a handle value), and its own lighting image (RGBA32F holding `start`, a
+/// colour attachment left for the transfer); `record(k, cmd, images)` records frame `k`.
+/// Returns each frame's lighting, read back.
+pub(crate) fn host_frames(
+    test: &TestGpu,
+    layout: &HostLayout,
+    desc: &GBufferDesc,
+    start: &[u8],
+    mut record: impl FnMut(usize, vk::CommandBuffer, FrameImages<'_>),
+) -> Vec<Vec<f32>> {
+    let gpu = &test.gpu;
+    let (w, h) = (desc.width, desc.height);
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+        | vk::ImageUsageFlags::SAMPLED
+        | vk::ImageUsageFlags::TRANSFER_SRC;
+    let lightings: Vec<GpuImage> = (0..3)
+        .map(|_| {
+            gpu.upload_image(
+                &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, lighting_usage),
+                &[start.to_vec()],
+                "host lighting",
+            )
+            .unwrap()
+        })
+        .collect();
+    let depth_aspect = match desc.depth.encoding {
+        lucent::embed::DepthEncoding::LinearView => vk::ImageAspectFlags::COLOR,
+        _ => vk::ImageAspectFlags::DEPTH,
+    };
+    let mut views = Vec::new();
+    submit_back_to_back(gpu, 3, |k, cmd| {
+        let depth_view = fresh_view(test, layout.depth.image, desc.depth.format, depth_aspect);
+        views.push(depth_view);
+        let depth = HostImage::new(
+            "host depth",
+            layout.depth.image,
+            depth_view,
+            desc.depth.format,
+            desc.extent(),
+            usage,
+        )
+        .in_state(ImageState::fragment_sampled());
+        let ids = match (&layout.ids, layout.stencil_ids) {
+            (Some(image), _) => Some(described(image, "host IDs", usage)),
+            (None, Some(view)) => Some(
+                HostImage::new(
+                    "host stencil IDs",
+                    layout.depth.image,
+                    view,
+                    vk::Format::D24_UNORM_S8_UINT,
+                    desc.extent(),
+                    usage,
+                )
+                .in_state(ImageState::fragment_sampled()),
+            ),
+            (None, None) => None,
+        };
+        let lighting = described(&lightings[k], "host lighting", lighting_usage)
+            .then(ImageState::transfer_src());
+        record(
+            k,
+            cmd,
+            FrameImages {
+                depth: &depth,
+                ids: ids.as_ref(),
+                lighting: &lighting,
+            },
+        );
+    });
+    for view in views {
+        // SAFETY: the frames that used it completed (submit_back_to_back waited).
+        unsafe { gpu.device.destroy_image_view(view, None) };
+    }
+    lightings
+        .into_iter()
+        .map(|lighting| {
+            let bytes = gpu
+                .read_image(&lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+                .unwrap();
+            gpu.destroy_image(lighting);
+            bytemuck::cast_slice(&bytes).to_vec()
+        })
+        .collect()
+}
+
 impl HostLayout {
     pub(crate) fn destroy(self, test: &TestGpu) {
         for view in self.views {

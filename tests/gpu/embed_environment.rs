@@ -5,16 +5,16 @@
 //! R32F; normals world or view space, xyz or octahedral, float or UNORM; the diffuse light
 //! with or without the albedo), and the effect must add what lucent's lighting pass adds.
 
-use crate::common::{submit_back_to_back, TestGpu};
+use crate::common::TestGpu;
 use crate::embed::{
-    built, changed, compare_host_frame, described, fresh_view, host_error, host_layout, options,
+    built, changed, compare_host_frame, described, host_error, host_frames, host_layout, options,
     tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
 
 use ash::vk;
 use glam::{DVec3, Vec3};
-use lucent::backend::{GpuImage, ImageDesc};
+use lucent::backend::ImageDesc;
 use lucent::embed::{
     capabilities, DiffuseDesc, Effect, Environment, EnvironmentEffect, EnvironmentEffectDesc,
     EnvironmentFrame, EnvironmentImages, GBufferDesc, HostError, HostImage, ImageState, NormalDesc,
@@ -167,48 +167,14 @@ fn the_environment_effect_on_host_layouts_equals_lucents_own_frame_and_the_f64_t
         })
         .unwrap();
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
-        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC;
         let start: Vec<u8> = match lit {
             Lit::WithAlbedo => bytemuck::cast_slice(without.hdr.as_ref().unwrap()).to_vec(),
             Lit::WithoutAlbedo => vec![0; (w * h * 16) as usize],
         };
-        let lightings: Vec<GpuImage> = (0..3)
-            .map(|_| {
-                gpu.upload_image(
-                    &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, lighting_usage),
-                    std::slice::from_ref(&start),
-                    "host lighting",
-                )
-                .unwrap()
-            })
-            .collect();
         // The environment changes per frame: the third frame's is black (adds nothing).
         let environments = [&environment, &environment, &black];
-        let mut views = Vec::new();
-        submit_back_to_back(gpu, 3, |k, cmd| {
-            let depth_aspect = if depth_kind == HostDepth::Linear {
-                vk::ImageAspectFlags::COLOR
-            } else {
-                vk::ImageAspectFlags::DEPTH
-            };
-            // Views made anew every frame (a recreated view can reuse a handle value).
-            let depth_view = fresh_view(&test, layout.depth.image, desc.depth.format, depth_aspect);
-            views.push(depth_view);
-            let depth = HostImage::new(
-                "host depth",
-                layout.depth.image,
-                depth_view,
-                desc.depth.format,
-                desc.extent(),
-                usage,
-            )
-            .in_state(ImageState::fragment_sampled());
-            let normals = described(&normals, "host normals", usage);
+        let frames = host_frames(&test, &layout, &desc, &start, |k, cmd, images| {
             let albedo_image = described(&albedo, "host albedo", usage);
-            let lighting = described(&lightings[k], "host lighting", lighting_usage)
-                .then(ImageState::transfer_src());
             effect
                 .record(
                     &lucent,
@@ -219,25 +185,17 @@ fn the_environment_effect_on_host_layouts_equals_lucents_own_frame_and_the_f64_t
                         camera: layout.camera,
                         environment: environments[k],
                         images: EnvironmentImages {
-                            depth: &depth,
-                            normals: &normals,
+                            depth: images.depth,
+                            normals: &described(&normals, "host normals", usage),
                             albedo: (lit == Lit::WithAlbedo).then_some(&albedo_image),
                         },
                         regions: &[],
-                        lighting: &lighting,
+                        lighting: images.lighting,
                     },
                 )
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
         });
-        for view in views {
-            // SAFETY: the frames that used it completed (submit_back_to_back waited).
-            unsafe { gpu.device.destroy_image_view(view, None) };
-        }
-        for (k, lighting) in lightings.iter().enumerate() {
-            let bytes = gpu
-                .read_image(lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .unwrap();
-            let texels: &[f32] = bytemuck::cast_slice(&bytes);
+        for (k, texels) in frames.iter().enumerate() {
             match lit {
                 Lit::WithAlbedo => {
                     let have = tonemapped(texels, exposure);
@@ -259,9 +217,7 @@ fn the_environment_effect_on_host_layouts_equals_lucents_own_frame_and_the_f64_t
         }
         effect.destroy(&lucent);
         drop(lucent);
-        for image in lightings.into_iter().chain([normals]) {
-            gpu.destroy_image(image);
-        }
+        gpu.destroy_image(normals);
         layout.destroy(&test);
     }
     gpu.destroy_image(albedo);

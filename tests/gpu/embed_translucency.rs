@@ -5,9 +5,9 @@
 //! or UNORM; IDs in a packed target's alpha, R8_UINT, stencil bits, R8_UNORM), and the effect
 //! must add what lucent's lighting pass adds.
 
-use crate::common::{submit_back_to_back, TestGpu};
+use crate::common::TestGpu;
 use crate::embed::{
-    built, changed, compare_host_frame, described, fresh_view, host_error, host_id, host_layout,
+    built, changed, compare_host_frame, described, host_error, host_frames, host_id, host_layout,
     options, tonemapped, wrap, HostDepth, HostIds,
 };
 
@@ -15,9 +15,8 @@ use ash::vk;
 use glam::{Mat3, Vec3};
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::{
-    HostError, HostImage, IdDesc, ImageState, NormalDesc, NormalSpace, ThicknessDesc,
-    TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages,
-    TranslucentMaterial,
+    HostError, IdDesc, NormalDesc, NormalSpace, ThicknessDesc, TranslucencyEffect,
+    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
 };
 use lucent::frame::{FrameSettings, Renderer, Technique};
 
@@ -290,19 +289,6 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
         })
         .unwrap();
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
-        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC;
-        let lightings: Vec<GpuImage> = (0..3)
-            .map(|_| {
-                gpu.upload_image(
-                    &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, lighting_usage),
-                    &[bytemuck::cast_slice(without.hdr.as_ref().unwrap()).to_vec()],
-                    "host lighting",
-                )
-                .unwrap()
-            })
-            .collect();
         // One layout draws over the translucent pixels' bounds only (a host's projected
         // object bounds), the others over the whole screen.
         let regions: Vec<vk::Rect2D> = if depth_kind == HostDepth::ReversedInfinite {
@@ -310,78 +296,44 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
         } else {
             Vec::new()
         };
-        let mut views = Vec::new();
-        submit_back_to_back(gpu, 3, |k, cmd| {
-            let depth_aspect = if depth_kind == HostDepth::Linear {
-                vk::ImageAspectFlags::COLOR
-            } else {
-                vk::ImageAspectFlags::DEPTH
-            };
-            // Views made anew every frame (a recreated view can reuse a handle value).
-            let depth_view = fresh_view(&test, layout.depth.image, desc.depth.format, depth_aspect);
-            views.push(depth_view);
-            let depth = HostImage::new(
-                "host depth",
-                layout.depth.image,
-                depth_view,
-                desc.depth.format,
-                desc.extent(),
-                usage,
-            )
-            .in_state(ImageState::fragment_sampled());
-            let normals = described(&normals, "host normals", usage);
-            let albedo = described(&albedo, "host albedo", usage);
-            let thickness_image = described(&thickness, "host thickness", usage);
-            let ids = match (&layout.ids, layout.stencil_ids, ids_kind) {
-                (_, _, None) => thickness_image.clone(),
-                (Some(image), _, _) => described(image, "host IDs", usage),
-                (None, Some(view), _) => HostImage::new(
-                    "host stencil IDs",
-                    layout.depth.image,
-                    view,
-                    vk::Format::D24_UNORM_S8_UINT,
-                    desc.extent(),
-                    usage,
-                )
-                .in_state(ImageState::fragment_sampled()),
-                (None, None, _) => unreachable!(),
-            };
-            let lighting = described(&lightings[k], "host lighting", lighting_usage)
-                .then(ImageState::transfer_src());
-            effect
-                .record(
-                    &lucent,
-                    cmd,
-                    &TranslucencyFrame {
-                        slot: k,
-                        view: 0,
-                        camera: layout.camera,
-                        lights: &scene.lights,
-                        images: TranslucencyImages {
-                            depth: &depth,
-                            normals: &normals,
-                            albedo: &albedo,
-                            thickness: &thickness_image,
-                            material_ids: &ids,
+        let frames = host_frames(
+            &test,
+            &layout,
+            &desc,
+            bytemuck::cast_slice(without.hdr.as_ref().unwrap()),
+            |k, cmd, images| {
+                let thickness_image = described(&thickness, "host thickness", usage);
+                effect
+                    .record(
+                        &lucent,
+                        cmd,
+                        &TranslucencyFrame {
+                            slot: k,
+                            view: 0,
+                            camera: layout.camera,
+                            lights: &scene.lights,
+                            images: TranslucencyImages {
+                                depth: images.depth,
+                                normals: &described(&normals, "host normals", usage),
+                                albedo: &described(&albedo, "host albedo", usage),
+                                thickness: &thickness_image,
+                                // Without an ID kind the IDs share the thickness's target.
+                                material_ids: match ids_kind {
+                                    None => &thickness_image,
+                                    Some(_) => images.ids.unwrap(),
+                                },
+                            },
+                            regions: &regions,
+                            lighting: images.lighting,
                         },
-                        regions: &regions,
-                        lighting: &lighting,
-                    },
-                )
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
-        });
-        for view in views {
-            // SAFETY: the frames that used it completed (submit_back_to_back waited).
-            unsafe { gpu.device.destroy_image_view(view, None) };
-        }
-        for (k, lighting) in lightings.iter().enumerate() {
-            let bytes = gpu
-                .read_image(lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .unwrap();
-            let have = tonemapped(bytemuck::cast_slice(&bytes), exposure);
+                    )
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            },
+        );
+        for (k, texels) in frames.iter().enumerate() {
             report.push(compare_host_frame(
                 &want,
-                &have,
+                &tonemapped(texels, exposure),
                 (w, h),
                 0,
                 &format!("{name}, frame {k}"),
@@ -390,7 +342,7 @@ fn the_translucency_effect_on_host_layouts_equals_lucents_own_frame() {
         }
         effect.destroy(&lucent);
         drop(lucent);
-        for image in lightings.into_iter().chain([normals, thickness]) {
+        for image in [normals, thickness] {
             gpu.destroy_image(image);
         }
         layout.destroy(&test);

@@ -10,15 +10,15 @@
 
 use std::path::Path;
 
-use crate::common::{submit_back_to_back, TestGpu};
+use crate::common::TestGpu;
 use crate::embed::{
-    built, changed, compare_host_frame, described, fresh_view, host_error, host_id, host_layout,
+    built, changed, compare_host_frame, described, host_error, host_frames, host_id, host_layout,
     options, tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
 
 use ash::vk;
-use lucent::backend::{GpuImage, ImageDesc};
+use lucent::backend::ImageDesc;
 use lucent::embed::{
     capabilities, DiffuseDesc, Effect, GBufferDesc, HostError, HostImage, IdDesc, ImageState,
     NormalDesc, ShadowFace, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame,
@@ -251,99 +251,50 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         })
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
-        let lighting_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC;
-        let lightings: Vec<GpuImage> = (0..3)
-            .map(|_| {
-                gpu.upload_image(
-                    &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, lighting_usage),
-                    &[bytemuck::cast_slice(&without.diffuse).to_vec()],
-                    "host lighting",
-                )
-                .unwrap()
-            })
-            .collect();
-        let mut views = Vec::new();
-        submit_back_to_back(gpu, 3, |k, cmd| {
-            let depth_aspect = if depth_kind == HostDepth::Linear {
-                vk::ImageAspectFlags::COLOR
-            } else {
-                vk::ImageAspectFlags::DEPTH
-            };
-            // Views made anew every frame (a recreated view can reuse a handle value).
-            let depth_view = fresh_view(&test, layout.depth.image, desc.depth.format, depth_aspect);
-            views.push(depth_view);
-            let depth = HostImage::new(
-                "host depth",
-                layout.depth.image,
-                depth_view,
-                desc.depth.format,
-                desc.extent(),
-                usage,
-            )
-            .in_state(ImageState::fragment_sampled());
-            let normals = described(&normals, "host normals", usage);
-            let albedo = described(&albedo, "host albedo", usage);
-            let shadows = HostImage::new(
-                "host shadow map",
-                shadow_map.image,
-                shadow_map.view,
-                vk::Format::D32_SFLOAT,
-                vk::Extent2D {
-                    width: sw,
-                    height: sh,
-                },
-                usage,
-            )
-            .in_state(ImageState::fragment_sampled());
-            let ids = match (&layout.ids, layout.stencil_ids) {
-                (Some(image), _) => described(image, "host IDs", usage),
-                (None, Some(view)) => HostImage::new(
-                    "host stencil IDs",
-                    layout.depth.image,
-                    view,
-                    vk::Format::D24_UNORM_S8_UINT,
-                    desc.extent(),
-                    usage,
-                )
-                .in_state(ImageState::fragment_sampled()),
-                (None, None) => unreachable!(),
-            };
-            let lighting = described(&lightings[k], "host lighting", lighting_usage)
-                .then(ImageState::transfer_src());
-            effect
-                .record(
-                    &lucent,
-                    cmd,
-                    &TransmissionFrame {
-                        slot: k,
-                        view: 0,
-                        camera: layout.camera,
-                        lights: &scene.lights,
-                        shadow_faces: &faces,
-                        images: TransmissionImages {
-                            depth: &depth,
-                            normals: &normals,
-                            material_ids: &ids,
-                            albedo: Some(&albedo),
-                            shadow_map: &shadows,
+        let shadows = HostImage::new(
+            "host shadow map",
+            shadow_map.image,
+            shadow_map.view,
+            vk::Format::D32_SFLOAT,
+            vk::Extent2D {
+                width: sw,
+                height: sh,
+            },
+            usage,
+        )
+        .in_state(ImageState::fragment_sampled());
+        let frames = host_frames(
+            &test,
+            &layout,
+            &desc,
+            bytemuck::cast_slice(&without.diffuse),
+            |k, cmd, images| {
+                effect
+                    .record(
+                        &lucent,
+                        cmd,
+                        &TransmissionFrame {
+                            slot: k,
+                            view: 0,
+                            camera: layout.camera,
+                            lights: &scene.lights,
+                            shadow_faces: &faces,
+                            images: TransmissionImages {
+                                depth: images.depth,
+                                normals: &described(&normals, "host normals", usage),
+                                material_ids: images.ids.unwrap(),
+                                albedo: Some(&described(&albedo, "host albedo", usage)),
+                                shadow_map: &shadows,
+                            },
+                            regions: &[],
+                            lighting: images.lighting,
                         },
-                        regions: &[],
-                        lighting: &lighting,
-                    },
-                )
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
-        });
-        for view in views {
-            // SAFETY: the frames that used it completed (submit_back_to_back waited).
-            unsafe { gpu.device.destroy_image_view(view, None) };
-        }
-        for (k, lighting) in lightings.iter().enumerate() {
-            let bytes = gpu
-                .read_image(lighting, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
-                .unwrap();
-            let have = tonemapped(bytemuck::cast_slice(&bytes), exposure);
+                    )
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            },
+        );
+        for (k, texels) in frames.iter().enumerate() {
+            let have = tonemapped(texels, exposure);
             // A position or normal the host encodes otherwise (reversed or linear depth,
             // octahedral normals) moves the point the map is read from (one texel inside along
             // the normal) by a hair: where that crosses to another map texel on a silhouette,
@@ -360,9 +311,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         }
         effect.destroy(&lucent);
         drop(lucent);
-        for image in lightings.into_iter().chain([normals]) {
-            gpu.destroy_image(image);
-        }
+        gpu.destroy_image(normals);
         layout.destroy(&test);
     }
     gpu.destroy_image(albedo);

@@ -37,11 +37,11 @@ use gpu_allocator::AllocatorDebugSettings;
 
 use crate::error::{LucentError, Result, VkResultExt};
 
+use super::buffer::GpuBuffer;
 use super::desc::{c_string, lock};
 pub use super::desc::{ContextDesc, DeviceInfo};
 use super::device::{create_device, pick_device, probe_device, queue_family_usable};
 use super::instance::{create_instance, messenger_create_info, CreatedInstance, MessengerState};
-use super::resources::GpuBuffer;
 
 /// The command pool, command buffer and fence behind [`GpuContext::submit_and_wait`].
 struct OneShot {

@@ -1,7 +1,8 @@
 //! The thin layer over `ash`: one abstraction level, no more.
 //!
 //! - [`context`]: the Vulkan context, created by lucent or wrapping a host engine's device.
-//! - [`resources`]: images and buffers with named allocations, readback.
+//! - [`resources`]: images and buffers with named allocations, readback (a buffer itself,
+//!   [`GpuBuffer`], is its own small module, which the context's staging uses too).
 //! - [`access`]: the one access table every barrier is derived from.
 //! - [`pipeline`]: graphics pipelines, made for the render pass and subpass a caller names.
 //! - [`descriptor`]: descriptor sets (one per pass, with its own pool) and samplers.
@@ -12,6 +13,7 @@
 //! - [`timer`]: GPU timestamp scopes, read without stalling.
 
 pub mod access;
+mod buffer;
 pub mod context;
 mod desc;
 pub mod descriptor;

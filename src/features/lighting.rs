@@ -13,8 +13,6 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
 use crate::backend::shader::PipelineShaders;
 use crate::gpu_scene::{Region, SceneGpu, FRAME};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
@@ -24,8 +22,7 @@ use super::pass::FullscreenPass;
 use super::shadows::{self, ShadowMaps};
 use super::util::Defines;
 
-/// Lit HDR colour.
-pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub use super::util::HDR_FORMAT;
 
 /// What the lighting pass writes.
 pub struct Lit {

@@ -55,6 +55,10 @@ impl Recording for RecordContext<'_> {
 /// A pass's shader defines, `("NAME", "VALUE")` (see [`crate::features::shipped`]).
 pub type Defines = Vec<(&'static str, &'static str)>;
 
+/// Lit HDR colour: the lighting pass's output and what the SSS blurs and Li et al.'s terms
+/// write (here, below both, so that the blurs need not import the lighting).
+pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
 /// A pass's pipeline together with its descriptor set: what most passes hold after `prepare`.
 pub struct PassPipeline {
     /// The pipeline.

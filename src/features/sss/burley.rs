@@ -31,8 +31,8 @@ use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssIn
 use super::{SssProfiles, MAX_SSS_PROFILES};
 use crate::backend::shader::PipelineShaders;
 use crate::features::knob::{Given, Knob, Takes};
-use crate::features::lighting::HDR_FORMAT;
 use crate::features::util::Defines;
+use crate::features::util::HDR_FORMAT;
 use crate::gpu_scene::{Region, SceneGpu, TableRegion};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 use crate::scene::profile::{burley_cdf, burley_radius, BurleyFit, BURLEY_REACH};

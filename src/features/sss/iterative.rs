@@ -12,9 +12,9 @@ use super::{
     LEAN_FINAL_SHADER, PACKED_FORMAT,
 };
 use crate::backend::shader::PipelineShaders;
-use crate::features::lighting::HDR_FORMAT;
 use crate::features::pass::FullscreenPass;
 use crate::features::util::Defines;
+use crate::features::util::HDR_FORMAT;
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 

@@ -777,7 +777,7 @@ pub fn host_albedo_pass(
         crate::graph::ImageInfo {
             width,
             height,
-            format: crate::features::lighting::HDR_FORMAT,
+            format: crate::features::util::HDR_FORMAT,
         },
     );
     let mut pass = FullscreenPass::new(graph, "sss albedo in", HOST_ALBEDO_FRAGMENT, scene);

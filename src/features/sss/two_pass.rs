@@ -13,9 +13,9 @@ use ash::vk;
 
 use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssInputs, SssKnobs};
 use crate::backend::shader::PipelineShaders;
-use crate::features::lighting::HDR_FORMAT;
 use crate::features::pass::FullscreenPass;
 use crate::features::util::Defines;
+use crate::features::util::HDR_FORMAT;
 use crate::gpu_scene::{SceneGpu, TableRegion, TileRect};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 

@@ -1555,6 +1555,9 @@ fn mesh_draws(buffer: vk::Buffer) -> Vec<MeshDraw> {
         .zip(ids)
         .map(|(&s, id)| MeshDraw::new(buffer, sphere_vertices, ball(s), id))
         .collect();
+    // The unit sphere's bounds (the floor's below): lucent's layered terms then blur only over
+    // the objects whose medium they act on at their distance.
+    let unit = (Vec3::splat(-1.0), Vec3::ONE);
     let leaf =
         Mat4::from_translation(Vec3::from(LEAF_CENTRE)) * Mat4::from_scale(Vec3::from(LEAF_RADII));
     draws.push(MeshDraw::new(buffer, sphere_vertices, leaf, LEAF_ID));
@@ -1564,10 +1567,17 @@ fn mesh_draws(buffer: vk::Buffer) -> Vec<MeshDraw> {
         ball(LAYERED_SPHERE),
         LAYERED_ID,
     ));
-    let mut floor = MeshDraw::new(buffer, 6, Mat4::IDENTITY, 0);
+    let mut floor = MeshDraw::new(buffer, 6, Mat4::IDENTITY, 0)
+        .with_bounds(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0));
     floor.first = sphere_vertices;
     draws.push(floor);
     draws
+        .into_iter()
+        .map(|d| match d.bounds {
+            Some(_) => d,
+            None => d.with_bounds(unit.0, unit.1),
+        })
+        .collect()
 }
 
 /// The faces lucent draws its light-space maps with, as the engine gives them: the sun's

@@ -40,7 +40,7 @@ use super::passes::{
     check_described, check_environment, check_lights, check_views, depth_role, id_role,
     import_host_image, EffectPasses,
 };
-use super::regions::clipped;
+use super::regions::{box_nearest_depth, box_screen_region, clipped};
 use super::shadow_faces::{shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -48,8 +48,8 @@ use crate::backend::format::format_name;
 use crate::backend::pipeline::HostVertexInput;
 use crate::error::HostError;
 use crate::features::layered::{
-    layered_passes, LayeredDesc, LayeredHost, LayeredInputs, LayeredKnobs, LayeredTableGpu,
-    MAX_LAYERED_MATERIALS, TABLE_REGION,
+    blurs_on_screen, layered_passes, LayeredDesc, LayeredHost, LayeredInputs, LayeredKnobs,
+    LayeredTableGpu, MAX_LAYERED_MATERIALS, TABLE_REGION,
 };
 use crate::features::shadows::{
     self, host_shadow_pass, HostShadowDraw, HostShadowFrame, ShadowUniforms, MAX_ATLAS_EXTENT,
@@ -313,6 +313,10 @@ pub struct MeshDraw {
     pub transform: Mat4,
     /// The host's material ID of the mesh.
     pub material_id: u8,
+    /// The mesh's bounding box in its own space (`None`: not given). When every layered mesh
+    /// of a frame has one, the term's blur draws only over the meshes whose medium it acts on
+    /// at their distance, as in lucent's own frames, instead of over every layered region.
+    pub bounds: Option<(glam::Vec3, glam::Vec3)>,
 }
 
 impl MeshDraw {
@@ -327,7 +331,14 @@ impl MeshDraw {
             vertex_offset: 0,
             transform,
             material_id,
+            bounds: None,
         }
+    }
+
+    /// This draw with its object-space bounding box.
+    pub fn with_bounds(mut self, low: glam::Vec3, high: glam::Vec3) -> Self {
+        self.bounds = Some((low, high));
+        self
     }
 
     /// This draw through `indices` (`count` then counts indices).
@@ -415,6 +426,8 @@ pub struct LayeredEffect {
     desc: LayeredEffectDesc,
     /// The table every frame shares; each frame adds its view.
     table: HostLayeredTableGpu,
+    /// The media, layered material `k` at `k - 1` (lengths in the G-buffer's units).
+    media: Vec<LayeredMedium>,
     /// What the light-space maps pass draws: filled just before each frame records.
     shadow_frame: Arc<Mutex<HostShadowFrame>>,
 }
@@ -496,7 +509,7 @@ impl LayeredEffect {
         let uint_ids = id_map.uint;
         let (host_ids, _) = crate::features::sss::IdMap::Host(id_map).rows();
         let layered = LayeredDesc {
-            materials: media,
+            materials: media.clone(),
             object_ids: Vec::new(),
             film: false,
         };
@@ -538,6 +551,7 @@ impl LayeredEffect {
             imports,
             desc,
             table,
+            media,
             shadow_frame,
         })
     }
@@ -582,22 +596,12 @@ impl LayeredEffect {
             bytemuck::bytes_of(&light_table),
         )?;
         // The layered passes draw in the slot's `layered` tiles, the term's blur in its
-        // `layered_blur` ones (which the blur's shader narrows per texel).
-        let rects = if frame.regions.is_empty() {
-            vec![TileRect {
-                x: 0,
-                y: 0,
-                width: gbuffer.width,
-                height: gbuffer.height,
-                translucent: true,
-            }]
-        } else {
-            clipped(frame.regions, gbuffer.extent())
-        };
+        // `layered_blur` ones.
+        let (layered_rects, blur_rects) = self.rects(frame, &draws);
         {
             let mut tiles = per_frame.tiles(ring);
-            tiles.layered_blur = rects.clone();
-            tiles.layered = rects;
+            tiles.layered = layered_rects;
+            tiles.layered_blur = blur_rects;
         }
         *self.shadow_frame.lock().unwrap_or_else(|e| e.into_inner()) = HostShadowFrame {
             tiles: face_tiles(&light_table, frame.light_faces.len()),
@@ -619,6 +623,60 @@ impl LayeredEffect {
             (frame.lighting, Role::Accumulate),
             timer,
         )
+    }
+
+    /// The layered passes' rectangles (the frame's regions; none: the whole screen) and the
+    /// term blur's: where every layered mesh has its bounds, those of the meshes whose medium
+    /// the blur acts on at their nearest point ([`crate::features::layered::blurs_on_screen`],
+    /// lucent's own rule), else the layered passes' own (the blur's shader then narrows it
+    /// per texel).
+    fn rects(
+        &self,
+        frame: &LayeredFrame<'_>,
+        draws: &[HostShadowDraw],
+    ) -> (Vec<TileRect>, Vec<TileRect>) {
+        let gbuffer = &self.desc.gbuffer;
+        let extent = gbuffer.extent();
+        let layered = if frame.regions.is_empty() {
+            vec![TileRect {
+                x: 0,
+                y: 0,
+                width: extent.width,
+                height: extent.height,
+                translucent: true,
+            }]
+        } else {
+            clipped(frame.regions, extent)
+        };
+        let camera = &frame.camera;
+        let focal_px = camera.projection.y_axis.y.abs() * extent.height as f32 * 0.5;
+        let texel_px = if self.desc.knobs.half_gather {
+            2.0
+        } else {
+            1.0
+        };
+        let mut blur = Vec::new();
+        for (mesh, draw) in frame.meshes.iter().zip(draws) {
+            let Some(medium) = usize::from(draw.layered_id)
+                .checked_sub(1)
+                .and_then(|k| self.media.get(k))
+            else {
+                continue;
+            };
+            let Some(bounds) = mesh.bounds else {
+                return (layered.clone(), layered);
+            };
+            let nearest = box_nearest_depth(bounds, mesh.transform, camera);
+            if !blurs_on_screen(medium, nearest, focal_px, texel_px) {
+                continue;
+            }
+            match box_screen_region(bounds, mesh.transform, camera, extent, 0.0) {
+                Some(region) => blur.extend(clipped(&[region], extent)),
+                // The box reaches the eye's plane: it may cover the whole screen.
+                None => return (layered.clone(), layered),
+            }
+        }
+        (layered, blur)
     }
 
     /// The frame's meshes as the light-space pass draws them, each checked: its buffers given,

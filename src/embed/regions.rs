@@ -14,13 +14,18 @@ use crate::gpu_scene::TileRect;
 /// [`screen_region`] of the box `lo..hi` (an object's bounds in its own space) placed in the
 /// world by `transform`.
 pub fn box_screen_region(
-    (lo, hi): (Vec3, Vec3),
+    bounds: (Vec3, Vec3),
     transform: glam::Mat4,
     camera: &HostCamera,
     extent: vk::Extent2D,
     reach: f32,
 ) -> Option<vk::Rect2D> {
-    let corners: Vec<Vec3> = (0..8)
+    screen_region(&box_corners(bounds, transform), camera, extent, reach)
+}
+
+/// The eight corners of the box `lo..hi` placed in the world by `transform`.
+fn box_corners((lo, hi): (Vec3, Vec3), transform: glam::Mat4) -> Vec<Vec3> {
+    (0..8)
         .map(|i| {
             let p = Vec3::new(
                 if i & 1 == 0 { lo.x } else { hi.x },
@@ -29,8 +34,27 @@ pub fn box_screen_region(
             );
             transform.transform_point3(p)
         })
-        .collect();
-    screen_region(&corners, camera, extent, reach)
+        .collect()
+}
+
+/// The view depth of the nearest corner of the box `bounds` placed by `transform` (0 when
+/// the box reaches the eye's plane or a corner is not finite), as lucent's own tiles measure
+/// how near an object comes.
+pub(crate) fn box_nearest_depth(
+    bounds: (Vec3, Vec3),
+    transform: glam::Mat4,
+    camera: &HostCamera,
+) -> f32 {
+    box_corners(bounds, transform)
+        .into_iter()
+        .map(|corner| -camera.view.transform_point3(corner).z)
+        .fold(f32::MAX, |nearest, depth| {
+            if depth.is_finite() && depth > 1e-6 {
+                nearest.min(depth)
+            } else {
+                0.0
+            }
+        })
 }
 
 /// The screen rectangle of the world-space points `corners` (an object's bounding box's eight

@@ -940,17 +940,22 @@ fn measure_layered(
                 mesh.indices.len(),
             ));
         }
+        // Each with its mesh's bounds, so the term's blur draws where lucent's does.
+        let bounds = crate::gpu_scene::tiles::mesh_bounds(scene);
         let draws: Vec<MeshDraw> = scene
             .objects
             .iter()
             .zip(&desc.object_ids)
             .map(|(o, &id)| {
                 let (vertices, indices, count) = meshes[o.mesh];
-                MeshDraw::new(vertices, count as u32, o.transform, id).with_indices(IndexBuffer {
-                    buffer: indices,
-                    offset: 0,
-                    index_type: vk::IndexType::UINT32,
-                })
+                let (low, high) = bounds[o.mesh];
+                MeshDraw::new(vertices, count as u32, o.transform, id)
+                    .with_indices(IndexBuffer {
+                        buffer: indices,
+                        offset: 0,
+                        index_type: vk::IndexType::UINT32,
+                    })
+                    .with_bounds(low, high)
             })
             .collect();
         let (faces, atlas) = match &shadows {

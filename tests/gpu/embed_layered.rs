@@ -357,7 +357,16 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
             .map(|(k, m)| LayeredMaterial::new(host_id(ids_kind, k as u8 + 1), m.clone()))
             .collect();
         let buffers = MeshBuffers::new(&test, &scene, meshes_kind);
-        let draws = buffers.draws(&scene, |k| host_id(ids_kind, object_ids[k]));
+        let mut draws = buffers.draws(&scene, |k| host_id(ids_kind, object_ids[k]));
+        if meshes_kind == HostMeshes::TwoBindings {
+            // With the meshes' bounds the term's blur draws over the objects it acts on only:
+            // the same frame.
+            let bounds = lucent::gpu_scene::tiles::mesh_bounds(&scene);
+            for (draw, object) in draws.iter_mut().zip(&scene.objects) {
+                let (low, high) = bounds[object.mesh];
+                *draw = draw.with_bounds(low, high);
+            }
+        }
         let lucent = wrap(&test, options(3));
         let mut effect = built(&test, &lucent, |u| {
             LayeredEffect::new(

@@ -31,7 +31,13 @@
 //!    sphere and a floor quad, f32 positions and R16G16B16A16_SNORM normals, 20 bytes a
 //!    vertex, not indexed), each object placed by its model matrix, with the faces the engine
 //!    gives: the sun's orthographic one and the back light's six.
-//! 6. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
+//!    The engine renders its own shadow maps of the same faces (depth only, standard Z, one
+//!    D32 atlas drawn from the same vertex buffer) for:
+//! 6. **lucent's SSS transmission** (`TransmissionEffect`): the light of both lights diffused
+//!    through the skin's and the marble's thin parts (their rims seen against the lights),
+//!    measured in the engine's shadow atlas, added to the lit diffuse (`--no-transmission`
+//!    leaves it and the engine's shadow maps out).
+//! 7. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
 //!    diffuse + specular itself instead (its own ambient, no translucency, no scatter).
@@ -41,7 +47,7 @@
 //!    `lucent_sh_ambient`, `lucent_translucency`) and lucent's data (the environment's
 //!    coefficients, the leaf's material row, the lights' translucency scales): no pass of
 //!    lucent's but the SSS, the same picture within the target's rounding.
-//! 7. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
+//! 8. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
 //! cargo run --release --example host_engine -- --size 640x480 --frames 6 --out f.png
@@ -78,6 +84,8 @@ use lucent::embed::{
     NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace, SssEffect, SssEffectDesc,
     SssFrame, SssImages, SssMaterial, SssProfile, ThicknessDesc, TranslucencyEffect,
     TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
+    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
+    TransmissionMaterial,
 };
 
 /// The engine's ambient light: a sky radiance above the horizon and a ground radiance below,
@@ -129,6 +137,8 @@ const LIGHT_SPACE: vk::Extent2D = vk::Extent2D {
     height: 768,
 };
 const SUN_FACE_EDGE: u32 = 512;
+/// The engine's shadow atlas: depth, standard Z (lucent reads shadow maps so).
+const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 const POINT_FACE_EDGE: u32 = 256;
 /// The procedural sphere's tessellation (its vertex count is `6 * STACKS * SLICES`).
 const STACKS: u32 = 48;
@@ -152,6 +162,8 @@ struct Args {
     /// `--fused`: the engine's lighting pass adds lucent's environment and translucency terms
     /// itself (`lucent::embed::glsl::TERMS`) instead of lucent's effects adding them after it.
     fused: bool,
+    /// `--no-transmission`: no SSS transmission (and no shadow maps of the engine's).
+    no_transmission: bool,
     /// `--timing`: time lucent's passes with GPU timestamps (`record_timed`) and print each
     /// pass's median over the frames.
     timing: bool,
@@ -162,7 +174,8 @@ struct Args {
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
                      [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
-                     [--engine-ambient] [--fused] [--timing] [--scene NAME]";
+                     [--engine-ambient] [--fused] [--no-transmission] [--timing] \
+                     [--scene NAME]";
 
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
@@ -175,6 +188,7 @@ fn parse_args() -> Result<Args, String> {
         whole_screen: false,
         engine_ambient: false,
         fused: false,
+        no_transmission: false,
         timing: false,
         scene: None,
     };
@@ -208,6 +222,7 @@ fn parse_args() -> Result<Args, String> {
             "--whole-screen" => args.whole_screen = true,
             "--engine-ambient" => args.engine_ambient = true,
             "--fused" => args.fused = true,
+            "--no-transmission" => args.no_transmission = true,
             "--timing" => args.timing = true,
             "--scene" => args.scene = Some(value()?),
             "--help" | "-h" => return Err(USAGE.into()),
@@ -296,6 +311,23 @@ void main() {{
             RZ = super::LEAF_RADII[2],
         )
     }
+
+    /// The engine's shadow maps: each object's positions from its vertex buffer, depth only
+    /// (`m`: the face's view-projection times the object's model matrix).
+    pub fn shadow_vert() -> String {
+        format!(
+            r#"#version 450
+{PUSH}
+layout(location = 0) in vec3 a_position;
+void main() {{
+    gl_Position = pc.m * vec4(a_position, 1.0);
+}}
+"#
+        )
+    }
+
+    /// Depth only: nothing to write.
+    pub const SHADOW_FRAG: &str = "#version 450\nvoid main() {}\n";
 
     pub fn gbuffer_frag() -> String {
         format!(
@@ -862,6 +894,9 @@ struct FrameSlot {
     specular: Target,
     hdr: Target,
     ldr: Target,
+    /// The engine's shadow atlas (the faces of `light_faces`; none with `--no-transmission`
+    /// or without lucent).
+    shadow: Option<Target>,
     /// Lighting (depth, normals, albedo), compose (diffuse, specular), tonemap (HDR).
     lighting_set: vk::DescriptorSet,
     compose_set: vk::DescriptorSet,
@@ -883,6 +918,8 @@ struct Pipelines {
     lighting_leaf: Option<vk::Pipeline>,
     compose: vk::Pipeline,
     tonemap: vk::Pipeline,
+    /// The shadow maps (depth only, standard Z).
+    shadow: vk::Pipeline,
 }
 
 fn compile(
@@ -913,16 +950,27 @@ fn compile(
     .map_err(|e| format!("vkCreateShaderModule ({name}): {e}"))
 }
 
-/// A graphics pipeline of `vert` + `frag` for dynamic rendering into `colours` (and `depth`:
-/// reversed Z, GREATER).
+/// What a pipeline reads from vertex buffers.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Vertices {
+    /// Nothing (fullscreen passes).
+    None,
+    /// The G-buffer's float of local thickness per vertex drawn.
+    Thickness,
+    /// The mesh buffer's positions (`mesh_vertices`).
+    Positions,
+}
+
+/// A graphics pipeline of `vert` + `frag` for dynamic rendering into `colours` (and `depth`,
+/// tested and written with its compare op).
 fn pipeline(
     device: &ash::Device,
     cache: vk::PipelineCache,
     layout: vk::PipelineLayout,
     (vert, frag): (vk::ShaderModule, vk::ShaderModule),
     colours: &[vk::Format],
-    depth: Option<vk::Format>,
-    thickness_attribute: bool,
+    depth: Option<(vk::Format, vk::CompareOp)>,
+    vertices: Vertices,
 ) -> Result<vk::Pipeline, String> {
     let stages = [
         vk::PipelineShaderStageCreateInfo::default()
@@ -934,22 +982,26 @@ fn pipeline(
             .module(frag)
             .name(c"main"),
     ];
-    // The G-buffer's one vertex attribute: a float of local thickness per vertex drawn.
+    // One attribute at location 0: the G-buffer's thickness, or the mesh buffer's position.
+    let (stride, format) = match vertices {
+        Vertices::Positions => (MESH_STRIDE, vk::Format::R32G32B32_SFLOAT),
+        _ => (4, vk::Format::R32_SFLOAT),
+    };
     let bindings = [vk::VertexInputBindingDescription::default()
         .binding(0)
-        .stride(4)
+        .stride(stride)
         .input_rate(vk::VertexInputRate::VERTEX)];
     let attributes = [vk::VertexInputAttributeDescription::default()
         .location(0)
         .binding(0)
-        .format(vk::Format::R32_SFLOAT)
+        .format(format)
         .offset(0)];
-    let vertex_input = if thickness_attribute {
+    let vertex_input = if vertices == Vertices::None {
+        vk::PipelineVertexInputStateCreateInfo::default()
+    } else {
         vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&bindings)
             .vertex_attribute_descriptions(&attributes)
-    } else {
-        vk::PipelineVertexInputStateCreateInfo::default()
     };
     let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
         .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
@@ -965,7 +1017,7 @@ fn pipeline(
     let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(depth.is_some())
         .depth_write_enable(depth.is_some())
-        .depth_compare_op(vk::CompareOp::GREATER);
+        .depth_compare_op(depth.map_or(vk::CompareOp::ALWAYS, |(_, op)| op));
     let blend: Vec<vk::PipelineColorBlendAttachmentState> = colours
         .iter()
         .map(|_| {
@@ -978,7 +1030,7 @@ fn pipeline(
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(colours)
-        .depth_attachment_format(depth.unwrap_or(vk::Format::UNDEFINED));
+        .depth_attachment_format(depth.map_or(vk::Format::UNDEFINED, |(format, _)| format));
     let info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
@@ -1050,6 +1102,20 @@ fn create_pipelines(
             Fragment,
             "tonemap.frag",
         )?,
+        compile(
+            device,
+            &compiler,
+            &shaders::shadow_vert(),
+            Vertex,
+            "shadow.vert",
+        )?,
+        compile(
+            device,
+            &compiler,
+            shaders::SHADOW_FRAG,
+            Fragment,
+            "shadow.frag",
+        )?,
     ];
     // --fused: the lighting's variant with lucent's translucency, for the leaf's rectangle.
     let leaf_module = match fused {
@@ -1114,15 +1180,27 @@ fn create_pipelines(
                 None,
             )
             .map_err(|e| format!("vkCreateDescriptorPool: {e}"))?;
-        let [_, gbuffer_vert, gbuffer_frag, lighting_frag, compose_frag, tonemap_frag] = modules;
+        let [_, gbuffer_vert, gbuffer_frag, lighting_frag, compose_frag, tonemap_frag, shadow_vert, shadow_frag] =
+            modules;
         let gbuffer = pipeline(
             device,
             cache,
             layout,
             (gbuffer_vert, gbuffer_frag),
             &[NORMAL_FORMAT, ALBEDO_FORMAT, ID_FORMAT, THICKNESS_FORMAT],
-            Some(DEPTH_FORMAT),
-            true,
+            // Reversed Z.
+            Some((DEPTH_FORMAT, vk::CompareOp::GREATER)),
+            Vertices::Thickness,
+        )?;
+        // Standard Z, as lucent reads shadow maps.
+        let shadow = pipeline(
+            device,
+            cache,
+            layout,
+            (shadow_vert, shadow_frag),
+            &[],
+            Some((SHADOW_FORMAT, vk::CompareOp::LESS)),
+            Vertices::Positions,
         )?;
         let lighting = pipeline(
             device,
@@ -1131,7 +1209,7 @@ fn create_pipelines(
             (fullscreen, lighting_frag),
             &[light_format, light_format],
             None,
-            false,
+            Vertices::None,
         )?;
         let lighting_leaf = match leaf_module {
             Some(module) => Some(pipeline(
@@ -1141,7 +1219,7 @@ fn create_pipelines(
                 (fullscreen, module),
                 &[light_format, light_format],
                 None,
-                false,
+                Vertices::None,
             )?),
             None => None,
         };
@@ -1152,7 +1230,7 @@ fn create_pipelines(
             (fullscreen, compose_frag),
             &[HDR_FORMAT],
             None,
-            false,
+            Vertices::None,
         )?;
         let tonemap = pipeline(
             device,
@@ -1161,7 +1239,7 @@ fn create_pipelines(
             (fullscreen, tonemap_frag),
             &[LDR_FORMAT],
             None,
-            false,
+            Vertices::None,
         )?;
         Ok(Pipelines {
             set_layout,
@@ -1173,6 +1251,7 @@ fn create_pipelines(
             lighting_leaf,
             compose,
             tonemap,
+            shadow,
         })
     };
     for module in modules.into_iter().chain(leaf_module) {
@@ -1185,7 +1264,7 @@ fn create_pipelines(
 fn destroy_pipelines(device: &ash::Device, p: &Pipelines) {
     // SAFETY: the device is idle; the objects are the engine's own.
     unsafe {
-        let pipelines = [p.gbuffer, p.lighting, p.compose, p.tonemap];
+        let pipelines = [p.gbuffer, p.lighting, p.compose, p.tonemap, p.shadow];
         for pipeline in pipelines.into_iter().chain(p.lighting_leaf) {
             device.destroy_pipeline(pipeline, None);
         }
@@ -1221,6 +1300,7 @@ fn create_slot(
     light_format: vk::Format,
     index: usize,
     timing: bool,
+    shadow_maps: bool,
 ) -> Result<FrameSlot, String> {
     let device = &engine.device;
     use vk::ImageUsageFlags as U;
@@ -1248,6 +1328,18 @@ fn create_slot(
     let specular = target(light_format, attachment_sampled, "lit specular")?;
     let hdr = target(HDR_FORMAT, attachment_sampled, "hdr")?;
     let ldr = target(LDR_FORMAT, U::COLOR_ATTACHMENT | U::TRANSFER_SRC, "ldr")?;
+    let shadow = if shadow_maps {
+        Some(create_target(
+            engine,
+            allocator,
+            LIGHT_SPACE,
+            SHADOW_FORMAT,
+            U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED,
+            format!("shadow atlas {index}"),
+        )?)
+    } else {
+        None
+    };
     // SAFETY: plain object creation on the engine's device; destroyed in `destroy_slot`.
     unsafe {
         let pool = device
@@ -1337,6 +1429,7 @@ fn create_slot(
             specular,
             hdr,
             ldr,
+            shadow,
             lighting_set: sets[0],
             compose_set: sets[1],
             tonemap_set: sets[2],
@@ -1377,19 +1470,22 @@ fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, slot: FrameSlot) 
         slot.specular,
         slot.hdr,
         slot.ldr,
-    ] {
+    ]
+    .into_iter()
+    .chain(slot.shadow)
+    {
         destroy_target(engine, allocator, target);
     }
 }
 
 /// Begins dynamic rendering into `colours` (cleared to 0 when `clear`) and `depth` (cleared
-/// to 0: reversed Z's far plane), with the viewport and scissor of `extent`.
+/// to the far plane's depth given with it), with the viewport and scissor of `extent`.
 fn begin_rendering(
     device: &ash::Device,
     cmd: vk::CommandBuffer,
     extent: vk::Extent2D,
     colours: &[vk::ImageView],
-    depth: Option<vk::ImageView>,
+    depth: Option<(vk::ImageView, f32)>,
     clear: bool,
 ) {
     let load = if clear {
@@ -1408,7 +1504,7 @@ fn begin_rendering(
                 .clear_value(vk::ClearValue::default())
         })
         .collect();
-    let depth_attachment = depth.map(|view| {
+    let depth_attachment = depth.map(|(view, far)| {
         vk::RenderingAttachmentInfo::default()
             .image_view(view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
@@ -1416,7 +1512,7 @@ fn begin_rendering(
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 0.0,
+                    depth: far,
                     stencil: 0,
                 },
             })
@@ -1488,6 +1584,25 @@ fn engine_lights(sun: Vec3) -> [Light; 2] {
     // The sun is high: little of it comes through the leaf towards the camera.
     sun.translucency_scale = 0.2;
     [sun, back]
+}
+
+/// Whether the frame inserts lucent's SSS transmission (and so renders its shadow maps).
+fn transmission_on(args: &Args) -> bool {
+    args.with_lucent && args.scene.is_none() && !args.no_transmission
+}
+
+/// The skin's and the marble's media, through which their transmission diffuses (lucent's
+/// `[material.medium]`: Jensen's skin1 and marble, in metres as the engine's world).
+fn transmission_materials() -> Result<Vec<TransmissionMaterial>, String> {
+    let medium = |preset: &str| {
+        LayeredMedium::preset(preset)
+            .map(lucent::embed::Medium::new)
+            .map_err(|e| e.to_string())
+    };
+    Ok(vec![
+        TransmissionMaterial::new(SKIN_ID, medium("skin1")?),
+        TransmissionMaterial::new(MARBLE_ID, medium("marble")?),
+    ])
 }
 
 /// The layered ball's medium: Jensen's apple with eq. 3's physical weights.
@@ -1700,6 +1815,7 @@ struct Timers {
     environment: Option<EffectTimer>,
     translucency: Option<EffectTimer>,
     layered: EffectTimer,
+    transmission: Option<EffectTimer>,
     sss: EffectTimer,
 }
 
@@ -1730,6 +1846,7 @@ impl Effects {
             ("environment", timers.environment.as_ref()),
             ("translucency", timers.translucency.as_ref()),
             ("layered", Some(&timers.layered)),
+            ("transmission", timers.transmission.as_ref()),
             ("sss", Some(&timers.sss)),
         ];
         for (effect, timer) in named {
@@ -1769,6 +1886,8 @@ enum Inserted {
         translucency: Option<Box<TranslucencyEffect>>,
         /// The apple-flesh ball's layered medium.
         layered: Box<LayeredEffect>,
+        /// The skin's and marble's transmission (none with `--no-transmission`).
+        transmission: Option<Box<TransmissionEffect>>,
         sss: Box<SssEffect>,
     },
     /// lucent's whole frame of a scene (`--scene`): every technique its materials ask for.
@@ -1783,6 +1902,7 @@ fn build_effects(
     environment: Option<EnvironmentEffectDesc>,
     translucency: Option<TranslucencyEffectDesc>,
     layered: LayeredEffectDesc,
+    transmission: Option<TransmissionEffectDesc>,
     sss: SssEffectDesc,
 ) -> lucent::Result<Inserted> {
     let environment = environment
@@ -1800,21 +1920,34 @@ fn build_effects(
             return Err(e);
         }
     };
-    let built =
-        LayeredEffect::new(lucent, uploads, layered).and_then(|layered| {
-            match SssEffect::new(lucent, uploads, sss) {
-                Ok(sss) => Ok((layered, sss)),
-                Err(e) => {
-                    layered.destroy(lucent);
-                    Err(e)
-                }
+    let built = LayeredEffect::new(lucent, uploads, layered).and_then(|layered| {
+        let transmission = match transmission
+            .map(|desc| TransmissionEffect::new(lucent, uploads, desc))
+            .transpose()
+        {
+            Ok(t) => t,
+            Err(e) => {
+                layered.destroy(lucent);
+                return Err(e);
             }
-        });
+        };
+        match SssEffect::new(lucent, uploads, sss) {
+            Ok(sss) => Ok((layered, transmission, sss)),
+            Err(e) => {
+                layered.destroy(lucent);
+                if let Some(transmission) = transmission {
+                    transmission.destroy(lucent);
+                }
+                Err(e)
+            }
+        }
+    });
     match built {
-        Ok((layered, sss)) => Ok(Inserted::Effects {
+        Ok((layered, transmission, sss)) => Ok(Inserted::Effects {
             environment: environment.map(Box::new),
             translucency: translucency.map(Box::new),
             layered: Box::new(layered),
+            transmission: transmission.map(Box::new),
             sss: Box::new(sss),
         }),
         Err(e) => {
@@ -2006,6 +2139,58 @@ fn record_frame(
     };
     let fragment_sampled = ImageState::fragment_sampled();
 
+    // 0. The shadow maps lucent's transmission reads (when it is inserted): every object into
+    // each face's tile of the atlas, depth only, standard Z.
+    if let Some(shadow) = &mut slot.shadow {
+        let depth_attachment = ImageState {
+            layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ..ImageState::depth_attachment()
+        };
+        shadow.transition(device, cmd, depth_attachment, true);
+        begin_rendering(
+            device,
+            cmd,
+            LIGHT_SPACE,
+            &[],
+            Some((shadow.view, 1.0)),
+            true,
+        );
+        let draws = mesh_draws(meshes);
+        for face in light_faces(sun) {
+            // SAFETY: inside the atlas's rendering.
+            unsafe {
+                device.cmd_set_viewport(
+                    cmd,
+                    0,
+                    &[vk::Viewport {
+                        x: face.rect.offset.x as f32,
+                        y: face.rect.offset.y as f32,
+                        width: face.rect.extent.width as f32,
+                        height: face.rect.extent.height as f32,
+                        min_depth: 0.0,
+                        max_depth: 1.0,
+                    }],
+                );
+                device.cmd_set_scissor(cmd, 0, &[face.rect]);
+            }
+            for draw in &draws {
+                bind(
+                    pipelines.shadow,
+                    None,
+                    face.projection * face.view * draw.transform,
+                );
+                // SAFETY: inside the atlas's rendering, the shadow pipeline bound.
+                unsafe {
+                    device.cmd_bind_vertex_buffers(cmd, 0, &[meshes], &[0]);
+                    device.cmd_draw(cmd, draw.count, 1, draw.first, 0);
+                }
+            }
+        }
+        // SAFETY: inside the atlas's rendering.
+        unsafe { device.cmd_end_rendering(cmd) };
+        shadow.transition(device, cmd, ImageState::depth_sampled(), false);
+    }
+
     // 1. The G-buffer.
     for target in [
         &mut slot.normal,
@@ -2030,7 +2215,8 @@ fn record_frame(
             slot.ids.view,
             slot.thickness.view,
         ],
-        Some(slot.depth.view),
+        // Reversed Z: the far plane is 0.
+        Some((slot.depth.view, 0.0)),
         true,
     );
     bind(pipelines.gbuffer, None, projection * view);
@@ -2130,6 +2316,7 @@ fn record_frame(
                 environment,
                 translucency,
                 layered,
+                transmission,
                 sss,
             } = &mut effects.inserted
             else {
@@ -2224,6 +2411,39 @@ fn record_frame(
                 None => layered.record(&effects.lucent, cmd, &layered_frame),
             }
             .map_err(|e| format!("lucent: {e}"))?;
+            // SSS transmission through the skin and the marble, measured in the engine's own
+            // shadow atlas (rendered above with the same faces).
+            if let (Some(transmission), Some(shadow)) = (transmission, &slot.shadow) {
+                let shadow_map = shadow.host_image(LIGHT_SPACE);
+                let transmission_frame = TransmissionFrame {
+                    slot: slot_index,
+                    view: 0,
+                    camera,
+                    lights: &lights,
+                    shadow_faces: &faces,
+                    images: TransmissionImages {
+                        depth: &depth,
+                        normals: &normals,
+                        material_ids: &ids,
+                        albedo: Some(&albedo),
+                        shadow_map: &shadow_map,
+                    },
+                    // The skin's and the marble's projected bounds.
+                    regions: &scattering_region(&camera, extent, 0.0, effects.whole_screen),
+                    lighting: &lighting,
+                };
+                let timer = effects
+                    .timers
+                    .get_mut(slot_index)
+                    .and_then(|t| t.transmission.as_mut());
+                match timer {
+                    Some(timer) => {
+                        transmission.record_timed(&effects.lucent, cmd, &transmission_frame, timer)
+                    }
+                    None => transmission.record(&effects.lucent, cmd, &transmission_frame),
+                }
+                .map_err(|e| format!("lucent: {e}"))?;
+            }
             slot.normal.state = normals.left_in();
             slot.thickness.state = thickness.left_in();
             // (The other images come back as they came: the SSS reads them below.)
@@ -2421,6 +2641,15 @@ fn create_effects(
         ),
         LIGHT_SPACE,
     );
+    let transmission_desc = if transmission_on(args) {
+        Some(TransmissionEffectDesc::new(
+            gbuffer.clone(),
+            transmission_materials()?,
+            SHADOW_FORMAT,
+        ))
+    } else {
+        None
+    };
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
@@ -2440,6 +2669,7 @@ fn create_effects(
             environment_desc,
             translucency_desc,
             layered_desc,
+            transmission_desc,
             desc,
         ),
         Some(name) => lucent.load_scene(name).and_then(|scene| {
@@ -2472,7 +2702,7 @@ fn create_effects(
     match &args.scene {
         None => eprintln!(
             "host_engine: lucent effects: {}layered media (apple flesh, ID {LAYERED_ID}; its \
-             light-space maps drawn from the engine's vertex buffer), sss ({} blur; skin ID \
+             light-space maps drawn from the engine's vertex buffer), {}sss ({} blur; skin ID \
              {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
             match (args.fused, args.engine_ambient) {
                 (true, _) => "environment and translucency (the leaf) in the engine's \
@@ -2483,6 +2713,11 @@ fn create_effects(
                     "environment (the engine's sky and ground), translucency (leaf ID \
                      {LEAF_ID}), "
                 ),
+            },
+            if transmission_on(args) {
+                "transmission (skin and marble, through the engine's shadow maps), "
+            } else {
+                ""
             },
             args.blur
         ),
@@ -2503,6 +2738,11 @@ fn create_effects(
                     },
                     translucency: if args.fused { None } else { Some(timer()?) },
                     layered: timer()?,
+                    transmission: if transmission_on(args) {
+                        Some(timer()?)
+                    } else {
+                        None
+                    },
                     sss: timer()?,
                 })
             })
@@ -2694,6 +2934,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 light_format,
                 k,
                 args.timing && args.with_lucent && args.scene.is_none(),
+                transmission_on(args),
             )?);
         }
         if args.with_lucent {
@@ -2789,6 +3030,9 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 timer.destroy(&effects.lucent);
             }
             timers.layered.destroy(&effects.lucent);
+            for timer in timers.transmission.into_iter() {
+                timer.destroy(&effects.lucent);
+            }
             timers.sss.destroy(&effects.lucent);
         }
         match effects.inserted {
@@ -2796,6 +3040,7 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 environment,
                 translucency,
                 layered,
+                transmission,
                 sss,
             } => {
                 if let Some(environment) = environment {
@@ -2805,6 +3050,9 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                     (*translucency).destroy(&effects.lucent);
                 }
                 (*layered).destroy(&effects.lucent);
+                if let Some(transmission) = transmission {
+                    (*transmission).destroy(&effects.lucent);
+                }
                 (*sss).destroy(&effects.lucent);
             }
             Inserted::Scene(scene) => (*scene).1.destroy(&effects.lucent),

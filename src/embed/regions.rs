@@ -115,7 +115,8 @@ pub fn screen_region(
 /// dropped. No region at all stays no tile (the whole screen); regions that all fall outside
 /// the screen become one empty tile, which draws nothing.
 pub(crate) fn clipped(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Vec<TileRect> {
-    let mut tiles: Vec<TileRect> = regions
+    // Each region clipped, as (x0, y0, x1, y1).
+    let rects: Vec<(u32, u32, u32, u32)> = regions
         .iter()
         .filter_map(|r| {
             let x0 = i64::from(r.offset.x).clamp(0, i64::from(extent.width));
@@ -124,25 +125,67 @@ pub(crate) fn clipped(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Vec<TileR
                 .clamp(0, i64::from(extent.width));
             let y1 = (i64::from(r.offset.y) + i64::from(r.extent.height))
                 .clamp(0, i64::from(extent.height));
-            (x1 > x0 && y1 > y0).then(|| TileRect {
-                x: x0 as u32,
-                y: y0 as u32,
-                width: (x1 - x0) as u32,
-                height: (y1 - y0) as u32,
-                translucent: true,
-            })
+            (x1 > x0 && y1 > y0).then_some((x0 as u32, y0 as u32, x1 as u32, y1 as u32))
         })
         .collect();
-    if tiles.is_empty() && !regions.is_empty() {
-        tiles.push(TileRect {
-            x: 0,
-            y: 0,
-            width: 0,
-            height: 0,
-            translucent: true,
-        });
+    if rects.is_empty() {
+        return if regions.is_empty() {
+            Vec::new()
+        } else {
+            vec![TileRect {
+                x: 0,
+                y: 0,
+                width: 0,
+                height: 0,
+                translucent: true,
+            }]
+        };
     }
-    tiles
+    disjoint(&rects)
+}
+
+/// The union of `rects` (x0, y0, x1, y1) as rectangles that do not overlap: passes that add
+/// into the host's light draw each pixel once however the host's regions overlap (two
+/// objects' boxes on screen). Vertical strips between the rectangles' x edges, each strip's
+/// covered y spans merged, then strips with the same span side by side merged back.
+fn disjoint(rects: &[(u32, u32, u32, u32)]) -> Vec<TileRect> {
+    let mut xs: Vec<u32> = rects.iter().flat_map(|r| [r.0, r.2]).collect();
+    xs.sort_unstable();
+    xs.dedup();
+    let mut out: Vec<TileRect> = Vec::new();
+    for strip in xs.windows(2) {
+        let (a, b) = (strip[0], strip[1]);
+        let mut spans: Vec<(u32, u32)> = rects
+            .iter()
+            .filter(|r| r.0 <= a && r.2 >= b)
+            .map(|r| (r.1, r.3))
+            .collect();
+        spans.sort_unstable();
+        let mut merged: Vec<(u32, u32)> = Vec::new();
+        for (y0, y1) in spans {
+            match merged.last_mut() {
+                Some(last) if y0 <= last.1 => last.1 = last.1.max(y1),
+                _ => merged.push((y0, y1)),
+            }
+        }
+        for (y0, y1) in merged {
+            // The same span ending where this strip starts: widen it.
+            match out
+                .iter_mut()
+                .find(|t| t.x + t.width == a && t.y == y0 && t.y + t.height == y1)
+            {
+                Some(t) => t.width += b - a,
+                None => out.push(TileRect {
+                    x: a,
+                    y: y0,
+                    width: b - a,
+                    height: y1 - y0,
+                    translucent: true,
+                }),
+            }
+        }
+    }
+    out
 }
 
 /// The screen as tiles of [`TILE_SIZE`] (merged into rectangles), marked where a region
@@ -194,6 +237,21 @@ mod tests {
                 .map(|t| (t.x, t.y, t.width, t.height))
                 .collect::<Vec<_>>(),
             [(0, 40, 20, 10), (90, 0, 10, 5)]
+        );
+        // Overlapping regions become rectangles that cover their union once.
+        let tiles = clipped(&[rect(10, 10, 40, 20), rect(30, 0, 40, 20)], extent);
+        let mut covered = vec![0u8; 100 * 50];
+        for t in &tiles {
+            for y in t.y..t.y + t.height {
+                for x in t.x..t.x + t.width {
+                    covered[(y * 100 + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(covered.iter().all(|&c| c <= 1), "{tiles:?}");
+        assert_eq!(
+            covered.iter().filter(|&&c| c == 1).count(),
+            40 * 20 * 2 - 20 * 10
         );
         // Regions all off screen draw nothing (one empty tile), not the whole screen.
         let off = clipped(&[rect(200, 0, 10, 10)], extent);

@@ -10,8 +10,8 @@
 //!
 //! 1. **G-buffer** (raster, procedural spheres, a thin jade leaf and a floor): reversed-Z D32
 //!    depth with an infinite far plane, octahedral normals in RG16_SNORM, albedo in RGBA8, the
-//!    engine's own material numbers in an R8_UINT target (skin 17, marble 42, blue plastic 5,
-//!    leaf 9, an apple-flesh ball 23, floor 0) and local thickness in R8_UNORM, which the
+//!    engine's own material numbers in an R8_UINT target (skin 17 (a sphere and a thin ear),
+//!    marble 42, blue plastic 5, leaf 9, an apple-flesh ball 23, floor 0) and local thickness in R8_UNORM, which the
 //!    leaf's draw takes from the engine's vertex buffer (baked once by
 //!    `lucent::embed::bake_thickness`).
 //! 2. **Lighting** (fullscreen): a sun and a point light behind the leaf (and, without lucent
@@ -119,6 +119,10 @@ const LEAF_ID: u8 = 9;
 /// The leaf: an ellipsoid's centre and radii (metres), thin along z.
 const LEAF_CENTRE: [f32; 3] = [-0.06, 0.15, -0.12];
 const LEAF_RADII: [f32; 3] = [0.06, 0.045, 0.006];
+/// A thin ear of skin (an ellipsoid 8 mm thick) beside the leaf, lit from behind by the back
+/// light: SSS transmission makes it glow red through its thickness.
+const EAR_CENTRE: [f32; 3] = [-0.2, 0.14, -0.17];
+const EAR_RADII: [f32; 3] = [0.035, 0.045, 0.004];
 /// A point light behind the leaf (position, colour times intensity, range): the engine lights
 /// with it, and lucent's translucency lets it through the leaf.
 const BACK_LIGHT: [f32; 3] = [-0.08, 0.17, -0.24];
@@ -247,7 +251,8 @@ void main() {
     const PUSH: &str =
         "layout(push_constant) uniform Push { mat4 m; vec4 eye; vec4 sun; vec4 params; } pc;\n";
 
-    /// Three spheres (instances 0-2), the leaf (3), a floor (4) and the layered ball (5),
+    /// Three spheres (instances 0-2), the leaf (3), a floor (4), the layered ball (5) and the
+    /// skin ear (6),
     /// generated from the vertex index.
     pub fn gbuffer_vert() -> String {
         format!(
@@ -279,10 +284,13 @@ void main() {{
         float theta = float(k.x) / {STACKS}.0 * 3.14159265;
         float phi = float(k.y) / {SLICES}.0 * 6.28318531;
         n = vec3(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
-        if (object == 3u) {{
-            // The leaf: the unit sphere scaled to an ellipsoid (normals by the inverse).
-            p = vec3({LX}, {LY}, {LZ}) + vec3({RX}, {RY}, {RZ}) * n;
-            n = normalize(n / vec3({RX}, {RY}, {RZ}));
+        if (object == 3u || object == 6u) {{
+            // The leaf (3) and the ear (6): the unit sphere scaled to an ellipsoid (normals by
+            // the inverse).
+            vec3 centre = object == 3u ? vec3({LX}, {LY}, {LZ}) : vec3({EX}, {EY}, {EZ});
+            vec3 radii = object == 3u ? vec3({RX}, {RY}, {RZ}) : vec3({ERX}, {ERY}, {ERZ});
+            p = centre + radii * n;
+            n = normalize(n / radii);
         }} else {{
             vec4 s = SPHERES[object == 5u ? 3u : object];
             p = s.xyz + s.w * n;
@@ -309,6 +317,12 @@ void main() {{
             RX = super::LEAF_RADII[0],
             RY = super::LEAF_RADII[1],
             RZ = super::LEAF_RADII[2],
+            EX = super::EAR_CENTRE[0],
+            EY = super::EAR_CENTRE[1],
+            EZ = super::EAR_CENTRE[2],
+            ERX = super::EAR_RADII[0],
+            ERY = super::EAR_RADII[1],
+            ERZ = super::EAR_RADII[2],
         )
     }
 
@@ -349,7 +363,7 @@ void main() {{
     vec3 albedo;
     float gloss;
     uint id;
-    if (v_object == 0u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = 0.5; id = {SKIN}u; }}
+    if (v_object == 0u || v_object == 6u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = 0.5; id = {SKIN}u; }}
     else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = 0.8; id = {MARBLE}u; }}
     else if (v_object == 2u) {{ albedo = vec3(0.20, 0.35, 0.75); gloss = 0.6; id = {PLASTIC}u; }}
     else if (v_object == 3u) {{ albedo = vec3(0.42, 0.78, 0.50); gloss = 0.7; id = {LEAF}u; }}
@@ -1299,8 +1313,8 @@ fn create_slot(
     extent: vk::Extent2D,
     light_format: vk::Format,
     index: usize,
-    timing: bool,
-    shadow_maps: bool,
+    // The engine's own timestamps around its lighting; its shadow atlas.
+    (timing, shadow_maps): (bool, bool),
 ) -> Result<FrameSlot, String> {
     let device = &engine.device;
     use vk::ImageUsageFlags as U;
@@ -1676,6 +1690,9 @@ fn mesh_draws(buffer: vk::Buffer) -> Vec<MeshDraw> {
     let leaf =
         Mat4::from_translation(Vec3::from(LEAF_CENTRE)) * Mat4::from_scale(Vec3::from(LEAF_RADII));
     draws.push(MeshDraw::new(buffer, sphere_vertices, leaf, LEAF_ID));
+    let ear =
+        Mat4::from_translation(Vec3::from(EAR_CENTRE)) * Mat4::from_scale(Vec3::from(EAR_RADII));
+    draws.push(MeshDraw::new(buffer, sphere_vertices, ear, SKIN_ID));
     draws.push(MeshDraw::new(
         buffer,
         sphere_vertices,
@@ -1791,20 +1808,23 @@ fn leaf_region(camera: &HostCamera, extent: vk::Extent2D, whole_screen: bool) ->
     region.filter(|_| !whole_screen).into_iter().collect()
 }
 
-/// The screen rectangles of the skin and marble spheres widened by the blurs' `reach`: where
-/// the SSS blurs run (a pass-through elsewhere).
+/// The screen rectangles of the skin and marble spheres and the skin ear widened by `reach`
+/// (the blurs', or 0): where the SSS blurs run (a pass-through elsewhere) and where the
+/// transmission is drawn.
 fn scattering_region(
     camera: &HostCamera,
     extent: vk::Extent2D,
     reach: f32,
     whole_screen: bool,
 ) -> Vec<vk::Rect2D> {
+    let ear = (Vec3::from(EAR_CENTRE), Vec3::from(EAR_RADII));
     let regions: Option<Vec<vk::Rect2D>> = SPHERES[..2]
         .iter()
-        .map(|&[x, y, z, r]| {
-            let (centre, half) = (Vec3::new(x, y, z), Vec3::splat(r));
-            let sphere = (centre - half, centre + half);
-            lucent::embed::box_screen_region(sphere, Mat4::IDENTITY, camera, extent, reach)
+        .map(|&[x, y, z, r]| (Vec3::new(x, y, z), Vec3::splat(r)))
+        .chain([ear])
+        .map(|(centre, half)| {
+            let object = (centre - half, centre + half);
+            lucent::embed::box_screen_region(object, Mat4::IDENTITY, camera, extent, reach)
         })
         .collect();
     regions.filter(|_| !whole_screen).unwrap_or_default()
@@ -2228,6 +2248,7 @@ fn record_frame(
         device.cmd_draw(cmd, 6 * STACKS * SLICES, 4, 0, 0);
         device.cmd_draw(cmd, 6, 1, 0, 4);
         device.cmd_draw(cmd, 6 * STACKS * SLICES, 1, 0, 5);
+        device.cmd_draw(cmd, 6 * STACKS * SLICES, 1, 0, 6);
         device.cmd_end_rendering(cmd);
     }
     for target in [
@@ -2933,8 +2954,10 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
                 extent,
                 light_format,
                 k,
-                args.timing && args.with_lucent && args.scene.is_none(),
-                transmission_on(args),
+                (
+                    args.timing && args.with_lucent && args.scene.is_none(),
+                    transmission_on(args),
+                ),
             )?);
         }
         if args.with_lucent {

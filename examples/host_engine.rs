@@ -2421,6 +2421,7 @@ fn record_frame(
                     depth: &depth,
                     normals: &normals,
                     material_ids: &ids,
+                    albedo: None,
                 },
                 regions: &layered_region(&camera, extent, effects.whole_screen),
                 lighting: &lighting,

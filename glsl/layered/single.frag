@@ -23,6 +23,11 @@
 layout(set = 0, binding = LUCENT_LAYER_DEPTH_BINDING) uniform usampler2D gbuffer_layer_depths;
 #endif
 
+#if defined(LUCENT_LAYERED_FILM) && defined(LUCENT_HOST_GBUFFER)
+// A host's film: its albedo image (src/embed/layered.rs `LayeredEffectDesc::with_film`).
+layout(set = 0, binding = LUCENT_HOST_FILM_BINDING) uniform sampler2D host_film;
+#endif
+
 #ifdef LUCENT_ENTRY_BINDING
 // Per map texel: the first surface's normal * 0.5 + 0.5 and its layered material ID / 255.
 layout(set = 0, binding = LUCENT_ENTRY_BINDING) uniform sampler2D shadow_entry;
@@ -406,7 +411,13 @@ void main() {
     // blurs' `post` texturing): every term here leaves through x_o, while the light entering
     // (the irradiance gathered, the entry points) is left alone. The G-buffer stores the
     // texel beside the material ID (white for untextured draws).
+#ifdef LUCENT_HOST_GBUFFER
+    // The host's albedo texel; a NaN or out-of-range one is guarded here.
+    vec3 film = texelFetch(host_film, px, 0).rgb;
+    terms *= clamp(mix(film, vec3(0.0), isnan(film)), 0.0, 1.0);
+#else
     terms *= texelFetch(gbuffer_layered, px, 0).gba;
+#endif
 #endif
     out_color = vec4(finite_term(terms), 0.0);
 }

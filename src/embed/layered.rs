@@ -25,8 +25,10 @@
 //! lucent's G-buffer does. The medium's lengths are scaled by the G-buffer's
 //! [`GBufferDesc::metres_per_unit`], not by its own `units_per_mm`.
 //!
-//! Not embedded (refused by name): layers whose thickness is read from a depth texture
-//! (`TexDep`), and the albedo film (`post` texturing of a layered material).
+//! A host with an albedo image may use it as the layered materials' film
+//! ([`LayeredEffectDesc::with_film`]: lucent's `post` texturing of a layered material, the
+//! albedo texture multiplying the light leaving the surface). Not embedded (refused by name):
+//! layers whose thickness is read from a depth texture (`TexDep`).
 
 use std::sync::{Arc, Mutex};
 
@@ -246,6 +248,9 @@ pub struct LayeredEffectDesc {
     pub knobs: LayeredKnobs,
     /// Views recorded per frame (1 to [`super::MAX_VIEWS_PER_FRAME`]).
     pub views_per_frame: usize,
+    /// The host's albedo image multiplies the light leaving the layered surfaces (a pigment
+    /// film: lucent's `post` texturing of a layered material); needs the G-buffer's albedo.
+    pub film: bool,
 }
 
 impl LayeredEffectDesc {
@@ -264,7 +269,15 @@ impl LayeredEffectDesc {
             light_space,
             knobs: LayeredKnobs::default(),
             views_per_frame: 1,
+            film: false,
         }
+    }
+
+    /// With the host's albedo image as the layered materials' film (the frame's
+    /// [`LayeredImages::albedo`]).
+    pub fn with_film(mut self) -> Self {
+        self.film = true;
+        self
     }
 
     /// With these knobs.
@@ -364,6 +377,9 @@ pub struct LayeredImages<'a> {
     /// The material IDs (for stencil bits: a view of the depth-stencil image's stencil
     /// aspect).
     pub material_ids: &'a HostImage,
+    /// The albedo, the layered materials' film: required with
+    /// [`LayeredEffectDesc::with_film`], refused without.
+    pub albedo: Option<&'a HostImage>,
 }
 
 /// One view of one frame: what [`LayeredEffect::record`] reads and adds to.
@@ -416,6 +432,7 @@ struct Imports {
     depth: ResourceId,
     normals: ResourceId,
     material_ids: ResourceId,
+    albedo: Option<ResourceId>,
     lighting: ResourceId,
 }
 
@@ -444,6 +461,15 @@ impl LayeredEffect {
             unreachable!("missing() lists each input the effect reads");
         };
         check_views(desc.views_per_frame)?;
+        if desc.film && gbuffer.albedo.is_none() {
+            return Err(HostError::Missing {
+                input: "albedo".into(),
+                needed_by: "the layered media's film multiplies the light leaving them by the \
+                            albedo (GBufferDesc::with_albedo, or no film)"
+                    .into(),
+            }
+            .into());
+        }
         let input = desc.vertices.check(lucent.gpu())?;
         let extent = desc.light_space;
         let sides = 16..=MAX_ATLAS_EXTENT;
@@ -608,12 +634,15 @@ impl LayeredEffect {
             draws,
         };
         let images = &frame.images;
-        let binds = [
+        let mut binds = vec![
             (self.imports.depth, images.depth),
             (self.imports.normals, images.normals),
             (self.imports.material_ids, images.material_ids),
             (self.imports.lighting, frame.lighting),
         ];
+        if let (Some(id), Some(albedo)) = (self.imports.albedo, images.albedo) {
+            binds.push((id, albedo));
+        }
         self.passes.record(
             lucent,
             cmd,
@@ -743,33 +772,53 @@ impl LayeredEffect {
         let images = &frame.images;
         let ids = gbuffer.material_ids.expect("checked at new");
         let normal_format = gbuffer.normals.expect("checked at new").format;
-        check_described(
-            lucent,
-            gbuffer.extent(),
-            &[
-                (
-                    images.depth,
-                    "depth",
-                    depth_role(gbuffer),
-                    gbuffer.depth.format,
-                ),
-                (images.normals, "normals", Role::SampledColor, normal_format),
-                (
-                    images.material_ids,
-                    "material IDs",
-                    id_role(&ids),
-                    ids.format,
-                ),
-                (
-                    frame.lighting,
-                    "lighting",
-                    Role::Accumulate,
-                    gbuffer.diffuse.format,
-                ),
-            ],
-        )?;
+        let albedo = match (self.desc.film, images.albedo) {
+            (true, Some(albedo)) => Some(albedo),
+            (false, None) => None,
+            (true, None) => {
+                return Err(HostError::Missing {
+                    input: "albedo".into(),
+                    needed_by: "the layered media's film (LayeredEffectDesc::with_film)".into(),
+                }
+                .into())
+            }
+            (false, Some(_)) => {
+                return Err(HostError::Description {
+                    field: "albedo".into(),
+                    problem: "given, but the effect was built without a film: pass None".into(),
+                }
+                .into())
+            }
+        };
+        let mut checks = vec![
+            (
+                images.depth,
+                "depth",
+                depth_role(gbuffer),
+                gbuffer.depth.format,
+            ),
+            (images.normals, "normals", Role::SampledColor, normal_format),
+            (
+                images.material_ids,
+                "material IDs",
+                id_role(&ids),
+                ids.format,
+            ),
+            (
+                frame.lighting,
+                "lighting",
+                Role::Accumulate,
+                gbuffer.diffuse.format,
+            ),
+        ];
+        if let (Some(albedo), Some(format)) = (albedo, gbuffer.albedo) {
+            checks.push((albedo, "albedo", Role::SampledColor, format));
+        }
+        check_described(lucent, gbuffer.extent(), &checks)?;
         distinct_inputs(
-            [images.depth, images.normals, images.material_ids],
+            [images.depth, images.normals, images.material_ids]
+                .into_iter()
+                .chain(albedo),
             frame.lighting,
         )
     }
@@ -803,6 +852,13 @@ fn declare(
     let normals = import("host normals", normal_format, sampled);
     let ids_format = gbuffer.material_ids.expect("checked at new").format;
     let material_ids = import("host material IDs", ids_format, sampled);
+    let albedo = desc.film.then(|| {
+        import(
+            "host albedo",
+            gbuffer.albedo.expect("checked at new"),
+            sampled,
+        )
+    });
     let lighting = import(
         "host lighting",
         gbuffer.diffuse.format,
@@ -812,6 +868,7 @@ fn declare(
         depth: depth.id(),
         normals: normals.id(),
         material_ids: material_ids.id(),
+        albedo: albedo.as_ref().map(|a| a.id()),
         lighting: lighting.id(),
     };
     let extent = (desc.light_space.width, desc.light_space.height);
@@ -823,11 +880,12 @@ fn declare(
         layer_depths: None,
         layer_depth_textures: 0,
         shadows: Some(&maps),
-        film: false,
+        film: desc.film,
         host: Some(LayeredHost {
             uint_ids,
             linear_depth: gbuffer.depth.encoding == DepthEncoding::LinearView,
         }),
+        host_film: albedo.as_ref(),
     };
     let lighting = layered_passes(&mut graph, lighting, &inputs, &desc.knobs, Some(scene_gpu));
     graph.export_image(&lighting, Access::ColorAttachmentWrite);

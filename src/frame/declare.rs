@@ -155,6 +155,7 @@ pub fn declare_frame(
                 shadows: shadow_maps.as_ref(),
                 film: gb.layout.layered_film,
                 host: None,
+                host_film: None,
             },
             &settings.layered,
             scene_gpu,

@@ -49,9 +49,10 @@ pub struct GBufferReadback {
     pub sss: Option<Vec<f32>>,
     /// View-plane LEAN slope y and second moments xx, yy, xy (LCB and LBB frames).
     pub lean: Option<Vec<[f32; 4]>>,
-    /// Li et al.'s layered material ID per pixel (frames with layered media; 0: the pixel is
-    /// not layered).
-    pub layered: Option<Vec<f32>>,
+    /// Li et al.'s layered target (frames with layered media): the material ID / 255 in red
+    /// (0: the pixel is not layered) and, in frames with the film, the film texel in green,
+    /// blue and alpha.
+    pub layered: Option<Vec<[f32; 4]>>,
     /// Device depth.
     pub depth: Vec<f32>,
     /// The layout the frame used.

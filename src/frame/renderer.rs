@@ -467,11 +467,7 @@ impl Renderer {
                 .map(|id| read(id).map(|t| t.into_iter().map(|v| (v[0] * 255.0).round()).collect()))
                 .transpose()?,
             lean: outputs.lean.map(read).transpose()?,
-            // Stored as ID / 255 in the red channel (UNORM8): rounding recovers the integer.
-            layered: outputs
-                .layered
-                .map(|id| read(id).map(|t| t.into_iter().map(|v| (v[0] * 255.0).round()).collect()))
-                .transpose()?,
+            layered: outputs.layered.map(read).transpose()?,
             depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
             layout: outputs.layout,
         })

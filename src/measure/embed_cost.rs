@@ -911,7 +911,8 @@ fn measure_layered(
         let ids: Vec<u8> = gb
             .layered
             .as_ref()
-            .map(|v| v.iter().map(|&k| k as u8).collect())
+            // The material ID / 255 in red (UNORM8: rounding recovers the integer).
+            .map(|v| v.iter().map(|t| (t[0] * 255.0).round() as u8).collect())
             .unwrap_or_default();
         let id_image = images.upload(
             gpu,
@@ -980,22 +981,24 @@ fn measure_layered(
             .enumerate()
             .map(|(k, m)| LayeredMaterial::new(k as u8 + 1, m.clone()))
             .collect();
-        let mut effect = build(gpu, lucent, |u| {
-            LayeredEffect::new(
-                lucent,
-                u,
-                LayeredEffectDesc::new(
-                    gbuffer,
-                    materials,
-                    VertexLayout::interleaved(24, 0, 12),
-                    vk::Extent2D {
-                        width: atlas.0,
-                        height: atlas.1,
-                    },
-                )
-                .with_knobs(renderer.settings.layered),
-            )
-        })?;
+        let effect_desc = LayeredEffectDesc::new(
+            gbuffer,
+            materials,
+            VertexLayout::interleaved(24, 0, 12),
+            vk::Extent2D {
+                width: atlas.0,
+                height: atlas.1,
+            },
+        )
+        .with_knobs(renderer.settings.layered);
+        // A scene whose layered materials have albedo textures has the film: the host's
+        // albedo image stands for it (one texel read per pixel, as lucent's).
+        let effect_desc = if desc.film {
+            effect_desc.with_film()
+        } else {
+            effect_desc
+        };
+        let mut effect = build(gpu, lucent, |u| LayeredEffect::new(lucent, u, effect_desc))?;
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -1019,6 +1022,7 @@ fn measure_layered(
                         depth: &host.depth,
                         normals: &host.normals,
                         material_ids: &id_image,
+                        albedo: desc.film.then_some(&host.albedo),
                     },
                     regions: &regions,
                     lighting: &host.lighting,

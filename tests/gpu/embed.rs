@@ -1985,6 +1985,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                         depth: images.depth,
                         normals: &colour_in,
                         material_ids: images.material_ids,
+                        albedo: None,
                     },
                     regions: &[],
                     lighting: &lighting,

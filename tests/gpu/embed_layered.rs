@@ -30,10 +30,12 @@ use lucent::features::layered::LayeredDesc;
 use lucent::features::shadows::ShadowDesc;
 use lucent::frame::{FrameSettings, Renderer};
 
-/// An apple ball and a two-layer skin slab (1 unit = 20 mm) over a plain floor that casts, lit
-/// by a point light (six faces), a spot light and a directional light, all casting; `weights`
-/// are both media's eq. 3 weights.
+/// An apple ball with a striped albedo texture (its film) and a two-layer skin slab (1 unit =
+/// 20 mm) over a plain floor that casts, lit by a point light (six faces), a spot light and a
+/// directional light, all casting; `weights` are both media's eq. 3 weights.
 fn scene(weights: [f32; 5]) -> lucent::scene::Scene {
+    let stripes = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools/truth/scenes/stripes.png");
+    let stripes = stripes.display();
     let source = format!(
         r#"name = "host-layered"
 ambient = [0.05, 0.05, 0.06]
@@ -55,6 +57,7 @@ name = "floor"
 generator = "plane"
 [[material]]
 name = "apple"
+albedo_texture = "{stripes}"
 [material.layered]
 preset = "apple"
 units_per_mm = 0.05
@@ -281,13 +284,28 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
         changed_pixels * 20 > (w * h) as usize,
         "the layered terms change only {changed_pixels} pixels"
     );
-    let ids: Vec<u8> = gb
-        .layered
-        .as_ref()
-        .unwrap()
+    // The layered target: the material ID / 255 in red, the film texel in green, blue, alpha.
+    let layered = gb.layered.as_ref().unwrap();
+    let ids: Vec<u8> = layered
         .iter()
-        .map(|&v| v as u8)
+        .map(|t| (t[0] * 255.0).round() as u8)
         .collect();
+    let film: Vec<u8> = layered
+        .iter()
+        .flat_map(|t| [t[1], t[2], t[3], 1.0].map(|v| (v * 255.0).round() as u8))
+        .collect();
+    let film_image = gpu
+        .upload_image(
+            &ImageDesc::color(
+                w,
+                h,
+                vk::Format::R8G8B8A8_UNORM,
+                vk::ImageUsageFlags::SAMPLED,
+            ),
+            &[film],
+            "host albedo (the film)",
+        )
+        .unwrap();
     let media = LayeredDesc::new(&scene).unwrap().unwrap().materials;
     assert_eq!(media.len(), 2);
     assert_eq!(*ids.iter().max().unwrap(), 2, "both media on screen");
@@ -349,7 +367,11 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
         }
         let (normals, normal_desc) =
             normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
-        let desc = layout.desc.clone().with_normals(normal_desc);
+        let desc = layout
+            .desc
+            .clone()
+            .with_normals(normal_desc)
+            .with_albedo(vk::Format::R8G8B8A8_UNORM);
         assert!(capabilities(&desc).unwrap()[3].1.runs());
         let materials: Vec<LayeredMaterial> = media
             .iter()
@@ -380,7 +402,8 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
                         width: aw,
                         height: ah,
                     },
-                ),
+                )
+                .with_film(),
             )
         })
         .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -413,6 +436,7 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
                                 depth: images.depth,
                                 normals: &described(&normals, "host normals", usage),
                                 material_ids: images.ids.unwrap(),
+                                albedo: Some(&described(&film_image, "host albedo", usage)),
                             },
                             regions: &[],
                             lighting: images.lighting,
@@ -438,6 +462,7 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
         buffers.destroy(&test);
         layout.destroy(&test);
     }
+    gpu.destroy_image(film_image);
     for line in &report {
         println!("{line}");
     }
@@ -633,6 +658,7 @@ fn a_layered_description_missing_an_input_or_with_bad_meshes_is_a_typed_error() 
                         depth: &d,
                         normals: &n,
                         material_ids: &i,
+                        albedo: None,
                     },
                     regions: &[],
                     lighting: &l,

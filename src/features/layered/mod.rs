@@ -315,6 +315,9 @@ pub struct LayeredInputs<'a> {
     /// `None`: lucent's own G-buffer. `Some`: a host's (`lucent::embed::LayeredEffect`), its
     /// depth, normals and material IDs decoded as the table's host fields and these say.
     pub host: Option<LayeredHost>,
+    /// A host's film (its albedo image), which single scattering multiplies the light leaving
+    /// the surface by when `film` is set on a host's G-buffer.
+    pub host_film: Option<&'a Handle<Image>>,
 }
 
 /// What a host's G-buffer changes in the layered passes' shaders (their permutation).
@@ -538,10 +541,14 @@ fn layered_pass<'g>(
         .and_then(|maps| maps.entry.as_ref())
         .filter(|_| single);
     let entry_depths = entry.and(shadows.and_then(|maps| maps.layer_depths.as_ref()));
+    // A host's film, read by single scattering (its binding comes last).
+    let host_film = inputs
+        .host_film
+        .filter(|_| single && inputs.film && inputs.host.is_some());
     for h in [layer_depths]
         .into_iter()
         .chain([shadows.map(|maps| &maps.depth), entry, entry_depths])
-        .chain([irradiance, half_term])
+        .chain([irradiance, half_term, host_film])
         .flatten()
     {
         pass.graph().sample(h);
@@ -579,6 +586,10 @@ fn layered_pass<'g>(
             }
         }
         pass.bind_shadows(&maps.depth);
+    }
+    if let Some(film) = host_film {
+        pass.binding_define("LUCENT_HOST_FILM_BINDING")
+            .bind_sampled(film, vk::Filter::NEAREST);
     }
     match (kind, scale) {
         (Kind::Irradiance, 2) => {
@@ -722,6 +733,11 @@ impl LayeredShape {
                 }
             }
             defines.extend(shadows::lighting_defines(next));
+            // The shadow table and the atlas.
+            next += 2;
+        }
+        if single && self.film && self.host.is_some() {
+            defines.push(("LUCENT_HOST_FILM_BINDING", NUMBERS[next]));
         }
         match (self.kind, self.half_res) {
             (Kind::Irradiance, true) => defines.push(("LUCENT_HALF_RES", "1")),
@@ -748,8 +764,8 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
             for layer_depths in [None, Some(1), Some(2)] {
                 for host in std::iter::once(None).chain(LayeredHost::ALL.map(Some)) {
                     // A host's G-buffer: lucent draws the maps with their entry target, and
-                    // neither depth textures nor the film are embedded.
-                    let embedded = layer_depths.is_none() && bit(3) && bit(4) && !bit(5) && !bit(7);
+                    // depth textures are not embedded (the film is the host's albedo image).
+                    let embedded = layer_depths.is_none() && bit(3) && bit(4) && !bit(5);
                     if host.is_some() && !embedded {
                         continue;
                     }
@@ -859,6 +875,7 @@ mod tests {
                     let mut graph = RenderGraph::new();
                     let mut image = |name: &str| graph.create_image(name, info);
                     let (depth, gb1, ids) = (image("depth"), image("gb1"), image("ids"));
+                    let film = image("film");
                     let layer_depths = (textures > 0).then(|| image("layer depths"));
                     let maps = bit(3).then(|| ShadowMaps {
                         depth: image("atlas"),
@@ -882,6 +899,7 @@ mod tests {
                         shadows: maps.as_ref(),
                         film: bit(7),
                         host,
+                        host_film: host.map(|_| &film),
                     };
                     let scale = if bit(0) { 2 } else { 1 };
                     let pass = layered_pass(

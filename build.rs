@@ -1,7 +1,7 @@
 //! Build script: the shipped SPIR-V bundle, and shaderc's link on Debian.
 //!
 //! 1. Compiles every permutation of `glsl/permutations.txt` (one `path NAME=VALUE ...` line
-//!    each, generated from `lucent::features::shipped::permutations`; see that module) with
+//!    each, generated from `lucent::shipped::permutations`; see that module) with
 //!    shaderc, in parallel, into `$OUT_DIR/shaders.bundle`, which the library embeds
 //!    (`include_bytes!`) and `ShaderCompiler::shipped` serves. The options and the `#include`
 //!    lookup are the run-time compiler's own (`src/backend/glsl_compile.rs`, included below).

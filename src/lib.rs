@@ -60,5 +60,6 @@ pub mod reference;
 #[cfg(feature = "report")]
 pub mod report;
 pub mod scene;
+pub mod shipped;
 
 pub use error::{HostError, ImageFault, LucentError, Result};

@@ -6,7 +6,7 @@
 //! - [`ShaderCompiler::shipped`]: the SPIR-V compiled with the crate. `build.rs` compiles every
 //!   permutation in `glsl/permutations.txt` (a shader path and its defines per line) with shaderc
 //!   into a bundle the library embeds, so a host needs neither `glsl/` nor shaderc at run time.
-//!   That manifest is generated from [`crate::features::shipped::permutations`], which enumerates
+//!   That manifest is generated from [`crate::shipped::permutations`], which enumerates
 //!   every permutation any frame lucent can build may ask for; a test fails when the committed
 //!   file differs from it. Asking for a permutation the bundle lacks is
 //!   [`LucentError::ShaderNotShipped`]. This is what the `lucent` command, the tests and an
@@ -263,7 +263,7 @@ pub const FULLSCREEN_VERTEX: &str = "fullscreen.vert";
 
 /// The shaders one graphics pipeline compiles: its vertex and fragment shader, both with the
 /// same defines (as `backend::pipeline::GraphicsPipeline::new` compiles them). What each pass's
-/// `shader_permutations` lists for the shipped SPIR-V (`crate::features::shipped`).
+/// `shader_permutations` lists for the shipped SPIR-V (`crate::shipped`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PipelineShaders {
     /// Vertex shader path under `glsl/`.

@@ -8,7 +8,7 @@
 //!
 //! The speed of light (`crate::measure::speed_of_light`, feature `measure`) puts them in
 //! place of each pass of a plan. Their defines and every permutation of them are here, with
-//! the passes, so the shipped SPIR-V ([`super::shipped`]) holds them whatever features the
+//! the passes, so the shipped SPIR-V ([`crate::shipped`]) holds them whatever features the
 //! library is built with.
 
 use crate::backend::shader::PipelineShaders;

@@ -21,7 +21,6 @@
 //! - [`pass`]: the fullscreen pass builder: each input stated once, for the graph and the
 //!   shader's bindings.
 //! - [`util`]: pass-level pipeline helpers (a pipeline with its descriptor set, tile draws).
-//! - [`shipped`]: every shader permutation the passes compile (the shipped SPIR-V's manifest).
 //! - [`technique`] and [`registry`]: the contract a technique module implements and the one
 //!   list of them, which everything that names techniques iterates.
 
@@ -36,7 +35,6 @@ pub mod lighting;
 pub mod pass;
 pub mod registry;
 pub mod shadows;
-pub mod shipped;
 pub mod sss;
 pub mod technique;
 pub mod tonemap;

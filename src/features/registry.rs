@@ -8,7 +8,7 @@
 //! and the shader permutations its passes compile. Everything that lists techniques iterates
 //! [`TECHNIQUES`]: the `--technique` names and their help ([`crate::frame::Technique`]), the
 //! warnings for knobs that do nothing in a frame, the demo's picker, bench and report, the
-//! gallery, the shipped SPIR-V manifest ([`super::shipped`]) and the tests. No enum or
+//! gallery, the shipped SPIR-V manifest ([`crate::shipped`]) and the tests. No enum or
 //! hand-written list elsewhere names a technique.
 //!
 //! Screen-space SSS techniques are blur chains: their module also implements

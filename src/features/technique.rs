@@ -30,7 +30,7 @@ pub trait TechniqueModule: Sync {
     fn knobs(&self) -> &'static [&'static Knob];
     /// The built-in scene made to show it, which bench and report measure it on.
     fn scene(&self) -> &'static str;
-    /// Every pipeline its passes may build, for the shipped SPIR-V ([`super::shipped`]).
+    /// Every pipeline its passes may build, for the shipped SPIR-V ([`crate::shipped`]).
     /// Techniques whose shading is compiled into another feature's pass (GDC 2011's term in
     /// the lighting pass) add nothing here.
     fn shader_permutations(&self, out: &mut Vec<PipelineShaders>);

@@ -52,7 +52,7 @@ impl Recording for RecordContext<'_> {
     }
 }
 
-/// A pass's shader defines, `("NAME", "VALUE")` (see [`crate::features::shipped`]).
+/// A pass's shader defines, `("NAME", "VALUE")` (see [`crate::shipped`]).
 pub type Defines = Vec<(&'static str, &'static str)>;
 
 /// Lit HDR colour: the lighting pass's output and what the SSS blurs and Li et al.'s terms

@@ -1,5 +1,5 @@
 //! The shipped SPIR-V: `glsl/permutations.txt` is exactly what the features enumerate
-//! (`lucent::features::shipped`), the bundle build.rs compiled holds exactly that, and its SPIR-V
+//! (`lucent::shipped`), the bundle build.rs compiled holds exactly that, and its SPIR-V
 //! is what the run-time compiler makes of the same sources.
 //!
 //! Regenerate the manifest after changing a pass's defines (or adding a shader):
@@ -12,7 +12,7 @@ use std::path::Path;
 
 use lucent::backend::shader::ShaderCompiler;
 use lucent::error::MANIFEST_COMMAND;
-use lucent::features::shipped;
+use lucent::shipped;
 
 fn manifest_path() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("glsl/permutations.txt")

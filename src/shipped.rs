@@ -1,5 +1,6 @@
-//! The closed set of shader permutations lucent's frames compile, which `build.rs` ships as
-//! SPIR-V ([`crate::backend::shader::ShaderCompiler::shipped`]).
+//! The closed set of shader permutations lucent's frames and embedded effects compile, which
+//! `build.rs` ships as SPIR-V ([`crate::backend::shader::ShaderCompiler::shipped`]). It sits
+//! above both the features and `embed` (it lists what each builds), so neither imports it.
 //!
 //! A build script cannot call the library, so the set is written down: [`permutations`]
 //! enumerates every (shader, defines) pair any pass of any frame may ask for, and
@@ -15,7 +16,7 @@
 //! it reads, its knobs), and that same function is what its module's `shader_permutations`
 //! calls over every shape the pass can have, so the two cannot drift apart. Binding numbers in
 //! defines are derived from the shape too, and a pass declared with
-//! [`super::pass::FullscreenPass`] numbers them from the bindings it has declared. The
+//! [`crate::features::pass::FullscreenPass`] numbers them from the bindings it has declared. The
 //! shapes enumerated are the whole input space of each function (every G-buffer layout flag,
 //! every knob value the defines distinguish), not only the scenes in the tests. Combinations
 //! one frame can never hold (LEAN without SSS, say) are included when the shader compiles them:
@@ -35,25 +36,28 @@ use crate::{LucentError, Result};
 /// Every pipeline any frame (and the speed-of-light copies of its passes) may build, in the
 /// features' order, repeats included.
 pub fn pipelines() -> Vec<PipelineShaders> {
+    use crate::features::{
+        antialias, copy_pass, debug_view, gbuffer, lighting, registry, shadows, sss, tonemap,
+    };
     let mut out = Vec::new();
-    super::shadows::shader_permutations(&mut out);
-    super::gbuffer::shader_permutations(&mut out);
-    super::lighting::shader_permutations(&mut out);
-    for technique in super::registry::TECHNIQUES {
+    shadows::shader_permutations(&mut out);
+    gbuffer::shader_permutations(&mut out);
+    lighting::shader_permutations(&mut out);
+    for technique in registry::TECHNIQUES {
         technique.shader_permutations(&mut out);
     }
     // The SSS passes over a host's material IDs (lucent::embed).
-    super::sss::host_id_permutations(&mut out);
+    sss::host_id_permutations(&mut out);
     // GDC 2011 translucency on a host's G-buffer (lucent::embed::TranslucencyEffect).
     crate::embed::translucency_permutations(&mut out);
     // The SH environment on a host's G-buffer (lucent::embed::EnvironmentEffect).
     crate::embed::environment_permutations(&mut out);
     // SSS transmission through a host's shadow maps (lucent::embed::TransmissionEffect).
     crate::embed::transmission_permutations(&mut out);
-    super::debug_view::shader_permutations(&mut out);
-    super::tonemap::shader_permutations(&mut out);
-    super::antialias::shader_permutations(&mut out);
-    super::copy_pass::shader_permutations(&mut out);
+    debug_view::shader_permutations(&mut out);
+    tonemap::shader_permutations(&mut out);
+    antialias::shader_permutations(&mut out);
+    copy_pass::shader_permutations(&mut out);
     out
 }
 
@@ -83,7 +87,7 @@ pub fn permutations() -> Result<Vec<String>> {
 pub fn manifest() -> Result<String> {
     let mut text = format!(
         "# Generated: every shader permutation lucent's frames compile \
-         (lucent::features::shipped).\n\
+         (lucent::shipped).\n\
          # build.rs compiles each line into the shipped SPIR-V bundle. Do not edit: \
          regenerate with\n#   {}\n",
         crate::error::MANIFEST_COMMAND

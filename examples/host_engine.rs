@@ -2158,6 +2158,10 @@ fn record_frame(
         }
     };
     let fragment_sampled = ImageState::fragment_sampled();
+    // The engine's objects and its lights' faces: what its shadow maps draw, and what it hands
+    // lucent's layered media and transmission.
+    let draws = mesh_draws(meshes);
+    let faces = light_faces(sun);
 
     // 0. The shadow maps lucent's transmission reads (when it is inserted): every object into
     // each face's tile of the atlas, depth only, standard Z.
@@ -2175,8 +2179,7 @@ fn record_frame(
             Some((shadow.view, 1.0)),
             true,
         );
-        let draws = mesh_draws(meshes);
-        for face in light_faces(sun) {
+        for face in &faces {
             // SAFETY: inside the atlas's rendering.
             unsafe {
                 device.cmd_set_viewport(
@@ -2407,8 +2410,6 @@ fn record_frame(
             // Li et al.'s terms of the layered ball, its light-space maps drawn from the
             // engine's vertex buffer.
             let lights = engine_lights(sun);
-            let faces = light_faces(sun);
-            let draws = mesh_draws(meshes);
             let layered_frame = LayeredFrame {
                 slot: slot_index,
                 view: 0,

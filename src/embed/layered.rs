@@ -39,8 +39,8 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
-    check_described, check_environment, check_lights, check_views, depth_role, id_role,
-    import_host_image, EffectPasses,
+    check_described, check_environment, check_lights, check_material_id, check_views, depth_role,
+    id_role, import_host_image, EffectPasses,
 };
 use super::regions::{box_nearest_depth, box_screen_region, clipped};
 use super::shadow_faces::{shadow_table, ShadowFace};
@@ -498,20 +498,14 @@ impl LayeredEffect {
         let mut host_materials = [[0u32; 4]; 64];
         let mut media = Vec::with_capacity(desc.materials.len());
         for (index, material) in desc.materials.iter().enumerate() {
-            let field = format!("materials[{index}] (ID {})", material.id);
             let id = usize::from(material.id);
-            if id == 0
-                || host_materials[id / 4][id % 4] != 0
-                || u32::from(material.id) > id_map.mask
-            {
-                return Err(HostError::Description {
-                    field,
-                    problem: "IDs are 1 to 255, each once, within the material ID image's bit \
-                              field"
-                        .into(),
-                }
-                .into());
-            }
+            check_material_id(
+                index,
+                material.id,
+                host_materials[id / 4][id % 4] != 0,
+                id_map.mask,
+            )?;
+            let field = format!("materials[{index}] (ID {id})");
             let medium = LayeredMedium {
                 units_per_mm,
                 ..material.medium.clone()
@@ -535,7 +529,7 @@ impl LayeredEffect {
         let uint_ids = id_map.uint;
         let (host_ids, _) = crate::features::sss::IdMap::Host(id_map).rows();
         let layered = LayeredDesc {
-            materials: media.clone(),
+            materials: media,
             object_ids: Vec::new(),
             film: false,
         };
@@ -577,7 +571,7 @@ impl LayeredEffect {
             imports,
             desc,
             table,
-            media,
+            media: layered.materials,
             shadow_frame,
         })
     }
@@ -684,7 +678,7 @@ impl LayeredEffect {
         } else {
             1.0
         };
-        let mut blur = Vec::new();
+        let mut blurred = Vec::new();
         for (mesh, draw) in frame.meshes.iter().zip(draws) {
             let Some(medium) = usize::from(draw.layered_id)
                 .checked_sub(1)
@@ -700,12 +694,13 @@ impl LayeredEffect {
                 continue;
             }
             match box_screen_region(bounds, mesh.transform, camera, extent, 0.0) {
-                Some(region) => blur.extend(clipped(&[region], extent)),
+                Some(region) => blurred.push(region),
                 // The box reaches the eye's plane: it may cover the whole screen.
                 None => return (layered.clone(), layered),
             }
         }
-        (layered, blur)
+        // One union of the meshes' regions: overlapping boxes are blurred once.
+        (layered, clipped(&blurred, extent))
     }
 
     /// The frame's meshes as the light-space pass draws them, each checked: its buffers given,

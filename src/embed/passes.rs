@@ -239,6 +239,19 @@ pub(crate) fn check_environment(environment: &crate::scene::Environment) -> Resu
     Ok(coefficients)
 }
 
+/// Checks material `index`'s host ID: 1 to 255, not `taken` by an earlier material, within
+/// the ID image's bit field (`mask`).
+pub(crate) fn check_material_id(index: usize, id: u8, taken: bool, mask: u32) -> Result<()> {
+    if id == 0 || taken || u32::from(id) > mask {
+        return Err(HostError::Description {
+            field: format!("materials[{index}] (ID {id})"),
+            problem: "IDs are 1 to 255, each once, within the material ID image's bit field".into(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
 /// Checks an effect's views per frame: 1 to [`super::MAX_VIEWS_PER_FRAME`].
 pub(crate) fn check_views(views: usize) -> Result<()> {
     if (1..=super::MAX_VIEWS_PER_FRAME).contains(&views) {

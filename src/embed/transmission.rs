@@ -33,8 +33,8 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{
-    check_described, check_lights, check_views, depth_role, frame_albedo, id_role,
-    import_host_image, EffectPasses,
+    check_described, check_lights, check_material_id, check_views, depth_role, frame_albedo,
+    id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
 use super::shadow_faces::{shadow_table, ShadowFace};
@@ -257,15 +257,7 @@ impl TransmissionEffect {
         let mm_per_unit = 1000.0 * f64::from(gbuffer.metres_per_unit);
         for (index, material) in desc.materials.iter().enumerate() {
             let id = usize::from(material.id);
-            if id == 0 || profile_of[id] != 0 || u32::from(material.id) > id_map.mask {
-                return Err(HostError::Description {
-                    field: format!("materials[{index}] (ID {id})"),
-                    problem: "IDs are 1 to 255, each once, within the material ID image's bit \
-                              field"
-                        .into(),
-                }
-                .into());
-            }
+            check_material_id(index, material.id, profile_of[id] != 0, id_map.mask)?;
             let profile = index + 1;
             profile_of[id] = profile as u8;
             let transmission = SssTransmission {

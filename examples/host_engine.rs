@@ -80,12 +80,12 @@ use lucent::embed::{
     capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, Environment,
     EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc,
     HostCamera, HostDevice, HostImage, IdDesc, ImageState, LayeredEffect, LayeredEffectDesc,
-    LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, Light, Lucent, MeshDraw,
-    NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace, SssEffect, SssEffectDesc,
-    SssFrame, SssImages, SssMaterial, SssProfile, ThicknessDesc, TranslucencyEffect,
-    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
-    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
-    TransmissionMaterial,
+    LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, LeanLighting, Light, Lucent,
+    MeshDraw, NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace,
+    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssProfile,
+    ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
+    TranslucencyImages, TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc,
+    TransmissionFrame, TransmissionImages, TransmissionMaterial,
 };
 
 /// The engine's ambient light: a sky radiance above the horizon and a ground radiance below,
@@ -157,6 +157,9 @@ struct Args {
     out: PathBuf,
     with_lucent: bool,
     blur: String,
+    /// `--marble-blur`: the marble's blur (the LEAN-mapping thesis's LBB by default, the
+    /// thesis's own material; `--blur` for the skin).
+    marble_blur: String,
     /// `--whole-screen`: the effects draw over the whole screen, not only over the objects'
     /// screen regions (the same picture; a check of the regions).
     whole_screen: bool,
@@ -177,7 +180,8 @@ struct Args {
 }
 
 const USAGE: &str = "usage: host_engine [--size WxH] [--frames N] [--out F.png] \
-                     [--blur separable|control|burley] [--without-lucent] [--whole-screen] \
+                     [--blur separable|control|burley|lcb|lbb|bilateral] \
+                     [--marble-blur BLUR] [--without-lucent] [--whole-screen] \
                      [--engine-ambient] [--fused] [--no-transmission] [--timing] \
                      [--scene NAME]";
 
@@ -189,6 +193,7 @@ fn parse_args() -> Result<Args, String> {
         out: PathBuf::from("host_engine.png"),
         with_lucent: true,
         blur: "separable".into(),
+        marble_blur: "lbb".into(),
         whole_screen: false,
         engine_ambient: false,
         fused: false,
@@ -222,6 +227,7 @@ fn parse_args() -> Result<Args, String> {
             }
             "--out" => args.out = PathBuf::from(value()?),
             "--blur" => args.blur = value()?,
+            "--marble-blur" => args.marble_blur = value()?,
             "--without-lucent" => args.with_lucent = false,
             "--whole-screen" => args.whole_screen = true,
             "--engine-ambient" => args.engine_ambient = true,
@@ -363,8 +369,8 @@ void main() {{
     vec3 albedo;
     float gloss;
     uint id;
-    if (v_object == 0u || v_object == 6u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = 0.5; id = {SKIN}u; }}
-    else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = 0.8; id = {MARBLE}u; }}
+    if (v_object == 0u || v_object == 6u) {{ albedo = vec3(0.80, 0.52, 0.40); gloss = {SKIN_GLOSS:?}; id = {SKIN}u; }}
+    else if (v_object == 1u) {{ albedo = vec3(0.83, 0.81, 0.78); gloss = {MARBLE_GLOSS:?}; id = {MARBLE}u; }}
     else if (v_object == 2u) {{ albedo = vec3(0.20, 0.35, 0.75); gloss = 0.6; id = {PLASTIC}u; }}
     else if (v_object == 3u) {{ albedo = vec3(0.42, 0.78, 0.50); gloss = 0.7; id = {LEAF}u; }}
     // Li et al.'s eq. 3 with physical weights: no Lambert term (λ1 = 0; the dipole is the
@@ -387,6 +393,8 @@ void main() {{
             LAYERED = super::LAYERED_ID,
             SKIN = super::SKIN_ID,
             MARBLE = super::MARBLE_ID,
+            SKIN_GLOSS = super::SKIN_GLOSS,
+            MARBLE_GLOSS = super::MARBLE_GLOSS,
             PLASTIC = super::PLASTIC_ID,
         )
     }
@@ -1605,6 +1613,26 @@ fn transmission_on(args: &Args) -> bool {
     args.with_lucent && args.scene.is_none() && !args.no_transmission
 }
 
+/// The blurs that blur LEAN moments and relight the specular (lucent's LEAN-mapping thesis).
+const LEAN_BLURS: [&str; 3] = ["lcb", "lbb", "bilateral"];
+
+/// Whether a scattering material's blur is a LEAN blur: the SSS effect then reads the
+/// normals, the lights and (with shadow maps) the shadow atlas.
+fn sss_lean(args: &Args) -> bool {
+    LEAN_BLURS.contains(&args.blur.as_str()) || LEAN_BLURS.contains(&args.marble_blur.as_str())
+}
+
+/// The engine's gloss of the skin and the marble (its G-buffer's albedo alpha).
+const SKIN_GLOSS: f32 = 0.5;
+const MARBLE_GLOSS: f32 = 0.8;
+
+/// lucent's surface for an engine gloss: the engine's Blinn-Phong exponent `2^(1 + 10 gloss)`
+/// is lucent's `2 / r^4 - 2` at roughness r, and its Schlick Fresnel starts at 0.04.
+fn engine_surface(gloss: f32) -> SpecularSurface {
+    let shininess = (1.0 + 10.0 * gloss).exp2();
+    SpecularSurface::new((2.0 / (shininess + 2.0)).powf(0.25), 0.04)
+}
+
 /// The skin's and the marble's media, through which their transmission diffuses (lucent's
 /// `[material.medium]`: Jensen's skin1 and marble, in metres as the engine's world).
 fn transmission_materials() -> Result<Vec<TransmissionMaterial>, String> {
@@ -1845,6 +1873,8 @@ struct Effects {
     inserted: Inserted,
     /// `--whole-screen`: no regions.
     whole_screen: bool,
+    /// A scattering material has a LEAN blur: the SSS effect reads the normals and lights.
+    sss_lean: bool,
     /// `--timing`: per frame slot, the effects' timers.
     timers: Vec<Timers>,
     /// Each timed pass's milliseconds, frame by frame (`effect: pass`).
@@ -2481,6 +2511,12 @@ fn record_frame(
                     ..slot.hdr.state
                 })
                 .then(fragment_sampled);
+            // The engine's shadow atlas (when it renders one), as the transmission left it.
+            let sss_shadow_map = slot
+                .shadow
+                .as_ref()
+                .filter(|_| effects.sss_lean)
+                .map(|shadow| shadow.host_image(LIGHT_SPACE));
             let frame = SssFrame {
                 slot: slot_index,
                 view: 0,
@@ -2495,6 +2531,18 @@ fn record_frame(
                 // The skin's and the marble's projected bounds: elsewhere a pass-through.
                 regions: &scattering_region(&camera, extent, sss.reach(), effects.whole_screen),
                 output: &output,
+                // A LEAN blur's LEAN moments come from the engine's normals, its specular is
+                // relit with the engine's lights, shadowed in the engine's shadow atlas.
+                lean: effects.sss_lean.then(|| LeanLighting {
+                    normals: &normals,
+                    lights: &lights,
+                    shadow_map: sss_shadow_map.as_ref(),
+                    shadow_faces: if sss_shadow_map.is_some() {
+                        &faces
+                    } else {
+                        &[]
+                    },
+                }),
             };
             match effects.timers.get_mut(slot_index) {
                 Some(t) => sss.record_timed(&effects.lucent, cmd, &frame, &mut t.sss),
@@ -2629,10 +2677,17 @@ fn create_effects(
     // SAFETY: the handles are the engine's, created together, and outlive `lucent` (dropped
     // before the engine is destroyed).
     let lucent = unsafe { Lucent::new(host, options) }.map_err(|e| e.to_string())?;
-    let profile = |preset: &str| -> Result<SssProfile, String> {
+    // Each material with its blur; a LEAN blur (LCB, LBB, bilateral) relights the specular
+    // from its blurred LEAN moments, with the surface the engine's own specular has.
+    let material = |id: u8, preset: &str, blur: &str, surface: SpecularSurface| {
         let mut profile = SssProfile::preset(preset).map_err(|e| e.to_string())?;
-        profile.blur = Some(args.blur.as_str().into());
-        Ok(profile)
+        profile.blur = Some(blur.into());
+        let material = SssMaterial::new(id, profile);
+        Ok::<_, String>(if LEAN_BLURS.contains(&blur) {
+            material.with_surface(surface)
+        } else {
+            material
+        })
     };
     let gbuffer = GBufferDesc::new(
         args.width,
@@ -2676,11 +2731,22 @@ fn create_effects(
     let desc = SssEffectDesc::new(
         gbuffer,
         vec![
-            SssMaterial::new(SKIN_ID, profile("skin")?),
-            SssMaterial::new(MARBLE_ID, profile("marble")?),
+            material(SKIN_ID, "skin", &args.blur, engine_surface(SKIN_GLOSS))?,
+            material(
+                MARBLE_ID,
+                "marble",
+                &args.marble_blur,
+                engine_surface(MARBLE_GLOSS),
+            )?,
         ],
         HDR_FORMAT,
     );
+    // The engine's shadow maps shadow the relit specular too, when it renders them.
+    let desc = if sss_lean(args) && transmission_on(args) {
+        desc.with_shadow_maps(SHADOW_FORMAT)
+    } else {
+        desc
+    };
     begin_slot(engine, slot)?;
     // SAFETY: the slot's command buffer is recording, outside rendering, on lucent's queue
     // family; it is submitted below before any frame records the effect.
@@ -2725,8 +2791,9 @@ fn create_effects(
     match &args.scene {
         None => eprintln!(
             "host_engine: lucent effects: {}layered media (apple flesh, ID {LAYERED_ID}; its \
-             light-space maps drawn from the engine's vertex buffer), {}sss ({} blur; skin ID \
-             {SKIN_ID}, marble ID {MARBLE_ID}; {staging_bytes} staging bytes uploaded)",
+             light-space maps drawn from the engine's vertex buffer), {}sss (skin ID {SKIN_ID} \
+             with the {} blur, marble ID {MARBLE_ID} with the {} blur; {staging_bytes} staging \
+             bytes uploaded)",
             match (args.fused, args.engine_ambient) {
                 (true, _) => "environment and translucency (the leaf) in the engine's \
                               lighting pass (lucent::embed::glsl::TERMS), "
@@ -2742,7 +2809,8 @@ fn create_effects(
             } else {
                 ""
             },
-            args.blur
+            args.blur,
+            args.marble_blur
         ),
         Some(name) => eprintln!(
             "host_engine: lucent's whole frame of scene '{name}' ({staging_bytes} staging \
@@ -2778,6 +2846,7 @@ fn create_effects(
         lucent,
         inserted,
         whole_screen: args.whole_screen,
+        sss_lean: sss_lean(args),
         timers,
         times: Default::default(),
     })

@@ -171,8 +171,18 @@ vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughne
     vec3 c = lean_covariance(b, m);
     float base = roughness_variance(roughness);
     float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
-    vec3 pos = world_position(frag_coord, d);
     mat3 view = mat3(frame.view);
+#ifdef LUCENT_SSS_HOST_IDS
+    // A host's frame (lucent::embed): its depth image may hold linear view depth, which
+    // world_position cannot unproject; the point on the pixel's ray at its view depth serves
+    // every encoding (glsl/common/host_depth.glsl's way, the view matrix inverted as the
+    // rotation and translation it is).
+    vec3 on_ray = (frame.view * vec4(world_position(frag_coord, 0.5), 1.0)).xyz;
+    vec3 at = on_ray * (linear_depth(d) / max(-on_ray.z, 1e-30));
+    vec3 pos = transpose(view) * (at - frame.view[3].xyz);
+#else
+    vec3 pos = world_position(frag_coord, d);
+#endif
     vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
     vec3 n = normalize(vec3(b, 1.0));
     float n_dot_v = dot(n, to_eye);

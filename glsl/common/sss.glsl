@@ -103,6 +103,27 @@ vec3 sss_albedo_after(int id, vec3 albedo) {
     return mode == 1 ? albedo : (mode == 2 ? sqrt(max(albedo, vec3(0.0))) : vec3(1.0));
 }
 
+// A host's albedo texel (lucent::embed), sanitized where it is read: a NaN or out-of-range
+// albedo must not reach the blur.
+vec3 sss_host_albedo(vec3 texel) {
+    return clamp(mix(texel, vec3(0.0), isnan(texel)), vec3(0.0), vec3(1.0));
+}
+
+// The smallest albedo divided by: a host's black albedo has no light left to recover, and
+// dividing by it would turn rounding into Inf.
+const float SSS_MIN_HOST_ALBEDO = 1.0 / 255.0;
+
+// What a host's light is multiplied by to hold the albedo as profile `id` wants it before the
+// blur (sss_albedo_before), from a light that holds all of the albedo (`included`: what belongs
+// after the blur is divided out) or none of it (glsl/sss/host_albedo.frag, host_lean.frag).
+vec3 sss_host_albedo_factor(int id, vec3 albedo, bool included) {
+    vec3 before = sss_albedo_before(id, albedo);
+    if (!included) {
+        return before;
+    }
+    return sss_texturing(id) == 0 ? vec3(1.0) : before / max(albedo, vec3(SSS_MIN_HOST_ALBEDO));
+}
+
 SssStep sss_step(int id, int step) {
     return sss_profiles.steps[id * MAX_SSS_STEPS + clamp(step, 0, MAX_SSS_STEPS - 1)];
 }

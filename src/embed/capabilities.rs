@@ -25,16 +25,21 @@ pub enum Effect {
     /// The SH environment's diffuse light added to the host's light
     /// ([`super::EnvironmentEffect`]).
     Environment,
+    /// Screen-space SSS with the LEAN-mapping thesis's blurs (LCB, LBB, the bilateral blur:
+    /// [`super::SssEffect`] with materials of those blurs), which blur LEAN moments made from
+    /// the host's normals with the light and relight the specular from them.
+    LeanSss,
 }
 
 impl Effect {
     /// Every effect, in the order [`capabilities`] reports them.
-    pub const ALL: [Effect; 5] = [
+    pub const ALL: [Effect; 6] = [
         Effect::Sss,
         Effect::Translucency,
         Effect::SssTransmission,
         Effect::LayeredMedia,
         Effect::Environment,
+        Effect::LeanSss,
     ];
 
     /// A short name (`sss`, `translucency`, ...).
@@ -45,6 +50,7 @@ impl Effect {
             Effect::SssTransmission => "sss-transmission",
             Effect::LayeredMedia => "layered-media",
             Effect::Environment => "environment",
+            Effect::LeanSss => "lean-sss",
         }
     }
 }
@@ -126,6 +132,22 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                     "material IDs",
                     "screen-space SSS picks each pixel's profile by its material ID \
                      (GBufferDesc::with_material_ids)",
+                ));
+            }
+        }
+        Effect::LeanSss => {
+            if gbuffer.material_ids.is_none() {
+                out.push(lack(
+                    "material IDs",
+                    "screen-space SSS picks each pixel's profile by its material ID \
+                     (GBufferDesc::with_material_ids)",
+                ));
+            }
+            if gbuffer.normals.is_none() {
+                out.push(lack(
+                    "normals",
+                    "LCB, LBB and the bilateral blur blur LEAN moments made from each pixel's \
+                     normal and relight the specular from them (GBufferDesc::with_normals)",
                 ));
             }
         }
@@ -267,6 +289,11 @@ mod tests {
             panic!("{:?}", support[4])
         };
         assert_eq!(environment.len(), 2);
+        // The LEAN blurs: IDs and normals.
+        let Support::Lacks(lean) = &support[5].1 else {
+            panic!("{:?}", support[5])
+        };
+        assert_eq!(lean.len(), 2);
         let without_albedo = GBufferDesc {
             diffuse: DiffuseDesc::without_albedo(vk::Format::R16G16B16A16_SFLOAT),
             ..bare.clone()

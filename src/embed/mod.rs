@@ -135,6 +135,7 @@
 //!     },
 //!     regions: &[], // the whole screen (or the skin's projected bounds)
 //!     output: &output,
+//!     lean: None, // normals and lights, for LCB, LBB and the bilateral blur
 //! };
 //! sss.record(&lucent, cmd, &frame)?;
 //! // ... the host's tonemap reads `output`; end `cmd`, submit it with its fence.
@@ -192,7 +193,10 @@ pub use layered::{
 pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
 pub use shadow_faces::ShadowFace;
-pub use sss::{SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, MAX_VIEWS_PER_FRAME};
+pub use sss::{
+    LeanLighting, SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
+    MAX_VIEWS_PER_FRAME,
+};
 pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;
 pub use translucency::{
@@ -225,8 +229,10 @@ pub use glam;
 /// [`EnvironmentEffect`], [`TransmissionEffect`] (with [`ShadowFace`]), [`glsl::TERMS`];
 /// [`capabilities`] reports SSS transmission and the environment as effects that run. 6:
 /// [`LayeredEffect`] (with [`VertexLayout`] and [`MeshDraw`]); `Support::NotEmbedded` is gone
-/// (every effect of [`Effect::ALL`] has a path on a host's G-buffer).
-pub const API_VERSION: u32 = 6;
+/// (every effect of [`Effect::ALL`] has a path on a host's G-buffer). 7: the LEAN blurs (LCB,
+/// LBB, bilateral) in [`SssEffect`] ([`SssFrame::lean`], [`SssMaterial::surface`],
+/// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`].
+pub const API_VERSION: u32 = 7;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -78,6 +78,22 @@ const CUBE_AXES: [Vec3; 6] = [
     Vec3::NEG_Z,
 ];
 
+/// A host's shadow map must be a depth format (the shadow lookups compare its depth).
+pub(crate) fn check_shadow_format(format: vk::Format) -> Result<()> {
+    use crate::backend::format::{format_info, format_name, FormatKind};
+    if format_info(format).is_some_and(|f| f.kind == FormatKind::Depth) {
+        return Ok(());
+    }
+    Err(HostError::Unsupported {
+        input: "shadow map".into(),
+        found: format!("format {}", format_name(format)),
+        accepted: "a depth format (D32_SFLOAT, D16_UNORM, D24_UNORM_S8_UINT, \
+                   D32_SFLOAT_S8_UINT, X8_D24_UNORM_PACK32)"
+            .into(),
+    }
+    .into())
+}
+
 /// The shadow table (glsl/common/shadows.glsl `Shadows`, what lucent's own light-space maps
 /// fill) of the host's faces in a shadow map of `extent`, each checked: its light exists and
 /// has one face (six for a point light, in [`CUBE_AXES`] order, together), its matrices are

@@ -1,6 +1,6 @@
-//! [`SssEffect`]: lucent's screen-space SSS (the control, the separable blur, 2-D Burley)
-//! inserted into a host's frame, on the host's own G-buffer ([`GBufferDesc`]). The bilateral
-//! blur, LCB and LBB blur lucent's LEAN G-buffer, which a host's does not carry: refused.
+//! [`SssEffect`]: lucent's screen-space SSS (the control, the separable blur, 2-D Burley,
+//! and the LEAN-mapping thesis's LCB, LBB and bilateral blur) inserted into a host's frame, on
+//! the host's own G-buffer ([`GBufferDesc`]).
 //!
 //! The host renders its G-buffer and lighting as usual, keeping the lit diffuse apart (and,
 //! ideally, the specular), and writes a material ID per pixel. lucent blurs the diffuse of
@@ -12,6 +12,15 @@
 //! diffuse holds its albedo differently from how a profile wants it before the blur
 //! ([`DiffuseAlbedo`] against [`Texturing`]), one fullscreen pass puts it right first
 //! (`sss albedo in`).
+//!
+//! LCB, LBB and the bilateral blur blur LEAN moments with the light and relight the specular
+//! from the blurred moments, for the host's lights ([`LeanLighting`]; shadowed by the host's
+//! shadow maps when it describes them). A host's G-buffer has no LEAN target, so one pass
+//! (`sss lean in`) builds it from the host's normals and its materials' roughness
+//! ([`SpecularSurface`]), with the albedo adjustment above folded in: a host normal is one
+//! direction per pixel, so the LEAN texel is that of a surface without a LEAN map (the spread
+//! of a normal map inside one pixel is lost; the spread the blur mixes across pixels is kept).
+//! On those materials' pixels the host's specular is replaced by the LEAN specular.
 //!
 //! Images are bound when a frame records, into that frame's slot and view: any number of
 //! different images over time, a view recreated between frames (even with a reused handle
@@ -25,19 +34,21 @@ use ash::vk;
 use super::capabilities::{require, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
-use super::passes::{check_views, EffectPasses};
+use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::marked_tiles;
+use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
 use crate::features::registry;
-use crate::features::sss::{self, IdMap, SssKnobs, SssProfiles};
-use crate::gpu_scene::{SceneGpu, SceneUpload, FRAME};
+use crate::features::sss::{self, HostAlbedo, IdMap, LeanInputs, SssKnobs, SssProfiles};
+use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
 use crate::scene::material::{SssProfile, Texturing};
+use crate::scene::Light;
 use crate::Result;
 
 /// Most views one frame may record ([`SssEffectDesc::views_per_frame`]).
@@ -52,16 +63,65 @@ pub struct SssMaterial {
     pub id: u8,
     /// Its profile: the Gaussians in millimetres (its `units_per_mm` is set from the
     /// G-buffer's [`GBufferDesc::metres_per_unit`]), the blur ([`SssProfile::blur`]: the
-    /// control, separable or Burley; the bilateral blur, LCB and LBB blur lucent's LEAN
-    /// G-buffer, which a host does not have) and where the albedo goes
-    /// ([`SssProfile::texturing`]).
+    /// control, separable, Burley, or a LEAN blur: LCB, LBB, bilateral) and where the albedo
+    /// goes ([`SssProfile::texturing`]).
     pub profile: SssProfile,
+    /// The specular surface the LEAN blurs relight (required with them, refused with the
+    /// others, whose specular is the host's own).
+    pub surface: Option<SpecularSurface>,
 }
 
 impl SssMaterial {
     /// Material `id` scattering with `profile`.
     pub fn new(id: u8, profile: SssProfile) -> Self {
-        Self { id, profile }
+        Self {
+            id,
+            profile,
+            surface: None,
+        }
+    }
+
+    /// With the specular surface a LEAN blur (LCB, LBB, bilateral) relights.
+    pub fn with_surface(mut self, surface: SpecularSurface) -> Self {
+        self.surface = Some(surface);
+        self
+    }
+}
+
+/// A material's specular as lucent's own materials describe it (`roughness`, `specular` of a
+/// scene's `[material]`): what LCB, LBB and the bilateral blur evaluate their LEAN specular
+/// with, in place of the host's specular, on the material's pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SpecularSurface {
+    /// Roughness, 0 to 1 (lucent's Blinn-Phong exponent `2 / r^4 - 2` and the LEAN lobe's base
+    /// variance come from it).
+    pub roughness: f32,
+    /// Specular intensity: reflectance at normal incidence, 0 to 1.
+    pub specular: f32,
+}
+
+impl SpecularSurface {
+    /// A surface of `roughness` reflecting `specular` at normal incidence.
+    pub fn new(roughness: f32, specular: f32) -> Self {
+        Self {
+            roughness,
+            specular,
+        }
+    }
+
+    /// Both finite and in 0..=1.
+    fn check(&self, field: &str) -> Result<()> {
+        for (name, value) in [("roughness", self.roughness), ("specular", self.specular)] {
+            if !(0.0..=1.0).contains(&value) {
+                return Err(HostError::Description {
+                    field: format!("{field}.surface.{name}"),
+                    problem: format!("{value} is not in 0 to 1"),
+                }
+                .into());
+            }
+        }
+        Ok(())
     }
 }
 
@@ -80,6 +140,9 @@ pub struct SssEffectDesc {
     /// Views recorded per frame (1 to [`MAX_VIEWS_PER_FRAME`]): each view of a frame has its
     /// own camera and images.
     pub views_per_frame: usize,
+    /// The format of the host's shadow map that shadows the LEAN blurs' specular (a depth
+    /// format), when it has one ([`LeanLighting::shadow_map`]). Only with a LEAN blur.
+    pub shadow_format: Option<vk::Format>,
 }
 
 impl SssEffectDesc {
@@ -96,7 +159,14 @@ impl SssEffectDesc {
             knobs: SssKnobs::default(),
             output_format,
             views_per_frame: 1,
+            shadow_format: None,
         }
+    }
+
+    /// With a shadow map of `format` shadowing the LEAN blurs' specular.
+    pub fn with_shadow_maps(mut self, format: vk::Format) -> Self {
+        self.shadow_format = Some(format);
+        self
     }
 
     /// With these knobs.
@@ -128,6 +198,23 @@ pub struct SssImages<'a> {
     pub material_ids: &'a HostImage,
 }
 
+/// What the LEAN blurs (LCB, LBB, bilateral) read besides the G-buffer's images: the normals
+/// their LEAN moments are made from, and the lights (and shadow maps) they relight the
+/// specular with.
+#[derive(Clone, Copy, Debug)]
+pub struct LeanLighting<'a> {
+    /// The normals (as [`GBufferDesc::normals`] describes them).
+    pub normals: &'a HostImage,
+    /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
+    pub lights: &'a [Light],
+    /// The shadow map holding every face of `shadow_faces`, when the description has a
+    /// shadow format ([`SssEffectDesc::with_shadow_maps`]).
+    pub shadow_map: Option<&'a HostImage>,
+    /// The faces of the lights' shadow maps (as [`super::TransmissionFrame::shadow_faces`]):
+    /// a light without one is unshadowed.
+    pub shadow_faces: &'a [ShadowFace],
+}
+
 /// One view of one frame: what [`SssEffect::record`] reads and writes.
 #[derive(Clone, Copy, Debug)]
 pub struct SssFrame<'a> {
@@ -148,6 +235,9 @@ pub struct SssFrame<'a> {
     pub regions: &'a [vk::Rect2D],
     /// The image the result is written into (a colour attachment of the output format).
     pub output: &'a HostImage,
+    /// With a LEAN blur's material: the normals and lights it relights the specular with
+    /// (`None` without one).
+    pub lean: Option<LeanLighting<'a>>,
 }
 
 /// The graph's imports, by input.
@@ -159,7 +249,24 @@ struct Imports {
     albedo: Option<ResourceId>,
     material_ids: ResourceId,
     output: ResourceId,
+    /// With LEAN blurs: the normals.
+    normals: Option<ResourceId>,
+    /// With LEAN blurs and a shadow format: the shadow map.
+    shadow_map: Option<ResourceId>,
 }
+
+/// The host LEAN pass's per-frame constants (glsl/sss/host_lean.frag `HostLean`, std140).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct HostLeanGpu {
+    normals: [u32; 4],
+    view_to_world: [[f32; 4]; 4],
+    /// Per profile number: x roughness, y specular intensity.
+    surface: [[f32; 4]; sss::MAX_SSS_PROFILES],
+}
+
+/// The host LEAN pass's constants in the per-frame buffer.
+static HOST_LEAN: Region = Region::new("host LEAN decode");
 
 /// Screen-space SSS over a host's G-buffer (see the module docs).
 pub struct SssEffect {
@@ -170,6 +277,8 @@ pub struct SssEffect {
     chains: usize,
     /// Each material's reach, world units, by its host ID ([`Self::reach_of`]).
     reaches: Vec<(u8, f32)>,
+    /// With LEAN blurs: the host LEAN pass's constants but for the view (written per frame).
+    lean: Option<HostLeanGpu>,
 }
 
 /// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
@@ -231,21 +340,34 @@ impl SssEffect {
             profile.validate()?;
             let blur = registry::blur_of(&profile)?;
             if blur.lean() {
-                let usable: Vec<&str> = registry::sss_blurs()
-                    .filter(|b| !b.lean())
-                    .map(|b| b.name())
-                    .collect();
-                return Err(HostError::Unsupported {
-                    input: field,
-                    found: format!("the {} blur", blur.name()),
-                    accepted: format!(
-                        "a blur of the lit light ({}): {} blurs lucent's LEAN G-buffer, which a \
-                         host's G-buffer does not carry",
-                        usable.join(", "),
-                        blur.name()
-                    ),
+                // The normals first: what capabilities says the LEAN blurs lack.
+                require(Effect::LeanSss, gbuffer)?;
+            }
+            match (blur.lean(), &material.surface) {
+                (true, Some(surface)) => surface.check(&format!("materials[{index}]"))?,
+                (true, None) => {
+                    return Err(HostError::Missing {
+                        input: format!("{field}.surface"),
+                        needed_by: format!(
+                            "the {} blur relights the specular from the blurred LEAN moments \
+                             with the material's roughness and specular intensity \
+                             (SssMaterial::with_surface)",
+                            blur.name()
+                        ),
+                    }
+                    .into())
                 }
-                .into());
+                (false, Some(_)) => {
+                    return Err(HostError::Unsupported {
+                        input: format!("{field}.surface"),
+                        found: format!("a specular surface with the {} blur", blur.name()),
+                        accepted: "a surface only with LCB, LBB or the bilateral blur, which \
+                                   relight the specular; the other blurs keep the host's"
+                            .into(),
+                    }
+                    .into())
+                }
+                (false, None) => {}
             }
             profile_of[usize::from(material.id)] = index as u8 + 1;
             profiles.push((profile, blur));
@@ -278,6 +400,34 @@ impl SssEffect {
         }
         id_map.profile_of = profile_of;
         let id_map = IdMap::Host(id_map);
+        let lean = profiles.iter().any(|(_, b)| b.lean());
+        if let Some(format) = desc.shadow_format {
+            if !lean {
+                return Err(HostError::Unsupported {
+                    input: "shadow map".into(),
+                    found: "a shadow format without a LEAN blur's material".into(),
+                    accepted: "shadow maps only with LCB, LBB or the bilateral blur, whose \
+                               relit specular they shadow"
+                        .into(),
+                }
+                .into());
+            }
+            check_shadow_format(format)?;
+        }
+        let lean_constants = if lean {
+            let normals = gbuffer.normals.expect("require(LeanSss) checked them");
+            let mut constants: HostLeanGpu = bytemuck::Zeroable::zeroed();
+            constants.normals = normals.decode()?;
+            // Material i has profile i + 1 (profile_of above).
+            for (index, material) in desc.materials.iter().enumerate() {
+                if let Some(surface) = material.surface {
+                    constants.surface[index + 1] = [surface.roughness, surface.specular, 0.0, 0.0];
+                }
+            }
+            Some(constants)
+        } else {
+            None
+        };
         let profiles = SssProfiles {
             transmission: vec![None; profiles.len()],
             profiles,
@@ -291,7 +441,23 @@ impl SssEffect {
             lean: false,
             albedo_maps: false,
             frames_in_flight: 1,
-            tables: sss::tables::regions(&profiles),
+            tables: {
+                let mut tables = sss::tables::regions(&profiles);
+                if lean_constants.is_some() {
+                    tables.push(TableRegion {
+                        region: &HOST_LEAN,
+                        bytes: std::mem::size_of::<HostLeanGpu>() as u64,
+                    });
+                }
+                if desc.shadow_format.is_some() {
+                    tables.push(TableRegion {
+                        region: &crate::features::shadows::TABLE_REGION,
+                        bytes: std::mem::size_of::<crate::features::shadows::ShadowUniforms>()
+                            as u64,
+                    });
+                }
+                tables
+            },
             layered_ids: None,
             layer_depth_textures: 0,
         };
@@ -301,7 +467,7 @@ impl SssEffect {
             "SssEffect",
             upload,
             desc.views_per_frame,
-            |scene_gpu| declare(&desc, &profiles, scene_gpu, albedo_pass, post_albedo),
+            |scene_gpu| declare(&desc, &profiles, scene_gpu, albedo_pass, post_albedo, lean),
         )?;
         let out = Self {
             passes,
@@ -315,6 +481,7 @@ impl SssEffect {
                 .map(|(m, (p, _))| (m.id, sss::profile_reach(p)))
                 .collect(),
             desc,
+            lean: lean_constants,
         };
         // The tables do not change between frames: written once into every slot.
         for slot in 0..out.passes.slots() {
@@ -360,10 +527,32 @@ impl SssEffect {
     ) -> Result<()> {
         let ring = self.passes.slot(frame.slot, frame.view)?;
         let gbuffer = &self.desc.gbuffer;
-        let uniforms = gbuffer.view_uniforms(&frame.camera)?;
+        let mut uniforms = gbuffer.view_uniforms(&frame.camera)?;
         let inputs = self.check_images(lucent, frame)?;
+        let mut shadows = None;
+        if let Some(lean) = &frame.lean {
+            check_lights(lean.lights)?;
+            uniforms = uniforms.with_lights(lean.lights);
+            if let Some(map) = lean.shadow_map {
+                shadows = Some(shadow_table(lean.lights, lean.shadow_faces, map.extent)?);
+            }
+        }
         let per_frame = self.passes.per_frame();
         per_frame.write(ring, &FRAME, bytemuck::bytes_of(&uniforms))?;
+        if let Some(constants) = &self.lean {
+            let constants = HostLeanGpu {
+                view_to_world: frame.camera.view.inverse().to_cols_array_2d(),
+                ..*constants
+            };
+            per_frame.write(ring, &HOST_LEAN, bytemuck::bytes_of(&constants))?;
+        }
+        if let Some(table) = &shadows {
+            per_frame.write(
+                ring,
+                &crate::features::shadows::TABLE_REGION,
+                bytemuck::bytes_of(table),
+            )?;
+        }
         // Each chain's tiles (none: the whole screen).
         per_frame.tiles(ring).sss = match marked_tiles(frame.regions, gbuffer.extent()) {
             Some(tiles) => vec![Some(tiles); self.chains],
@@ -380,6 +569,14 @@ impl SssEffect {
         }
         if let (Some(id), Some(image)) = (self.imports.albedo, frame.images.albedo) {
             binds.push((id, image));
+        }
+        if let Some(lean) = &frame.lean {
+            if let Some(id) = self.imports.normals {
+                binds.push((id, lean.normals));
+            }
+            if let (Some(id), Some(map)) = (self.imports.shadow_map, lean.shadow_map) {
+                binds.push((id, map));
+            }
         }
         self.passes.record(
             lucent,
@@ -477,14 +674,107 @@ impl SssEffect {
                 }
             }
         }
+        let (normals, shadow_map) = self.check_lean(lucent, frame)?;
         let all = [
             Some(images.depth),
             Some(images.diffuse),
             Some(images.material_ids),
             images.specular,
             images.albedo,
+            normals,
+            shadow_map,
         ];
         distinct_inputs(all.into_iter().flatten(), frame.output)
+    }
+
+    /// Checks `frame.lean` against the effect: there exactly when a LEAN blur is, its
+    /// normals as described, its shadow map there exactly when the description has a shadow
+    /// format. Returns the normals and the shadow map.
+    fn check_lean<'a>(
+        &self,
+        lucent: &Lucent,
+        frame: &SssFrame<'a>,
+    ) -> Result<(Option<&'a HostImage>, Option<&'a HostImage>)> {
+        let lean = match (&self.lean, &frame.lean) {
+            (None, None) => return Ok((None, None)),
+            (Some(_), Some(lean)) => lean,
+            (Some(_), None) => {
+                return Err(HostError::Missing {
+                    input: "lean".into(),
+                    needed_by: "a material of LCB, LBB or the bilateral blur: their LEAN \
+                                moments are made from the normals and their specular relit \
+                                with the lights (SssFrame::lean)"
+                        .into(),
+                }
+                .into())
+            }
+            (None, Some(_)) => {
+                return Err(HostError::Unsupported {
+                    input: "lean".into(),
+                    found: "normals and lights for an effect without a LEAN blur".into(),
+                    accepted: "SssFrame::lean only with a material of LCB, LBB or the \
+                               bilateral blur (the other blurs keep the host's specular)"
+                        .into(),
+                }
+                .into())
+            }
+        };
+        let gbuffer = &self.desc.gbuffer;
+        let normal_format = gbuffer.normals.expect("checked at new").format;
+        check_image(
+            lucent.gpu(),
+            lean.normals,
+            "normals",
+            Role::SampledColor,
+            gbuffer.extent(),
+            |f| f == normal_format,
+            &format!("{} (the description's)", format_name(normal_format)),
+        )?;
+        let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
+            (Some(format), Some(map)) => {
+                check_image(
+                    lucent.gpu(),
+                    map,
+                    "shadow map",
+                    Role::SampledDepth,
+                    map.extent,
+                    |f| f == format,
+                    &format!("{} (the description's)", format_name(format)),
+                )?;
+                Some(map)
+            }
+            (None, None) => {
+                if !lean.shadow_faces.is_empty() {
+                    return Err(HostError::Description {
+                        field: "lean.shadow_faces".into(),
+                        problem: "faces without a shadow map (the description has no shadow \
+                                  format: SssEffectDesc::with_shadow_maps)"
+                            .into(),
+                    }
+                    .into());
+                }
+                None
+            }
+            (Some(_), None) => {
+                return Err(HostError::Missing {
+                    input: "shadow map".into(),
+                    needed_by: "the description has a shadow format (LeanLighting::shadow_map)"
+                        .into(),
+                }
+                .into())
+            }
+            (None, Some(map)) => {
+                return Err(HostError::Image {
+                    image: map.name.clone(),
+                    kind: ImageFault::Aliased,
+                    problem: "given as the shadow map, which the description has no format \
+                              for (SssEffectDesc::with_shadow_maps)"
+                        .into(),
+                }
+                .into())
+            }
+        };
+        Ok((Some(lean.normals), shadow_map))
     }
 }
 
@@ -496,6 +786,7 @@ fn declare(
     scene_gpu: &Arc<SceneGpu>,
     albedo_pass: bool,
     post_albedo: bool,
+    lean: bool,
 ) -> (RenderGraph, Imports) {
     let gbuffer = &desc.gbuffer;
     let (width, height) = (gbuffer.width, gbuffer.height);
@@ -532,6 +823,13 @@ fn declare(
         desc.output_format,
         Access::ColorAttachmentWrite,
     );
+    let normals = lean.then(|| {
+        let format = gbuffer.normals.expect("checked at new").format;
+        import(&mut graph, "host normals", format, sampled)
+    });
+    let shadow_map = desc
+        .shadow_format
+        .map(|format| import(&mut graph, "host shadow map", format, sampled));
     let imports = Imports {
         depth: depth.id(),
         diffuse: diffuse.id(),
@@ -539,6 +837,8 @@ fn declare(
         albedo: albedo.as_ref().map(Handle::id),
         material_ids: material_ids.id(),
         output: output.id(),
+        normals: normals.as_ref().map(Handle::id),
+        shadow_map: shadow_map.as_ref().map(Handle::id),
     };
     let cleared;
     let specular = match &specular {
@@ -563,7 +863,35 @@ fn declare(
         id_defines,
     };
     let adjusted;
-    if albedo_pass {
+    let lean_targets;
+    if let Some(normals) = &normals {
+        // The LEAN chains' G-buffer targets, the albedo put right in the same pass.
+        let mode = match (albedo_pass, gbuffer.diffuse.albedo) {
+            (false, _) => None,
+            (true, DiffuseAlbedo::Included) => Some(HostAlbedo::Included),
+            (true, DiffuseAlbedo::Excluded) => Some(HostAlbedo::Excluded),
+        };
+        let host_albedo = mode.map(|mode| (albedo.as_ref().expect("checked at new"), mode));
+        lean_targets = sss::host_lean_pass(
+            &mut graph,
+            &inputs,
+            normals,
+            host_albedo,
+            &HOST_LEAN,
+            width,
+            height,
+            Some(scene_gpu),
+        );
+        inputs.diffuse = &lean_targets.diffuse;
+        inputs.lean = Some(LeanInputs {
+            view_plane: &lean_targets.view_plane,
+            gb0: &lean_targets.gb0,
+            gb1: &lean_targets.gb1,
+        });
+        // The LEAN chains' diffuse carries the slope in its alpha, not depth.
+        inputs.depth_in_alpha = false;
+        inputs.shadow_depth = shadow_map.as_ref();
+    } else if albedo_pass {
         let albedo = albedo.as_ref().expect("checked at new");
         let included = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
         adjusted = sss::host_albedo_pass(

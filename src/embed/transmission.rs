@@ -37,10 +37,10 @@ use super::passes::{
     id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
-use super::shadow_faces::{shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
-use crate::backend::format::{format_info, format_name, FormatKind};
+use crate::backend::format::format_name;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
@@ -229,17 +229,7 @@ impl TransmissionEffect {
             unreachable!("missing() lists each input the effect reads");
         };
         check_views(desc.views_per_frame)?;
-        let is_depth = format_info(desc.shadow_format).is_some_and(|f| f.kind == FormatKind::Depth);
-        if !is_depth {
-            return Err(HostError::Unsupported {
-                input: "shadow map".into(),
-                found: format!("format {}", format_name(desc.shadow_format)),
-                accepted: "a depth format (D32_SFLOAT, D16_UNORM, D24_UNORM_S8_UINT, \
-                           D32_SFLOAT_S8_UINT, X8_D24_UNORM_PACK32)"
-                    .into(),
-            }
-            .into());
-        }
+        check_shadow_format(desc.shadow_format)?;
         if desc.materials.is_empty() || desc.materials.len() >= MAX_SSS_PROFILES {
             return Err(HostError::Description {
                 field: "materials".into(),

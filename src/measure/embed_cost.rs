@@ -43,11 +43,11 @@ use crate::embed::{
     DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, EnvironmentEffect, EnvironmentEffectDesc,
     EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
     ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages,
-    LayeredMaterial, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace, SssEffect,
-    SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect,
-    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
-    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
-    TransmissionMaterial, VertexLayout,
+    LayeredMaterial, LeanLighting, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace,
+    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc,
+    TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages,
+    TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame,
+    TransmissionImages, TransmissionMaterial, VertexLayout,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -157,13 +157,9 @@ pub fn embed_cost(
     // `none`, plain lighting: what a host inserts of it is the SH environment's light.
     let environment = matches!(technique, Technique::None);
     let layered = module.is_some_and(|m| m.name() == crate::features::layered::LAYERED.name());
-    let blur =
-        module.and_then(|m| registry::sss_blurs().find(|b| b.name() == m.name() && !b.lean()));
+    let blur = module.and_then(|m| registry::sss_blurs().find(|b| b.name() == m.name()));
     if !translucency && !environment && !layered && blur.is_none() {
-        let blurs: Vec<&str> = registry::sss_blurs()
-            .filter(|b| !b.lean())
-            .map(|b| b.name())
-            .collect();
+        let blurs: Vec<&str> = registry::sss_blurs().map(|b| b.name()).collect();
         return Err(LucentError::InvalidInput(format!(
             "--embed measures an effect a host can insert: --technique {}, translucency, \
              layered or none (the SH environment) (not '{}')",
@@ -351,6 +347,8 @@ fn measure_sss(
         technique,
         export_gbuffer: true,
         export_lit: true,
+        // The LEAN blurs' specular is shadowed: the host's shadow map is lucent's atlas.
+        export_shadows: blur.lean(),
         ..FrameSettings::new(width, height)
     };
     // A host's lit diffuse carries its albedo: blurred with the light.
@@ -425,7 +423,7 @@ fn measure_sss(
             rgba16f(&lit.diffuse),
             "host output",
         )?;
-        let gbuffer = GBufferDesc::new(
+        let mut gbuffer = GBufferDesc::new(
             width,
             height,
             DepthDesc::device(vk::Format::D32_SFLOAT),
@@ -438,18 +436,68 @@ fn measure_sss(
         .with_specular(hdr)
         .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
         .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        // The LEAN blurs: lucent's normals (GB1), each material's surface, the scene's lights
+        // and, where they cast, lucent's light-space atlas with each face's matrices.
+        let lean = if blur.lean() {
+            gbuffer = gbuffer.with_normals(NormalDesc::world(hdr));
+            let normals = images.upload(gpu, &colour, rgba16f(&gb.gb1), "host normals")?;
+            let normals = host_image(normals, "host normals", hdr, size, sampled);
+            let shadows =
+                match crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false) {
+                    Some(desc) => {
+                        let faces: Vec<ShadowFace> = desc
+                            .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
+                            .into_iter()
+                            .map(ShadowFace::from)
+                            .collect();
+                        let (sw, sh, depths) = renderer.read_shadow_map(gpu)?;
+                        let map = images.upload(
+                            gpu,
+                            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, sampled),
+                            bytemuck::cast_slice(&depths).to_vec(),
+                            "host shadow map",
+                        )?;
+                        let map = host_image(
+                            map,
+                            "host shadow map",
+                            vk::Format::D32_SFLOAT,
+                            (sw, sh),
+                            sampled,
+                        );
+                        Some((map, faces))
+                    }
+                    None => None,
+                };
+            Some((normals, shadows))
+        } else {
+            None
+        };
+        let surface_of = |profile: usize| {
+            frame_profiles
+                .object_ids
+                .iter()
+                .position(|&id| usize::from(id) == profile)
+                .map(|object| {
+                    let m = &scene.objects[object].material;
+                    SpecularSurface::new(m.roughness, m.specular)
+                })
+        };
         let materials = profiles
             .into_iter()
             .enumerate()
-            .map(|(i, p)| SssMaterial::new(i as u8 + 1, p))
+            .map(|(i, p)| {
+                let material = SssMaterial::new(i as u8 + 1, p);
+                match surface_of(i + 1).filter(|_| lean.is_some()) {
+                    Some(surface) => material.with_surface(surface),
+                    None => material,
+                }
+            })
             .collect();
-        let mut effect = build(gpu, lucent, |u| {
-            SssEffect::new(
-                lucent,
-                u,
-                SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss),
-            )
-        })?;
+        let mut desc = SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss);
+        if let Some((_, Some(_))) = &lean {
+            desc = desc.with_shadow_maps(vk::Format::D32_SFLOAT);
+        }
+        let mut effect = build(gpu, lucent, |u| SssEffect::new(lucent, u, desc))?;
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -486,6 +534,12 @@ fn measure_sss(
                     },
                     regions: &regions,
                     output: &output,
+                    lean: lean.as_ref().map(|(normals, shadows)| LeanLighting {
+                        normals,
+                        lights: &scene.lights,
+                        shadow_map: shadows.as_ref().map(|(map, _)| map),
+                        shadow_faces: shadows.as_ref().map_or(&[], |(_, faces)| faces),
+                    }),
                 },
                 timer,
             )

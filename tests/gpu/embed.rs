@@ -208,7 +208,9 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
             && log.contains("layered: light-space maps")
             && log.contains("layered: single scattering")
             && log.contains("transmission: host transmission")
-            && log.contains("sss: horizontal blur"),
+            && log.contains("sss: separable horizontal blur")
+            && log.contains("sss: sss lean in")
+            && log.contains("sss: lbb final lighting"),
         "{log}"
     );
     // The effects drawn only over the objects' screen regions (the default: tiles left out,
@@ -226,7 +228,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
             && log.contains("translucency (leaf")
             && log.contains("layered media (apple flesh")
             && log.contains("transmission (skin and marble")
-            && log.contains("sss (separable blur"),
+            && log.contains("with the separable blur, marble ID 42 with the lbb blur"),
         "{log}"
     );
     // lucent's EnvironmentEffect adds the engine's own sky-over-ground ambient (the engine's
@@ -345,6 +347,24 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
         "transmission changed only {through} pixels ({} and {})",
         with.display(),
         no_transmission.display()
+    );
+    // The marble's LBB (the LEAN-mapping thesis's technique, the example's default) relights
+    // its specular from the blurred LEAN moments of the engine's normals: against the
+    // separable blur, which keeps the engine's specular, the marble's highlight changes.
+    let separable = dir.join("marble-separable.png");
+    run(&separable, &["--marble-blur", "separable"]);
+    let (_, _, d) = read_png_rgba8(&separable).unwrap();
+    let relit = a
+        .chunks_exact(4)
+        .zip(d.chunks_exact(4))
+        .filter(|(x, y)| differs(x, y))
+        .count();
+    println!("host_engine: the marble's LBB against the separable blur changes {relit} pixels");
+    assert!(
+        relit > 50,
+        "the marble's LEAN blur changed only {relit} pixels ({} and {})",
+        with.display(),
+        separable.display()
     );
     // The right of the frame is the blue plastic sphere (the engine's material 5, no profile)
     // and the floor (0): lucent leaves their light as the engine lit it.
@@ -963,8 +983,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
         &lucent::features::sss::control::CONTROL,
         &lucent::features::sss::burley::BURLEY,
     ] {
-        // (bilateral blurs lucent's LEAN G-buffer, which a host does not have: refused, in
-        // the typed-error test)
+        // (the LEAN blurs, LCB, LBB and bilateral: tests/gpu/embed_lean.rs)
         let sss_blur = blur(technique);
         // lucent's own frame, keeping what a host's lighting would have made.
         let mut settings = FrameSettings {
@@ -1176,6 +1195,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                             },
                             regions: &regions,
                             output: &output,
+                            lean: None,
                         },
                     )
                     .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -1449,7 +1469,8 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
         vec![material(5)],
     ));
     assert!(e.to_string().contains("does not fit"), "{e}");
-    // The LEAN blurs (LBB, bilateral), which blur a G-buffer a host does not have.
+    // The LEAN blurs (LBB, bilateral) make their LEAN moments from normals, which this
+    // description lacks (tests/gpu/embed_lean.rs has their other errors).
     for lean_blur in [
         &lucent::features::sss::lbb::LBB
             as &'static dyn lucent::features::registry::TechniqueModule,
@@ -1461,7 +1482,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
         };
         let e = refused(desc(gbuffer.clone(), vec![SssMaterial::new(1, lean)]));
         assert!(
-            matches!(&e, HostError::Unsupported { .. }) && e.to_string().contains("LEAN"),
+            matches!(&e, HostError::Missing { input, .. } if input == "normals"),
             "{e}"
         );
     }
@@ -1511,6 +1532,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
             images,
             regions: &[],
             output: &out_host,
+            lean: None,
         };
         recorded(&test, |cmd| effect.record(&lucent, cmd, &frame))
     };
@@ -1890,6 +1912,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                     images,
                     regions: &[],
                     output: &output,
+                    lean: None,
                 },
             )
         })
@@ -2251,6 +2274,7 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                             output: &described(output, "view output", usage)
                                 .in_state(ImageState::UNDEFINED)
                                 .then(ImageState::transfer_src()),
+                            lean: None,
                         },
                     )
                     .unwrap();

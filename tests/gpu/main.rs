@@ -15,6 +15,7 @@ mod deformation;
 mod embed;
 mod embed_environment;
 mod embed_layered;
+mod embed_lean;
 mod embed_translucency;
 mod embed_transmission;
 mod environment;

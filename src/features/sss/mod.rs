@@ -792,22 +792,114 @@ pub fn host_albedo_pass(
     out
 }
 
-/// Defines of the permutations a host's frame cannot have: the LEAN G-buffer's and shadowed
-/// LEAN specular. (Linear depth in the diffuse's alpha a host can have:
-/// `embed::DiffuseDesc::with_depth_in_alpha`.)
-const LUCENT_ONLY_DEFINES: [&str; 2] = ["LUCENT_SSS_LEAN", "LUCENT_SHADOWS"];
+/// The host LEAN pass's shader (lucent::embed).
+const HOST_LEAN_FRAGMENT: &str = "sss/host_lean.frag";
+
+/// How the host LEAN pass treats a host's albedo: none read (the light is blurred as it is),
+/// or read and put into the light as each profile wants it from a light that holds none of it
+/// or all of it (as [`host_albedo_pass`] does).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HostAlbedo {
+    /// No albedo image: the light as it is, GB0's albedo white.
+    None,
+    /// The host's light holds none of the albedo.
+    Excluded,
+    /// The host's light holds all of it.
+    Included,
+}
+
+impl HostAlbedo {
+    const ALL: [HostAlbedo; 3] = [HostAlbedo::None, HostAlbedo::Excluded, HostAlbedo::Included];
+}
+
+/// The host LEAN pass's defines: the ID decode and the albedo's treatment.
+fn host_lean_defines(
+    id_defines: &'static [(&'static str, &'static str)],
+    albedo: HostAlbedo,
+) -> Vec<(&'static str, &'static str)> {
+    let mut defines = id_defines.to_vec();
+    match albedo {
+        HostAlbedo::None => {}
+        HostAlbedo::Excluded => defines.push(("LUCENT_SSS_HOST_ALBEDO", "1")),
+        HostAlbedo::Included => defines.push(("LUCENT_SSS_HOST_ALBEDO", "2")),
+    }
+    defines
+}
+
+/// What the host LEAN pass writes: the G-buffer targets LCB's, LBB's and the bilateral blur's
+/// chains read, in lucent's layout.
+pub struct HostLeanTargets {
+    /// The lit diffuse, the view-plane LEAN slope x in alpha (the chains' `diffuse`).
+    pub diffuse: Handle<Image>,
+    /// The LEAN slope y and moments ([`LeanInputs::view_plane`]).
+    pub view_plane: Handle<Image>,
+    /// Albedo + specular intensity ([`LeanInputs::gb0`]).
+    pub gb0: Handle<Image>,
+    /// Normal + roughness ([`LeanInputs::gb1`]).
+    pub gb1: Handle<Image>,
+}
+
+/// The G-buffer targets the LEAN chains read, made from a host's lit diffuse, normals and
+/// material IDs (lucent::embed; `glsl/sss/host_lean.frag`): one fullscreen pass with four
+/// colour outputs, where lucent's own frames write them in the G-buffer pass. `decode` is the
+/// per-frame region of the host's normal encoding and its materials' surfaces (binding 2);
+/// `albedo` the host's albedo image when [`HostAlbedo`] reads one.
+#[allow(clippy::too_many_arguments)]
+pub fn host_lean_pass(
+    graph: &mut RenderGraph,
+    inputs: &SssInputs<'_>,
+    normals: &Handle<Image>,
+    albedo: Option<(&Handle<Image>, HostAlbedo)>,
+    decode: &'static crate::gpu_scene::Region,
+    width: u32,
+    height: u32,
+    scene: Option<&Arc<SceneGpu>>,
+) -> HostLeanTargets {
+    let info = |format| crate::graph::ImageInfo {
+        width,
+        height,
+        format,
+    };
+    let mut targets = HostLeanTargets {
+        diffuse: graph.create_image("sss.host diffuse", info(crate::features::util::HDR_FORMAT)),
+        view_plane: graph
+            .create_image("sss.host lean", info(crate::features::gbuffer::LEAN_FORMAT)),
+        gb0: graph.create_image("sss.host albedo", info(HOST_SURFACE_FORMAT)),
+        gb1: graph.create_image("sss.host normal", info(HOST_SURFACE_FORMAT)),
+    };
+    let mode = albedo.map_or(HostAlbedo::None, |(_, mode)| mode);
+    let mut pass = FullscreenPass::new(graph, "sss lean in", HOST_LEAN_FRAGMENT, scene);
+    pass.per_frame(&FRAME)
+        .per_frame(&tables::PROFILES)
+        .per_frame(decode)
+        .sample(inputs.diffuse)
+        .sample(normals)
+        .sample(inputs.profile_ids);
+    if let Some((albedo, _)) = albedo {
+        pass.sample(albedo);
+    }
+    pass.defines(&host_lean_defines(inputs.id_defines, mode));
+    for target in [
+        &mut targets.diffuse,
+        &mut targets.view_plane,
+        &mut targets.gb0,
+        &mut targets.gb1,
+    ] {
+        pass.color(target, crate::graph::LoadOp::DontCare);
+    }
+    pass.finish();
+    targets
+}
+
+/// The host LEAN pass's GB0 and GB1 counterparts: fp16, as lucent's `half` G-buffer keeps them.
+const HOST_SURFACE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 /// Adds, for every SSS pass permutation in `out` a host's frame can have, its two host-ID
 /// variants ([`IdMap::defines`]: UNORM and unsigned IDs), for the shipped SPIR-V.
 pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     let host: Vec<crate::backend::shader::PipelineShaders> = out
         .iter()
-        .filter(|p| p.fragment.starts_with("sss/") && !p.fragment.ends_with("lean_brdf.frag"))
-        .filter(|p| {
-            !p.defines
-                .iter()
-                .any(|(name, _)| LUCENT_ONLY_DEFINES.contains(&name.as_str()))
-        })
+        .filter(|p| p.fragment.starts_with("sss/"))
         .cloned()
         .collect();
     for uint in [false, true] {
@@ -825,6 +917,13 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
                 "fullscreen.vert",
                 HOST_ALBEDO_FRAGMENT,
                 &host_albedo_defines(ids, included),
+            ));
+        }
+        for albedo in HostAlbedo::ALL {
+            out.push(crate::backend::shader::PipelineShaders::new(
+                "fullscreen.vert",
+                HOST_LEAN_FRAGMENT,
+                &host_lean_defines(ids, albedo),
             ));
         }
         for p in &host {

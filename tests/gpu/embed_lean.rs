@@ -1,0 +1,453 @@
+//! The LEAN-mapping thesis's blurs (LCB, LBB, the two-pass bilateral blur) as a host's
+//! `lucent::embed::SssEffect` against lucent's own frame of the same scene: the host's lit
+//! diffuse and specular are lucent's lighting pass's, its normals lucent's GB1 re-encoded, its
+//! shadow map lucent's light-space atlas with each face's matrices, its G-buffer in host layouts
+//! (reversed-Z infinite depth with R8_UINT IDs and view-space octahedral normals, D24S8 with the
+//! IDs in stencil bits, linear depth with the IDs in bits of a packed target). The effect builds
+//! the LEAN target from the normals, blurs it with the light and relights the specular with the
+//! host's lights: its output must be lucent's own frame.
+
+use std::path::Path;
+
+use crate::common::TestGpu;
+use crate::embed::{
+    built, compare_host_frame, described, host_error, host_frames, host_id, host_layout, options,
+    tonemapped, wrap, HostDepth, HostIds,
+};
+use crate::embed_translucency::{normal_image, HostNormals};
+
+use ash::vk;
+use lucent::backend::ImageDesc;
+use lucent::embed::{
+    capabilities, DepthDesc, DiffuseDesc, Effect, GBufferDesc, HostError, HostImage, IdDesc,
+    ImageState, LeanLighting, NormalDesc, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc,
+    SssFrame, SssImages, SssMaterial,
+};
+use lucent::features::registry;
+use lucent::features::shadows::ShadowDesc;
+use lucent::features::sss::SssProfiles;
+use lucent::frame::{FrameSettings, Renderer, Technique};
+use lucent::scene::material::{SssProfile, Texturing};
+
+/// A ball of skin and a slab of marble, glossy, lit by a sun and a point light that both cast
+/// shadows (the ball shadows the slab), 1 unit = 20 mm, the profiles widened so the blur spans
+/// many pixels.
+fn scene() -> lucent::scene::Scene {
+    let source = r#"name = "host-lean"
+ambient = [0.03, 0.03, 0.03]
+sky = [0.0, 0.0, 0.0]
+[camera]
+eye = [0.0, 0.6, 3.2]
+target = [0.0, 0.0, 0.0]
+fov_y_degrees = 40.0
+[[mesh]]
+name = "ball"
+generator = "icosphere"
+level = 3
+[[mesh]]
+name = "slab"
+generator = "cube"
+level = 2
+[[material]]
+name = "skin"
+albedo = [0.85, 0.6, 0.5]
+specular = 0.35
+roughness = 0.35
+[material.sss]
+preset = "skin"
+units_per_mm = 0.4
+[[material]]
+name = "marble"
+albedo = [0.9, 0.9, 0.85]
+specular = 0.6
+roughness = 0.2
+[material.sss]
+preset = "marble"
+units_per_mm = 0.4
+[[object]]
+mesh = "ball"
+material = "skin"
+translate = [-0.35, 0.1, 0.3]
+scale = [0.45, 0.45, 0.45]
+[[object]]
+mesh = "slab"
+material = "marble"
+translate = [0.3, -0.2, -0.3]
+scale = [0.7, 0.5, 0.2]
+[[light]]
+type = "directional"
+direction = [-0.5, -0.6, -0.6]
+intensity = 2.5
+[[light]]
+type = "point"
+position = [1.2, 0.9, 1.5]
+intensity = 10.0
+range = 50.0
+"#;
+    lucent::scene::file::parse_scene(Path::new("host-lean.toml"), source)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (192, 144);
+    let scene = scene();
+    let exposure = f64::from(scene.exposure);
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let mut report = Vec::new();
+    for blur in ["lbb", "lcb", "bilateral"] {
+        let mut settings = FrameSettings {
+            technique: Technique::parse(blur).unwrap(),
+            export_hdr: true,
+            export_gbuffer: true,
+            export_lit: true,
+            export_shadows: true,
+            ..FrameSettings::new(w, h)
+        };
+        // A host's lit diffuse carries its albedo: blurred with the light.
+        settings.sss.texturing = Some(Texturing::Pre);
+        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings)
+            .unwrap_or_else(|e| panic!("{blur}: {e}"));
+        let images = renderer.render_once(gpu).unwrap();
+        let lit = renderer.read_lit(gpu).unwrap();
+        let (sw, sh, shadow_depths) = renderer.read_shadow_map(gpu).unwrap();
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        let gb = images.gbuffer.unwrap();
+        assert!(
+            gb.lean.is_some(),
+            "{blur}: lucent's frame has its LEAN target"
+        );
+        let want = tonemapped(&images.hdr.unwrap(), exposure);
+        let ids: Vec<u8> = gb.sss.as_ref().unwrap().iter().map(|&v| v as u8).collect();
+
+        // The blurred frame must differ from the lit one, or the comparison proves nothing;
+        // and so must its specular (the LEAN specular is relit from the blurred moments).
+        let unblurred: Vec<f32> = lit
+            .diffuse
+            .iter()
+            .zip(&lit.specular)
+            .flat_map(|(d, s)| [d[0] + s[0], d[1] + s[1], d[2] + s[2], 1.0])
+            .collect();
+        let plain = tonemapped(&unblurred, exposure);
+        let changed = want
+            .chunks_exact(4)
+            .zip(plain.chunks_exact(4))
+            .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 4))
+            .count();
+        assert!(
+            changed * 20 > (w * h) as usize,
+            "{blur}: the blur changes only {changed} pixels"
+        );
+
+        // lucent's profiles in its ID order, each material's surface from the scene.
+        let frame_profiles = SssProfiles::new(
+            &scene,
+            Some(registry::sss_blur(blur).unwrap()),
+            None,
+            Some(Texturing::Pre),
+            &registry::blur_of,
+        )
+        .unwrap()
+        .unwrap();
+        let surface_of = |k: u8| {
+            let object = frame_profiles
+                .object_ids
+                .iter()
+                .position(|&id| id == k)
+                .expect("each profile is an object's");
+            let m = &scene.objects[object].material;
+            SpecularSurface::new(m.roughness, m.specular)
+        };
+        let profiles: Vec<SssProfile> = frame_profiles
+            .profiles
+            .iter()
+            .map(|(p, b)| SssProfile {
+                blur: Some(b.name().into()),
+                ..p.clone()
+            })
+            .collect();
+        let metres_per_unit = 1.0 / (1000.0 * profiles[0].units_per_mm);
+
+        let faces: Vec<ShadowFace> = ShadowDesc::new(&scene, &settings.shadows, false)
+            .unwrap()
+            .face_matrices(&scene, &lucent::gpu_scene::tiles::mesh_bounds(&scene))
+            .into_iter()
+            .map(ShadowFace::from)
+            .collect();
+        assert_eq!(faces.len(), 7, "a sun's face and a point light's six");
+        let shadow_map = gpu
+            .upload_image(
+                &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+                &[bytemuck::cast_slice(&shadow_depths).to_vec()],
+                "host shadow map",
+            )
+            .unwrap();
+        let rgba32 = |t: &[[f32; 4]], name| {
+            gpu.upload_image(
+                &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, usage),
+                &[bytemuck::cast_slice(t).to_vec()],
+                name,
+            )
+            .unwrap()
+        };
+        // The host's alpha is its own (lucent's holds the LEAN slope x there).
+        let diffuse_rgb: Vec<[f32; 4]> = lit
+            .diffuse
+            .iter()
+            .map(|d| [d[0], d[1], d[2], 0.25])
+            .collect();
+        let diffuse = rgba32(&diffuse_rgb, "host diffuse");
+        let specular = rgba32(&lit.specular, "host specular");
+
+        for (name, depth_kind, ids_kind, normals_kind) in [
+            (
+                "reversed-Z infinite D32, R8_UINT IDs, view-space octahedral RG16 normals",
+                HostDepth::ReversedInfinite,
+                HostIds::Uint,
+                HostNormals::ViewOctahedralUnorm,
+            ),
+            (
+                "D24S8 with IDs in stencil bits 4-7, world RGBA16F normals",
+                HostDepth::D24Stencil,
+                HostIds::Stencil,
+                HostNormals::WorldHalf,
+            ),
+            (
+                "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
+                 normals",
+                HostDepth::Linear,
+                HostIds::AlphaBits,
+                HostNormals::WorldOctahedralFloat,
+            ),
+        ] {
+            let mut layout = host_layout(
+                &test,
+                depth_kind,
+                ids_kind,
+                w,
+                h,
+                &scene,
+                &gb.depth,
+                &ids,
+                metres_per_unit,
+            );
+            if depth_kind == HostDepth::ReversedInfinite {
+                // The same pixels as lucent's frame: its clip-space y convention.
+                let mut projection = layout.camera.projection;
+                projection.y_axis.y = -projection.y_axis.y;
+                layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
+            }
+            let (normals, normal_desc) =
+                normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
+            let desc = layout.desc.clone().with_normals(normal_desc);
+            assert!(capabilities(&desc).unwrap()[5].1.runs(), "{name}");
+            let materials: Vec<SssMaterial> = profiles
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let k = i as u8 + 1;
+                    SssMaterial::new(host_id(ids_kind, k), p.clone()).with_surface(surface_of(k))
+                })
+                .collect();
+            let lucent = wrap(&test, options(3));
+            let effect_desc =
+                SssEffectDesc::new(desc.clone(), materials, vk::Format::R32G32B32A32_SFLOAT)
+                    .with_knobs(settings.sss)
+                    .with_shadow_maps(vk::Format::D32_SFLOAT);
+            let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, effect_desc))
+                .unwrap_or_else(|e| panic!("{blur} on {name}: {e}"));
+            let shadows = HostImage::new(
+                "host shadow map",
+                shadow_map.image,
+                shadow_map.view,
+                vk::Format::D32_SFLOAT,
+                vk::Extent2D {
+                    width: sw,
+                    height: sh,
+                },
+                usage,
+            )
+            .in_state(ImageState::fragment_sampled());
+            let normals_host = described(&normals, "host normals", usage);
+            let diffuse_host = described(&diffuse, "host diffuse", usage);
+            let specular_host = described(&specular, "host specular", usage);
+            // The frames' output is host_frames' lighting image (its start is overwritten).
+            let frames = host_frames(
+                &test,
+                &layout,
+                &desc,
+                bytemuck::cast_slice(&diffuse_rgb),
+                |k, cmd, images| {
+                    let output = images.lighting.clone().in_state(ImageState::UNDEFINED);
+                    effect
+                        .record(
+                            &lucent,
+                            cmd,
+                            &SssFrame {
+                                slot: k,
+                                view: 0,
+                                camera: layout.camera,
+                                images: SssImages {
+                                    depth: images.depth,
+                                    diffuse: &diffuse_host,
+                                    specular: Some(&specular_host),
+                                    albedo: None,
+                                    material_ids: images.ids.unwrap(),
+                                },
+                                regions: &[],
+                                output: &output,
+                                lean: Some(LeanLighting {
+                                    normals: &normals_host,
+                                    lights: &scene.lights,
+                                    shadow_map: Some(&shadows),
+                                    shadow_faces: &faces,
+                                }),
+                            },
+                        )
+                        .unwrap_or_else(|e| panic!("{blur} on {name}: {e}"));
+                },
+            );
+            for (k, texels) in frames.iter().enumerate() {
+                let have = tonemapped(texels, exposure);
+                // The normals come re-encoded (octahedral, 16-bit) and the positions through
+                // another depth: the LEAN slopes move by a hair, and the specular with them
+                // where it is steep. At most 0.1% of the channel values over 1/255.
+                report.push(compare_host_frame(
+                    &want,
+                    &have,
+                    (w, h),
+                    want.len() / 1000,
+                    &format!("{blur} on {name}, frame {k}"),
+                    &format!("embed-lean-{blur}-{k}"),
+                ));
+            }
+            effect.destroy(&lucent);
+            drop(lucent);
+            gpu.destroy_image(normals);
+            layout.destroy(&test);
+        }
+        gpu.destroy_image(diffuse);
+        gpu.destroy_image(specular);
+        gpu.destroy_image(shadow_map);
+    }
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
+#[test]
+fn a_lean_blur_without_normals_a_surface_or_its_lighting_is_a_typed_error() {
+    let test = TestGpu::new();
+    let lucent = wrap(&test, options(2));
+    let gbuffer = GBufferDesc::new(
+        64,
+        48,
+        DepthDesc::device(vk::Format::D32_SFLOAT),
+        DiffuseDesc::with_albedo(vk::Format::R16G16B16A16_SFLOAT),
+    )
+    .with_material_ids(IdDesc::value(vk::Format::R8_UINT));
+    let lbb = |surface: bool| {
+        let profile = SssProfile {
+            blur: Some("lbb".into()),
+            texturing: Texturing::Pre,
+            ..SssProfile::preset("skin").unwrap()
+        };
+        let material = SssMaterial::new(1, profile);
+        if surface {
+            material.with_surface(SpecularSurface::new(0.4, 0.3))
+        } else {
+            material
+        }
+    };
+    let format = vk::Format::R16G16B16A16_SFLOAT;
+    let build = |desc: SssEffectDesc| built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc));
+    // No normals in the description: what capabilities says too.
+    let e = host_error(build(SssEffectDesc::new(
+        gbuffer.clone(),
+        vec![lbb(true)],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input == "normals"),
+        "{e}"
+    );
+    let Some((Effect::LeanSss, support)) = capabilities(&gbuffer).unwrap().get(5).cloned() else {
+        panic!("the LEAN blurs' entry")
+    };
+    assert!(!support.runs());
+    let with_normals =
+        gbuffer.with_normals(NormalDesc::world(vk::Format::A2B10G10R10_UNORM_PACK32));
+    // A LEAN blur without a surface; a surface with a blur that keeps the host's specular; a
+    // roughness out of range; a shadow format without a LEAN blur, and one that is not depth.
+    let e = host_error(build(SssEffectDesc::new(
+        with_normals.clone(),
+        vec![lbb(false)],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input.ends_with(".surface")),
+        "{e}"
+    );
+    let separable = SssMaterial::new(
+        1,
+        SssProfile {
+            blur: Some("separable".into()),
+            texturing: Texturing::Pre,
+            ..SssProfile::preset("skin").unwrap()
+        },
+    );
+    let e = host_error(build(SssEffectDesc::new(
+        with_normals.clone(),
+        vec![separable
+            .clone()
+            .with_surface(SpecularSurface::new(0.4, 0.3))],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input.ends_with(".surface")),
+        "{e}"
+    );
+    let rough =
+        SssMaterial::new(1, lbb(false).profile).with_surface(SpecularSurface::new(1.5, 0.3));
+    let e = host_error(build(SssEffectDesc::new(
+        with_normals.clone(),
+        vec![rough],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Description { field, .. } if field.ends_with("roughness")),
+        "{e}"
+    );
+    let e = host_error(build(
+        SssEffectDesc::new(with_normals.clone(), vec![separable], format)
+            .with_shadow_maps(vk::Format::D32_SFLOAT),
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "shadow map"),
+        "{e}"
+    );
+    let e = host_error(build(
+        SssEffectDesc::new(with_normals.clone(), vec![lbb(true)], format)
+            .with_shadow_maps(vk::Format::R32_SFLOAT),
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "shadow map"),
+        "{e}"
+    );
+    // Built right, it has its LEAN pass.
+    let effect = build(SssEffectDesc::new(with_normals, vec![lbb(true)], format)).unwrap();
+    let passes: Vec<String> = effect
+        .plan()
+        .passes
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    assert!(passes.iter().any(|p| p == "sss lean in"), "{passes:?}");
+    effect.destroy(&lucent);
+    drop(lucent);
+    test.finish();
+}

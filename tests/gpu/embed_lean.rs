@@ -14,7 +14,7 @@ use crate::embed::{
     built, compare_host_frame, described, host_error, host_frames, host_id, host_layout, options,
     tonemapped, wrap, HostDepth, HostIds,
 };
-use crate::embed_translucency::{normal_image, HostNormals};
+use crate::embed_translucency::{normal_image, rgba8, HostNormals};
 
 use ash::vk;
 use lucent::backend::ImageDesc;
@@ -88,16 +88,74 @@ range = 50.0
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// A host layout of the comparison: its name, depth, IDs and normals.
+type Layout = (&'static str, HostDepth, HostIds, HostNormals);
+
+/// The three layouts every LEAN blur is compared on.
+const LAYOUTS: [Layout; 3] = [
+    (
+        "reversed-Z infinite D32, R8_UINT IDs, view-space octahedral RG16 normals",
+        HostDepth::ReversedInfinite,
+        HostIds::Uint,
+        HostNormals::ViewOctahedralUnorm,
+    ),
+    (
+        "D24S8 with IDs in stencil bits 4-7, world RGBA16F normals",
+        HostDepth::D24Stencil,
+        HostIds::Stencil,
+        HostNormals::WorldHalf,
+    ),
+    (
+        "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F normals",
+        HostDepth::Linear,
+        HostIds::AlphaBits,
+        HostNormals::WorldOctahedralFloat,
+    ),
+];
+
 #[test]
 fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
     let test = TestGpu::new();
+    let mut report = Vec::new();
+    for blur in ["lbb", "lcb", "bilateral"] {
+        compare_lean(&test, blur, Texturing::Pre, &LAYOUTS, &mut report);
+    }
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
+/// The albedo after the scatter (`Texturing::Post`): the host's light holds the whole albedo,
+/// the effect's LEAN pass divides it out before the blur (the `sss albedo in` it replaces) and
+/// the final pass multiplies the host's albedo image back in.
+#[test]
+fn a_lean_blur_with_the_albedo_after_the_scatter_equals_lucents_own_frame() {
+    let test = TestGpu::new();
+    let mut report = Vec::new();
+    compare_lean(&test, "lbb", Texturing::Post, &LAYOUTS[1..2], &mut report);
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
+/// Renders `scene()` with `blur` and `texturing` in lucent's own frame and through a host's
+/// `SssEffect` on each of `layouts` (three frames in flight, views recreated), and compares
+/// them, pushing a line per frame into `report`.
+fn compare_lean(
+    test: &TestGpu,
+    blur: &str,
+    texturing: Texturing,
+    layouts: &[Layout],
+    report: &mut Vec<String>,
+) {
     let gpu = &test.gpu;
     let (w, h) = (192, 144);
     let scene = scene();
     let exposure = f64::from(scene.exposure);
     let usage = vk::ImageUsageFlags::SAMPLED;
-    let mut report = Vec::new();
-    for blur in ["lbb", "lcb", "bilateral"] {
+    {
         let mut settings = FrameSettings {
             technique: Technique::parse(blur).unwrap(),
             export_hdr: true,
@@ -106,8 +164,7 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
             export_shadows: true,
             ..FrameSettings::new(w, h)
         };
-        // A host's lit diffuse carries its albedo: blurred with the light.
-        settings.sss.texturing = Some(Texturing::Pre);
+        settings.sss.texturing = Some(texturing);
         let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings)
             .unwrap_or_else(|e| panic!("{blur}: {e}"));
         let images = renderer.render_once(gpu).unwrap();
@@ -147,7 +204,7 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
             &scene,
             Some(registry::sss_blur(blur).unwrap()),
             None,
-            Some(Texturing::Pre),
+            Some(texturing),
             &registry::blur_of,
         )
         .unwrap()
@@ -193,38 +250,40 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
             )
             .unwrap()
         };
-        // The host's alpha is its own (lucent's holds the LEAN slope x there).
+        // The host's light holds the whole albedo (lucent's leaves it out of a scattering
+        // pixel's light when it goes after the scatter); its alpha is its own (lucent's holds
+        // the LEAN slope x there).
+        let post = texturing != Texturing::Pre;
+        let albedo_bytes = rgba8(&gb.gb0);
         let diffuse_rgb: Vec<[f32; 4]> = lit
             .diffuse
             .iter()
-            .map(|d| [d[0], d[1], d[2], 0.25])
+            .zip(albedo_bytes.chunks_exact(4))
+            .zip(&ids)
+            .map(|((d, a), &id)| {
+                let f = |c: usize| {
+                    if post && id > 0 {
+                        f32::from(a[c]) / 255.0
+                    } else {
+                        1.0
+                    }
+                };
+                [d[0] * f(0), d[1] * f(1), d[2] * f(2), 0.25]
+            })
             .collect();
+        let albedo = gpu
+            .upload_image(
+                &ImageDesc::color(w, h, vk::Format::R8G8B8A8_UNORM, usage),
+                &[albedo_bytes],
+                "host albedo",
+            )
+            .unwrap();
         let diffuse = rgba32(&diffuse_rgb, "host diffuse");
         let specular = rgba32(&lit.specular, "host specular");
 
-        for (name, depth_kind, ids_kind, normals_kind) in [
-            (
-                "reversed-Z infinite D32, R8_UINT IDs, view-space octahedral RG16 normals",
-                HostDepth::ReversedInfinite,
-                HostIds::Uint,
-                HostNormals::ViewOctahedralUnorm,
-            ),
-            (
-                "D24S8 with IDs in stencil bits 4-7, world RGBA16F normals",
-                HostDepth::D24Stencil,
-                HostIds::Stencil,
-                HostNormals::WorldHalf,
-            ),
-            (
-                "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
-                 normals",
-                HostDepth::Linear,
-                HostIds::AlphaBits,
-                HostNormals::WorldOctahedralFloat,
-            ),
-        ] {
+        for &(name, depth_kind, ids_kind, normals_kind) in layouts {
             let mut layout = host_layout(
-                &test,
+                test,
                 depth_kind,
                 ids_kind,
                 w,
@@ -241,8 +300,11 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
                 layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
             }
             let (normals, normal_desc) =
-                normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
-            let desc = layout.desc.clone().with_normals(normal_desc);
+                normal_image(test, normals_kind, w, h, &gb.gb1, layout.camera.view);
+            let mut desc = layout.desc.clone().with_normals(normal_desc);
+            if post {
+                desc = desc.with_albedo(vk::Format::R8G8B8A8_UNORM);
+            }
             assert!(capabilities(&desc).unwrap()[5].1.runs(), "{name}");
             let materials: Vec<SssMaterial> = profiles
                 .iter()
@@ -252,12 +314,12 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
                     SssMaterial::new(host_id(ids_kind, k), p.clone()).with_surface(surface_of(k))
                 })
                 .collect();
-            let lucent = wrap(&test, options(3));
+            let lucent = wrap(test, options(3));
             let effect_desc =
                 SssEffectDesc::new(desc.clone(), materials, vk::Format::R32G32B32A32_SFLOAT)
                     .with_knobs(settings.sss)
                     .with_shadow_maps(vk::Format::D32_SFLOAT);
-            let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, effect_desc))
+            let mut effect = built(test, &lucent, |u| SssEffect::new(&lucent, u, effect_desc))
                 .unwrap_or_else(|e| panic!("{blur} on {name}: {e}"));
             let shadows = HostImage::new(
                 "host shadow map",
@@ -274,9 +336,10 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
             let normals_host = described(&normals, "host normals", usage);
             let diffuse_host = described(&diffuse, "host diffuse", usage);
             let specular_host = described(&specular, "host specular", usage);
+            let albedo_host = described(&albedo, "host albedo", usage);
             // The frames' output is host_frames' lighting image (its start is overwritten).
             let frames = host_frames(
-                &test,
+                test,
                 &layout,
                 &desc,
                 bytemuck::cast_slice(&diffuse_rgb),
@@ -294,7 +357,7 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
                                     depth: images.depth,
                                     diffuse: &diffuse_host,
                                     specular: Some(&specular_host),
-                                    albedo: None,
+                                    albedo: post.then_some(&albedo_host),
                                     material_ids: images.ids.unwrap(),
                                 },
                                 regions: &[],
@@ -320,23 +383,20 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
                     &have,
                     (w, h),
                     want.len() / 1000,
-                    &format!("{blur} on {name}, frame {k}"),
-                    &format!("embed-lean-{blur}-{k}"),
+                    &format!("{blur} ({}) on {name}, frame {k}", texturing.name()),
+                    &format!("embed-lean-{blur}-{}-{k}", texturing.name()),
                 ));
             }
             effect.destroy(&lucent);
             drop(lucent);
             gpu.destroy_image(normals);
-            layout.destroy(&test);
+            layout.destroy(test);
         }
         gpu.destroy_image(diffuse);
         gpu.destroy_image(specular);
+        gpu.destroy_image(albedo);
         gpu.destroy_image(shadow_map);
     }
-    for line in &report {
-        println!("{line}");
-    }
-    test.finish();
 }
 
 #[test]

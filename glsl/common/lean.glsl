@@ -12,6 +12,10 @@
 #include "gbuffer.glsl"
 #include "lighting.glsl"
 #ifdef LUCENT_SHADOWS
+#ifdef LUCENT_SSS_HOST_IDS
+// A host's shadow map may store reversed Z (shadows.glsl shadow_stored_depth).
+#define LUCENT_SHADOW_REVERSIBLE 1
+#endif
 #include "shadows.glsl"
 #endif
 

@@ -12,8 +12,9 @@
 #define MAX_SHADOW_FACES 384
 
 struct ShadowFace {
-    mat4 view_proj;  // world to the face's clip space
-    vec4 rect;       // xy: the tile's top-left texel in the atlas; z: its edge in texels
+    mat4 view_proj;  // world to the face's clip space (standard Z: depth 0 near, 1 far)
+    vec4 rect;       // xy: the tile's top-left texel in the atlas; z: its edge in texels;
+                     // w: 1 where the map stores reversed Z (a host's, LUCENT_SHADOW_REVERSIBLE)
     vec4 params;     // a map texel's world size at a point: x * clip.w + y
 };
 
@@ -38,6 +39,19 @@ layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2D shadow_de
 #ifdef LUCENT_SHADOW_IDS
 layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_ids;
 #endif
+
+// The standard-Z depths of stored texels `d` of face `face`'s map. lucent's own maps store
+// standard Z. A host's map may store reversed Z (src/embed/shadow_faces.rs): its face's
+// view_proj is then the host's projection with z flipped (depth 1 - d), so positions project
+// to standard Z, and only the stored texels are flipped here. Passes reading a host's maps
+// define LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
+vec4 shadow_stored_depth(int face, vec4 d) {
+#ifdef LUCENT_SHADOW_REVERSIBLE
+    return shadows.faces[face].rect.w > 0.5 ? 1.0 - d : d;
+#else
+    return d;
+#endif
+}
 
 // The face of `light`'s map that sees `pos` (-1: the light casts no shadow). A point light's
 // six faces are +X, -X, +Y, -Y, +Z, -Z: the major axis of (pos - light) picks one.
@@ -177,7 +191,7 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
             // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
             // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
             vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadows.atlas.zw;
-            vec4 occluder = textureGather(shadow_depth, corner, 0);
+            vec4 occluder = shadow_stored_depth(index, textureGather(shadow_depth, corner, 0));
             vec4 lit = step(vec4(reference), occluder);
             float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];
             float y0 = wy[2 * by], y1 = wy[2 * by + 1];

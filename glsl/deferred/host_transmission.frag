@@ -19,6 +19,8 @@
 #define LUCENT_SSS_PROFILES_BINDING 1
 #define LUCENT_SHADOWS 1
 #define LUCENT_SHADOW_BINDING 3
+// The host's shadow map may store reversed Z (glsl/common/shadows.glsl shadow_stored_depth).
+#define LUCENT_SHADOW_REVERSIBLE 1
 #include "../common/sss_transmission.glsl"
 #include "../common/host_ids.glsl"
 #include "../common/host_normals.glsl"

@@ -23,7 +23,8 @@ pub struct ShadowFace {
     pub light: usize,
     /// World to the face's view space (looking down -z).
     pub view: Mat4,
-    /// The face's view to clip space: standard Z (0 near, 1 far, finite planes), perspective
+    /// The face's view to clip space: standard Z (0 near, 1 far) or reversed Z (1 near, 0
+    /// far), a finite or infinite far plane, perspective
     /// (a spot light's cone, a point light's 90-degree faces) or orthographic (a directional
     /// light), either y convention.
     pub projection: Mat4,
@@ -97,7 +98,7 @@ pub(crate) fn check_shadow_format(format: vk::Format) -> Result<()> {
 /// The shadow table (glsl/common/shadows.glsl `Shadows`, what lucent's own light-space maps
 /// fill) of the host's faces in a shadow map of `extent`, each checked: its light exists and
 /// has one face (six for a point light, in [`CUBE_AXES`] order, together), its matrices are
-/// finite with a standard-Z projection, its rectangle square and inside the map.
+/// finite with a standard- or reversed-Z projection, its rectangle square and inside the map.
 pub(crate) fn shadow_table(
     lights: &[Light],
     faces: &[ShadowFace],
@@ -207,19 +208,28 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
         ));
     }
     let edge = r.extent.width as f32;
-    let standard = || {
-        "a perspective or orthographic projection with standard Z (depth 0 at a \
-                       finite near plane, 1 at a finite far one)"
+    let accepted = || {
+        "a perspective or orthographic projection mapping a near plane in front of the eye to \
+         depth 0 and a farther (or infinite) plane to 1 (standard Z), or the other way round \
+         (reversed Z)"
             .to_string()
     };
-    let (near, far) = projection_depth_ends(&projection).ok_or_else(standard)?;
-    if !(near > 0.0 && far > near && far.is_finite()) {
-        return Err(standard());
+    let (at_0, at_1) = projection_depth_ends(&projection).ok_or_else(accepted)?;
+    // Reversed Z stores 1 at the near plane: 1 - d is the standard depth of the same planes
+    // (exactly, for every perspective or orthographic mapping with those planes, an infinite
+    // far plane included), so the face is read through the projection with z flipped and its
+    // texels flipped in the shader (glsl/common/shadows.glsl shadow_stored_depth).
+    let reversed = at_0 > at_1;
+    let (near, far) = if reversed { (at_1, at_0) } else { (at_0, at_1) };
+    if !(near > 0.0 && far > near && near.is_finite()) {
+        return Err(accepted());
     }
-    let (near, far) = (near as f32, far as f32);
+    // An infinite far plane: a far one the f32 decode cannot tell from it (near * far / (far
+    // - d (far - near)) is near / (1 - d) to f32's precision), finite in the table.
+    let (near, far) = (near as f32, far.min(1e30) as f32);
     let scale = projection.y_axis.y.abs();
     if scale.is_nan() || scale <= 0.0 {
-        return Err(standard());
+        return Err(accepted());
     }
     let orthographic = projection.w_axis.w != 0.0;
     // A map texel's world size at a point: x * clip.w + y (glsl map_texel_size).
@@ -229,9 +239,26 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
     } else {
         [texel, 0.0, near, far]
     };
+    // z' = w - z: depth 1 - d.
+    let flip = Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    );
+    let projection = if reversed {
+        flip * projection
+    } else {
+        projection
+    };
     Ok(ShadowFaceGpu {
         view_proj: (projection * view).to_cols_array_2d(),
-        rect: [r.offset.x as f32, r.offset.y as f32, edge, 0.0],
+        rect: [
+            r.offset.x as f32,
+            r.offset.y as f32,
+            edge,
+            if reversed { 1.0 } else { 0.0 },
+        ],
         params,
     })
 }
@@ -284,16 +311,53 @@ mod tests {
             ShadowFace::new(1, view, projection, rect(0, 0, 256)), // no such light
             ShadowFace::new(0, view, projection, rect(300, 0, 256)), // outside the map
             ShadowFace::new(0, view, projection, rect(-1, 0, 64)),
+            // Its near plane behind the eye.
             ShadowFace::new(
                 0,
                 view,
-                Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.1),
+                Mat4::perspective_rh(1.0, 1.0, -0.1, 20.0),
                 rect(0, 0, 64),
             ),
             ShadowFace::new(0, Mat4::ZERO, projection, rect(0, 0, 64)),
         ] {
             assert!(shadow_table(&[spot], &[bad], extent).is_err(), "{bad:?}");
         }
+        // Reversed Z (near and far swapped): the same row read through z flipped, flagged;
+        // and with an infinite far plane, a far one f32 cannot tell from it.
+        let reversed = ShadowFace::new(
+            0,
+            view,
+            Mat4::perspective_rh(1.0, 1.0, 20.0, 0.1),
+            rect(256, 0, 256),
+        );
+        let flipped = shadow_table(&[spot], &[reversed], extent).unwrap().faces[0];
+        assert_eq!(flipped.rect, [256.0, 0.0, 256.0, 1.0]);
+        for (a, b) in flipped.params.iter().zip(&row.params) {
+            assert!(
+                (a - b).abs() <= 1e-5 * b.abs(),
+                "{flipped:?} against {row:?}"
+            );
+        }
+        for (a, b) in flipped
+            .view_proj
+            .iter()
+            .flatten()
+            .zip(row.view_proj.iter().flatten())
+        {
+            assert!((a - b).abs() < 1e-5, "{flipped:?} against {row:?}");
+        }
+        let infinite = ShadowFace::new(
+            0,
+            view,
+            Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.1),
+            rect(0, 0, 64),
+        );
+        let far = shadow_table(&[spot], &[infinite], extent).unwrap().faces[0];
+        assert_eq!(far.rect[3], 1.0);
+        assert!(
+            (far.params[2] - 0.1).abs() < 1e-6 && far.params[3] >= 1e29,
+            "{far:?}"
+        );
         // A point light needs its six faces, in order.
         let point = Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 5.0);
         let cube: Vec<ShadowFace> = CUBE_AXES

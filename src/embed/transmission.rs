@@ -14,8 +14,8 @@
 //!
 //! The host describes the maps it already renders for its shadows ([`ShadowFace`]): one depth
 //! image (an atlas: each face a square rectangle of it), and per face its light, its view and
-//! projection matrices (standard Z: depth 0 at the near plane, 1 at the far; perspective or
-//! orthographic) and its rectangle, with which it rendered the map. A point light has six
+//! projection matrices (perspective or orthographic; standard Z, depth 0 at the near plane
+//! and 1 at the far, or reversed Z; a finite or infinite far plane) and its rectangle, with which it rendered the map. A point light has six
 //! faces, +X, -X, +Y, -Y, +Z, -Z in that order (checked from their view matrices); a spot or
 //! directional light one. Lights without faces transmit nothing (nothing measures the
 //! thickness), as in lucent's own frames.

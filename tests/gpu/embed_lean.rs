@@ -15,6 +15,7 @@ use crate::embed::{
     tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
+use crate::embed_transmission::{host_shadow_map, HostShadowZ};
 
 use ash::vk;
 use lucent::backend::ImageDesc;
@@ -235,13 +236,7 @@ fn compare_lean(
             .map(ShadowFace::from)
             .collect();
         assert_eq!(faces.len(), 7, "a sun's face and a point light's six");
-        let shadow_map = gpu
-            .upload_image(
-                &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-                &[bytemuck::cast_slice(&shadow_depths).to_vec()],
-                "host shadow map",
-            )
-            .unwrap();
+
         let rgba32 = |t: &[[f32; 4]], name| {
             gpu.upload_image(
                 &ImageDesc::color(w, h, vk::Format::R32G32B32A32_SFLOAT, usage),
@@ -282,6 +277,22 @@ fn compare_lean(
         let specular = rgba32(&lit.specular, "host specular");
 
         for &(name, depth_kind, ids_kind, normals_kind) in layouts {
+            // The reversed-Z G-buffer's host stores its shadow map reversed too, the
+            // linear-depth one reversed with an infinite far plane.
+            let shadow_z = match depth_kind {
+                HostDepth::ReversedInfinite => HostShadowZ::Reversed,
+                HostDepth::Linear => HostShadowZ::ReversedInfinite,
+                _ => HostShadowZ::Standard,
+            };
+            let (host_depths, host_faces) =
+                host_shadow_map(&shadow_depths, (sw, sh), &faces, shadow_z);
+            let shadow_map = gpu
+                .upload_image(
+                    &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+                    &[bytemuck::cast_slice(&host_depths).to_vec()],
+                    "host shadow map",
+                )
+                .unwrap();
             let mut layout = host_layout(
                 test,
                 depth_kind,
@@ -366,7 +377,7 @@ fn compare_lean(
                                     normals: &normals_host,
                                     lights: &scene.lights,
                                     shadow_map: Some(&shadows),
-                                    shadow_faces: &faces,
+                                    shadow_faces: &host_faces,
                                 }),
                             },
                         )
@@ -390,12 +401,12 @@ fn compare_lean(
             effect.destroy(&lucent);
             drop(lucent);
             gpu.destroy_image(normals);
+            gpu.destroy_image(shadow_map);
             layout.destroy(test);
         }
         gpu.destroy_image(diffuse);
         gpu.destroy_image(specular);
         gpu.destroy_image(albedo);
-        gpu.destroy_image(shadow_map);
     }
 }
 

@@ -92,6 +92,76 @@ intensity = 1.5
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// How a host's shadow map stores depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum HostShadowZ {
+    /// Standard Z: lucent's own atlas as it is.
+    Standard,
+    /// Reversed Z with the same planes: 1 - d.
+    Reversed,
+    /// Reversed Z with an infinite far plane on the perspective faces (near / distance; the
+    /// orthographic faces reversed with their planes).
+    ReversedInfinite,
+}
+
+/// lucent's light-space atlas (`depths`, `size`) and its `faces` as a host storing depth as
+/// `z` hands them over: each face's projection changed to store that depth, each texel of its
+/// rectangle re-encoded (texels outside every face: the reversed clear value, 0).
+pub(crate) fn host_shadow_map(
+    depths: &[f32],
+    (width, _height): (u32, u32),
+    faces: &[ShadowFace],
+    z: HostShadowZ,
+) -> (Vec<f32>, Vec<ShadowFace>) {
+    if z == HostShadowZ::Standard {
+        return (depths.to_vec(), faces.to_vec());
+    }
+    let mut out = vec![0.0f32; depths.len()];
+    let mut host_faces = Vec::with_capacity(faces.len());
+    // z' = w - z: depth 1 - d with the same planes.
+    let flip = glam::Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    );
+    for face in faces {
+        let p = face.projection;
+        let orthographic = p.w_axis.w != 0.0;
+        let (near, far) = lucent::gpu_scene::projection_depth_ends(&p).unwrap();
+        let infinite = z == HostShadowZ::ReversedInfinite && !orthographic;
+        let projection = if infinite {
+            // Clip z = near, w = the distance: depth near / distance (glam's
+            // perspective_infinite_reverse_rh).
+            let mut q = p;
+            q.z_axis.z = 0.0;
+            q.w_axis.z = near as f32;
+            q
+        } else {
+            flip * p
+        };
+        let r = face.rect;
+        for y in r.offset.y as u32..r.offset.y as u32 + r.extent.height {
+            for x in r.offset.x as u32..r.offset.x as u32 + r.extent.width {
+                let i = (y * width + x) as usize;
+                let d = f64::from(depths[i]);
+                out[i] = if d >= 1.0 {
+                    0.0
+                } else if infinite {
+                    let distance = near * far / (far - d * (far - near));
+                    (near / distance) as f32
+                } else {
+                    (1.0 - d) as f32
+                };
+            }
+        }
+        host_faces.push(ShadowFace::new(
+            face.light, face.view, projection, face.rect,
+        ));
+    }
+    (out, host_faces)
+}
+
 #[test]
 fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
     let test = TestGpu::new();
@@ -179,13 +249,6 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         "a point light's six faces, a spot's and a sun's"
     );
     let usage = vk::ImageUsageFlags::SAMPLED;
-    let shadow_map = gpu
-        .upload_image(
-            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-            &[bytemuck::cast_slice(&depths).to_vec()],
-            "host shadow map",
-        )
-        .unwrap();
     let albedo = gpu
         .upload_image(
             &ImageDesc::color(w, h, vk::Format::R8G8B8A8_UNORM, usage),
@@ -194,33 +257,46 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         )
         .unwrap();
     let mut report = Vec::new();
-    for (name, depth_kind, ids_kind, normals_kind) in [
+    for (name, depth_kind, ids_kind, normals_kind, shadow_z) in [
         (
             "D32, world RGBA16F normals, R8_UNORM IDs",
             HostDepth::Standard,
             HostIds::Unorm,
             HostNormals::WorldHalf,
+            HostShadowZ::Standard,
         ),
         (
-            "reversed-Z infinite D32, view-space octahedral RG16 normals, R8_UINT IDs",
+            "reversed-Z infinite D32, view-space octahedral RG16 normals, R8_UINT IDs, a \
+             reversed-Z shadow map",
             HostDepth::ReversedInfinite,
             HostIds::Uint,
             HostNormals::ViewOctahedralUnorm,
+            HostShadowZ::Reversed,
         ),
         (
             "D24S8 with IDs in stencil bits 4-7, world RGBA16_UNORM normals",
             HostDepth::D24Stencil,
             HostIds::Stencil,
             HostNormals::WorldUnorm,
+            HostShadowZ::Standard,
         ),
         (
             "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
-             normals",
+             normals, a reversed-Z infinite-far shadow map",
             HostDepth::Linear,
             HostIds::AlphaBits,
             HostNormals::WorldOctahedralFloat,
+            HostShadowZ::ReversedInfinite,
         ),
     ] {
+        let (host_depths, host_faces) = host_shadow_map(&depths, (sw, sh), &faces, shadow_z);
+        let shadow_map = gpu
+            .upload_image(
+                &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+                &[bytemuck::cast_slice(&host_depths).to_vec()],
+                "host shadow map",
+            )
+            .unwrap();
         let mut layout = host_layout(
             &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
         );
@@ -278,7 +354,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
                             view: 0,
                             camera: layout.camera,
                             lights: &scene.lights,
-                            shadow_faces: &faces,
+                            shadow_faces: &host_faces,
                             images: TransmissionImages {
                                 depth: images.depth,
                                 normals: &described(&normals, "host normals", usage),
@@ -312,10 +388,10 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         effect.destroy(&lucent);
         drop(lucent);
         gpu.destroy_image(normals);
+        gpu.destroy_image(shadow_map);
         layout.destroy(&test);
     }
     gpu.destroy_image(albedo);
-    gpu.destroy_image(shadow_map);
     for line in &report {
         println!("{line}");
     }

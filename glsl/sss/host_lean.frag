@@ -15,7 +15,8 @@
 // keep) is not in a host's normal image; what the blur mixes across pixels is.
 // The specular intensity and roughness are the host material's (`SssMaterial::with_surface`),
 // per profile; pixels without a profile get LEAN_HOST_DEFAULT_ROUGHNESS (their texels only
-// weigh in where a blur's tap lands on them).
+// weigh in where a blur's tap lands on them). LUCENT_SSS_PASSTHROUGH: the variant drawn
+// outside the chains' tiles, the light alone.
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 #include "../common/lean.glsl"
@@ -56,6 +57,15 @@ void main() {
     light *= sss_host_albedo_factor(id, albedo, LUCENT_SSS_HOST_ALBEDO == 2);
 #endif
     light = clamp(mix(light, vec3(0.0), isnan(light)), vec3(0.0), vec3(65504.0));
+#ifdef LUCENT_SSS_PASSTHROUGH
+    // Outside every chain's tiles (the host's regions): no blur reads the LEAN texels here,
+    // only the final passes' pass-through reads the light.
+    out_diffuse = vec4(light, 0.0);
+    out_lean = vec4(0.0);
+    out_gb0 = vec4(0.0);
+    out_gb1 = vec4(0.0);
+    return;
+#endif
     vec4 surface = id > 0 ? host.surface[id] : vec4(LEAN_HOST_DEFAULT_ROUGHNESS, 0.0, 0.0, 0.0);
     float roughness = clamp(surface.x, 0.0, 1.0);
     float specular = clamp(surface.y, 0.0, 1.0);

@@ -878,7 +878,22 @@ pub fn host_lean_pass(
     if let Some((albedo, _)) = albedo {
         pass.sample(albedo);
     }
-    pass.defines(&host_lean_defines(inputs.id_defines, mode));
+    pass.defines(&host_lean_defines(inputs.id_defines, mode))
+        // The LEAN texels only where a chain blurs (its tiles: the host's regions); elsewhere
+        // the light alone, which the chains' final passes pass through.
+        .variant(HOST_LEAN_PASSTHROUGH.to_vec())
+        .tiles(|scene, ctx| {
+            let chains = &scene.per_frame.tiles(ctx.frame).sss;
+            let mut union: Vec<crate::gpu_scene::TileRect> = Vec::new();
+            for tiles in chains {
+                for &tile in tiles.as_ref()? {
+                    if !union.contains(&tile) {
+                        union.push(tile);
+                    }
+                }
+            }
+            (!chains.is_empty()).then_some(union)
+        });
     for target in [
         &mut targets.diffuse,
         &mut targets.view_plane,
@@ -890,6 +905,9 @@ pub fn host_lean_pass(
     pass.finish();
     targets
 }
+
+/// The host LEAN pass's variant drawn outside the chains' tiles: the light alone.
+const HOST_LEAN_PASSTHROUGH: &[(&str, &str)] = &[("LUCENT_SSS_PASSTHROUGH", "1")];
 
 /// The host LEAN pass's GB0 and GB1 counterparts: fp16, as lucent's `half` G-buffer keeps them.
 const HOST_SURFACE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -920,10 +938,21 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
             ));
         }
         for albedo in HostAlbedo::ALL {
+            let defines = host_lean_defines(ids, albedo);
             out.push(crate::backend::shader::PipelineShaders::new(
                 "fullscreen.vert",
                 HOST_LEAN_FRAGMENT,
-                &host_lean_defines(ids, albedo),
+                &defines,
+            ));
+            let with_passthrough: Vec<_> = defines
+                .iter()
+                .chain(HOST_LEAN_PASSTHROUGH)
+                .copied()
+                .collect();
+            out.push(crate::backend::shader::PipelineShaders::new(
+                "fullscreen.vert",
+                HOST_LEAN_FRAGMENT,
+                &with_passthrough,
             ));
         }
         for p in &host {

@@ -14,7 +14,8 @@
 struct ShadowFace {
     mat4 view_proj;  // world to the face's clip space (standard Z: depth 0 near, 1 far)
     vec4 rect;       // xy: the tile's top-left texel in the atlas; z: its edge in texels;
-                     // w: 1 where the map stores reversed Z (a host's, LUCENT_SHADOW_REVERSIBLE)
+                     // w: a host's map's (LUCENT_SHADOW_REVERSIBLE): 1 if it stores reversed
+                     // Z, plus 2 x its array layer (LUCENT_SHADOW_ARRAY)
     vec4 params;     // a map texel's world size at a point: x * clip.w + y
 };
 
@@ -35,7 +36,12 @@ layout(push_constant) uniform ShadowObject {
     ivec4 face_id;  // x: face; y: the object's translucency material ID (0: none); z: layered ID
 } shadow_object;
 #else
+#ifdef LUCENT_SHADOW_ARRAY
+// A host's shadow map as an array of layers (cascades, a cube's faces), each face in its own.
+layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2DArray shadow_depth;
+#else
 layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2D shadow_depth;
+#endif
 #ifdef LUCENT_SHADOW_IDS
 layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_ids;
 #endif
@@ -47,10 +53,22 @@ layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_i
 // define LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
 vec4 shadow_stored_depth(int face, vec4 d) {
 #ifdef LUCENT_SHADOW_REVERSIBLE
-    return shadows.faces[face].rect.w > 0.5 ? 1.0 - d : d;
+    return mod(shadows.faces[face].rect.w, 2.0) > 0.5 ? 1.0 - d : d;
 #else
     return d;
 #endif
+}
+
+// The depth texels of face `face`'s map around atlas coordinate `corner` (textureGather's
+// order), from its layer where the map is an array (LUCENT_SHADOW_ARRAY), as standard Z.
+vec4 shadow_gather_depth(int face, vec2 corner) {
+#ifdef LUCENT_SHADOW_ARRAY
+    float layer = floor(shadows.faces[face].rect.w * 0.5);
+    vec4 d = textureGather(shadow_depth, vec3(corner, layer), 0);
+#else
+    vec4 d = textureGather(shadow_depth, corner, 0);
+#endif
+    return shadow_stored_depth(face, d);
 }
 
 // The face of `light`'s map that sees `pos` (-1: the light casts no shadow). A point light's
@@ -191,7 +209,7 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
             // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
             // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
             vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadows.atlas.zw;
-            vec4 occluder = shadow_stored_depth(index, textureGather(shadow_depth, corner, 0));
+            vec4 occluder = shadow_gather_depth(index, corner);
             vec4 lit = step(vec4(reference), occluder);
             float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];
             float y0 = wy[2 * by], y1 = wy[2 * by + 1];

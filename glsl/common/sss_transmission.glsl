@@ -68,7 +68,7 @@ vec3 sss_transmitted(int id, int i, vec3 pos, vec3 normal, vec3 to_light) {
     vec2 corner;
     vec4 w;
     map_bilinear(face, t, corner, w);
-    vec4 d = shadow_stored_depth(face, textureGather(shadow_depth, corner, 0));
+    vec4 d = shadow_gather_depth(face, corner);
     Light light = frame.lights[i];
     vec3 sum = vec3(0.0);
     for (int k = 0; k < 4; ++k) {

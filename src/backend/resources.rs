@@ -54,6 +54,8 @@ pub struct ImageDesc {
     pub aspect: vk::ImageAspectFlags,
     /// Mip levels (1 for render targets).
     pub mip_levels: u32,
+    /// Array layers (1: a 2-D image; more: a 2-D array, its view a 2-D array view).
+    pub layers: u32,
 }
 
 impl ImageDesc {
@@ -66,6 +68,7 @@ impl ImageDesc {
             usage,
             aspect: vk::ImageAspectFlags::COLOR,
             mip_levels: 1,
+            layers: 1,
         }
     }
 
@@ -78,7 +81,14 @@ impl ImageDesc {
             usage,
             aspect: vk::ImageAspectFlags::DEPTH,
             mip_levels: 1,
+            layers: 1,
         }
+    }
+
+    /// The same image as an array of `layers` layers (a shadow map's cascades or cube faces);
+    /// uploads then hold the layers one after the other.
+    pub fn with_layers(self, layers: u32) -> Self {
+        Self { layers, ..self }
     }
 
     /// The image's extent as a 3D extent with depth 1.
@@ -90,14 +100,14 @@ impl ImageDesc {
         }
     }
 
-    /// The subresource range covering the whole image (every mip, one layer).
+    /// The subresource range covering the whole image (every mip, every layer).
     pub fn subresource_range(&self) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange {
             aspect_mask: self.aspect,
             base_mip_level: 0,
             level_count: self.mip_levels.max(1),
             base_array_layer: 0,
-            layer_count: 1,
+            layer_count: self.layers.max(1),
         }
     }
 }
@@ -486,7 +496,7 @@ impl GpuContext {
                     aspect_mask: desc.aspect,
                     mip_level: shift,
                     base_array_layer: 0,
-                    layer_count: 1,
+                    layer_count: desc.layers.max(1),
                 },
                 image_offset: vk::Offset3D::default(),
                 image_extent: vk::Extent3D {
@@ -758,7 +768,7 @@ impl GpuContext {
             .format(desc.format)
             .extent(desc.extent())
             .mip_levels(desc.mip_levels.max(1))
-            .array_layers(1)
+            .array_layers(desc.layers.max(1))
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
@@ -842,7 +852,8 @@ impl GpuContext {
         .vk("vkBindImageMemory")
     }
 
-    /// Creates a 2D view of the whole of `image` with `desc`'s format and aspect.
+    /// Creates a 2D view (a 2-D array view for an array) of the whole of `image` with
+    /// `desc`'s format and aspect.
     pub fn create_view(
         &self,
         image: vk::Image,
@@ -851,7 +862,11 @@ impl GpuContext {
     ) -> Result<vk::ImageView> {
         let info = vk::ImageViewCreateInfo::default()
             .image(image)
-            .view_type(vk::ImageViewType::TYPE_2D)
+            .view_type(if desc.layers > 1 {
+                vk::ImageViewType::TYPE_2D_ARRAY
+            } else {
+                vk::ImageViewType::TYPE_2D
+            })
             .format(desc.format)
             .subresource_range(desc.subresource_range());
         // SAFETY: `image` is a live 2D image of this device created with `desc` and bound to

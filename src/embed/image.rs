@@ -155,7 +155,8 @@ pub struct HostImage {
     /// The image.
     pub image: vk::Image,
     /// A 2-D view of mip 0, layer 0 (a depth-stencil image's view: the aspect lucent reads,
-    /// depth for depth, stencil for material IDs in stencil bits).
+    /// depth for depth, stencil for material IDs in stencil bits); for an image of
+    /// [`HostImage::layers`] layers, a 2-D array view of mip 0, layers 0 to `layers - 1`.
     pub view: vk::ImageView,
     /// The format the image (and view) were created with.
     pub format: vk::Format,
@@ -168,6 +169,9 @@ pub struct HostImage {
     /// The state lucent leaves it in; `None`: the state it came in ([`HostImage::state`]),
     /// which must then not be UNDEFINED.
     pub final_state: Option<ImageState>,
+    /// The array layers lucent reads (1: a 2-D image; more: a shadow map's cascades or cube
+    /// faces as an array, [`HostImage::with_layers`]), all in [`HostImage::state`].
+    pub layers: u32,
 }
 
 impl HostImage {
@@ -189,7 +193,15 @@ impl HostImage {
             usage,
             state: ImageState::UNDEFINED,
             final_state: None,
+            layers: 1,
         }
+    }
+
+    /// An array of `layers` layers (from 0; the view a 2-D array view of them): a shadow map
+    /// whose faces lie in layers ([`super::ShadowFace::layer`]).
+    pub fn with_layers(mut self, layers: u32) -> Self {
+        self.layers = layers;
+        self
     }
 
     /// The state the image is in when lucent's commands start.
@@ -523,6 +535,19 @@ pub(crate) fn check_image(
             "needs an image and a view".into(),
         ));
     }
+    // Only a shadow map's faces lie in layers (ShadowFace::layer); lucent reads one layer of
+    // everything else.
+    if image.layers == 0 || (image.layers > 1 && input != "shadow map") {
+        return Err(invalid(
+            &image.name,
+            ImageFault::Size,
+            format!(
+                "has {} array layers; the {input} is one layer (only a shadow map may be an \
+                 array)",
+                image.layers
+            ),
+        ));
+    }
     if image.extent != extent {
         return Err(invalid(
             &image.name,
@@ -657,7 +682,7 @@ pub(crate) fn record_transition(
             base_mip_level: 0,
             level_count: 1,
             base_array_layer: 0,
-            layer_count: 1,
+            layer_count: image.layers.max(1),
         });
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);

@@ -231,7 +231,8 @@ pub use glam;
 /// [`LayeredEffect`] (with [`VertexLayout`] and [`MeshDraw`]); `Support::NotEmbedded` is gone
 /// (every effect of [`Effect::ALL`] has a path on a host's G-buffer). 7: the LEAN blurs (LCB,
 /// LBB, bilateral) in [`SssEffect`] ([`SssFrame::lean`], [`SssMaterial::surface`],
-/// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`].
+/// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`]; host shadow maps in reversed Z and
+/// as arrays ([`ShadowFace::layer`], [`HostImage::layers`], `with_shadow_array`).
 pub const API_VERSION: u32 = 7;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

@@ -386,8 +386,10 @@ impl EffectPasses {
         timer: Option<&mut EffectTimer>,
     ) -> Result<()> {
         let gpu = lucent.gpu();
-        let binds: Vec<(ResourceId, vk::Image, vk::ImageView)> =
-            binds.iter().map(|(id, i)| (*id, i.image, i.view)).collect();
+        let binds: Vec<(ResourceId, vk::Image, vk::ImageView, u32)> = binds
+            .iter()
+            .map(|(id, i)| (*id, i.image, i.view, i.layers))
+            .collect();
         let executable = self.executable.as_mut().expect("alive until destroy");
         executable.bind_imports(gpu, ring, &binds)?;
         let sampled = Role::SampledColor.working_state();

@@ -31,17 +31,27 @@ pub struct ShadowFace {
     /// Its square rectangle in the shadow map image, in texels, which the host's viewport
     /// covered when it rendered the face.
     pub rect: vk::Rect2D,
+    /// The array layer it lies in, for a shadow map that is an array of layers (cascades, a
+    /// cube's faces: [`super::HostImage::with_layers`]); 0 in an atlas.
+    pub layer: u32,
 }
 
 impl ShadowFace {
-    /// Face `rect` of light `light`, rendered with `view` and `projection`.
+    /// Face `rect` of light `light`, rendered with `view` and `projection`, in layer 0.
     pub fn new(light: usize, view: Mat4, projection: Mat4, rect: vk::Rect2D) -> Self {
         Self {
             light,
             view,
             projection,
             rect,
+            layer: 0,
         }
+    }
+
+    /// The face in array layer `layer` of the shadow map.
+    pub fn in_layer(mut self, layer: u32) -> Self {
+        self.layer = layer;
+        self
     }
 }
 
@@ -79,6 +89,24 @@ const CUBE_AXES: [Vec3; 6] = [
     Vec3::NEG_Z,
 ];
 
+/// A host's shadow map's layers against the effect's description: an array (`array`, its
+/// view a 2-D array view) may have any number; an atlas is one 2-D image.
+pub(crate) fn check_shadow_layers(map: &super::HostImage, array: bool) -> Result<()> {
+    if array || map.layers <= 1 {
+        return Ok(());
+    }
+    Err(HostError::Image {
+        image: map.name.clone(),
+        kind: crate::error::ImageFault::Size,
+        problem: format!(
+            "has {} layers, but the effect was described with one 2-D shadow map (an atlas); \
+             describe an array with with_shadow_array",
+            map.layers
+        ),
+    }
+    .into())
+}
+
 /// A host's shadow map must be a depth format (the shadow lookups compare its depth).
 pub(crate) fn check_shadow_format(format: vk::Format) -> Result<()> {
     use crate::backend::format::{format_info, format_name, FormatKind};
@@ -103,6 +131,7 @@ pub(crate) fn shadow_table(
     lights: &[Light],
     faces: &[ShadowFace],
     extent: vk::Extent2D,
+    layers: u32,
 ) -> Result<ShadowUniforms> {
     let bad = |index: usize, problem: String| -> crate::LucentError {
         HostError::Description {
@@ -162,6 +191,17 @@ pub(crate) fn shadow_table(
         table.lights[light] = [index as i32, count as i32, 0, 0];
         for k in 0..count {
             let face = &faces[index + k];
+            if face.layer >= layers.max(1) {
+                return Err(bad(
+                    index + k,
+                    format!(
+                        "layer {}: the shadow map has {} layer{}",
+                        face.layer,
+                        layers.max(1),
+                        if layers > 1 { "s" } else { "" }
+                    ),
+                ));
+            }
             table.faces[index + k] =
                 face_row(face, extent).map_err(|problem| bad(index + k, problem))?;
             if count == 6 {
@@ -253,11 +293,12 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
     };
     Ok(ShadowFaceGpu {
         view_proj: (projection * view).to_cols_array_2d(),
+        // w: reversed Z in its lowest bit, the array layer above (glsl shadow_layer).
         rect: [
             r.offset.x as f32,
             r.offset.y as f32,
             edge,
-            if reversed { 1.0 } else { 0.0 },
+            (2 * face.layer + u32::from(reversed)) as f32,
         ],
         params,
     })
@@ -275,6 +316,31 @@ mod tests {
                 height: edge,
             },
         }
+    }
+
+    #[test]
+    fn an_array_map_needs_an_array_description() {
+        let map = |layers| {
+            super::super::HostImage::new(
+                "cascades",
+                vk::Image::null(),
+                vk::ImageView::null(),
+                vk::Format::D32_SFLOAT,
+                vk::Extent2D {
+                    width: 8,
+                    height: 8,
+                },
+                vk::ImageUsageFlags::SAMPLED,
+            )
+            .with_layers(layers)
+        };
+        check_shadow_layers(&map(1), false).unwrap();
+        check_shadow_layers(&map(4), true).unwrap();
+        let e = check_shadow_layers(&map(4), false).unwrap_err().to_string();
+        assert!(
+            e.contains("'cascades'") && e.contains("with_shadow_array"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -296,7 +362,7 @@ mod tests {
             ..Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 1.0)
         };
         let face = ShadowFace::new(0, view, projection, rect(256, 0, 256));
-        let table = shadow_table(&[spot], &[face], extent).unwrap();
+        let table = shadow_table(&[spot], &[face], extent, 1).unwrap();
         assert_eq!(table.lights[0], [0, 1, 0, 0]);
         assert_eq!(table.lights[1][0], -1);
         let row = table.faces[0];
@@ -320,7 +386,7 @@ mod tests {
             ),
             ShadowFace::new(0, Mat4::ZERO, projection, rect(0, 0, 64)),
         ] {
-            assert!(shadow_table(&[spot], &[bad], extent).is_err(), "{bad:?}");
+            assert!(shadow_table(&[spot], &[bad], extent, 1).is_err(), "{bad:?}");
         }
         // Reversed Z (near and far swapped): the same row read through z flipped, flagged;
         // and with an infinite far plane, a far one f32 cannot tell from it.
@@ -330,7 +396,7 @@ mod tests {
             Mat4::perspective_rh(1.0, 1.0, 20.0, 0.1),
             rect(256, 0, 256),
         );
-        let flipped = shadow_table(&[spot], &[reversed], extent).unwrap().faces[0];
+        let flipped = shadow_table(&[spot], &[reversed], extent, 1).unwrap().faces[0];
         assert_eq!(flipped.rect, [256.0, 0.0, 256.0, 1.0]);
         for (a, b) in flipped.params.iter().zip(&row.params) {
             assert!(
@@ -352,7 +418,11 @@ mod tests {
             Mat4::perspective_infinite_reverse_rh(1.0, 1.0, 0.1),
             rect(0, 0, 64),
         );
-        let far = shadow_table(&[spot], &[infinite], extent).unwrap().faces[0];
+        // In layer 2 of a three-layer array: the layer above the reversed bit; no layer 3.
+        let layered = shadow_table(&[spot], &[infinite.in_layer(2)], extent, 3).unwrap();
+        assert_eq!(layered.faces[0].rect[3], 5.0);
+        assert!(shadow_table(&[spot], &[infinite.in_layer(3)], extent, 3).is_err());
+        let far = shadow_table(&[spot], &[infinite], extent, 1).unwrap().faces[0];
         assert_eq!(far.rect[3], 1.0);
         assert!(
             (far.params[2] - 0.1).abs() < 1e-6 && far.params[3] >= 1e29,
@@ -370,11 +440,11 @@ mod tests {
                 ShadowFace::new(0, view, projection, rect(64 * k as i32, 0, 64))
             })
             .collect();
-        let table = shadow_table(&[point], &cube, extent).unwrap();
+        let table = shadow_table(&[point], &cube, extent, 1).unwrap();
         assert_eq!(table.lights[0], [0, 6, 0, 0]);
         let mut swapped = cube.clone();
         swapped.swap(0, 1);
-        assert!(shadow_table(&[point], &swapped, extent).is_err());
-        assert!(shadow_table(&[point], &cube[..3], extent).is_err());
+        assert!(shadow_table(&[point], &swapped, extent, 1).is_err());
+        assert!(shadow_table(&[point], &cube[..3], extent, 1).is_err());
     }
 }

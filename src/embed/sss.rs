@@ -36,7 +36,7 @@ use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEn
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::marked_tiles;
-use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, check_shadow_layers, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
@@ -143,6 +143,9 @@ pub struct SssEffectDesc {
     /// The format of the host's shadow map that shadows the LEAN blurs' specular (a depth
     /// format), when it has one ([`LeanLighting::shadow_map`]). Only with a LEAN blur.
     pub shadow_format: Option<vk::Format>,
+    /// That shadow map is an array of layers (its view a 2-D array view), each face in its
+    /// [`ShadowFace::layer`] ([`Self::with_shadow_array`]); else one 2-D image (an atlas).
+    pub shadow_array: bool,
 }
 
 impl SssEffectDesc {
@@ -160,7 +163,15 @@ impl SssEffectDesc {
             output_format,
             views_per_frame: 1,
             shadow_format: None,
+            shadow_array: false,
         }
+    }
+
+    /// The shadow map of [`Self::with_shadow_maps`] is an array of layers
+    /// ([`HostImage::with_layers`]), each face in its own ([`ShadowFace::in_layer`]).
+    pub fn with_shadow_array(mut self) -> Self {
+        self.shadow_array = true;
+        self
     }
 
     /// With a shadow map of `format` shadowing the LEAN blurs' specular.
@@ -401,6 +412,15 @@ impl SssEffect {
         id_map.profile_of = profile_of;
         let id_map = IdMap::Host(id_map);
         let lean = profiles.iter().any(|(_, b)| b.lean());
+        if desc.shadow_array && desc.shadow_format.is_none() {
+            return Err(HostError::Description {
+                field: "shadow_array".into(),
+                problem:
+                    "a shadow map array without a shadow map (SssEffectDesc::with_shadow_maps)"
+                        .into(),
+            }
+            .into());
+        }
         if let Some(format) = desc.shadow_format {
             if !lean {
                 return Err(HostError::Unsupported {
@@ -534,7 +554,12 @@ impl SssEffect {
             check_lights(lean.lights)?;
             uniforms = uniforms.with_lights(lean.lights);
             if let Some(map) = lean.shadow_map {
-                shadows = Some(shadow_table(lean.lights, lean.shadow_faces, map.extent)?);
+                shadows = Some(shadow_table(
+                    lean.lights,
+                    lean.shadow_faces,
+                    map.extent,
+                    map.layers,
+                )?);
             }
         }
         let per_frame = self.passes.per_frame();
@@ -732,6 +757,7 @@ impl SssEffect {
         )?;
         let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
             (Some(format), Some(map)) => {
+                check_shadow_layers(map, self.desc.shadow_array)?;
                 check_image(
                     lucent.gpu(),
                     map,
@@ -856,6 +882,7 @@ fn declare(
         profile_ids: &material_ids,
         lean: None,
         shadow_depth: None,
+        shadow_array: false,
         albedo: None,
         // The host's alpha is its own unless it holds linear depth: then the taps read it
         // there, as in lucent's own frames; otherwise they read the depth image.
@@ -891,6 +918,7 @@ fn declare(
         // The LEAN chains' diffuse carries the slope in its alpha, not depth.
         inputs.depth_in_alpha = false;
         inputs.shadow_depth = shadow_map.as_ref();
+        inputs.shadow_array = desc.shadow_array;
     } else if albedo_pass {
         let albedo = albedo.as_ref().expect("checked at new");
         let included = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;

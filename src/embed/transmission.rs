@@ -37,7 +37,7 @@ use super::passes::{
     id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
-use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, check_shadow_layers, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::format_name;
@@ -88,6 +88,10 @@ pub struct TransmissionEffectDesc {
     /// The format of the host's shadow map (a depth format: `D32_SFLOAT`, `D16_UNORM`,
     /// `D24_UNORM_S8_UINT`, `D32_SFLOAT_S8_UINT`, `X8_D24_UNORM_PACK32`).
     pub shadow_format: vk::Format,
+    /// The shadow map is an array of layers (cascades, a cube's faces), its view a 2-D array
+    /// view, each face in its [`ShadowFace::layer`] ([`Self::with_shadow_array`]); else one
+    /// 2-D image (an atlas).
+    pub shadow_array: bool,
     /// Views recorded per frame (1 to [`super::MAX_VIEWS_PER_FRAME`]).
     pub views_per_frame: usize,
 }
@@ -104,8 +108,16 @@ impl TransmissionEffectDesc {
             gbuffer,
             materials,
             shadow_format,
+            shadow_array: false,
             views_per_frame: 1,
         }
+    }
+
+    /// The shadow map is an array of layers (its view a 2-D array view,
+    /// [`HostImage::with_layers`]), each face in its own ([`ShadowFace::in_layer`]).
+    pub fn with_shadow_array(mut self) -> Self {
+        self.shadow_array = true;
+        self
     }
 
     /// With this many views per frame.
@@ -195,20 +207,30 @@ pub struct TransmissionEffect {
 }
 
 /// The shader defines of a host's ID image (unsigned or UNORM) and whether the albedo is read.
-fn defines(uint_ids: bool, albedo: bool) -> &'static [(&'static str, &'static str)] {
-    match (uint_ids, albedo) {
-        (false, false) => &[],
-        (true, false) => &[("LUCENT_HOST_IDS_UINT", "1")],
-        (false, true) => &[("LUCENT_HOST_ALBEDO", "1")],
-        (true, true) => &[("LUCENT_HOST_ALBEDO", "1"), ("LUCENT_HOST_IDS_UINT", "1")],
+fn defines(uint_ids: bool, albedo: bool, array: bool) -> Vec<(&'static str, &'static str)> {
+    let mut defines = Vec::new();
+    if albedo {
+        defines.push(("LUCENT_HOST_ALBEDO", "1"));
     }
+    if uint_ids {
+        defines.push(("LUCENT_HOST_IDS_UINT", "1"));
+    }
+    if array {
+        defines.push(("LUCENT_SHADOW_ARRAY", "1"));
+    }
+    defines
 }
 
 /// Every pipeline the effect may build, for the shipped SPIR-V.
 pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
     for uint in [false, true] {
         for albedo in [false, true] {
-            out.push(PipelineShaders::fullscreen(FRAGMENT, defines(uint, albedo)));
+            for array in [false, true] {
+                out.push(PipelineShaders::fullscreen(
+                    FRAGMENT,
+                    &defines(uint, albedo, array),
+                ));
+            }
         }
     }
 }
@@ -328,6 +350,7 @@ impl TransmissionEffect {
             frame.lights,
             frame.shadow_faces,
             frame.images.shadow_map.extent,
+            frame.images.shadow_map.layers,
         )?;
         let gbuffer = &self.desc.gbuffer;
         let uniforms = gbuffer
@@ -407,6 +430,7 @@ impl TransmissionEffect {
         check_described(lucent, gbuffer.extent(), &checks)?;
         // The shadow map has a size of its own.
         let shadow_format = self.desc.shadow_format;
+        check_shadow_layers(images.shadow_map, self.desc.shadow_array)?;
         check_image(
             lucent.gpu(),
             images.shadow_map,
@@ -485,7 +509,7 @@ fn declare(
     if let Some(albedo) = &albedo {
         pass.sample(albedo);
     }
-    pass.defines(defines(uint_ids, reads_albedo))
+    pass.defines(&defines(uint_ids, reads_albedo, desc.shadow_array))
         .tiles(|scene, ctx| {
             let regions = &scene.per_frame.tiles(ctx.frame).lighting;
             (!regions.is_empty()).then(|| regions.clone())

@@ -119,6 +119,7 @@ pub fn declare_frame(
         (Some(profiles), Some(specular), Some(profile_ids)) => sss::sss_passes(
             graph,
             &sss::SssInputs {
+                shadow_array: false,
                 diffuse: &lit.color,
                 specular,
                 depth: &gb.depth,

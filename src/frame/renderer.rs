@@ -321,7 +321,7 @@ impl Renderer {
             ));
         }
         self.executable
-            .bind_imports(gpu, slot, &[(self.outputs.display, image, view)])
+            .bind_imports(gpu, slot, &[(self.outputs.display, image, view, 1)])
     }
 
     /// Records one frame for slot `slot` into `cmd` (in the recording state), with a

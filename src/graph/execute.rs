@@ -87,6 +87,9 @@ pub struct Executable {
     physical: Vec<Physical>,
     images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
+    /// Array layers per image its barriers cover (1 but for an imported array: a host's
+    /// shadow map cascades, [`Self::bind_imports`]).
+    layers: Vec<u32>,
     /// Depth-only views of depth-stencil images (null for every other image).
     depth_views: Vec<vk::ImageView>,
     /// `views` with `depth_views` where those exist: what descriptors point at.
@@ -132,6 +135,7 @@ impl Executable {
         let mut exe = Executable {
             physical: Vec::new(),
             images: vec![vk::Image::null(); plan.resources.len()],
+            layers: vec![1; plan.resources.len()],
             views: vec![vk::ImageView::null(); plan.resources.len()],
             depth_views: vec![vk::ImageView::null(); plan.resources.len()],
             descriptor_views: Vec::new(),
@@ -168,6 +172,7 @@ impl Executable {
             usage: r.usage,
             aspect: r.info.aspect(),
             mip_levels: 1,
+            layers: 1,
         }
     }
 
@@ -327,7 +332,7 @@ impl Executable {
         &mut self,
         gpu: &GpuContext,
         slot: usize,
-        binds: &[(ResourceId, vk::Image, vk::ImageView)],
+        binds: &[(ResourceId, vk::Image, vk::ImageView, u32)],
     ) -> Result<()> {
         if slot >= self.slots {
             return Err(LucentError::Graph(format!(
@@ -335,7 +340,7 @@ impl Executable {
                 self.slots
             )));
         }
-        for &(id, image, view) in binds {
+        for &(id, image, view, layers) in binds {
             let resource = self.plan.resources.get(id).ok_or_else(|| {
                 LucentError::Graph(format!("bind_imports: no resource {id} in this plan"))
             })?;
@@ -353,8 +358,9 @@ impl Executable {
             }
             self.images[id] = image;
             self.views[id] = view;
+            self.layers[id] = layers.max(1);
         }
-        for &(id, _, view) in binds {
+        for &(id, _, view, _) in binds {
             for p in 0..self.plan.passes.len() {
                 let reads_through_descriptors = self.plan.passes[p]
                     .reads
@@ -577,7 +583,7 @@ impl Executable {
                         base_mip_level: 0,
                         level_count: 1,
                         base_array_layer: 0,
-                        layer_count: 1,
+                        layer_count: self.layers[b.resource],
                     })
             })
             .collect();

@@ -15,7 +15,7 @@ use crate::embed::{
     tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
-use crate::embed_transmission::{host_shadow_map, HostShadowZ};
+use crate::embed_transmission::{host_shadow_array, host_shadow_map, HostShadowZ};
 
 use ash::vk;
 use lucent::backend::ImageDesc;
@@ -284,15 +284,33 @@ fn compare_lean(
                 HostDepth::Linear => HostShadowZ::ReversedInfinite,
                 _ => HostShadowZ::Standard,
             };
-            let (host_depths, host_faces) =
-                host_shadow_map(&shadow_depths, (sw, sh), &faces, shadow_z);
-            let shadow_map = gpu
-                .upload_image(
-                    &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-                    &[bytemuck::cast_slice(&host_depths).to_vec()],
-                    "host shadow map",
-                )
-                .unwrap();
+            // The D24S8 one keeps each face in a layer of an array.
+            let array = depth_kind == HostDepth::D24Stencil;
+            let (shadow_map, (map_w, map_h), layers, host_faces) = if array {
+                let (texels, edge, host_faces) =
+                    host_shadow_array(&shadow_depths, (sw, sh), &faces);
+                let layers = host_faces.len() as u32;
+                let image = gpu
+                    .upload_image(
+                        &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage)
+                            .with_layers(layers),
+                        &[bytemuck::cast_slice(&texels).to_vec()],
+                        "host shadow map array",
+                    )
+                    .unwrap();
+                (image, (edge, edge), layers, host_faces)
+            } else {
+                let (host_depths, host_faces) =
+                    host_shadow_map(&shadow_depths, (sw, sh), &faces, shadow_z);
+                let image = gpu
+                    .upload_image(
+                        &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+                        &[bytemuck::cast_slice(&host_depths).to_vec()],
+                        "host shadow map",
+                    )
+                    .unwrap();
+                (image, (sw, sh), 1, host_faces)
+            };
             let mut layout = host_layout(
                 test,
                 depth_kind,
@@ -330,6 +348,11 @@ fn compare_lean(
                 SssEffectDesc::new(desc.clone(), materials, vk::Format::R32G32B32A32_SFLOAT)
                     .with_knobs(settings.sss)
                     .with_shadow_maps(vk::Format::D32_SFLOAT);
+            let effect_desc = if array {
+                effect_desc.with_shadow_array()
+            } else {
+                effect_desc
+            };
             let mut effect = built(test, &lucent, |u| SssEffect::new(&lucent, u, effect_desc))
                 .unwrap_or_else(|e| panic!("{blur} on {name}: {e}"));
             let shadows = HostImage::new(
@@ -338,11 +361,12 @@ fn compare_lean(
                 shadow_map.view,
                 vk::Format::D32_SFLOAT,
                 vk::Extent2D {
-                    width: sw,
-                    height: sh,
+                    width: map_w,
+                    height: map_h,
                 },
                 usage,
             )
+            .with_layers(layers)
             .in_state(ImageState::fragment_sampled());
             let normals_host = described(&normals, "host normals", usage);
             let diffuse_host = described(&diffuse, "host diffuse", usage);
@@ -499,6 +523,13 @@ fn a_lean_blur_without_normals_a_surface_or_its_lighting_is_a_typed_error() {
     ));
     assert!(
         matches!(&e, HostError::Unsupported { input, .. } if input == "shadow map"),
+        "{e}"
+    );
+    let e = host_error(build(
+        SssEffectDesc::new(with_normals.clone(), vec![lbb(true)], format).with_shadow_array(),
+    ));
+    assert!(
+        matches!(&e, HostError::Description { field, .. } if field == "shadow_array"),
         "{e}"
     );
     let e = host_error(build(

@@ -162,6 +162,38 @@ pub(crate) fn host_shadow_map(
     (out, host_faces)
 }
 
+/// lucent's light-space atlas (`depths`, `size`) and its `faces` as a host keeping each face in
+/// a layer of its own hands them over: an array of square layers as large as the largest face,
+/// each face at the top left of its layer (the rest cleared to depth 1), each face's layer
+/// given. Returns the layers' texels one after the other, their edge, and the faces.
+pub(crate) fn host_shadow_array(
+    depths: &[f32],
+    (width, _height): (u32, u32),
+    faces: &[ShadowFace],
+) -> (Vec<f32>, u32, Vec<ShadowFace>) {
+    let edge = faces.iter().map(|f| f.rect.extent.width).max().unwrap();
+    let layer_texels = (edge * edge) as usize;
+    let mut out = vec![1.0f32; layer_texels * faces.len()];
+    let mut host_faces = Vec::with_capacity(faces.len());
+    for (layer, face) in faces.iter().enumerate() {
+        let r = face.rect;
+        for y in 0..r.extent.height {
+            for x in 0..r.extent.width {
+                let from = ((r.offset.y as u32 + y) * width + r.offset.x as u32 + x) as usize;
+                out[layer * layer_texels + (y * edge + x) as usize] = depths[from];
+            }
+        }
+        let rect = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: r.extent,
+        };
+        host_faces.push(
+            ShadowFace::new(face.light, face.view, face.projection, rect).in_layer(layer as u32),
+        );
+    }
+    (out, edge, host_faces)
+}
+
 #[test]
 fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
     let test = TestGpu::new();
@@ -257,13 +289,14 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         )
         .unwrap();
     let mut report = Vec::new();
-    for (name, depth_kind, ids_kind, normals_kind, shadow_z) in [
+    for (name, depth_kind, ids_kind, normals_kind, shadow_z, array) in [
         (
             "D32, world RGBA16F normals, R8_UNORM IDs",
             HostDepth::Standard,
             HostIds::Unorm,
             HostNormals::WorldHalf,
             HostShadowZ::Standard,
+            false,
         ),
         (
             "reversed-Z infinite D32, view-space octahedral RG16 normals, R8_UINT IDs, a \
@@ -272,6 +305,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::Uint,
             HostNormals::ViewOctahedralUnorm,
             HostShadowZ::Reversed,
+            false,
         ),
         (
             "D24S8 with IDs in stencil bits 4-7, world RGBA16_UNORM normals",
@@ -279,6 +313,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::Stencil,
             HostNormals::WorldUnorm,
             HostShadowZ::Standard,
+            false,
         ),
         (
             "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
@@ -287,16 +322,40 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::AlphaBits,
             HostNormals::WorldOctahedralFloat,
             HostShadowZ::ReversedInfinite,
+            false,
+        ),
+        (
+            "D32, world RGBA16F normals, R8_UNORM IDs, each shadow face in a layer of an array",
+            HostDepth::Standard,
+            HostIds::Unorm,
+            HostNormals::WorldHalf,
+            HostShadowZ::Standard,
+            true,
         ),
     ] {
-        let (host_depths, host_faces) = host_shadow_map(&depths, (sw, sh), &faces, shadow_z);
-        let shadow_map = gpu
-            .upload_image(
-                &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-                &[bytemuck::cast_slice(&host_depths).to_vec()],
-                "host shadow map",
-            )
-            .unwrap();
+        let (shadow_map, (map_w, map_h), layers, host_faces) = if array {
+            let (texels, edge, host_faces) = host_shadow_array(&depths, (sw, sh), &faces);
+            let layers = host_faces.len() as u32;
+            let image = gpu
+                .upload_image(
+                    &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage)
+                        .with_layers(layers),
+                    &[bytemuck::cast_slice(&texels).to_vec()],
+                    "host shadow map array",
+                )
+                .unwrap();
+            (image, (edge, edge), layers, host_faces)
+        } else {
+            let (host_depths, host_faces) = host_shadow_map(&depths, (sw, sh), &faces, shadow_z);
+            let image = gpu
+                .upload_image(
+                    &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
+                    &[bytemuck::cast_slice(&host_depths).to_vec()],
+                    "host shadow map",
+                )
+                .unwrap();
+            (image, (sw, sh), 1, host_faces)
+        };
         let mut layout = host_layout(
             &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
         );
@@ -319,11 +378,15 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             .collect();
         let lucent = wrap(&test, options(3));
         let mut effect = built(&test, &lucent, |u| {
-            TransmissionEffect::new(
-                &lucent,
-                u,
-                TransmissionEffectDesc::new(desc.clone(), materials, vk::Format::D32_SFLOAT),
-            )
+            TransmissionEffect::new(&lucent, u, {
+                let effect =
+                    TransmissionEffectDesc::new(desc.clone(), materials, vk::Format::D32_SFLOAT);
+                if array {
+                    effect.with_shadow_array()
+                } else {
+                    effect
+                }
+            })
         })
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
@@ -333,11 +396,12 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             shadow_map.view,
             vk::Format::D32_SFLOAT,
             vk::Extent2D {
-                width: sw,
-                height: sh,
+                width: map_w,
+                height: map_h,
             },
             usage,
         )
+        .with_layers(layers)
         .in_state(ImageState::fragment_sampled());
         let frames = host_frames(
             &test,

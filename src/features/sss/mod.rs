@@ -624,6 +624,9 @@ pub struct SssInputs<'a> {
     pub lean: Option<LeanInputs<'a>>,
     /// The light-space maps' depth, when some light casts shadows (LEAN specular is shadowed).
     pub shadow_depth: Option<&'a Handle<Image>>,
+    /// `shadow_depth` is an array of layers (a host's cascades or cube faces, each face in its
+    /// layer: define `LUCENT_SHADOW_ARRAY`); lucent's own maps are one atlas.
+    pub shadow_array: bool,
     /// G-buffer albedo (GB0), when some profile applies its albedo after the blur
     /// ([`Texturing`]): the lighting pass left it out of `diffuse`, and each chain's last pass
     /// multiplies it back in (define `LUCENT_SSS_ALBEDO`). `None`: the light carries its
@@ -792,6 +795,9 @@ pub fn host_albedo_pass(
     out
 }
 
+/// The define of a pass reading a host's shadow map that is an array of layers.
+const SHADOW_ARRAY: &[(&str, &str)] = &[("LUCENT_SHADOW_ARRAY", "1")];
+
 /// The host LEAN pass's shader (lucent::embed).
 const HOST_LEAN_FRAGMENT: &str = "sss/host_lean.frag";
 
@@ -920,6 +926,19 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
         .filter(|p| p.fragment.starts_with("sss/"))
         .cloned()
         .collect();
+    // A host's shadow map may be an array (its cascades, a cube's faces).
+    let arrays: Vec<crate::backend::shader::PipelineShaders> = host
+        .iter()
+        .filter(|p| p.defines.iter().any(|(name, _)| name == "LUCENT_SHADOWS"))
+        .map(|p| {
+            let mut p = p.clone();
+            p.defines
+                .push(("LUCENT_SHADOW_ARRAY".to_string(), "1".to_string()));
+            p
+        })
+        .collect();
+    let host: Vec<crate::backend::shader::PipelineShaders> =
+        host.into_iter().chain(arrays).collect();
     for uint in [false, true] {
         let map = IdMap::Host(HostIdMap {
             uint,

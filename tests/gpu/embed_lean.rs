@@ -15,14 +15,14 @@ use crate::embed::{
     tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
-use crate::embed_transmission::{host_shadow_array, host_shadow_map, HostShadowZ};
+use crate::embed_transmission::{upload_host_shadow_map, HostShadowZ};
 
 use ash::vk;
 use lucent::backend::ImageDesc;
 use lucent::embed::{
-    capabilities, DepthDesc, DiffuseDesc, Effect, GBufferDesc, HostError, HostImage, IdDesc,
-    ImageState, LeanLighting, NormalDesc, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc,
-    SssFrame, SssImages, SssMaterial,
+    capabilities, DepthDesc, DiffuseDesc, Effect, GBufferDesc, HostError, IdDesc, ImageState,
+    LeanLighting, NormalDesc, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc, SssFrame,
+    SssImages, SssMaterial,
 };
 use lucent::features::registry;
 use lucent::features::shadows::ShadowDesc;
@@ -286,31 +286,8 @@ fn compare_lean(
             };
             // The D24S8 one keeps each face in a layer of an array.
             let array = depth_kind == HostDepth::D24Stencil;
-            let (shadow_map, (map_w, map_h), layers, host_faces) = if array {
-                let (texels, edge, host_faces) =
-                    host_shadow_array(&shadow_depths, (sw, sh), &faces);
-                let layers = host_faces.len() as u32;
-                let image = gpu
-                    .upload_image(
-                        &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage)
-                            .with_layers(layers),
-                        &[bytemuck::cast_slice(&texels).to_vec()],
-                        "host shadow map array",
-                    )
-                    .unwrap();
-                (image, (edge, edge), layers, host_faces)
-            } else {
-                let (host_depths, host_faces) =
-                    host_shadow_map(&shadow_depths, (sw, sh), &faces, shadow_z);
-                let image = gpu
-                    .upload_image(
-                        &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-                        &[bytemuck::cast_slice(&host_depths).to_vec()],
-                        "host shadow map",
-                    )
-                    .unwrap();
-                (image, (sw, sh), 1, host_faces)
-            };
+            let shadow_map =
+                upload_host_shadow_map(test, &shadow_depths, (sw, sh), &faces, shadow_z, array);
             let mut layout = host_layout(
                 test,
                 depth_kind,
@@ -355,19 +332,6 @@ fn compare_lean(
             };
             let mut effect = built(test, &lucent, |u| SssEffect::new(&lucent, u, effect_desc))
                 .unwrap_or_else(|e| panic!("{blur} on {name}: {e}"));
-            let shadows = HostImage::new(
-                "host shadow map",
-                shadow_map.image,
-                shadow_map.view,
-                vk::Format::D32_SFLOAT,
-                vk::Extent2D {
-                    width: map_w,
-                    height: map_h,
-                },
-                usage,
-            )
-            .with_layers(layers)
-            .in_state(ImageState::fragment_sampled());
             let normals_host = described(&normals, "host normals", usage);
             let diffuse_host = described(&diffuse, "host diffuse", usage);
             let specular_host = described(&specular, "host specular", usage);
@@ -400,8 +364,8 @@ fn compare_lean(
                                 lean: Some(LeanLighting {
                                     normals: &normals_host,
                                     lights: &scene.lights,
-                                    shadow_map: Some(&shadows),
-                                    shadow_faces: &host_faces,
+                                    shadow_map: Some(&shadow_map.host),
+                                    shadow_faces: &shadow_map.faces,
                                 }),
                             },
                         )
@@ -425,7 +389,7 @@ fn compare_lean(
             effect.destroy(&lucent);
             drop(lucent);
             gpu.destroy_image(normals);
-            gpu.destroy_image(shadow_map);
+            gpu.destroy_image(shadow_map.image);
             layout.destroy(test);
         }
         gpu.destroy_image(diffuse);

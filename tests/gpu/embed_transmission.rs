@@ -18,7 +18,7 @@ use crate::embed::{
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
 
 use ash::vk;
-use lucent::backend::ImageDesc;
+use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::{
     capabilities, DiffuseDesc, Effect, GBufferDesc, HostError, HostImage, IdDesc, ImageState,
     NormalDesc, ShadowFace, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame,
@@ -107,7 +107,7 @@ pub(crate) enum HostShadowZ {
 /// lucent's light-space atlas (`depths`, `size`) and its `faces` as a host storing depth as
 /// `z` hands them over: each face's projection changed to store that depth, each texel of its
 /// rectangle re-encoded (texels outside every face: the reversed clear value, 0).
-pub(crate) fn host_shadow_map(
+fn host_shadow_map(
     depths: &[f32],
     (width, _height): (u32, u32),
     faces: &[ShadowFace],
@@ -166,7 +166,7 @@ pub(crate) fn host_shadow_map(
 /// a layer of its own hands them over: an array of square layers as large as the largest face,
 /// each face at the top left of its layer (the rest cleared to depth 1), each face's layer
 /// given. Returns the layers' texels one after the other, their edge, and the faces.
-pub(crate) fn host_shadow_array(
+fn host_shadow_array(
     depths: &[f32],
     (width, _height): (u32, u32),
     faces: &[ShadowFace],
@@ -192,6 +192,56 @@ pub(crate) fn host_shadow_array(
         );
     }
     (out, edge, host_faces)
+}
+
+/// A host's shadow map made from lucent's atlas (`depths`, `size`) and `faces`: stored as `z`
+/// in one atlas, or (`array`, standard Z) with each face in a layer of its own; uploaded, with
+/// its `HostImage` (sampled in the fragment shader) and the faces as the host gives them.
+pub(crate) struct HostShadowMap {
+    pub(crate) image: GpuImage,
+    pub(crate) host: HostImage,
+    pub(crate) faces: Vec<ShadowFace>,
+}
+
+pub(crate) fn upload_host_shadow_map(
+    test: &TestGpu,
+    depths: &[f32],
+    size: (u32, u32),
+    faces: &[ShadowFace],
+    z: HostShadowZ,
+    array: bool,
+) -> HostShadowMap {
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let (texels, (w, h), layers, faces) = if array {
+        let (texels, edge, faces) = host_shadow_array(depths, size, faces);
+        let layers = faces.len() as u32;
+        (texels, (edge, edge), layers, faces)
+    } else {
+        let (texels, faces) = host_shadow_map(depths, size, faces, z);
+        (texels, size, 1, faces)
+    };
+    let image = test
+        .gpu
+        .upload_image(
+            &ImageDesc::depth(w, h, vk::Format::D32_SFLOAT, usage).with_layers(layers),
+            &[bytemuck::cast_slice(&texels).to_vec()],
+            "host shadow map",
+        )
+        .unwrap();
+    let host = HostImage::new(
+        "host shadow map",
+        image.image,
+        image.view,
+        vk::Format::D32_SFLOAT,
+        vk::Extent2D {
+            width: w,
+            height: h,
+        },
+        usage,
+    )
+    .with_layers(layers)
+    .in_state(ImageState::fragment_sampled());
+    HostShadowMap { image, host, faces }
 }
 
 #[test]
@@ -333,29 +383,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             true,
         ),
     ] {
-        let (shadow_map, (map_w, map_h), layers, host_faces) = if array {
-            let (texels, edge, host_faces) = host_shadow_array(&depths, (sw, sh), &faces);
-            let layers = host_faces.len() as u32;
-            let image = gpu
-                .upload_image(
-                    &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage)
-                        .with_layers(layers),
-                    &[bytemuck::cast_slice(&texels).to_vec()],
-                    "host shadow map array",
-                )
-                .unwrap();
-            (image, (edge, edge), layers, host_faces)
-        } else {
-            let (host_depths, host_faces) = host_shadow_map(&depths, (sw, sh), &faces, shadow_z);
-            let image = gpu
-                .upload_image(
-                    &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, usage),
-                    &[bytemuck::cast_slice(&host_depths).to_vec()],
-                    "host shadow map",
-                )
-                .unwrap();
-            (image, (sw, sh), 1, host_faces)
-        };
+        let shadow_map = upload_host_shadow_map(&test, &depths, (sw, sh), &faces, shadow_z, array);
         let mut layout = host_layout(
             &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
         );
@@ -390,19 +418,6 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         })
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
-        let shadows = HostImage::new(
-            "host shadow map",
-            shadow_map.image,
-            shadow_map.view,
-            vk::Format::D32_SFLOAT,
-            vk::Extent2D {
-                width: map_w,
-                height: map_h,
-            },
-            usage,
-        )
-        .with_layers(layers)
-        .in_state(ImageState::fragment_sampled());
         let frames = host_frames(
             &test,
             &layout,
@@ -418,13 +433,13 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
                             view: 0,
                             camera: layout.camera,
                             lights: &scene.lights,
-                            shadow_faces: &host_faces,
+                            shadow_faces: &shadow_map.faces,
                             images: TransmissionImages {
                                 depth: images.depth,
                                 normals: &described(&normals, "host normals", usage),
                                 material_ids: images.ids.unwrap(),
                                 albedo: Some(&described(&albedo, "host albedo", usage)),
-                                shadow_map: &shadows,
+                                shadow_map: &shadow_map.host,
                             },
                             regions: &[],
                             lighting: images.lighting,
@@ -452,7 +467,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         effect.destroy(&lucent);
         drop(lucent);
         gpu.destroy_image(normals);
-        gpu.destroy_image(shadow_map);
+        gpu.destroy_image(shadow_map.image);
         layout.destroy(&test);
     }
     gpu.destroy_image(albedo);

@@ -28,8 +28,7 @@ use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Screen-space SSS profile ID per pixel (ID / 255; 0: the pixel does not scatter).
 pub const SSS_PROFILE_FORMAT: vk::Format = vk::Format::R8_UNORM;
-/// LCB and LBB: view-plane LEAN slope y and moments (blurred, so at least fp16).
-pub const LEAN_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub use super::util::LEAN_FORMAT;
 /// Layered media: the layered material ID per pixel (ID / 255; 0: not layered), in frames
 /// whose layered materials have no albedo texture ([`GBufferLayout::layered_format`]).
 pub const LAYERED_ID_FORMAT: vk::Format = vk::Format::R8_UNORM;

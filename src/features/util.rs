@@ -59,6 +59,11 @@ pub type Defines = Vec<(&'static str, &'static str)>;
 /// write (here, below both, so that the blurs need not import the lighting).
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
+/// LCB and LBB: view-plane LEAN slope y and moments (blurred, so at least fp16): the G-buffer
+/// pass writes it, or for a host the SSS chains' own pass (here, below both, so that the
+/// blurs need not import the G-buffer).
+pub const LEAN_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
 /// A pass's pipeline together with its descriptor set: what most passes hold after `prepare`.
 pub struct PassPipeline {
     /// The pipeline.

@@ -1625,6 +1625,29 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
     );
     // And a correct frame after all of them.
     frame(good_images, 1, 0).unwrap();
+    // Normals and lights for a LEAN blur, given to an effect without one: refused, as a LEAN
+    // effect without them is (tests/gpu/embed_lean.rs builds those).
+    let with_lean = SssFrame {
+        slot: 0,
+        view: 0,
+        camera,
+        images: good_images,
+        regions: &[],
+        output: &out_host,
+        lean: Some(lucent::embed::LeanLighting {
+            normals: &diffuse_host,
+            lights: &scene.lights,
+            shadow_map: None,
+            shadow_faces: &[],
+        }),
+    };
+    let e = host_error(recorded(&test, |cmd| {
+        effect.record(&lucent, cmd, &with_lean)
+    }));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "lean"),
+        "{e}"
+    );
     effect.destroy(&lucent);
     drop(lucent);
     for image in [image, colour, depth, ids, out] {

@@ -868,8 +868,7 @@ pub fn host_lean_pass(
     };
     let mut targets = HostLeanTargets {
         diffuse: graph.create_image("sss.host diffuse", info(crate::features::util::HDR_FORMAT)),
-        view_plane: graph
-            .create_image("sss.host lean", info(crate::features::util::LEAN_FORMAT)),
+        view_plane: graph.create_image("sss.host lean", info(crate::features::util::LEAN_FORMAT)),
         gb0: graph.create_image("sss.host albedo", info(HOST_SURFACE_FORMAT)),
         gb1: graph.create_image("sss.host normal", info(HOST_SURFACE_FORMAT)),
     };

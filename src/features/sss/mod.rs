@@ -869,8 +869,8 @@ pub fn host_lean_pass(
     let mut targets = HostLeanTargets {
         diffuse: graph.create_image("sss.host diffuse", info(crate::features::util::HDR_FORMAT)),
         view_plane: graph.create_image("sss.host lean", info(crate::features::util::LEAN_FORMAT)),
-        gb0: graph.create_image("sss.host albedo", info(HOST_SURFACE_FORMAT)),
-        gb1: graph.create_image("sss.host normal", info(HOST_SURFACE_FORMAT)),
+        gb0: graph.create_image("sss.host albedo", info(HOST_GB0_FORMAT)),
+        gb1: graph.create_image("sss.host normal", info(HOST_GB1_FORMAT)),
     };
     let mode = albedo.map_or(HostAlbedo::None, |(_, mode)| mode);
     let mut pass = FullscreenPass::new(graph, "sss lean in", HOST_LEAN_FRAGMENT, scene);
@@ -914,8 +914,10 @@ pub fn host_lean_pass(
 /// The host LEAN pass's variant drawn outside the chains' tiles: the light alone.
 const HOST_LEAN_PASSTHROUGH: &[(&str, &str)] = &[("LUCENT_SSS_PASSTHROUGH", "1")];
 
-/// The host LEAN pass's GB0 and GB1 counterparts: fp16, as lucent's `half` G-buffer keeps them.
-const HOST_SURFACE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// The host LEAN pass's GB0 and GB1 counterparts, as lucent's production (`compact`) G-buffer
+/// keeps them: albedo and specular intensity in 8 bits, normal and roughness in fp16.
+const HOST_GB0_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+const HOST_GB1_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 /// Adds, for every SSS pass permutation in `out` a host's frame can have, its two host-ID
 /// variants ([`IdMap::defines`]: UNORM and unsigned IDs), for the shipped SPIR-V.

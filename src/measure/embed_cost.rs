@@ -262,6 +262,39 @@ pub fn embed_cost(
     })
 }
 
+/// lucent's light-space atlas of `renderer`'s last frame (its scene's `shadows`) as a host's
+/// shadow map: uploaded into `images`, with each face's matrices as a host gives them
+/// ([`crate::features::shadows::ShadowDesc::face_matrices`]).
+fn atlas_as_host_map(
+    gpu: &GpuContext,
+    renderer: &Renderer,
+    scene: &Scene,
+    shadows: &crate::features::shadows::ShadowDesc,
+    images: &mut Images,
+) -> Result<(HostImage, Vec<ShadowFace>)> {
+    let faces: Vec<ShadowFace> = shadows
+        .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
+        .into_iter()
+        .map(ShadowFace::from)
+        .collect();
+    let (width, height, depths) = renderer.read_shadow_map(gpu)?;
+    let sampled = vk::ImageUsageFlags::SAMPLED;
+    let map = images.upload(
+        gpu,
+        &ImageDesc::depth(width, height, vk::Format::D32_SFLOAT, sampled),
+        bytemuck::cast_slice(&depths).to_vec(),
+        "host shadow map",
+    )?;
+    let map = host_image(
+        map,
+        "host shadow map",
+        vk::Format::D32_SFLOAT,
+        (width, height),
+        sampled,
+    );
+    Ok((map, faces))
+}
+
 /// The images of one measurement, destroyed together.
 #[derive(Default)]
 struct Images(Vec<GpuImage>);
@@ -444,28 +477,13 @@ fn measure_sss(
             let normals = host_image(normals, "host normals", hdr, size, sampled);
             let shadows =
                 match crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false) {
-                    Some(desc) => {
-                        let faces: Vec<ShadowFace> = desc
-                            .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
-                            .into_iter()
-                            .map(ShadowFace::from)
-                            .collect();
-                        let (sw, sh, depths) = renderer.read_shadow_map(gpu)?;
-                        let map = images.upload(
-                            gpu,
-                            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, sampled),
-                            bytemuck::cast_slice(&depths).to_vec(),
-                            "host shadow map",
-                        )?;
-                        let map = host_image(
-                            map,
-                            "host shadow map",
-                            vk::Format::D32_SFLOAT,
-                            (sw, sh),
-                            sampled,
-                        );
-                        Some((map, faces))
-                    }
+                    Some(desc) => Some(atlas_as_host_map(
+                        gpu,
+                        &renderer,
+                        scene,
+                        &desc,
+                        &mut images,
+                    )?),
                     None => None,
                 };
             Some((normals, shadows))
@@ -814,21 +832,8 @@ fn measure_transmission(
     let measured = (|| {
         let (width, height) = size;
         let (host, gb) = HostGBuffer::of(gpu, &pair.lit, &mut images, size)?;
-        let (sw, sh, depths) = pair.lit.read_shadow_map(gpu)?;
         let sampled = vk::ImageUsageFlags::SAMPLED;
-        let shadow_map = images.upload(
-            gpu,
-            &ImageDesc::depth(sw, sh, vk::Format::D32_SFLOAT, sampled),
-            bytemuck::cast_slice(&depths).to_vec(),
-            "host shadow map",
-        )?;
-        let shadow_map = host_image(
-            shadow_map,
-            "host shadow map",
-            vk::Format::D32_SFLOAT,
-            (sw, sh),
-            sampled,
-        );
+        let (shadow_map, faces) = atlas_as_host_map(gpu, &pair.lit, scene, &shadows, &mut images)?;
         // lucent's profile numbers as the host's IDs, each with its object's medium.
         let ids: Vec<u8> = gb
             .sss
@@ -875,11 +880,6 @@ fn measure_transmission(
                 TransmissionEffectDesc::new(gbuffer, materials, vk::Format::D32_SFLOAT),
             )
         })?;
-        let faces: Vec<ShadowFace> = shadows
-            .face_matrices(scene, &crate::gpu_scene::tiles::mesh_bounds(scene))
-            .into_iter()
-            .map(ShadowFace::from)
-            .collect();
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),

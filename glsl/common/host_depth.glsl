@@ -6,15 +6,20 @@
 #ifndef LUCENT_HOST_DEPTH_GLSL
 #define LUCENT_HOST_DEPTH_GLSL
 
-// The world position on the ray through `frag_coord` at view depth `z`: the ray's direction
+// The view-space point on the ray through `frag_coord` at view depth `z`: the ray's direction
 // from the frame's inverse view-projection (its point at device depth 0.5 is finite for
-// standard, reversed and infinite projections alike), brought back to the world by
-// `view_to_world` (the inverse of the frame's view matrix).
-vec3 position_at_view_depth(vec2 frag_coord, float z, mat4 view_to_world) {
+// standard, reversed and infinite projections alike).
+vec3 view_point_at_depth(vec2 frag_coord, float z) {
     vec3 on_ray = world_position(frag_coord, 0.5);
     vec3 view = (frame.view * vec4(on_ray, 1.0)).xyz;
-    vec3 at = view * (z / max(-view.z, 1e-30));
-    return (view_to_world * vec4(at, 1.0)).xyz;
+    return view * (z / max(-view.z, 1e-30));
+}
+
+// The world position on the ray through `frag_coord` at view depth `z`
+// (view_point_at_depth), brought back to the world by `view_to_world` (the inverse of the
+// frame's view matrix).
+vec3 position_at_view_depth(vec2 frag_coord, float z, mat4 view_to_world) {
+    return (view_to_world * vec4(view_point_at_depth(frag_coord, z), 1.0)).xyz;
 }
 
 // The world position at `frag_coord` of depth texel value `d`: unprojected as a device depth,

@@ -11,6 +11,9 @@
 
 #include "gbuffer.glsl"
 #include "lighting.glsl"
+#ifdef LUCENT_SSS_HOST_IDS
+#include "host_depth.glsl"
+#endif
 #ifdef LUCENT_SHADOWS
 #ifdef LUCENT_SSS_HOST_IDS
 // A host's shadow map may store reversed Z (shadows.glsl shadow_stored_depth).
@@ -179,11 +182,10 @@ vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughne
 #ifdef LUCENT_SSS_HOST_IDS
     // A host's frame (lucent::embed): its depth image may hold linear view depth, which
     // world_position cannot unproject; the point on the pixel's ray at its view depth serves
-    // every encoding (glsl/common/host_depth.glsl's way, the view matrix inverted as the
-    // rotation and translation it is).
-    vec3 on_ray = (frame.view * vec4(world_position(frag_coord, 0.5), 1.0)).xyz;
-    vec3 at = on_ray * (linear_depth(d) / max(-on_ray.z, 1e-30));
-    vec3 pos = transpose(view) * (at - frame.view[3].xyz);
+    // every encoding (host_depth.glsl), brought back to the world through the view matrix
+    // inverted as the rotation and translation it is.
+    vec3 pos = transpose(view) * (view_point_at_depth(frag_coord, linear_depth(d)) -
+                                  frame.view[3].xyz);
 #else
     vec3 pos = world_position(frag_coord, d);
 #endif

@@ -234,6 +234,9 @@ pub(crate) enum Role {
     SampledColor,
     /// Sampled depth (or stencil: material IDs in stencil bits) of a depth-stencil image.
     SampledDepth,
+    /// Sampled depth of a host's shadow map: the one input that may be an array of layers
+    /// (its faces in layers, [`super::ShadowFace::layer`]).
+    ShadowMap,
 }
 
 impl Role {
@@ -243,7 +246,7 @@ impl Role {
                 vk::ImageUsageFlags::COLOR_ATTACHMENT,
                 "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT (lucent writes it as a colour attachment)",
             ),
-            Role::SampledColor | Role::SampledDepth => (
+            Role::SampledColor | Role::SampledDepth | Role::ShadowMap => (
                 vk::ImageUsageFlags::SAMPLED,
                 "VK_IMAGE_USAGE_SAMPLED_BIT (lucent samples it)",
             ),
@@ -258,7 +261,7 @@ impl Role {
                 vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND,
                 "COLOR_ATTACHMENT_BLEND",
             ),
-            Role::SampledColor | Role::SampledDepth => {
+            Role::SampledColor | Role::SampledDepth | Role::ShadowMap => {
                 (vk::FormatFeatureFlags::SAMPLED_IMAGE, "SAMPLED_IMAGE")
             }
         }
@@ -268,7 +271,9 @@ impl Role {
     pub(crate) fn working_state(self) -> ImageState {
         match self {
             Role::Output | Role::Accumulate => ImageState::color_attachment(),
-            Role::SampledColor | Role::SampledDepth => ImageState::fragment_sampled(),
+            Role::SampledColor | Role::SampledDepth | Role::ShadowMap => {
+                ImageState::fragment_sampled()
+            }
         }
     }
 }
@@ -537,7 +542,7 @@ pub(crate) fn check_image(
     }
     // Only a shadow map's faces lie in layers (ShadowFace::layer); lucent reads one layer of
     // everything else.
-    if image.layers == 0 || (image.layers > 1 && input != "shadow map") {
+    if image.layers == 0 || (image.layers > 1 && role != Role::ShadowMap) {
         return Err(invalid(
             &image.name,
             ImageFault::Size,
@@ -558,7 +563,7 @@ pub(crate) fn check_image(
             ),
         ));
     }
-    let depth_role = role == Role::SampledDepth;
+    let depth_role = matches!(role, Role::SampledDepth | Role::ShadowMap);
     if !format_ok(image.format) || is_depth(image.format) != depth_role {
         return Err(HostError::Unsupported {
             input: format!("{input} ('{}')", image.name),

@@ -8,6 +8,7 @@
 use ash::vk;
 use glam::{Mat4, Vec3};
 
+use super::image::{check_image, HostImage, Role};
 use crate::error::HostError;
 use crate::features::shadows::{ShadowFaceGpu, ShadowUniforms, MAX_SHADOW_FACES};
 use crate::gpu_scene::projection_depth_ends;
@@ -89,9 +90,33 @@ const CUBE_AXES: [Vec3; 6] = [
     Vec3::NEG_Z,
 ];
 
+/// Checks a frame's host shadow map against the effect's description: its layers (an array,
+/// `array`, may have any number; an atlas is one 2-D image), then as an image of the
+/// description's `format` ([`check_image`], its own size).
+pub(crate) fn check_shadow_map(
+    gpu: &crate::backend::GpuContext,
+    map: &HostImage,
+    format: vk::Format,
+    array: bool,
+) -> Result<()> {
+    check_shadow_layers(map, array)?;
+    check_image(
+        gpu,
+        map,
+        "shadow map",
+        Role::ShadowMap,
+        map.extent,
+        |f| f == format,
+        &format!(
+            "{} (the description's)",
+            crate::backend::format::format_name(format)
+        ),
+    )
+}
+
 /// A host's shadow map's layers against the effect's description: an array (`array`, its
 /// view a 2-D array view) may have any number; an atlas is one 2-D image.
-pub(crate) fn check_shadow_layers(map: &super::HostImage, array: bool) -> Result<()> {
+fn check_shadow_layers(map: &HostImage, array: bool) -> Result<()> {
     if array || map.layers <= 1 {
         return Ok(());
     }
@@ -293,7 +318,8 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
     };
     Ok(ShadowFaceGpu {
         view_proj: (projection * view).to_cols_array_2d(),
-        // w: reversed Z in its lowest bit, the array layer above (glsl shadow_layer).
+        // w: reversed Z in its lowest bit, the array layer above (glsl/common/shadows.glsl
+        // shadow_stored_depth, shadow_gather_depth).
         rect: [
             r.offset.x as f32,
             r.offset.y as f32,
@@ -321,7 +347,7 @@ mod tests {
     #[test]
     fn an_array_map_needs_an_array_description() {
         let map = |layers| {
-            super::super::HostImage::new(
+            HostImage::new(
                 "cascades",
                 vk::Image::null(),
                 vk::ImageView::null(),

@@ -36,7 +36,7 @@ use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEn
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::marked_tiles;
-use super::shadow_faces::{check_shadow_format, check_shadow_layers, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, check_shadow_map, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
@@ -470,11 +470,7 @@ impl SssEffect {
                     });
                 }
                 if desc.shadow_format.is_some() {
-                    tables.push(TableRegion {
-                        region: &crate::features::shadows::TABLE_REGION,
-                        bytes: std::mem::size_of::<crate::features::shadows::ShadowUniforms>()
-                            as u64,
-                    });
+                    tables.push(crate::features::shadows::table_region());
                 }
                 tables
             },
@@ -757,16 +753,7 @@ impl SssEffect {
         )?;
         let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
             (Some(format), Some(map)) => {
-                check_shadow_layers(map, self.desc.shadow_array)?;
-                check_image(
-                    lucent.gpu(),
-                    map,
-                    "shadow map",
-                    Role::SampledDepth,
-                    map.extent,
-                    |f| f == format,
-                    &format!("{} (the description's)", format_name(format)),
-                )?;
+                check_shadow_map(lucent.gpu(), map, format, self.desc.shadow_array)?;
                 Some(map)
             }
             (None, None) => {

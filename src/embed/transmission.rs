@@ -15,8 +15,8 @@
 //! The host describes the maps it already renders for its shadows ([`ShadowFace`]): one depth
 //! image (an atlas: each face a square rectangle of it), and per face its light, its view and
 //! projection matrices (perspective or orthographic; standard Z, depth 0 at the near plane
-//! and 1 at the far, or reversed Z; a finite or infinite far plane) and its rectangle, with which it rendered the map. A point light has six
-//! faces, +X, -X, +Y, -Y, +Z, -Z in that order (checked from their view matrices); a spot or
+//! and 1 at the far, or reversed Z; a finite or infinite far plane) and its rectangle, with
+//! which it rendered the map. A point light has six faces, +X, -X, +Y, -Y, +Z, -Z in that order (checked from their view matrices); a spot or
 //! directional light one. Lights without faces transmit nothing (nothing measures the
 //! thickness), as in lucent's own frames.
 //!
@@ -31,16 +31,15 @@ use ash::vk;
 
 use super::capabilities::{require, Effect};
 use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
-use super::image::{check_image, distinct_inputs, HostImage, Role};
+use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_material_id, check_views, depth_role, frame_albedo,
     id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
-use super::shadow_faces::{check_shadow_format, check_shadow_layers, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, check_shadow_map, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
-use crate::backend::format::format_name;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
@@ -428,17 +427,12 @@ impl TransmissionEffect {
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
         check_described(lucent, gbuffer.extent(), &checks)?;
-        // The shadow map has a size of its own.
-        let shadow_format = self.desc.shadow_format;
-        check_shadow_layers(images.shadow_map, self.desc.shadow_array)?;
-        check_image(
+        // The shadow map has a size (and maybe layers) of its own.
+        check_shadow_map(
             lucent.gpu(),
             images.shadow_map,
-            "shadow map",
-            Role::SampledDepth,
-            images.shadow_map.extent,
-            |f| f == shadow_format,
-            &format!("{} (the description's)", format_name(shadow_format)),
+            self.desc.shadow_format,
+            self.desc.shadow_array,
         )?;
         distinct_inputs(
             [

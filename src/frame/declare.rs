@@ -119,7 +119,6 @@ pub fn declare_frame(
         (Some(profiles), Some(specular), Some(profile_ids)) => sss::sss_passes(
             graph,
             &sss::SssInputs {
-                shadow_array: false,
                 diffuse: &lit.color,
                 specular,
                 depth: &gb.depth,
@@ -130,6 +129,8 @@ pub fn declare_frame(
                     gb1: &gb.gb1,
                 }),
                 shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
+                // lucent's own light-space maps are one atlas.
+                shadow_array: false,
                 albedo: layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: profiles.depth_in_alpha(),
                 id_defines: profiles.id_map.defines(),

@@ -476,16 +476,9 @@ fn measure_sss(
             let normals = images.upload(gpu, &colour, rgba16f(&gb.gb1), "host normals")?;
             let normals = host_image(normals, "host normals", hdr, size, sampled);
             let shadows =
-                match crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false) {
-                    Some(desc) => Some(atlas_as_host_map(
-                        gpu,
-                        &renderer,
-                        scene,
-                        &desc,
-                        &mut images,
-                    )?),
-                    None => None,
-                };
+                crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false)
+                    .map(|desc| atlas_as_host_map(gpu, &renderer, scene, &desc, &mut images))
+                    .transpose()?;
             Some((normals, shadows))
         } else {
             None

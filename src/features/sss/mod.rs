@@ -933,8 +933,11 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
         .filter(|p| p.defines.iter().any(|(name, _)| name == "LUCENT_SHADOWS"))
         .map(|p| {
             let mut p = p.clone();
-            p.defines
-                .push(("LUCENT_SHADOW_ARRAY".to_string(), "1".to_string()));
+            p.defines.extend(
+                SHADOW_ARRAY
+                    .iter()
+                    .map(|(name, value)| (name.to_string(), value.to_string())),
+            );
             p
         })
         .collect();

@@ -194,6 +194,10 @@ impl Demo<'_> {
                     }
                 }
             });
+        // The assets' licences (CC BY) ask for credit wherever they are shown.
+        for credit in &self.scene.credits {
+            ui.label(egui::RichText::new(credit).small());
+        }
         egui::ComboBox::from_label("technique (T)")
             .selected_text(self.technique.name())
             .show_ui(ui, |ui| {

@@ -445,6 +445,7 @@ fn frame_scene() -> Scene {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     }
 }
 

@@ -89,6 +89,7 @@ pub fn sphere_scene(medium: LayeredMedium, lights: Vec<Light>) -> Result<Scene> 
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     })
 }
 

@@ -237,6 +237,7 @@ pub fn case_scene(case: &SweepCase) -> Result<Scene> {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     })
 }
 

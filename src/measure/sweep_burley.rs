@@ -185,6 +185,7 @@ pub fn case_scene(case: &BurleyCase) -> Result<Scene> {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     })
 }
 

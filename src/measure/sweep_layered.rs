@@ -499,6 +499,7 @@ pub fn case_scene(case: &LayeredCase) -> Result<Scene> {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     })
 }
 

@@ -892,6 +892,7 @@ mod tests {
             exposure: 1.0,
             deformation: None,
             time: 0.0,
+            credits: Vec::new(),
         }
     }
 

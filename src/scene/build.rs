@@ -26,6 +26,7 @@ pub(super) fn base_scene(name: &str, camera: Camera) -> Scene {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     }
 }
 

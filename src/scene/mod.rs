@@ -105,6 +105,10 @@ pub struct Scene {
     /// The instant shown, in seconds: the deformation is evaluated at it (`render --time`;
     /// the benchmark and the demo advance it every frame). 0 for a scene just loaded.
     pub time: f32,
+    /// Attributions of the assets the scene shows (a scan's name, source and licence), one
+    /// line each: `lucent render` prints them and the demo's panel shows them, as a licence
+    /// such as CC BY asks wherever the asset is shown.
+    pub credits: Vec<String>,
 }
 
 /// A mesh deformation over time, evaluated on the CPU per frame.

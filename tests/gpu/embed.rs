@@ -2406,6 +2406,7 @@ fn host_built_scene() -> lucent::scene::Scene {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     }
 }
 

@@ -58,6 +58,7 @@ fn occluder_scene(light: Light) -> Scene {
         exposure: 1.0,
         deformation: None,
         time: 0.0,
+        credits: Vec::new(),
     }
 }
 

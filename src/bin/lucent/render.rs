@@ -21,7 +21,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let mut outputs = vec![("--out", out.as_path())];
     outputs.extend(exr.as_deref().map(|e| ("--exr", e)));
     check_scene_outputs(&frame.scene, &outputs)?;
-    with_renderer(&frame, &gpu, exr.is_some(), |session, renderer, _| {
+    with_renderer(&frame, &gpu, exr.is_some(), |session, renderer, scene| {
         let gpu = &session.gpu;
         let (width, height) = (renderer.settings.width, renderer.settings.height);
         let mut runner = FrameRunner::new(gpu, renderer.executable.plan.physical.len())?;
@@ -35,6 +35,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
             timing.wall_ms,
             gpu.info.describe()
         );
+        // The assets' licences (CC BY) ask for credit wherever they are shown.
+        for credit in &scene.credits {
+            println!("credit: {credit}");
+        }
         if let Some(exr) = &exr {
             output::write_exr_rgba32f(exr, width, height, &renderer.read_hdr(gpu)?)?;
             println!("wrote {}", exr.display());

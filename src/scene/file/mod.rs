@@ -25,6 +25,9 @@ use schema::SceneToml;
 /// Largest file a scene may be (a scene file is a few kilobytes; this refuses binary garbage).
 const MAX_SCENE_FILE_BYTES: u64 = 4 * 1024 * 1024;
 
+/// The longest `credits` line a scene may carry (a licence notice with its links fits).
+const MAX_CREDIT_BYTES: usize = 1000;
+
 /// The scene file being read: its name and text, for errors, and its directory, which relative
 /// paths inside it are resolved against.
 struct SceneFile<'a> {
@@ -286,6 +289,28 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
             format!("{exposure} must be finite and > 0"),
         ));
     }
+    let credits = raw
+        .credits
+        .iter()
+        .map(|credit| {
+            let text = credit.get_ref().trim();
+            // One printable line each: the demo's panel and `lucent render` print them as is.
+            if text.is_empty()
+                || text.len() > MAX_CREDIT_BYTES
+                || text.chars().any(char::is_control)
+            {
+                return Err(top.error(
+                    "credits",
+                    Some(credit.span()),
+                    format!(
+                        "each credit must be one line of 1 to {MAX_CREDIT_BYTES} bytes without \
+                         control characters"
+                    ),
+                ));
+            }
+            Ok(text.to_string())
+        })
+        .collect::<Result<Vec<_>>>()?;
     let name = raw.name.clone().unwrap_or_else(|| {
         path.file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -302,6 +327,7 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
         exposure,
         deformation,
         time: 0.0,
+        credits,
     })
 }
 

@@ -13,6 +13,9 @@ use toml::Spanned;
 #[serde(deny_unknown_fields)]
 pub(super) struct SceneToml {
     pub(super) name: Option<String>,
+    /// Attributions of the assets the scene shows (name, source, licence).
+    #[serde(default)]
+    pub(super) credits: Vec<Spanned<String>>,
     /// Gone: the materials decide the frame. Kept only to explain that.
     pub(super) technique: Option<Spanned<toml::Value>>,
     pub(super) ambient: Option<Spanned<[f32; 3]>>,

@@ -43,8 +43,9 @@ pub const GALLERY_SCENES: &[GalleryScene<'static>] = &[
     GalleryScene {
         scene: "showcase-skin",
         technique: None,
-        shows: "separable SSS with d'Eon's skin profile (10x): the red terminator; the ears also \
-                translucent",
+        shows: "separable SSS on Lee Perry-Smith's scanned head: Jensen's skin1 at physical \
+                scale, its colour map after the scatter; the red terminator, the ear glowing \
+                against the back light (the medium's transmission through its thickness)",
     },
     GalleryScene {
         scene: "showcase-skin",
@@ -103,6 +104,8 @@ pub struct GalleryEntry {
     pub difference: PathBuf,
     /// The numbers.
     pub look: Look,
+    /// The scene's credits (its assets' licences ask for them wherever they are shown).
+    pub credits: Vec<String>,
 }
 
 /// Renders the gallery's `scenes` ([`GALLERY_SCENES`], or any others) into `out` with
@@ -169,6 +172,7 @@ pub fn gallery(
             plain: file("-none"),
             difference: file("-difference"),
             look: images.look,
+            credits: scene.credits.clone(),
         };
         write_png_rgba8(&entry.frame, w, h, &images.with)?;
         write_png_rgba8(&entry.plain, w, h, &images.without)?;
@@ -213,7 +217,8 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
         "{}x{}, technique `{}` unless a title names another, anti-aliasing `{}`, on {device}. \
          Each scene beside plain \
          lighting (`--technique none`) and their difference (x4). *Changed*: pixels that \
-         moved by more than {CHANGED_THRESHOLD}/255; *halo*: pixels of objects with no \
+         moved by more than {CHANGED_THRESHOLD}/255, of the frame and of the objects the \
+         techniques render; *halo*: pixels of objects with no \
          technique that moved by more than {HALO_THRESHOLD}/255. Frame times are one frame \
          each (a hint; `lucent bench` measures).\n",
         settings.width,
@@ -223,14 +228,15 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
     );
     let _ = writeln!(
         out,
-        "| scene | changed | technique pixels | halo pixels | frame / none (ms) |\n|---|---:|---:|---:|---:|"
+        "| scene | changed | changed on objects | technique pixels | halo pixels | frame / none (ms) |\n|---|---:|---:|---:|---:|---:|"
     );
     for e in entries {
         let _ = writeln!(
             out,
-            "| {} | {:.1}% | {} | {} (max {}/255) | {:.0} / {:.0} |",
+            "| {} | {:.1}% | {:.1}% | {} | {} (max {}/255) | {:.0} / {:.0} |",
             e.scene,
             100.0 * e.look.changed,
+            100.0 * e.look.changed_on_objects,
             e.look.technique_pixels,
             e.look.halo_pixels,
             e.look.halo_max,
@@ -252,6 +258,9 @@ pub fn markdown(entries: &[GalleryEntry], settings: &FrameSettings, device: &str
             name(&e.plain),
             name(&e.difference)
         );
+        for credit in &e.credits {
+            let _ = writeln!(out, "\n*{credit}*");
+        }
     }
     out
 }

@@ -348,12 +348,16 @@ pub const BASELINE_AMD: &[Benchmark] = &[
     ),
     (
         "showcase-skin",
+        // Not measured on this machine: the scanned head (issue 36) replaced the sculpted one,
+        // so each row is the old one times the new/old ratio measured on the AMD 25/17 machine
+        // (gbuffer + lighting 3.43x: the medium's transmission and the two texture maps;
+        // blurs 1.31-1.34x; tonemap 1.14x; maps 1.07x). Measure anew on such a machine.
         &[
-            ("light-space maps", 0.96),
-            ("gbuffer + lighting", 3.23),
-            ("horizontal blur", 3.77),
-            ("vertical blur", 2.39),
-            ("tonemap", 1.86),
+            ("light-space maps", 1.03),
+            ("gbuffer + lighting", 11.08),
+            ("horizontal blur", 5.07),
+            ("vertical blur", 3.136),
+            ("tonemap", 2.12),
         ],
     ),
     (
@@ -586,12 +590,14 @@ pub const BASELINE_INTEL: &[Benchmark] = &[
     ),
     (
         "showcase-skin",
+        // Not measured on this machine: the old row times the new/old ratios of the AMD 25/17
+        // table (issue 36's scanned head; see BASELINE_AMD). Measure anew on such a machine.
         &[
-            ("light-space maps", 0.96),
-            ("gbuffer + lighting", 2.94),
-            ("horizontal blur", 4.80),
-            ("vertical blur", 3.48),
-            ("tonemap", 1.83),
+            ("light-space maps", 1.03),
+            ("gbuffer + lighting", 10.08),
+            ("horizontal blur", 6.45),
+            ("vertical blur", 4.57),
+            ("tonemap", 2.09),
         ],
     ),
     (
@@ -825,12 +831,15 @@ pub const BASELINE_AMD_25_17: &[Benchmark] = &[
     ),
     (
         "showcase-skin",
+        // The scanned head (issue 36): the median of three `lucent bench --speed-of-light`
+        // runs at the gate's settings (9.78-11.12x for gbuffer + lighting, which now adds the
+        // skin medium's transmission per light and samples the colour and normal maps).
         &[
-            ("gbuffer + lighting", 3.01),
-            ("horizontal blur", 4.06),
-            ("light-space maps", 0.97),
-            ("tonemap", 2.13),
-            ("vertical blur", 2.66),
+            ("gbuffer + lighting", 10.32),
+            ("horizontal blur", 5.46),
+            ("light-space maps", 1.04),
+            ("tonemap", 2.43),
+            ("vertical blur", 3.49),
         ],
     ),
     (

@@ -35,6 +35,9 @@ pub struct Look {
     pub changed: f64,
     /// Pixels covered by materials with a technique.
     pub technique_pixels: usize,
+    /// Share of those pixels changed by more than [`CHANGED_THRESHOLD`]: how much of the
+    /// objects the technique renders it changes, whatever part of the frame they fill.
+    pub changed_on_objects: f64,
     /// Pixels outside them changed by more than [`HALO_THRESHOLD`].
     pub halo_pixels: usize,
     /// The largest change of a pixel outside them (display units, 0-255).
@@ -93,6 +96,7 @@ pub fn look(
 /// The numbers of a look from its two frames (RGBA8) and the technique mask.
 pub fn measure(with: &[u8], without: &[u8], mask: &[bool], frame_ms: (f64, f64)) -> Look {
     let mut changed = 0usize;
+    let mut changed_on_objects = 0usize;
     let mut halo_pixels = 0usize;
     let mut halo_max = 0u8;
     for ((a, b), &technique) in with.chunks_exact(4).zip(without.chunks_exact(4)).zip(mask) {
@@ -104,6 +108,7 @@ pub fn measure(with: &[u8], without: &[u8], mask: &[bool], frame_ms: (f64, f64))
             .unwrap_or(0);
         if change > CHANGED_THRESHOLD {
             changed += 1;
+            changed_on_objects += usize::from(technique);
         }
         if !technique {
             if change > HALO_THRESHOLD {
@@ -112,9 +117,11 @@ pub fn measure(with: &[u8], without: &[u8], mask: &[bool], frame_ms: (f64, f64))
             halo_max = halo_max.max(change);
         }
     }
+    let technique_pixels = mask.iter().filter(|m| **m).count();
     Look {
         changed: changed as f64 / mask.len().max(1) as f64,
-        technique_pixels: mask.iter().filter(|m| **m).count(),
+        technique_pixels,
+        changed_on_objects: changed_on_objects as f64 / technique_pixels.max(1) as f64,
         halo_pixels,
         halo_max,
         frame_ms,

@@ -52,7 +52,7 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
     ),
     (
         "showcase-skin",
-        "a sculpted head with ears, skin profile at 10x scale, side-lit: the red terminator, ears glowing from a back light",
+        "Lee Perry-Smith's scanned head (CC BY 3.0) as skin1 with its colour and normal maps: the red terminator, the ear glowing against a back light",
     ),
     (
         "showcase-marble",

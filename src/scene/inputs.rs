@@ -11,8 +11,12 @@ use std::path::{Path, PathBuf};
 
 /// The scene file itself and every file it names, each with what it is (`"the scene file"`,
 /// `"the mesh of [[mesh]] 'ball'"`); empty for a built-in scene. Reads at most the scene file
-/// (with the loader's checks: a regular file, capped).
+/// (with the loader's checks: a regular file, capped). A built-in scene made from a scene
+/// file in `assets/` (`showcase-skin`) lists that file's inputs.
 pub fn scene_inputs(name_or_path: &str) -> Vec<(String, PathBuf)> {
+    if let Some(file) = super::showcase::builtin_scene_file(name_or_path) {
+        return scene_inputs(&file.to_string_lossy());
+    }
     let path = Path::new(name_or_path);
     if !(name_or_path.ends_with(".toml") || (path.exists() && !path.is_dir())) {
         return Vec::new();

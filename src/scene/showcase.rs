@@ -4,17 +4,21 @@
 //!
 //! - `showcase-translucency`: GDC 2011 where it shines: thin objects (an ear, two leaves, a
 //!   wax panel) with baked thickness, a warm light behind them, the camera looking into it.
-//! - `showcase-skin`: a sculpted head with ears, d'Eon's skin profile at 10x physical scale so
-//!   the red Gaussians span tens of pixels, a key light from the side (the red terminator) and
-//!   a back light through the ears (translucency and SSS on one material).
+//! - `showcase-skin`: Lee Perry-Smith's scanned head (`assets/showcase-skin.toml`) as Jensen's
+//!   skin1 at physical scale, its colour map applied after the scatter, a key light from the
+//!   front left (the red terminator), a fill, and a back light the ear glows against (the
+//!   medium's transmission through the ear's thickness).
 //! - `showcase-marble`: veined marble (a procedural albedo and a fine normal map lined up with
 //!   the veins) under a grazing light, the marble profile at 5x: SSS turns the grainy bumps
 //!   into the soft, waxy look of stone that light enters.
 //! - `showcase-layered`: Li et al.'s media as jade (a thin leaf, a ring) and wax (candles),
 //!   lit from behind and the side: thin parts glow with the colour the medium transmits.
 //!
-//! Every mesh is made here from the generators by sculpting (a displacement of the vertices,
-//! normals and tangents recomputed), so the scenes need no file from outside the repository.
+//! Every other mesh is made here from the generators by sculpting (a displacement of the
+//! vertices, normals and tangents recomputed); the head is a scan in `assets/`, so no scene
+//! needs a file from outside the repository.
+
+use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 
@@ -26,7 +30,7 @@ use super::material::{
     Light, LightKind, Material, ProceduralTexture, SssProfile, TextureSource, ThicknessSource,
 };
 use super::{normals, Mesh, Scene};
-use crate::Result;
+use crate::{LucentError, Result};
 
 /// `mesh` with every vertex moved by `displace` (object space in, object space out), normals
 /// recomputed angle-weighted and tangents from the UVs; the exact shape is dropped.
@@ -41,12 +45,6 @@ fn sculpt(mut mesh: Mesh, displace: impl Fn(Vec3) -> Vec3) -> Mesh {
     }
     mesh.shape = None;
     mesh
-}
-
-/// A Gaussian bump of height 1 at `centre` with radii `radius` (per axis).
-fn bump(p: Vec3, centre: Vec3, radius: Vec3) -> f32 {
-    let d = (p - centre) / radius;
-    (-d.length_squared()).exp()
 }
 
 /// A thin, cupped ear-like shell: the unit icosphere flattened to `thickness` along z, an
@@ -178,106 +176,30 @@ pub fn translucency() -> Result<Scene> {
     Ok(s)
 }
 
-/// A head with a nose, brow, eye sockets and cheeks sculpted from an icosphere (1.9 units tall).
-fn head_mesh() -> Result<Mesh> {
-    Ok(sculpt(
-        generators::generate(Generator::Icosphere, 5)?,
-        |p| {
-            // The skull: taller than wide, deeper at the back, the jaw narrower.
-            let jaw = 1.0 - 0.22 * (-p.y).max(0.0);
-            let mut q = Vec3::new(p.x * 0.72 * jaw, p.y * 0.95, p.z * 0.82);
-            let front = p.z.max(0.0);
-            let n = p.normalize_or_zero();
-            let mut out = 0.0;
-            // Nose (ridge and tip), brow, cheeks, chin; eye sockets and the mouth's groove in.
-            out += 0.2 * bump(p, Vec3::new(0.0, -0.12, 1.0), Vec3::new(0.12, 0.26, 0.3)) * front;
-            out += 0.1 * bump(p, Vec3::new(0.0, -0.3, 1.0), Vec3::new(0.17, 0.1, 0.3)) * front;
-            out += 0.07 * bump(p, Vec3::new(0.0, 0.24, 0.97), Vec3::new(0.5, 0.09, 0.3)) * front;
-            out += 0.06 * bump(p, Vec3::new(0.4, -0.18, 0.85), Vec3::new(0.2, 0.2, 0.3)) * front;
-            out += 0.06 * bump(p, Vec3::new(-0.4, -0.18, 0.85), Vec3::new(0.2, 0.2, 0.3)) * front;
-            out += 0.07 * bump(p, Vec3::new(0.0, -0.78, 0.62), Vec3::new(0.2, 0.12, 0.3)) * front;
-            out -= 0.045 * bump(p, Vec3::new(0.3, 0.1, 0.95), Vec3::new(0.17, 0.11, 0.3)) * front;
-            out -= 0.045 * bump(p, Vec3::new(-0.3, 0.1, 0.95), Vec3::new(0.17, 0.11, 0.3)) * front;
-            out -= 0.03 * bump(p, Vec3::new(0.0, -0.52, 0.9), Vec3::new(0.22, 0.03, 0.3)) * front;
-            q += n * out;
-            q
-        },
-    ))
+/// The folder of the assets built-in scenes load (`assets/` in the repository): the build's
+/// own copy, so `lucent` finds it from any working directory.
+pub fn assets_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets")
 }
 
-/// Screen-space SSS on skin: the red terminator and glowing ears.
+/// The scene file a built-in scene is made from, for those written as one (`showcase-skin`).
+pub fn builtin_scene_file(name: &str) -> Option<PathBuf> {
+    (name == "showcase-skin").then(|| assets_dir().join("showcase-skin.toml"))
+}
+
+/// Screen-space SSS on skin: Lee Perry-Smith's scanned head as skin1, key, fill and a back
+/// light through the ear (`assets/showcase-skin.toml` says what each part is for).
 pub fn skin() -> Result<Scene> {
-    let mut s = base_scene(
-        "showcase-skin",
-        camera(Vec3::new(0.9, 1.3, 2.55), Vec3::new(0.05, 1.05, 0.0)),
-    );
-    s.sky = Vec3::new(0.02, 0.022, 0.03);
-    s.environment =
-        Environment::hemisphere(Vec3::new(0.045, 0.05, 0.065), Vec3::new(0.02, 0.016, 0.014));
-    let head = s.add_mesh(head_mesh()?);
-    let ear = s.add_mesh(ear_mesh(0.16)?);
-    // The head is about 1.9 units for a real 230 mm: 0.008 units per mm; the profile at 10x
-    // so its widest (red) Gaussians span tens of pixels at gallery sizes.
-    let mut profile = SssProfile::preset("skin")?;
-    profile.units_per_mm = 0.08;
-    let mut skin = Material::opaque("skin", Vec3::new(0.85, 0.6, 0.5), 0.3, 0.45);
-    skin.sss = Some(profile.clone());
-    // Turned a little toward the camera.
-    let turn = Quat::from_rotation_y(0.3);
-    s.add(
-        head,
-        Mat4::from_rotation_translation(turn, Vec3::new(0.0, 1.1, 0.0)),
-        skin.clone(),
-    );
-    // Ears: skin that also lets the back light through (translucency and SSS on one material).
-    let mut ear_material = translucent(
-        "ear skin",
-        Vec3::new(0.85, 0.6, 0.5),
-        ThicknessSource::Bake,
-        Vec3::new(1.0, 0.3, 0.18),
-    );
-    ear_material.sss = Some(profile);
-    if let Some(t) = &mut ear_material.translucency {
-        t.power = 5.0;
-        t.distortion = 0.3;
-        t.ambient = 0.1;
-        // The head stands between the back light and the far ear: its shadow falls on the
-        // light through that ear (lucent's extension; the talk's term would light it anyway).
-        t.shadowed = true;
+    let path = builtin_scene_file("showcase-skin").expect("showcase-skin is a scene file");
+    if !path.is_file() {
+        return Err(LucentError::file(
+            &path,
+            "the head scan showcase-skin loads is not there: lucent's built-in scenes read \
+             the repository's assets/ folder (this binary was built from a checkout that has \
+             moved or lost it)",
+        ));
     }
-    for side in [-1.0f32, 1.0] {
-        s.add(
-            ear,
-            Mat4::from_scale_rotation_translation(
-                Vec3::new(0.22, 0.32, 0.3),
-                turn * Quat::from_rotation_y(side * 1.15),
-                Vec3::new(0.0, 1.1, 0.0) + turn * Vec3::new(side * 0.8, -0.02, -0.08),
-            ),
-            ear_material.clone(),
-        );
-    }
-    s.lights = vec![
-        // The key light from the camera's right, level with the face: half the face in light,
-        // the terminator down its middle.
-        Light::point(
-            Vec3::new(3.2, 1.6, 0.4),
-            Vec3::new(1.0, 0.95, 0.88),
-            26.0,
-            12.0,
-        ),
-        // A warm back light behind the near ear: it glows, and the head's rim with it.
-        {
-            let mut l = Light::point(
-                Vec3::new(1.5, 1.4, -1.6),
-                Vec3::new(1.0, 0.8, 0.6),
-                10.0,
-                8.0,
-            );
-            l.translucency_scale = 2.0;
-            l
-        },
-    ];
-    Ok(s)
+    super::file::load_scene_file(&path)
 }
 
 /// Veined marble under a grazing light.
@@ -475,7 +397,6 @@ mod tests {
         for (name, mesh) in [
             ("ear", ear_mesh(0.09).unwrap()),
             ("leaf", leaf_mesh().unwrap()),
-            ("head", head_mesh().unwrap()),
         ] {
             mesh.validate(name).unwrap();
             assert!(mesh.normals.iter().all(|n| n.is_finite()));
@@ -492,5 +413,33 @@ mod tests {
             }
             assert!(!s.lights.is_empty());
         }
+    }
+
+    #[test]
+    fn showcase_skin_is_the_scan_with_both_maps_and_its_credit() {
+        let s = skin().unwrap();
+        assert_eq!(s.name, "showcase-skin");
+        assert_eq!(s.objects.len(), 1);
+        let skin = &s.objects[0].material;
+        let file = |t: &Option<TextureSource>| match t {
+            Some(TextureSource::File(p)) => p.file_name().unwrap().to_string_lossy().into_owned(),
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(file(&skin.albedo_texture), "Map-COL.jpg");
+        assert_eq!(
+            file(&skin.normal_texture),
+            "Infinite-Level_02_Tangent_SmoothUV.jpg"
+        );
+        assert!(skin.medium.is_some() && skin.sss.is_some());
+        assert!(s.meshes[0].positions.len() >= 8838);
+        assert!(s.credits.iter().any(|c| c.contains("Lee Perry-Smith")));
+        // Its inputs are the scene file's, so no output may overwrite the scan.
+        let inputs = crate::scene::inputs::scene_inputs("showcase-skin");
+        assert!(
+            inputs
+                .iter()
+                .any(|(_, p)| p.ends_with("lee-perry-smith.obj")),
+            "{inputs:?}"
+        );
     }
 }

@@ -19,6 +19,7 @@ use lucent::frame::{
 use lucent::graph::Plan;
 use lucent::reference::translucency::{shade_gbuffer, LightingInputs};
 use lucent::scene::material::TechniqueName;
+use lucent::scene::texture::TextureSource;
 use lucent::scene::Scene;
 
 use crate::common;
@@ -566,7 +567,7 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
     // MTL: one face's material has Kd, the other's map_Kd; both are rendered.
     std::fs::write(
         dir.join("quad.mtl"),
-        "newmtl green\nKd 0.2 0.6 0.3\nnewmtl painted\nKd 1 1 1\nmap_Kd orange.png\n",
+        "newmtl green\nKd 0.2 0.6 0.3\nnewmtl painted\nKd 1 1 1\nmap_Kd orange.png\nnorm flat.png\n",
     )
     .unwrap();
     std::fs::write(
@@ -577,12 +578,38 @@ fn albedo_textures_and_mtl_map_kd_are_applied() {
          usemtl painted\nf 2/1/1 3/4/1 6/3/1 5/2/1\n",
     )
     .unwrap();
+    // A flat tangent-space normal map: `norm` is the part's normal map, drawn (it leaves
+    // the normals as they are).
+    solid_png(&dir.join("flat.png"), [128, 128, 255]);
     let obj = write_scene("obj.toml", "obj = \"quad.obj\"", "specular = 0.2");
     assert_eq!(obj.objects.len(), 2, "one object per MTL material");
+    let normal_maps: Vec<_> = obj
+        .objects
+        .iter()
+        .map(|o| o.material.normal_texture.clone())
+        .collect();
+    assert_eq!(
+        normal_maps,
+        [None, Some(TextureSource::File(dir.join("flat.png")))],
+        "the MTL's norm"
+    );
     let images = test.render(&obj, s);
     let (left, right) = albedo_left_right(&images, w, h);
     assert!(close(left, Vec3::new(0.2, 0.6, 0.3)), "Kd: {left}");
     assert!(close(right, orange), "map_Kd: {right} vs {orange}");
+    // `mtl = false`: one mesh, the object's own material on every face.
+    let plain = write_scene(
+        "no-mtl.toml",
+        "obj = \"quad.obj\"\nmtl = false",
+        "albedo = [1.0, 0.5, 1.0]",
+    );
+    assert_eq!(plain.objects.len(), 1);
+    assert_eq!(plain.objects[0].material.albedo_texture, None);
+    let (left, right) = albedo_left_right(&test.render(&plain, s), w, h);
+    assert!(
+        close(left, Vec3::new(1.0, 0.5, 1.0)) && close(right, Vec3::new(1.0, 0.5, 1.0)),
+        "{left} {right}"
+    );
 
     // A corrupt texture is an error naming the file.
     std::fs::write(dir.join("orange.png"), b"\x89PNG\r\n\x1a\nnot really").unwrap();

@@ -52,6 +52,62 @@ fn each_showcase_scene_changes_five_percent_of_its_pixels_without_halos() {
 }
 
 #[test]
+fn showcase_skin_is_the_scanned_head_its_sss_shows_and_its_ear_glows() {
+    // Issue 36: SSS changes at least 8% of the head's pixels against `--technique none`
+    // without a halo, and the light the skin diffuses through the ear's thickness makes it glow
+    // red against the back light (the medium's transmission on against off).
+    let test = TestGpu::new();
+    let scene = lucent::bake::scene::load_scene_baked("showcase-skin").unwrap();
+    assert!(
+        scene
+            .credits
+            .iter()
+            .any(|c| c.contains("Lee Perry-Smith") && c.contains("CC BY 3.0")),
+        "{:?}",
+        scene.credits
+    );
+    for (w, h) in [(640, 480), (320, 240)] {
+        let images = look::look(
+            &test.gpu,
+            &test.shaders,
+            &test.cache,
+            &scene,
+            FrameSettings::new(w, h),
+        )
+        .unwrap();
+        let l = images.look;
+        eprintln!(
+            "showcase-skin {w}x{h}: {:.1}% of the head changed, {} head pixels, {} halo",
+            100.0 * l.changed_on_objects,
+            l.technique_pixels,
+            l.halo_pixels
+        );
+        assert!(l.changed_on_objects >= 0.08, "{w}x{h}: {l:?}");
+        assert_eq!(l.halo_pixels, 0, "{w}x{h}: {l:?}");
+        let mut opaque = FrameSettings::new(w, h);
+        opaque.sss.transmission = false;
+        let without = test.render(&scene, opaque);
+        let glowing = images
+            .with
+            .chunks_exact(4)
+            .zip(without.display.chunks_exact(4))
+            .filter(|(a, b)| {
+                let red = i32::from(a[0]) - i32::from(b[0]);
+                let green = i32::from(a[1]) - i32::from(b[1]);
+                red > 24 && red > green
+            })
+            .count();
+        eprintln!("showcase-skin {w}x{h}: {glowing} pixels glow red through the skin");
+        assert!(
+            glowing * 200 >= l.technique_pixels,
+            "{w}x{h}: only {glowing} of {} head pixels glow",
+            l.technique_pixels
+        );
+    }
+    test.finish();
+}
+
+#[test]
 fn showcase_scenes_match_their_goldens() {
     // Same settings as tests/golden/LIST's `showcase-*` lines.
     let test = TestGpu::new();

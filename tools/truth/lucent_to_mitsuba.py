@@ -243,8 +243,8 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
     sc = _Scene(path)
     t = sc.toml
     notes: list[str] = []
-    known_top = {"name", "technique", "ambient", "environment", "sky", "exposure", "camera",
-                 "mesh", "material", "object", "light", "deformation"}
+    known_top = {"name", "credits", "technique", "ambient", "environment", "sky", "exposure",
+                 "camera", "mesh", "material", "object", "light", "deformation"}
     for key in t:
         if key not in known_top:
             raise sc.refuse(key, "unknown key (lucent refuses it too)")
@@ -253,6 +253,9 @@ def convert(path: Path, work_dir: Path, allow_dielectric_delta_lights: bool = Fa
     if "deformation" in t:
         raise sc.refuse("deformation", "a deforming mesh is not converted: the truth would "
                         "have to re-run lucent's CPU wave at the same --time")
+    for credit in t.get("credits", []):
+        # Kept with the truth (its JSON's notes): the assets' licences ask for credit.
+        notes.append(f"credit: {credit}")
     if "exposure" in t:
         notes.append("`exposure`: a tonemapping multiplier; lucent's --exr and this EXR are "
                      "both linear radiance before it")
@@ -480,7 +483,7 @@ def mesh_shape(sc, index, mesh, obj, okey, matrix, work_dir):
 
     mkey = f"mesh[{index}]"
     for key in mesh:
-        if key not in {"name", "obj", "generator", "level", "triangles"}:
+        if key not in {"name", "obj", "mtl", "generator", "level", "triangles"}:
             raise sc.refuse(f"{mkey}.{key}", "unknown key")
     to_world = mi.ScalarTransform4f(matrix.tolist())
     if "obj" in mesh:
@@ -488,9 +491,14 @@ def mesh_shape(sc, index, mesh, obj, okey, matrix, work_dir):
         if not file.exists():
             raise sc.refuse(f"{mkey}.obj", f"mesh file {file} not found")
         text = file.read_text(errors="replace")
-        if any(line.split()[:1] in (["usemtl"], ["mtllib"]) for line in text.splitlines()):
+        # `mtl = false`: lucent draws the faces with the object's material alone, and
+        # Mitsuba's OBJ loader ignores `mtllib` and `usemtl`, so both see one surface.
+        uses_mtl = mesh.get("mtl", True) is not False
+        if uses_mtl and any(line.split()[:1] in (["usemtl"], ["mtllib"])
+                            for line in text.splitlines()):
             raise sc.refuse(f"{mkey}.obj", f"{file} uses MTL materials (lucent splits it into "
-                            "parts with the MTL's Kd and map_Kd); not converted")
+                            "parts with the MTL's Kd, map_Kd and norm); not converted (`mtl = "
+                            "false` draws it with the object's material alone)")
         # Closedness of an OBJ is not checked: a medium inside an open OBJ is the user's call.
         return ({"type": "obj", "filename": str(file), "to_world": to_world},
                 obj_bounds(file), True)

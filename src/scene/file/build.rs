@@ -100,14 +100,28 @@ pub(super) fn meshes<'a>(file: &SceneFile<'_>, tables: &'a [MeshToml]) -> Result
                 }
                 let loaded = obj::load_obj(&obj_path)?;
                 let mut parts = Vec::new();
-                for (part, material) in loaded.parts() {
-                    out.meshes.push(part);
-                    parts.push((out.meshes.len() - 1, material.cloned()));
+                if value(&m.mtl).unwrap_or(true) {
+                    for (part, material) in loaded.parts() {
+                        out.meshes.push(part);
+                        parts.push((out.meshes.len() - 1, material.cloned()));
+                    }
+                } else {
+                    // `mtl = false`: one mesh, drawn with the objects' materials alone.
+                    out.meshes.push(loaded.mesh);
+                    parts.push((out.meshes.len() - 1, None));
                 }
                 out.parts.push(parts);
                 continue;
             }
             (None, Some(generator)) => {
+                if let Some(mtl) = &m.mtl {
+                    return Err(at.error(
+                        "mtl",
+                        Some(mtl.span()),
+                        "`mtl` chooses whether an OBJ's MTL materials are used: a `generator` \
+                         mesh has none",
+                    ));
+                }
                 let generator = Generator::parse(generator.get_ref())
                     .map_err(|e| at.error("generator", Some(generator.span()), e))?;
                 match (&m.level, &m.triangles) {

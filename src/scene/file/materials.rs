@@ -717,15 +717,20 @@ fn depth_textures(
 }
 
 /// `material` on the faces of an OBJ part whose MTL material is `mtl`: the MTL's `map_Kd`
-/// becomes the albedo texture unless the scene's material has one, and its `Kd` the albedo
-/// unless the scene's material sets `albedo` (clamped to [0, 1], which is all a reflectance
-/// can be).
+/// becomes the albedo texture unless the scene's material has one, its `norm` the normal map
+/// unless the scene's material has one, and its `Kd` the albedo unless the scene's material
+/// sets `albedo` (clamped to [0, 1], which is all a reflectance can be).
 pub(super) fn with_mtl(material: &Material, mtl: &ObjMaterial, explicit_albedo: bool) -> Material {
     let mut m = material.clone();
     m.name = format!("{} ({})", material.name, mtl.name);
     if m.albedo_texture.is_none() {
         if let Some(t) = &mtl.diffuse_texture {
             m.albedo_texture = Some(TextureSource::File(t.clone()));
+        }
+    }
+    if m.normal_texture.is_none() {
+        if let Some(t) = &mtl.normal_texture {
+            m.normal_texture = Some(TextureSource::File(t.clone()));
         }
     }
     if let (false, Some(kd)) = (explicit_albedo, mtl.diffuse) {

@@ -71,6 +71,9 @@ pub(super) struct CameraToml {
 pub(super) struct MeshToml {
     pub(super) name: Spanned<String>,
     pub(super) obj: Option<Spanned<PathBuf>>,
+    /// With `obj`: whether the OBJ's MTL materials are used (default true); `false` draws its
+    /// faces with the objects' materials alone.
+    pub(super) mtl: Option<Spanned<bool>>,
     pub(super) generator: Option<Spanned<String>>,
     pub(super) level: Option<Spanned<u32>>,
     pub(super) triangles: Option<Spanned<u64>>,

@@ -76,7 +76,8 @@ pub struct ObjMaterial {
     /// `map_Kd`: diffuse texture, resolved relative to the MTL file's directory (Windows `\`
     /// separators accepted); `None` also when the file named is not there (a repair note).
     pub diffuse_texture: Option<PathBuf>,
-    /// `map_Bump` / `bump`: normal map, resolved like `diffuse_texture`.
+    /// `norm`: tangent-space normal map, resolved like `diffuse_texture` (`map_Bump` / `bump`
+    /// name height maps, which lucent does not render: a note says so).
     pub normal_texture: Option<PathBuf>,
 }
 

@@ -34,7 +34,13 @@ const TEXTURE_KEYS: &[(&str, usize)] = &[
     ("map_bump", 8),
     ("bump", 4),
     ("map_d", 5),
+    ("norm", 4),
 ];
+
+/// MTL keys that name a bump (height) map: lucent renders tangent-space normal maps (`norm`)
+/// only, so these are noted as not rendered, never read as normal maps (a height map read as
+/// one would tilt every normal).
+const BUMP_KEYS: &[&str] = &["map_Bump", "map_bump", "bump"];
 
 /// Where the texture an MTL file names is (relative to the MTL's directory `dir`), if it is
 /// there: as written, or with Windows separators (`.\tex.jpg`, `maps\wood.png`, which a
@@ -104,7 +110,13 @@ fn scan_mtl(text: &str, dir: &Path) -> std::result::Result<Vec<String>, String> 
                         return Err(format!("line {ln}: {key} names no texture file"));
                     }
                     let name = texture_file_name(value);
-                    if resolve_texture(dir, name).is_none() {
+                    if BUMP_KEYS.contains(&key) {
+                        notes.push(format!(
+                            "line {ln}: {key} '{name}' is a bump (height) map, which lucent \
+                             does not render: ignored (a tangent-space normal map is `norm`, \
+                             or the scene's `normal_texture`)"
+                        ));
+                    } else if resolve_texture(dir, name).is_none() {
                         notes.push(format!(
                             "line {ln}: texture '{name}' ({key}) not found (looked for {}): \
                              ignored, the material is drawn without it",
@@ -149,9 +161,10 @@ pub(super) fn load_mtl_file(
                 .diffuse_texture
                 .as_deref()
                 .and_then(|t| resolve_texture(dir, texture_file_name(t))),
+            // `norm` (tobj keeps it among the keys it does not know).
             normal_texture: m
-                .normal_texture
-                .as_deref()
+                .unknown_param
+                .get("norm")
                 .and_then(|t| resolve_texture(dir, texture_file_name(t))),
         })
         .collect();
@@ -210,7 +223,7 @@ mod tests {
         std::fs::write(dir.join("wood.png"), b"not checked here").unwrap();
         std::fs::write(
             dir.join("good.mtl"),
-            "newmtl wood\nKd 0.5 0.25 1\nmap_Kd -s 1 1 1 wood.png\nbump wood.png\n",
+            "newmtl wood\nKd 0.5 0.25 1\nmap_Kd -s 1 1 1 wood.png\nnorm wood.png\n",
         )
         .unwrap();
         std::fs::write(dir.join("bad.mtl"), "newmtl x\nKd 0.5 0.5\n").unwrap();
@@ -252,13 +265,23 @@ mod tests {
         std::fs::write(dir.join("maps/wood.png"), b"not checked here").unwrap();
         std::fs::write(
             dir.join("win.mtl"),
-            "newmtl wood\nmap_Kd .\\wood.png\nbump maps\\wood.png\n",
+            "newmtl wood\nmap_Kd .\\wood.png\nnorm maps\\wood.png\n",
         )
         .unwrap();
         let (m, notes) = load_mtl(&dir.join("win.mtl")).unwrap();
         assert!(notes.is_empty(), "{notes:?}");
         assert_eq!(m[0].diffuse_texture, Some(dir.join("wood.png")));
         assert_eq!(m[0].normal_texture, Some(dir.join("maps/wood.png")));
+        // A bump (height) map is not a normal map: noted as not rendered, not read as one.
+        std::fs::write(dir.join("bump.mtl"), "newmtl wood\nbump wood.png\n").unwrap();
+        let (m, notes) = load_mtl(&dir.join("bump.mtl")).unwrap();
+        assert_eq!(m[0].normal_texture, None);
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains("line 2: bump 'wood.png' is a bump (height) map")),
+            "{notes:?}"
+        );
         std::fs::remove_dir_all(dir).ok();
     }
 }

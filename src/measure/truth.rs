@@ -26,6 +26,7 @@ use crate::{LucentError, Result};
 pub const ERODE_PIXELS: usize = 1;
 
 /// One truth: the scene, its path-traced radiance and which pixels are the object's.
+#[derive(Clone)]
 pub struct Truth {
     /// The scene's name (its file stem).
     pub name: String,
@@ -46,6 +47,25 @@ pub struct Truth {
     /// The truth's noise (half the relative difference of two seeds' 4x4-pixel block means),
     /// from the JSON (when it says).
     pub noise: Option<f64>,
+    /// Parts of the frame measured apart as well (`truths/NAME.regions.toml`).
+    pub regions: Vec<TruthRegion>,
+}
+
+/// A part of a truth's frame measured on its own as well as with the rest (a head's ear: the
+/// thin part where screen-space diffusion and the truth differ most), from
+/// `truths/NAME.regions.toml`:
+///
+/// ```toml
+/// [[region]]
+/// name = "ear"             # letters, digits, '-' and '_'
+/// rect = [154, 80, 184, 130] # x0, y0, x1, y1 in the truth's pixels (x1, y1 excluded)
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TruthRegion {
+    /// Its name (the report's `NAME-REGION`).
+    pub name: String,
+    /// `[x0, y0, x1, y1]`, pixels of the truth's size, the ends excluded.
+    pub rect: [u32; 4],
 }
 
 impl Truth {
@@ -53,6 +73,90 @@ impl Truth {
     pub fn object_pixels(&self) -> usize {
         self.mask.iter().filter(|&&m| m).count()
     }
+
+    /// This truth measured over `region` only (its object pixels inside the rectangle), named
+    /// `NAME-REGION`, without regions of its own.
+    pub fn region(&self, region: &TruthRegion) -> Truth {
+        let [x0, y0, x1, y1] = region.rect.map(|v| v as usize);
+        let width = self.width as usize;
+        let mask = self
+            .mask
+            .iter()
+            .enumerate()
+            .map(|(i, &m)| {
+                let (x, y) = (i % width, i / width);
+                m && (x0..x1).contains(&x) && (y0..y1).contains(&y)
+            })
+            .collect();
+        Truth {
+            name: format!("{}-{}", self.name, region.name),
+            mask,
+            regions: Vec::new(),
+            ..self.clone()
+        }
+    }
+}
+
+/// The regions of truth `name` in `truths` (none without a regions file); each must have a
+/// name of letters, digits, `-` and `_`, and a non-empty rectangle inside `width` x `height`.
+/// Errors name the file.
+pub fn load_regions(
+    truths: &Path,
+    name: &str,
+    width: u32,
+    height: u32,
+) -> Result<Vec<TruthRegion>> {
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Regions {
+        region: Vec<RegionToml>,
+    }
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct RegionToml {
+        name: String,
+        rect: [u32; 4],
+    }
+    let path = truths.join(format!("{name}.regions.toml"));
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    let bytes = crate::files::read_capped(&path, 1 << 20, "regions file")
+        .map_err(|e| LucentError::file(&path, e))?;
+    let text = String::from_utf8(bytes).map_err(|_| LucentError::file(&path, "not UTF-8"))?;
+    let parsed: Regions =
+        toml::from_str(&text).map_err(|e| LucentError::file(&path, e.message().to_string()))?;
+    parsed
+        .region
+        .into_iter()
+        .map(|r| {
+            let [x0, y0, x1, y1] = r.rect;
+            let named = !r.name.is_empty()
+                && r.name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+            if !named {
+                return Err(LucentError::file(
+                    &path,
+                    format!("region name '{}': use letters, digits, '-' and '_'", r.name),
+                ));
+            }
+            if !(x0 < x1 && y0 < y1 && x1 <= width && y1 <= height) {
+                return Err(LucentError::file(
+                    &path,
+                    format!(
+                        "region '{}': rect {:?} is not a non-empty rectangle inside the \
+                         truth's {width}x{height} pixels",
+                        r.name, r.rect
+                    ),
+                ));
+            }
+            Ok(TruthRegion {
+                name: r.name,
+                rect: r.rect,
+            })
+        })
+        .collect()
 }
 
 /// A lucent frame measured against a truth.
@@ -151,6 +255,7 @@ pub fn load_truth(dir: &Path, name: &str) -> Result<Truth> {
         })
         .transpose()?;
     let field = |key: &str| json.as_ref().and_then(|j| j.get(key).cloned());
+    let regions = load_regions(&truths, name, width, height)?;
     Ok(Truth {
         name: name.to_string(),
         scene_path,
@@ -161,6 +266,7 @@ pub fn load_truth(dir: &Path, name: &str) -> Result<Truth> {
         mask,
         spp: field("spp_total").and_then(|v| v.as_u64()),
         noise: field("noise_4x4").and_then(|v| v.as_f64()),
+        regions,
     })
 }
 
@@ -270,5 +376,64 @@ mod tests {
         let eroded = object_mask(&coverage, 5, 5, 1);
         assert_eq!(eroded.iter().filter(|&&m| m).count(), 1);
         assert!(eroded[12]);
+    }
+
+    #[test]
+    fn regions_are_read_checked_and_cut_the_mask() {
+        let dir = std::env::temp_dir().join(format!("lucent-regions-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |text: &str| std::fs::write(dir.join("t.regions.toml"), text).unwrap();
+        assert_eq!(load_regions(&dir, "t", 8, 6).unwrap(), Vec::new());
+        write("[[region]]\nname = \"ear\"\nrect = [2, 1, 5, 4]\n");
+        let regions = load_regions(&dir, "t", 8, 6).unwrap();
+        assert_eq!(
+            regions,
+            [TruthRegion {
+                name: "ear".into(),
+                rect: [2, 1, 5, 4]
+            }]
+        );
+        for (bad, says) in [
+            (
+                "[[region]]\nname = \"ear\"\nrect = [2, 1, 9, 4]\n",
+                "inside the truth's 8x6",
+            ),
+            (
+                "[[region]]\nname = \"ear\"\nrect = [5, 1, 5, 4]\n",
+                "non-empty",
+            ),
+            (
+                "[[region]]\nname = \"the ear\"\nrect = [2, 1, 5, 4]\n",
+                "letters, digits",
+            ),
+            ("[[region]]\nname = \"ear\"\n", "rect"),
+        ] {
+            write(bad);
+            let e = load_regions(&dir, "t", 8, 6).unwrap_err().to_string();
+            assert!(
+                e.contains("t.regions.toml") && e.contains(says),
+                "{bad}: {e}"
+            );
+        }
+        // The region's mask is the object's mask inside the rectangle.
+        let truth = Truth {
+            name: "t".into(),
+            scene_path: dir.join("t.toml"),
+            scene: crate::scene::builtin("smoke").unwrap(),
+            width: 8,
+            height: 6,
+            radiance: vec![1.0; 8 * 6 * 4],
+            mask: (0..48).map(|i| i % 8 != 3).collect(),
+            spp: None,
+            noise: None,
+            regions,
+        };
+        let ear = truth.region(&truth.regions[0]);
+        assert_eq!(ear.name, "t-ear");
+        assert!(ear.regions.is_empty());
+        // Rows 1-3, columns 2 and 4 (column 3 is not the object's).
+        assert_eq!(ear.object_pixels(), 6);
+        assert!(ear.mask[8 + 2] && !ear.mask[8 + 3] && ear.mask[3 * 8 + 4] && !ear.mask[4 * 8 + 2]);
+        std::fs::remove_dir_all(dir).ok();
     }
 }

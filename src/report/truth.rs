@@ -2,7 +2,9 @@
 //! scene, as (error against the truth, milliseconds); which technique comes closest to the
 //! light transport it imitates under a few cost budgets.
 //!
-//! For each truth of the truth directory (`tools/truth`, [`crate::measure::truth`]):
+//! For each truth of the truth directory (`tools/truth`, [`crate::measure::truth`]), and for
+//! each region a truth names (`truths/NAME.regions.toml`: a head's ear, measured on its own as
+//! `NAME-REGION` from the same frames):
 //! - **error**: every variant renders the scene once at the truth's size; its linear HDR frame
 //!   is measured against the truth over the object's pixels: relative mean absolute error,
 //!   energy per channel, and FLIP after the scene's tonemap.
@@ -306,27 +308,50 @@ pub fn run(
             opts.warmup,
             |_, _| {},
         )?;
-        let results = variants
+        let results = |truth: &Truth| -> Vec<TruthResult> {
+            variants
+                .iter()
+                .zip(&frames)
+                .zip(&timed)
+                .map(|((variant, hdr), timed)| TruthResult {
+                    variant: variant.clone(),
+                    error: hdr
+                        .as_ref()
+                        .map_err(Clone::clone)
+                        .and_then(|hdr| measure(truth, hdr).map_err(|e| e.to_string())),
+                    renders_as_none: variant.technique != Technique::None
+                        && hdr.as_ref().ok().zip(plain).is_some_and(|(a, b)| a == b),
+                    frame: timed.wall(),
+                })
+                .collect()
+        };
+        // Each region of the frame (a head's ear) is a row of its own: the same frames and
+        // times, measured over its pixels only.
+        let parts: Vec<SceneResults> = truth
+            .regions
             .iter()
-            .zip(&frames)
-            .zip(&timed)
-            .map(|((variant, hdr), timed)| TruthResult {
-                variant: variant.clone(),
-                error: hdr
-                    .as_ref()
-                    .map_err(Clone::clone)
-                    .and_then(|hdr| measure(&truth, hdr).map_err(|e| e.to_string())),
-                renders_as_none: variant.technique != Technique::None
-                    && hdr.as_ref().ok().zip(plain).is_some_and(|(a, b)| a == b),
-                frame: timed.wall(),
+            .map(|region| {
+                let part = truth.region(region);
+                let [x0, y0, x1, y1] = region.rect;
+                SceneResults {
+                    results: results(&part),
+                    truth: part,
+                    description: format!(
+                        "`{}` measured over its {} only (pixels x {x0}..{x1}, y {y0}..{y1} of \
+                         the truth's frame): {description}",
+                        truth.name, region.name
+                    ),
+                    timed_size,
+                }
             })
             .collect();
         out.push(SceneResults {
+            results: results(&truth),
             truth,
             description,
             timed_size,
-            results,
         });
+        out.extend(parts);
     }
     Ok(out)
 }

@@ -8,7 +8,7 @@ use std::path::{Component, Path, PathBuf};
 use std::sync::Arc;
 
 use ::gltf::json;
-use ::gltf::json::validation::{Error as ValidationError, Validate};
+use ::gltf::json::validation::{Checked, Error as ValidationError, Validate};
 
 /// Largest `.gltf`/`.glb` file, and largest buffer or image file it names (2 GiB, the OBJ
 /// loader's cap).
@@ -80,6 +80,11 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
         return Err(format!(
             "truncated GLB: its header says {length} bytes, the file has {}",
             bytes.len()
+        ));
+    }
+    if length < 12 {
+        return Err(format!(
+            "truncated GLB: its header says {length} bytes, less than the 12-byte header itself"
         ));
     }
     if length < bytes.len() {
@@ -175,6 +180,26 @@ fn check_required_extensions(root: &json::Root) -> Result<(), String> {
 /// error as a message naming the JSON path. The crate refuses required extensions it was
 /// not built to parse; [`check_required_extensions`] decided those already.
 fn validate(root: &json::Root) -> Result<(), String> {
+    // The crate's check that POSITION has `min` and `max` indexes the accessors without a
+    // bound check (gltf-json 1.4.1 mesh.rs): the index is checked here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, accessor) in &primitive.attributes {
+                if accessor.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => format!("{s:?}"),
+                        Checked::Invalid => "?".into(),
+                    };
+                    return Err(format!(
+                        "invalid glTF: meshes[{m}].primitives[{p}].attributes ({name}): \
+                         accessors[{}] does not exist ({} accessors)",
+                        accessor.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, json::Path::new, &mut |path, error| {
         errors.push((path(), error));

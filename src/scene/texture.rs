@@ -815,8 +815,8 @@ pub fn scale_normals(image: DynamicImage, scale: f32) -> DynamicImage {
         let mut rgba = image.into_rgba8();
         for p in rgba.pixels_mut() {
             let c = scaled([0, 1, 2].map(|i| f32::from(p.0[i]) / 255.0));
-            for i in 0..3 {
-                p.0[i] = (c[i] * 255.0).round().clamp(0.0, 255.0) as u8;
+            for (stored, value) in p.0.iter_mut().zip(c) {
+                *stored = (value * 255.0).round().clamp(0.0, 255.0) as u8;
             }
         }
         DynamicImage::ImageRgba8(rgba)

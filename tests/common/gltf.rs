@@ -58,7 +58,7 @@ impl GltfBuilder {
 
     /// A buffer view of `bytes` (4-byte aligned in the buffer).
     pub fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -180,11 +180,11 @@ impl GltfBuilder {
     /// The asset as a `.glb`: header, JSON chunk, BIN chunk.
     pub fn glb(&self) -> Vec<u8> {
         let mut json = self.json_with_buffer(None).to_string().into_bytes();
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + json.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };

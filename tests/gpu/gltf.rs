@@ -74,7 +74,7 @@ fn camera_and_light_toml(scene: &Scene) -> String {
 /// Renders both scenes and checks they are within 1/255; returns the difference.
 fn same_frame(test: &TestGpu, gltf: &Scene, toml: &Scene, name: &str) -> u8 {
     let settings = FrameSettings::new(W, H);
-    let a = test.render(gltf, settings.clone()).display;
+    let a = test.render(gltf, settings).display;
     let b = test.render(toml, settings).display;
     let d = max_difference(&a, &b);
     // Not a black frame: the asset is in view and lit.

@@ -118,7 +118,7 @@ impl<'a> Accessors<'a> {
                          {what}: its elements would overlap"
                     ));
                 }
-                if s > MAX_STRIDE || s % component_bytes(component) != 0 {
+                if s > MAX_STRIDE || !s.is_multiple_of(component_bytes(component)) {
                     return Err(format!(
                         "{view_what}: byteStride {s} must be a multiple of {} and at most \
                          {MAX_STRIDE}",

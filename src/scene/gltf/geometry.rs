@@ -150,7 +150,7 @@ pub fn primitive(
         }
         (_, false) => generate_tangents(&positions, &normals, &uvs, &indices),
     };
-    for (semantic, _) in &primitive.attributes {
+    for semantic in primitive.attributes.keys() {
         let name = match semantic {
             Checked::Valid(Semantic::Positions | Semantic::Normals) => continue,
             Checked::Valid(Semantic::Tangents) if !uvs.is_empty() => continue,

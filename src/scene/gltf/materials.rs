@@ -421,7 +421,7 @@ fn convert(
                 "KHR_materials_ior" => {
                     let mut f = fields;
                     if let Some(v) = f.number("ior")? {
-                        if !(v >= 1.0 && v <= 10.0) {
+                        if !(1.0..=10.0).contains(&v) {
                             return Err(format!(
                                 "{}.ior: {v} must be in [1, 10] (lucent does not read ior 0, \
                                  the extension's fully reflective special case)",
@@ -573,7 +573,7 @@ fn convert(
                     ));
                 }
                 let g = s.number("scatterAnisotropy")?.unwrap_or(0.0);
-                if !(g.abs() < 1.0) {
+                if g.abs() >= 1.0 {
                     return Err(format!(
                         "{}.scatterAnisotropy: {g} must be in (-1, 1)",
                         s.what

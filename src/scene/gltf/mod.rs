@@ -196,10 +196,12 @@ fn load(path: &Path, options: &GltfOptions) -> std::result::Result<GltfAsset, St
                 .ok_or_else(|| format!("{what}: meshes[{m}] does not exist"))?;
             for (p, primitive) in mesh.primitives.iter().enumerate() {
                 let key = primitive.material.map(|i| i.value());
-                if !converted.contains_key(&key) {
-                    converted.insert(key, materials.convert(key)?);
-                }
-                let material = &converted[&key];
+                let material = match converted.entry(key) {
+                    std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                    std::collections::hash_map::Entry::Vacant(e) => {
+                        e.insert(materials.convert(key)?)
+                    }
+                };
                 let index = match mesh_of.get(&(m, p)) {
                     Some(&i) => i,
                     None => {

@@ -155,42 +155,42 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
 
 /// Samples each thickness texture into the vertex colours of the meshes drawn with it.
 fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
-    let mut done: Vec<(usize, std::path::PathBuf)> = Vec::new();
+    let mut done: Vec<(usize, material::TextureSource)> = Vec::new();
     for object in &scene.objects {
         let Some(material::ThicknessSource::Texture(source)) =
             object.material.translucency.as_ref().map(|t| &t.thickness)
         else {
             continue;
         };
-        let material::TextureSource::File(path) = source else {
+        if let material::TextureSource::Procedural(_) = source {
             return Err(crate::LucentError::InvalidInput(format!(
                 "material '{}': a procedural texture cannot be a thickness map",
                 object.material.name
             )));
-        };
-        if done.iter().any(|(m, p)| *m == object.mesh && p == path) {
+        }
+        if done.iter().any(|(m, s)| *m == object.mesh && s == source) {
             continue;
         }
         let mesh = &scene.meshes[object.mesh];
         if let Some((m, other)) = done.iter().find(|(m, _)| *m == object.mesh) {
             return Err(crate::LucentError::InvalidInput(format!(
                 "mesh {m} is drawn with two thickness textures ({} and {}); give each its own mesh",
-                other.display(),
-                path.display()
+                other.describe(),
+                source.describe()
             )));
         }
         if mesh.uvs.len() != mesh.positions.len() {
-            return Err(crate::LucentError::file(
-                path,
-                format!(
-                    "thickness texture of material '{}': its mesh has no texture coordinates",
-                    object.material.name
-                ),
-            ));
+            return Err(crate::LucentError::InvalidInput(format!(
+                "{}: thickness texture of material '{}': its mesh has no texture coordinates",
+                source.describe(),
+                object.material.name
+            )));
         }
         // As stored (its decoded size in memory): the vertices sample it bilinearly, no mip or
         // f32 copy is ever needed.
-        let texture = texture::decode_texture(path, texture::TextureUsage::Data)?;
+        let Some(texture) = source.decode(texture::TextureUsage::Data)? else {
+            continue;
+        };
         let colors = mesh
             .uvs
             .iter()
@@ -201,7 +201,7 @@ fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
             })
             .collect();
         scene.meshes[object.mesh].colors = colors;
-        done.push((object.mesh, path.clone()));
+        done.push((object.mesh, source.clone()));
     }
     Ok(())
 }

@@ -384,10 +384,7 @@ fn layered_lines(l: &crate::scene::layered::LayeredMedium) -> String {
 }
 
 fn texture_name(t: &crate::scene::material::TextureSource) -> String {
-    match t {
-        crate::scene::material::TextureSource::File(p) => p.display().to_string(),
-        crate::scene::material::TextureSource::Procedural(p) => format!("{p:?}"),
-    }
+    t.describe()
 }
 
 /// Appends one line per material.

@@ -369,24 +369,32 @@ pub fn upload_texture_file(
     name: &str,
 ) -> Result<GpuImage> {
     let decoded = decode_texture(path, usage)?;
-    warn_non_finite(path, &decoded);
+    upload_decoded(gpu, decoded, &path.display().to_string(), name)
+}
+
+/// Uploads an image decoded as stored ([`upload_texture_file`]'s way); `what` names its
+/// source in the warning about non-finite texels.
+fn upload_decoded(
+    gpu: &GpuContext,
+    decoded: crate::scene::texture::DecodedImage,
+    what: &str,
+    name: &str,
+) -> Result<GpuImage> {
+    warn_non_finite(what, &decoded);
     let (width, height, layout) = (decoded.width, decoded.height, decoded.upload_layout());
     upload_chain(gpu, width, height, layout, name, move |out| {
         crate::scene::texture::write_texture_chain(decoded, out)
     })
 }
 
-fn warn_non_finite(path: &std::path::Path, decoded: &crate::scene::texture::DecodedImage) {
+fn warn_non_finite(what: &str, decoded: &crate::scene::texture::DecodedImage) {
     let replaced = decoded.non_finite();
     if replaced > 0 {
-        log::warn!(
-            "{}: replaced {replaced} NaN or infinite texel values with 0",
-            path.display()
-        );
+        log::warn!("{what}: replaced {replaced} NaN or infinite texel values with 0");
     }
 }
 
-/// Uploads a map of `usage` from `source`: a file through [`upload_texture_file`], a
+/// Uploads a map of `usage` from `source`: a file or an encoded image decoded as stored, a
 /// procedural texture through [`upload_texture`].
 fn upload_source(
     gpu: &GpuContext,
@@ -396,6 +404,12 @@ fn upload_source(
 ) -> Result<GpuImage> {
     match source {
         TextureSource::File(path) => upload_texture_file(gpu, path, usage, name),
+        TextureSource::Encoded(e) => upload_decoded(
+            gpu,
+            crate::scene::texture::decode_encoded(e, usage)?,
+            &source.describe(),
+            name,
+        ),
         TextureSource::Procedural(p) => {
             upload_texture(gpu, &procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?, name)
         }
@@ -642,14 +656,20 @@ impl SceneGpu {
             let sources = distinct_sources(scene, |o| o.material.normal_texture.as_ref());
             for (i, source) in sources.iter().enumerate() {
                 let name = format!("{} normal map {i}", scene.name);
-                match source {
-                    TextureSource::File(path) if lean => {
+                // A file or an encoded image in a LEAN frame: decoded as stored (procedural
+                // maps are made, not decoded).
+                let decoded = match source {
+                    TextureSource::Procedural(_) => None,
+                    _ if lean => source.decode(TextureUsage::Data)?,
+                    _ => None,
+                };
+                match (decoded, source) {
+                    (Some(normals), _) => {
                         // The LEAN maps straight from the decoded file into their staging
                         // buffers: no f32 copy of the normal map or of either LEAN map. Map 2
                         // holds one value (M.xy), so it is one fp16 channel (sampled as
                         // (r, 0, 0, 1), what the four-channel map stored).
-                        let normals = decode_texture(path, TextureUsage::Data)?;
-                        warn_non_finite(path, &normals);
+                        warn_non_finite(&source.describe(), &normals);
                         let (w, h) = (normals.width, normals.height);
                         for (which, layout) in [(1, UploadLayout::Half), (2, UploadLayout::HalfRed)]
                         {
@@ -666,16 +686,16 @@ impl SceneGpu {
                             }
                         }
                     }
-                    TextureSource::File(_) => {
-                        maps.normal
-                            .push(upload_source(gpu, source, TextureUsage::Data, &name)?);
-                    }
-                    TextureSource::Procedural(p) => {
+                    (None, TextureSource::Procedural(p)) => {
                         push(
                             maps,
                             &procedural_texture(p, PROCEDURAL_TEXTURE_SIZE)?,
                             &name,
                         )?;
+                    }
+                    (None, _) => {
+                        maps.normal
+                            .push(upload_source(gpu, source, TextureUsage::Data, &name)?);
                     }
                 }
             }

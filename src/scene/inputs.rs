@@ -2,7 +2,7 @@
 //! against ([`crate::files::check_outputs`]), so `render --scene s.toml --out s.toml` or an
 //! output onto the scene's normal map is refused before any work.
 //!
-//! This reads only the keys that name files (`[[mesh]] obj`, `[[material]] albedo_texture`,
+//! This reads only the keys that name files (`[[mesh]] obj` and `gltf`, `[[material]] albedo_texture`,
 //! `normal_texture`, `translucency.thickness` when it is a path, `[environment] file`; see
 //! `docs/scene-format.toml`), resolved against the scene file's directory as the loader
 //! resolves them. A file that does not parse names only itself: the loader reports the error.
@@ -55,11 +55,13 @@ pub fn scene_inputs(name_or_path: &str) -> Vec<(String, PathBuf)> {
             .to_string()
     };
     for mesh in entries("mesh") {
-        if let Some(obj) = mesh.get("obj").and_then(toml::Value::as_str) {
-            inputs.push((
-                format!("the mesh of [[mesh]] '{}'", name_of(&mesh)),
-                resolve(obj),
-            ));
+        for key in ["obj", "gltf"] {
+            if let Some(file) = mesh.get(key).and_then(toml::Value::as_str) {
+                inputs.push((
+                    format!("the mesh of [[mesh]] '{}'", name_of(&mesh)),
+                    resolve(file),
+                ));
+            }
         }
     }
     if let Some(file) = table

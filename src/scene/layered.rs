@@ -41,7 +41,7 @@
 
 use glam::Vec3;
 
-use super::texture::{load_texture, Texture, TextureSource, TextureUsage};
+use super::texture::{Texture, TextureSource, TextureUsage};
 use crate::{LucentError, Result};
 
 /// Most layers a medium may have (two RGBA depth textures).
@@ -474,12 +474,7 @@ impl LayeredMedium {
     pub fn load_depth_textures(&self) -> Result<Vec<Texture>> {
         self.depth_textures
             .iter()
-            .map(|t| match t {
-                TextureSource::File(p) => load_texture(p, TextureUsage::Data),
-                TextureSource::Procedural(p) => {
-                    super::texture::procedural_texture(p, super::texture::PROCEDURAL_TEXTURE_SIZE)
-                }
-            })
+            .map(|t| super::texture::load_source(t, TextureUsage::Data))
             .collect()
     }
 

@@ -10,6 +10,7 @@ pub mod builtin;
 pub mod environment;
 pub mod file;
 pub mod generators;
+pub mod gltf;
 pub mod inputs;
 pub mod layered;
 pub mod lean;

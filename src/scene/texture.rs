@@ -25,6 +25,7 @@
 //! `f32` copy) for what samples it on the CPU: thickness maps, `lucent inspect`, the upload.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::Vec3;
 use image::{DynamicImage, ImageReader, Limits};
@@ -42,6 +43,82 @@ pub enum TextureSource {
     File(PathBuf),
     /// Made in code, so built-in scenes need no file from outside the repository.
     Procedural(ProceduralTexture),
+    /// An encoded image (PNG, JPEG, ...) held in memory: what a glTF asset's images are
+    /// (a data URI, a GLB buffer view, or a file its loader read), decoded with the same
+    /// checks and limits as a file.
+    Encoded(EncodedImage),
+}
+
+/// An encoded image held in memory ([`TextureSource::Encoded`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EncodedImage {
+    /// The file it came from (a glTF asset): errors name it.
+    pub file: PathBuf,
+    /// Which image of that file it is (`image 2 "skin"`): errors name it after the file.
+    pub name: String,
+    /// The encoded bytes, shared by every material that uses the image.
+    pub bytes: Arc<[u8]>,
+    /// For a tangent-space normal map, the factor its x and y are scaled by once decoded
+    /// (glTF's `normalTexture.scale`: `normalize((2 c - 1) * (s, s, 1))`, then stored back as
+    /// `n / 2 + 1 / 2`); 1 leaves the texels as stored.
+    pub normal_scale: f32,
+}
+
+impl EncodedImage {
+    /// An error about this image: names the file, then the image.
+    pub fn error(&self, message: impl std::fmt::Display) -> LucentError {
+        LucentError::file(&self.file, format!("{}: {message}", self.name))
+    }
+
+    /// The size the image's header declares, after the checks a file gets (not empty, a known
+    /// format) and [`check_texture_size`]'s limits; nothing is decoded.
+    pub fn dimensions(&self) -> Result<(u32, u32)> {
+        let (width, height) = self
+            .reader()?
+            .into_dimensions()
+            .map_err(|e| self.error(format!("corrupt or unsupported image: {e}")))?;
+        match texture_size_problem(width, height) {
+            Some(problem) => Err(self.error(problem)),
+            None => Ok((width, height)),
+        }
+    }
+
+    fn reader(&self) -> Result<ImageReader<std::io::Cursor<&[u8]>>> {
+        if self.bytes.is_empty() {
+            return Err(self.error("image is empty (0 bytes)"));
+        }
+        let reader = ImageReader::new(std::io::Cursor::new(&self.bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| self.error(format!("cannot read image: {e}")))?;
+        if reader.format().is_none() {
+            return Err(self.error(
+                "not an image: format not recognised (supported: PNG, JPEG, TGA, EXR, HDR)",
+            ));
+        }
+        Ok(reader)
+    }
+}
+
+impl TextureSource {
+    /// What logs and errors call it: the file's path, the procedural texture, or the encoded
+    /// image's file and name.
+    pub fn describe(&self) -> String {
+        match self {
+            TextureSource::File(path) => path.display().to_string(),
+            TextureSource::Procedural(p) => format!("{p:?}"),
+            TextureSource::Encoded(e) => format!("{}: {}", e.file.display(), e.name),
+        }
+    }
+
+    /// The image decoded as stored ([`decode_texture`], or [`decode_encoded`]); `None` for a
+    /// procedural texture, which is made, not decoded.
+    pub fn decode(&self, usage: TextureUsage) -> Result<Option<DecodedImage>> {
+        match self {
+            TextureSource::File(path) => decode_texture(path, usage).map(Some),
+            TextureSource::Encoded(e) => decode_encoded(e, usage).map(Some),
+            TextureSource::Procedural(_) => Ok(None),
+        }
+    }
 }
 
 /// Textures lucent can make itself.
@@ -349,10 +426,17 @@ pub fn texture_dimensions(path: &Path) -> Result<(u32, u32)> {
 /// side or more than [`MAX_TEXTURE_TEXELS`] texels. The message names the size, the limit and
 /// what the image would cost.
 pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
+    match texture_size_problem(width, height) {
+        Some(problem) => Err(LucentError::file(path, problem)),
+        None => Ok(()),
+    }
+}
+
+/// What [`check_texture_size`] says about a `width x height` image, or `None` when it fits.
+fn texture_size_problem(width: u32, height: u32) -> Option<String> {
     if width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
-        return Err(LucentError::file(
-            path,
-            format!("image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"),
+        return Some(format!(
+            "image is {width}x{height}, larger than {MAX_TEXTURE_SIZE} per side"
         ));
     }
     let texels = u64::from(width) * u64::from(height);
@@ -362,20 +446,17 @@ pub fn check_texture_size(path: &Path, width: u32, height: u32) -> Result<()> {
             super::upload::level_bytes(width, height, super::upload::UploadLayout::Unorm8)
                 .iter()
                 .sum();
-        return Err(LucentError::file(
-            path,
-            format!(
-                "image is {width}x{height} ({texels} texels), more than the {MAX_TEXTURE_TEXELS} \
-                 texels (8192x8192) a texture may have: it would take {} on the GPU as 8-bit \
-                 RGBA with mips (twice that while loading; a 16-bit or float file twice that \
-                 again) and {} of host memory as linear RGBA f32 where the CPU computes with \
-                 it; scale it down to at most 8192x8192",
-                crate::error::format_bytes(gpu),
-                crate::error::format_bytes(cost)
-            ),
+        return Some(format!(
+            "image is {width}x{height} ({texels} texels), more than the {MAX_TEXTURE_TEXELS} \
+             texels (8192x8192) a texture may have: it would take {} on the GPU as 8-bit \
+             RGBA with mips (twice that while loading; a 16-bit or float file twice that \
+             again) and {} of host memory as linear RGBA f32 where the CPU computes with \
+             it; scale it down to at most 8192x8192",
+            crate::error::format_bytes(gpu),
+            crate::error::format_bytes(cost)
         ));
     }
-    Ok(())
+    None
 }
 
 /// The image files `scene` uploads as textures (its materials' normal and albedo maps), each
@@ -392,14 +473,26 @@ pub fn scene_texture_sizes(
         let m = &object.material;
         let maps = [(&m.normal_texture, true), (&m.albedo_texture, false)];
         for (source, normal) in maps {
-            let Some(TextureSource::File(path)) = source else {
-                continue;
+            let (path, (width, height)) = match source {
+                Some(TextureSource::File(path)) => {
+                    if sizes.iter().any(|(p, _, _, n)| p == path && *n == normal) {
+                        continue;
+                    }
+                    let size = texture_dimensions(path)?;
+                    check_texture_size(path, size.0, size.1)?;
+                    (path.clone(), size)
+                }
+                Some(TextureSource::Encoded(e)) => {
+                    let name =
+                        PathBuf::from(source.as_ref().map_or(String::new(), |s| s.describe()));
+                    if sizes.iter().any(|(p, _, _, n)| *p == name && *n == normal) {
+                        continue;
+                    }
+                    (name, e.dimensions()?)
+                }
+                _ => continue,
             };
-            if sizes.iter().any(|(p, _, _, n)| p == path && *n == normal) {
-                continue;
-            }
-            let (width, height) = texture_dimensions(path)?;
-            check_texture_size(path, width, height)?;
+            let path = &path;
             if let Some(limit) = max_dimension.filter(|&l| width > l || height > l) {
                 return Err(LucentError::file(
                     path,
@@ -431,6 +524,24 @@ pub fn scene_texture_sizes(
 pub fn load_texture(path: &Path, usage: TextureUsage) -> Result<Texture> {
     let (width, height, texels) = decode(path, usage)?;
     Texture::from_texels(&path.display().to_string(), width, height, usage, texels)
+}
+
+/// Loads any texture source as [`load_texture`] loads a file: a file, an encoded image (the
+/// same checks and limits) or a procedural texture made at [`PROCEDURAL_TEXTURE_SIZE`].
+pub fn load_source(source: &TextureSource, usage: TextureUsage) -> Result<Texture> {
+    match source {
+        TextureSource::File(path) => load_texture(path, usage),
+        TextureSource::Procedural(p) => procedural_texture(p, PROCEDURAL_TEXTURE_SIZE),
+        TextureSource::Encoded(e) => {
+            let decoded = decode_encoded(e, usage)?;
+            let (texels, replaced) = decoded.texels();
+            let what = source.describe();
+            if replaced > 0 {
+                log::warn!("{what}: replaced {replaced} NaN or infinite texel values with 0");
+            }
+            Texture::from_texels(&what, decoded.width, decoded.height, usage, texels)
+        }
+    }
 }
 
 /// An image file decoded but kept in the layout it was stored in (8- or 16-bit integers, or
@@ -645,7 +756,29 @@ pub fn decode_texture(path: &Path, usage: TextureUsage) -> Result<DecodedImage> 
     // Read the header alone first, so an absurd size is refused before anything is allocated.
     let (width, height) = texture_dimensions(path)?;
     check_texture_size(path, width, height)?;
-    let mut reader = open_image(path)?;
+    let reader = open_image(path)?;
+    let image = decode_limited(reader).map_err(|e| corrupt(path, e))?;
+    Ok(DecodedImage::new(image, usage))
+}
+
+/// Decodes an encoded image held in memory with the checks and limits of [`decode_texture`]
+/// (its header's size first), then scales a normal map's x and y by its `normal_scale`.
+pub fn decode_encoded(encoded: &EncodedImage, usage: TextureUsage) -> Result<DecodedImage> {
+    encoded.dimensions()?;
+    let image = decode_limited(encoded.reader()?)
+        .map_err(|e| encoded.error(format!("corrupt or unsupported image: {e}")))?;
+    let image = if encoded.normal_scale == 1.0 {
+        image
+    } else {
+        scale_normals(image, encoded.normal_scale)
+    };
+    Ok(DecodedImage::new(image, usage))
+}
+
+/// Decodes what `reader` reads, allocating no more than the largest accepted image needs.
+fn decode_limited<R: std::io::BufRead + std::io::Seek>(
+    mut reader: ImageReader<R>,
+) -> std::result::Result<DynamicImage, image::ImageError> {
     let mut limits = Limits::default();
     limits.max_image_width = Some(MAX_TEXTURE_SIZE);
     limits.max_image_height = Some(MAX_TEXTURE_SIZE);
@@ -653,28 +786,75 @@ pub fn decode_texture(path: &Path, usage: TextureUsage) -> Result<DecodedImage> 
     // decoder may not allocate more, whatever the header said.
     limits.max_alloc = Some(MAX_TEXTURE_TEXELS * 16);
     reader.limits(limits);
-    let image = reader.decode().map_err(|e| corrupt(path, e))?;
-    // Float formats (EXR, HDR) store linear values; 8/16-bit ones store sRGB for colours.
-    let stored_linear = matches!(
+    reader.decode()
+}
+
+/// A tangent-space normal map with x and y scaled by `scale` (glTF's `normalTexture.scale`):
+/// each texel `c` becomes `normalize((2 c - 1) * (scale, scale, 1)) / 2 + 1 / 2`. 8-bit maps
+/// stay 8-bit (rounded), anything else becomes RGBA `f32`. A texel whose scaled normal has no
+/// length (a zero texel at scale 0) becomes the flat normal.
+pub fn scale_normals(image: DynamicImage, scale: f32) -> DynamicImage {
+    let scaled = |c: [f32; 3]| -> [f32; 3] {
+        let n = Vec3::new(
+            (c[0] * 2.0 - 1.0) * scale,
+            (c[1] * 2.0 - 1.0) * scale,
+            c[2] * 2.0 - 1.0,
+        );
+        // Guarded where it is born: a zero or non-finite vector has no direction.
+        let n = n.try_normalize().unwrap_or(Vec3::Z);
+        (n * 0.5 + Vec3::splat(0.5)).to_array()
+    };
+    let eight_bit = matches!(
         image,
-        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+        DynamicImage::ImageLuma8(_)
+            | DynamicImage::ImageLumaA8(_)
+            | DynamicImage::ImageRgb8(_)
+            | DynamicImage::ImageRgba8(_)
     );
-    let srgb = usage == TextureUsage::Color && !stored_linear;
-    let lut = std::array::from_fn(|i| {
-        let v = i as f32 / 255.0;
-        if srgb {
-            srgb_to_linear(v)
-        } else {
-            v
+    if eight_bit {
+        let mut rgba = image.into_rgba8();
+        for p in rgba.pixels_mut() {
+            let c = scaled([0, 1, 2].map(|i| f32::from(p.0[i]) / 255.0));
+            for (stored, value) in p.0.iter_mut().zip(c) {
+                *stored = (value * 255.0).round().clamp(0.0, 255.0) as u8;
+            }
         }
-    });
-    Ok(DecodedImage {
-        width: image.width(),
-        height: image.height(),
-        image,
-        lut,
-        srgb,
-    })
+        DynamicImage::ImageRgba8(rgba)
+    } else {
+        let mut rgba = image.into_rgba32f();
+        for p in rgba.pixels_mut() {
+            let c = scaled([p.0[0], p.0[1], p.0[2]]);
+            p.0[..3].copy_from_slice(&c);
+        }
+        DynamicImage::ImageRgba32F(rgba)
+    }
+}
+
+impl DecodedImage {
+    /// `image` as [`decode_texture`] keeps it, its texels read as `usage` says.
+    fn new(image: DynamicImage, usage: TextureUsage) -> Self {
+        // Float formats (EXR, HDR) store linear values; 8/16-bit ones store sRGB for colours.
+        let stored_linear = matches!(
+            image,
+            DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+        );
+        let srgb = usage == TextureUsage::Color && !stored_linear;
+        let lut = std::array::from_fn(|i| {
+            let v = i as f32 / 255.0;
+            if srgb {
+                srgb_to_linear(v)
+            } else {
+                v
+            }
+        });
+        DecodedImage {
+            width: image.width(),
+            height: image.height(),
+            image,
+            lut,
+            srgb,
+        }
+    }
 }
 
 /// Decodes an image file to linear RGBA `f32` texels (level 0). The decoded image is dropped

@@ -6,7 +6,11 @@
 #[path = "../common/mod.rs"]
 #[allow(dead_code)] // the harness serves three binaries; this one does not use all of it
 mod common;
+#[path = "../common/gltf.rs"]
+#[allow(dead_code)] // shared with the GPU tests
+mod gltf_file;
 
+mod bad_gltf;
 mod bad_inputs;
 mod bench;
 mod demo;

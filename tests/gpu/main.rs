@@ -6,6 +6,9 @@
 #[path = "../common/mod.rs"]
 #[allow(dead_code)] // the harness serves three binaries; this one does not use all of it
 mod common;
+#[path = "../common/gltf.rs"]
+#[allow(dead_code)] // shared with the CLI tests
+mod gltf_file;
 
 mod antialias;
 mod burley;
@@ -19,6 +22,7 @@ mod embed_lean;
 mod embed_translucency;
 mod embed_transmission;
 mod environment;
+mod gltf;
 mod graph_gpu;
 mod layered;
 mod materials;

@@ -63,12 +63,28 @@ pub(super) fn camera(file: &SceneFile<'_>, cam: &CameraToml) -> Result<Camera> {
 /// The `[[mesh]]` tables: every mesh drawn, and each table's parts of it.
 pub(super) struct Meshes<'a> {
     pub(super) meshes: Vec<Mesh>,
-    /// Per table: the parts, each an index into `meshes` and the MTL material its faces use.
-    /// An OBJ whose faces use MTL materials with a colour or texture is one part per material
-    /// (each drawn with its `Kd` and `map_Kd`); every other mesh is one part.
-    parts: Vec<Vec<(usize, Option<ObjMaterial>)>>,
+    /// Per table: the parts. An OBJ whose faces use MTL materials with a colour or texture is
+    /// one part per material (each drawn with its `Kd` and `map_Kd`); a glTF asset one part
+    /// per primitive a node draws; every other mesh is one part.
+    parts: Vec<Vec<Part>>,
     /// The table of each mesh name.
     index: HashMap<&'a str, usize>,
+}
+
+/// One part of a `[[mesh]]`: an index into [`Meshes::meshes`] and where its material and
+/// placement come from.
+struct Part {
+    mesh: usize,
+    source: PartSource,
+}
+
+enum PartSource {
+    /// A generated mesh or an OBJ part without an MTL material.
+    Plain,
+    /// An OBJ part whose faces use this MTL material.
+    Mtl(ObjMaterial),
+    /// A glTF primitive: its node's transform (asset space) and its material.
+    Gltf(Mat4, Box<Material>),
 }
 
 /// The `[[mesh]]` tables: OBJ files loaded, generators run.
@@ -98,22 +114,55 @@ pub(super) fn meshes<'a>(file: &SceneFile<'_>, tables: &'a [MeshToml]) -> Result
                         format!("mesh file {} not found", obj_path.display()),
                     ));
                 }
+                if let Some(u) = &m.units_per_mm {
+                    return Err(at.error(
+                        "units_per_mm",
+                        Some(u.span()),
+                        "only a `gltf` mesh reads `units_per_mm` (its media's units)",
+                    ));
+                }
+                if m.gltf.is_some() {
+                    return Err(at.error(
+                        "gltf",
+                        span(&m.gltf),
+                        format!("mesh '{name}' needs exactly one of `obj`, `gltf` or `generator`"),
+                    ));
+                }
                 let loaded = obj::load_obj(&obj_path)?;
                 let mut parts = Vec::new();
                 if value(&m.mtl).unwrap_or(true) {
                     for (part, material) in loaded.parts() {
                         out.meshes.push(part);
-                        parts.push((out.meshes.len() - 1, material.cloned()));
+                        parts.push(Part {
+                            mesh: out.meshes.len() - 1,
+                            source: material
+                                .map_or(PartSource::Plain, |m| PartSource::Mtl(m.clone())),
+                        });
                     }
                 } else {
                     // `mtl = false`: one mesh, drawn with the objects' materials alone.
                     out.meshes.push(loaded.mesh);
-                    parts.push((out.meshes.len() - 1, None));
+                    parts.push(Part {
+                        mesh: out.meshes.len() - 1,
+                        source: PartSource::Plain,
+                    });
                 }
                 out.parts.push(parts);
                 continue;
             }
-            (None, Some(generator)) => {
+            (None, None) if m.gltf.is_some() => {
+                if let Some(mtl) = &m.mtl {
+                    return Err(at.error(
+                        "mtl",
+                        Some(mtl.span()),
+                        "`mtl` chooses whether an OBJ's MTL materials are used: a `gltf` \
+                         mesh's materials are its own (an [[object]]'s `material` replaces them)",
+                    ));
+                }
+                out.parts.push(gltf_parts(file, i, m, &mut out.meshes)?);
+                continue;
+            }
+            (None, Some(generator)) if m.gltf.is_none() && m.units_per_mm.is_none() => {
                 if let Some(mtl) = &m.mtl {
                     return Err(at.error(
                         "mtl",
@@ -145,14 +194,80 @@ pub(super) fn meshes<'a>(file: &SceneFile<'_>, tables: &'a [MeshToml]) -> Result
                 return Err(at.error(
                     "name",
                     Some(m.name.span()),
-                    format!("mesh '{name}' needs exactly one of `obj` or `generator`"),
+                    format!(
+                        "mesh '{name}' needs exactly one of `obj`, `gltf` or `generator` (and \
+                         `units_per_mm` only with `gltf`)"
+                    ),
                 ))
             }
         };
         out.meshes.push(mesh);
-        out.parts.push(vec![(out.meshes.len() - 1, None)]);
+        out.parts.push(vec![Part {
+            mesh: out.meshes.len() - 1,
+            source: PartSource::Plain,
+        }]);
     }
     Ok(out)
+}
+
+/// `[[mesh]]` number `i` with a `gltf` asset: its default scene's primitives, each a part
+/// placed by its node, with its material; the asset's cameras and lights are the scene
+/// file's business (warned about when the asset has them).
+fn gltf_parts(
+    file: &SceneFile<'_>,
+    i: usize,
+    m: &MeshToml,
+    meshes: &mut Vec<Mesh>,
+) -> Result<Vec<Part>> {
+    let at = file.table("mesh", Some(i));
+    let Some(given) = &m.gltf else {
+        return Ok(Vec::new());
+    };
+    let path = file.resolve(given.get_ref());
+    if !path.exists() {
+        return Err(at.error(
+            "gltf",
+            Some(given.span()),
+            format!("glTF file {} not found", path.display()),
+        ));
+    }
+    let mut options = crate::scene::gltf::GltfOptions::default();
+    if let Some(u) = &m.units_per_mm {
+        let v = *u.get_ref();
+        let range = crate::scene::layered::UNITS_PER_MM_RANGE;
+        if !(v.is_finite() && range.contains(&v)) {
+            return Err(at.error(
+                "units_per_mm",
+                Some(u.span()),
+                format!(
+                    "{v} must be in [{:e}, {:e}] (scene units per millimetre of the asset's \
+                     media: 0.001 when a unit is a metre, glTF's unit)",
+                    range.start(),
+                    range.end()
+                ),
+            ));
+        }
+        options.units_per_mm = v;
+    }
+    let asset = crate::scene::gltf::load_gltf(&path, &options)?;
+    if asset.camera.is_some() || !asset.lights.is_empty() {
+        log::warn!(
+            "{}: its camera and KHR_lights_punctual lights ignored: the scene file {} places \
+             the asset and lights it",
+            path.display(),
+            file.path.display()
+        );
+    }
+    let first = meshes.len();
+    meshes.extend(asset.meshes);
+    Ok(asset
+        .objects
+        .into_iter()
+        .map(|o| Part {
+            mesh: first + o.mesh,
+            source: PartSource::Gltf(o.transform, Box::new(o.material)),
+        })
+        .collect())
 }
 
 /// The `[[object]]` tables: each mesh part placed, with its material (`materials` by name;
@@ -175,17 +290,35 @@ pub(super) fn objects(
                 format!("no mesh named '{mesh_name}'"),
             )
         })?;
-        let material_name = o.material.get_ref();
-        let material = materials
-            .get(material_name.as_str())
-            .ok_or_else(|| {
-                at.error(
+        let parts = &meshes.parts[mesh_entry];
+        let gltf_mesh = parts
+            .iter()
+            .any(|p| matches!(p.source, PartSource::Gltf(..)));
+        let material = match &o.material {
+            Some(name) => Some(
+                materials
+                    .get(name.get_ref().as_str())
+                    .ok_or_else(|| {
+                        at.error(
+                            "material",
+                            Some(name.span()),
+                            format!("no material named '{}'", name.get_ref()),
+                        )
+                    })?
+                    .clone(),
+            ),
+            None if gltf_mesh => None,
+            None => {
+                return Err(at.error(
                     "material",
-                    Some(o.material.span()),
-                    format!("no material named '{material_name}'"),
-                )
-            })?
-            .clone();
+                    None,
+                    format!(
+                        "missing `material`: only an object of a `gltf` mesh may leave it out \
+                         (to keep the asset's materials); mesh '{mesh_name}' is not one"
+                    ),
+                ))
+            }
+        };
         at.check3("translate", o.translate.as_ref(), f32::NEG_INFINITY)?;
         at.check3(
             "rotate_degrees",
@@ -216,18 +349,35 @@ pub(super) fn objects(
             rotation,
             Vec3::from(value(&o.translate).unwrap_or_default()),
         );
-        let explicit_albedo = material_tables
-            .iter()
-            .find(|m| m.name.get_ref() == material_name)
-            .is_some_and(|m| m.albedo.is_some());
-        for (mesh, obj_material) in &meshes.parts[mesh_entry] {
-            let material = match obj_material {
-                Some(m) => super::materials::with_mtl(&material, m, explicit_albedo),
-                None => material.clone(),
+        let explicit_albedo = o.material.as_ref().is_some_and(|name| {
+            material_tables
+                .iter()
+                .find(|m| m.name.get_ref() == name.get_ref())
+                .is_some_and(|m| m.albedo.is_some())
+        });
+        for part in parts {
+            let (material, placed) = match (&part.source, &material) {
+                (PartSource::Plain, Some(m)) => (m.clone(), transform),
+                (PartSource::Mtl(mtl), Some(m)) => (
+                    super::materials::with_mtl(m, mtl, explicit_albedo),
+                    transform,
+                ),
+                // A named material overrides the asset's; the node still places the part.
+                (PartSource::Gltf(node, _), Some(m)) => (m.clone(), transform * *node),
+                (PartSource::Gltf(node, own), None) => ((**own).clone(), transform * *node),
+                // `material` is required for every other mesh (checked above).
+                (_, None) => continue,
             };
+            if !placed.is_finite() {
+                return Err(at.error(
+                    "scale",
+                    span(&o.scale),
+                    "the object's transform times the asset's node transform is not finite",
+                ));
+            }
             objects.push(Object {
-                mesh: *mesh,
-                transform,
+                mesh: part.mesh,
+                transform: placed,
                 material,
             });
         }

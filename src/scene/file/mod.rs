@@ -331,11 +331,18 @@ pub fn parse_scene(path: &Path, source: &str) -> Result<Scene> {
     })
 }
 
-/// Loads a scene by built-in name, or from a `.toml` file when `name_or_path` ends in `.toml`
-/// or names an existing file. Only parses and checks: thickness the materials ask to bake or
-/// sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
+/// Loads a scene by built-in name, from a glTF asset when `name_or_path` ends in `.gltf` or
+/// `.glb` ([`crate::scene::gltf::load_gltf_scene`]), or from a `.toml` file when it ends in
+/// `.toml` or names an existing file. Only parses and checks: thickness the materials ask to
+/// bake or sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
 pub fn load_scene(name_or_path: &str) -> Result<Scene> {
     let path = Path::new(name_or_path);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if matches!(extension.as_deref(), Some("gltf" | "glb")) {
+        return super::gltf::load_gltf_scene(path);
+    }
     // Anything at that path but a directory is the user's file (a FIFO or device named as a
     // scene gets the loader's "not a regular file" error, not "unknown scene").
     if name_or_path.ends_with(".toml") || (path.exists() && !path.is_dir()) {
@@ -495,6 +502,87 @@ material = "red"
         // The scene still loads.
         let s = MINIMAL.replace("target = [0, 0, 0]", "target = [0, 0, 0]\nnear = 1e-7");
         assert_eq!(parse(&s).unwrap().camera.near, 1e-7);
+    }
+
+    /// A one-triangle glTF asset (`tri.gltf` + `tri.bin`) in a fresh folder, its node
+    /// translated by (1, 0, 0), its material red; returns the folder.
+    fn gltf_triangle(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("lucent-gltf-scene-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let positions: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let bin: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+        std::fs::write(dir.join("tri.bin"), &bin).unwrap();
+        let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0, "translation": [1, 0, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1],
+                "metallicFactor": 0}}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "buffers": [{"uri": "tri.bin", "byteLength": 36}]}"#;
+        std::fs::write(dir.join("tri.gltf"), json).unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_scene_file_places_gltf_assets_with_their_materials_or_its_own() {
+        let dir = gltf_triangle("place");
+        let scene = MINIMAL
+            .replace(
+                "[[mesh]]\nname = \"ball\"",
+                "[[mesh]]\nname = \"tri\"\ngltf = \"tri.gltf\"\n\n[[mesh]]\nname = \"ball\"",
+            )
+            .replace(
+                "[[object]]\nmesh = \"ball\"",
+                "[[object]]\nmesh = \"tri\"\ntranslate = [0, 2, 0]\n\n[[object]]\nmesh = \"tri\"\n\
+                 material = \"red\"\n\n[[object]]\nmesh = \"ball\"",
+            );
+        let path = dir.join("scene.toml");
+        let s = parse_scene(&path, &scene).unwrap();
+        assert_eq!(s.objects.len(), 3);
+        // The asset's own material (base colour red, dielectric), placed by the object and
+        // then the node.
+        let own = &s.objects[0];
+        assert_eq!(own.material.albedo, Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(
+            own.transform.transform_point3(Vec3::ZERO),
+            Vec3::new(1.0, 2.0, 0.0)
+        );
+        // A named material overrides it; the node still places the part.
+        assert_eq!(s.objects[1].material.name, "red");
+        assert_eq!(s.objects[1].transform.transform_point3(Vec3::ZERO), Vec3::X);
+
+        // Errors name the file, the line and the key.
+        let missing = scene.replace("gltf = \"tri.gltf\"", "gltf = \"nope.glb\"");
+        let e = parse_scene(&path, &missing).unwrap_err().to_string();
+        assert!(e.contains("mesh[0].gltf") && e.contains("not found"), "{e}");
+        let both = scene.replace(
+            "gltf = \"tri.gltf\"",
+            "gltf = \"tri.gltf\"\ngenerator = \"cube\"",
+        );
+        let e = parse_scene(&path, &both).unwrap_err().to_string();
+        assert!(
+            e.contains("exactly one of `obj`, `gltf` or `generator`"),
+            "{e}"
+        );
+        let units = MINIMAL.replace("level = 1", "level = 1\nunits_per_mm = 0.01");
+        let e = parse(&units).unwrap_err().to_string();
+        assert!(e.contains("units_per_mm") && e.contains("gltf"), "{e}");
+        let bad_units = scene.replace(
+            "gltf = \"tri.gltf\"",
+            "gltf = \"tri.gltf\"\nunits_per_mm = -1",
+        );
+        let e = parse_scene(&path, &bad_units).unwrap_err().to_string();
+        assert!(e.contains("mesh[0].units_per_mm"), "{e}");
+        let no_material = MINIMAL.replace("material = \"red\"\n", "");
+        let e = parse(&no_material).unwrap_err().to_string();
+        assert!(
+            e.contains("object[0].material") && e.contains("gltf"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(dir).ok();
     }
 
     #[test]

@@ -74,6 +74,11 @@ pub(super) struct MeshToml {
     /// With `obj`: whether the OBJ's MTL materials are used (default true); `false` draws its
     /// faces with the objects' materials alone.
     pub(super) mtl: Option<Spanned<bool>>,
+    /// A glTF 2.0 asset (`.gltf` or `.glb`): every mesh of its default scene, placed by its
+    /// nodes, with its materials unless the `[[object]]` names one.
+    pub(super) gltf: Option<Spanned<PathBuf>>,
+    /// With `gltf`: scene units per millimetre of its media (default 0.001, a glTF metre).
+    pub(super) units_per_mm: Option<Spanned<f32>>,
     pub(super) generator: Option<Spanned<String>>,
     pub(super) level: Option<Spanned<u32>>,
     pub(super) triangles: Option<Spanned<u64>>,
@@ -226,7 +231,8 @@ impl<'de> Deserialize<'de> for ScaleToml {
 #[serde(deny_unknown_fields)]
 pub(super) struct ObjectToml {
     pub(super) mesh: Spanned<String>,
-    pub(super) material: Spanned<String>,
+    /// Required, except for a glTF mesh, whose own materials it then keeps.
+    pub(super) material: Option<Spanned<String>>,
     pub(super) translate: Option<Spanned<[f32; 3]>>,
     pub(super) rotate_degrees: Option<Spanned<[f32; 3]>>,
     pub(super) scale: Option<Spanned<ScaleToml>>,

@@ -2,6 +2,8 @@
 //! are generated and textures procedural; thickness asked to be baked is baked by whoever loads
 //! the scene ([`crate::bake::scene::prepare_thickness`], cached).
 
+use std::path::Path;
+
 use glam::{Mat4, Vec3};
 
 use super::build::{base_scene, camera, translucent};
@@ -63,6 +65,27 @@ pub const BUILTIN_SCENES: &[(&str, &str)] = &[
         "Li et al.'s layered media as jade and wax: a thin jade leaf, a jade ring, wax candles, lit from behind",
     ),
 ];
+
+/// Loads a scene by built-in name, from a glTF asset when `name_or_path` ends in `.gltf` or
+/// `.glb` ([`crate::scene::gltf::load_gltf_scene`]), or from a `.toml` file when it ends in
+/// `.toml` or names an existing file. Only parses and checks: thickness the materials ask to
+/// bake or sample is prepared by the caller ([`crate::bake::scene::prepare_thickness`]).
+pub fn load_scene(name_or_path: &str) -> Result<Scene> {
+    let path = Path::new(name_or_path);
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if matches!(extension.as_deref(), Some("gltf" | "glb")) {
+        return super::gltf::load_gltf_scene(path);
+    }
+    // Anything at that path but a directory is the user's file (a FIFO or device named as a
+    // scene gets the loader's "not a regular file" error, not "unknown scene").
+    if name_or_path.ends_with(".toml") || (path.exists() && !path.is_dir()) {
+        super::file::load_scene_file(path)
+    } else {
+        builtin(name_or_path)
+    }
+}
 
 /// A built-in scene by name (`scaling:N` picks the triangle count of `scaling`).
 pub fn builtin(name: &str) -> Result<Scene> {

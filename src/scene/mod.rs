@@ -7,6 +7,7 @@
 pub mod albedo;
 mod build;
 pub mod builtin;
+pub mod camera_range;
 pub mod environment;
 pub mod file;
 pub mod generators;
@@ -27,9 +28,9 @@ pub mod upload;
 
 use glam::{Mat4, Vec3};
 
+pub use builtin::load_scene;
 pub use builtin::{builtin, BUILTIN_SCENES};
 pub use environment::Environment;
-pub use file::load_scene;
 pub use material::{Light, LightKind, Material};
 pub use mesh::{Mesh, Shape};
 

@@ -11,7 +11,8 @@ use super::schema::{
     CameraToml, DeformationToml, EnvironmentToml, LightToml, MaterialToml, MeshToml, ObjectToml,
     ScaleToml,
 };
-use super::{depth_range_warning, span, value, SceneFile};
+use super::{span, value, SceneFile};
+use crate::scene::camera_range::depth_range_warning;
 use crate::scene::generators::{self, Generator};
 use crate::scene::material::{Light, LightKind, Material};
 use crate::scene::obj::{self, ObjMaterial};

@@ -474,7 +474,7 @@ fn camera(
     };
     let far = far.max(p.znear * 2.0);
     let distance = (centre - eye).dot(forward).max(p.znear * 2.0);
-    if let Some(w) = super::file::depth_range_warning(p.znear, far, distance) {
+    if let Some(w) = super::camera_range::depth_range_warning(p.znear, far, distance) {
         log::warn!("{}: cameras[{c}]: {w}", path.display());
     }
     Ok(Some(GltfCamera {

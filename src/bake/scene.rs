@@ -9,6 +9,7 @@
 
 use glam::Vec3;
 
+use crate::scene::material::ThicknessSource;
 use crate::scene::{self, material, texture, Scene};
 
 /// The thickness bake cache used when the caller names none: `thickness` in
@@ -91,23 +92,22 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
         progress: false,
         measure: crate::bake::BakeMeasure::Distance,
     };
-    // (mesh, transform, extinction) -> the mesh index its objects draw.
-    let mut done: Vec<(usize, glam::Mat4, material::Extinction, usize)> = Vec::new();
+    // (mesh, transform, extinction, thickness) -> the mesh index its objects draw.
+    type Key = (usize, glam::Mat4, material::Extinction, ThicknessSource);
+    let mut done: Vec<(Key, usize)> = Vec::new();
     for i in 0..scene.objects.len() {
         let object = &scene.objects[i];
-        let Some(extinction) = object
+        let Some((extinction, thickness)) = object
             .material
             .translucency_in_table()
-            .and_then(|t| t.extinction)
+            .and_then(|t| Some((t.extinction?, t.thickness.clone())))
         else {
             continue;
         };
         let (mesh, transform) = (object.mesh, object.transform);
-        if let Some(&(_, _, _, m)) = done
-            .iter()
-            .find(|(m, t, e, _)| *m == mesh && *t == transform && *e == extinction)
-        {
-            scene.objects[i].mesh = m;
+        let key: Key = (mesh, transform, extinction, thickness);
+        if let Some((_, m)) = done.iter().find(|(k, _)| *k == key) {
+            scene.objects[i].mesh = *m;
             continue;
         }
         // The object's own copy when another translucent object (or another medium, or the
@@ -119,38 +119,95 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
                 && !(o.transform == transform
                     && o.material
                         .translucency_in_table()
-                        .and_then(|t| t.extinction)
-                        == Some(extinction))
-        }) || done.iter().any(|(m, ..)| *m == mesh);
+                        .and_then(|t| Some((t.extinction?, t.thickness.clone())))
+                        == Some((extinction, key.3.clone())))
+        }) || done.iter().any(|((m, ..), _)| *m == mesh);
         let target = if shared {
             scene.meshes.push(scene.meshes[mesh].clone());
             scene.meshes.len() - 1
         } else {
             mesh
         };
-        let mut placed = scene.meshes[mesh].clone();
-        placed.colors.clear();
-        let normal_matrix = transform.inverse().transpose();
-        for p in &mut placed.positions {
-            *p = transform.transform_point3(*p);
-        }
-        for n in &mut placed.normals {
-            // Outward stays outward (a mirroring transform flips the winding the baker does
-            // not read: it casts along -N). Zero normals stay zero (the baker falls back).
-            *n = normal_matrix.transform_vector3(*n);
-        }
-        let values = crate::bake::cached_per_vertex(&placed, &options, cache_dir)?;
-        // The values are t / D, D the placed mesh's diagonal (the bake's default distance).
-        let diagonal = crate::bake::bounding_box_diagonal(&placed);
-        let mm_per_value = diagonal * extinction.mm_per_unit;
-        scene.meshes[target].colors = values
+        let distances_mm = match &key.3 {
+            ThicknessSource::Volume { factor, texture } => {
+                volume_distances(&scene.meshes[mesh], *factor, texture.as_ref(), transform)?
+                    .into_iter()
+                    .map(|units| units * extinction.mm_per_unit)
+                    .collect::<Vec<f32>>()
+            }
+            _ => {
+                let mut placed = scene.meshes[mesh].clone();
+                placed.colors.clear();
+                let normal_matrix = transform.inverse().transpose();
+                for p in &mut placed.positions {
+                    *p = transform.transform_point3(*p);
+                }
+                for n in &mut placed.normals {
+                    // Outward stays outward (a mirroring transform flips the winding the baker
+                    // does not read: it casts along -N). Zero normals stay zero (the baker
+                    // falls back).
+                    *n = normal_matrix.transform_vector3(*n);
+                }
+                let values = crate::bake::cached_per_vertex(&placed, &options, cache_dir)?;
+                // The values are t / D, D the placed mesh's diagonal (the bake's default
+                // distance).
+                let diagonal = crate::bake::bounding_box_diagonal(&placed);
+                let mm_per_value = diagonal * extinction.mm_per_unit;
+                values.into_iter().map(|v| v * mm_per_value).collect()
+            }
+        };
+        scene.meshes[target].colors = distances_mm
             .into_iter()
-            .map(|v| extinction.transmittance(v * mm_per_value))
+            .map(|mm| extinction.transmittance(mm))
             .collect();
         scene.objects[i].mesh = target;
-        done.push((mesh, transform, extinction, target));
+        done.push((key, target));
     }
     Ok(())
+}
+
+/// The distance under each vertex of `mesh` placed by `transform`, in scene units, from a
+/// glTF volume's thickness: `factor` times the texture's green channel at the vertex's UV
+/// (`factor` alone without a texture), times the transform's mean scale (glTF gives the
+/// thickness in the mesh's own units).
+fn volume_distances(
+    mesh: &crate::scene::Mesh,
+    factor: f32,
+    texture: Option<&material::TextureSource>,
+    transform: glam::Mat4,
+) -> crate::Result<Vec<f32>> {
+    // The cube root of the volume scale: a uniform scale exactly, the mean of a non-uniform
+    // one. Finite (validated transforms), >= 0.
+    let scale = glam::Mat3::from_mat4(transform).determinant().abs().cbrt();
+    let units = |g: f32| (factor * g * scale).max(0.0);
+    let Some(source) = texture else {
+        return Ok(vec![units(1.0); mesh.positions.len()]);
+    };
+    if mesh.uvs.len() != mesh.positions.len() {
+        return Err(crate::LucentError::InvalidInput(format!(
+            "{}: a volume's thickness texture: its mesh has no texture coordinates",
+            source.describe()
+        )));
+    }
+    let Some(decoded) = source.decode(texture::TextureUsage::Data)? else {
+        return Err(crate::LucentError::InvalidInput(format!(
+            "{}: a procedural texture cannot be a volume's thickness",
+            source.describe()
+        )));
+    };
+    Ok(mesh
+        .uvs
+        .iter()
+        .map(|&uv| {
+            // glTF: the thickness is in the green channel, 0-1.
+            let g = decoded.sample_bilinear(uv)[1];
+            units(if g.is_finite() {
+                g.clamp(0.0, 1.0)
+            } else {
+                0.0
+            })
+        })
+        .collect())
 }
 
 /// Samples each thickness texture into the vertex colours of the meshes drawn with it.

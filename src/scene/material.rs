@@ -33,6 +33,16 @@ pub enum ThicknessSource {
     PerVertex,
     /// Baked at load by [`crate::bake`], cached on disk keyed by mesh content.
     Bake,
+    /// A distance under the surface in the mesh's own units, as glTF's `KHR_materials_volume`
+    /// gives it: `factor` times the texture's green channel (`factor` alone without one),
+    /// scaled with the object. Only for a term derived from a medium (`extinction`): its
+    /// transmittance through this distance replaces the one through the baked distance.
+    Volume {
+        /// `thicknessFactor`: mesh units, finite, >= 0.
+        factor: f32,
+        /// `thicknessTexture` (linear; its green channel scales `factor`).
+        texture: Option<TextureSource>,
+    },
 }
 
 /// How the translucency's view-dependent lobe raises to its power.
@@ -333,10 +343,24 @@ impl Material {
             if !(t.color.is_finite() && t.color.min_element() >= 0.0) {
                 return bad("translucency color must be finite and >= 0".into());
             }
-            if let ThicknessSource::Constant(c) = t.thickness {
-                if !(0.0..=1.0).contains(&c) {
+            match &t.thickness {
+                ThicknessSource::Constant(c) if !(0.0..=1.0).contains(c) => {
                     return bad(format!("thickness {c} must be in [0, 1]"));
                 }
+                ThicknessSource::Volume { factor, .. } => {
+                    if !(factor.is_finite() && *factor >= 0.0) {
+                        return bad(format!("volume thickness {factor} must be finite and >= 0"));
+                    }
+                    // A distance means something only to a term derived from a medium.
+                    if t.extinction.is_none() {
+                        return bad(
+                            "a volume thickness (a distance) needs the medium's extinction: \
+                             GDC 2011's own term reads a 0-1 thickness"
+                                .into(),
+                        );
+                    }
+                }
+                _ => {}
             }
         }
         if let Some(p) = &self.sss {

@@ -379,3 +379,75 @@ fn a_textured_node_transformed_two_primitive_asset_renders_as_its_toml() {
     );
     test.finish();
 }
+
+#[test]
+fn a_volumes_thickness_is_the_distance_the_mediums_gdc_2011_term_reads() {
+    // KHR_materials_volume's thicknessFactor (mesh units: metres) times its texture's green
+    // channel replaces the baked distance in the term derived from the medium: the vertex
+    // colours are the medium's transmittance through exactly that distance.
+    use lucent::scene::material::ThicknessSource;
+    let dir = common::temp_dir("gltf-thickness");
+    let volume = |thickness: serde_json::Value| {
+        let mut ext = json!({
+            "attenuationColor": [0.5, 0.3, 0.2], "attenuationDistance": 0.004,
+            "thicknessFactor": 0.003
+        });
+        if !thickness.is_null() {
+            ext["thicknessTexture"] = thickness;
+        }
+        json!({
+            "extensions": {
+                "KHR_materials_volume": ext,
+                "KHR_materials_volume_scatter": {"multiscatterColor": [0.9, 0.6, 0.4]}
+            }
+        })
+    };
+    let check = |scene: &Scene, green: f32| {
+        let object = &scene.objects[0];
+        let term = &object.material.medium.as_ref().unwrap().translucency;
+        assert!(
+            matches!(term.thickness, ThicknessSource::Volume { factor, .. } if factor == 0.003),
+            "{:?}",
+            term.thickness
+        );
+        // 3 mm (a glTF unit is a metre) times the green channel, the node unscaled.
+        let expected = term.extinction.unwrap().transmittance(3.0 * green);
+        let colors = &scene.meshes[object.mesh].colors;
+        assert_eq!(colors.len(), scene.meshes[object.mesh].positions.len());
+        for c in colors {
+            assert!(
+                (*c - expected).abs().max_element() < 1e-4,
+                "{c} vs {expected}"
+            );
+        }
+        expected
+    };
+    let (b, _) = sphere_asset(volume(serde_json::Value::Null));
+    let plain = dir.join("factor.glb");
+    std::fs::write(&plain, b.glb()).unwrap();
+    let whole = check(&load(&plain), 1.0);
+
+    // A uniform green of 128/255 halves the distance: more light through.
+    let (mut b, _) = sphere_asset(volume(json!({"index": 0})));
+    let half = png(|_, _| [0, 128, 0]);
+    b.push(
+        "images",
+        json!({"uri": format!("data:image/png;base64,{}", base64(&half))}),
+    );
+    b.push("textures", json!({"source": 0}));
+    let textured = dir.join("texture.glb");
+    std::fs::write(&textured, b.glb()).unwrap();
+    let halved = check(&load(&textured), 128.0 / 255.0);
+    assert!(halved.x > whole.x, "{halved} {whole}");
+
+    // Under a forced `--technique translucency` the frame renders, finite, validation clean.
+    let test = TestGpu::new();
+    let settings = FrameSettings {
+        technique: lucent::frame::Technique::parse("translucency").unwrap(),
+        export_hdr: true,
+        ..FrameSettings::new(W, H)
+    };
+    let frame = test.render(&load(&textured), settings);
+    assert!(frame.hdr.unwrap().iter().all(|v| v.is_finite()));
+    test.finish();
+}

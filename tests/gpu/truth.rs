@@ -413,6 +413,124 @@ fn lucent_stays_within_its_recorded_distance_of_the_path_traced_truth() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+#[test]
+fn the_scanned_head_and_its_ear_stay_within_their_recorded_distance_of_the_truth() {
+    // Issue 36: Lee Perry-Smith's head as skin1 (eta 1, untextured), side-lit and back-lit,
+    // the whole head and its ear (`truths/head-skin1-*.regions.toml`). Recorded with `lucent
+    // report truth --scenes head-skin1-sidelit,head-skin1-backlit --quick`.
+    struct HeadCase {
+        scene: &'static str,
+        region: Option<&'static str>,
+        technique: &'static str,
+        error: f64,
+        /// The red channel's energy must stay inside this range.
+        red: (f64, f64),
+    }
+    let cases = [
+        HeadCase {
+            scene: "head-skin1-sidelit",
+            region: None,
+            technique: "none",
+            error: 0.1125,
+            red: (0.95, 1.02),
+        },
+        HeadCase {
+            scene: "head-skin1-sidelit",
+            region: None,
+            technique: "separable",
+            error: 0.0822,
+            red: (0.90, 0.97),
+        },
+        HeadCase {
+            scene: "head-skin1-sidelit",
+            region: None,
+            technique: "burley",
+            error: 0.0820,
+            red: (0.90, 0.97),
+        },
+        HeadCase {
+            scene: "head-skin1-sidelit",
+            region: Some("ear"),
+            technique: "burley",
+            error: 0.1214,
+            red: (0.84, 0.91),
+        },
+        HeadCase {
+            scene: "head-skin1-backlit",
+            region: None,
+            technique: "none",
+            error: 0.2746,
+            red: (0.72, 0.80),
+        },
+        HeadCase {
+            scene: "head-skin1-backlit",
+            region: None,
+            technique: "separable",
+            error: 0.1707,
+            red: (0.84, 0.91),
+        },
+        // The back-lit ear: every technique lets through 52-67% of the truth's red.
+        HeadCase {
+            scene: "head-skin1-backlit",
+            region: Some("ear"),
+            technique: "none",
+            error: 0.5678,
+            red: (0.32, 0.39),
+        },
+        HeadCase {
+            scene: "head-skin1-backlit",
+            region: Some("ear"),
+            technique: "separable",
+            error: 0.3562,
+            red: (0.56, 0.64),
+        },
+    ];
+    let test = TestGpu::new();
+    let mut failures = Vec::new();
+    for case in cases {
+        let whole = load_truth(&truth_dir(), case.scene).unwrap_or_else(|e| panic!("{e}"));
+        let truth = match case.region {
+            None => whole.clone(),
+            Some(name) => {
+                let region = whole.regions.iter().find(|r| r.name == name).unwrap();
+                whole.region(region)
+            }
+        };
+        assert!(
+            truth.object_pixels() > 500,
+            "{}: {}",
+            truth.name,
+            truth.object_pixels()
+        );
+        let settings = FrameSettings {
+            technique: technique(case.technique),
+            export_hdr: true,
+            ..FrameSettings::new(truth.width, truth.height)
+        };
+        let frame = test.render(&truth.scene, settings).hdr.unwrap();
+        let measured = measure(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
+        println!(
+            "{} under {}: error {:.4} (recorded {}), energy {:.3?}",
+            truth.name, case.technique, measured.error, case.error, measured.energy
+        );
+        if measured.error > case.error + ERROR_SLACK
+            || !(case.red.0..=case.red.1).contains(&measured.energy[0])
+        {
+            failures.push(format!(
+                "{} under {}: error {:.4} (recorded {}), red energy {:.3} (range {:?})",
+                truth.name,
+                case.technique,
+                measured.error,
+                case.error,
+                measured.energy[0],
+                case.red
+            ));
+        }
+    }
+    test.finish();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// The slab truth's scene with its skin1 layer given as one `[material.medium]` (the same
 /// medium: Jensen 2001's skin1 at eta 1, 0.05 units/mm), no `[material.layered]`, the albedo
 /// derived (its white-sky albedo), and GDC 2011's term as derived from the medium with

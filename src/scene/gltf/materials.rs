@@ -324,6 +324,16 @@ impl<'a> Fields<'a> {
         }
     }
 
+    /// A `textureInfo` object (`index`, `texCoord`, `extensions`).
+    fn texture_info(&mut self, key: &str) -> Result<Option<json::texture::Info>, String> {
+        match self.map.remove(key) {
+            None => Ok(None),
+            Some(value) => serde_json::from_value(value)
+                .map(Some)
+                .map_err(|e| format!("{}.{key}: not a textureInfo ({e})", self.what)),
+        }
+    }
+
     /// A key lucent reads but does not use: removed with a warning naming it.
     fn ignore(&mut self, key: &str, why: &str) {
         if self.map.remove(key).is_some() {
@@ -536,14 +546,38 @@ fn convert(
     if let Some(mut v) = volume {
         let distance = v.number("attenuationDistance")?;
         let color = v.vec3("attenuationColor")?.unwrap_or(Vec3::ONE);
-        v.ignore(
-            "thicknessFactor",
-            "lucent bakes the thickness from the mesh where a technique needs one",
-        );
-        v.ignore(
-            "thicknessTexture",
-            "lucent bakes the thickness from the mesh where a technique needs one",
-        );
+        // The thickness (mesh units): what GDC 2011's term derived from the medium reads
+        // instead of the distance lucent would bake. 0, the default, is a thin wall.
+        let thickness_factor = v.number("thicknessFactor")?.unwrap_or(0.0);
+        if thickness_factor < 0.0 {
+            return Err(format!(
+                "{}.thicknessFactor: {thickness_factor} must be >= 0",
+                v.what
+            ));
+        }
+        let thickness_texture = match v.texture_info("thicknessTexture")? {
+            Some(info) if thickness_factor > 0.0 => {
+                let key = format!("{}.thicknessTexture", v.what);
+                let transform = info
+                    .extensions
+                    .as_ref()
+                    .and_then(|e| e.texture_transform.as_ref());
+                let (source, mapping) =
+                    cx.texture(&key, info.index.value(), info.tex_coord, transform, 1.0)?;
+                use_uv("KHR_materials_volume.thicknessTexture", mapping, &mut uv);
+                Some(source)
+            }
+            Some(_) => {
+                log::warn!(
+                    "{}: {}.thicknessTexture ignored: thicknessFactor is 0 (a thin wall), \
+                     which the texture multiplies",
+                    path.display(),
+                    v.what
+                );
+                None
+            }
+            None => None,
+        };
         let volume_what = v.what.clone();
         v.finish();
         if let Some(d) = distance {
@@ -597,7 +631,15 @@ fn convert(
                         layered
                             .validate()
                             .map_err(|e| format!("{scatter_what}: {e}"))?;
-                        let derived = Medium::new(layered.clone());
+                        let mut derived = Medium::new(layered.clone());
+                        if thickness_factor > 0.0 {
+                            // The term derived from the medium (a forced `--technique
+                            // translucency`) reads the asset's thickness, not a bake.
+                            derived.translucency.thickness = ThicknessSource::Volume {
+                                factor: thickness_factor,
+                                texture: thickness_texture.clone(),
+                            };
+                        }
                         // The base colour tints what the medium gives (white by default).
                         material.albedo = derived.albedo * base * (1.0 - metallic);
                         if material.translucency.is_none() {

@@ -147,7 +147,7 @@ pub struct BenchArgs {
 #[derive(Args)]
 pub struct DemoArgs {
     /// Scene: a built-in name (see `lucent scenes`) or a .toml scene file.
-    #[arg(long, default_value = "cubes")]
+    #[arg(long, default_value = "showcase-skin")]
     pub scene: String,
     /// Technique at start (default: the one the scene is made for).
     #[arg(long)]

@@ -1,6 +1,6 @@
 //! `lucent report truth --quick --out DIR` from the command line, validation on, on the
 //! committed truths (tools/truth): it finishes, writes `truth.md` and one plot per truth scene
-//! that decodes as a PNG, has a section per scene with one row per technique (every row a finite
+//! (and per region a truth names) that decodes as a PNG, has a section per scene with one row per technique (every row a finite
 //! error, FLIP, energies and a positive time), and the budget table names a best technique for
 //! every scene. A truth directory that does not exist, and a scene it does not hold, are clear
 //! errors.
@@ -33,8 +33,15 @@ fn quick_truth_report_measures_every_technique_on_every_truth() {
     );
     let text = std::fs::read_to_string(dir.join("truth.md")).unwrap();
     println!("{text}");
-    let names = lucent::measure::truth::truth_names(&truths).unwrap();
-    assert!(names.len() >= 5, "{names:?}");
+    let scenes = lucent::measure::truth::truth_names(&truths).unwrap();
+    assert!(scenes.len() >= 5, "{scenes:?}");
+    // Every truth, then each region it names (`NAME-REGION`, measured apart: a head's ear).
+    let mut names = scenes.clone();
+    for scene in &scenes {
+        let truth = lucent::measure::truth::load_truth(&truths, scene).unwrap();
+        names.extend(truth.regions.iter().map(|r| format!("{scene}-{}", r.name)));
+    }
+    assert!(names.iter().any(|n| n.ends_with("-ear")), "{names:?}");
     assert!(
         !text.contains("NaN") && !text.contains("not rendered"),
         "{text}"

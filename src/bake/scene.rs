@@ -97,11 +97,7 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
     let mut done: Vec<(Key, usize)> = Vec::new();
     for i in 0..scene.objects.len() {
         let object = &scene.objects[i];
-        let Some((extinction, thickness)) = object
-            .material
-            .translucency_in_table()
-            .and_then(|t| Some((t.extinction?, t.thickness.clone())))
-        else {
+        let Some((extinction, thickness)) = medium_term(&object.material) else {
             continue;
         };
         let (mesh, transform) = (object.mesh, object.transform);
@@ -117,10 +113,7 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
                 && o.mesh == mesh
                 && o.material.translucency_in_table().is_some()
                 && !(o.transform == transform
-                    && o.material
-                        .translucency_in_table()
-                        .and_then(|t| Some((t.extinction?, t.thickness.clone())))
-                        == Some((extinction, key.3.clone())))
+                    && medium_term(&o.material) == Some((extinction, key.3.clone())))
         }) || done.iter().any(|((m, ..), _)| *m == mesh);
         let target = if shared {
             scene.meshes.push(scene.meshes[mesh].clone());
@@ -166,6 +159,12 @@ fn prepare_medium_thickness(scene: &mut Scene, cache_dir: &std::path::Path) -> c
     Ok(())
 }
 
+/// The extinction and thickness of `material`'s GDC 2011 term when it derives from a medium.
+fn medium_term(material: &material::Material) -> Option<(material::Extinction, ThicknessSource)> {
+    let term = material.translucency_in_table()?;
+    Some((term.extinction?, term.thickness.clone()))
+}
+
 /// The distance under each vertex of `mesh` placed by `transform`, in scene units, from a
 /// glTF volume's thickness: `factor` times the texture's green channel at the vertex's UV
 /// (`factor` alone without a texture), times the transform's mean scale (glTF gives the
@@ -183,24 +182,16 @@ fn volume_distances(
     let Some(source) = texture else {
         return Ok(vec![units(1.0); mesh.positions.len()]);
     };
-    if mesh.uvs.len() != mesh.positions.len() {
-        return Err(crate::LucentError::InvalidInput(format!(
-            "{}: a volume's thickness texture: its mesh has no texture coordinates",
-            source.describe()
-        )));
-    }
-    let Some(decoded) = source.decode(texture::TextureUsage::Data)? else {
+    let Some(texels) = sample_at_vertices(mesh, source, "a volume's thickness texture")? else {
         return Err(crate::LucentError::InvalidInput(format!(
             "{}: a procedural texture cannot be a volume's thickness",
             source.describe()
         )));
     };
-    Ok(mesh
-        .uvs
-        .iter()
-        .map(|&uv| {
+    Ok(texels
+        .into_iter()
+        .map(|[_, g, _, _]| {
             // glTF: the thickness is in the green channel, 0-1.
-            let g = decoded.sample_bilinear(uv)[1];
             units(if g.is_finite() {
                 g.clamp(0.0, 1.0)
             } else {
@@ -208,6 +199,32 @@ fn volume_distances(
             })
         })
         .collect())
+}
+
+/// `source` sampled bilinearly at each vertex's UV of `mesh`, decoded as stored (its decoded
+/// size in memory: no mip or f32 copy is ever needed); `None` for a procedural texture, which
+/// has no texels to decode. `what` names the map in the error for a mesh without texture
+/// coordinates.
+fn sample_at_vertices(
+    mesh: &crate::scene::Mesh,
+    source: &material::TextureSource,
+    what: &str,
+) -> crate::Result<Option<Vec<[f32; 4]>>> {
+    if mesh.uvs.len() != mesh.positions.len() {
+        return Err(crate::LucentError::InvalidInput(format!(
+            "{}: {what}: its mesh has no texture coordinates",
+            source.describe()
+        )));
+    }
+    let Some(texture) = source.decode(texture::TextureUsage::Data)? else {
+        return Ok(None);
+    };
+    Ok(Some(
+        mesh.uvs
+            .iter()
+            .map(|&uv| texture.sample_bilinear(uv))
+            .collect(),
+    ))
 }
 
 /// Samples each thickness texture into the vertex colours of the meshes drawn with it.
@@ -236,26 +253,14 @@ fn sample_thickness_textures(scene: &mut Scene) -> crate::Result<()> {
                 source.describe()
             )));
         }
-        if mesh.uvs.len() != mesh.positions.len() {
-            return Err(crate::LucentError::InvalidInput(format!(
-                "{}: thickness texture of material '{}': its mesh has no texture coordinates",
-                source.describe(),
-                object.material.name
-            )));
-        }
-        // As stored (its decoded size in memory): the vertices sample it bilinearly, no mip or
-        // f32 copy is ever needed.
-        let Some(texture) = source.decode(texture::TextureUsage::Data)? else {
+        let what = format!("thickness texture of material '{}'", object.material.name);
+        let Some(texels) = sample_at_vertices(mesh, source, &what)? else {
             continue;
         };
-        let colors = mesh
-            .uvs
-            .iter()
-            .map(|&uv| {
-                let [r, g, b, _] = texture.sample_bilinear(uv);
-                // Thickness is a fraction of light let through: [0, 1], whatever the file held.
-                Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE)
-            })
+        let colors = texels
+            .into_iter()
+            // Thickness is a fraction of light let through: [0, 1], whatever the file held.
+            .map(|[r, g, b, _]| Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE))
             .collect();
         scene.meshes[object.mesh].colors = colors;
         done.push((object.mesh, source.clone()));

@@ -83,7 +83,7 @@ use lucent::embed::{
     LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, LeanLighting, Light, Lucent,
     MeshDraw, NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace,
     SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssProfile,
-    ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
+    SssRegion, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
     TranslucencyImages, TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc,
     TransmissionFrame, TransmissionImages, TransmissionMaterial,
 };
@@ -1836,26 +1836,68 @@ fn leaf_region(camera: &HostCamera, extent: vk::Extent2D, whole_screen: bool) ->
     region.filter(|_| !whole_screen).into_iter().collect()
 }
 
-/// The screen rectangles of the skin and marble spheres and the skin ear widened by `reach`
-/// (the blurs', or 0): where the SSS blurs run (a pass-through elsewhere) and where the
-/// transmission is drawn.
-fn scattering_region(
+/// The objects that scatter: the skin sphere, the marble sphere and the skin ear, each with
+/// its material and its bounds (lowest and highest corner, metres).
+fn scattering_objects() -> [(u8, (Vec3, Vec3)); 3] {
+    let sphere = |[x, y, z, r]: [f32; 4]| {
+        let (centre, radius) = (Vec3::new(x, y, z), Vec3::splat(r));
+        (centre - radius, centre + radius)
+    };
+    let (ear_centre, ear_half) = (Vec3::from(EAR_CENTRE), Vec3::from(EAR_RADII));
+    [
+        (SKIN_ID, sphere(SPHERES[0])),
+        (MARBLE_ID, sphere(SPHERES[1])),
+        (SKIN_ID, (ear_centre - ear_half, ear_centre + ear_half)),
+    ]
+}
+
+/// The scattering objects' screen rectangles, each widened by `reach` of its material: `None`
+/// when one crosses the eye's plane, or with `--whole-screen` (no region: the whole screen).
+fn scattering_rects(
     camera: &HostCamera,
     extent: vk::Extent2D,
-    reach: f32,
+    reach: impl Fn(u8) -> f32,
     whole_screen: bool,
-) -> Vec<vk::Rect2D> {
-    let ear = (Vec3::from(EAR_CENTRE), Vec3::from(EAR_RADII));
-    let regions: Option<Vec<vk::Rect2D>> = SPHERES[..2]
-        .iter()
-        .map(|&[x, y, z, r]| (Vec3::new(x, y, z), Vec3::splat(r)))
-        .chain([ear])
-        .map(|(centre, half)| {
-            let object = (centre - half, centre + half);
-            lucent::embed::box_screen_region(object, Mat4::IDENTITY, camera, extent, reach)
+) -> Option<Vec<(u8, vk::Rect2D)>> {
+    let regions: Option<Vec<(u8, vk::Rect2D)>> = scattering_objects()
+        .into_iter()
+        .map(|(id, bounds)| {
+            lucent::embed::box_screen_region(bounds, Mat4::IDENTITY, camera, extent, reach(id))
+                .map(|rect| (id, rect))
         })
         .collect();
-    regions.filter(|_| !whole_screen).unwrap_or_default()
+    regions.filter(|_| !whole_screen)
+}
+
+/// Where the transmission is drawn: the scattering objects' screen rectangles.
+fn transmission_regions(
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    whole_screen: bool,
+) -> Vec<vk::Rect2D> {
+    scattering_rects(camera, extent, |_| 0.0, whole_screen)
+        .map(|rects| rects.into_iter().map(|(_, rect)| rect).collect())
+        .unwrap_or_default()
+}
+
+/// The SSS blurs' regions: each scattering object's rectangle widened by its own material's
+/// reach and given for that material, so each blur chain (the skin's, the marble's) draws
+/// only on its own objects' tiles and passes the light through elsewhere.
+fn sss_regions(
+    camera: &HostCamera,
+    extent: vk::Extent2D,
+    sss: &SssEffect,
+    whole_screen: bool,
+) -> Vec<SssRegion> {
+    let reach = |id| sss.reach_of(id).unwrap_or_else(|| sss.reach());
+    scattering_rects(camera, extent, reach, whole_screen)
+        .map(|rects| {
+            rects
+                .into_iter()
+                .map(|(id, rect)| SssRegion::of(id, rect))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// One frame slot's timers, one per effect (`--timing`).
@@ -2482,7 +2524,7 @@ fn record_frame(
                         shadow_map: &shadow_map,
                     },
                     // The skin's and the marble's projected bounds.
-                    regions: &scattering_region(&camera, extent, 0.0, effects.whole_screen),
+                    regions: &transmission_regions(&camera, extent, effects.whole_screen),
                     lighting: &lighting,
                 };
                 let timer = effects
@@ -2528,8 +2570,9 @@ fn record_frame(
                     albedo: Some(&albedo),
                     material_ids: &ids,
                 },
-                // The skin's and the marble's projected bounds: elsewhere a pass-through.
-                regions: &scattering_region(&camera, extent, sss.reach(), effects.whole_screen),
+                // The skin's and the marble's projected bounds, each for its own blur chain:
+                // elsewhere a pass-through.
+                regions: &sss_regions(&camera, extent, sss, effects.whole_screen),
                 output: &output,
                 // A LEAN blur's LEAN moments come from the engine's normals, its specular is
                 // relit with the engine's lights, shadowed in the engine's shadow atlas.

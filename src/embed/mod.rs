@@ -195,7 +195,7 @@ pub use scene::SceneRenderer;
 pub use shadow_faces::ShadowFace;
 pub use sss::{
     LeanLighting, SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
-    MAX_VIEWS_PER_FRAME,
+    SssRegion, MAX_VIEWS_PER_FRAME,
 };
 pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;
@@ -232,8 +232,10 @@ pub use glam;
 /// (every effect of [`Effect::ALL`] has a path on a host's G-buffer). 7: the LEAN blurs (LCB,
 /// LBB, bilateral) in [`SssEffect`] ([`SssFrame::lean`], [`SssMaterial::surface`],
 /// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`]; host shadow maps in reversed Z and
-/// as arrays ([`ShadowFace::layer`], [`HostImage::layers`], `with_shadow_array`).
-pub const API_VERSION: u32 = 7;
+/// as arrays ([`ShadowFace::layer`], [`HostImage::layers`], `with_shadow_array`). 8:
+/// [`SssFrame::regions`] per material ([`SssRegion`]): each blur chain runs on its own
+/// materials' regions.
+pub const API_VERSION: u32 = 8;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -188,14 +188,11 @@ fn disjoint(rects: &[(u32, u32, u32, u32)]) -> Vec<TileRect> {
     out
 }
 
-/// The screen as tiles of [`TILE_SIZE`] (merged into rectangles), marked where a region
-/// touches them, for passes that draw their own shader in the marked tiles and a pass-through
-/// variant elsewhere (the SSS chains). `None` (no region): the whole screen with their own
-/// shader.
-pub(crate) fn marked_tiles(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Option<Vec<TileRect>> {
-    if regions.is_empty() {
-        return None;
-    }
+/// The screen as tiles of [`TILE_SIZE`] (merged into rectangles), marked where `regions` touch
+/// them, for passes that draw their own shader in the marked tiles and a pass-through variant
+/// elsewhere (the SSS chains, each with its own materials' regions): with no region, none is
+/// marked (a chain none of whose materials has a region passes the light through everywhere).
+pub(crate) fn tiles_marked_by(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Vec<TileRect> {
     let columns = extent.width.div_ceil(TILE_SIZE);
     let rows = extent.height.div_ceil(TILE_SIZE);
     let mut marked = vec![false; (columns * rows) as usize];
@@ -209,7 +206,7 @@ pub(crate) fn marked_tiles(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Opti
             }
         }
     }
-    Some(tile_rects(columns, &marked, extent.width, extent.height))
+    tile_rects(columns, &marked, extent.width, extent.height)
 }
 
 #[cfg(test)]
@@ -260,12 +257,11 @@ mod tests {
     }
 
     #[test]
-    fn marked_tiles_cover_the_screen_and_mark_what_the_regions_touch() {
+    fn marked_tiles_cover_the_screen_and_mark_what_the_regions_touch_or_none() {
         let extent = vk::Extent2D {
             width: 200,
             height: 100,
         };
-        assert!(marked_tiles(&[], extent).is_none());
         let region = vk::Rect2D {
             offset: vk::Offset2D { x: 70, y: 10 },
             extent: vk::Extent2D {
@@ -273,11 +269,18 @@ mod tests {
                 height: 10,
             },
         };
-        let tiles = marked_tiles(&[region], extent).unwrap();
+        let tiles = tiles_marked_by(&[region], extent);
         let area: u32 = tiles.iter().map(|t| t.width * t.height).sum();
         assert_eq!(area, 200 * 100, "every pixel in exactly one rectangle");
         let marked: Vec<_> = tiles.iter().filter(|t| t.translucent).collect();
         assert_eq!(marked.len(), 1);
         assert_eq!((marked[0].x, marked[0].y, marked[0].width), (64, 0, 64));
+        // No region: the whole screen in tiles, none marked.
+        let none = tiles_marked_by(&[], extent);
+        assert_eq!(
+            none.iter().map(|t| t.width * t.height).sum::<u32>(),
+            200 * 100
+        );
+        assert!(none.iter().all(|t| !t.translucent));
     }
 }

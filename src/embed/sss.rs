@@ -35,7 +35,7 @@ use super::capabilities::{require, Effect};
 use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
-use super::regions::marked_tiles;
+use super::regions::tiles_marked_by;
 use super::shadow_faces::{check_shadow_format, check_shadow_map, shadow_table, ShadowFace};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
@@ -43,7 +43,7 @@ use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
 use crate::features::registry;
 use crate::features::sss::{self, HostAlbedo, IdMap, LeanInputs, SssKnobs, SssProfiles};
-use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
+use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
 use crate::graph::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
 };
@@ -226,6 +226,36 @@ pub struct LeanLighting<'a> {
     pub shadow_faces: &'a [ShadowFace],
 }
 
+/// A screen rectangle where scattered light may reach this frame ([`SssFrame::regions`]): for
+/// one material's blur chain, or for every chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SssRegion {
+    /// The rectangle, in pixels (it may reach past the screen: it is clipped).
+    pub rect: vk::Rect2D,
+    /// The host material ID whose blur chain runs here (`None`: every chain).
+    pub material: Option<u8>,
+}
+
+impl SssRegion {
+    /// Where material `id`'s light may reach: its objects' bounds widened by
+    /// [`SssEffect::reach_of`] `id`. Only its own blur chain runs here.
+    pub fn of(id: u8, rect: vk::Rect2D) -> Self {
+        Self {
+            rect,
+            material: Some(id),
+        }
+    }
+
+    /// Where any material's light may reach: every blur chain runs here.
+    pub fn any(rect: vk::Rect2D) -> Self {
+        Self {
+            rect,
+            material: None,
+        }
+    }
+}
+
 /// One view of one frame: what [`SssEffect::record`] reads and writes.
 #[derive(Clone, Copy, Debug)]
 pub struct SssFrame<'a> {
@@ -240,10 +270,13 @@ pub struct SssFrame<'a> {
     /// Screen rectangles the scattering materials' light may reach this frame: their
     /// objects' projected bounds widened by the blurs' reach ([`SssEffect::reach_of`] each
     /// object's material's, or [`SssEffect::reach`] the widest; [`super::screen_region`]
-    /// computes both). The blurs run on the 64-pixel tiles these
-    /// touch and a pass-through elsewhere, as in lucent's own frames; a region that leaves
-    /// out the reach changes the result near its edge. Empty: the whole screen.
-    pub regions: &'a [vk::Rect2D],
+    /// computes both), each for one material ([`SssRegion::of`]) or for all
+    /// ([`SssRegion::any`]). Each blur chain runs on the 64-pixel tiles its own materials'
+    /// regions (and the regions for all) touch and a pass-through elsewhere, as lucent's own
+    /// frames give each chain its own objects' tiles: a region that leaves out the reach
+    /// changes the result near its edge, and a material without a region is not blurred
+    /// (when other regions are given). Empty: the whole screen for every chain.
+    pub regions: &'a [SssRegion],
     /// The image the result is written into (a colour attachment of the output format).
     pub output: &'a HostImage,
     /// With a LEAN blur's material: the normals and lights it relights the specular with
@@ -284,8 +317,10 @@ pub struct SssEffect {
     passes: EffectPasses,
     imports: Imports,
     desc: SssEffectDesc,
-    /// The blur chains the profiles use (each draws in the frame's tiles).
+    /// The blur chains the profiles use (each draws in its own materials' tiles).
     chains: usize,
+    /// Each material's blur chain (an index into the chains), by its host ID.
+    chain_of: Vec<(u8, usize)>,
     /// Each material's reach, world units, by its host ID ([`Self::reach_of`]).
     reaches: Vec<(u8, f32)>,
     /// With LEAN blurs: the host LEAN pass's constants but for the view (written per frame).
@@ -490,6 +525,18 @@ impl SssEffect {
             imports,
             chains: profiles.chains().len(),
             // Material i has profile i + 1 (profile_of above).
+            chain_of: {
+                let chains = profiles.chains();
+                desc.materials
+                    .iter()
+                    .zip(&profiles.profiles)
+                    .map(|(m, (_, blur))| {
+                        let chain = chains.iter().position(|c| c == blur);
+                        (m.id, chain.expect("chains() lists every profile's blur"))
+                    })
+                    .collect()
+            },
+            // Material i has profile i + 1 (profile_of above).
             reaches: desc
                 .materials
                 .iter()
@@ -575,10 +622,7 @@ impl SssEffect {
             )?;
         }
         // Each chain's tiles (none: the whole screen).
-        per_frame.tiles(ring).sss = match marked_tiles(frame.regions, gbuffer.extent()) {
-            Some(tiles) => vec![Some(tiles); self.chains],
-            None => Vec::new(),
-        };
+        per_frame.tiles(ring).sss = self.chain_tiles(frame.regions)?;
         let mut binds = vec![
             (self.imports.depth, frame.images.depth),
             (self.imports.diffuse, frame.images.diffuse),
@@ -608,6 +652,42 @@ impl SssEffect {
             (frame.output, Role::Output),
             timer,
         )
+    }
+
+    /// Each blur chain's tiles for `regions` (empty: every chain on the whole screen): the
+    /// tiles touched by the regions of the chain's own materials and by those for all.
+    fn chain_tiles(&self, regions: &[SssRegion]) -> Result<Vec<Option<Vec<TileRect>>>> {
+        let extent = self.desc.gbuffer.extent();
+        if regions.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut rects = vec![Vec::new(); self.chains];
+        for (index, region) in regions.iter().enumerate() {
+            match region.material {
+                None => rects.iter_mut().for_each(|r| r.push(region.rect)),
+                Some(id) => {
+                    let Some(&(_, chain)) = self.chain_of.iter().find(|&&(i, _)| i == id) else {
+                        return Err(HostError::Description {
+                            field: format!("regions[{index}].material"),
+                            problem: format!(
+                                "ID {id} is none of the effect's materials (SssEffectDesc::materials: {})",
+                                self.chain_of
+                                    .iter()
+                                    .map(|(i, _)| i.to_string())
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        }
+                        .into());
+                    };
+                    rects[chain].push(region.rect);
+                }
+            }
+        }
+        Ok(rects
+            .iter()
+            .map(|r| Some(tiles_marked_by(r, extent)))
+            .collect())
     }
 
     /// Checks every image of `frame` against the description; returns the inputs, one per

@@ -192,6 +192,29 @@ pub fn tile_rects(columns: u32, tiles: &[bool], width: u32, height: u32) -> Vec<
         .collect()
 }
 
+/// One screen's worth of tile rectangles whose marked tiles are those marked in any of
+/// `partitions` (each [`tile_rects`] of the same screen: several passes' tiles, such as the
+/// SSS chains', for a pass that must cover all of them once). Laying the partitions over each
+/// other instead would draw a pixel once per partition, a pass-through over a marked one.
+pub fn union_of_marked<'a>(partitions: impl IntoIterator<Item = &'a [TileRect]>) -> Vec<TileRect> {
+    let partitions: Vec<&[TileRect]> = partitions.into_iter().collect();
+    let rects = || partitions.iter().flat_map(|p| p.iter());
+    // Every partition covers the whole screen: its far corner is the screen's.
+    let width = rects().map(|r| r.x + r.width).max().unwrap_or(0);
+    let height = rects().map(|r| r.y + r.height).max().unwrap_or(0);
+    let columns = width.div_ceil(TILE_SIZE);
+    let rows = height.div_ceil(TILE_SIZE);
+    let mut marked = vec![false; (columns * rows) as usize];
+    for r in rects().filter(|r| r.translucent && r.width * r.height > 0) {
+        for row in r.y / TILE_SIZE..(r.y + r.height).div_ceil(TILE_SIZE) {
+            for column in r.x / TILE_SIZE..(r.x + r.width).div_ceil(TILE_SIZE) {
+                marked[(row * columns + column) as usize] = true;
+            }
+        }
+    }
+    tile_rects(columns, &marked, width, height)
+}
+
 /// Object-space bounding box of each mesh.
 pub fn mesh_bounds(scene: &Scene) -> Vec<(Vec3, Vec3)> {
     bounds_of(&scene.meshes)
@@ -261,5 +284,40 @@ mod tests {
         }
         assert!(covered.iter().all(|&c| c == 1));
         assert_eq!(rects.iter().filter(|r| r.translucent).count(), 1);
+    }
+
+    #[test]
+    fn the_union_of_two_partitions_covers_each_pixel_once_marked_where_either_is() {
+        // 150 x 100: 3 x 2 tiles, the last column and row clipped.
+        let (w, h, columns) = (150, 100, 3);
+        let a = tile_rects(columns, &[true, false, false, false, false, false], w, h);
+        let b = tile_rects(columns, &[false, false, false, false, false, true], w, h);
+        let union = union_of_marked([&a[..], &b[..]]);
+        let mut covered = vec![0u8; (w * h) as usize];
+        let mut marked = vec![false; (w * h) as usize];
+        for r in &union {
+            for y in r.y..r.y + r.height {
+                for x in r.x..r.x + r.width {
+                    covered[(y * w + x) as usize] += 1;
+                    marked[(y * w + x) as usize] = r.translucent;
+                }
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1), "{union:?}");
+        let at = |x: u32, y: u32| marked[(y * w + x) as usize];
+        assert!(at(0, 0) && at(63, 63) && at(149, 99) && at(128, 64));
+        assert!(!at(64, 0) && !at(0, 64) && !at(127, 99));
+        // Nothing marked anywhere: one unmarked rectangle, the whole screen.
+        let none = tile_rects(columns, &[false; 6], w, h);
+        assert_eq!(
+            union_of_marked([&none[..], &none[..]]),
+            vec![TileRect {
+                x: 0,
+                y: 0,
+                width: w,
+                height: h,
+                translucent: false
+            }]
+        );
     }
 }

@@ -44,10 +44,10 @@ use crate::embed::{
     EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
     ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages,
     LayeredMaterial, LeanLighting, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace,
-    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc,
-    TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages,
-    TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc, TransmissionFrame,
-    TransmissionImages, TransmissionMaterial, VertexLayout,
+    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssRegion,
+    ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
+    TranslucencyImages, TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc,
+    TransmissionFrame, TransmissionImages, TransmissionMaterial, VertexLayout,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -517,10 +517,17 @@ fn measure_sss(
         // lucent's own frame does over its tiles.
         // Each scattering object's bounds widened by its own profile's reach (its host ID is
         // its profile number), as lucent's own frame widens its tiles.
-        let regions = object_regions(scene, &camera, (width, height), |i, _| {
-            let id = frame_profiles.object_ids.get(i).copied().unwrap_or(0);
-            effect.reach_of(id).filter(|_| id > 0)
-        });
+        // Each region is given for its object's material, so each blur chain draws on its
+        // own objects' tiles, as lucent's own frame does.
+        let object_id = |i: usize| frame_profiles.object_ids.get(i).copied().unwrap_or(0);
+        let regions: Vec<SssRegion> =
+            object_regions_each(scene, &camera, (width, height), |i, _| {
+                let id = object_id(i);
+                effect.reach_of(id).filter(|_| id > 0)
+            })
+            .into_iter()
+            .map(|(i, rect)| SssRegion::of(object_id(i), rect))
+            .collect();
         let depth = host_image(depth, "host depth", vk::Format::D32_SFLOAT, size, sampled);
         let diffuse = host_image(diffuse, "host diffuse", hdr, size, sampled);
         let specular = host_image(specular, "host specular", hdr, size, sampled);
@@ -1309,18 +1316,32 @@ fn time_term(
 fn object_regions(
     scene: &Scene,
     camera: &HostCamera,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     reach: impl Fn(usize, &crate::scene::Object) -> Option<f32>,
 ) -> Vec<vk::Rect2D> {
+    object_regions_each(scene, camera, size, reach)
+        .into_iter()
+        .map(|(_, rect)| rect)
+        .collect()
+}
+
+/// [`object_regions`], each with its object's index.
+fn object_regions_each(
+    scene: &Scene,
+    camera: &HostCamera,
+    (width, height): (u32, u32),
+    reach: impl Fn(usize, &crate::scene::Object) -> Option<f32>,
+) -> Vec<(usize, vk::Rect2D)> {
     let bounds = crate::gpu_scene::tiles::mesh_bounds(scene);
     let extent = vk::Extent2D { width, height };
-    let regions: Option<Vec<vk::Rect2D>> = scene
+    let regions: Option<Vec<(usize, vk::Rect2D)>> = scene
         .objects
         .iter()
         .enumerate()
-        .filter_map(|(i, o)| reach(i, o).map(|r| (o, r)))
-        .map(|(o, r)| {
+        .filter_map(|(i, o)| reach(i, o).map(|r| (i, o, r)))
+        .map(|(i, o, r)| {
             crate::embed::box_screen_region(bounds[o.mesh], o.transform, camera, extent, r)
+                .map(|rect| (i, rect))
         })
         .collect();
     regions.unwrap_or_default()

@@ -20,8 +20,9 @@ use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
     DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice, HostError,
     HostImage, IdDesc, ImageFault, ImageState, Lucent, NormalDesc, OptionalFeatures, SceneRenderer,
-    SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, ThicknessDesc, TranslucencyEffect,
-    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial, Uploads,
+    SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssRegion, ThicknessDesc,
+    TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages,
+    TranslucentMaterial, Uploads,
 };
 use lucent::features::sss::SssProfiles;
 use lucent::frame::{FrameSettings, Renderer, Technique};
@@ -888,21 +889,35 @@ impl HostLayout {
 }
 
 /// The screen regions of `scene`'s scattering objects (their boxes' corners in the world)
-/// seen by `camera`, widened by `reach`: what a host passes as `SssFrame::regions`. None (the
-/// whole screen) when one crosses the eye's plane.
+/// seen by `camera`, each widened by its material's reach and given for its material (its
+/// host ID, `id_of` the object): what a host passes as `SssFrame::regions`. None (the whole
+/// screen) when one crosses the eye's plane.
 fn sss_regions(
     scene: &lucent::scene::Scene,
     camera: &HostCamera,
     extent: vk::Extent2D,
-    reach: f32,
-) -> Vec<vk::Rect2D> {
+    effect: &SssEffect,
+    id_of: impl Fn(usize) -> u8,
+) -> Vec<SssRegion> {
     let bounds = lucent::gpu_scene::tiles::mesh_bounds(scene);
-    let regions: Option<Vec<vk::Rect2D>> = scene
+    let regions: Option<Vec<SssRegion>> = scene
         .objects
         .iter()
-        .filter(|o| o.material.sss.is_some())
-        .map(|o| {
-            lucent::embed::box_screen_region(bounds[o.mesh], o.transform, camera, extent, reach)
+        .enumerate()
+        .filter(|(_, o)| o.material.sss.is_some())
+        .map(|(i, o)| {
+            let id = id_of(i);
+            let reach = effect
+                .reach_of(id)
+                .expect("every scattering object's ID has a material");
+            let rect = lucent::embed::box_screen_region(
+                bounds[o.mesh],
+                o.transform,
+                camera,
+                extent,
+                reach,
+            );
+            rect.map(|rect| SssRegion::of(id, rect))
         })
         .collect();
     regions.unwrap_or_default()
@@ -1007,7 +1022,7 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
         assert!(ids.iter().any(|&v| v > 0), "the skin scene scatters");
 
         // The scene's profiles in the frame's ID order, their scale the host's world scale.
-        let profiles: Vec<SssProfile> = SssProfiles::new(
+        let frame_profiles = SssProfiles::new(
             &scene,
             Some(sss_blur),
             None,
@@ -1015,14 +1030,17 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
             &lucent::features::registry::blur_of,
         )
         .unwrap()
-        .unwrap()
-        .profiles
-        .into_iter()
-        .map(|(mut p, b)| {
-            p.blur = Some(b.name().into());
-            p
-        })
-        .collect();
+        .unwrap();
+        // Each object's profile number (0: none), which the host IDs below follow.
+        let object_ids = frame_profiles.object_ids.clone();
+        let profiles: Vec<SssProfile> = frame_profiles
+            .profiles
+            .into_iter()
+            .map(|(mut p, b)| {
+                p.blur = Some(b.name().into());
+                p
+            })
+            .collect();
         let units_per_mm = profiles[0].units_per_mm;
         assert!(profiles.iter().all(|p| p.units_per_mm == units_per_mm));
         let metres_per_unit = 1.0 / (1000.0 * units_per_mm);
@@ -1119,8 +1137,10 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
             // (widened by the blurs' reach) touch, as a host computes them; the others on the
             // whole screen. (At this size and the widened profiles' reach the regions touch
             // every tile: the example's test covers regions that leave tiles out.)
-            let regions: Vec<vk::Rect2D> = if depth_kind == HostDepth::D24Stencil {
-                sss_regions(&scene, &layout.camera, layout.desc.extent(), effect.reach())
+            let regions: Vec<SssRegion> = if depth_kind == HostDepth::D24Stencil {
+                sss_regions(&scene, &layout.camera, layout.desc.extent(), &effect, |i| {
+                    host_id(ids_kind, object_ids[i])
+                })
             } else {
                 Vec::new()
             };
@@ -1646,6 +1666,30 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
     }));
     assert!(
         matches!(&e, HostError::Unsupported { input, .. } if input == "lean"),
+        "{e}"
+    );
+    // A region for a material the effect does not have (its one material is 7).
+    let rect = vk::Rect2D {
+        offset: vk::Offset2D { x: 8, y: 8 },
+        extent: vk::Extent2D {
+            width: 16,
+            height: 16,
+        },
+    };
+    let stray = [SssRegion::of(7, rect), SssRegion::of(8, rect)];
+    let e = host_error(recorded(&test, |cmd| {
+        effect.record(
+            &lucent,
+            cmd,
+            &SssFrame {
+                regions: &stray,
+                lean: None,
+                ..with_lean
+            },
+        )
+    }));
+    assert!(
+        matches!(&e, HostError::Description { field, .. } if field == "regions[1].material"),
         "{e}"
     );
     effect.destroy(&lucent);

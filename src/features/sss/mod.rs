@@ -888,16 +888,13 @@ pub fn host_lean_pass(
         // the light alone, which the chains' final passes pass through.
         .variant(HOST_LEAN_PASSTHROUGH.to_vec())
         .tiles(|scene, ctx| {
+            // Each chain's tiles cover the screen, marked on its own materials' regions: the
+            // union marks every tile some chain blurs (a chain on the whole screen: all).
             let chains = &scene.per_frame.tiles(ctx.frame).sss;
-            let mut union: Vec<crate::gpu_scene::TileRect> = Vec::new();
-            for tiles in chains {
-                for &tile in tiles.as_ref()? {
-                    if !union.contains(&tile) {
-                        union.push(tile);
-                    }
-                }
-            }
-            (!chains.is_empty()).then_some(union)
+            let partitions: Option<Vec<&[crate::gpu_scene::TileRect]>> =
+                chains.iter().map(|c| c.as_deref()).collect();
+            Some(crate::gpu_scene::tiles::union_of_marked(partitions?))
+                .filter(|_| !chains.is_empty())
         });
     for target in [
         &mut targets.diffuse,

@@ -82,6 +82,7 @@ void main() {
     bool scatters = sss_in_chain(id, int(blur.step.w + 0.5));
     vec3 blurred = center.rgb;
     if (scatters) {
+        int key = sss_id_key(texelFetch(profile_tex, px, 0));
         float depth_m = depth_at(px, center);
         vec4 dist = burley.distance[id];
         // Guarded: a zero d would divide by zero in the shape; the table holds d > 0.
@@ -116,8 +117,7 @@ void main() {
                 direction = turn * direction;
                 ivec2 tap_px = clamp(px + ivec2(round(offset)), ivec2(0), size - 1);
                 // Other profiles and pixels that do not scatter are rejected.
-                int tap_id = sss_decode_id(texelFetch(profile_tex, tap_px, 0));
-                if (tap_id != id) {
+                if (sss_id_key(texelFetch(profile_tex, tap_px, 0)) != key) {
                     continue;
                 }
                 vec4 light = texelFetch(diffuse_tex, tap_px, 0);

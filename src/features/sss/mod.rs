@@ -1003,6 +1003,47 @@ fn chain_tiles(
 mod tests {
     use super::*;
 
+    /// glsl/common/sss.glsl `sss_host_profile`, step for step, on the table's rows.
+    fn host_profile(rows: &[[u32; 4]; 16], host_id: u32) -> usize {
+        let id = host_id.min(255) as usize;
+        let word = rows[id / 16][(id / 4) % 4];
+        let profile = ((word >> (8 * (id % 4))) & 255) as usize % MAX_SSS_PROFILES;
+        if host_id > 255 {
+            0
+        } else {
+            profile
+        }
+    }
+
+    #[test]
+    fn host_ids_map_to_their_profiles_and_every_other_id_to_none() {
+        for materials in [vec![17u8], vec![17, 42, 5, 255, 1], (1..32).rev().collect()] {
+            let mut profile_of = vec![0u8; 256];
+            for (index, &id) in materials.iter().enumerate() {
+                profile_of[usize::from(id)] = index as u8 + 1;
+            }
+            let map = IdMap::Host(HostIdMap {
+                uint: true,
+                channel: 0,
+                shift: 0,
+                mask: 0xff,
+                unorm_max: 0,
+                profile_of: profile_of.clone(),
+            });
+            let (_, rows) = map.rows();
+            for id in 0..256u32 {
+                assert_eq!(
+                    host_profile(&rows, id),
+                    usize::from(profile_of[id as usize]),
+                    "ID {id} of {materials:?}"
+                );
+            }
+            // A 16-bit ID image's IDs past 255 have no profile.
+            assert_eq!(host_profile(&rows, 256 + 17), 0);
+            assert_eq!(host_profile(&rows, 4096), 0);
+        }
+    }
+
     #[test]
     fn steps_add_up_to_each_gaussian_and_weights_to_one() {
         let skin = SssProfile::preset("skin").unwrap();

@@ -65,25 +65,12 @@ int sss_host_profile(uint host_id) {
     return int((word >> (8u * (host_id % 4u))) & 255u) % MAX_SSS_PROFILES;
 }
 
-// The profile number of the texel `t` of the profile ID image (texelFetch's result).
-int sss_decode_id(vec4 t) {
-#ifdef LUCENT_SSS_HOST_IDS
-    return sss_host_profile(host_material_id(t, sss_profiles.id_decode));
-#else
-    return sss_profile_id(t.r);
-#endif
-}
-
-int sss_decode_id(uvec4 t) {
-    // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
-    return sss_host_profile(host_material_id(t, sss_profiles.id_decode));
-}
-
-// A key of the profile ID image's texel `t` that equals a scattering pixel's key exactly when
-// `t` has the same profile, for the taps of a pixel that scatters: lucent's profile number, or
-// a host's material ID itself (each of the host's SSS materials has a profile of its own, and
-// an ID without one differs from every ID with one). A tap then skips the ID-to-profile table
-// (Burley's gather: 1.08-1.15x lucent's own pass with the table per tap).
+// A key of the profile ID image's texel `t` (texelFetch's result) that equals a scattering
+// pixel's key exactly when `t` has the same profile, for the taps of a pixel that scatters:
+// lucent's profile number, or a host's material ID itself (each of the host's SSS materials has
+// a profile of its own, and an ID without one differs from every ID with one). A tap then
+// skips the ID-to-profile table (Burley's gather: 1.08x lucent's own pass with the table per
+// tap, 1.05x without).
 int sss_id_key(vec4 t) {
 #ifdef LUCENT_SSS_HOST_IDS
     return int(host_material_id(t, sss_profiles.id_decode));
@@ -93,7 +80,21 @@ int sss_id_key(vec4 t) {
 }
 
 int sss_id_key(uvec4 t) {
+    // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
     return int(host_material_id(t, sss_profiles.id_decode));
+}
+
+// The profile number of the texel `t` of the profile ID image.
+int sss_decode_id(vec4 t) {
+#ifdef LUCENT_SSS_HOST_IDS
+    return sss_host_profile(uint(sss_id_key(t)));
+#else
+    return sss_id_key(t);
+#endif
+}
+
+int sss_decode_id(uvec4 t) {
+    return sss_host_profile(uint(sss_id_key(t)));
 }
 
 // Whether profile `id` is blurred by chain `chain` (0 never is).

@@ -260,13 +260,7 @@ mod tests {
         let rects = tile_rects(columns, &tiles, w, h);
         assert_eq!(
             rects,
-            vec![TileRect {
-                x: 0,
-                y: 0,
-                width: w,
-                height: h,
-                translucent: false
-            }],
+            unmarked_screen(w, h),
             "no translucent tile: one rectangle, the whole screen"
         );
         // A marked tile in the middle splits the screen into rectangles that cover every
@@ -311,13 +305,18 @@ mod tests {
         let none = tile_rects(columns, &[false; 6], w, h);
         assert_eq!(
             union_of_marked([&none[..], &none[..]]),
-            vec![TileRect {
-                x: 0,
-                y: 0,
-                width: w,
-                height: h,
-                translucent: false
-            }]
+            unmarked_screen(w, h)
         );
+    }
+
+    /// The whole `w` x `h` screen as one unmarked rectangle.
+    fn unmarked_screen(w: u32, h: u32) -> Vec<TileRect> {
+        vec![TileRect {
+            x: 0,
+            y: 0,
+            width: w,
+            height: h,
+            translucent: false,
+        }]
     }
 }

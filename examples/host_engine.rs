@@ -1613,15 +1613,6 @@ fn transmission_on(args: &Args) -> bool {
     args.with_lucent && args.scene.is_none() && !args.no_transmission
 }
 
-/// The blurs that blur LEAN moments and relight the specular (lucent's LEAN-mapping thesis).
-const LEAN_BLURS: [&str; 3] = ["lcb", "lbb", "bilateral"];
-
-/// Whether a scattering material's blur is a LEAN blur: the SSS effect then reads the
-/// normals, the lights and (with shadow maps) the shadow atlas.
-fn sss_lean(args: &Args) -> bool {
-    LEAN_BLURS.contains(&args.blur.as_str()) || LEAN_BLURS.contains(&args.marble_blur.as_str())
-}
-
 /// The engine's gloss of the skin and the marble (its G-buffer's albedo alpha).
 const SKIN_GLOSS: f32 = 0.5;
 const MARBLE_GLOSS: f32 = 0.8;
@@ -2725,12 +2716,10 @@ fn create_effects(
     let material = |id: u8, preset: &str, blur: &str, surface: SpecularSurface| {
         let mut profile = SssProfile::preset(preset).map_err(|e| e.to_string())?;
         profile.blur = Some(blur.into());
-        let material = SssMaterial::new(id, profile);
-        Ok::<_, String>(if LEAN_BLURS.contains(&blur) {
-            material.with_surface(surface)
-        } else {
-            material
-        })
+        // A blur that relights the specular (LCB, LBB, bilateral) takes the engine's gloss.
+        SssMaterial::new(id, profile)
+            .with_surface_if_relit(surface)
+            .map_err(|e| e.to_string())
     };
     let gbuffer = GBufferDesc::new(
         args.width,
@@ -2784,8 +2773,10 @@ fn create_effects(
         ],
         HDR_FORMAT,
     );
-    // The engine's shadow maps shadow the relit specular too, when it renders them.
-    let desc = if sss_lean(args) && transmission_on(args) {
+    // A blur that relights the specular (its material has a surface) reads the normals and
+    // the lights; the engine's shadow maps shadow that specular too, when it renders them.
+    let sss_lean = desc.materials.iter().any(|m| m.surface.is_some());
+    let desc = if sss_lean && transmission_on(args) {
         desc.with_shadow_maps(SHADOW_FORMAT)
     } else {
         desc
@@ -2889,7 +2880,7 @@ fn create_effects(
         lucent,
         inserted,
         whole_screen: args.whole_screen,
-        sss_lean: sss_lean(args),
+        sss_lean,
         timers,
         times: Default::default(),
     })

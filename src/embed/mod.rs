@@ -234,7 +234,7 @@ pub use glam;
 /// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`]; host shadow maps in reversed Z and
 /// as arrays ([`ShadowFace::layer`], [`HostImage::layers`], `with_shadow_array`). 8:
 /// [`SssFrame::regions`] per material ([`SssRegion`]): each blur chain runs on its own
-/// materials' regions.
+/// materials' regions; [`SssMaterial::relights_specular`].
 pub const API_VERSION: u32 = 8;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

@@ -86,6 +86,25 @@ impl SssMaterial {
         self.surface = Some(surface);
         self
     }
+
+    /// Whether its profile's blur relights the specular (LCB, LBB, the bilateral blur): the
+    /// material then needs a [`SpecularSurface`] ([`Self::with_surface`]), and the effect the
+    /// normals and the lights ([`SssFrame::lean`]). The blur named by the profile, or the
+    /// default blur when it names none; an unknown name is an error that lists the blurs.
+    pub fn relights_specular(&self) -> Result<bool> {
+        Ok(registry::blur_of(&self.profile)?.lean())
+    }
+
+    /// [`Self::with_surface`] when the profile's blur relights the specular
+    /// ([`Self::relights_specular`]), the material as it is otherwise: what a host that
+    /// knows each material's surface gives whatever blur the profile names.
+    pub fn with_surface_if_relit(self, surface: SpecularSurface) -> Result<Self> {
+        Ok(if self.relights_specular()? {
+            self.with_surface(surface)
+        } else {
+            self
+        })
+    }
 }
 
 /// A material's specular as lucent's own materials describe it (`roughness`, `specular` of a
@@ -1077,5 +1096,34 @@ mod tests {
         assert!(!needs_albedo_pass(DiffuseAlbedo::Included, &pre));
         assert!(needs_albedo_pass(DiffuseAlbedo::Included, &post));
         assert!(needs_albedo_pass(DiffuseAlbedo::Excluded, &pre));
+    }
+
+    #[test]
+    fn a_material_says_whether_its_blur_relights_the_specular() {
+        let material = |blur: Option<&str>| {
+            let mut profile = SssProfile::preset("skin").expect("a preset");
+            profile.blur = blur.map(Into::into);
+            SssMaterial::new(3, profile)
+        };
+        for (blur, relit) in [
+            (Some("lcb"), true),
+            (Some("lbb"), true),
+            (Some("bilateral"), true),
+            (Some("separable"), false),
+            (Some("control"), false),
+            (Some("burley"), false),
+            // No blur named: the default blur (separable).
+            (None, false),
+        ] {
+            let m = material(blur);
+            assert_eq!(m.relights_specular().unwrap(), relit, "{blur:?}");
+            let surface = SpecularSurface::new(0.4, 0.3);
+            let given = m.with_surface_if_relit(surface).unwrap().surface;
+            assert_eq!(given, relit.then_some(surface), "{blur:?}");
+        }
+        let e = material(Some("gaussian-ish"))
+            .relights_specular()
+            .unwrap_err();
+        assert!(e.to_string().contains("separable"), "{e}");
     }
 }

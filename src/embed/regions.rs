@@ -8,7 +8,7 @@ use ash::vk;
 use glam::Vec3;
 
 use super::HostCamera;
-use crate::gpu_scene::tiles::{tile_rects, TILE_SIZE};
+use crate::gpu_scene::tiles::tiles_touched_by;
 use crate::gpu_scene::TileRect;
 
 /// [`screen_region`] of the box `lo..hi` (an object's bounds in its own space) placed in the
@@ -188,25 +188,12 @@ fn disjoint(rects: &[(u32, u32, u32, u32)]) -> Vec<TileRect> {
     out
 }
 
-/// The screen as tiles of [`TILE_SIZE`] (merged into rectangles), marked where `regions` touch
+/// The screen as tiles of [`crate::gpu_scene::tiles::TILE_SIZE`] (merged into rectangles), marked where `regions` touch
 /// them, for passes that draw their own shader in the marked tiles and a pass-through variant
 /// elsewhere (the SSS chains, each with its own materials' regions): with no region, none is
 /// marked (a chain none of whose materials has a region passes the light through everywhere).
 pub(crate) fn tiles_marked_by(regions: &[vk::Rect2D], extent: vk::Extent2D) -> Vec<TileRect> {
-    let columns = extent.width.div_ceil(TILE_SIZE);
-    let rows = extent.height.div_ceil(TILE_SIZE);
-    let mut marked = vec![false; (columns * rows) as usize];
-    for r in clipped(regions, extent)
-        .iter()
-        .filter(|r| r.width * r.height > 0)
-    {
-        for row in r.y / TILE_SIZE..(r.y + r.height).div_ceil(TILE_SIZE) {
-            for column in r.x / TILE_SIZE..(r.x + r.width).div_ceil(TILE_SIZE) {
-                marked[(row * columns + column) as usize] = true;
-            }
-        }
-    }
-    tile_rects(columns, &marked, extent.width, extent.height)
+    tiles_touched_by(clipped(regions, extent), extent.width, extent.height)
 }
 
 #[cfg(test)]

@@ -338,12 +338,19 @@ pub struct SssEffect {
     desc: SssEffectDesc,
     /// The blur chains the profiles use (each draws in its own materials' tiles).
     chains: usize,
-    /// Each material's blur chain (an index into the chains), by its host ID.
-    chain_of: Vec<(u8, usize)>,
-    /// Each material's reach, world units, by its host ID ([`Self::reach_of`]).
-    reaches: Vec<(u8, f32)>,
+    /// Each material's host ID, reach and chain, in the description's order.
+    materials: Vec<MaterialChain>,
     /// With LEAN blurs: the host LEAN pass's constants but for the view (written per frame).
     lean: Option<HostLeanGpu>,
+}
+
+/// One of an [`SssEffect`]'s materials: its host ID, its reach ([`SssEffect::reach_of`]) and
+/// the blur chain its pixels are diffused by (an index into the profiles' chains).
+#[derive(Clone, Copy, Debug)]
+struct MaterialChain {
+    id: u8,
+    reach: f32,
+    chain: usize,
 }
 
 /// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
@@ -539,29 +546,26 @@ impl SssEffect {
             desc.views_per_frame,
             |scene_gpu| declare(&desc, &profiles, scene_gpu, albedo_pass, post_albedo, lean),
         )?;
+        let chains = profiles.chains();
+        // Material i has profile i + 1 (profile_of above).
+        let materials = desc
+            .materials
+            .iter()
+            .zip(&profiles.profiles)
+            .map(|(m, (profile, blur))| MaterialChain {
+                id: m.id,
+                reach: sss::profile_reach(profile),
+                chain: chains
+                    .iter()
+                    .position(|c| c == blur)
+                    .expect("chains() lists every profile's blur"),
+            })
+            .collect();
         let out = Self {
             passes,
             imports,
-            chains: profiles.chains().len(),
-            // Material i has profile i + 1 (profile_of above).
-            chain_of: {
-                let chains = profiles.chains();
-                desc.materials
-                    .iter()
-                    .zip(&profiles.profiles)
-                    .map(|(m, (_, blur))| {
-                        let chain = chains.iter().position(|c| c == blur);
-                        (m.id, chain.expect("chains() lists every profile's blur"))
-                    })
-                    .collect()
-            },
-            // Material i has profile i + 1 (profile_of above).
-            reaches: desc
-                .materials
-                .iter()
-                .zip(&profiles.profiles)
-                .map(|(m, (p, _))| (m.id, sss::profile_reach(p)))
-                .collect(),
+            chains: chains.len(),
+            materials,
             desc,
             lean: lean_constants,
         };
@@ -582,17 +586,14 @@ impl SssEffect {
     /// projected at the object's depth for [`SssFrame::regions`] ([`super::screen_region`]
     /// does).
     pub fn reach(&self) -> f32 {
-        self.reaches.iter().map(|&(_, r)| r).fold(0.0, f32::max)
+        self.materials.iter().map(|m| m.reach).fold(0.0, f32::max)
     }
 
     /// The reach of the material with host ID `id` alone (`None`: no material has it): widen
     /// each object's bounds by its own material's reach and the regions cover no more than
     /// the blurs need, as lucent's own frames widen each object's tiles by its own profile's.
     pub fn reach_of(&self, id: u8) -> Option<f32> {
-        self.reaches
-            .iter()
-            .find(|&&(i, _)| i == id)
-            .map(|&(_, r)| r)
+        self.materials.iter().find(|m| m.id == id).map(|m| m.reach)
     }
 
     super::passes::effect_methods!(
@@ -685,21 +686,21 @@ impl SssEffect {
             match region.material {
                 None => rects.iter_mut().for_each(|r| r.push(region.rect)),
                 Some(id) => {
-                    let Some(&(_, chain)) = self.chain_of.iter().find(|&&(i, _)| i == id) else {
+                    let Some(material) = self.materials.iter().find(|m| m.id == id) else {
                         return Err(HostError::Description {
                             field: format!("regions[{index}].material"),
                             problem: format!(
                                 "ID {id} is none of the effect's materials (SssEffectDesc::materials: {})",
-                                self.chain_of
+                                self.materials
                                     .iter()
-                                    .map(|(i, _)| i.to_string())
+                                    .map(|m| m.id.to_string())
                                     .collect::<Vec<_>>()
                                     .join(", ")
                             ),
                         }
                         .into());
                     };
-                    rects[chain].push(region.rect);
+                    rects[material.chain].push(region.rect);
                 }
             }
         }

@@ -192,20 +192,18 @@ pub fn tile_rects(columns: u32, tiles: &[bool], width: u32, height: u32) -> Vec<
         .collect()
 }
 
-/// One screen's worth of tile rectangles whose marked tiles are those marked in any of
-/// `partitions` (each [`tile_rects`] of the same screen: several passes' tiles, such as the
-/// SSS chains', for a pass that must cover all of them once). Laying the partitions over each
-/// other instead would draw a pixel once per partition, a pass-through over a marked one.
-pub fn union_of_marked<'a>(partitions: impl IntoIterator<Item = &'a [TileRect]>) -> Vec<TileRect> {
-    let partitions: Vec<&[TileRect]> = partitions.into_iter().collect();
-    let rects = || partitions.iter().flat_map(|p| p.iter());
-    // Every partition covers the whole screen: its far corner is the screen's.
-    let width = rects().map(|r| r.x + r.width).max().unwrap_or(0);
-    let height = rects().map(|r| r.y + r.height).max().unwrap_or(0);
+/// The `width` x `height` screen as [`tile_rects`], marked where any of `rects` (pixel
+/// rectangles inside the screen) touches a tile: for passes that draw their own shader in
+/// the marked tiles and a pass-through elsewhere (the SSS chains). No rectangle: none marked.
+pub fn tiles_touched_by(
+    rects: impl IntoIterator<Item = TileRect>,
+    width: u32,
+    height: u32,
+) -> Vec<TileRect> {
     let columns = width.div_ceil(TILE_SIZE);
     let rows = height.div_ceil(TILE_SIZE);
     let mut marked = vec![false; (columns * rows) as usize];
-    for r in rects().filter(|r| r.translucent && r.width * r.height > 0) {
+    for r in rects.into_iter().filter(|r| r.width * r.height > 0) {
         for row in r.y / TILE_SIZE..(r.y + r.height).div_ceil(TILE_SIZE) {
             for column in r.x / TILE_SIZE..(r.x + r.width).div_ceil(TILE_SIZE) {
                 marked[(row * columns + column) as usize] = true;
@@ -213,6 +211,18 @@ pub fn union_of_marked<'a>(partitions: impl IntoIterator<Item = &'a [TileRect]>)
         }
     }
     tile_rects(columns, &marked, width, height)
+}
+
+/// One screen's worth of tile rectangles whose marked tiles are those marked in any of
+/// `partitions` (each [`tile_rects`] of the same screen: several passes' tiles, such as the
+/// SSS chains', for a pass that must cover all of them once). Laying the partitions over each
+/// other instead would draw a pixel once per partition, a pass-through over a marked one.
+pub fn union_of_marked<'a>(partitions: impl IntoIterator<Item = &'a [TileRect]>) -> Vec<TileRect> {
+    let rects: Vec<TileRect> = partitions.into_iter().flatten().copied().collect();
+    // Every partition covers the whole screen: its far corner is the screen's.
+    let width = rects.iter().map(|r| r.x + r.width).max().unwrap_or(0);
+    let height = rects.iter().map(|r| r.y + r.height).max().unwrap_or(0);
+    tiles_touched_by(rects.into_iter().filter(|r| r.translucent), width, height)
 }
 
 /// Object-space bounding box of each mesh.

@@ -513,12 +513,9 @@ fn measure_sss(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
         );
-        // The host blurs over its scattering objects' screen bounds widened by the reach, as
-        // lucent's own frame does over its tiles.
-        // Each scattering object's bounds widened by its own profile's reach (its host ID is
-        // its profile number), as lucent's own frame widens its tiles.
-        // Each region is given for its object's material, so each blur chain draws on its
-        // own objects' tiles, as lucent's own frame does.
+        // Each scattering object's screen bounds widened by its own profile's reach (its host
+        // ID is its profile number), given for its material: each blur chain draws on its own
+        // objects' tiles, as lucent's own frame does.
         let object_id = |i: usize| frame_profiles.object_ids.get(i).copied().unwrap_or(0);
         let regions: Vec<SssRegion> =
             object_regions_each(scene, &camera, (width, height), |i, _| {

@@ -1,8 +1,8 @@
 //! `lucent report truth --quick --out DIR` from the command line, validation on, on the
 //! committed truths (tools/truth): it finishes, writes `truth.md` and one plot per truth scene
-//! (and per region a truth names) that decodes as a PNG, has a section per scene with one row per technique (every row a finite
-//! error, FLIP, energies and a positive time), and the budget table names a best technique for
-//! every scene. A truth directory that does not exist, and a scene it does not hold, are clear
+//! (and per region a truth names) that decodes as a PNG, has a section per scene with one row
+//! per technique (every row a finite error, FLIP, energies and a positive time), and the
+//! budget table names a best technique for every scene. A truth directory that does not exist, and a scene it does not hold, are clear
 //! errors.
 
 use std::path::{Path, PathBuf};

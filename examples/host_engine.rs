@@ -42,11 +42,13 @@
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
 //!    diffuse + specular itself instead (its own ambient, no translucency, no scatter).
 //!
-//!    With `--fused` the engine adds the environment and the translucency inside its own
-//!    lighting pass instead, with lucent's GLSL (`lucent::embed::glsl::TERMS`:
-//!    `lucent_sh_ambient`, `lucent_translucency`) and lucent's data (the environment's
-//!    coefficients, the leaf's material row, the lights' translucency scales): no pass of
-//!    lucent's but the SSS, the same picture within the target's rounding.
+//!    With `--fused` the engine adds the environment, the translucency and the transmission
+//!    inside its own lighting pass instead, with lucent's GLSL (`lucent::embed::glsl::TERMS`:
+//!    `lucent_sh_ambient`, `lucent_translucency`, `lucent_sss_transmitted`) and lucent's data
+//!    (the environment's coefficients, the leaf's material row, the lights' translucency
+//!    scales, the skin's and marble's medium rows), the transmission's thickness measured by
+//!    the engine's own lookup of its shadow atlas: no pass of lucent's but the layered media
+//!    and the SSS, the same picture within the target's rounding.
 //! 8. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
@@ -166,8 +168,9 @@ struct Args {
     /// `--engine-ambient`: the engine's lighting adds its own ambient term instead of lucent's
     /// `EnvironmentEffect` adding the same light (a check of the effect).
     engine_ambient: bool,
-    /// `--fused`: the engine's lighting pass adds lucent's environment and translucency terms
-    /// itself (`lucent::embed::glsl::TERMS`) instead of lucent's effects adding them after it.
+    /// `--fused`: the engine's lighting pass adds lucent's environment, translucency and
+    /// transmission terms itself (`lucent::embed::glsl::TERMS`) instead of lucent's effects
+    /// adding them after it.
     fused: bool,
     /// `--no-transmission`: no SSS transmission (and no shadow maps of the engine's).
     no_transmission: bool,
@@ -407,16 +410,164 @@ void main() {{
         pub leaf_row: [f32; 4],
         /// The sun's and the back light's translucency scales.
         pub scales: [f32; 2],
+        /// SSS transmission (none with `--no-transmission`): the skin's and the marble's
+        /// medium rows (`TransmissionMaterial::rows`) and the engine's shadow faces.
+        pub transmission: Option<FusedTransmission>,
+    }
+
+    /// The data of lucent's transmission term in the engine's lighting (`--fused`).
+    pub struct FusedTransmission {
+        /// The skin's and the marble's rows.
+        pub media: [[[f32; 4]; 4]; 2],
+        /// The engine's shadow faces, as its lighting reads its atlas: the sun's, then the
+        /// back light's six (+X, -X, +Y, -Y, +Z, -Z).
+        pub faces: Vec<super::AtlasFace>,
+    }
+
+    /// Which of lucent's per-object terms a lighting variant adds (`--fused`): each is drawn
+    /// only over the tiles of the objects that need it.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub struct Terms {
+        /// GDC 2011 translucency (the leaf).
+        pub leaf: bool,
+        /// SSS transmission (the skin and the marble).
+        pub transmission: bool,
+    }
+
+    impl Terms {
+        /// No per-object term: the plain lighting (lucent's SH ambient with `--fused`).
+        pub const NONE: Terms = Terms {
+            leaf: false,
+            transmission: false,
+        };
+
+        /// The variants `--fused` compiles, the plain one first.
+        pub const ALL: [Terms; 4] = [
+            Terms::NONE,
+            Terms {
+                leaf: true,
+                transmission: false,
+            },
+            Terms {
+                leaf: false,
+                transmission: true,
+            },
+            Terms {
+                leaf: true,
+                transmission: true,
+            },
+        ];
+
+        /// This variant's index in [`Self::ALL`].
+        pub fn index(self) -> usize {
+            usize::from(self.leaf) + 2 * usize::from(self.transmission)
+        }
+    }
+
+    /// The engine's shadow lookup for lucent's transmission: its atlas (binding 5, standard
+    /// Z), each face's constants, and lucent's recipe for the thickness a map measures (the
+    /// point one map texel inside, the four texels around it, lucent's transmission term per
+    /// texel weighted bilinearly: `lucent_sss_transmitted`).
+    fn transmission_glsl(t: &FusedTransmission, vec4: &dyn Fn([f32; 4]) -> String) -> String {
+        let mat4 = |m: &[[f32; 4]; 4]| format!("mat4({})", m.map(vec4).join(", "));
+        format!(
+            r#"
+const vec4 SKIN_MEDIUM[4] = vec4[4]({SKIN_MEDIUM});
+const vec4 MARBLE_MEDIUM[4] = vec4[4]({MARBLE_MEDIUM});
+layout(set = 0, binding = 5) uniform sampler2D shadow_atlas;   // the engine's, standard Z
+// Face f's world-to-clip matrix (standard Z); its rectangle (xy: its corner in the atlas in
+// texels, z: its edge); its parameters (x * clip.w + y: a map texel's world size at a point;
+// z: near, negative when orthographic; w: far). Chosen by comparisons, not read from a
+// constant array: a CPU driver copies a dynamically indexed constant array per pixel.
+void face_data(int f, out mat4 view_proj, out vec4 rect, out vec4 params) {{
+{FACES}
+}}
+
+// Distance along face f's axis of device depth d (standard Z).
+float face_distance(vec4 params, float d) {{
+    float near = abs(params.z), far = params.w;
+    if (params.z < 0.0) {{
+        return near + d * (far - near);
+    }}
+    return near * far / max(far - d * (far - near), 1e-12);
+}}
+
+// The light that reaches p (normal n, towards the light l) through the object from face f's
+// light: `point` lights at `light_pos` fall off as the engine's back light, the sun does not.
+vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 radiance,
+                         bool point, vec3 light_pos) {{
+    if (!(dot(n, l) < 0.0)) {{
+        return vec3(0.0);  // the lit side: the light does not pass through the object to here
+    }}
+    mat4 view_proj;
+    vec4 rect, params;
+    face_data(f, view_proj, rect, params);
+    vec4 clip = view_proj * vec4(p, 1.0);
+    vec3 inner = p - n * (params.x * abs(clip.w) + params.y);
+    clip = view_proj * vec4(inner, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
+          ndc.z <= 1.0)) {{
+        return vec3(0.0);  // outside the face: nothing measures the thickness
+    }}
+    vec2 t = rect.xy + (ndc.xy * 0.5 + 0.5) * rect.z;
+    float d_inner = face_distance(params, ndc.z);
+    vec2 c = clamp(t - 0.5, rect.xy, rect.xy + rect.z - 1.001);
+    vec2 base = floor(c);
+    vec2 fr = c - base;
+    vec4 w = vec4((1.0 - fr.x) * fr.y, fr.x * fr.y, fr.x * (1.0 - fr.y), (1.0 - fr.x) * (1.0 - fr.y));
+    vec4 d = textureGather(shadow_atlas, (base + 1.0) / vec2(textureSize(shadow_atlas, 0)), 0);
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {{
+        if (!(d[k] < 1.0)) {{
+            continue;  // nothing between the light and the far plane
+        }}
+        float d_map = face_distance(params, d[k]);
+        vec3 entry;
+        vec3 light = radiance;
+        if (point) {{
+            entry = light_pos + (inner - light_pos) * min(d_map / max(d_inner, 1e-12), 1.0);
+            light *= back_light_falloff(entry);
+        }} else {{
+            entry = inner + l * max(d_inner - d_map, 0.0);
+        }}
+        sum += w[k] * lucent_sss_transmitted(medium, n, l, length(entry - p), light);
+    }}
+    return sum;
+}}
+"#,
+            FACES = t
+                .faces
+                .iter()
+                .enumerate()
+                .map(|(k, f)| format!(
+                    // The last face is the else: every output is written.
+                    "    {}{{ view_proj = {}; rect = {}; params = {}; }}",
+                    match k {
+                        0 => format!("if (f == {k}) "),
+                        _ if k + 1 == t.faces.len() => "else ".to_string(),
+                        _ => format!("else if (f == {k}) "),
+                    },
+                    mat4(&f.view_proj),
+                    vec4(f.rect),
+                    vec4(f.params)
+                ))
+                .collect::<Vec<_>>()
+                .join("\n"),
+            SKIN_MEDIUM = t.media[0].map(vec4).join(", "),
+            MARBLE_MEDIUM = t.media[1].map(vec4).join(", "),
+        )
     }
 
     /// The lighting shader; with `fused`, lucent's GLSL terms and the constants they read
     /// (the engine's own data, compiled in), called where it shades each light: the SH
-    /// ambient everywhere, the translucency in the `leaf` variant only (drawn over the leaf's
-    /// screen rectangle, the plain one elsewhere: a CPU driver runs both sides of a branch,
-    /// so a branch on the ID would cost the whole screen the term).
-    pub fn lighting_frag(fused: Option<&Fused>, leaf: bool) -> String {
+    /// ambient everywhere, the translucency and the transmission in the variants `terms`
+    /// names only (each drawn over the tiles of the objects that need it, the plain one
+    /// elsewhere: a CPU driver runs both sides of a branch, so a branch on the ID would cost
+    /// the whole screen the term).
+    pub fn lighting_frag(fused: Option<&Fused>, terms: Terms) -> String {
         let vec4 = |v: [f32; 4]| format!("vec4({:?}, {:?}, {:?}, {:?})", v[0], v[1], v[2], v[3]);
-        let (terms, ambient, transmitted) = match fused {
+        let (terms_glsl, ambient, transmitted) = match fused {
             None => (
                 String::new(),
                 // The engine's own ambient (pc.params.y 1), or none where lucent's
@@ -424,25 +575,49 @@ void main() {{
                 "mix(ground, sky, n.y * 0.5 + 0.5) * pc.params.y".to_string(),
                 String::new(),
             ),
-            Some(f) if !leaf => (
-                format!(
+            Some(f) => {
+                let mut glsl = format!(
                     "{}\nconst vec4 LUCENT_SH[9] = vec4[9]({});\n",
                     lucent::embed::glsl::TERMS,
                     f.sh.iter().map(|&c| vec4(c)).collect::<Vec<_>>().join(", "),
-                ),
-                "lucent_sh_ambient(LUCENT_SH, n)".to_string(),
-                String::new(),
-            ),
-            Some(f) => (
-                format!(
-                    "{}\nconst vec4 LUCENT_SH[9] = vec4[9]({});\nconst vec4 LEAF_ROW = {};\n",
-                    lucent::embed::glsl::TERMS,
-                    f.sh.iter().map(|&c| vec4(c)).collect::<Vec<_>>().join(", "),
-                    vec4(f.leaf_row)
-                ),
-                "lucent_sh_ambient(LUCENT_SH, n)".to_string(),
-                format!(
-                    r#"
+                );
+                let mut added = String::new();
+                if terms.leaf {
+                    glsl += &format!("const vec4 LEAF_ROW = {};\n", vec4(f.leaf_row));
+                    added += &leaf_glsl(f);
+                }
+                if let (true, Some(t)) = (terms.transmission, &f.transmission) {
+                    glsl += &transmission_glsl(t, &vec4);
+                    added += &format!(
+                        r#"
+    // SSS transmission through the skin and the marble, from both lights, measured in the
+    // engine's shadow atlas: lucent's term (what its TransmissionEffect adds).
+    uint medium_id = texelFetch(id_tex, px, 0).r;
+    if (medium_id == {SKIN}u || medium_id == {MARBLE}u) {{
+        vec4 medium[4] = medium_id == {SKIN}u ? SKIN_MEDIUM : MARBLE_MEDIUM;
+        vec3 through = transmitted_through(medium, 0, p, n, l, sun, false, vec3(0.0));
+        vec3 from_back = p - BACK_LIGHT;
+        vec3 axes = abs(from_back);
+        int axis = (axes.x >= axes.y && axes.x >= axes.z) ? 0 : (axes.y >= axes.z ? 1 : 2);
+        int face = 1 + 2 * axis + (from_back[axis] < 0.0 ? 1 : 0);
+        through += transmitted_through(medium, face, p, n, to_back * inversesqrt(dist2),
+                                       BACK_RADIANCE, true, BACK_LIGHT);
+        diffuse += a.rgb * through / 3.14159265;
+    }}"#,
+                        SKIN = super::SKIN_ID,
+                        MARBLE = super::MARBLE_ID,
+                    );
+                }
+                (glsl, "lucent_sh_ambient(LUCENT_SH, n)".to_string(), added)
+            }
+        };
+        lighting_source(&terms_glsl, &ambient, &transmitted)
+    }
+
+    /// GDC 2011's translucency through the leaf, from both lights: lucent's term.
+    fn leaf_glsl(f: &Fused) -> String {
+        format!(
+            r#"
     // GDC 2011 translucency through the leaf, from both lights: lucent's term.
     if (texelFetch(id_tex, px, 0).r == {LEAF}u) {{
         vec3 thickness = vec3(texelFetch(thickness_tex, px, 0).r);
@@ -450,21 +625,32 @@ void main() {{
         diffuse += lucent_translucency(a.rgb, thickness, LEAF_ROW, v, v_dot_n, l, sun, 1.0,
                                        {SUN_SCALE:?});
         diffuse += lucent_translucency(a.rgb, thickness, LEAF_ROW, v, v_dot_n,
-                                       to_back * inversesqrt(dist2), vec3({BR}, {BG}, {BB}),
-                                       window * window / dist2, {BACK_SCALE:?});
+                                       to_back * inversesqrt(dist2), BACK_RADIANCE,
+                                       back_light_falloff(p), {BACK_SCALE:?});
     }}"#,
-                    LEAF = super::LEAF_ID,
-                    SUN_SCALE = f.scales[0],
-                    BACK_SCALE = f.scales[1],
-                    BR = super::BACK_LIGHT_RADIANCE[0],
-                    BG = super::BACK_LIGHT_RADIANCE[1],
-                    BB = super::BACK_LIGHT_RADIANCE[2],
-                ),
-            ),
-        };
+            LEAF = super::LEAF_ID,
+            SUN_SCALE = f.scales[0],
+            BACK_SCALE = f.scales[1],
+        )
+    }
+
+    /// The lighting shader's source around lucent's terms (`terms`: their GLSL and constants,
+    /// `ambient`: the ambient expression, `added`: what main adds to the lit diffuse).
+    fn lighting_source(terms: &str, ambient: &str, added: &str) -> String {
         format!(
             r#"#version 450
 {PUSH}
+// The engine's back light: its position and radiance.
+const vec3 BACK_LIGHT = vec3({BX}, {BY}, {BZ});
+const vec3 BACK_RADIANCE = vec3({BR}, {BG}, {BB});
+// The back light's falloff at q: lucent's point-light falloff (a smooth window to its range).
+float back_light_falloff(vec3 q) {{
+    vec3 to_back = BACK_LIGHT - q;
+    float dist2 = max(dot(to_back, to_back), 1e-4);
+    float ratio = sqrt(dist2) / {BRANGE};
+    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+    return window * window / dist2;
+}}
 {terms}
 layout(set = 0, binding = 0) uniform sampler2D depth_tex;   // reversed Z, infinite far
 layout(set = 0, binding = 1) uniform sampler2D normal_tex;
@@ -500,14 +686,12 @@ void main() {{
     vec3 sun = vec3(1.0, 0.95, 0.88) * pc.sun.w;
     vec3 ground = vec3({GR}, {GG}, {GB}), sky = vec3({SR}, {SG}, {SB});
     vec3 ambient = {ambient};
-    // The back light, with lucent's point-light falloff (a smooth window to its range).
-    vec3 to_back = vec3({BX}, {BY}, {BZ}) - p;
+    // The back light, with lucent's point-light falloff.
+    vec3 to_back = BACK_LIGHT - p;
     float dist2 = max(dot(to_back, to_back), 1e-4);
-    float ratio = sqrt(dist2) / {BRANGE};
-    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
-    vec3 back = vec3({BR}, {BG}, {BB}) * (window * window / dist2);
+    vec3 back = BACK_RADIANCE * back_light_falloff(p);
     float nb = max(dot(n, to_back * inversesqrt(dist2)), 0.0);
-    vec3 diffuse = a.rgb * ((sun * nl + back * nb) / 3.14159265 + ambient);{transmitted}
+    vec3 diffuse = a.rgb * ((sun * nl + back * nb) / 3.14159265 + ambient);{added}
     o_diffuse = vec4(diffuse, 1.0);
     float shininess = exp2(1.0 + 10.0 * a.a);
     float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(h, v), 0.0), 5.0);
@@ -936,8 +1120,10 @@ struct Pipelines {
     pool: vk::DescriptorPool,
     gbuffer: vk::Pipeline,
     lighting: vk::Pipeline,
-    /// `--fused`: the lighting with lucent's translucency, drawn over the leaf's rectangle.
-    lighting_leaf: Option<vk::Pipeline>,
+    /// `--fused`: the lighting's variants with lucent's per-object terms (the leaf's
+    /// translucency, the skin's and marble's transmission), each drawn over the tiles of the
+    /// objects that need it ([`shaders::Terms`]).
+    lighting_terms: Vec<(shaders::Terms, vk::Pipeline)>,
     compose: vk::Pipeline,
     tonemap: vk::Pipeline,
     /// The shadow maps (depth only, standard Z).
@@ -1071,6 +1257,11 @@ fn pipeline(
         .map_err(|(_, e)| format!("vkCreateGraphicsPipelines: {e}"))
 }
 
+/// The combined image samplers of the engine's one set layout: the lighting reads depth,
+/// normals, albedo, IDs, thickness and (with `--fused` transmission) its shadow atlas; the
+/// other passes' sets read fewer.
+const BINDINGS: u32 = 6;
+
 fn create_pipelines(
     engine: &Engine,
     cache: vk::PipelineCache,
@@ -1106,7 +1297,7 @@ fn create_pipelines(
         compile(
             device,
             &compiler,
-            &shaders::lighting_frag(fused, false),
+            &shaders::lighting_frag(fused, shaders::Terms::NONE),
             Fragment,
             "lighting.frag",
         )?,
@@ -1139,20 +1330,34 @@ fn create_pipelines(
             "shadow.frag",
         )?,
     ];
-    // --fused: the lighting's variant with lucent's translucency, for the leaf's rectangle.
-    let leaf_module = match fused {
-        Some(_) => Some(compile(
-            device,
-            &compiler,
-            &shaders::lighting_frag(fused, true),
-            Fragment,
-            "lighting_leaf.frag",
-        )?),
-        None => None,
-    };
+    // --fused: the lighting's variants with lucent's per-object terms (the transmission's
+    // only where the engine renders shadow maps).
+    let mut term_modules = Vec::new();
+    if let Some(f) = fused {
+        for terms in shaders::Terms::ALL.into_iter().skip(1) {
+            if terms.transmission && f.transmission.is_none() {
+                continue;
+            }
+            let name = format!("lighting_{terms:?}.frag");
+            let source = shaders::lighting_frag(fused, terms);
+            match compile(device, &compiler, &source, Fragment, &name) {
+                Ok(module) => term_modules.push((terms, module)),
+                Err(e) => {
+                    for module in modules
+                        .into_iter()
+                        .chain(term_modules.into_iter().map(|t| t.1))
+                    {
+                        // SAFETY: made above, used by nothing yet.
+                        unsafe { device.destroy_shader_module(module, None) };
+                    }
+                    return Err(e);
+                }
+            }
+        }
+    }
     // SAFETY: plain object creation on the engine's device; destroyed in `destroy_pipelines`.
     let made = unsafe {
-        let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..5)
+        let bindings: Vec<vk::DescriptorSetLayoutBinding> = (0..BINDINGS)
             .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
@@ -1193,7 +1398,7 @@ fn create_pipelines(
         let sets = 3 * FRAMES_IN_FLIGHT as u32;
         let sizes = [vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(5 * sets)];
+            .descriptor_count(BINDINGS * sets)];
         let pool = device
             .create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default()
@@ -1233,18 +1438,21 @@ fn create_pipelines(
             None,
             Vertices::None,
         )?;
-        let lighting_leaf = match leaf_module {
-            Some(module) => Some(pipeline(
-                device,
-                cache,
-                layout,
-                (fullscreen, module),
-                &[light_format, light_format],
-                None,
-                Vertices::None,
-            )?),
-            None => None,
-        };
+        let mut lighting_terms = Vec::new();
+        for &(terms, module) in &term_modules {
+            lighting_terms.push((
+                terms,
+                pipeline(
+                    device,
+                    cache,
+                    layout,
+                    (fullscreen, module),
+                    &[light_format, light_format],
+                    None,
+                    Vertices::None,
+                )?,
+            ));
+        }
         let compose = pipeline(
             device,
             cache,
@@ -1270,13 +1478,16 @@ fn create_pipelines(
             pool,
             gbuffer,
             lighting,
-            lighting_leaf,
+            lighting_terms,
             compose,
             tonemap,
             shadow,
         })
     };
-    for module in modules.into_iter().chain(leaf_module) {
+    for module in modules
+        .into_iter()
+        .chain(term_modules.into_iter().map(|(_, module)| module))
+    {
         // SAFETY: the pipelines are made (or failed); the modules are no longer needed.
         unsafe { device.destroy_shader_module(module, None) };
     }
@@ -1287,7 +1498,10 @@ fn destroy_pipelines(device: &ash::Device, p: &Pipelines) {
     // SAFETY: the device is idle; the objects are the engine's own.
     unsafe {
         let pipelines = [p.gbuffer, p.lighting, p.compose, p.tonemap, p.shadow];
-        for pipeline in pipelines.into_iter().chain(p.lighting_leaf) {
+        for pipeline in pipelines
+            .into_iter()
+            .chain(p.lighting_terms.iter().map(|&(_, pipeline)| pipeline))
+        {
             device.destroy_pipeline(pipeline, None);
         }
         device.destroy_descriptor_pool(p.pool, None);
@@ -1416,6 +1630,16 @@ fn create_slot(
             (sets[1], 4, diffuse.view, sampled),
             (sets[2], 3, ids.view, sampled),
             (sets[2], 4, hdr.view, sampled),
+            // The shadow atlas: the lighting reads it to add lucent's transmission itself
+            // (--fused); without one (and in the other sets), never read.
+            (
+                sets[0],
+                5,
+                shadow.as_ref().map_or(depth.view, |s| s.view),
+                ImageState::depth_sampled().layout,
+            ),
+            (sets[1], 5, diffuse.view, sampled),
+            (sets[2], 5, hdr.view, sampled),
         ];
         let infos: Vec<[vk::DescriptorImageInfo; 1]> = writes
             .iter()
@@ -1613,6 +1837,12 @@ fn transmission_on(args: &Args) -> bool {
     args.with_lucent && args.scene.is_none() && !args.no_transmission
 }
 
+/// Whether lucent's `TransmissionEffect` adds the transmission (not with `--fused`, where the
+/// engine's lighting adds it).
+fn transmission_effect_on(args: &Args) -> bool {
+    transmission_on(args) && !args.fused
+}
+
 /// The engine's gloss of the skin and the marble (its G-buffer's albedo alpha).
 const SKIN_GLOSS: f32 = 0.5;
 const MARBLE_GLOSS: f32 = 0.8;
@@ -1636,6 +1866,18 @@ fn transmission_materials() -> Result<Vec<TransmissionMaterial>, String> {
         TransmissionMaterial::new(SKIN_ID, medium("skin1")?),
         TransmissionMaterial::new(MARBLE_ID, medium("marble")?),
     ])
+}
+
+/// lucent's transmission as the engine's lighting adds it (`--fused`): the skin's and the
+/// marble's medium rows in the engine's metres, its shadow faces as its lighting reads them.
+fn fused_transmission() -> Result<shaders::FusedTransmission, String> {
+    let rows = |m: &TransmissionMaterial| m.rows(1.0).map_err(|e| e.to_string());
+    let [skin, marble] = <[TransmissionMaterial; 2]>::try_from(transmission_materials()?)
+        .map_err(|_| "two transmitting materials".to_string())?;
+    Ok(shaders::FusedTransmission {
+        media: [rows(&skin)?, rows(&marble)?],
+        faces: atlas_faces(sun_direction()),
+    })
 }
 
 /// The layered ball's medium: Jensen's apple with eq. 3's physical weights.
@@ -1756,7 +1998,7 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
     let mut faces = vec![ShadowFace::new(
         0,
         Mat4::look_to_rh(centre + sun, -sun, Vec3::Y),
-        Mat4::orthographic_rh(-0.35, 0.35, -0.35, 0.35, 0.05, 2.0),
+        Mat4::orthographic_rh(-0.35, 0.35, -0.35, 0.35, SUN_NEAR_FAR.0, SUN_NEAR_FAR.1),
         square(0, 0, SUN_FACE_EDGE),
     )];
     let axes = [
@@ -1772,11 +2014,68 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
         faces.push(ShadowFace::new(
             1,
             Mat4::look_to_rh(Vec3::from(BACK_LIGHT), axis, up),
-            Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.005, BACK_LIGHT_RANGE),
+            Mat4::perspective_rh(
+                std::f32::consts::FRAC_PI_2,
+                1.0,
+                POINT_FACE_NEAR,
+                BACK_LIGHT_RANGE,
+            ),
             tile(k as u32),
         ));
     }
     faces
+}
+
+/// The sun's shadow face's near and far planes (orthographic, metres from its eye).
+const SUN_NEAR_FAR: (f32, f32) = (0.05, 2.0);
+/// The back light's faces' near plane (their far plane is its range).
+const POINT_FACE_NEAR: f32 = 0.005;
+
+/// One of the engine's shadow faces as its own lighting reads its atlas to add lucent's
+/// transmission term (`--fused`).
+pub struct AtlasFace {
+    /// World to the face's clip space (standard Z).
+    pub view_proj: [[f32; 4]; 4],
+    /// xy: the face's corner in the atlas, z: its edge (texels); w: 0.
+    pub rect: [f32; 4],
+    /// x * clip.w + y: a map texel's world size at a point; z: the near plane (negative for
+    /// the orthographic face); w: the far plane.
+    pub params: [f32; 4],
+}
+
+/// The faces of [`light_faces`] as the engine's lighting reads them (`--fused`): the sun's
+/// orthographic face first, then the back light's six perspective ones.
+fn atlas_faces(sun: Vec3) -> Vec<AtlasFace> {
+    light_faces(sun)
+        .iter()
+        .enumerate()
+        .map(|(k, face)| {
+            let edge = face.rect.extent.width as f32;
+            // A map texel's world size: the view's extent over the edge, at distance w on a
+            // perspective face.
+            let texel = 2.0 / (face.projection.y_axis.y.abs() * edge);
+            let params = if k == 0 {
+                [0.0, texel, -SUN_NEAR_FAR.0, SUN_NEAR_FAR.1]
+            } else {
+                [texel, 0.0, POINT_FACE_NEAR, BACK_LIGHT_RANGE]
+            };
+            AtlasFace {
+                view_proj: (face.projection * face.view).to_cols_array_2d(),
+                rect: [
+                    face.rect.offset.x as f32,
+                    face.rect.offset.y as f32,
+                    edge,
+                    0.0,
+                ],
+                params,
+            }
+        })
+        .collect()
+}
+
+/// The sun's direction (towards it).
+fn sun_direction() -> Vec3 {
+    Vec3::new(0.9, 0.75, -0.35).normalize()
 }
 
 /// The screen rectangle the layered ball covers: where Li et al.'s passes draw.
@@ -1792,30 +2091,59 @@ fn layered_region(
     region.filter(|_| !whole_screen).into_iter().collect()
 }
 
-/// The parts of `whole` outside `inner` (inside it): up to four rectangles, none empty.
-fn around(whole: vk::Rect2D, inner: vk::Rect2D) -> Vec<vk::Rect2D> {
-    let (x0, y0) = (inner.offset.x, inner.offset.y);
-    let (x1, y1) = (
-        x0 + inner.extent.width as i32,
-        y0 + inner.extent.height as i32,
-    );
-    let (w, h) = (whole.extent.width as i32, whole.extent.height as i32);
-    let rect = |x: i32, y: i32, right: i32, bottom: i32| vk::Rect2D {
-        offset: vk::Offset2D { x, y },
-        extent: vk::Extent2D {
-            width: (right - x).max(0) as u32,
-            height: (bottom - y).max(0) as u32,
-        },
+/// The lighting's draws with `--fused`: the screen in 64-pixel tiles, each with the terms
+/// whose objects' rectangles it touches (`leaf`: the leaf's translucency, `media`: the
+/// transmission), runs of equal tiles along a row merged, sorted by their terms (one bind
+/// each). Every pixel is drawn once.
+fn term_tiles(
+    extent: vk::Extent2D,
+    leaf: &[vk::Rect2D],
+    media: &[vk::Rect2D],
+) -> Vec<(shaders::Terms, vk::Rect2D)> {
+    const TILE: u32 = 64;
+    let touches = |rects: &[vk::Rect2D], x: u32, y: u32| {
+        rects.iter().any(|r| {
+            let (x0, y0) = (r.offset.x.max(0) as u32, r.offset.y.max(0) as u32);
+            let (x1, y1) = (
+                (r.offset.x + r.extent.width as i32).max(0) as u32,
+                (r.offset.y + r.extent.height as i32).max(0) as u32,
+            );
+            x0 < x + TILE && x < x1 && y0 < y + TILE && y < y1
+        })
     };
-    [
-        rect(0, 0, w, y0),
-        rect(0, y1, w, h),
-        rect(0, y0, x0, y1),
-        rect(x1, y0, w, y1),
-    ]
-    .into_iter()
-    .filter(|r| r.extent.width > 0 && r.extent.height > 0)
-    .collect()
+    let mut draws: Vec<(shaders::Terms, vk::Rect2D)> = Vec::new();
+    for y in (0..extent.height).step_by(TILE as usize) {
+        let mut row: Vec<(shaders::Terms, u32, u32)> = Vec::new();
+        for x in (0..extent.width).step_by(TILE as usize) {
+            let terms = shaders::Terms {
+                leaf: touches(leaf, x, y),
+                transmission: touches(media, x, y),
+            };
+            let right = (x + TILE).min(extent.width);
+            match row.last_mut() {
+                Some((last, _, end)) if *last == terms => *end = right,
+                _ => row.push((terms, x, right)),
+            }
+        }
+        let height = TILE.min(extent.height - y);
+        draws.extend(row.into_iter().map(|(terms, x0, x1)| {
+            (
+                terms,
+                vk::Rect2D {
+                    offset: vk::Offset2D {
+                        x: x0 as i32,
+                        y: y as i32,
+                    },
+                    extent: vk::Extent2D {
+                        width: x1 - x0,
+                        height,
+                    },
+                },
+            )
+        }));
+    }
+    draws.sort_by_key(|(terms, _)| terms.index());
+    draws
 }
 
 /// The screen rectangle the leaf covers: where the translucency pass draws (none, the whole
@@ -1969,7 +2297,7 @@ enum Inserted {
         translucency: Option<Box<TranslucencyEffect>>,
         /// The apple-flesh ball's layered medium.
         layered: Box<LayeredEffect>,
-        /// The skin's and marble's transmission (none with `--no-transmission`).
+        /// The skin's and marble's transmission (none with `--no-transmission` or `--fused`).
         transmission: Option<Box<TransmissionEffect>>,
         sss: Box<SssEffect>,
     },
@@ -2182,7 +2510,7 @@ fn record_frame(
     // The frame-in-flight slot (`slot` is the engine's for it).
     let slot_index = frame % FRAMES_IN_FLIGHT;
     let (view, projection, eye) = camera(frame, extent.width as f32 / extent.height as f32);
-    let sun = Vec3::new(0.9, 0.75, -0.35).normalize();
+    let sun = sun_direction();
     // The engine adds its own ambient unless lucent's environment effect adds it.
     let engine_ambient = match effects.as_deref() {
         Some(Effects {
@@ -2349,40 +2677,49 @@ fn record_frame(
         false,
     );
     let inverse = (projection * view).inverse();
-    match pipelines.lighting_leaf {
-        // --fused: lucent's translucency in the leaf's rectangle only, the plain lighting
-        // around it (as lucent's own lighting pass draws its translucency variant on the
-        // tiles translucent objects cover).
-        Some(leaf_pipeline) => {
-            let whole = vk::Rect2D {
-                offset: vk::Offset2D::default(),
-                extent,
-            };
-            let leaf = leaf_region(&HostCamera::new(view, projection), extent, false)
-                .first()
-                .copied()
-                .unwrap_or(whole);
-            bind(pipelines.lighting, Some(slot.lighting_set), inverse);
-            for rect in around(whole, leaf) {
-                // SAFETY: inside the lighting's rendering, its pipeline and set bound.
-                unsafe {
-                    device.cmd_set_scissor(cmd, 0, &[rect]);
-                    device.cmd_draw(cmd, 3, 1, 0, 0);
-                }
+    if pipelines.lighting_terms.is_empty() {
+        bind(pipelines.lighting, Some(slot.lighting_set), inverse);
+        // SAFETY: inside the lighting's rendering, its pipeline and set bound.
+        unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) };
+    } else {
+        // --fused: lucent's translucency and transmission only on the tiles their objects
+        // touch, the plain lighting elsewhere (as lucent's own lighting pass draws its
+        // variants on the tiles of the objects that need them).
+        let camera = HostCamera::new(view, projection);
+        let whole = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        };
+        let or_whole = |rects: Vec<vk::Rect2D>| if rects.is_empty() { vec![whole] } else { rects };
+        let leaf = or_whole(leaf_region(&camera, extent, false));
+        let transmitting = pipelines
+            .lighting_terms
+            .iter()
+            .any(|(terms, _)| terms.transmission);
+        let media = if transmitting {
+            or_whole(transmission_regions(&camera, extent, false))
+        } else {
+            Vec::new()
+        };
+        let mut bound = None;
+        for (terms, rect) in term_tiles(extent, &leaf, &media) {
+            if bound != Some(terms) {
+                let pipeline = pipelines
+                    .lighting_terms
+                    .iter()
+                    .find(|(t, _)| *t == terms)
+                    .map_or(pipelines.lighting, |&(_, pipeline)| pipeline);
+                bind(pipeline, Some(slot.lighting_set), inverse);
+                bound = Some(terms);
             }
-            bind(leaf_pipeline, Some(slot.lighting_set), inverse);
-            // SAFETY: as above; the scissor is set back to the whole target after.
-            unsafe {
-                device.cmd_set_scissor(cmd, 0, &[leaf]);
-                device.cmd_draw(cmd, 3, 1, 0, 0);
-                device.cmd_set_scissor(cmd, 0, &[whole]);
-            }
-        }
-        None => {
-            bind(pipelines.lighting, Some(slot.lighting_set), inverse);
             // SAFETY: inside the lighting's rendering, its pipeline and set bound.
-            unsafe { device.cmd_draw(cmd, 3, 1, 0, 0) };
+            unsafe {
+                device.cmd_set_scissor(cmd, 0, &[rect]);
+                device.cmd_draw(cmd, 3, 1, 0, 0);
+            }
         }
+        // SAFETY: as above: the scissor back to the whole target.
+        unsafe { device.cmd_set_scissor(cmd, 0, &[whole]) };
     }
     // SAFETY: inside the lighting's rendering.
     unsafe {
@@ -2751,7 +3088,7 @@ fn create_effects(
         ),
         LIGHT_SPACE,
     );
-    let transmission_desc = if transmission_on(args) {
+    let transmission_desc = if transmission_effect_on(args) {
         Some(TransmissionEffectDesc::new(
             gbuffer.clone(),
             transmission_materials()?,
@@ -2829,16 +3166,22 @@ fn create_effects(
              with the {} blur, marble ID {MARBLE_ID} with the {} blur; {staging_bytes} staging \
              bytes uploaded)",
             match (args.fused, args.engine_ambient) {
-                (true, _) => "environment and translucency (the leaf) in the engine's \
-                              lighting pass (lucent::embed::glsl::TERMS), "
-                    .to_string(),
+                (true, _) => format!(
+                    "environment, translucency (the leaf){} in the engine's lighting pass \
+                     (lucent::embed::glsl::TERMS), ",
+                    if transmission_on(args) {
+                        " and transmission (skin and marble, the engine's shadow lookup)"
+                    } else {
+                        ""
+                    }
+                ),
                 (false, true) => format!("translucency (leaf ID {LEAF_ID}), "),
                 (false, false) => format!(
                     "environment (the engine's sky and ground), translucency (leaf ID \
                      {LEAF_ID}), "
                 ),
             },
-            if transmission_on(args) {
+            if transmission_effect_on(args) {
                 "transmission (skin and marble, through the engine's shadow maps), "
             } else {
                 ""
@@ -2863,7 +3206,7 @@ fn create_effects(
                     },
                     translucency: if args.fused { None } else { Some(timer()?) },
                     layered: timer()?,
-                    transmission: if transmission_on(args) {
+                    transmission: if transmission_effect_on(args) {
                         Some(timer()?)
                     } else {
                         None
@@ -3044,11 +3387,19 @@ fn run(args: &Args, engine: &Engine) -> Result<(), String> {
     let mut pipelines = None;
     let mut effects = None;
     let setup = (|| {
-        let fused = (args.fused && args.with_lucent).then(|| shaders::Fused {
-            sh: engine_environment().coefficients(),
-            leaf_row: leaf_material().row(),
-            scales: engine_lights(Vec3::Y).map(|l| l.translucency_scale),
-        });
+        let fused = match (args.fused && args.with_lucent, transmission_on(args)) {
+            (false, _) => None,
+            (true, transmits) => Some(shaders::Fused {
+                sh: engine_environment().coefficients(),
+                leaf_row: leaf_material().row(),
+                scales: engine_lights(Vec3::Y).map(|l| l.translucency_scale),
+                transmission: if transmits {
+                    Some(fused_transmission()?)
+                } else {
+                    None
+                },
+            }),
+        };
         let made = create_pipelines(engine, pipeline_cache, light_format, fused.as_ref())?;
         let made = pipelines.insert(made);
         for k in 0..FRAMES_IN_FLIGHT {

@@ -18,7 +18,7 @@
 #include "gbuffer.glsl"
 #include "lighting.glsl"
 #include "layer_depths.glsl"
-#include "dipole.glsl"
+#include "../embed/lucent_terms.glsl"
 #ifdef LUCENT_SHADOWS
 #include "shadows.glsl"
 #endif
@@ -257,12 +257,12 @@ vec3 dipole_rd(int mat, float r) {
 // the light that entered which diffuses out farther than a from its entry,
 // 2 pi ∫_a^inf Rd(r) r dr = (alpha'/2) sum over z_r, z_v of z e^(-sigma_tr d) / d with
 // d = sqrt(a^2 + z^2) (Dipole::transmitted_beyond; HDRP's thick transmission reads its profile
-// at the thickness the same way). The sum is dipole.glsl's, which screen-space SSS materials
+// at the thickness the same way). The sum is glsl/embed/lucent_terms.glsl's, which screen-space SSS materials
 // with a medium read too (sss_transmission.glsl): both techniques diffuse through a thickness
 // alike.
 vec3 dipole_beyond(int mat, float a) {
     return 0.5 * MAT.alpha_prime.rgb *
-           dipole_beyond_sum(MAT.sigma_tr.rgb, MAT.z_r.rgb, MAT.z_v.rgb, a);
+           lucent_dipole_beyond_sum(MAT.sigma_tr.rgb, MAT.z_r.rgb, MAT.z_v.rgb, a);
 }
 
 // The light transmitted into the surface at p (outward normal n): radiance x falloff x cos x

@@ -4,13 +4,13 @@
 // the light-space map measures and leaves here, before the blur (which then spreads it). The
 // lighting pass includes this (through sss_medium.glsl) with LUCENT_SHADOWS, the SSS profile
 // table and the pixel's profile ID. The thickness is the light's path through the object, so
-// a back-lit slab gets its thickness and a side-lit sphere its chords. The f64 twin is
-// src/reference/transmission.rs (`transmittance_over_albedo`, `sss_transmitted`): change both
-// together.
+// a back-lit slab gets its thickness and a side-lit sphere its chords. The f64 twins are
+// src/reference/transmission.rs (`sss_transmitted`) and src/scene/transmittance.rs
+// (`transmittance_over_albedo`): change them together.
 #ifndef LUCENT_SSS_TRANSMISSION_GLSL
 #define LUCENT_SSS_TRANSMISSION_GLSL
 
-#include "dipole.glsl"
+#include "../embed/lucent_terms.glsl"
 #include "sss.glsl"
 #include "shadows.glsl"
 
@@ -20,25 +20,13 @@ bool sss_transmits(int id) {
     return sss_profiles.medium[id * 6].a > 0.0;
 }
 
-// The medium's diffuse transmittance through `a` scene units relative to its albedo A (its
-// white-sky albedo; src/reference/transmission.rs `transmittance_over_albedo`): the light
-// Donner and Jensen's multipole lets through a slab of that thickness, never less than the
-// light the semi-infinite dipole diffuses farther than a from its entry (what Li et al.'s
-// layered pass adds, layered.glsl `dipole_beyond`; it takes over where a slab thinner than a
-// mean free path leaves the multipole invalid), over A, times the albedo where the diffuse
-// light's is, so a material whose albedo is the medium's transmits the model's light.
-// Held in [0, min(1 / A, 1000)] (the slab lets through at most all the light).
+// The medium's diffuse transmittance through `a` scene units relative to its albedo (its
+// white-sky albedo): glsl/embed/lucent_terms.glsl `lucent_sss_transmittance` on profile `id`'s
+// four transmission rows, the same function a host's lighting pass calls.
 vec3 sss_transmittance(int id, float a) {
-    vec4 sigma_tr = sss_profiles.medium[id * 6];
-    vec4 z_r = sss_profiles.medium[id * 6 + 1];
-    vec4 z_v = sss_profiles.medium[id * 6 + 2];
-    vec4 to_light_over_albedo = sss_profiles.medium[id * 6 + 3];
-    vec3 most = vec3(z_r.a, z_v.a, to_light_over_albedo.a);
-    // Millimetres; held below 1e18 so a^2 stays finite in f32 (the map's far plane is nearer).
-    float a_mm = clamp(a * sigma_tr.a, 0.0, 1e18);
-    vec3 through = max(dipole_beyond_sum(sigma_tr.rgb, z_r.rgb, z_v.rgb, a_mm),
-                       multipole_slab_sum(sigma_tr.rgb, z_r.rgb, z_v.rgb, a_mm));
-    return clamp(to_light_over_albedo.rgb * through, vec3(0.0), most);
+    vec4 medium[4] = vec4[4](sss_profiles.medium[id * 6], sss_profiles.medium[id * 6 + 1],
+                             sss_profiles.medium[id * 6 + 2], sss_profiles.medium[id * 6 + 3]);
+    return lucent_sss_transmittance(medium, a);
 }
 
 // Light `i`'s radiance diffused through the object to `pos` (outward normal `normal`, the

@@ -1,11 +1,13 @@
 // lucent's per-pixel lighting terms for a host's own lighting pass (lucent::embed::glsl::TERMS):
 // self-contained GLSL (no bindings, no includes) a host includes in the shader that loops over
 // its lights, so the terms cost what they cost in lucent's own lighting pass, which calls the
-// same functions (glsl/common/scene.glsl, glsl/common/translucency.glsl). The data comes from
-// the Rust side: an environment's nine coefficients (`Environment::coefficients`), a
-// translucent material's row (`TranslucentMaterial::row`), each light's translucency scale
-// (`Light::translucency_scale`). The f64 twins are src/scene/environment.rs
-// (`Environment::ambient_radiance`) and src/reference/translucency.rs: change them together.
+// same functions (glsl/common/scene.glsl, glsl/common/translucency.glsl,
+// glsl/common/sss_transmission.glsl). The data comes from the Rust side: an environment's nine
+// coefficients (`Environment::coefficients`), a translucent material's row
+// (`TranslucentMaterial::row`), each light's translucency scale (`Light::translucency_scale`),
+// a transmitting material's medium rows (`TransmissionMaterial::rows`). The f64 twins are
+// src/scene/environment.rs (`Environment::ambient_radiance`), src/reference/translucency.rs and
+// src/scene/transmittance.rs: change them together.
 #ifndef LUCENT_TERMS_GLSL
 #define LUCENT_TERMS_GLSL
 
@@ -72,6 +74,102 @@ vec3 lucent_translucency(vec3 albedo, vec3 thickness, vec4 material, vec3 to_eye
     float back = -(dot(to_eye, to_light) + material.y * v_dot_n);
     float lobe = lucent_translucency_lobe(back, material.x, material.w) * translucency_scale;
     return albedo * (lobe + material.z) * thickness * radiance * attenuation;
+}
+
+// Diffusion through a thickness: Jensen's dipole (2001) and Donner and Jensen's multipole
+// (2005), shared by Li et al.'s layered passes (glsl/common/layered.glsl `dipole_beyond`) and
+// screen-space SSS's diffuse transmission (glsl/common/sss_transmission.glsl and a host's
+// lighting, below). The f64 twins are src/scene/transmittance.rs (`beyond_sum`,
+// `multipole_sum`; `Dipole::transmitted_beyond` in src/reference/dipole.rs): change both together.
+
+// Sum over the real (depth z_r) and virtual (height z_v) sources of z e^(-sigma_tr d) / d,
+// d = sqrt(a^2 + z^2), per channel: the light that diffuses out farther than `a` from its
+// entry is (alpha' / 2) times this. Every length in one unit (a >= 0). d >= z > 0 (z_r is
+// 1 / sigma_t' with sigma_t' held above 1e-12 where the constants are made, so z^2 <= 1e24 and
+// z_v^2 < 1e31: no f32 overflow), so z / d <= 1; e^-x of a large x is 0: finite for every
+// finite a, and exactly sum(e^(-sigma_tr z)) at a = 0.
+vec3 lucent_dipole_beyond_sum(vec3 sigma_tr, vec3 z_r, vec3 z_v, float a) {
+    float a2 = a * a;
+    vec3 dr = sqrt(a2 + z_r * z_r);
+    vec3 dv = sqrt(a2 + z_v * z_v);
+    return z_r / dr * exp(-sigma_tr * dr) + z_v / dv * exp(-sigma_tr * dv);
+}
+
+// e^x - 1 for x <= 0 without the cancellation of exp(x) - 1 near 0 (|x| < 1e-3: three
+// Taylor terms).
+vec3 lucent_expm1(vec3 x) {
+    return mix(exp(x) - 1.0, x * (1.0 + x * (0.5 + x / 6.0)), lessThan(abs(x), vec3(1e-3)));
+}
+
+// One row of the multipole's sources, summed over every image: sum over i of
+// sign(x - i P) e^(-sigma |x - i P|) for |x| < P, in closed form (two geometric series):
+// sign(x) e^(-sigma |x|) (1 - e^(-sigma (P - 2|x|))) / (1 - e^(-sigma P)), written with expm1 so
+// a weak absorber does not cancel, and its limit (P - 2|x|) / P where sigma P -> 0.
+vec3 lucent_multipole_row(vec3 sigma, vec3 x, vec3 period) {
+    vec3 ax = min(abs(x), period);
+    vec3 weak = (period - 2.0 * ax) / period;
+    vec3 strong = lucent_expm1(-sigma * (period - 2.0 * ax)) /
+                  min(lucent_expm1(-sigma * period), vec3(-1e-30));
+    vec3 ratio = mix(strong, weak, lessThan(sigma * period, vec3(1e-6)));
+    return sign(x) * exp(-sigma * ax) * ratio;
+}
+
+// Donner and Jensen's (2005) multipole through a slab of thickness `a`: the dipole mirrored
+// about both faces (extrapolated boundaries z_b = (z_v - z_r) / 2 beyond each), real sources
+// at i P + z_r and virtual ones at i P - z_r - 2 z_b, P = 2 (a + 2 z_b), every integer i. Its
+// transmission profile integrated over the far face is (alpha' / 2) times the sum over the
+// real sources of sign(a - z) e^(-sigma_tr |a - z|) less the same over the virtual ones
+// (2 pi ∫ h (1 + sigma d) e^(-sigma d) / d^3 r dr = sign(h) e^(-sigma |h|), d^2 = r^2 + h^2),
+// summed over every i in closed form (lucent_multipole_row; |a - z_r| and a + z_r + 2 z_b are both
+// below P since 2 z_b > z_r). A clear slab gets diffusion's 2 (z_r + z_b) / (a + 2 z_b).
+// Diffusion through a slab is only valid when the slab holds the real source (a > z_r):
+// thinner, the sum goes negative, so lucent_sss_transmittance never takes less than the semi-infinite
+// dipole's light beyond a (lucent_dipole_beyond_sum). Finite: each row is at most 1 in size.
+vec3 lucent_multipole_slab_sum(vec3 sigma_tr, vec3 z_r, vec3 z_v, float a) {
+    vec3 boundaries = z_v - z_r; // 2 z_b
+    vec3 period = 2.0 * (a + boundaries);
+    return lucent_multipole_row(sigma_tr, a - z_r, period) -
+           lucent_multipole_row(sigma_tr, a + z_r + boundaries, period);
+}
+
+// A medium's diffuse transmittance through `thickness` (scene units) relative to its albedo
+// A: the light Donner and Jensen's multipole lets through a slab of that thickness, never less
+// than the light the semi-infinite dipole diffuses farther than the thickness from its entry
+// (it takes over where a slab thinner than a mean free path leaves the multipole invalid),
+// over A; times the albedo where the diffuse light has it, it is the model's light through the
+// slab. `medium` is the material's four rows (lucent::embed::TransmissionMaterial::rows, or
+// lucent's SSS profile table): sigma_tr (w: millimetres per scene unit), z_r, z_v (mm), and
+// (alpha' / 2) / A; the w of the last three is the most each channel lets through (1 / A, at
+// most 1000). Held in [0, that]: a slab lets through at most all the light. The f64 twin is
+// src/scene/transmittance.rs `transmittance_over_albedo`.
+vec3 lucent_sss_transmittance(vec4 medium[4], float thickness) {
+    vec3 most = vec3(medium[1].w, medium[2].w, medium[3].w);
+    // Millimetres; held below 1e18 so a^2 stays finite in f32 (and NaN becomes 0).
+    float a_mm = clamp(thickness * medium[0].w, 0.0, 1e18);
+    vec3 through = max(lucent_dipole_beyond_sum(medium[0].rgb, medium[1].rgb, medium[2].rgb, a_mm),
+                       lucent_multipole_slab_sum(medium[0].rgb, medium[1].rgb, medium[2].rgb, a_mm));
+    return clamp(medium[3].rgb * through, vec3(0.0), most);
+}
+
+// One light's diffuse transmission through an object to a surface point (HDRP's "thick" mode,
+// what lucent's TransmissionEffect and its own lighting add): the light that reached the
+// object's far side at its entry point (`light_at_entry`: the light's radiance times its
+// falloff there; unshadowed, the entry point is where the light comes in), diffused through
+// `thickness` (the distance from the entry point to the shaded point, scene units), times the
+// back-facing cosine max(-dot(normal, to_light), 0) (`to_light` unit, from the point). The
+// result is light before the albedo and 1 / pi, as a Lambert term's irradiance: multiply by
+// albedo / pi where the host's diffuse light has its albedo. The thickness comes from the
+// host's shadow map of the light: lucent's recipe (glsl/common/sss_transmission.glsl
+// `sss_transmitted`) looks up the map from the point moved one map texel inside along
+// -normal, reads the four texels around it, and sums this term over them with their bilinear
+// weights (the transmittance is filtered, not the distance, which would leave a staircase).
+vec3 lucent_sss_transmitted(vec4 medium[4], vec3 normal, vec3 to_light, float thickness,
+                            vec3 light_at_entry) {
+    float back = -dot(normal, to_light);
+    if (!(back > 0.0)) {
+        return vec3(0.0);
+    }
+    return back * light_at_entry * lucent_sss_transmittance(medium, thickness);
 }
 
 #endif

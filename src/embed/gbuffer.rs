@@ -501,8 +501,28 @@ pub struct GBufferDesc {
     /// The local thickness, when the host has it (GDC 2011 translucency reads it).
     pub thickness: Option<ThicknessDesc>,
     /// The size of the host's world unit in metres (1: metres, 0.01: centimetres): the SSS
-    /// profiles' millimetres are converted with it.
+    /// profiles' millimetres are converted with it. Finite, above 0 and at most
+    /// [`MAX_METRES_PER_UNIT`].
     pub metres_per_unit: f32,
+}
+
+/// The largest world unit a host may describe, in metres: a million kilometres. Larger, a
+/// medium's millimetres per unit would pass f32's range where the shaders multiply a
+/// thickness by it.
+pub const MAX_METRES_PER_UNIT: f32 = 1e9;
+
+/// Checks a world unit's size in metres: finite, above 0, at most [`MAX_METRES_PER_UNIT`].
+pub(crate) fn check_metres_per_unit(metres: f32) -> crate::Result<()> {
+    if metres.is_finite() && metres > 0.0 && metres <= MAX_METRES_PER_UNIT {
+        return Ok(());
+    }
+    Err(HostError::Description {
+        field: "metres_per_unit".into(),
+        problem: format!(
+            "{metres} must be a finite number above 0 and at most {MAX_METRES_PER_UNIT}"
+        ),
+    }
+    .into())
 }
 
 impl GBufferDesc {
@@ -585,12 +605,7 @@ impl GBufferDesc {
                 ),
             ));
         }
-        if !(self.metres_per_unit.is_finite() && self.metres_per_unit > 0.0) {
-            return Err(description(
-                "metres_per_unit",
-                format!("{} must be a finite number > 0", self.metres_per_unit),
-            ));
-        }
+        check_metres_per_unit(self.metres_per_unit)?;
         let depth_ok = match self.depth.encoding {
             DepthEncoding::Device => matches!(
                 self.depth.format,
@@ -867,6 +882,8 @@ mod tests {
         .is_err());
         assert!(gbuffer().with_metres_per_unit(0.0).check().is_err());
         assert!(gbuffer().with_metres_per_unit(f32::NAN).check().is_err());
+        assert!(gbuffer().with_metres_per_unit(2e9).check().is_err());
+        assert!(gbuffer().with_metres_per_unit(1e9).check().is_ok());
         let good = HostCamera::new(
             Mat4::look_at_rh(glam::Vec3::Z, glam::Vec3::ZERO, glam::Vec3::Y),
             Mat4::perspective_infinite_reverse_rh(1.0, 2.0, 0.1),

@@ -1,13 +1,14 @@
 //! GLSL a host includes in its own shaders: lucent's per-pixel lighting terms as functions of
 //! plain values, for a host that adds them inside the lighting pass that loops over its lights
 //! instead of recording an effect's fullscreen pass after it. That is where lucent's own
-//! lighting pass adds them, so they cost the host what they cost lucent: a few instructions per
-//! pixel and light, no extra read of the G-buffer, no extra pass.
+//! lighting pass adds them: no extra read of the G-buffer, no extra pass (docs/embedding.md
+//! measures what each costs inside `examples/host_engine.rs`'s lighting).
 //!
 //! | function | the effect it replaces | the data, from the Rust side |
 //! |---|---|---|
 //! | `vec3 lucent_sh_ambient(vec4 sh[9], vec3 n)` | [`super::EnvironmentEffect`] | `sh`: [`crate::scene::Environment::coefficients`]; times the albedo where the host's diffuse has it |
 //! | `vec3 lucent_translucency(albedo, thickness, material, to_eye, v_dot_n, to_light, radiance, attenuation, translucency_scale)` | [`super::TranslucencyEffect`] | `material`: [`super::TranslucentMaterial::row`]; `translucency_scale`: [`super::Light::translucency_scale`]; per light, added to the diffuse |
+//! | `vec3 lucent_sss_transmitted(vec4 medium[4], normal, to_light, thickness, light_at_entry)` (and `lucent_sss_transmittance(medium, thickness)` under it) | [`super::TransmissionEffect`] | `medium`: [`super::TransmissionMaterial::rows`] in the host's unit; `thickness` and `light_at_entry` from the host's own lookup of its shadow map (lucent's recipe: docs/embedding.md); per light and map texel, weighted bilinearly, times albedo / pi |
 //!
 //! The text is self-contained (no bindings, no includes; every name starts with `lucent_`),
 //! GLSL 450. lucent's own shaders include the same file (`glsl/embed/lucent_terms.glsl`), so
@@ -18,6 +19,7 @@
 //! // A host's lighting shader, assembled at start-up:
 //! let source = format!("#version 450\n{}\n{}", lucent::embed::glsl::TERMS, "void main() {}");
 //! assert!(source.contains("vec3 lucent_translucency("));
+//! assert!(source.contains("vec3 lucent_sss_transmitted("));
 //! ```
 
 /// lucent's lighting terms as GLSL functions (see the module docs).

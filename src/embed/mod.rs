@@ -27,8 +27,9 @@
 //!   the refracted view ray, the dipole's multiple scattering) added to the host's lit
 //!   diffuse; lucent draws its light-space maps from the host's own vertex and index buffers
 //!   ([`VertexLayout`], [`MeshDraw`]) with the faces the host gives ([`ShadowFace`]).
-//! - [`glsl::TERMS`]: the environment's and GDC 2011's terms as GLSL for the host's own
-//!   lighting pass, where they cost what they cost in lucent's.
+//! - [`glsl::TERMS`]: the environment's, GDC 2011's and the transmission's terms as GLSL for
+//!   the host's own lighting pass, with no pass of their own (docs/embedding.md measures
+//!   what each costs there).
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
@@ -184,6 +185,7 @@ pub use environment::{
 pub use gbuffer::{
     DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
     IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
+    MAX_METRES_PER_UNIT,
 };
 pub use image::{HostImage, ImageState};
 pub use layered::{
@@ -234,8 +236,11 @@ pub use glam;
 /// [`SssEffectDesc::shadow_format`]), [`Effect::LeanSss`]; host shadow maps in reversed Z and
 /// as arrays ([`ShadowFace::layer`], [`HostImage::layers`], `with_shadow_array`). 8:
 /// [`SssFrame::regions`] per material ([`SssRegion`]): each blur chain runs on its own
-/// materials' regions; [`SssMaterial::relights_specular`].
-pub const API_VERSION: u32 = 8;
+/// materials' regions; [`SssMaterial::relights_specular`]. 9: SSS transmission in
+/// [`glsl::TERMS`] (`lucent_sss_transmittance`, `lucent_sss_transmitted`) with
+/// [`TransmissionMaterial::rows`]; [`GBufferDesc::metres_per_unit`] at most
+/// [`MAX_METRES_PER_UNIT`].
+pub const API_VERSION: u32 = 9;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

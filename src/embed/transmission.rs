@@ -30,7 +30,9 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
+use super::gbuffer::{
+    check_metres_per_unit, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
+};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_material_id, check_views, depth_role, frame_albedo,
@@ -72,6 +74,22 @@ impl TransmissionMaterial {
     /// Material `id` with `medium`.
     pub fn new(id: u8, medium: Medium) -> Self {
         Self { id, medium }
+    }
+
+    /// The medium's four rows as a host's own lighting pass reads them
+    /// ([`super::glsl::TERMS`]' `lucent_sss_transmittance(vec4 medium[4], thickness)` and
+    /// `lucent_sss_transmitted`), its lengths in the host's world at `metres_per_unit`
+    /// ([`GBufferDesc::metres_per_unit`]): the same rows [`TransmissionEffect`] and lucent's
+    /// own frames read from the SSS profile table. Every value is finite; a unit that is not
+    /// finite, above 0 and at most [`super::gbuffer::MAX_METRES_PER_UNIT`] is refused
+    /// ([`HostError::Description`], field `metres_per_unit`).
+    pub fn rows(&self, metres_per_unit: f32) -> Result<[[f32; 4]; 4]> {
+        check_metres_per_unit(metres_per_unit)?;
+        Ok(SssTransmission {
+            mm_per_unit: 1000.0 * f64::from(metres_per_unit),
+            ..SssTransmission::of(&self.medium)
+        }
+        .rows())
     }
 }
 
@@ -276,7 +294,7 @@ impl TransmissionEffect {
                 ..SssTransmission::of(&material.medium)
             };
             let rows = &mut table.medium[profile * MEDIUM_ROWS..];
-            rows[..4].copy_from_slice(&transmission.rows());
+            rows[..4].copy_from_slice(&material.rows(gbuffer.metres_per_unit)?);
             rows[4..MEDIUM_ROWS].copy_from_slice(&transmission.reflectance_rows());
         }
         id_map.profile_of = profile_of;
@@ -519,3 +537,47 @@ const _: () = {
     const fn send<T: Send>() {}
     send::<TransmissionEffect>();
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::layered::LayeredMedium;
+
+    fn skin() -> TransmissionMaterial {
+        TransmissionMaterial::new(3, Medium::new(LayeredMedium::preset("skin1").unwrap()))
+    }
+
+    /// A host's lighting pass reads the rows lucent's own frames read, in the host's unit:
+    /// millimetres per unit from `metres_per_unit`, the rest of the medium unchanged.
+    #[test]
+    fn the_rows_a_host_reads_are_lucents_in_the_hosts_unit() {
+        let material = skin();
+        let metres = material.rows(1.0).unwrap();
+        let centimetres = material.rows(0.01).unwrap();
+        let lucent = SssTransmission {
+            mm_per_unit: 1000.0,
+            ..SssTransmission::of(&material.medium)
+        }
+        .rows();
+        assert_eq!(metres, lucent);
+        assert_eq!(metres[0][3], 1000.0);
+        assert!((centimetres[0][3] - 10.0).abs() < 1e-5);
+        assert_eq!(metres[1..], centimetres[1..]);
+        assert!(metres.iter().flatten().all(|v| v.is_finite()));
+    }
+
+    /// A unit no f32 shader can multiply a thickness by is refused, naming the field.
+    #[test]
+    fn rows_refuse_a_unit_that_is_not_a_length() {
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY, 2e9] {
+            let message = skin().rows(bad).unwrap_err().to_string();
+            assert!(message.contains("metres_per_unit"), "{bad}: {message}");
+        }
+        assert!(skin()
+            .rows(1e9)
+            .unwrap()
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite()));
+    }
+}

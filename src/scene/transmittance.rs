@@ -6,8 +6,8 @@
 
 use super::layered::Dipole;
 
-/// `sum_{z = z_r, z_v} z e^(-sigma_tr d) / d`, `d = sqrt(a^2 + z^2)` (glsl/common/dipole.glsl
-/// `dipole_beyond_sum`): the dipole's light diffusing out farther than `a` from its entry is
+/// `sum_{z = z_r, z_v} z e^(-sigma_tr d) / d`, `d = sqrt(a^2 + z^2)` (glsl/embed/lucent_terms.glsl
+/// `lucent_dipole_beyond_sum`): the dipole's light diffusing out farther than `a` from its entry is
 /// `alpha' / 2` times it ([`Dipole::transmitted_beyond`]). Lengths in the dipole's unit.
 pub fn beyond_sum(dipole: &Dipole, a: f64) -> f64 {
     let term = |z: f64| {
@@ -38,7 +38,7 @@ fn multipole_row(sigma: f64, x: f64, period: f64) -> f64 {
 }
 
 /// Donner and Jensen's (2005) multipole through a slab of thickness `a` (glsl
-/// `multipole_slab_sum`), every image summed in closed form: with `z_b = (z_v - z_r) / 2` and
+/// `lucent_multipole_slab_sum`), every image summed in closed form: with `z_b = (z_v - z_r) / 2` and
 /// `P = 2 (a + 2 z_b)`, real sources at `i P + z_r`, virtual ones at `i P - z_r - 2 z_b`:
 /// `sum_i sign(a - z_ri) e^(-sigma_tr |a - z_ri|) - sign(a - z_vi) e^(-sigma_tr |a - z_vi|)`;
 /// the slab's total diffuse transmittance is `alpha' / 2` times it. Negative for slabs that

@@ -621,7 +621,26 @@ impl GpuContext {
     /// writes to the image are waited for. The image needs `TRANSFER_SRC` usage and a format
     /// known to the format table ([`crate::backend::format`]).
     pub fn read_image(&self, image: &GpuImage, layout: vk::ImageLayout) -> Result<Vec<u8>> {
+        self.read_image_at(image, layout, 0, 0)
+    }
+
+    /// [`Self::read_image`] of mip level `mip` and array layer `layer` (that subresource in
+    /// `layout`; the others are not touched): the level's size, tightly packed.
+    pub fn read_image_at(
+        &self,
+        image: &GpuImage,
+        layout: vk::ImageLayout,
+        mip: u32,
+        layer: u32,
+    ) -> Result<Vec<u8>> {
         let desc = &image.desc;
+        if mip >= desc.mip_levels.max(1) || layer >= desc.layers.max(1) {
+            return Err(LucentError::InvalidInput(format!(
+                "image '{}' has {} mip levels and {} layers: no mip {mip}, layer {layer}",
+                image.name, desc.mip_levels, desc.layers
+            )));
+        }
+        let (width, height) = ((desc.width >> mip).max(1), (desc.height >> mip).max(1));
         if matches!(
             layout,
             vk::ImageLayout::UNDEFINED | vk::ImageLayout::PREINITIALIZED
@@ -662,14 +681,20 @@ impl GpuContext {
                 image.name, desc.format
             ))
         })?;
-        let size = u64::from(desc.width) * u64::from(desc.height) * u64::from(texel);
+        let size = u64::from(width) * u64::from(height) * u64::from(texel);
         let readback = self.create_buffer(
             size,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
             &format!("{} (readback)", image.name),
         )?;
-        let range = desc.subresource_range();
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: desc.aspect,
+            base_mip_level: mip,
+            level_count: 1,
+            base_array_layer: layer,
+            layer_count: 1,
+        };
         let copied = self.submit_and_wait(|cmd| {
             self.begin_label(cmd, &format!("read back {}", image.name));
             // Wait for every earlier write to the image, whatever wrote it, then move it to
@@ -691,12 +716,16 @@ impl GpuContext {
                 buffer_image_height: 0,
                 image_subresource: vk::ImageSubresourceLayers {
                     aspect_mask: copy_aspect,
-                    mip_level: 0,
-                    base_array_layer: 0,
+                    mip_level: mip,
+                    base_array_layer: layer,
                     layer_count: 1,
                 },
                 image_offset: vk::Offset3D::default(),
-                image_extent: desc.extent(),
+                image_extent: vk::Extent3D {
+                    width,
+                    height,
+                    depth: 1,
+                },
             };
             // Back to the caller's layout. The copy only read the image, so an execution
             // dependency suffices on the source side; the transition's writes must be visible to

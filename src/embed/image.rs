@@ -154,13 +154,13 @@ pub struct HostImage {
     pub name: String,
     /// The image.
     pub image: vk::Image,
-    /// A 2-D view of mip 0, layer 0 (a depth-stencil image's view: the aspect lucent reads,
-    /// depth for depth, stencil for material IDs in stencil bits); for an image of
-    /// [`HostImage::layers`] layers, a 2-D array view of mip 0, layers 0 to `layers - 1`.
+    /// A 2-D view of mip [`HostImage::mip`], layer [`HostImage::base_layer`] (a depth-stencil
+    /// image's view: the aspect lucent reads, depth for depth, stencil for material IDs in
+    /// stencil bits); for [`HostImage::layers`] layers, a 2-D array view of them.
     pub view: vk::ImageView,
     /// The format the image (and view) were created with.
     pub format: vk::Format,
-    /// Its size.
+    /// Its size: the size of the view's mip level.
     pub extent: vk::Extent2D,
     /// The usage flags it was created with.
     pub usage: vk::ImageUsageFlags,
@@ -172,6 +172,13 @@ pub struct HostImage {
     /// The array layers lucent reads (1: a 2-D image; more: a shadow map's cascades or cube
     /// faces as an array, [`HostImage::with_layers`]), all in [`HostImage::state`].
     pub layers: u32,
+    /// The mip level the view shows ([`HostImage::at`]): lucent's barriers cover that level
+    /// only, the image's other levels keep their states.
+    pub mip: u32,
+    /// The first array layer the view shows ([`HostImage::at`]): a stereo renderer's eye in
+    /// a layer of a two-layer image, a G-buffer in one layer of an array. lucent's barriers
+    /// cover `base_layer..base_layer + layers` only.
+    pub base_layer: u32,
 }
 
 impl HostImage {
@@ -194,11 +201,32 @@ impl HostImage {
             state: ImageState::UNDEFINED,
             final_state: None,
             layers: 1,
+            mip: 0,
+            base_layer: 0,
         }
     }
 
-    /// An array of `layers` layers (from 0; the view a 2-D array view of them): a shadow map
-    /// whose faces lie in layers ([`super::ShadowFace::layer`]).
+    /// The view shows mip `mip` and array layer `base_layer` (the first of
+    /// [`HostImage::layers`]) of the image: lucent's barriers cover those subresources only,
+    /// and [`HostImage::extent`] is that mip's size.
+    pub fn at(mut self, mip: u32, base_layer: u32) -> Self {
+        self.mip = mip;
+        self.base_layer = base_layer;
+        self
+    }
+
+    /// The subresources lucent's barriers cover.
+    pub(crate) fn subresources(&self) -> crate::graph::Subresources {
+        crate::graph::Subresources {
+            mip: self.mip,
+            base_layer: self.base_layer,
+            layers: self.layers,
+        }
+    }
+
+    /// An array of `layers` layers (from [`HostImage::base_layer`]; the view a 2-D array view
+    /// of them): a shadow map whose faces lie in layers ([`super::ShadowFace::layer`], counted
+    /// from the view's first layer).
     pub fn with_layers(mut self, layers: u32) -> Self {
         self.layers = layers;
         self
@@ -553,6 +581,22 @@ pub(crate) fn check_image(
             ),
         ));
     }
+    // A mip level past the device's largest chain, or layers past u32: no image has them (a
+    // mistake, or garbage in the description), and a barrier naming them is invalid.
+    let max_mip = 31 - gpu.info.max_image_dimension_2d.max(1).leading_zeros();
+    if image.mip > max_mip || image.base_layer.checked_add(image.layers).is_none() {
+        return Err(invalid(
+            &image.name,
+            ImageFault::Size,
+            format!(
+                "names mip {} and layers {} to {}; this device's images have mips 0 to \
+                 {max_mip}",
+                image.mip,
+                image.base_layer,
+                u64::from(image.base_layer) + u64::from(image.layers) - 1
+            ),
+        ));
+    }
     if image.extent != extent {
         return Err(invalid(
             &image.name,
@@ -682,13 +726,7 @@ pub(crate) fn record_transition(
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image.image)
-        .subresource_range(vk::ImageSubresourceRange {
-            aspect_mask: aspect,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: image.layers.max(1),
-        });
+        .subresource_range(image.subresources().vk(aspect));
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
     // SAFETY: `cmd` is recording (the caller's contract) and the image is the host's valid

@@ -239,7 +239,8 @@ pub use glam;
 /// materials' regions; [`SssMaterial::relights_specular`]. 9: SSS transmission in
 /// [`glsl::TERMS`] (`lucent_sss_transmittance`, `lucent_sss_transmitted`) with
 /// [`TransmissionMaterial::rows`]; [`GBufferDesc::metres_per_unit`] at most
-/// [`MAX_METRES_PER_UNIT`].
+/// [`MAX_METRES_PER_UNIT`]; host images that are one mip level or layer of a larger image
+/// ([`HostImage::at`]).
 pub const API_VERSION: u32 = 9;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

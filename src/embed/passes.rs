@@ -386,9 +386,14 @@ impl EffectPasses {
         timer: Option<&mut EffectTimer>,
     ) -> Result<()> {
         let gpu = lucent.gpu();
-        let binds: Vec<(ResourceId, vk::Image, vk::ImageView, u32)> = binds
+        let binds: Vec<(
+            ResourceId,
+            vk::Image,
+            vk::ImageView,
+            crate::graph::Subresources,
+        )> = binds
             .iter()
-            .map(|(id, i)| (*id, i.image, i.view, i.layers))
+            .map(|(id, i)| (*id, i.image, i.view, i.subresources()))
             .collect();
         let executable = self.executable.as_mut().expect("alive until destroy");
         executable.bind_imports(gpu, ring, &binds)?;

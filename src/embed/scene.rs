@@ -134,8 +134,13 @@ impl SceneRenderer {
             ),
         )?;
         self.renderer.update_slot(scene, slot)?;
-        self.renderer
-            .bind_target(lucent.gpu(), slot, output.image, output.view)?;
+        self.renderer.bind_target_at(
+            lucent.gpu(),
+            slot,
+            output.image,
+            output.view,
+            output.subresources(),
+        )?;
         let final_state = output.left_in();
         let gpu = lucent.gpu();
         let working = Role::Output.working_state();

@@ -17,7 +17,7 @@ use crate::gpu_scene::tiles::{
     bounds_of, mesh_bounds, object_tiles, object_tiles_at_depth, tile_rects, translucent_tiles,
 };
 use crate::gpu_scene::{FrameUniforms, SceneGpu, SlotTiles, FRAME};
-use crate::graph::{Executable, RenderGraph, ResourceId};
+use crate::graph::{Executable, RenderGraph, ResourceId, Subresources};
 use crate::scene::{Scene, MAX_LIGHTS};
 use crate::{LucentError, Result};
 use glam::Vec3;
@@ -315,13 +315,26 @@ impl Renderer {
         image: vk::Image,
         view: vk::ImageView,
     ) -> Result<()> {
+        self.bind_target_at(gpu, slot, image, view, Subresources::FIRST)
+    }
+
+    /// [`Self::bind_target`] for a view of one mip level and layer of a larger image
+    /// (`range`): the frame's barriers on the target cover those subresources only.
+    pub fn bind_target_at(
+        &mut self,
+        gpu: &GpuContext,
+        slot: usize,
+        image: vk::Image,
+        view: vk::ImageView,
+        range: Subresources,
+    ) -> Result<()> {
         if !self.outputs.target {
             return Err(LucentError::InvalidInput(
                 "bind_target: the frame was built without a target (FrameSettings::target)".into(),
             ));
         }
         self.executable
-            .bind_imports(gpu, slot, &[(self.outputs.display, image, view, 1)])
+            .bind_imports(gpu, slot, &[(self.outputs.display, image, view, range)])
     }
 
     /// Records one frame for slot `slot` into `cmd` (in the recording state), with a

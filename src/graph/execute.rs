@@ -79,6 +79,38 @@ enum Physical {
     Imported,
 }
 
+/// The subresources of an image the graph's barriers cover: one mip level and a run of array
+/// layers (an imported image's view shows exactly these).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Subresources {
+    /// The mip level.
+    pub mip: u32,
+    /// The first array layer.
+    pub base_layer: u32,
+    /// How many layers (1: a 2-D view; more: a 2-D array view).
+    pub layers: u32,
+}
+
+impl Subresources {
+    /// Mip 0, layer 0: every image the graph owns, and most imports.
+    pub const FIRST: Subresources = Subresources {
+        mip: 0,
+        base_layer: 0,
+        layers: 1,
+    };
+
+    /// The Vulkan range of these subresources in `aspect`.
+    pub fn vk(self, aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange {
+            aspect_mask: aspect,
+            base_mip_level: self.mip,
+            level_count: 1,
+            base_array_layer: self.base_layer,
+            layer_count: self.layers.max(1),
+        }
+    }
+}
+
 /// A plan made real on a device, ready to record every frame.
 pub struct Executable {
     /// The plan being executed.
@@ -87,9 +119,10 @@ pub struct Executable {
     physical: Vec<Physical>,
     images: Vec<vk::Image>,
     views: Vec<vk::ImageView>,
-    /// Array layers per image its barriers cover (1 but for an imported array: a host's
-    /// shadow map cascades, [`Self::bind_imports`]).
-    layers: Vec<u32>,
+    /// The subresources per image its barriers cover (mip 0, layer 0 but for an imported
+    /// image's: a host's image may be one mip or layer of a larger one, or an array of
+    /// layers, a shadow map's cascades, [`Self::bind_imports`]).
+    ranges: Vec<Subresources>,
     /// Depth-only views of depth-stencil images (null for every other image).
     depth_views: Vec<vk::ImageView>,
     /// `views` with `depth_views` where those exist: what descriptors point at.
@@ -135,7 +168,7 @@ impl Executable {
         let mut exe = Executable {
             physical: Vec::new(),
             images: vec![vk::Image::null(); plan.resources.len()],
-            layers: vec![1; plan.resources.len()],
+            ranges: vec![Subresources::FIRST; plan.resources.len()],
             views: vec![vk::ImageView::null(); plan.resources.len()],
             depth_views: vec![vk::ImageView::null(); plan.resources.len()],
             descriptor_views: Vec::new(),
@@ -332,7 +365,7 @@ impl Executable {
         &mut self,
         gpu: &GpuContext,
         slot: usize,
-        binds: &[(ResourceId, vk::Image, vk::ImageView, u32)],
+        binds: &[(ResourceId, vk::Image, vk::ImageView, Subresources)],
     ) -> Result<()> {
         if slot >= self.slots {
             return Err(LucentError::Graph(format!(
@@ -340,7 +373,7 @@ impl Executable {
                 self.slots
             )));
         }
-        for &(id, image, view, layers) in binds {
+        for &(id, image, view, range) in binds {
             let resource = self.plan.resources.get(id).ok_or_else(|| {
                 LucentError::Graph(format!("bind_imports: no resource {id} in this plan"))
             })?;
@@ -358,7 +391,10 @@ impl Executable {
             }
             self.images[id] = image;
             self.views[id] = view;
-            self.layers[id] = layers.max(1);
+            self.ranges[id] = Subresources {
+                layers: range.layers.max(1),
+                ..range
+            };
         }
         for &(id, _, view, _) in binds {
             for p in 0..self.plan.passes.len() {
@@ -578,13 +614,9 @@ impl Executable {
                     .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                     .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                     .image(self.images[b.resource])
-                    .subresource_range(vk::ImageSubresourceRange {
-                        aspect_mask: self.plan.resources[b.resource].info.aspect(),
-                        base_mip_level: 0,
-                        level_count: 1,
-                        base_array_layer: 0,
-                        layer_count: self.layers[b.resource],
-                    })
+                    .subresource_range(
+                        self.ranges[b.resource].vk(self.plan.resources[b.resource].info.aspect()),
+                    )
             })
             .collect();
         let dependency = vk::DependencyInfo::default().image_memory_barriers(&image_barriers);

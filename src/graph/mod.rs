@@ -49,7 +49,7 @@ pub use declare::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, MeshDraws, MeshViews, PassKind, PingPong,
     RenderGraph, ResourceId,
 };
-pub use execute::{Executable, PrepareContext, RecordContext};
+pub use execute::{Executable, PrepareContext, RecordContext, Subresources};
 
 use crate::backend::GpuContext;
 use crate::Result;

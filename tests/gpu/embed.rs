@@ -1354,6 +1354,20 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
             vec!["'back buffer'", "32x48"],
         ),
         (
+            "a mip level no image of the device has",
+            with(&|i| i.mip = 40),
+            0,
+            Box::new(image_fault(ImageFault::Size)),
+            vec!["'back buffer'", "mip 40"],
+        ),
+        (
+            "layers past the end of u32",
+            with(&|i| i.base_layer = u32::MAX),
+            0,
+            Box::new(image_fault(ImageFault::Size)),
+            vec!["'back buffer'", "layers 4294967295"],
+        ),
+        (
             "another format than the renderer's",
             with(&|i| i.format = vk::Format::R16G16B16A16_SFLOAT),
             0,
@@ -2204,10 +2218,25 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
     test.finish();
 }
 
+/// Where [`two_views_per_frame_each_equal_their_view_alone`] writes each view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ViewOutputs {
+    /// An image of its own each.
+    Separate,
+    /// View k into layer k of one two-layer image (stereo), through a 2-D view of the layer.
+    Layers,
+    /// Mip 1 of an image twice the size, with two levels (mip 0 never touched).
+    SecondMip,
+}
+
 #[test]
 fn two_views_per_frame_each_equal_their_view_alone() {
     // Split screen or stereo: two cameras recorded into one frame's command buffer, for the
-    // same slot, each with its own images, each as it would be alone.
+    // same slot, each with its own images, each as it would be alone; the same into the two
+    // layers of one array image (a stereo renderer's eyes), and into the second mip level of
+    // larger images: lucent's barriers then cover the view's layer or level only (a barrier
+    // on layer 0 or mip 0 instead leaves the written subresource in the wrong layout, which
+    // the validation layer reports).
     let test = TestGpu::new();
     let gpu = &test.gpu;
     let (w, h) = (160, 120);
@@ -2306,21 +2335,70 @@ fn two_views_per_frame_each_equal_their_view_alone() {
     .with_material_ids(IdDesc::value(vk::Format::R8_UINT))
     .with_metres_per_unit(1.0 / (1000.0 * profile[0].0.units_per_mm));
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-    let render = |views_per_frame: usize, which: &[usize]| -> Vec<Vec<u8>> {
+    let format = vk::Format::R16G16B16A16_SFLOAT;
+    // A 2-D view of mip `mip`, layer `layer` of `image`.
+    let view_of = |image: &GpuImage, mip: u32, layer: u32| {
+        let info = vk::ImageViewCreateInfo::default()
+            .image(image.image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(vk::ImageSubresourceRange {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                base_mip_level: mip,
+                level_count: 1,
+                base_array_layer: layer,
+                layer_count: 1,
+            });
+        // SAFETY: the image is live, made with this format and these levels and layers.
+        unsafe { gpu.device.create_image_view(&info, None) }.unwrap()
+    };
+    let render = |views_per_frame: usize, which: &[usize], into: ViewOutputs| -> Vec<Vec<u8>> {
         let lucent = wrap(&test, options(1));
-        let desc = SssEffectDesc::new(
-            gbuffer.clone(),
-            materials.clone(),
-            vk::Format::R16G16B16A16_SFLOAT,
-        )
-        .with_views_per_frame(views_per_frame);
+        let desc = SssEffectDesc::new(gbuffer.clone(), materials.clone(), format)
+            .with_views_per_frame(views_per_frame);
         let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
-        let outputs: Vec<GpuImage> = which
+        // Per view: the image, the view of what it writes, its mip and layer.
+        let targets: Vec<GpuImage> = match into {
+            ViewOutputs::Separate => which
+                .iter()
+                .map(|_| output_image(&test, w, h, format, usage))
+                .collect(),
+            ViewOutputs::Layers => vec![gpu
+                .create_image(
+                    &ImageDesc::color(w, h, format, usage).with_layers(2),
+                    "stereo output",
+                )
+                .unwrap()],
+            ViewOutputs::SecondMip => which
+                .iter()
+                .map(|_| {
+                    let mut desc = ImageDesc::color(2 * w, 2 * h, format, usage);
+                    desc.mip_levels = 2;
+                    gpu.create_image(&desc, "two-level output").unwrap()
+                })
+                .collect(),
+        };
+        let outputs: Vec<(&GpuImage, vk::ImageView, u32, u32)> = which
             .iter()
-            .map(|_| output_image(&test, w, h, vk::Format::R16G16B16A16_SFLOAT, usage))
+            .enumerate()
+            .map(|(index, _)| match into {
+                ViewOutputs::Separate => (&targets[index], targets[index].view, 0, 0),
+                ViewOutputs::Layers => {
+                    let layer = index as u32;
+                    (&targets[0], view_of(&targets[0], 0, layer), 0, layer)
+                }
+                ViewOutputs::SecondMip => (&targets[index], view_of(&targets[index], 1, 0), 1, 0),
+            })
             .collect();
         recorded(&test, |cmd| {
-            for (index, (&k, output)) in which.iter().zip(&outputs).enumerate() {
+            for (index, (&k, &(output, view, mip, layer))) in which.iter().zip(&outputs).enumerate()
+            {
+                let mut host_output = described(output, "view output", usage);
+                host_output.view = view;
+                host_output.extent = vk::Extent2D {
+                    width: w,
+                    height: h,
+                };
                 let [depth, diffuse, specular, ids] = &images[k];
                 let aspect = w as f32 / h as f32;
                 let frame_images = SssImages {
@@ -2343,7 +2421,8 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                             ),
                             images: frame_images,
                             regions: &[],
-                            output: &described(output, "view output", usage)
+                            output: &host_output
+                                .at(mip, layer)
                                 .in_state(ImageState::UNDEFINED)
                                 .then(ImageState::transfer_src()),
                             lean: None,
@@ -2354,26 +2433,41 @@ fn two_views_per_frame_each_equal_their_view_alone() {
         });
         let out: Vec<Vec<u8>> = outputs
             .iter()
-            .map(|o| {
-                gpu.read_image(o, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+            .map(|&(image, _, mip, layer)| {
+                gpu.read_image_at(image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, mip, layer)
                     .unwrap()
             })
             .collect();
         effect.destroy(&lucent);
         drop(lucent);
-        for o in outputs {
-            gpu.destroy_image(o);
+        for &(image, view, _, _) in &outputs {
+            if view != image.view {
+                // SAFETY: the frame completed (`recorded` waits); the view is the test's.
+                unsafe { gpu.device.destroy_image_view(view, None) };
+            }
+        }
+        for image in targets {
+            gpu.destroy_image(image);
         }
         out
     };
-    let both = render(2, &[0, 1]);
-    let alone = [render(1, &[0]).remove(0), render(1, &[1]).remove(0)];
+    let alone = [
+        render(1, &[0], ViewOutputs::Separate).remove(0),
+        render(1, &[1], ViewOutputs::Separate).remove(0),
+    ];
     assert_ne!(alone[0], alone[1], "the two views differ");
-    for k in 0..2 {
-        assert_eq!(
-            both[k], alone[k],
-            "view {k} recorded beside the other differs from alone"
-        );
+    for into in [
+        ViewOutputs::Separate,
+        ViewOutputs::Layers,
+        ViewOutputs::SecondMip,
+    ] {
+        let both = render(2, &[0, 1], into);
+        for k in 0..2 {
+            assert_eq!(
+                both[k], alone[k],
+                "view {k} recorded beside the other ({into:?}) differs from alone"
+            );
+        }
     }
     for set in images {
         for image in set {

@@ -46,9 +46,10 @@
 //!    inside its own lighting pass instead, with lucent's GLSL (`lucent::embed::glsl::TERMS`:
 //!    `lucent_sh_ambient`, `lucent_translucency`, `lucent_sss_transmitted`) and lucent's data
 //!    (the environment's coefficients, the leaf's material row, the lights' translucency
-//!    scales, the skin's and marble's medium rows), the transmission's thickness measured by
-//!    the engine's own lookup of its shadow atlas: no pass of lucent's but the layered media
-//!    and the SSS, the same picture within the target's rounding.
+//!    scales, the skin's and marble's medium rows), the transmission's thickness measured in
+//!    the engine's own shadow atlas with lucent's lookup (`lucent_shadow_texels`, the faces'
+//!    rows from `ShadowFace::terms_rows`): no pass of lucent's but the layered media and the
+//!    SSS, the same picture within the target's rounding.
 //! 8. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
 //! ```sh
@@ -419,9 +420,10 @@ void main() {{
     pub struct FusedTransmission {
         /// The skin's and the marble's rows.
         pub media: [[[f32; 4]; 4]; 2],
-        /// The engine's shadow faces, as its lighting reads its atlas: the sun's, then the
-        /// back light's six (+X, -X, +Y, -Y, +Z, -Z).
-        pub faces: Vec<super::AtlasFace>,
+        /// The engine's shadow faces as its lighting reads its atlas
+        /// (`ShadowFace::terms_rows`): the sun's, then the back light's six (+X, -X, +Y, -Y,
+        /// +Z, -Z).
+        pub faces: Vec<[[f32; 4]; 6]>,
     }
 
     /// Which of lucent's per-object terms a lighting variant adds (`--fused`): each is drawn
@@ -464,7 +466,7 @@ void main() {{
         }
     }
 
-    /// The engine's shadow lookup for lucent's transmission: its atlas (binding 5, standard
+    /// lucent's transmission on the engine's shadow maps: its atlas (binding 5, standard
     /// Z), each face's constants, and lucent's recipe for the thickness a map measures (the
     /// point one map texel inside, the four texels around it, lucent's transmission term per
     /// texel weighted bilinearly: `lucent_sss_transmitted`).
@@ -475,25 +477,17 @@ void main() {{
 const vec4 SKIN_MEDIUM[4] = vec4[4]({SKIN_MEDIUM});
 const vec4 MARBLE_MEDIUM[4] = vec4[4]({MARBLE_MEDIUM});
 layout(set = 0, binding = 5) uniform sampler2D shadow_atlas;   // the engine's, standard Z
-// Face f's world-to-clip matrix (standard Z); its rectangle (xy: its corner in the atlas in
-// texels, z: its edge); its parameters (x * clip.w + y: a map texel's world size at a point;
-// z: near, negative when orthographic; w: far). Chosen by comparisons, not read from a
-// constant array: a CPU driver copies a dynamically indexed constant array per pixel.
+// Face f's rows (lucent::embed::ShadowFace::terms_rows: its world-to-clip matrix, standard
+// Z; its rectangle in the atlas; its texel size, near and far). Chosen by comparisons, not
+// read from a constant array: a CPU driver copies a dynamically indexed constant array per
+// pixel.
 void face_data(int f, out mat4 view_proj, out vec4 rect, out vec4 params) {{
 {FACES}
 }}
 
-// Distance along face f's axis of device depth d (standard Z).
-float face_distance(vec4 params, float d) {{
-    float near = abs(params.z), far = params.w;
-    if (params.z < 0.0) {{
-        return near + d * (far - near);
-    }}
-    return near * far / max(far - d * (far - near), 1e-12);
-}}
-
 // The light that reaches p (normal n, towards the light l) through the object from face f's
-// light: `point` lights at `light_pos` fall off as the engine's back light, the sun does not.
+// light (at light_pos; `point` lights fall off as the engine's back light, the sun does not):
+// lucent's recipe (lucent_shadow_texels) on the engine's atlas and lucent's term per entry.
 vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 radiance,
                          bool point, vec3 light_pos) {{
     if (!(dot(n, l) < 0.0)) {{
@@ -502,35 +496,21 @@ vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 rad
     mat4 view_proj;
     vec4 rect, params;
     face_data(f, view_proj, rect, params);
-    vec4 clip = view_proj * vec4(p, 1.0);
-    vec3 inner = p - n * (params.x * abs(clip.w) + params.y);
-    clip = view_proj * vec4(inner, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
-          ndc.z <= 1.0)) {{
+    vec3 inner;
+    float inner_distance;
+    vec4 texel_distances, w;
+    if (!lucent_shadow_texels(shadow_atlas, view_proj, rect, params, p, n, inner,
+                              inner_distance, texel_distances, w)) {{
         return vec3(0.0);  // outside the face: nothing measures the thickness
     }}
-    vec2 t = rect.xy + (ndc.xy * 0.5 + 0.5) * rect.z;
-    float d_inner = face_distance(params, ndc.z);
-    vec2 c = clamp(t - 0.5, rect.xy, rect.xy + rect.z - 1.001);
-    vec2 base = floor(c);
-    vec2 fr = c - base;
-    vec4 w = vec4((1.0 - fr.x) * fr.y, fr.x * fr.y, fr.x * (1.0 - fr.y), (1.0 - fr.x) * (1.0 - fr.y));
-    vec4 d = textureGather(shadow_atlas, (base + 1.0) / vec2(textureSize(shadow_atlas, 0)), 0);
     vec3 sum = vec3(0.0);
     for (int k = 0; k < 4; ++k) {{
-        if (!(d[k] < 1.0)) {{
-            continue;  // nothing between the light and the far plane
+        if (!(w[k] > 0.0)) {{
+            continue;  // the texel holds the far plane: no entry
         }}
-        float d_map = face_distance(params, d[k]);
-        vec3 entry;
-        vec3 light = radiance;
-        if (point) {{
-            entry = light_pos + (inner - light_pos) * min(d_map / max(d_inner, 1e-12), 1.0);
-            light *= back_light_falloff(entry);
-        }} else {{
-            entry = inner + l * max(d_inner - d_map, 0.0);
-        }}
+        vec3 entry = lucent_map_entry_point(params, light_pos, inner, l, inner_distance,
+                                            texel_distances[k]);
+        vec3 light = point ? radiance * back_light_falloff(entry) : radiance;
         sum += w[k] * lucent_sss_transmitted(medium, n, l, length(entry - p), light);
     }}
     return sum;
@@ -548,9 +528,9 @@ vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 rad
                         _ if k + 1 == t.faces.len() => "else ".to_string(),
                         _ => format!("else if (f == {k}) "),
                     },
-                    mat4(&f.view_proj),
-                    vec4(f.rect),
-                    vec4(f.params)
+                    mat4(&[f[0], f[1], f[2], f[3]]),
+                    vec4(f[4]),
+                    vec4(f[5])
                 ))
                 .collect::<Vec<_>>()
                 .join("\n"),
@@ -1876,7 +1856,10 @@ fn fused_transmission() -> Result<shaders::FusedTransmission, String> {
         .map_err(|_| "two transmitting materials".to_string())?;
     Ok(shaders::FusedTransmission {
         media: [rows(&skin)?, rows(&marble)?],
-        faces: atlas_faces(sun_direction()),
+        faces: light_faces(sun_direction())
+            .iter()
+            .map(|face| face.terms_rows(LIGHT_SPACE).map_err(|e| e.to_string()))
+            .collect::<Result<_, _>>()?,
     })
 }
 
@@ -2030,48 +2013,6 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
 const SUN_NEAR_FAR: (f32, f32) = (0.05, 2.0);
 /// The back light's faces' near plane (their far plane is its range).
 const POINT_FACE_NEAR: f32 = 0.005;
-
-/// One of the engine's shadow faces as its own lighting reads its atlas to add lucent's
-/// transmission term (`--fused`).
-pub struct AtlasFace {
-    /// World to the face's clip space (standard Z).
-    pub view_proj: [[f32; 4]; 4],
-    /// xy: the face's corner in the atlas, z: its edge (texels); w: 0.
-    pub rect: [f32; 4],
-    /// x * clip.w + y: a map texel's world size at a point; z: the near plane (negative for
-    /// the orthographic face); w: the far plane.
-    pub params: [f32; 4],
-}
-
-/// The faces of [`light_faces`] as the engine's lighting reads them (`--fused`): the sun's
-/// orthographic face first, then the back light's six perspective ones.
-fn atlas_faces(sun: Vec3) -> Vec<AtlasFace> {
-    light_faces(sun)
-        .iter()
-        .enumerate()
-        .map(|(k, face)| {
-            let edge = face.rect.extent.width as f32;
-            // A map texel's world size: the view's extent over the edge, at distance w on a
-            // perspective face.
-            let texel = 2.0 / (face.projection.y_axis.y.abs() * edge);
-            let params = if k == 0 {
-                [0.0, texel, -SUN_NEAR_FAR.0, SUN_NEAR_FAR.1]
-            } else {
-                [texel, 0.0, POINT_FACE_NEAR, BACK_LIGHT_RANGE]
-            };
-            AtlasFace {
-                view_proj: (face.projection * face.view).to_cols_array_2d(),
-                rect: [
-                    face.rect.offset.x as f32,
-                    face.rect.offset.y as f32,
-                    edge,
-                    0.0,
-                ],
-                params,
-            }
-        })
-        .collect()
-}
 
 /// The sun's direction (towards it).
 fn sun_direction() -> Vec3 {
@@ -3170,7 +3111,8 @@ fn create_effects(
                     "environment, translucency (the leaf){} in the engine's lighting pass \
                      (lucent::embed::glsl::TERMS), ",
                     if transmission_on(args) {
-                        " and transmission (skin and marble, the engine's shadow lookup)"
+                        " and transmission (skin and marble, lucent's lookup of the engine's \
+                         shadow atlas)"
                     } else {
                         ""
                     }

@@ -8,6 +8,9 @@
 #ifndef LUCENT_SHADOWS_GLSL
 #define LUCENT_SHADOWS_GLSL
 
+// The lookups themselves, on a face's rows as arguments (shared with a host's lighting pass).
+#include "../embed/lucent_terms.glsl"
+
 #define MAX_SHADOW_LIGHTS 64
 #define MAX_SHADOW_FACES 384
 
@@ -89,12 +92,7 @@ int shadow_face(int light, vec3 pos) {
 
 // Distance from the face's eye along its axis (world units) of a device depth `d`.
 float shadow_distance(vec4 params, float d) {
-    float near = abs(params.z), far = params.w;
-    if (params.z < 0.0) {
-        return near + d * (far - near); // orthographic: linear
-    }
-    // Perspective: depth 1 is the far plane; the max keeps d = 1 from dividing by zero.
-    return near * far / max(far - d * (far - near), 1e-12);
+    return lucent_face_distance(params, d);
 }
 
 // The device depth of a distance `z` from the face's eye along its axis (the inverse of
@@ -114,23 +112,15 @@ float shadow_device_depth(vec4 params, float z) {
 
 // A map texel's world size at `p` on face `face`: how far a lookup moves to step one texel.
 float map_texel_size(int face, vec3 p) {
-    vec4 clip = shadows.faces[face].view_proj * vec4(p, 1.0);
-    return shadows.faces[face].params.x * abs(clip.w) + shadows.faces[face].params.y;
+    return lucent_map_texel_size(shadows.faces[face].view_proj, shadows.faces[face].params, p);
 }
 
 // Where `p` falls in face `face`'s map: its atlas position `t` in texels (texel k's centre at
 // k + 0.5) and its distance along the face's axis; false outside the face's cone (w <= 0
 // would divide by zero) or map.
 bool map_position(int face, vec3 p, out vec2 t, out float distance) {
-    vec4 clip = shadows.faces[face].view_proj * vec4(p, 1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
-          ndc.z <= 1.0)) {
-        return false;
-    }
-    t = shadows.faces[face].rect.xy + (ndc.xy * 0.5 + 0.5) * shadows.faces[face].rect.z;
-    distance = shadow_distance(shadows.faces[face].params, ndc.z);
-    return true;
+    return lucent_map_position(shadows.faces[face].view_proj, shadows.faces[face].rect,
+                               shadows.faces[face].params, p, t, distance);
 }
 
 // The texel of face `face`'s tile nearest atlas position `t`.
@@ -144,12 +134,7 @@ ivec2 map_texel(int face, vec2 t) {
 // the tile): the textureGather coordinate that returns them and their bilinear weights, in
 // gather order (x0 y1, x1 y1, x1 y0, x0 y0).
 void map_bilinear(int face, vec2 t, out vec2 corner, out vec4 weights) {
-    vec4 rect = shadows.faces[face].rect;
-    vec2 c = clamp(t - 0.5, rect.xy, rect.xy + rect.z - 1.001);
-    vec2 base = floor(c);
-    corner = (base + 1.0) * shadows.atlas.zw;
-    vec2 f = c - base;
-    weights = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+    lucent_map_bilinear(shadows.faces[face].rect, shadows.atlas.zw, t, corner, weights);
 }
 
 // Where light `light`'s ray to `p` (at distance `d_p` along face `face`'s axis) meets a
@@ -158,11 +143,8 @@ void map_bilinear(int face, vec2 t, out vec2 corner, out vec4 weights) {
 // scale with the distance from it (d_p > 0 there; the max guards a point on the light's eye).
 // A point nearer than the surface is its own entry point.
 vec3 map_entry_point(int face, int light, vec3 p, vec3 to_light, float d_p, float d_map) {
-    if (shadows.faces[face].params.z < 0.0) {
-        return p + to_light * max(d_p - d_map, 0.0);
-    }
-    vec3 l = frame.lights[light].position_type.xyz;
-    return l + (p - l) * min(d_map / max(d_p, 1e-12), 1.0);
+    return lucent_map_entry_point(shadows.faces[face].params,
+                                  frame.lights[light].position_type.xyz, p, to_light, d_p, d_map);
 }
 
 // How much of `light` reaches `pos` (normal `normal`, towards the light `to_light`): x for light

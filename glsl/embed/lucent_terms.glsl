@@ -159,10 +159,11 @@ vec3 lucent_sss_transmittance(vec4 medium[4], float thickness) {
 // back-facing cosine max(-dot(normal, to_light), 0) (`to_light` unit, from the point). The
 // result is light before the albedo and 1 / pi, as a Lambert term's irradiance: multiply by
 // albedo / pi where the host's diffuse light has its albedo. The thickness comes from the
-// host's shadow map of the light: lucent's recipe (glsl/common/sss_transmission.glsl
-// `sss_transmitted`) looks up the map from the point moved one map texel inside along
-// -normal, reads the four texels around it, and sums this term over them with their bilinear
-// weights (the transmittance is filtered, not the distance, which would leave a staircase).
+// host's shadow map of the light: lucent's recipe (`lucent_shadow_texels` below, which
+// glsl/common/sss_transmission.glsl `sss_transmitted` follows on lucent's own maps) looks up
+// the map from the point moved one map texel inside along -normal, reads the four texels
+// around it, and sums this term over them with their bilinear weights (the transmittance is
+// filtered, not the distance, which would leave a staircase).
 vec3 lucent_sss_transmitted(vec4 medium[4], vec3 normal, vec3 to_light, float thickness,
                             vec3 light_at_entry) {
     float back = -dot(normal, to_light);
@@ -170,6 +171,106 @@ vec3 lucent_sss_transmitted(vec4 medium[4], vec3 normal, vec3 to_light, float th
         return vec3(0.0);
     }
     return back * light_at_entry * lucent_sss_transmittance(medium, thickness);
+}
+
+// A face of a shadow map, as lucent reads one (lucent::embed::ShadowFace::terms_rows, the
+// same rows lucent's own shadow table holds, glsl/common/shadows.glsl): `view_proj` world to
+// the face's clip space (standard Z: depth 0 near, 1 far); `rect` xy its corner in the map and
+// z its edge (texels), w 1 when the map stores reversed Z (plus 2 x its layer in an array
+// map); `params` x * clip.w + y a map texel's world size at a point, z the near plane
+// (negative: orthographic), w the far plane.
+
+// Distance from the face's eye along its axis (world units) of a standard-Z depth `d`.
+float lucent_face_distance(vec4 params, float d) {
+    float near = abs(params.z), far = params.w;
+    if (params.z < 0.0) {
+        return near + d * (far - near); // orthographic: linear
+    }
+    // Perspective: depth 1 is the far plane; the max keeps d = 1 from dividing by zero.
+    return near * far / max(far - d * (far - near), 1e-12);
+}
+
+// A map texel's world size at `p`: how far a lookup moves to step one texel.
+float lucent_map_texel_size(mat4 view_proj, vec4 params, vec3 p) {
+    vec4 clip = view_proj * vec4(p, 1.0);
+    return params.x * abs(clip.w) + params.y;
+}
+
+// Where `p` falls in the face's map: its map position `t` in texels (texel k's centre at
+// k + 0.5) and its distance along the face's axis; false outside the face's cone (w <= 0
+// would divide by zero) or map.
+bool lucent_map_position(mat4 view_proj, vec4 rect, vec4 params, vec3 p, out vec2 t,
+                         out float distance) {
+    vec4 clip = view_proj * vec4(p, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (!(clip.w > 0.0 && all(lessThanEqual(abs(ndc.xy), vec2(1.0))) && ndc.z >= 0.0 &&
+          ndc.z <= 1.0)) {
+        t = vec2(0.0);
+        distance = 0.0;
+        return false;
+    }
+    t = rect.xy + (ndc.xy * 0.5 + 0.5) * rect.z;
+    distance = lucent_face_distance(params, ndc.z);
+    return true;
+}
+
+// The 2x2 texels of the face's tile whose centres surround map position `t` (kept inside the
+// tile): the textureGather coordinate that returns them (`inv_map_size`: 1 / the map's size)
+// and their bilinear weights, in gather order (x0 y1, x1 y1, x1 y0, x0 y0).
+void lucent_map_bilinear(vec4 rect, vec2 inv_map_size, vec2 t, out vec2 corner,
+                         out vec4 weights) {
+    vec2 c = clamp(t - 0.5, rect.xy, rect.xy + rect.z - 1.001);
+    vec2 base = floor(c);
+    corner = (base + 1.0) * inv_map_size;
+    vec2 f = c - base;
+    weights = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+}
+
+// Where the light's ray to `p` (at distance `d_p` along the face's axis) meets a surface the
+// map holds at distance `d_map`: along the light's direction `to_light` on an orthographic
+// (directional) face; on a perspective one, on the ray from the light at `light_position`,
+// where axial distances scale with the distance from it (d_p > 0 there; the max guards a
+// point on the light's eye). A point nearer than the surface is its own entry point.
+vec3 lucent_map_entry_point(vec4 params, vec3 light_position, vec3 p, vec3 to_light, float d_p,
+                            float d_map) {
+    if (params.z < 0.0) {
+        return p + to_light * max(d_p - d_map, 0.0);
+    }
+    return light_position + (p - light_position) * min(d_map / max(d_p, 1e-12), 1.0);
+}
+
+// lucent's recipe for the thickness a shadow map measures, which SSS transmission diffuses
+// through: from `pos` (outward normal `normal`) moved one map texel inside (`inner`, at
+// `inner_distance` along the face's axis), the four texels of the face's map around it, the
+// distance along the axis each holds (`texel_distances`) and their bilinear weights
+// (`weights`; 0 where a texel holds the far plane: nothing there). False where the face does
+// not see the point (nothing measures the thickness). For each texel k with a weight, the
+// light enters the object at lucent_map_entry_point(params, light_position, inner, to_light,
+// inner_distance, texel_distances[k]); a host sums weights[k] * lucent_sss_transmitted(medium,
+// normal, to_light, length(entry - pos), its light's radiance and falloff at the entry), as
+// lucent does. The entries are made one at a time in that loop: returning all four (twelve
+// values held per pixel where the distances are four) made examples/host_engine.rs's whole
+// lighting pass 1.25x on llvmpipe.
+bool lucent_shadow_texels(sampler2D map, mat4 view_proj, vec4 rect, vec4 params, vec3 pos,
+                          vec3 normal, out vec3 inner, out float inner_distance,
+                          out vec4 texel_distances, out vec4 weights) {
+    inner = pos - normal * lucent_map_texel_size(view_proj, params, pos);
+    texel_distances = vec4(0.0);
+    weights = vec4(0.0);
+    vec2 t;
+    if (!lucent_map_position(view_proj, rect, params, inner, t, inner_distance)) {
+        return false;
+    }
+    vec2 corner;
+    lucent_map_bilinear(rect, 1.0 / vec2(textureSize(map, 0)), t, corner, weights);
+    vec4 d = textureGather(map, corner, 0);
+    // A reversed-Z map stores 1 - d (the face's view_proj is standard Z).
+    d = mod(rect.w, 2.0) > 0.5 ? 1.0 - d : d;
+    // The far plane: nothing between the light and it, no entry.
+    weights *= vec4(lessThan(d, vec4(1.0)));
+    texel_distances = vec4(lucent_face_distance(params, d.x), lucent_face_distance(params, d.y),
+                           lucent_face_distance(params, d.z), lucent_face_distance(params, d.w));
+    return true;
 }
 
 #endif

@@ -8,7 +8,8 @@
 //! |---|---|---|
 //! | `vec3 lucent_sh_ambient(vec4 sh[9], vec3 n)` | [`super::EnvironmentEffect`] | `sh`: [`crate::scene::Environment::coefficients`]; times the albedo where the host's diffuse has it |
 //! | `vec3 lucent_translucency(albedo, thickness, material, to_eye, v_dot_n, to_light, radiance, attenuation, translucency_scale)` | [`super::TranslucencyEffect`] | `material`: [`super::TranslucentMaterial::row`]; `translucency_scale`: [`super::Light::translucency_scale`]; per light, added to the diffuse |
-//! | `vec3 lucent_sss_transmitted(vec4 medium[4], normal, to_light, thickness, light_at_entry)` (and `lucent_sss_transmittance(medium, thickness)` under it) | [`super::TransmissionEffect`] | `medium`: [`super::TransmissionMaterial::rows`] in the host's unit; `thickness` and `light_at_entry` from the host's own lookup of its shadow map (lucent's recipe: docs/embedding.md); per light and map texel, weighted bilinearly, times albedo / pi |
+//! | `vec3 lucent_sss_transmitted(vec4 medium[4], normal, to_light, thickness, light_at_entry)` (and `lucent_sss_transmittance(medium, thickness)` under it) | [`super::TransmissionEffect`] | `medium`: [`super::TransmissionMaterial::rows`] in the host's unit; per light and map texel, weighted bilinearly, times albedo / pi |
+//! | `bool lucent_shadow_texels(map, view_proj, rect, params, pos, normal, out inner, out inner_distance, out texel_distances, out weights)`, `vec3 lucent_map_entry_point(params, light_position, inner, to_light, inner_distance, texel_distance)` | the thickness [`super::TransmissionEffect`] measures | the host's shadow map (a `sampler2D`) and each face's rows, [`super::ShadowFace::terms_rows`]: the texels around the point and where the light enters through each (docs/embedding.md) |
 //!
 //! The text is self-contained (no bindings, no includes; every name starts with `lucent_`),
 //! GLSL 450. lucent's own shaders include the same file (`glsl/embed/lucent_terms.glsl`), so
@@ -20,6 +21,7 @@
 //! let source = format!("#version 450\n{}\n{}", lucent::embed::glsl::TERMS, "void main() {}");
 //! assert!(source.contains("vec3 lucent_translucency("));
 //! assert!(source.contains("vec3 lucent_sss_transmitted("));
+//! assert!(source.contains("bool lucent_shadow_texels("));
 //! ```
 
 /// lucent's lighting terms as GLSL functions (see the module docs).

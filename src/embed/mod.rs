@@ -238,7 +238,8 @@ pub use glam;
 /// [`SssFrame::regions`] per material ([`SssRegion`]): each blur chain runs on its own
 /// materials' regions; [`SssMaterial::relights_specular`]. 9: SSS transmission in
 /// [`glsl::TERMS`] (`lucent_sss_transmittance`, `lucent_sss_transmitted`) with
-/// [`TransmissionMaterial::rows`]; [`GBufferDesc::metres_per_unit`] at most
+/// [`TransmissionMaterial::rows`] and the shadow-map lookup (`lucent_shadow_texels`,
+/// [`ShadowFace::terms_rows`]); [`GBufferDesc::metres_per_unit`] at most
 /// [`MAX_METRES_PER_UNIT`]; host images that are one mip level or layer of a larger image
 /// ([`HostImage::at`]).
 pub const API_VERSION: u32 = 9;

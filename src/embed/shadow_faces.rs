@@ -54,6 +54,23 @@ impl ShadowFace {
         self.layer = layer;
         self
     }
+
+    /// The face as a host's own lighting pass reads it with [`super::glsl::TERMS`]'
+    /// `lucent_shadow_texels(map, view_proj, rect, params, ...)` (the rows lucent's own
+    /// shadow table holds): rows 0-3 the columns of `view_proj` (world to the face's clip
+    /// space, standard Z even for a reversed-Z face), row 4 `rect` (its corner and edge in
+    /// the map of `map_extent`; w: 1 for reversed Z, plus 2 x its layer), row 5 `params` (a
+    /// map texel's world size, near and far). A face outside the map or not square, or whose
+    /// projection is not one lucent reads, is refused ([`HostError::Description`], field
+    /// `shadow face`).
+    pub fn terms_rows(&self, map_extent: vk::Extent2D) -> Result<[[f32; 4]; 6]> {
+        let row = face_row(self, map_extent).map_err(|problem| HostError::Description {
+            field: "shadow face".into(),
+            problem,
+        })?;
+        let [c0, c1, c2, c3] = row.view_proj;
+        Ok([c0, c1, c2, c3, row.rect, row.params])
+    }
 }
 
 /// A face of lucent's own light-space atlas as a host describes it
@@ -393,6 +410,16 @@ mod tests {
         assert_eq!(table.lights[1][0], -1);
         let row = table.faces[0];
         assert_eq!(row.rect, [256.0, 0.0, 256.0, 0.0]);
+        // A host's lighting pass reads the same row (embed::glsl::TERMS).
+        let [c0, c1, c2, c3, rect_row, params] = face.terms_rows(extent).unwrap();
+        assert_eq!([c0, c1, c2, c3], row.view_proj);
+        assert_eq!((rect_row, params), (row.rect, row.params));
+        let outside = ShadowFace::new(0, view, projection, rect(300, 0, 256));
+        let message = outside.terms_rows(extent).unwrap_err().to_string();
+        assert!(
+            message.contains("shadow face") && message.contains("512x256"),
+            "{message}"
+        );
         assert!((row.params[2] - 0.1).abs() < 1e-4 && (row.params[3] - 20.0).abs() < 0.05);
         // x = 2 tan(fov / 2) / edge.
         assert!(

@@ -1981,7 +1981,7 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
     let mut faces = vec![ShadowFace::new(
         0,
         Mat4::look_to_rh(centre + sun, -sun, Vec3::Y),
-        Mat4::orthographic_rh(-0.35, 0.35, -0.35, 0.35, SUN_NEAR_FAR.0, SUN_NEAR_FAR.1),
+        Mat4::orthographic_rh(-0.35, 0.35, -0.35, 0.35, 0.05, 2.0),
         square(0, 0, SUN_FACE_EDGE),
     )];
     let axes = [
@@ -1997,22 +1997,12 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
         faces.push(ShadowFace::new(
             1,
             Mat4::look_to_rh(Vec3::from(BACK_LIGHT), axis, up),
-            Mat4::perspective_rh(
-                std::f32::consts::FRAC_PI_2,
-                1.0,
-                POINT_FACE_NEAR,
-                BACK_LIGHT_RANGE,
-            ),
+            Mat4::perspective_rh(std::f32::consts::FRAC_PI_2, 1.0, 0.005, BACK_LIGHT_RANGE),
             tile(k as u32),
         ));
     }
     faces
 }
-
-/// The sun's shadow face's near and far planes (orthographic, metres from its eye).
-const SUN_NEAR_FAR: (f32, f32) = (0.05, 2.0);
-/// The back light's faces' near plane (their far plane is its range).
-const POINT_FACE_NEAR: f32 = 0.005;
 
 /// The sun's direction (towards it).
 fn sun_direction() -> Vec3 {

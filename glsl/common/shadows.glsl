@@ -56,7 +56,7 @@ layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_i
 // define LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
 vec4 shadow_stored_depth(int face, vec4 d) {
 #ifdef LUCENT_SHADOW_REVERSIBLE
-    return mod(shadows.faces[face].rect.w, 2.0) > 0.5 ? 1.0 - d : d;
+    return lucent_stored_depth(shadows.faces[face].rect, d);
 #else
     return d;
 #endif

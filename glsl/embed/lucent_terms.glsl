@@ -144,7 +144,7 @@ vec3 lucent_multipole_slab_sum(vec3 sigma_tr, vec3 z_r, vec3 z_v, float a) {
 // src/scene/transmittance.rs `transmittance_over_albedo`.
 vec3 lucent_sss_transmittance(vec4 medium[4], float thickness) {
     vec3 most = vec3(medium[1].w, medium[2].w, medium[3].w);
-    // Millimetres; held below 1e18 so a^2 stays finite in f32 (and NaN becomes 0).
+    // Millimetres; held below 1e18 so a^2 stays finite in f32 (the map's far plane is nearer).
     float a_mm = clamp(thickness * medium[0].w, 0.0, 1e18);
     vec3 through = max(lucent_dipole_beyond_sum(medium[0].rgb, medium[1].rgb, medium[2].rgb, a_mm),
                        lucent_multipole_slab_sum(medium[0].rgb, medium[1].rgb, medium[2].rgb, a_mm));
@@ -179,6 +179,13 @@ vec3 lucent_sss_transmitted(vec4 medium[4], vec3 normal, vec3 to_light, float th
 // z its edge (texels), w 1 when the map stores reversed Z (plus 2 x its layer in an array
 // map); `params` x * clip.w + y a map texel's world size at a point, z the near plane
 // (negative: orthographic), w the far plane.
+
+// The standard-Z depths of texels `d` stored in the face's map: a reversed-Z map (rect.w odd)
+// stores 1 - d, exactly the standard depth of the same planes (its face's view_proj is the
+// projection with z flipped).
+vec4 lucent_stored_depth(vec4 rect, vec4 d) {
+    return mod(rect.w, 2.0) > 0.5 ? 1.0 - d : d;
+}
 
 // Distance from the face's eye along its axis (world units) of a standard-Z depth `d`.
 float lucent_face_distance(vec4 params, float d) {
@@ -263,9 +270,7 @@ bool lucent_shadow_texels(sampler2D map, mat4 view_proj, vec4 rect, vec4 params,
     }
     vec2 corner;
     lucent_map_bilinear(rect, 1.0 / vec2(textureSize(map, 0)), t, corner, weights);
-    vec4 d = textureGather(map, corner, 0);
-    // A reversed-Z map stores 1 - d (the face's view_proj is standard Z).
-    d = mod(rect.w, 2.0) > 0.5 ? 1.0 - d : d;
+    vec4 d = lucent_stored_depth(rect, textureGather(map, corner, 0));
     // The far plane: nothing between the light and it, no entry.
     weights *= vec4(lessThan(d, vec4(1.0)));
     texel_distances = vec4(lucent_face_distance(params, d.x), lucent_face_distance(params, d.y),

@@ -84,12 +84,17 @@ impl TransmissionMaterial {
     /// finite, above 0 and at most [`super::gbuffer::MAX_METRES_PER_UNIT`] is refused
     /// ([`HostError::Description`], field `metres_per_unit`).
     pub fn rows(&self, metres_per_unit: f32) -> Result<[[f32; 4]; 4]> {
+        Ok(self.transmission(metres_per_unit)?.rows())
+    }
+
+    /// The medium's transmission with its lengths in the host's world at `metres_per_unit`
+    /// (checked as [`Self::rows`] says).
+    fn transmission(&self, metres_per_unit: f32) -> Result<SssTransmission> {
         check_metres_per_unit(metres_per_unit)?;
         Ok(SssTransmission {
             mm_per_unit: 1000.0 * f64::from(metres_per_unit),
             ..SssTransmission::of(&self.medium)
-        }
-        .rows())
+        })
     }
 }
 
@@ -283,18 +288,14 @@ impl TransmissionEffect {
         let mut id_map = ids.decode(Vec::new())?;
         let mut profile_of = vec![0u8; 256];
         let mut table: ProfileTableGpu = bytemuck::Zeroable::zeroed();
-        let mm_per_unit = 1000.0 * f64::from(gbuffer.metres_per_unit);
         for (index, material) in desc.materials.iter().enumerate() {
             let id = usize::from(material.id);
             check_material_id(index, material.id, profile_of[id] != 0, id_map.mask)?;
             let profile = index + 1;
             profile_of[id] = profile as u8;
-            let transmission = SssTransmission {
-                mm_per_unit,
-                ..SssTransmission::of(&material.medium)
-            };
+            let transmission = material.transmission(gbuffer.metres_per_unit)?;
             let rows = &mut table.medium[profile * MEDIUM_ROWS..];
-            rows[..4].copy_from_slice(&material.rows(gbuffer.metres_per_unit)?);
+            rows[..4].copy_from_slice(&transmission.rows());
             rows[4..MEDIUM_ROWS].copy_from_slice(&transmission.reflectance_rows());
         }
         id_map.profile_of = profile_of;

@@ -58,6 +58,15 @@ pub enum LucentError {
         MANIFEST_COMMAND
     )]
     ShaderNotShipped { permutation: String },
+    /// A shader's descriptor bindings disagree with what its pass declares
+    /// ([`crate::backend::bindings`]): a resource the pass binds under no name or number, or
+    /// of another kind.
+    #[error("pipeline '{pipeline}': {shader}: {message}")]
+    ShaderBindings {
+        pipeline: String,
+        shader: String,
+        message: String,
+    },
     /// The render graph is malformed (e.g. a pass reads a resource nothing wrote).
     #[error("render graph: {0}")]
     Graph(String),

@@ -20,34 +20,34 @@
 #endif
 
 #if LUCENT_COPY_INPUTS > 0
-layout(set = 0, binding = 0) uniform sampler2D in0;
+layout(set = 0) uniform sampler2D in0;
 #endif
 #if LUCENT_COPY_INPUTS > 1
-layout(set = 0, binding = 1) uniform sampler2D in1;
+layout(set = 0) uniform sampler2D in1;
 #endif
 #if LUCENT_COPY_INPUTS > 2
-layout(set = 0, binding = 2) uniform sampler2D in2;
+layout(set = 0) uniform sampler2D in2;
 #endif
 #if LUCENT_COPY_INPUTS > 3
-layout(set = 0, binding = 3) uniform sampler2D in3;
+layout(set = 0) uniform sampler2D in3;
 #endif
 #if LUCENT_COPY_INPUTS > 4
-layout(set = 0, binding = 4) uniform sampler2D in4;
+layout(set = 0) uniform sampler2D in4;
 #endif
 #if LUCENT_COPY_INPUTS > 5
-layout(set = 0, binding = 5) uniform sampler2D in5;
+layout(set = 0) uniform sampler2D in5;
 #endif
 #if LUCENT_COPY_INPUTS > 6
-layout(set = 0, binding = 6) uniform sampler2D in6;
+layout(set = 0) uniform sampler2D in6;
 #endif
 #if LUCENT_COPY_INPUTS > 7
-layout(set = 0, binding = 7) uniform sampler2D in7;
+layout(set = 0) uniform sampler2D in7;
 #endif
 #if LUCENT_COPY_INPUTS > 8
-layout(set = 0, binding = 8) uniform sampler2D in8;
+layout(set = 0) uniform sampler2D in8;
 #endif
 #if LUCENT_COPY_INPUTS > 9
-layout(set = 0, binding = 9) uniform sampler2D in9;
+layout(set = 0) uniform sampler2D in9;
 #endif
 #if LUCENT_COPY_OUTPUTS > 0
 layout(location = 0) out vec4 out0;

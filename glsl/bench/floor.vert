@@ -21,14 +21,14 @@ struct ShadowFace {
     vec4 rect;
     vec4 params;
 };
-layout(std140, set = 0, binding = 0) uniform Shadows {
+layout(std140, set = 0) uniform Shadows {
     vec4 atlas;
     ivec4 lights[MAX_SHADOW_LIGHTS];
     ShadowFace faces[MAX_SHADOW_FACES];
 } shadows;
 #else
 // The first member of glsl/common/scene.glsl's frame uniforms.
-layout(std140, set = 0, binding = 0) uniform Frame {
+layout(std140, set = 0) uniform Frame {
     mat4 view_proj;
 } frame;
 #endif

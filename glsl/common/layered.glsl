@@ -48,7 +48,7 @@ struct LayeredMaterial {
     vec4 total;                                  // its total diffuse reflectance
 };
 
-layout(std140, set = 0, binding = 1) uniform Layered {
+layout(std140, set = 0) uniform Layered {
     ivec4 knobs;  // x march steps, y pixel lights, z phase (0 HG, 1 Schlick), w downscale
     LayeredMaterial materials[MAX_LAYERED_MATERIALS];
 #ifdef LUCENT_HOST_GBUFFER
@@ -59,12 +59,12 @@ layout(std140, set = 0, binding = 1) uniform Layered {
 #endif
 } layered;
 
-layout(set = 0, binding = 2) uniform sampler2D gbuffer_depth;
-layout(set = 0, binding = 3) uniform sampler2D gbuffer_normal;
+layout(set = 0) uniform sampler2D gbuffer_depth;
+layout(set = 0) uniform sampler2D gbuffer_normal;
 #if defined(LUCENT_HOST_GBUFFER) && defined(LUCENT_HOST_IDS_UINT)
-layout(set = 0, binding = 4) uniform usampler2D gbuffer_layered;
+layout(set = 0) uniform usampler2D gbuffer_layered;
 #else
-layout(set = 0, binding = 4) uniform sampler2D gbuffer_layered;
+layout(set = 0) uniform sampler2D gbuffer_layered;
 #endif
 
 // The layered material ID at a full-resolution pixel (0: not layered).

@@ -11,12 +11,12 @@
 // texels of an axis hold the same rotation, 1 - f + f = 1). It keeps only texels of the
 // pixel's material and at its depth (a texel holds its 2x2 block's top-left pixel), so no
 // term leaks across silhouettes or between
-// objects. Include after layered.glsl with LUCENT_HALF_TERM_BINDING defined.
+// objects. Include after layered.glsl with LUCENT_HALF_TERM defined.
 #ifndef LUCENT_LAYERED_UPSAMPLE_GLSL
 #define LUCENT_LAYERED_UPSAMPLE_GLSL
 
 // rgb: the weighted multiple-scattering term; alpha: the texel's layered material ID.
-layout(set = 0, binding = LUCENT_HALF_TERM_BINDING) uniform sampler2D half_term;
+layout(set = 0) uniform sampler2D half_term;
 
 #ifdef LUCENT_FULL_RES_TERM
 // The full-resolution term at pixel `px` of material `id`: the mean over its 3x3 neighbours of

@@ -17,7 +17,7 @@ struct Light {
     vec4 params;          // x: cos(inner half-angle); y: translucency scale (GDC 2011 fLTScale)
 };
 
-layout(std140, set = 0, binding = 0) uniform Frame {
+layout(std140, set = 0) uniform Frame {
     mat4 view_proj;
     mat4 inv_view_proj;
     mat4 view;            // world to view space (right-handed, the camera looks down -z)

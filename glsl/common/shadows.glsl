@@ -1,10 +1,11 @@
 // Light-space maps (src/features/shadows.rs): the per-frame shadow table and, in lighting
 // passes, the lookup. The table's layout must match `ShadowUniforms` (std140).
 //
-// The light-space maps pass includes this file with no define: the table is its binding 0 and
-// its push constants name the object and face. Lighting passes define LUCENT_SHADOWS and
-// LUCENT_SHADOW_BINDING (the table's binding; the depth atlas follows, then with
-// LUCENT_SHADOW_IDS the ID atlas) and include scene.glsl first.
+// The light-space maps pass includes this file with no define: it reads the table, and its
+// push constants name the object and face. Lighting passes define LUCENT_SHADOWS (they read
+// the depth atlas too, and with LUCENT_SHADOW_IDS the ID atlas) and include scene.glsl first.
+// Every resource here is bound by its name (`Shadows`, `shadow_depth`, `shadow_ids`), at the
+// number the pass declares (src/backend/bindings.rs).
 #ifndef LUCENT_SHADOWS_GLSL
 #define LUCENT_SHADOWS_GLSL
 
@@ -22,11 +23,7 @@ struct ShadowFace {
     vec4 params;     // a map texel's world size at a point: x * clip.w + y
 };
 
-#ifndef LUCENT_SHADOW_BINDING
-#define LUCENT_SHADOW_BINDING 0
-#endif
-
-layout(std140, set = 0, binding = LUCENT_SHADOW_BINDING) uniform Shadows {
+layout(std140, set = 0) uniform Shadows {
     vec4 atlas;                          // xy: size in texels; zw: 1 / size
     ivec4 lights[MAX_SHADOW_LIGHTS];     // x: first face (-1: no map); y: face count (1 or 6)
     ShadowFace faces[MAX_SHADOW_FACES];
@@ -41,12 +38,12 @@ layout(push_constant) uniform ShadowObject {
 #else
 #ifdef LUCENT_SHADOW_ARRAY
 // A host's shadow map as an array of layers (cascades, a cube's faces), each face in its own.
-layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2DArray shadow_depth;
+layout(set = 0) uniform sampler2DArray shadow_depth;
 #else
-layout(set = 0, binding = LUCENT_SHADOW_BINDING + 1) uniform sampler2D shadow_depth;
+layout(set = 0) uniform sampler2D shadow_depth;
 #endif
 #ifdef LUCENT_SHADOW_IDS
-layout(set = 0, binding = LUCENT_SHADOW_BINDING + 2) uniform usampler2D shadow_ids;
+layout(set = 0) uniform usampler2D shadow_ids;
 #endif
 
 // The standard-Z depths of stored texels `d` of face `face`'s map. lucent's own maps store

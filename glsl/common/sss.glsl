@@ -16,11 +16,7 @@ struct SssStep {
     vec4 weight;  // rgb: the completed Gaussian's weight in the sum; a: their mean
 };
 
-// The lighting pass reads the table at a binding of its own (LUCENT_SSS_PROFILES_BINDING).
-#ifndef LUCENT_SSS_PROFILES_BINDING
-#define LUCENT_SSS_PROFILES_BINDING 1
-#endif
-layout(std140, set = 0, binding = LUCENT_SSS_PROFILES_BINDING) uniform SssProfiles {
+layout(std140, set = 0) uniform SssProfiles {
     vec4 info[MAX_SSS_PROFILES];  // x: chain index; y: step count; z: Gaussian count;
                                   // w: texturing (sss_albedo_before)
     SssStep steps[MAX_SSS_PROFILES * MAX_SSS_STEPS];
@@ -164,7 +160,7 @@ vec3 sss_profile_at(int id, float d2) {
 // The two-pass blurs' kernels (src/features/sss/kernel.rs `KernelTableGpu`), binding 2 of
 // their passes: per profile x the sample count, y one over the kernel's reach (world units),
 // z that reach, w one over the falloff table's reach.
-layout(std140, set = 0, binding = 2) uniform SssKernels {
+layout(std140, set = 0) uniform SssKernels {
     vec4 info[MAX_SSS_PROFILES];
     vec4 taps[MAX_SSS_PROFILES * MAX_KERNEL_SAMPLES];  // rgb weight, a offset (world units)
     vec4 falloff[MAX_SSS_PROFILES * FALLOFF_ENTRIES];  // rgb 1-D profile, a its distance

@@ -19,11 +19,7 @@
 
 // x: power (iLTPower), y: distortion (fLTDistortion), z: ambient (fLTAmbient), w: pow mode
 // (+ TRANSLUCENCY_SHADOWED). Row 0 is unused: material ID 0 means "not translucent".
-// Binding 5 of the lighting pass; an effect on a host's G-buffer numbers it otherwise.
-#ifndef LUCENT_TRANSLUCENCY_TABLE_BINDING
-#define LUCENT_TRANSLUCENCY_TABLE_BINDING 5
-#endif
-layout(std140, set = 0, binding = LUCENT_TRANSLUCENCY_TABLE_BINDING) uniform TranslucencyMaterials {
+layout(std140, set = 0) uniform TranslucencyMaterials {
     vec4 rows[256];
 } translucency_materials;
 

@@ -21,14 +21,14 @@
 // The GDC 2011 translucency term alone: `source` is GB0, then GB1, GB2 and depth; binding 5 is
 // the material table (glsl/common/translucency.glsl).
 #include "../common/translucency.glsl"
-layout(set = 0, binding = 2) uniform sampler2D gb1_tex;
-layout(set = 0, binding = 3) uniform sampler2D gb2_tex;
-layout(set = 0, binding = 4) uniform sampler2D depth_tex;
+layout(set = 0) uniform sampler2D gb1_tex;
+layout(set = 0) uniform sampler2D gb2_tex;
+layout(set = 0) uniform sampler2D depth_tex;
 #endif
 
-layout(set = 0, binding = 1) uniform sampler2D source;
+layout(set = 0) uniform sampler2D source;
 #ifdef LUCENT_VIEW_SECOND
-layout(set = 0, binding = 2) uniform sampler2D second;
+layout(set = 0) uniform sampler2D second;
 #endif
 
 layout(location = 0) in vec2 in_uv;

@@ -4,22 +4,22 @@
 // permutation: LUCENT_SSS_PROFILE
 // permutation: LUCENT_LAYERED
 // permutation: LUCENT_SSS_PROFILE LUCENT_LAYERED LUCENT_SSS_LOCATION=2 LUCENT_LAYERED_LOCATION=3
-// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_LOCATION=3 LUCENT_DEPTH_MAP_BINDING=1
-// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_LOCATION=3 LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=1 LUCENT_DEPTH_MAP_BINDING=2
+// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_LOCATION=3
+// permutation: LUCENT_LAYERED LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_LOCATION=3 LUCENT_ALBEDO_MAP
 // permutation: LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_NORMAL_MAP
 // permutation: LUCENT_SSS_PROFILE LUCENT_LEAN
 // permutation: LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP
-// permutation: LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=1
-// permutation: LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=2
+// permutation: LUCENT_ALBEDO_MAP
+// permutation: LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP
 // permutation: LUCENT_TRANSLUCENCY LUCENT_SSS_PROFILE LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3
-// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_ALBEDO_BINDING=3 LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3 LUCENT_LEAN_LOCATION=4
+// permutation: LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_SSS_PROFILE LUCENT_LEAN LUCENT_NORMAL_MAP LUCENT_ALBEDO_MAP LUCENT_GB2_LOCATION=2 LUCENT_SSS_LOCATION=3 LUCENT_LEAN_LOCATION=4
 // The G-buffer pass (src/features/deferred.rs): GB0 and GB1 at locations 0 and 1, then the
 // targets the frame's materials need at the locations the defines give (GB2 with
 // translucency, the SSS profile ID with SSS, the LEAN target with LCB or LBB blurs, the
-// layered ID and TexDep texels with layered media). Set 0: binding 0 the frame uniforms, then
-// the material textures the frame has (normal or LEAN map 1, LEAN map 2, albedo map at
-// LUCENT_ALBEDO_BINDING, the layer depth textures from LUCENT_DEPTH_MAP_BINDING).
+// layered ID and TexDep texels with layered media). Set 0: the frame uniforms, then the
+// material textures the frame has (normal or LEAN map 1, LEAN map 2, albedo map, layer depth
+// textures), each bound by its name (src/features/gbuffer.rs `bindings`).
 #ifndef LUCENT_GB2_LOCATION
 #define LUCENT_GB2_LOCATION 2
 #endif
@@ -32,14 +32,8 @@
 #ifndef LUCENT_LAYERED_LOCATION
 #define LUCENT_LAYERED_LOCATION 2
 #endif
-#ifndef LUCENT_ALBEDO_BINDING
-#define LUCENT_ALBEDO_BINDING 1
-#endif
 #ifndef LUCENT_LAYER_DEPTH_LOCATION
 #define LUCENT_LAYER_DEPTH_LOCATION 3
-#endif
-#ifndef LUCENT_DEPTH_MAP_BINDING
-#define LUCENT_DEPTH_MAP_BINDING 1
 #endif
 #include "../common/gbuffer.glsl"
 #include "object.glsl"
@@ -57,11 +51,11 @@ layout(location = 3) in vec4 in_tangent;
 #endif
 #ifdef LUCENT_ALBEDO_MAP
 // Albedo texture (decoded from sRGB to linear at load), multiplied with the material's albedo.
-layout(set = 0, binding = LUCENT_ALBEDO_BINDING) uniform sampler2D albedo_map;
+layout(set = 0) uniform sampler2D albedo_map;
 #endif
 #ifdef LUCENT_NORMAL_MAP
 // Tangent-space normal map, stored as n * 0.5 + 0.5 (binding 0 is the frame uniforms).
-layout(set = 0, binding = 1) uniform sampler2D normal_map;
+layout(set = 0) uniform sampler2D normal_map;
 
 // The shading normal: the map's normal in the interpolated tangent frame. A degenerate frame
 // (zero tangent, or one parallel to the normal) falls back to the vertex normal.
@@ -80,7 +74,7 @@ vec3 mapped_normal(vec3 n) {
 // In LEAN frames binding 1 holds LEAN map 1 (slope mean xy, moments xx yy) instead of the
 // normal map, and binding 2 LEAN map 2 (moment xy), mip-filtered like any texture: filtering
 // moments is what LEAN mapping is for.
-layout(set = 0, binding = 2) uniform sampler2D lean2_map;
+layout(set = 0) uniform sampler2D lean2_map;
 #endif
 #endif
 #ifdef LUCENT_TRANSLUCENCY
@@ -105,9 +99,9 @@ layout(location = LUCENT_LAYERED_LOCATION) out vec4 out_layered;
 #include "../common/layer_depths.glsl"
 // Li et al.'s TexDep: the draw's depth textures (linear data; a draw without them binds a
 // zero texture) and their texels at this pixel, packed for single scattering.
-layout(set = 0, binding = LUCENT_DEPTH_MAP_BINDING) uniform sampler2D depth_map0;
+layout(set = 0) uniform sampler2D depth_map0;
 #if LUCENT_LAYER_DEPTHS > 1
-layout(set = 0, binding = LUCENT_DEPTH_MAP_BINDING + 1) uniform sampler2D depth_map1;
+layout(set = 0) uniform sampler2D depth_map1;
 #endif
 layout(location = LUCENT_LAYER_DEPTH_LOCATION) out uvec4 out_layer_depths;
 #endif

@@ -13,7 +13,7 @@
 #include "../common/host_normals.glsl"
 
 // The host's encodings (src/embed/environment.rs `HostEnvironmentGpu`).
-layout(std140, set = 0, binding = 1) uniform HostEnvironment {
+layout(std140, set = 0) uniform HostEnvironment {
     uvec4 normals;       // host_normals.glsl's encoding
     uvec4 depth;         // x: 1 = linear view depth (else device depth); y: 1 = the
                          // background's device depth is 1 (standard Z), 0: it is 0 (reversed)
@@ -22,10 +22,10 @@ layout(std140, set = 0, binding = 1) uniform HostEnvironment {
     mat4 view_to_world;  // the inverse of the frame's view matrix
 } host;
 
-layout(set = 0, binding = 2) uniform sampler2D depth_image;
-layout(set = 0, binding = 3) uniform sampler2D normal_image;
+layout(set = 0) uniform sampler2D depth_image;
+layout(set = 0) uniform sampler2D normal_image;
 #ifdef LUCENT_HOST_ALBEDO
-layout(set = 0, binding = 4) uniform sampler2D albedo_image;
+layout(set = 0) uniform sampler2D albedo_image;
 #endif
 
 layout(location = 0) in vec2 in_uv;

@@ -13,14 +13,13 @@
 #include "../common/lighting.glsl"
 // Materials choose their pow form per row (a host's table may hold both).
 #define LUCENT_POW_MODES 3
-#define LUCENT_TRANSLUCENCY_TABLE_BINDING 1
 #include "../common/translucency.glsl"
 #include "../common/host_ids.glsl"
 #include "../common/host_normals.glsl"
 #include "../common/host_depth.glsl"
 
 // The host's encodings (src/embed/translucency.rs `HostTranslucencyGpu`).
-layout(std140, set = 0, binding = 2) uniform HostTranslucency {
+layout(std140, set = 0) uniform HostTranslucency {
     uvec4 ids;         // host_ids.glsl's decode
     uvec4 normals;     // x: octahedral; y: view space; z: UNORM channels mapped from [0, 1]
     uvec4 thickness;   // x: the channel (0-3), 4 = rgb
@@ -29,14 +28,14 @@ layout(std140, set = 0, binding = 2) uniform HostTranslucency {
     mat4 view_to_world;    // the inverse of the frame's view matrix
 } host;
 
-layout(set = 0, binding = 3) uniform sampler2D depth_image;
-layout(set = 0, binding = 4) uniform sampler2D normal_image;
-layout(set = 0, binding = 5) uniform sampler2D albedo_image;
-layout(set = 0, binding = 6) uniform sampler2D thickness_image;
+layout(set = 0) uniform sampler2D depth_image;
+layout(set = 0) uniform sampler2D normal_image;
+layout(set = 0) uniform sampler2D albedo_image;
+layout(set = 0) uniform sampler2D thickness_image;
 #ifdef LUCENT_HOST_IDS_UINT
-layout(set = 0, binding = 7) uniform usampler2D id_image;
+layout(set = 0) uniform usampler2D id_image;
 #else
-layout(set = 0, binding = 7) uniform sampler2D id_image;
+layout(set = 0) uniform sampler2D id_image;
 #endif
 
 layout(location = 0) in vec2 in_uv;

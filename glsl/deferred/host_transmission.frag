@@ -14,11 +14,9 @@
 #include "../common/scene.glsl"
 #include "../common/gbuffer.glsl"
 #include "../common/lighting.glsl"
-// The media (lucent's SSS profile table, only its medium rows and host ID map filled), the
-// decode, then the shadow table and map (src/embed/transmission.rs `declare`).
-#define LUCENT_SSS_PROFILES_BINDING 1
+// The media (lucent's SSS profile table, only its medium rows and host ID map filled) and
+// the shadow table and map (src/embed/transmission.rs `declare`).
 #define LUCENT_SHADOWS 1
-#define LUCENT_SHADOW_BINDING 3
 // The host's shadow map may store reversed Z (glsl/common/shadows.glsl shadow_stored_depth).
 #define LUCENT_SHADOW_REVERSIBLE 1
 #include "../common/sss_transmission.glsl"
@@ -27,21 +25,21 @@
 #include "../common/host_depth.glsl"
 
 // The host's encodings (src/embed/transmission.rs `HostTransmissionGpu`).
-layout(std140, set = 0, binding = 2) uniform HostTransmission {
+layout(std140, set = 0) uniform HostTransmission {
     uvec4 normals;         // host_normals.glsl's encoding
     uvec4 depth;           // x: 1 = linear view depth (else device depth)
     mat4 view_to_world;    // the inverse of the frame's view matrix
 } host;
 
-layout(set = 0, binding = 5) uniform sampler2D depth_image;
-layout(set = 0, binding = 6) uniform sampler2D normal_image;
+layout(set = 0) uniform sampler2D depth_image;
+layout(set = 0) uniform sampler2D normal_image;
 #ifdef LUCENT_HOST_IDS_UINT
-layout(set = 0, binding = 7) uniform usampler2D id_image;
+layout(set = 0) uniform usampler2D id_image;
 #else
-layout(set = 0, binding = 7) uniform sampler2D id_image;
+layout(set = 0) uniform sampler2D id_image;
 #endif
 #ifdef LUCENT_HOST_ALBEDO
-layout(set = 0, binding = 8) uniform sampler2D albedo_image;
+layout(set = 0) uniform sampler2D albedo_image;
 #endif
 
 layout(location = 0) in vec2 in_uv;

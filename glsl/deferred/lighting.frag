@@ -9,16 +9,16 @@
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_FAULT_INJECTION
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_SSS_TEXTURING=4
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=6 LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_SSS_TEXTURING
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_DEPTH_IN_ALPHA LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
 // permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_TRANSLUCENCY LUCENT_COLORED_THICKNESS LUCENT_POW_MODES=3
-// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
-// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_SHADOWS LUCENT_SHADOW_BINDING=4
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6 LUCENT_SSS_MEDIUM
-// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING=4 LUCENT_SSS_MEDIUM
+// permutation: LUCENT_SHADOWS
+// permutation: LUCENT_SHADOWS LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=1
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SHADOWS LUCENT_SHADOW_IDS LUCENT_TRANSLUCENCY LUCENT_POW_MODES=3
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_LEAN LUCENT_SHADOWS
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING LUCENT_SHADOWS LUCENT_SSS_MEDIUM
+// permutation: LUCENT_SPLIT_SPECULAR LUCENT_SSS_TEXTURING LUCENT_SSS_MEDIUM
 // Deferred lighting, merged with the G-buffer pass as its second subpass: reads the G-buffer
 // only at this pixel through input attachments. With LUCENT_TRANSLUCENCY it is the variant
 // drawn over the screen tiles translucent objects may cover (src/gpu_scene/tiles.rs):
@@ -37,9 +37,8 @@
 #endif
 #ifdef LUCENT_SSS_TEXTURING
 // SSS materials whose albedo is applied after the blur (`Texturing`): the pixel's profile ID
-// (binding LUCENT_SSS_TEXTURING, an input attachment after GB2's) and the profile table
-// (the next binding) say how much of the albedo goes into the diffuse light.
-#define LUCENT_SSS_PROFILES_BINDING (LUCENT_SSS_TEXTURING + 1)
+// (an input attachment after GB2's) and the profile table say how much of the albedo goes
+// into the diffuse light.
 #include "../common/sss.glsl"
 #endif
 #ifdef LUCENT_SSS_MEDIUM
@@ -87,18 +86,18 @@ vec2 translucent_visibility(int i, vec3 pos, vec3 normal, vec3 to_light, float a
 }
 #endif
 
-layout(input_attachment_index = 0, set = 0, binding = 1) uniform subpassInput gb0;
-layout(input_attachment_index = 1, set = 0, binding = 2) uniform subpassInput gb1;
-layout(input_attachment_index = 2, set = 0, binding = 3) uniform subpassInput depth;
+layout(input_attachment_index = 0, set = 0) uniform subpassInput gb0;
+layout(input_attachment_index = 1, set = 0) uniform subpassInput gb1;
+layout(input_attachment_index = 2, set = 0) uniform subpassInput depth;
 #ifdef LUCENT_TRANSLUCENCY
-layout(input_attachment_index = 3, set = 0, binding = 4) uniform subpassInput gb2;
+layout(input_attachment_index = 3, set = 0) uniform subpassInput gb2;
 #endif
 #ifdef LUCENT_SSS_TEXTURING
 #ifdef LUCENT_TRANSLUCENCY
-layout(input_attachment_index = 4, set = 0, binding = LUCENT_SSS_TEXTURING)
+layout(input_attachment_index = 4, set = 0)
     uniform subpassInput profile_ids;
 #else
-layout(input_attachment_index = 3, set = 0, binding = LUCENT_SSS_TEXTURING)
+layout(input_attachment_index = 3, set = 0)
     uniform subpassInput profile_ids;
 #endif
 #endif

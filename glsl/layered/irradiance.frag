@@ -1,6 +1,6 @@
 #version 450
-// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=5
-// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=5 LUCENT_HALF_RES
+// permutation: LUCENT_SHADOWS
+// permutation: LUCENT_SHADOWS LUCENT_HALF_RES
 // Li et al.'s diffuse irradiance image (src/features/layered.rs, `layered irradiance`): per
 // pixel of a layered object, the light transmitted into its surface (shadowed), the pixel
 // lights multiple scattering gathers. At half resolution each texel takes the top-left pixel

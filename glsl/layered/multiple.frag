@@ -14,7 +14,7 @@
 #include "../common/layered.glsl"
 #include "../common/sampling.glsl"
 
-layout(set = 0, binding = 5) uniform sampler2D irradiance_tex;
+layout(set = 0) uniform sampler2D irradiance_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;

@@ -1,45 +1,45 @@
 #version 450
-// permutation: LUCENT_ENTRY_BINDING=5 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=6
-// permutation: LUCENT_LAYER_DEPTHS=1 LUCENT_LAYER_DEPTH_BINDING=5
-// permutation: LUCENT_HALF_TERM_BINDING=5
-// permutation: LUCENT_HALF_TERM_BINDING=5 LUCENT_FULL_RES_TERM
-// permutation: LUCENT_HALF_TERM_BINDING=5 LUCENT_LAYERED_FILM
-// permutation: LUCENT_LAYER_DEPTHS=2 LUCENT_LAYER_DEPTH_BINDING=5 LUCENT_ENTRY_BINDING=6 LUCENT_ENTRY_DEPTH_BINDING=7 LUCENT_SHADOWS LUCENT_SHADOW_BINDING=8
+// permutation: LUCENT_ENTRY LUCENT_SHADOWS
+// permutation: LUCENT_LAYER_DEPTHS=1
+// permutation: LUCENT_HALF_TERM
+// permutation: LUCENT_HALF_TERM LUCENT_FULL_RES_TERM
+// permutation: LUCENT_HALF_TERM LUCENT_LAYERED_FILM
+// permutation: LUCENT_LAYER_DEPTHS=2 LUCENT_ENTRY LUCENT_ENTRY_DEPTHS LUCENT_SHADOWS
 // Li et al.'s single scattering (eqs. 4-11) and the transmitted term L_t, added into the lit
 // image (src/features/layered.rs, `single scattering`), weighted by eq. 3's λ4 and λ3.
 // Set 0 as glsl/common/layered.glsl, then (media with TexDep layers) the G-buffer's layer
 // depth texels, then (lights with maps) the entry atlas, its layer depth texels (with TexDep)
-// and the shadow bindings; the multiple-scattering term (LUCENT_HALF_TERM_BINDING), which this
+// and the shadow bindings; the multiple-scattering term (LUCENT_HALF_TERM), which this
 // pass resolves over 3x3 pixels (LUCENT_FULL_RES_TERM) or, with `--half-gather`, upsamples,
 // and adds. With LUCENT_LAYERED_FILM (a layered material has an albedo texture) the sum is
 // multiplied by the texel the G-buffer stored beside the material ID.
 #include "../common/layered.glsl"
-#ifdef LUCENT_HALF_TERM_BINDING
+#ifdef LUCENT_HALF_TERM
 #include "../common/layered_upsample.glsl"
 #endif
 
 #ifdef LUCENT_LAYER_DEPTHS
 // Per pixel: the depth-texture texels at x_o (layer_depths.glsl).
-layout(set = 0, binding = LUCENT_LAYER_DEPTH_BINDING) uniform usampler2D gbuffer_layer_depths;
+layout(set = 0) uniform usampler2D gbuffer_layer_depths;
 #endif
 
 #if defined(LUCENT_LAYERED_FILM) && defined(LUCENT_HOST_GBUFFER)
 // A host's film: its albedo image (src/embed/layered.rs `LayeredEffectDesc::with_film`).
-layout(set = 0, binding = LUCENT_HOST_FILM_BINDING) uniform sampler2D host_film;
+layout(set = 0) uniform sampler2D host_film;
 #endif
 
-#ifdef LUCENT_ENTRY_BINDING
+#ifdef LUCENT_ENTRY
 // Per map texel: the first surface's normal * 0.5 + 0.5 and its layered material ID / 255.
-layout(set = 0, binding = LUCENT_ENTRY_BINDING) uniform sampler2D shadow_entry;
-#if defined(LUCENT_LAYER_DEPTHS) && defined(LUCENT_ENTRY_DEPTH_BINDING)
+layout(set = 0) uniform sampler2D shadow_entry;
+#if defined(LUCENT_LAYER_DEPTHS) && defined(LUCENT_ENTRY_DEPTHS)
 // Per map texel: the depth-texture texels at the first surface (where light enters).
-layout(set = 0, binding = LUCENT_ENTRY_DEPTH_BINDING) uniform usampler2D shadow_layer_depths;
+layout(set = 0) uniform usampler2D shadow_layer_depths;
 #endif
 #endif
 
 // The depth texels of light-space texel `texel` (the entry surface's TexDep layers).
 uvec4 entry_texels(ivec2 texel, uvec4 fallback) {
-#if defined(LUCENT_ENTRY_BINDING) && defined(LUCENT_LAYER_DEPTHS) && defined(LUCENT_ENTRY_DEPTH_BINDING)
+#if defined(LUCENT_ENTRY) && defined(LUCENT_LAYER_DEPTHS) && defined(LUCENT_ENTRY_DEPTHS)
     return texelFetch(shadow_layer_depths, texel, 0);
 #else
     return fallback;
@@ -72,7 +72,7 @@ bool light_entry_plane(vec3 m, vec3 to_light, vec3 x_o, vec3 n_o, uvec4 texels_o
 // at the shaded point as the surface (light_entry_plane).
 bool light_entry(int i, vec3 m, vec3 to_light, int id, vec3 x_o, vec3 n_o, uvec4 texels_o,
                  out vec3 p_in, out vec3 n_in, out uvec4 texels_in) {
-#ifdef LUCENT_ENTRY_BINDING
+#ifdef LUCENT_ENTRY
     int face = shadow_face(i, m);
     vec2 t;
     float d_m;
@@ -157,7 +157,7 @@ float unseen_entry(vec3 p, vec3 n) {
 // light sees it). Lights without a map give none (the plane at x_o is its own entry).
 vec3 transmitted_light(int i, vec3 x_o, vec3 n_o, vec3 to_light, int id, float eta, int mat,
                        uvec4 texels_o) {
-#ifdef LUCENT_ENTRY_BINDING
+#ifdef LUCENT_ENTRY
     int face = shadow_face(i, x_o);
     if (face < 0) {
         return vec3(0.0);
@@ -403,7 +403,7 @@ void main() {
     l_t *= t_o / PI;
     vec3 l_ss = t_o * sum;
     vec3 terms = MAT.weights.x * l_t + MAT.weights.y * l_ss;
-#ifdef LUCENT_HALF_TERM_BINDING
+#ifdef LUCENT_HALF_TERM
     terms += upsampled_multiple(px, id); // already weighted by λ5
 #endif
 #ifdef LUCENT_LAYERED_FILM

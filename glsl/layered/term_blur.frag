@@ -17,7 +17,7 @@
 // resolution and texel k holds pixel 2k.
 #include "../common/layered.glsl"
 
-layout(set = 0, binding = 5) uniform sampler2D term_tex;
+layout(set = 0) uniform sampler2D term_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_term;

@@ -21,7 +21,7 @@
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D ldr;  // read with texelFetch only
+layout(set = 0) uniform sampler2D ldr;  // read with texelFetch only
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;

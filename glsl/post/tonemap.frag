@@ -9,7 +9,7 @@
 #include "../common/scene.glsl"
 #include "../common/color.glsl"
 
-layout(set = 0, binding = 1) uniform sampler2D hdr;
+layout(set = 0) uniform sampler2D hdr;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;

@@ -23,9 +23,9 @@ layout(location = LUCENT_ENTRY_LOCATION) out vec4 out_entry;
 #ifdef LUCENT_LAYER_DEPTHS
 #include "../common/layer_depths.glsl"
 layout(location = 1) in vec2 in_uv;
-layout(set = 0, binding = 1) uniform sampler2D depth_map0;
+layout(set = 0) uniform sampler2D depth_map0;
 #if LUCENT_LAYER_DEPTHS > 1
-layout(set = 0, binding = 2) uniform sampler2D depth_map1;
+layout(set = 0) uniform sampler2D depth_map1;
 #endif
 layout(location = LUCENT_LAYER_DEPTH_LOCATION) out uvec4 out_layer_depths;
 #endif

@@ -5,7 +5,7 @@
 // permutation: LUCENT_SSS_SAMPLES=25 LUCENT_SSS_VERTICAL LUCENT_SSS_PASSTHROUGH LUCENT_SSS_BASE
 // permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SSS_PROFILE_EDGES
 // permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ALBEDO
-// permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
+// permutation: LUCENT_SSS_SAMPLES=17 LUCENT_SSS_VERTICAL LUCENT_SHADOWS
 // The bilateral SSS blur (the LEAN-mapping SSS thesis's idea in two passes), one direction per
 // pass (see two_pass_kernel.glsl): LUCENT_SSS_SAMPLES point taps at whole texels evenly over
 // the profile's reach, each weighted per channel by the whole profile at the tap's 3D distance
@@ -17,15 +17,15 @@
 #include "two_pass_kernel.glsl"
 #include "../common/lean.glsl"
 
-layout(set = 0, binding = IMAGE0 + 3) uniform sampler2D lean_tex;     // slope y, moments
+layout(set = 0) uniform sampler2D lean_tex;     // slope y, moments
 #ifdef LUCENT_SSS_VERTICAL
 #define LUCENT_SSS_COMPOSE
-layout(set = 0, binding = IMAGE0 + 4) uniform sampler2D diffuse_tex;  // unblurred diffuse
-layout(set = 0, binding = IMAGE0 + 5) uniform sampler2D specular_tex;
-layout(set = 0, binding = IMAGE0 + 6) uniform sampler2D albedo_tex;   // GB0: a = specular
-layout(set = 0, binding = IMAGE0 + 7) uniform sampler2D normal_tex;   // GB1: a = roughness
+layout(set = 0) uniform sampler2D diffuse_tex;  // unblurred diffuse
+layout(set = 0) uniform sampler2D specular_tex;
+layout(set = 0) uniform sampler2D albedo_tex;   // GB0: a = specular
+layout(set = 0) uniform sampler2D normal_tex;   // GB1: a = roughness
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = IMAGE0 + 8) uniform sampler2D base_tex;     // the previous chain's
+layout(set = 0) uniform sampler2D base_tex;     // the previous chain's
 #endif
 #else
 layout(location = 1) out vec4 out_lean;

@@ -43,14 +43,14 @@
 #endif
 
 #ifdef LUCENT_SSS_PACKED_IN
-layout(set = 0, binding = 2) uniform usampler2D packed_tex;  // both texels, packed (nearest)
+layout(set = 0) uniform usampler2D packed_tex;  // both texels, packed (nearest)
 #else
-layout(set = 0, binding = 2) uniform sampler2D color_tex;    // linear filtering, clamp to edge
+layout(set = 0) uniform sampler2D color_tex;    // linear filtering, clamp to edge
 #endif
-layout(set = 0, binding = 3) uniform sampler2D depth_tex;    // device depth, read with texelFetch
-layout(set = 0, binding = 4) uniform SSS_ID_SAMPLER profile_tex;  // SSS profile ID, 0 = not SSS
+layout(set = 0) uniform sampler2D depth_tex;    // device depth, read with texelFetch
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;  // SSS profile ID, 0 = not SSS
 #if defined(LUCENT_SSS_LEAN) && !defined(LUCENT_SSS_PACKED_IN)
-layout(set = 0, binding = 5) uniform sampler2D lean_tex;     // slope y, moments (same filter)
+layout(set = 0) uniform sampler2D lean_tex;     // slope y, moments (same filter)
 #endif
 
 layout(push_constant) uniform Blur {

@@ -19,7 +19,7 @@
 // Per profile ID: rgb d per channel (world units), a the widest; knobs: x the sample budget,
 // y 1 to rotate the spiral per pixel, z the reach in units of d; radii: the inverse CDF r / d
 // at BURLEY_RADII + 1 evenly spaced fractions of the profile within the reach (four a vec4).
-layout(std140, set = 0, binding = 2) uniform SssBurley {
+layout(std140, set = 0) uniform SssBurley {
     vec4 distance[MAX_SSS_PROFILES];
     vec4 knobs;
     vec4 radii[BURLEY_RADII / 4 + 1];
@@ -28,9 +28,9 @@ layout(std140, set = 0, binding = 2) uniform SssBurley {
     vec4 inverse_pdf[BURLEY_RADII / 4 + 1];
 } burley;
 
-layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;   // lit diffuse (+ depth)
-layout(set = 0, binding = 4) uniform sampler2D depth_tex;     // device depth
-layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
+layout(set = 0) uniform sampler2D diffuse_tex;   // lit diffuse (+ depth)
+layout(set = 0) uniform sampler2D depth_tex;     // device depth
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
 
 layout(push_constant) uniform Blur {
     vec4 step;  // w: the chain

@@ -26,34 +26,34 @@
 #include "../common/sss.glsl"
 
 // The Burley table (glsl/sss/burley.frag): per profile ID, a = the widest d in world units.
-layout(std140, set = 0, binding = 2) uniform SssBurley {
+layout(std140, set = 0) uniform SssBurley {
     vec4 distance[MAX_SSS_PROFILES];
     vec4 knobs;  // z: the reach in units of d
 } burley;
 
-layout(set = 0, binding = 3) uniform sampler2D gathered_tex;  // diffused light, depth in alpha
-layout(set = 0, binding = 4) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
-layout(set = 0, binding = 5) uniform sampler2D diffuse_tex;   // lit diffuse
-layout(set = 0, binding = 6) uniform sampler2D specular_tex;  // lit specular
+layout(set = 0) uniform sampler2D gathered_tex;  // diffused light, depth in alpha
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;   // profile IDs
+layout(set = 0) uniform sampler2D diffuse_tex;   // lit diffuse
+layout(set = 0) uniform sampler2D specular_tex;  // lit specular
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 7) uniform sampler2D base_tex;      // the previous chain's result
+layout(set = 0) uniform sampler2D base_tex;      // the previous chain's result
 #endif
 #ifdef LUCENT_SSS_ALBEDO
 // GB0: the albedo the lighting pass left out of the light (sss_albedo_after).
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 8) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #else
-layout(set = 0, binding = 7) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #endif
 #endif
 #ifdef LUCENT_SSS_HALF_RES
 // Device depth, the last binding.
 #if defined(LUCENT_SSS_BASE) && defined(LUCENT_SSS_ALBEDO)
-layout(set = 0, binding = 9) uniform sampler2D depth_tex;
+layout(set = 0) uniform sampler2D depth_tex;
 #elif defined(LUCENT_SSS_BASE) || defined(LUCENT_SSS_ALBEDO)
-layout(set = 0, binding = 8) uniform sampler2D depth_tex;
+layout(set = 0) uniform sampler2D depth_tex;
 #else
-layout(set = 0, binding = 7) uniform sampler2D depth_tex;
+layout(set = 0) uniform sampler2D depth_tex;
 #endif
 #endif
 

@@ -7,19 +7,19 @@
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 
-layout(set = 0, binding = 2) uniform sampler2D sum_tex;
-layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;
-layout(set = 0, binding = 4) uniform sampler2D specular_tex;
-layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;
+layout(set = 0) uniform sampler2D sum_tex;
+layout(set = 0) uniform sampler2D diffuse_tex;
+layout(set = 0) uniform sampler2D specular_tex;
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 6) uniform sampler2D base_tex;
+layout(set = 0) uniform sampler2D base_tex;
 #endif
 #ifdef LUCENT_SSS_ALBEDO
 // GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 7) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #else
-layout(set = 0, binding = 6) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #endif
 #endif
 

@@ -7,9 +7,9 @@
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 
-layout(set = 0, binding = 2) uniform sampler2D diffuse_tex;
-layout(set = 0, binding = 3) uniform sampler2D albedo_tex;
-layout(set = 0, binding = 4) uniform SSS_ID_SAMPLER profile_tex;
+layout(set = 0) uniform sampler2D diffuse_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out vec4 out_color;

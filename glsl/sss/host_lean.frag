@@ -23,17 +23,17 @@
 #include "../common/host_normals.glsl"
 
 // The host's encodings and its materials' surfaces (src/embed/sss.rs `HostLeanGpu`, std140).
-layout(std140, set = 0, binding = 2) uniform HostLean {
+layout(std140, set = 0) uniform HostLean {
     uvec4 normals;          // host_normals.glsl's encoding
     mat4 view_to_world;     // the inverse of the frame's view matrix
     vec4 surface[MAX_SSS_PROFILES];  // per profile: x roughness, y specular intensity
 } host;
 
-layout(set = 0, binding = 3) uniform sampler2D diffuse_tex;
-layout(set = 0, binding = 4) uniform sampler2D normal_tex;
-layout(set = 0, binding = 5) uniform SSS_ID_SAMPLER profile_tex;
+layout(set = 0) uniform sampler2D diffuse_tex;
+layout(set = 0) uniform sampler2D normal_tex;
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;
 #ifdef LUCENT_SSS_HOST_ALBEDO
-layout(set = 0, binding = 6) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #endif
 
 layout(location = 0) in vec2 in_uv;

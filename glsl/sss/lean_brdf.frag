@@ -3,7 +3,7 @@
 // permutation: LUCENT_SSS_BASE
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_ALBEDO
 // permutation: LUCENT_SSS_BASE LUCENT_SSS_PASSTHROUGH
-// permutation: LUCENT_SHADOWS LUCENT_SHADOW_BINDING=20
+// permutation: LUCENT_SHADOWS
 // LCB and LBB, the final lighting pass (the thesis's BRDF shader, Annex A 8.1.3): on the pixels
 // of this chain's profiles, the blurred diffuse light plus LEAN specular with Fresnel evaluated
 // on the blurred view-plane slopes and moments, for every light; elsewhere the previous chain's
@@ -13,16 +13,16 @@
 #include "../common/lean.glsl"
 #include "../common/sss.glsl"
 
-layout(set = 0, binding = 2) uniform sampler2D sum_tex;       // blurred diffuse rgb + slope x
-layout(set = 0, binding = 3) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
-layout(set = 0, binding = 4) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
-layout(set = 0, binding = 5) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
-layout(set = 0, binding = 6) uniform SSS_ID_SAMPLER profile_tex;   // SSS profile ID
-layout(set = 0, binding = 7) uniform sampler2D depth_tex;
-layout(set = 0, binding = 8) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
-layout(set = 0, binding = 9) uniform sampler2D normal_tex;    // GB1: a = roughness
+layout(set = 0) uniform sampler2D sum_tex;       // blurred diffuse rgb + slope x
+layout(set = 0) uniform sampler2D lean_sum_tex;  // blurred slope y + moments
+layout(set = 0) uniform sampler2D diffuse_tex;   // unblurred diffuse (non-SSS)
+layout(set = 0) uniform sampler2D specular_tex;  // lighting pass specular (non-SSS)
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;   // SSS profile ID
+layout(set = 0) uniform sampler2D depth_tex;
+layout(set = 0) uniform sampler2D albedo_tex;    // GB0: a = specular intensity
+layout(set = 0) uniform sampler2D normal_tex;    // GB1: a = roughness
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = 10) uniform sampler2D base_tex;     // the previous chain's result
+layout(set = 0) uniform sampler2D base_tex;     // the previous chain's result
 #endif
 
 layout(push_constant) uniform Chain {

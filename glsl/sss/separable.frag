@@ -23,17 +23,17 @@
 
 #if defined(LUCENT_SSS_VERTICAL) && !defined(LUCENT_SSS_HALF_RES)
 #define LUCENT_SSS_COMPOSE
-layout(set = 0, binding = IMAGE0 + 3) uniform sampler2D diffuse_tex;  // unblurred diffuse
-layout(set = 0, binding = IMAGE0 + 4) uniform sampler2D specular_tex;
+layout(set = 0) uniform sampler2D diffuse_tex;  // unblurred diffuse
+layout(set = 0) uniform sampler2D specular_tex;
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = IMAGE0 + 5) uniform sampler2D base_tex;     // the previous chain's
+layout(set = 0) uniform sampler2D base_tex;     // the previous chain's
 #endif
 #ifdef LUCENT_SSS_ALBEDO
 // GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
 #ifdef LUCENT_SSS_BASE
-layout(set = 0, binding = IMAGE0 + 6) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #else
-layout(set = 0, binding = IMAGE0 + 5) uniform sampler2D albedo_tex;
+layout(set = 0) uniform sampler2D albedo_tex;
 #endif
 #endif
 #endif

@@ -17,11 +17,10 @@
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 
-// The images every pass samples; a shader's own inputs follow from IMAGE0 + 3.
-#define IMAGE0 3
-layout(set = 0, binding = IMAGE0) uniform sampler2D color_tex;        // light (+ alpha)
-layout(set = 0, binding = IMAGE0 + 1) uniform sampler2D depth_tex;    // device depth, full res
-layout(set = 0, binding = IMAGE0 + 2) uniform SSS_ID_SAMPLER profile_tex;  // profile IDs, full res
+// The images every pass samples (each shader's own inputs are declared after them).
+layout(set = 0) uniform sampler2D color_tex;        // light (+ alpha)
+layout(set = 0) uniform sampler2D depth_tex;    // device depth, full res
+layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;  // profile IDs, full res
 
 layout(push_constant) uniform Blur {
     vec4 step;  // xy: direction (1,0) or (0,1); w: the chain

@@ -51,6 +51,20 @@ pub enum Binding {
     SampledPerSlot(vk::Sampler),
 }
 
+impl Binding {
+    /// The descriptor type it is bound as.
+    pub fn kind(&self) -> vk::DescriptorType {
+        match self {
+            Binding::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::PerFrame(_) => vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
+            Binding::InputAttachment(..) => vk::DescriptorType::INPUT_ATTACHMENT,
+            Binding::Sampled(..) | Binding::SampledPerSlot(_) => {
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER
+            }
+        }
+    }
+}
+
 /// A descriptor set with its own pool and layout (passes have one set each), or one copy of it
 /// per frame slot when a binding's view is given per slot.
 pub struct DescriptorSet {
@@ -90,14 +104,7 @@ impl DescriptorSet {
             1
         };
         let device = &ctx.gpu().device;
-        let kind = |b: &Binding| match b {
-            Binding::Uniform(_) => vk::DescriptorType::UNIFORM_BUFFER,
-            Binding::PerFrame(_) => vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
-            Binding::InputAttachment(..) => vk::DescriptorType::INPUT_ATTACHMENT,
-            Binding::Sampled(..) | Binding::SampledPerSlot(_) => {
-                vk::DescriptorType::COMBINED_IMAGE_SAMPLER
-            }
-        };
+        let kind = Binding::kind;
         let layout_bindings: Vec<vk::DescriptorSetLayoutBinding> = bindings
             .iter()
             .enumerate()

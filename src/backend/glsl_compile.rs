@@ -17,7 +17,7 @@ use super::shader_files::{normalize_relative, path_to_name};
 /// newer system shaderc does not invalidate entries: their SPIR-V stays valid, only possibly
 /// less optimised.)
 pub const COMPILER_SETTINGS: &str =
-    "lucent-spirv-cache-v1;shaderc-rs-0.10;glsl;vulkan1.3;spirv1.6;opt=performance;debug-info=off";
+    "lucent-spirv-cache-v2;shaderc-rs-0.10;glsl;vulkan1.3;spirv1.6;opt=performance;auto-bind;resource-names";
 
 /// Largest GLSL source or include read.
 pub const MAX_SOURCE_BYTES: u64 = 4 << 20;
@@ -73,6 +73,12 @@ pub fn compile_glsl(
     );
     options.set_target_spirv(shaderc::SpirvVersion::V1_6);
     options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+    // Resources without a `binding` qualifier get glslang's numbers, which lucent overwrites
+    // with the pass's declared order by the resource's name (backend/bindings.rs). Without
+    // debug info the optimiser strips every name, so it is generated and then stripped here
+    // down to the resources' names ([`keep_resource_names`]).
+    options.set_auto_bind_uniforms(true);
+    options.set_generate_debug_info();
     for (define, value) in defines {
         options.add_macro_definition(define, Some(value));
     }
@@ -109,13 +115,70 @@ pub fn compile_glsl(
     } else {
         String::new()
     };
-    let spirv = artifact.as_binary().to_vec();
+    let spirv = keep_resource_names(artifact.as_binary());
     drop(options);
     Ok(GlslOutput {
         spirv,
         files: files.into_inner(),
         warnings,
     })
+}
+
+/// `spirv` without its debug instructions (source text, line numbers, processing notes, names
+/// and member names) but the names of the variables in descriptor sets and of the blocks they
+/// point at: what binding by name needs, a few words per resource. The code is untouched.
+pub fn keep_resource_names(spirv: &[u32]) -> Vec<u32> {
+    const HEADER_WORDS: usize = 5;
+    const OP_SOURCE_CONTINUED: u32 = 2;
+    const OP_SOURCE: u32 = 3;
+    const OP_SOURCE_EXTENSION: u32 = 4;
+    const OP_NAME: u32 = 5;
+    const OP_MEMBER_NAME: u32 = 6;
+    const OP_STRING: u32 = 7;
+    const OP_LINE: u32 = 8;
+    const OP_TYPE_POINTER: u32 = 32;
+    const OP_VARIABLE: u32 = 59;
+    const OP_DECORATE: u32 = 71;
+    const OP_NO_LINE: u32 = 317;
+    const OP_MODULE_PROCESSED: u32 = 330;
+    const DECORATION_DESCRIPTOR_SET: u32 = 34;
+    let instructions = || {
+        let mut at = HEADER_WORDS.min(spirv.len());
+        std::iter::from_fn(move || {
+            let count = (*spirv.get(at)? >> 16) as usize;
+            let instruction = spirv.get(at..at + count.max(1))?;
+            at += count.max(1);
+            Some(instruction)
+        })
+    };
+    // Variables in a descriptor set, and what their pointer types point at.
+    let in_sets: Vec<u32> = instructions()
+        .filter(|i| i[0] & 0xffff == OP_DECORATE && i.get(2) == Some(&DECORATION_DESCRIPTOR_SET))
+        .filter_map(|i| i.get(1).copied())
+        .collect();
+    let pointees: BTreeMap<u32, u32> = instructions()
+        .filter(|i| i[0] & 0xffff == OP_TYPE_POINTER && i.len() > 3)
+        .map(|i| (i[1], i[3]))
+        .collect();
+    let mut named: Vec<u32> = in_sets.clone();
+    for i in instructions().filter(|i| i[0] & 0xffff == OP_VARIABLE && i.len() > 2) {
+        if in_sets.contains(&i[2]) {
+            named.extend(pointees.get(&i[1]));
+        }
+    }
+    let mut out = spirv[..HEADER_WORDS.min(spirv.len())].to_vec();
+    for instruction in instructions() {
+        let keep = match instruction[0] & 0xffff {
+            OP_SOURCE_CONTINUED | OP_SOURCE | OP_SOURCE_EXTENSION | OP_STRING | OP_LINE
+            | OP_NO_LINE | OP_MODULE_PROCESSED | OP_MEMBER_NAME => false,
+            OP_NAME => instruction.get(1).is_some_and(|id| named.contains(id)),
+            _ => true,
+        };
+        if keep {
+            out.extend_from_slice(instruction);
+        }
+    }
+    out
 }
 
 /// `NAME=VALUE` pairs separated by spaces, for messages.

@@ -6,6 +6,7 @@
 //! - [`access`]: the one access table every barrier is derived from.
 //! - [`pipeline`]: graphics pipelines, made for the render pass and subpass a caller names.
 //! - [`descriptor`]: descriptor sets (one per pass, with its own pool) and samplers.
+//! - [`bindings`]: a pass's binding numbers written into its shaders by name, and checked.
 //! - [`format`](mod@format): the one format table (sizes, channels, encodings, names).
 //! - [`shader`]: SPIR-V shipped with the crate or compiled at run time (feature
 //!   `runtime-shaders`), shader modules, pipeline cache.
@@ -13,6 +14,7 @@
 //! - [`timer`]: GPU timestamp scopes, read without stalling.
 
 pub mod access;
+pub mod bindings;
 mod buffer;
 pub mod context;
 mod desc;

@@ -7,6 +7,7 @@
 
 use ash::vk;
 
+use super::bindings::{bind_by_name, SetBinding};
 use super::shader::{create_shader_module, ShaderCompiler};
 use super::GpuContext;
 use crate::error::VkResultExt;
@@ -98,6 +99,9 @@ pub struct GraphicsPipelineDesc<'a> {
     pub additive_attachments: u32,
     /// Descriptor set layouts (set 0, 1, ...).
     pub set_layouts: &'a [vk::DescriptorSetLayout],
+    /// Set 0's bindings in order, as its layout was made: the shaders' resources take their
+    /// numbers from it by name and are checked against it ([`super::bindings`]).
+    pub bindings: &'a [SetBinding<'a>],
     /// Push constant bytes visible to vertex and fragment stages.
     pub push_constant_bytes: u32,
     /// Name for debug tools.
@@ -118,6 +122,7 @@ impl<'a> GraphicsPipelineDesc<'a> {
             cull_back: false,
             additive_attachments: 0,
             set_layouts: &[],
+            bindings: &[],
             push_constant_bytes: 0,
             name,
         }
@@ -137,8 +142,17 @@ impl GraphicsPipeline {
     /// Viewport and scissor are dynamic (the executor sets them).
     pub fn new(ctx: &impl PipelineTarget, desc: &GraphicsPipelineDesc<'_>) -> Result<Self> {
         let device = &ctx.gpu().device;
-        let vert = ctx.shaders().compile(desc.vertex, desc.defines)?;
-        let frag = ctx.shaders().compile(desc.fragment, desc.defines)?;
+        let mut vert = ctx.shaders().compile(desc.vertex, desc.defines)?;
+        let mut frag = ctx.shaders().compile(desc.fragment, desc.defines)?;
+        for (shader, path) in [(&mut vert, desc.vertex), (&mut frag, desc.fragment)] {
+            bind_by_name(&mut shader.spirv, desc.bindings).map_err(|message| {
+                crate::LucentError::ShaderBindings {
+                    pipeline: desc.name.to_string(),
+                    shader: path.to_string(),
+                    message,
+                }
+            })?;
+        }
         let vert_module = create_shader_module(device, &vert.spirv)?;
         let frag_module = match create_shader_module(device, &frag.spirv) {
             Ok(m) => m,

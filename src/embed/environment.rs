@@ -125,7 +125,7 @@ struct HostEnvironmentGpu {
 }
 
 /// The effect's constants in the per-frame buffer.
-static HOST_ENVIRONMENT: Region = Region::new("host environment decode");
+static HOST_ENVIRONMENT: Region = Region::new("host environment decode", "HostEnvironment");
 
 /// The graph's imports, by input.
 #[derive(Clone, Copy, Debug)]
@@ -357,10 +357,10 @@ fn declare(desc: &EnvironmentEffectDesc, scene_gpu: &Arc<SceneGpu>) -> (RenderGr
     let mut pass = FullscreenPass::new(&mut graph, "host environment", FRAGMENT, Some(scene_gpu));
     pass.per_frame(&FRAME)
         .per_frame(&HOST_ENVIRONMENT)
-        .sample(&depth)
-        .sample(&normals);
+        .sample("depth_image", &depth)
+        .sample("normal_image", &normals);
     if let Some(albedo) = &albedo {
-        pass.sample(albedo);
+        pass.sample("albedo_image", albedo);
     }
     pass.defines(defines(reads_albedo))
         .tiles(|scene, ctx| {

@@ -329,7 +329,7 @@ struct HostLeanGpu {
 }
 
 /// The host LEAN pass's constants in the per-frame buffer.
-static HOST_LEAN: Region = Region::new("host LEAN decode");
+static HOST_LEAN: Region = Region::new("host LEAN decode", "HostLean");
 
 /// Screen-space SSS over a host's G-buffer (see the module docs).
 pub struct SssEffect {

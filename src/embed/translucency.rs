@@ -242,7 +242,7 @@ struct HostTranslucencyGpu {
 }
 
 /// The effect's constants in the per-frame buffer.
-static HOST_TRANSLUCENCY: Region = Region::new("host translucency decode");
+static HOST_TRANSLUCENCY: Region = Region::new("host translucency decode", "HostTranslucency");
 
 /// The graph's imports, by input.
 #[derive(Clone, Copy, Debug)]
@@ -531,11 +531,11 @@ fn declare(
     pass.per_frame(&FRAME)
         .per_frame(&TABLE_REGION)
         .per_frame(&HOST_TRANSLUCENCY)
-        .sample(&depth)
-        .sample(&normals)
-        .sample(&albedo)
-        .sample(&thickness)
-        .sample(&material_ids)
+        .sample("depth_image", &depth)
+        .sample("normal_image", &normals)
+        .sample("albedo_image", &albedo)
+        .sample("thickness_image", &thickness)
+        .sample("id_image", &material_ids)
         .defines(defines(uint_ids))
         .tiles(|scene, ctx| {
             let regions = &scene.per_frame.tiles(ctx.frame).lighting;

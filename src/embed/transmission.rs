@@ -204,9 +204,9 @@ struct HostTransmissionGpu {
 
 /// The effect's constants, its profile table (the media) and its shadow table in the
 /// per-frame buffer.
-static HOST_TRANSMISSION: Region = Region::new("host transmission decode");
-static MEDIA: Region = Region::new("host transmission media");
-static SHADOWS: Region = Region::new("host shadow maps' table");
+static HOST_TRANSMISSION: Region = Region::new("host transmission decode", "HostTransmission");
+static MEDIA: Region = Region::new("host transmission media", "SssProfiles");
+static SHADOWS: Region = Region::new("host shadow maps' table", "Shadows");
 
 /// The graph's imports, by input.
 #[derive(Clone, Copy, Debug)]
@@ -508,19 +508,16 @@ fn declare(
         lighting: lighting.id(),
     };
     let mut pass = FullscreenPass::new(&mut graph, "host transmission", FRAGMENT, Some(scene_gpu));
-    // Bindings in the shader's order: the frame (0), the media (1), the decode (2), the
-    // shadow table (3) and map (4, glsl/common/shadows.glsl's LUCENT_SHADOW_BINDING + 1),
-    // then the G-buffer.
     pass.per_frame(&FRAME)
         .per_frame(&MEDIA)
         .per_frame(&HOST_TRANSMISSION)
         .per_frame(&SHADOWS)
-        .sample(&shadow_map)
-        .sample(&depth)
-        .sample(&normals)
-        .sample(&material_ids);
+        .sample("shadow_depth", &shadow_map)
+        .sample("depth_image", &depth)
+        .sample("normal_image", &normals)
+        .sample("id_image", &material_ids);
     if let Some(albedo) = &albedo {
-        pass.sample(albedo);
+        pass.sample("albedo_image", albedo);
     }
     pass.defines(&defines(uint_ids, reads_albedo, desc.shadow_array))
         .tiles(|scene, ctx| {

@@ -82,7 +82,7 @@ pub fn fxaa_pass(
     let mut pass = FullscreenPass::new(graph, "fxaa", FXAA_FRAGMENT, scene);
     // Read with texel fetches only (the shader averages the texels it needs between).
     pass.per_frame(&FRAME)
-        .sample(ldr)
+        .sample("ldr", ldr)
         .color(&mut display, LoadOp::DontCare)
         .defines(fxaa_defines(linear));
     pass.finish();

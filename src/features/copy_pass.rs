@@ -21,6 +21,11 @@ pub const MAX_COPY_INPUTS: usize = 10;
 
 /// The copy's fragment shader.
 pub const COPY_FRAGMENT: &str = "bench/copy.frag";
+
+/// The copy shader's names for its inputs, in binding order (`in0` ... `in9`).
+pub const COPY_INPUT_NAMES: [&str; MAX_COPY_INPUTS] = [
+    "in0", "in1", "in2", "in3", "in4", "in5", "in6", "in7", "in8", "in9",
+];
 /// The mesh floor's vertex shader.
 pub const FLOOR_VERTEX: &str = "bench/floor.vert";
 /// The mesh floor's fragment shader.

@@ -116,14 +116,20 @@ pub fn debug_view_pass(
         _ => ViewInputs::One,
     };
     let mut pass = FullscreenPass::new(graph, "debug view", VIEW_FRAGMENT, scene);
-    pass.per_frame(&FRAME).sample(source);
+    pass.per_frame(&FRAME).sample("source", source);
     if let Some(s) = second {
-        pass.sample(s);
+        // The term's view reads GB1 there (glsl/debug/view.frag).
+        let name = if inputs == ViewInputs::Term {
+            "gb1_tex"
+        } else {
+            "second"
+        };
+        pass.sample(name, s);
     }
     if let Some((gb2, depth)) = term_inputs {
         if inputs == ViewInputs::Term {
-            pass.sample(gb2)
-                .sample(depth)
+            pass.sample("gb2_tex", gb2)
+                .sample("depth_tex", depth)
                 .per_frame(&super::translucency::TABLE_REGION);
         } else {
             pass.graph().sample(gb2).sample(depth);

@@ -247,18 +247,12 @@ impl GBufferLayout {
         }
         if self.albedo_maps {
             defines.push(("LUCENT_ALBEDO_MAP", "1"));
-            let binding = 1 + usize::from(self.normal_maps) * (1 + usize::from(self.lean));
-            defines.push(("LUCENT_ALBEDO_BINDING", LOCATIONS[binding]));
         }
         if self.layer_depths() {
             defines.push((
                 "LUCENT_LAYER_DEPTHS",
                 layer_depths_define(self.layer_depth_textures),
             ));
-            let binding = 1
-                + usize::from(self.normal_maps) * (1 + usize::from(self.lean))
-                + usize::from(self.albedo_maps);
-            defines.push(("LUCENT_DEPTH_MAP_BINDING", LOCATIONS[binding]));
         }
         for (i, target) in self.extra_targets().into_iter().enumerate() {
             defines.push((target.location_define(), LOCATIONS[2 + i]));
@@ -480,20 +474,24 @@ impl GBufferPass {
     /// Set 0's bindings with material-texture set `index` of the scene's maps
     /// (glsl/deferred/gbuffer.frag): the frame uniforms, then the normal (or LEAN 1) map, LEAN
     /// map 2, the albedo map and the depth maps, those the frame has.
-    fn bindings(&self, index: usize) -> Vec<Binding> {
-        let mut bindings = vec![Binding::PerFrame(self.scene.per_frame.binding(&FRAME))];
+    fn bindings(&self, index: usize) -> Vec<(&'static str, Binding)> {
+        let frame = Binding::PerFrame(self.scene.per_frame.binding(&FRAME));
+        let mut bindings = vec![(FRAME.block, frame)];
         if let Some(maps) = &self.scene.maps {
             let set = maps.sets.get(index).copied().unwrap_or_default();
             let (normal, albedo) = (set.normal, set.albedo);
+            let sampled = |map: &crate::backend::resources::GpuImage| {
+                Binding::Sampled(map.view, maps.sampler)
+            };
             if let Some(map) = maps.normal.get(normal) {
-                bindings.push(Binding::Sampled(map.view, maps.sampler));
-                // LEAN frames: the second LEAN map follows.
+                bindings.push(("normal_map", sampled(map)));
+                // LEAN frames: the second LEAN map.
                 if let Some(lean2) = maps.lean2.get(normal) {
-                    bindings.push(Binding::Sampled(lean2.view, maps.sampler));
+                    bindings.push(("lean2_map", sampled(lean2)));
                 }
             }
             if let Some(map) = maps.albedo.get(albedo) {
-                bindings.push(Binding::Sampled(map.view, maps.sampler));
+                bindings.push(("albedo_map", sampled(map)));
             }
             if self.layout.layer_depths() {
                 bindings.extend(depth_map_bindings(
@@ -509,9 +507,11 @@ impl GBufferPass {
 
 impl PassExec for GBufferPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
+        let (names, bindings): (Vec<_>, Vec<_>) = self.bindings(0).into_iter().unzip();
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &self.bindings(0),
+            &bindings,
+            &names,
             &GraphicsPipelineDesc {
                 vertex: GBUFFER_VERTEX,
                 fragment: GBUFFER_FRAGMENT,
@@ -524,6 +524,7 @@ impl PassExec for GBufferPass {
                 cull_back: true,
                 additive_attachments: 0,
                 set_layouts: &[],
+                bindings: &[],
                 push_constant_bytes: std::mem::size_of::<crate::gpu_scene::ObjectConstants>()
                     as u32,
                 name: "gbuffer",
@@ -532,9 +533,10 @@ impl PassExec for GBufferPass {
         let sets = self.scene.maps.as_ref().map_or(0, |m| m.sets.len());
         for index in 1..sets {
             // Identically defined layouts are compatible: these sets bind to the pipeline's.
+            let bindings: Vec<Binding> = self.bindings(index).into_iter().map(|b| b.1).collect();
             let set = DescriptorSet::new(
                 ctx,
-                &self.bindings(index),
+                &bindings,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 "gbuffer material maps",
                 ctx.slots,

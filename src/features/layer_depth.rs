@@ -33,11 +33,12 @@ pub fn depth_map_bindings(
     maps: &crate::gpu_scene::MaterialMaps,
     depth: [usize; 2],
     textures: usize,
-) -> Vec<Binding> {
+) -> Vec<(&'static str, Binding)> {
     depth
         .iter()
         .take(textures.clamp(1, 2))
         .filter_map(|&i| maps.depth.get(i).or(maps.depth.first()))
-        .map(|map| Binding::Sampled(map.view, maps.sampler))
+        .zip(["depth_map0", "depth_map1"])
+        .map(|(map, name)| (name, Binding::Sampled(map.view, maps.sampler)))
         .collect()
 }

@@ -66,33 +66,29 @@ pub fn lighting_pass(
     let shadow_ids = shadows.map(|maps| maps.ids.is_some());
     let (plain, translucent) = lighting_defines(&gb.layout, shadow_ids);
     let mut pass = FullscreenPass::new(graph, "lighting", LIGHTING_FRAGMENT, scene);
-    // Bindings 0-3 always; 4 (GB2) and 5 (material table) only with translucency; then the
-    // shadow table and atlases (glsl/deferred/lighting.frag, glsl/common/shadows.glsl).
+    // The G-buffer always; GB2 and the material table with translucency; the profile IDs and
+    // table with SSS texturing or media; the shadow table and atlases with shadows
+    // (glsl/deferred/lighting.frag, glsl/common/shadows.glsl), each under the shader's name.
     pass.defines(&plain)
         .per_frame(&FRAME)
-        .input(&gb.gb0)
-        .input(&gb.gb1)
-        .input(&gb.depth);
+        .input("gb0", &gb.gb0)
+        .input("gb1", &gb.gb1)
+        .input("depth", &gb.depth);
     if let Some(gb2) = &gb.gb2 {
-        pass.input(gb2)
+        pass.input("gb2", gb2)
             .per_frame(&super::translucency::TABLE_REGION);
     }
     if reads_profiles(&gb.layout) {
-        // `lighting_defines` numbered these two bindings (LUCENT_SSS_TEXTURING).
         let (Some(ids), Some(table)) = (&gb.sss, sss_profiles) else {
             panic!("a frame with SSS texturing or transmission has profile IDs and a table");
         };
-        pass.input(ids).per_frame(table);
+        pass.input("profile_ids", ids).per_frame(table);
     }
     if let Some(maps) = shadows {
-        // `lighting_defines` numbered the shadow bindings from here.
-        debug_assert_eq!(
-            pass.next_binding(),
-            lighting_bindings_before_shadows(&gb.layout)
-        );
-        pass.per_frame(&shadows::TABLE_REGION).sample(&maps.depth);
+        pass.per_frame(&shadows::TABLE_REGION)
+            .sample("shadow_depth", &maps.depth);
         if let Some(ids) = &maps.ids {
-            pass.sample(ids);
+            pass.sample("shadow_ids", ids);
         }
     }
     pass.color(&mut hdr, LoadOp::DontCare);
@@ -115,22 +111,10 @@ pub fn lighting_pass(
 /// The lighting pass's fragment shader.
 const LIGHTING_FRAGMENT: &str = "deferred/lighting.frag";
 
-/// The lighting pass's descriptor bindings before the SSS texturing pair
-/// (glsl/deferred/lighting.frag): 0-3 always, 4 (GB2) and 5 (material table) with translucency.
-fn lighting_bindings_before_texturing(layout: &GBufferLayout) -> usize {
-    4 + 2 * usize::from(layout.translucency.is_some())
-}
-
 /// Whether the lighting pass reads the SSS profile IDs and table: some profile applies its
 /// albedo after the blur, or transmits light through its medium.
 fn reads_profiles(layout: &GBufferLayout) -> bool {
     layout.sss_texturing || layout.sss_medium
-}
-
-/// The lighting pass's descriptor bindings before the shadow bindings: then the profile IDs and
-/// the SSS profile table when it reads them ([`reads_profiles`]).
-fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
-    lighting_bindings_before_texturing(layout) + 2 * usize::from(reads_profiles(layout))
 }
 
 /// The lighting pass's defines: the plain shader's, and with translucency the extra ones of the
@@ -139,23 +123,15 @@ fn lighting_bindings_before_shadows(layout: &GBufferLayout) -> usize {
 fn lighting_defines(layout: &GBufferLayout, shadows: Option<bool>) -> (Defines, Option<Defines>) {
     let mut plain: Vec<(&'static str, &'static str)> = Vec::new();
     if shadows.is_some() {
-        plain.extend(shadows::lighting_defines(lighting_bindings_before_shadows(
-            layout,
-        )));
+        plain.extend(shadows::LIGHTING_DEFINES);
     }
     if layout.sss {
         plain.push(("LUCENT_SPLIT_SPECULAR", "1"));
     }
     if reads_profiles(layout) {
-        // The profile IDs' binding (named for its first use: profiles in `pre` mode keep
+        // The profile IDs and table (named for their first use: profiles in `pre` mode keep
         // their albedo in the light, sss_albedo_before).
-        plain.push((
-            "LUCENT_SSS_TEXTURING",
-            match lighting_bindings_before_texturing(layout) {
-                4 => "4",
-                _ => "6",
-            },
-        ));
+        plain.push(("LUCENT_SSS_TEXTURING", "1"));
     }
     if layout.sss_medium {
         // Media's reflectance, and their transmission where light-space maps measure the

@@ -2,10 +2,10 @@
 //!
 //! A [`FullscreenPass`] is declared with one call chain: each [`sample`](FullscreenPass::sample),
 //! [`input`](FullscreenPass::input) or [`color`](FullscreenPass::color) declares the graph access
-//! and appends the shader's next descriptor binding, [`per_frame`](FullscreenPass::per_frame)
-//! appends a region of the per-frame buffer, and binding numbers a shader takes as defines
-//! ([`binding_define`](FullscreenPass::binding_define), [`shadows`](FullscreenPass::shadows))
-//! come from that same order. The pass owns its pipeline (and the variant some passes draw
+//! and appends a descriptor binding under the name the shader gives the resource, and
+//! [`per_frame`](FullscreenPass::per_frame) a region of the per-frame buffer under its uniform
+//! block's name: the shader declares its resources without numbers, and the declaration's
+//! order numbers them ([`crate::backend::bindings`]). The pass owns its pipeline (and the variant some passes draw
 //! outside their tiles), its descriptor set and its samplers, and records the fullscreen
 //! triangle over the whole screen or over tile rectangles. Declared without a scene on the GPU
 //! (`lucent plan`), it declares the graph accesses only.
@@ -37,24 +37,28 @@ use crate::graph::{
 };
 use crate::Result;
 
-/// Binding numbers as define strings.
-const NUMBERS: [&str; 24] = [
-    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12", "13", "14", "15", "16",
-    "17", "18", "19", "20", "21", "22", "23",
-];
-
 /// The rectangles a pass draws in the recorded frame (`None`: the whole screen).
 type Tiles = Box<dyn Fn(&SceneGpu, &RecordContext<'_>) -> Option<Vec<TileRect>> + Send>;
 
 /// One descriptor binding, as declared.
 #[derive(Clone, Copy, Debug)]
 enum Slot {
-    /// A region of the per-frame buffer.
+    /// A region of the per-frame buffer (the shaders' name for it is its block's).
     PerFrame(&'static Region),
-    /// An image sampled through a clamp sampler with this filter.
-    Sampled(ResourceId, vk::Filter),
-    /// An input attachment in this layout.
-    Input(ResourceId, vk::ImageLayout),
+    /// An image the shaders name so, sampled through a clamp sampler with this filter.
+    Sampled(&'static str, ResourceId, vk::Filter),
+    /// An image the shaders name so, an input attachment in this layout.
+    Input(&'static str, ResourceId, vk::ImageLayout),
+}
+
+impl Slot {
+    /// The name the shaders give the binding, which numbers it there.
+    fn name(&self) -> &'static str {
+        match *self {
+            Slot::PerFrame(region) => region.block,
+            Slot::Sampled(name, ..) | Slot::Input(name, ..) => name,
+        }
+    }
 }
 
 /// A fullscreen raster pass being declared (see the module docs). Finish it with
@@ -147,39 +151,49 @@ impl<'g> FullscreenPass<'g> {
         self
     }
 
-    /// Samples the image (nearest texels) and binds it.
-    pub fn sample(&mut self, handle: &Handle<Image>) -> &mut Self {
-        self.sample_with(handle, vk::Filter::NEAREST)
+    /// Samples the image (nearest texels) and binds it as the shaders' `name`.
+    pub fn sample(&mut self, name: &'static str, handle: &Handle<Image>) -> &mut Self {
+        self.sample_with(name, handle, vk::Filter::NEAREST)
     }
 
-    /// Samples the image (`LINEAR`: taps between texels) and binds it.
-    pub fn sample_with(&mut self, handle: &Handle<Image>, filter: vk::Filter) -> &mut Self {
+    /// Samples the image (`LINEAR`: taps between texels) and binds it as the shaders' `name`.
+    pub fn sample_with(
+        &mut self,
+        name: &'static str,
+        handle: &Handle<Image>,
+        filter: vk::Filter,
+    ) -> &mut Self {
         self.pass.sample(handle);
-        self.slots.push(Slot::Sampled(handle.id(), filter));
+        self.slots.push(Slot::Sampled(name, handle.id(), filter));
         self
     }
 
-    /// Binds an image the pass already declared a read of, sampled with `filter` (for shaders
-    /// that number an image after ones the graph reads later).
+    /// Binds an image the pass already declared a read of as the shaders' `name`, sampled
+    /// with `filter` (an image the graph reads before the pass binds it).
     ///
     /// # Panics
     /// If the pass does not read the image's current version (a declaration bug).
-    pub fn bind_sampled(&mut self, handle: &Handle<Image>, filter: vk::Filter) -> &mut Self {
+    pub fn bind_sampled(
+        &mut self,
+        name: &'static str,
+        handle: &Handle<Image>,
+        filter: vk::Filter,
+    ) -> &mut Self {
         assert!(
             self.pass.reads(handle),
             "pass '{}' binds an image it does not read",
             self.name
         );
-        self.slots.push(Slot::Sampled(handle.id(), filter));
+        self.slots.push(Slot::Sampled(name, handle.id(), filter));
         self
     }
 
     /// Reads the image at the pixel being shaded (`subpassLoad`) and binds it as an input
-    /// attachment.
-    pub fn input(&mut self, handle: &Handle<Image>) -> &mut Self {
+    /// attachment, the shaders' `name`.
+    pub fn input(&mut self, name: &'static str, handle: &Handle<Image>) -> &mut Self {
         let layout = self.pass.input_access(handle).info().layout;
         self.pass.input(handle);
-        self.slots.push(Slot::Input(handle.id(), layout));
+        self.slots.push(Slot::Input(name, handle.id(), layout));
         self
     }
 
@@ -209,15 +223,8 @@ impl<'g> FullscreenPass<'g> {
         self
     }
 
-    /// Defines `name` as the number of the next binding (a shader whose bindings depend on
-    /// the pass's inputs takes their numbers as defines).
-    pub fn binding_define(&mut self, name: &'static str) -> &mut Self {
-        let number = NUMBERS[self.slots.len().min(NUMBERS.len() - 1)];
-        self.define(name, number)
-    }
-
-    /// Samples the light-space maps' depth atlas: their defines (glsl/common/shadows.glsl,
-    /// numbered from the next binding), the shadow table and the atlas.
+    /// Samples the light-space maps' depth atlas: their defines (glsl/common/shadows.glsl),
+    /// the shadow table and the atlas.
     pub fn shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
         self.pass.sample(depth);
         self.bind_shadows(depth)
@@ -225,9 +232,12 @@ impl<'g> FullscreenPass<'g> {
 
     /// [`Self::shadows`] for a depth atlas the pass already declared a read of.
     pub fn bind_shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
-        self.defines(&super::shadows::lighting_defines(self.slots.len()));
-        self.per_frame(&super::shadows::TABLE_REGION)
-            .bind_sampled(depth, vk::Filter::NEAREST)
+        self.defines(&super::shadows::LIGHTING_DEFINES);
+        self.per_frame(&super::shadows::TABLE_REGION).bind_sampled(
+            "shadow_depth",
+            depth,
+            vk::Filter::NEAREST,
+        )
     }
 
     /// Push constants the pass pushes before drawing (visible to both stages).
@@ -273,11 +283,6 @@ impl<'g> FullscreenPass<'g> {
             label: "translucent",
         });
         self
-    }
-
-    /// The number the next binding gets.
-    pub fn next_binding(&self) -> usize {
-        self.slots.len()
     }
 
     /// The shader defines declared so far: what the pipeline is built with once the pass is
@@ -349,6 +354,7 @@ fn sampler(
 impl PassExec for FullscreenExec {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         let views = ctx.descriptor_views;
+        let names: Vec<&'static str> = self.slots.iter().map(Slot::name).collect();
         let mut bindings = Vec::with_capacity(self.slots.len());
         for slot in &self.slots {
             bindings.push(match *slot {
@@ -361,7 +367,7 @@ impl PassExec for FullscreenExec {
                     })?;
                     Binding::PerFrame(scene.per_frame.binding(region))
                 }
-                Slot::Sampled(id, filter) => {
+                Slot::Sampled(_, id, filter) => {
                     let sampler = sampler(&mut self.samplers, ctx, filter)?;
                     if views[id] == vk::ImageView::null() {
                         // A host's image bound when its frame is recorded (bind_view).
@@ -370,7 +376,7 @@ impl PassExec for FullscreenExec {
                         Binding::Sampled(views[id], sampler)
                     }
                 }
-                Slot::Input(id, layout) => Binding::InputAttachment(views[id], layout),
+                Slot::Input(_, id, layout) => Binding::InputAttachment(views[id], layout),
             });
         }
         let desc = GraphicsPipelineDesc {
@@ -385,7 +391,7 @@ impl PassExec for FullscreenExec {
             self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);
             return Ok(());
         }
-        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &names, &desc)?;
         if let Some(variant) = &self.variant {
             let name = format!("{} ({})", self.name, variant.label);
             let (main, variant) = pipeline.with_variant(ctx, &desc, &variant.extra, &name)?;
@@ -461,7 +467,7 @@ impl PassExec for FullscreenExec {
             crate::LucentError::Graph(format!("pass '{}' has no descriptor set", self.name))
         })?;
         for (binding, s) in self.slots.iter().enumerate() {
-            if matches!(*s, Slot::Sampled(sampled, _) if sampled == id) {
+            if matches!(*s, Slot::Sampled(_, sampled, _) if sampled == id) {
                 pipeline
                     .set
                     .write_view(&gpu.device, slot, binding as u32, view)?;
@@ -504,7 +510,7 @@ mod tests {
     }
 
     #[test]
-    fn binding_numbers_follow_the_declaration_order() {
+    fn bindings_follow_the_declaration_order_under_the_shaders_names() {
         let mut graph = RenderGraph::new();
         let (a, b, depth) = (
             image(&mut graph, "a"),
@@ -513,19 +519,16 @@ mod tests {
         );
         let mut out = image(&mut graph, "out");
         let mut pass = FullscreenPass::new(&mut graph, "pass", "post/tonemap.frag", None);
-        pass.per_frame(&FRAME).sample(&a).graph().sample(&depth);
-        pass.binding_define("LUCENT_B_BINDING")
-            .sample_with(&b, vk::Filter::LINEAR)
+        pass.per_frame(&FRAME)
+            .sample("a", &a)
+            .graph()
+            .sample(&depth);
+        pass.sample_with("b", &b, vk::Filter::LINEAR)
             .bind_shadows(&depth)
             .color(&mut out, LoadOp::DontCare);
-        assert_eq!(
-            pass.shader_defines(),
-            &[
-                ("LUCENT_B_BINDING", "2"),
-                ("LUCENT_SHADOWS", "1"),
-                ("LUCENT_SHADOW_BINDING", "3"),
-            ]
-        );
+        let names: Vec<&str> = pass.slots.iter().map(Slot::name).collect();
+        assert_eq!(names, ["Frame", "a", "b", "Shadows", "shadow_depth"]);
+        assert_eq!(pass.shader_defines(), &[("LUCENT_SHADOWS", "1")]);
         pass.finish();
         // Planning only: the graph accesses, in declaration order, and no code.
         let decl = &graph.passes[0];
@@ -542,6 +545,6 @@ mod tests {
         let mut graph = RenderGraph::new();
         let a = image(&mut graph, "a");
         let mut pass = FullscreenPass::new(&mut graph, "pass", "post/tonemap.frag", None);
-        pass.bind_sampled(&a, vk::Filter::NEAREST);
+        pass.bind_sampled("a", &a, vk::Filter::NEAREST);
     }
 }

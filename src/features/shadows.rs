@@ -274,7 +274,7 @@ impl ShadowUniforms {
 pub const SHADOW_TABLE_BYTES: u64 = std::mem::size_of::<ShadowUniforms>() as u64;
 
 /// The light-space maps' table in the per-frame buffer.
-pub static TABLE_REGION: Region = Region::new("light-space maps' table");
+pub static TABLE_REGION: Region = Region::new("light-space maps' table", "Shadows");
 
 /// The per-frame region a frame with shadows writes its table into.
 pub fn table_region() -> TableRegion {
@@ -493,10 +493,9 @@ impl ShadowPass {
 
     /// Set 0 with depth-texture pair `index` (glsl/shadow/depth.frag): the maps' table, then
     /// in frames with `TexDep` media the pair's textures.
-    fn bindings(&self, index: usize) -> Vec<Binding> {
-        let mut bindings = vec![Binding::PerFrame(
-            self.scene.per_frame.binding(&TABLE_REGION),
-        )];
+    fn bindings(&self, index: usize) -> Vec<(&'static str, Binding)> {
+        let table = Binding::PerFrame(self.scene.per_frame.binding(&TABLE_REGION));
+        let mut bindings = vec![(TABLE_REGION.block, table)];
         if let (true, Some(maps)) = (self.layer_depths(), &self.scene.maps) {
             let pair = maps.depth_sets.get(index).copied().unwrap_or([0, 0]);
             bindings.extend(super::layer_depth::depth_map_bindings(
@@ -516,9 +515,11 @@ impl PassExec for ShadowPass {
             self.desc.entry,
             self.desc.layer_depth_textures,
         );
+        let (names, bindings): (Vec<_>, Vec<_>) = self.bindings(0).into_iter().unzip();
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &self.bindings(0),
+            &bindings,
+            &names,
             &GraphicsPipelineDesc {
                 vertex: SHADOW_VERTEX,
                 fragment: SHADOW_FRAGMENT,
@@ -538,6 +539,7 @@ impl PassExec for ShadowPass {
                 cull_back: false,
                 additive_attachments: 0,
                 set_layouts: &[],
+                bindings: &[],
                 push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
                 name: "light-space maps",
             },
@@ -549,9 +551,10 @@ impl PassExec for ShadowPass {
         };
         for index in 1..pairs {
             // Identically defined layouts are compatible: these sets bind to the pipeline's.
+            let bindings: Vec<Binding> = self.bindings(index).into_iter().map(|b| b.1).collect();
             let set = DescriptorSet::new(
                 ctx,
-                &self.bindings(index),
+                &bindings,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 "light-space depth maps",
                 ctx.slots,
@@ -699,6 +702,7 @@ impl PassExec for HostShadowPass {
             &[Binding::PerFrame(
                 self.scene.per_frame.binding(&TABLE_REGION),
             )],
+            &[TABLE_REGION.block],
             &GraphicsPipelineDesc {
                 vertex: SHADOW_VERTEX,
                 fragment: SHADOW_FRAGMENT,
@@ -709,6 +713,7 @@ impl PassExec for HostShadowPass {
                 cull_back: false,
                 additive_attachments: 0,
                 set_layouts: &[],
+                bindings: &[],
                 push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
                 name: "light-space maps",
             },
@@ -824,22 +829,9 @@ pub(crate) fn shader_permutations(out: &mut Vec<crate::backend::shader::Pipeline
     }
 }
 
-/// Binding numbers as shader define strings (LUCENT_SHADOW_BINDING).
-const BINDINGS: [&str; 24] = [
-    "0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11", "12", "13", "14", "15", "16",
-    "17", "18", "19", "20", "21", "22", "23",
-];
-
-/// The defines of a pass whose shadow bindings start at `first` (glsl/common/shadows.glsl).
-pub fn lighting_defines(first: usize) -> [(&'static str, &'static str); 2] {
-    [
-        ("LUCENT_SHADOWS", "1"),
-        (
-            "LUCENT_SHADOW_BINDING",
-            BINDINGS[first.min(BINDINGS.len() - 1)],
-        ),
-    ]
-}
+/// The defines of a pass that looks up the light-space maps (glsl/common/shadows.glsl; its
+/// bindings go by their names).
+pub const LIGHTING_DEFINES: [(&str, &str); 1] = [("LUCENT_SHADOWS", "1")];
 
 #[cfg(test)]
 mod tests {

@@ -76,7 +76,7 @@ fn declare(
 ) -> Handle<Image> {
     let mut pass = FullscreenPass::new(graph, "tonemap", TONEMAP_FRAGMENT, scene);
     pass.per_frame(&FRAME)
-        .sample(hdr)
+        .sample("hdr", hdr)
         .color(&mut output, LoadOp::DontCare)
         .defines(tonemap_defines(encoding));
     pass.finish();

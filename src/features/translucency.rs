@@ -196,7 +196,7 @@ pub struct MaterialTableGpu {
 }
 
 /// The GDC 2011 material table in the per-frame buffer.
-pub static TABLE_REGION: Region = Region::new("GDC 2011 material table");
+pub static TABLE_REGION: Region = Region::new("GDC 2011 material table", "TranslucencyMaterials");
 
 /// The per-frame region a frame with translucency writes its material table into.
 pub fn table_region() -> TableRegion {

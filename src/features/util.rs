@@ -5,6 +5,7 @@
 
 use ash::vk;
 
+use crate::backend::bindings::SetBinding;
 use crate::backend::descriptor::{Binding, DescriptorSet};
 use crate::backend::pipeline::{GraphicsPipeline, GraphicsPipelineDesc};
 use crate::backend::pipeline::{PipelineTarget, Recording};
@@ -70,16 +71,29 @@ pub struct PassPipeline {
     pub pipeline: GraphicsPipeline,
     /// Its one descriptor set (set 0).
     pub set: DescriptorSet,
+    /// The set's bindings as declared (names, kinds), which a variant's shaders bind by too.
+    declared: Vec<SetBinding<'static>>,
 }
 
 impl PassPipeline {
     /// Creates the descriptor set from `bindings` (visible to vertex and fragment stages) and
-    /// the pipeline described by `desc` with that set as set 0.
+    /// the pipeline described by `desc` with that set as set 0. `names` gives the name each
+    /// binding has in the shaders, which numbers them ([`crate::backend::bindings`]); a
+    /// binding past its end (or every binding, when it is empty) is numbered by the shaders.
     pub fn new(
         ctx: &PrepareContext<'_>,
         bindings: &[Binding],
+        names: &[&'static str],
         desc: &GraphicsPipelineDesc<'_>,
     ) -> Result<Self> {
+        let declared: Vec<SetBinding<'static>> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| SetBinding {
+                name: names.get(i).copied(),
+                kind: b.kind(),
+            })
+            .collect();
         let mut set = DescriptorSet::new(
             ctx,
             bindings,
@@ -90,10 +104,15 @@ impl PassPipeline {
         let layouts = [set.layout];
         let desc = GraphicsPipelineDesc {
             set_layouts: &layouts,
+            bindings: &declared,
             ..*desc
         };
         match GraphicsPipeline::new(ctx, &desc) {
-            Ok(pipeline) => Ok(Self { pipeline, set }),
+            Ok(pipeline) => Ok(Self {
+                pipeline,
+                set,
+                declared,
+            }),
             Err(e) => {
                 set.destroy(&ctx.gpu.device);
                 Err(e)
@@ -119,6 +138,7 @@ impl PassPipeline {
             &GraphicsPipelineDesc {
                 defines: &defines,
                 set_layouts: &layouts,
+                bindings: &self.declared,
                 name,
                 ..*desc
             },

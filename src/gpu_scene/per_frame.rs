@@ -242,12 +242,15 @@ fn depth_decode(projection: &glam::Mat4) -> [f32; 4] {
 pub struct Region {
     /// What it holds, for errors (never empty: two statics never share an address).
     pub name: &'static str,
+    /// The name of the uniform block the shaders read it as (`uniform Frame { ... };`), by
+    /// which a pass binding it gives the block its number ([`crate::backend::bindings`]).
+    pub block: &'static str,
 }
 
 impl Region {
-    /// A region holding `name`.
-    pub const fn new(name: &'static str) -> Self {
-        Self { name }
+    /// A region holding `name`, read by the shaders as the uniform block `block`.
+    pub const fn new(name: &'static str, block: &'static str) -> Self {
+        Self { name, block }
     }
 }
 
@@ -260,7 +263,7 @@ impl PartialEq for Region {
 impl Eq for Region {}
 
 /// The frame uniforms ([`FrameUniforms`]): every pass's binding 0.
-pub static FRAME: Region = Region::new("frame uniforms");
+pub static FRAME: Region = Region::new("frame uniforms", "Frame");
 
 /// A table region of a frame and its size in bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -52,8 +52,8 @@ use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::features::copy_pass::{
-    copy_defines, floor_defines, COPY_FRAGMENT, FLOOR_FRAGMENT, FLOOR_VERTEX, MAX_COPY_IMAGES,
-    MAX_COPY_INPUTS,
+    copy_defines, floor_defines, COPY_FRAGMENT, COPY_INPUT_NAMES, FLOOR_FRAGMENT, FLOOR_VERTEX,
+    MAX_COPY_IMAGES, MAX_COPY_INPUTS,
 };
 use crate::features::pass::FullscreenPass;
 use crate::features::util::PassPipeline;
@@ -463,8 +463,8 @@ fn declare_copy(graph: &mut RenderGraph, f: usize, name: &str, floor: &PassFloor
     let defines = copy_defines(inputs.len(), floor.colour_writes.len(), depth.is_some());
     let mut pass = FullscreenPass::standalone(graph, name, COPY_FRAGMENT);
     pass.defines(&defines);
-    for input in &inputs {
-        pass.sample(input);
+    for (input, name) in inputs.iter().zip(COPY_INPUT_NAMES) {
+        pass.sample(name, input);
     }
     for output in &mut outputs {
         pass.color(output, LoadOp::DontCare);
@@ -546,6 +546,7 @@ impl PassExec for MeshFloorPass {
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &[Binding::PerFrame(self.scene.per_frame.binding(region))],
+            &[region.block],
             &GraphicsPipelineDesc {
                 vertex: FLOOR_VERTEX,
                 fragment: FLOOR_FRAGMENT,
@@ -555,6 +556,7 @@ impl PassExec for MeshFloorPass {
                 cull_back: self.draws.cull_back,
                 additive_attachments: 0,
                 set_layouts: &[],
+                bindings: &[],
                 push_constant_bytes: std::mem::size_of::<FloorConstants>() as u32,
                 name: "mesh floor",
             },

@@ -286,7 +286,7 @@ pub struct LayeredTableGpu {
 pub const LAYERED_TABLE_BYTES: u64 = std::mem::size_of::<LayeredTableGpu>() as u64;
 
 /// The layered media's table in the per-frame buffer.
-pub static TABLE_REGION: Region = Region::new("layered media table");
+pub static TABLE_REGION: Region = Region::new("layered media table", "Layered");
 
 /// The per-frame region a frame with layered materials writes its table into.
 pub fn table_region() -> TableRegion {
@@ -528,9 +528,9 @@ fn layered_pass<'g>(
     }
     pass.per_frame(&FRAME)
         .per_frame(&TABLE_REGION)
-        .sample(inputs.depth)
-        .sample(inputs.gb1)
-        .sample(inputs.ids);
+        .sample("gbuffer_depth", inputs.depth)
+        .sample("gbuffer_normal", inputs.gb1)
+        .sample("gbuffer_layered", inputs.ids);
     // Only single scattering reads layer thicknesses (multiple scattering's dipole is the
     // first layer's, semi-infinite, as in the paper).
     let layer_depths = inputs.layer_depths.filter(|_| single);
@@ -556,11 +556,20 @@ fn layered_pass<'g>(
     // The image the pass reads at binding 5: the irradiance (the gather) or the term (its
     // blur).
     if let Some(irradiance) = irradiance {
-        pass.bind_sampled(irradiance, vk::Filter::NEAREST);
+        // The term's blur reads the term; multiple scattering the gathered irradiance.
+        let name = if kind == Kind::Blur {
+            "term_tex"
+        } else {
+            "irradiance_tex"
+        };
+        pass.bind_sampled(name, irradiance, vk::Filter::NEAREST);
     }
     if let (true, Some(half_term)) = (single, half_term) {
-        pass.binding_define("LUCENT_HALF_TERM_BINDING")
-            .bind_sampled(half_term, vk::Filter::NEAREST);
+        pass.define("LUCENT_HALF_TERM", "1").bind_sampled(
+            "half_term",
+            half_term,
+            vk::Filter::NEAREST,
+        );
         if scale == 1 && !half_gather {
             pass.define("LUCENT_FULL_RES_TERM", "1");
         }
@@ -573,23 +582,27 @@ fn layered_pass<'g>(
             "LUCENT_LAYER_DEPTHS",
             super::layer_depth::layer_depths_define(inputs.layer_depth_textures),
         )
-        .binding_define("LUCENT_LAYER_DEPTH_BINDING")
-        .bind_sampled(depths, vk::Filter::NEAREST);
+        .bind_sampled("gbuffer_layer_depths", depths, vk::Filter::NEAREST);
     }
     if let Some(maps) = shadows {
         if let Some(entry) = entry {
-            pass.binding_define("LUCENT_ENTRY_BINDING")
-                .bind_sampled(entry, vk::Filter::NEAREST);
+            pass.define("LUCENT_ENTRY", "1").bind_sampled(
+                "shadow_entry",
+                entry,
+                vk::Filter::NEAREST,
+            );
             if let (Some(_), Some(depths)) = (layer_depths, entry_depths) {
-                pass.binding_define("LUCENT_ENTRY_DEPTH_BINDING")
-                    .bind_sampled(depths, vk::Filter::NEAREST);
+                pass.define("LUCENT_ENTRY_DEPTHS", "1").bind_sampled(
+                    "shadow_layer_depths",
+                    depths,
+                    vk::Filter::NEAREST,
+                );
             }
         }
         pass.bind_shadows(&maps.depth);
     }
     if let Some(film) = host_film {
-        pass.binding_define("LUCENT_HOST_FILM_BINDING")
-            .bind_sampled(film, vk::Filter::NEAREST);
+        pass.bind_sampled("host_film", film, vk::Filter::NEAREST);
     }
     match (kind, scale) {
         (Kind::Irradiance, 2) => {
@@ -677,7 +690,6 @@ struct LayeredShape {
     kind: Kind,
     /// The pass runs at half resolution (scale 2).
     half_res: bool,
-    irradiance: bool,
     half_term: bool,
     /// The term single scattering reads is at full resolution (resolved over 3x3 pixels).
     full_res_term: bool,
@@ -693,20 +705,15 @@ struct LayeredShape {
 }
 
 impl LayeredShape {
-    /// The defines [`layered_pass`] gives a pass of this shape, binding numbers counted as it
-    /// appends the bindings (glsl/common/layered.glsl: 0 frame, 1 layered table, 2 depth, 3
-    /// GB1, 4 IDs, then the pass's own in this order).
+    /// The defines [`layered_pass`] gives a pass of this shape.
     fn defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut defines: Vec<(&str, &str)> = Vec::new();
         if let Some(host) = self.host {
             defines.extend(host.defines());
         }
-        let mut next = 5;
         let single = self.kind == Kind::Single;
-        next += usize::from(self.irradiance);
         if single && self.half_term {
-            defines.push(("LUCENT_HALF_TERM_BINDING", NUMBERS[next]));
-            next += 1;
+            defines.push(("LUCENT_HALF_TERM", "1"));
             if self.full_res_term && !self.half_res {
                 defines.push(("LUCENT_FULL_RES_TERM", "1"));
             }
@@ -720,24 +727,15 @@ impl LayeredShape {
                 "LUCENT_LAYER_DEPTHS",
                 super::layer_depth::layer_depths_define(textures),
             ));
-            defines.push(("LUCENT_LAYER_DEPTH_BINDING", NUMBERS[next]));
-            next += 1;
         }
         if self.shadows && matches!(self.kind, Kind::Irradiance | Kind::Single) {
             if single && self.entry {
-                defines.push(("LUCENT_ENTRY_BINDING", NUMBERS[next]));
-                next += 1;
+                defines.push(("LUCENT_ENTRY", "1"));
                 if texdep && self.entry_depths {
-                    defines.push(("LUCENT_ENTRY_DEPTH_BINDING", NUMBERS[next]));
-                    next += 1;
+                    defines.push(("LUCENT_ENTRY_DEPTHS", "1"));
                 }
             }
-            defines.extend(shadows::lighting_defines(next));
-            // The shadow table and the atlas.
-            next += 2;
-        }
-        if single && self.film && self.host.is_some() {
-            defines.push(("LUCENT_HOST_FILM_BINDING", NUMBERS[next]));
+            defines.extend(shadows::LIGHTING_DEFINES);
         }
         match (self.kind, self.half_res) {
             (Kind::Irradiance, true) => defines.push(("LUCENT_HALF_RES", "1")),
@@ -772,7 +770,6 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
                     let shape = LayeredShape {
                         kind,
                         half_res: bit(0),
-                        irradiance: bit(1),
                         half_term: bit(2),
                         full_res_term: bit(6),
                         layer_depths,
@@ -791,9 +788,6 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
         }
     }
 }
-
-/// Binding numbers as define strings.
-const NUMBERS: [&str; 12] = ["0", "1", "2", "3", "4", "5", "6", "7", "8", "9", "10", "11"];
 
 /// Li et al.'s layered media as a registered technique (`--technique layered`).
 pub struct LiLayeredMedia;
@@ -914,7 +908,6 @@ mod tests {
                     let shape = LayeredShape {
                         kind,
                         half_res: bit(0),
-                        irradiance: bit(1),
                         half_term: bit(2),
                         full_res_term: bit(6),
                         layer_depths: (textures > 0).then_some(textures),

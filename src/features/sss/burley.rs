@@ -24,8 +24,6 @@
 
 use std::sync::Arc;
 
-use ash::vk;
-
 use super::settings::BURLEY_BUDGET_RANGE;
 use super::{chain_tiles, sss_pass, BlurConstants, Chain, SssBlurTechnique, SssInputs, SssKnobs};
 use super::{SssProfiles, MAX_SSS_PROFILES};
@@ -123,7 +121,7 @@ pub static FIT: Knob = Knob {
 };
 
 /// The Burley table in the per-frame buffer.
-pub static TABLE_REGION: Region = Region::new("SSS Burley table");
+pub static TABLE_REGION: Region = Region::new("SSS Burley table", "SssBurley");
 
 /// The Burley table, std140 (glsl/sss/burley.frag `SssBurley`).
 #[repr(C)]
@@ -318,9 +316,9 @@ impl SssBlurTechnique for BurleyChain {
         let name = format!("{}burley", chain.prefix);
         let mut pass = sss_pass(graph, inputs, &name, GATHER_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
-        for image in [inputs.diffuse, inputs.depth, inputs.profile_ids] {
-            pass.sample_with(image, vk::Filter::NEAREST);
-        }
+        pass.sample("diffuse_tex", inputs.diffuse)
+            .sample("depth_tex", inputs.depth)
+            .sample("profile_tex", inputs.profile_ids);
         // Per pixel: the centre's light and profile, then per sample its light and profile ID
         // (depth travels in the light's alpha), up to the budget.
         pass.taps(2 + 2 * knobs.burley_budget);
@@ -340,21 +338,20 @@ impl SssBlurTechnique for BurleyChain {
         let name = format!("{}burley resolve", chain.prefix);
         let mut pass = sss_pass(graph, inputs, &name, RESOLVE_FRAGMENT, scene, constants);
         pass.per_frame(&TABLE_REGION);
-        let mut reads = vec![
-            &gathered,
-            inputs.profile_ids,
-            inputs.diffuse,
-            inputs.specular,
-        ];
-        reads.extend(base);
+        pass.sample("gathered_tex", &gathered)
+            .sample("profile_tex", inputs.profile_ids)
+            .sample("diffuse_tex", inputs.diffuse)
+            .sample("specular_tex", inputs.specular);
+        if let Some(base) = base {
+            pass.sample("base_tex", base);
+        }
         // The albedo the lighting pass left out of the light; at half resolution the depth
         // (each pixel's own, against the gathered texels').
-        reads.extend(inputs.albedo);
-        if half_res {
-            reads.push(inputs.depth);
+        if let Some(albedo) = inputs.albedo {
+            pass.sample("albedo_tex", albedo);
         }
-        for image in reads {
-            pass.sample_with(image, vk::Filter::NEAREST);
+        if half_res {
+            pass.sample("depth_tex", inputs.depth);
         }
         // The centre's profile, then nine gathered texels (and their profile IDs with several
         // profiles), the lit diffuse and specular.

@@ -104,6 +104,7 @@ pub(super) fn chain_passes(
             chain,
             constants([1.0, 0.0]),
             &source_handles,
+            packed && source_handles.len() == 1,
             inputs,
         );
         pass.taps(fetches(source_handles.len() as u32))
@@ -128,6 +129,7 @@ pub(super) fn chain_passes(
             chain,
             constants([0.0, 1.0]),
             &temps,
+            packed && temps.len() == 1,
             inputs,
         );
         pass.taps(fetches(temps.len() as u32))
@@ -170,18 +172,26 @@ pub(super) fn chain_passes(
     };
     // The chain's last pass samples every input at its own pixel: on the pixels of its chain's
     // profiles it writes the blurred light; elsewhere the previous chain's result (`base`), or
-    // the lighting pass's diffuse + specular. Inputs in the shader's binding order (after the
-    // frame uniforms and the profile table).
-    let mut reads: Vec<&Handle<Image>> = sum.iter().collect();
-    reads.extend([inputs.diffuse, inputs.specular, inputs.profile_ids]);
+    // the lighting pass's diffuse + specular. Each input with the shaders' name for it.
+    let mut reads: Vec<(&'static str, &Handle<Image>)> =
+        ["sum_tex", "lean_sum_tex"].into_iter().zip(&sum).collect();
+    reads.extend([
+        ("diffuse_tex", inputs.diffuse),
+        ("specular_tex", inputs.specular),
+        ("profile_tex", inputs.profile_ids),
+    ]);
     if let Some(l) = lean {
-        reads.extend([inputs.depth, l.gb0, l.gb1]);
+        reads.extend([
+            ("depth_tex", inputs.depth),
+            ("albedo_tex", l.gb0),
+            ("normal_tex", l.gb1),
+        ]);
     }
-    reads.extend(base);
+    reads.extend(base.map(|b| ("base_tex", b)));
     // The albedo left out of the light: LCB's and LBB's pass reads GB0 already; the control's
-    // combine reads it last.
+    // combine reads it too.
     if let (Some(albedo), None) = (inputs.albedo, lean) {
-        reads.push(albedo);
+        reads.push(("albedo_tex", albedo));
     }
     let constants = BlurConstants {
         step: [0.0, 0.0, 0.0, chain.index as f32],
@@ -201,8 +211,8 @@ pub(super) fn chain_passes(
         false,
     );
     pass.defines(&defines);
-    for h in &reads {
-        pass.sample(h);
+    for (name, h) in reads {
+        pass.sample(name, h);
     }
     // LEAN specular is direct light: the light-space maps shadow it.
     if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some()) {
@@ -224,13 +234,13 @@ pub(super) fn chain_passes(
     hdr
 }
 
-/// Starts a blur pass of an iterative chain reading `colors` (the light, and with LCB and LBB
-/// the LEAN texel): bindings as glsl/sss/blur.frag declares them, 5 the LEAN texel, though the
-/// graph reads it second. The control's taps fall between texels (linear); depth, profile IDs
+/// Starts a blur pass of an iterative chain reading `colors` (the light, packed with the LEAN
+/// texel when `packed_in`, or with LCB and LBB the LEAN texel beside it). The control's taps fall between texels (linear); depth, profile IDs
 /// and the bilateral blur's whole-texel taps are read nearest (texelFetch; depth formats need
 /// not support linear filtering). It draws only where objects of its chain (and their blur's
 /// reach) can be: every pixel a tap of a scattering pixel reads is written; the rest is never
 /// read.
+#[allow(clippy::too_many_arguments)]
 fn blur_pass<'g>(
     graph: &'g mut RenderGraph,
     name: &str,
@@ -238,6 +248,7 @@ fn blur_pass<'g>(
     chain: &Chain,
     constants: BlurConstants,
     colors: &[&Handle<Image>],
+    packed_in: bool,
     inputs: &SssInputs<'_>,
 ) -> FullscreenPass<'g> {
     let filter = if chain.blur.bilateral() {
@@ -246,14 +257,13 @@ fn blur_pass<'g>(
         vk::Filter::LINEAR
     };
     let mut pass = sss_pass(graph, inputs, name, BLUR_FRAGMENT, scene, constants);
-    pass.sample_with(colors[0], filter);
+    let first = if packed_in { "packed_tex" } else { "color_tex" };
+    pass.sample_with(first, colors[0], filter);
     for lean in &colors[1..] {
-        pass.graph().sample(lean);
+        pass.sample_with("lean_tex", lean, filter);
     }
-    pass.sample(inputs.depth).sample(inputs.profile_ids);
-    for lean in &colors[1..] {
-        pass.bind_sampled(lean, filter);
-    }
+    pass.sample("depth_tex", inputs.depth)
+        .sample("profile_tex", inputs.profile_ids);
     let index = chain.index;
     pass.tiles(move |scene, ctx| chain_tiles(scene, ctx, index));
     pass
@@ -312,14 +322,6 @@ fn blur_defines(
     defines
 }
 
-/// The final pass's bindings before the shadow bindings: the per-frame pair, the sums (two
-/// with LEAN), diffuse, specular, profile IDs, with LEAN depth, GB0 and GB1, and the previous
-/// chain's result (`base`).
-fn final_bindings(lean: bool, base: bool) -> usize {
-    let sums = if lean { 2 } else { 1 };
-    2 + sums + 3 + 3 * usize::from(lean) + usize::from(base)
-}
-
 /// The final pass's defines (`lean`: LEAN `final lighting`, else `combine`), and with LEAN the
 /// pass-through variant's extra define. `shadows`: LEAN specular reads the light-space maps.
 fn final_defines(
@@ -336,9 +338,7 @@ fn final_defines(
         defines.push(("LUCENT_SSS_ALBEDO", "1"));
     }
     if shadows {
-        defines.extend(crate::features::shadows::lighting_defines(final_bindings(
-            lean, base,
-        )));
+        defines.extend(crate::features::shadows::LIGHTING_DEFINES);
     }
     (defines, lean.then(|| vec![("LUCENT_SSS_PASSTHROUGH", "1")]))
 }

@@ -786,9 +786,9 @@ pub fn host_albedo_pass(
     let mut pass = FullscreenPass::new(graph, "sss albedo in", HOST_ALBEDO_FRAGMENT, scene);
     pass.per_frame(&FRAME)
         .per_frame(&tables::PROFILES)
-        .sample(inputs.diffuse)
-        .sample(albedo)
-        .sample(inputs.profile_ids)
+        .sample("diffuse_tex", inputs.diffuse)
+        .sample("albedo_tex", albedo)
+        .sample("profile_tex", inputs.profile_ids)
         .defines(&host_albedo_defines(inputs.id_defines, included))
         .color(&mut out, crate::graph::LoadOp::DontCare);
     pass.finish();
@@ -877,11 +877,11 @@ pub fn host_lean_pass(
     pass.per_frame(&FRAME)
         .per_frame(&tables::PROFILES)
         .per_frame(decode)
-        .sample(inputs.diffuse)
-        .sample(normals)
-        .sample(inputs.profile_ids);
+        .sample("diffuse_tex", inputs.diffuse)
+        .sample("normal_tex", normals)
+        .sample("profile_tex", inputs.profile_ids);
     if let Some((albedo, _)) = albedo {
-        pass.sample(albedo);
+        pass.sample("albedo_tex", albedo);
     }
     pass.defines(&host_lean_defines(inputs.id_defines, mode))
         // The LEAN texels only where a chain blurs (its tiles: the host's regions); elsewhere

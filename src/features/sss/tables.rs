@@ -9,11 +9,11 @@ use crate::gpu_scene::{PerFrame, Region, TableRegion};
 use crate::Result;
 
 /// The SSS profile table ([`super::ProfileTableGpu`]): every frame with SSS.
-pub static PROFILES: Region = Region::new("SSS profile table");
+pub static PROFILES: Region = Region::new("SSS profile table", "SssProfiles");
 
 /// The two-pass blurs' kernel table ([`super::kernel::kernel_table`]): frames with a two-pass
 /// chain.
-pub static KERNELS: Region = Region::new("SSS kernel table");
+pub static KERNELS: Region = Region::new("SSS kernel table", "SssKernels");
 
 /// The regions `profiles`' frame needs: the profile table and each chain's own table (once
 /// per region: chains that share a table share its region).

@@ -61,7 +61,7 @@ pub(super) fn chain_passes(
     };
     let mut temp = graph.create_image(&chain.image_name("temp"), blur_info);
     let mut temp_lean = lean.map(|_| graph.create_image(&chain.image_name("temp.lean"), blur_info));
-    let shape = |vertical: bool, compose: bool, inputs: usize| PassShape {
+    let shape = |vertical: bool, compose: bool| PassShape {
         bilateral: blur.bilateral(),
         vertical,
         compose,
@@ -72,19 +72,22 @@ pub(super) fn chain_passes(
         point_taps: knobs.point_taps,
         albedo: compose && albedo_after,
         samples,
-        inputs,
     };
 
     // Horizontal: the lit diffuse (and the LEAN target) into the temporaries.
-    let mut reads: Vec<&Handle<Image>> = vec![inputs.diffuse, inputs.depth, inputs.profile_ids];
-    reads.extend(lean.map(|l| l.view_plane));
+    let mut reads: Vec<(&'static str, &Handle<Image>)> = vec![
+        ("color_tex", inputs.diffuse),
+        ("depth_tex", inputs.depth),
+        ("profile_tex", inputs.profile_ids),
+    ];
+    reads.extend(lean.map(|l| ("lean_tex", l.view_plane)));
     let mut pass = blur_pass(
         graph,
         inputs,
         &format!("{}horizontal blur", chain.prefix),
         scene,
         chain,
-        shape(false, false, reads.len()),
+        shape(false, false),
         [1.0, 0.0],
         &reads,
     );
@@ -115,17 +118,24 @@ pub(super) fn chain_passes(
     } else {
         result(graph)
     };
-    let mut reads: Vec<&Handle<Image>> = vec![&temp, inputs.depth, inputs.profile_ids];
-    reads.extend(temp_lean.as_ref());
+    let mut reads: Vec<(&'static str, &Handle<Image>)> = vec![
+        ("color_tex", &temp),
+        ("depth_tex", inputs.depth),
+        ("profile_tex", inputs.profile_ids),
+    ];
+    reads.extend(temp_lean.as_ref().map(|t| ("lean_tex", t)));
     if !half_res {
-        reads.extend([inputs.diffuse, inputs.specular]);
+        reads.extend([
+            ("diffuse_tex", inputs.diffuse),
+            ("specular_tex", inputs.specular),
+        ]);
         if let Some(l) = lean {
-            reads.extend([l.gb0, l.gb1]);
+            reads.extend([("albedo_tex", l.gb0), ("normal_tex", l.gb1)]);
         }
-        reads.extend(base);
-        // The albedo left out of the light, read last (the LEAN pass reads GB0 already).
+        reads.extend(base.map(|b| ("base_tex", b)));
+        // The albedo left out of the light (the LEAN pass reads GB0 already).
         if lean.is_none() {
-            reads.extend(inputs.albedo);
+            reads.extend(inputs.albedo.map(|a| ("albedo_tex", a)));
         }
     }
     let mut pass = blur_pass(
@@ -134,7 +144,7 @@ pub(super) fn chain_passes(
         &format!("{}vertical blur", chain.prefix),
         scene,
         chain,
-        shape(true, !half_res, reads.len()),
+        shape(true, !half_res),
         [0.0, 1.0],
         &reads,
     );
@@ -154,22 +164,22 @@ pub(super) fn chain_passes(
 
     // Upsample: the half-resolution blur composed at full resolution.
     let mut hdr = result(graph);
-    let mut reads: Vec<&Handle<Image>> = vec![
-        &vertical_out,
-        inputs.depth,
-        inputs.profile_ids,
-        inputs.diffuse,
-        inputs.specular,
+    let mut reads: Vec<(&'static str, &Handle<Image>)> = vec![
+        ("blurred_tex", &vertical_out),
+        ("depth_tex", inputs.depth),
+        ("profile_tex", inputs.profile_ids),
+        ("diffuse_tex", inputs.diffuse),
+        ("specular_tex", inputs.specular),
     ];
-    reads.extend(base);
-    reads.extend(inputs.albedo);
+    reads.extend(base.map(|b| ("base_tex", b)));
+    reads.extend(inputs.albedo.map(|a| ("albedo_tex", a)));
     let mut pass = blur_pass(
         graph,
         inputs,
         &format!("{}upsample", chain.prefix),
         scene,
         chain,
-        shape(true, true, reads.len()),
+        shape(true, true),
         [0.0, 0.0],
         &reads,
     );
@@ -179,8 +189,8 @@ pub(super) fn chain_passes(
 }
 
 /// Starts one pass of a two-pass chain: the kernel table bound after the per-frame pair, then
-/// `reads` in the shader's binding order (the light the separable blur taps between texels
-/// linear, the rest nearest), pushing the blur `direction`. It draws only where objects of its
+/// `reads`, each with the shaders' name for it (the light, first, the separable blur taps
+/// between texels linear, the rest nearest), pushing the blur `direction`. It draws only where objects of its
 /// chain (and their blur's reach) can be, at half resolution in halved rectangles; a composing
 /// pass draws its pass-through variant on the other rectangles.
 #[allow(clippy::too_many_arguments)]
@@ -192,20 +202,20 @@ fn blur_pass<'g>(
     chain: &Chain,
     shape: PassShape,
     direction: [f32; 2],
-    reads: &[&Handle<Image>],
+    reads: &[(&'static str, &Handle<Image>)],
 ) -> FullscreenPass<'g> {
     let constants = BlurConstants {
         step: [direction[0], direction[1], 0.0, chain.index as f32],
     };
     let mut pass = sss_pass(graph, inputs, name, shape.fragment(), scene, constants);
     pass.per_frame(&super::tables::KERNELS);
-    for (i, h) in reads.iter().enumerate() {
+    for (i, &(name, h)) in reads.iter().enumerate() {
         let filter = if i == 0 && !chain.blur.bilateral() {
             vk::Filter::LINEAR
         } else {
             vk::Filter::NEAREST
         };
-        pass.sample_with(h, filter);
+        pass.sample_with(name, h, filter);
     }
     let (defines, passthrough) = shape.defines(false);
     pass.defines(&defines);
@@ -242,8 +252,6 @@ struct PassShape {
     /// (`SssInputs::albedo`).
     albedo: bool,
     samples: u32,
-    /// Images sampled (after the per-frame bindings and the kernel table).
-    inputs: usize,
 }
 
 impl PassShape {
@@ -260,11 +268,6 @@ impl PassShape {
         } else {
             "sss/separable.frag"
         }
-    }
-
-    /// Bindings before the shadow bindings: the per-frame pair, the kernel table, the inputs.
-    fn bindings(&self) -> usize {
-        3 + self.inputs
     }
 
     /// The defines (`shadows`: the bilateral vertical pass's LEAN specular reads the
@@ -312,7 +315,7 @@ impl PassShape {
             }
         }
         if shadows {
-            defines.extend(crate::features::shadows::lighting_defines(self.bindings()));
+            defines.extend(crate::features::shadows::LIGHTING_DEFINES);
         }
         (
             defines,
@@ -321,10 +324,7 @@ impl PassShape {
     }
 }
 
-/// The pipelines a two-pass chain of `blur` builds in any frame. Only the shadowed pass (the
-/// bilateral chain's full-resolution vertical pass with LEAN) numbers bindings after its
-/// inputs: temp, depth, profile IDs, the LEAN temp, diffuse, specular, GB0, GB1 and the
-/// previous chain's result (`base`), as `chain_passes` reads them.
+/// The pipelines a two-pass chain of `blur` builds in any frame.
 pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<PipelineShaders>) {
     for flags in 0u32..1 << 8 {
         let bit = |i: u32| flags & (1 << i) != 0;
@@ -344,7 +344,6 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
                 point_taps: bit(6),
                 albedo: bit(7),
                 samples,
-                inputs: 8 + usize::from(bit(3)),
             };
             for shadows in [false, true] {
                 let (defines, passthrough) = shape.defines(shadows);

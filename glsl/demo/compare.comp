@@ -5,9 +5,9 @@
 // Difference: |technique - plain| x gain, on the display-encoded values.
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(set = 0, binding = 0, rgba8) uniform readonly image2D plain_image;
-layout(set = 0, binding = 1, rgba8) uniform readonly image2D technique_image;
-layout(set = 0, binding = 2, rgba8) uniform writeonly image2D out_image;
+layout(set = 0, rgba8) uniform readonly image2D plain_image;
+layout(set = 0, rgba8) uniform readonly image2D technique_image;
+layout(set = 0, rgba8) uniform writeonly image2D out_image;
 
 layout(push_constant) uniform Compare {
     // Columns left of it show the plain frame (0: none do).

@@ -15,6 +15,7 @@
 
 use ash::vk;
 
+use crate::backend::bindings::{bind_by_name, SetBinding};
 use crate::backend::resources::{GpuImage, ImageDesc};
 use crate::backend::shader::{create_shader_module, PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
@@ -26,6 +27,22 @@ use super::controls::{Comparison, DIFFERENCE_GAIN};
 
 /// The shader, relative to the GLSL root.
 pub const SHADER: &str = "demo/compare.comp";
+
+/// The shader's storage images in binding order: the plain frame, the technique's, the output
+/// (the shader takes their numbers from here by name, `backend::bindings`).
+const IMAGES: [SetBinding<'static>; 3] = [
+    storage_image("plain_image"),
+    storage_image("technique_image"),
+    storage_image("out_image"),
+];
+
+/// A storage image binding the shader calls `name`.
+const fn storage_image(name: &'static str) -> SetBinding<'static> {
+    SetBinding {
+        name: Some(name),
+        kind: vk::DescriptorType::STORAGE_IMAGE,
+    }
+}
 /// The shader's work group edge (`local_size_x`, `local_size_y`).
 const GROUP: u32 = 8;
 /// The format of the display images and of the comparison's own images.
@@ -74,7 +91,14 @@ impl Comparer {
         shaders: &ShaderCompiler,
         pipeline_cache: &PipelineCache,
     ) -> Result<Self> {
-        let compiled = shaders.compile(SHADER, &[])?;
+        let mut compiled = shaders.compile(SHADER, &[])?;
+        bind_by_name(&mut compiled.spirv, &IMAGES).map_err(|message| {
+            LucentError::ShaderBindings {
+                pipeline: "demo compare".into(),
+                shader: SHADER.into(),
+                message,
+            }
+        })?;
         let device = &gpu.device;
         let mut comparer = Self {
             set_layout: vk::DescriptorSetLayout::null(),
@@ -85,11 +109,11 @@ impl Comparer {
             images: None,
             written: false,
         };
-        let bindings: Vec<_> = (0..3)
+        let bindings: Vec<_> = (0..IMAGES.len() as u32)
             .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
-                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .descriptor_type(IMAGES[b as usize].kind)
                     .descriptor_count(1)
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })

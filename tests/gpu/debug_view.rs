@@ -226,3 +226,20 @@ fn translucency_term_view_is_the_difference_translucency_makes() {
     assert!(lit > 500, "only {lit} pixels show a translucency term");
     test.finish();
 }
+
+/// The demo's comparison shader (a compute pipeline, made outside the render graph, compiled
+/// at run time as the demo compiles its shaders) binds its three storage images by the names
+/// the shader gives them, and makes its pipeline without a validation error. The scripted demo
+/// turns the comparison views on too, but the demo shows a failed comparison in its panel
+/// instead of failing, so this is where a wrong name fails.
+#[cfg(all(feature = "window", feature = "runtime-shaders"))]
+#[test]
+fn the_demos_comparison_pipeline_binds_its_images_by_name() {
+    let test = TestGpu::new();
+    let root = lucent::backend::shader::ShaderCompiler::default_glsl_root();
+    let shaders = lucent::backend::shader::ShaderCompiler::new(root, None).unwrap();
+    let comparer = lucent::demo::compare::Comparer::new(&test.gpu, &shaders, &test.cache)
+        .expect("the comparison pipeline");
+    comparer.destroy(&test.gpu);
+    test.finish();
+}

@@ -2225,7 +2225,8 @@ fn a_hosts_allocator_and_pipeline_cache_are_used_and_left_alive() {
 enum ViewOutputs {
     /// An image of its own each.
     Separate,
-    /// View k into layer k of one two-layer image (stereo), through a 2-D view of the layer.
+    /// View k into layer k of one two-layer image (stereo), through a 2-D view of the layer,
+    /// reading its inputs from layer k of two-layer images too.
     Layers,
     /// Mip 1 of an image twice the size, with two levels (mip 0 never touched).
     SecondMip,
@@ -2235,10 +2236,11 @@ enum ViewOutputs {
 fn two_views_per_frame_each_equal_their_view_alone() {
     // Split screen or stereo: two cameras recorded into one frame's command buffer, for the
     // same slot, each with its own images, each as it would be alone; the same into the two
-    // layers of one array image (a stereo renderer's eyes), and into the second mip level of
-    // larger images: lucent's barriers then cover the view's layer or level only (a barrier
-    // on layer 0 or mip 0 instead leaves the written subresource in the wrong layout, which
-    // the validation layer reports).
+    // layers of one array image (a stereo renderer's eyes), reading each eye's G-buffer and
+    // light from the layers of array images, and into the second mip level of larger images:
+    // lucent's barriers then cover the view's layer or level only (a barrier on layer 0 or mip
+    // 0 instead leaves the written subresource in the wrong layout, which the validation layer
+    // reports).
     let test = TestGpu::new();
     let gpu = &test.gpu;
     let (w, h) = (160, 120);
@@ -2281,33 +2283,33 @@ fn two_views_per_frame_each_equal_their_view_alone() {
         };
         gpu.upload_image(&desc, &[bytes], "view input").unwrap()
     };
-    let images: Vec<[GpuImage; 4]> = inputs
+    // Per view: depth, diffuse, specular and IDs, their formats and texels.
+    let formats = [
+        vk::Format::D32_SFLOAT,
+        vk::Format::R32G32B32A32_SFLOAT,
+        vk::Format::R32G32B32A32_SFLOAT,
+        vk::Format::R8_UINT,
+    ];
+    let texels: Vec<[Vec<u8>; 4]> = inputs
         .iter()
         .map(|(gb, lit)| {
             [
-                upload(
-                    vk::Format::D32_SFLOAT,
-                    bytemuck::cast_slice(&gb.depth).to_vec(),
-                    true,
-                ),
-                upload(
-                    vk::Format::R32G32B32A32_SFLOAT,
-                    f32_bytes(&lit.diffuse),
-                    false,
-                ),
-                upload(
-                    vk::Format::R32G32B32A32_SFLOAT,
-                    f32_bytes(&lit.specular),
-                    false,
-                ),
-                upload(
-                    vk::Format::R8_UINT,
-                    gb.sss.as_ref().unwrap().iter().map(|&v| v as u8).collect(),
-                    false,
-                ),
+                bytemuck::cast_slice(&gb.depth).to_vec(),
+                f32_bytes(&lit.diffuse),
+                f32_bytes(&lit.specular),
+                gb.sss.as_ref().unwrap().iter().map(|&v| v as u8).collect(),
             ]
         })
         .collect();
+    let images: Vec<[GpuImage; 4]> = texels
+        .iter()
+        .map(|view| [0, 1, 2, 3].map(|i| upload(formats[i], view[i].clone(), i == 0)))
+        .collect();
+    // The same inputs as two-layer images, view k's in layer k (a stereo G-buffer).
+    let layered: [GpuImage; 4] = [0, 1, 2, 3].map(|i| {
+        let layers = [texels[0][i].clone(), texels[1][i].clone()];
+        upload_layers(&test, &images[0][i].desc, &layers)
+    });
     let profile = SssProfiles::new(
         &scene,
         Some(blur(&lucent::features::sss::separable::SEPARABLE)),
@@ -2392,6 +2394,8 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                 ViewOutputs::SecondMip => (&targets[index], view_of(&targets[index], 1, 0), 1, 0),
             })
             .collect();
+        // The 2-D views of input layers the frame reads, destroyed after it.
+        let mut input_views = Vec::new();
         recorded(&test, |cmd| {
             for (index, (&k, &(output, view, mip, layer))) in which.iter().zip(&outputs).enumerate()
             {
@@ -2401,14 +2405,35 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                     width: w,
                     height: h,
                 };
-                let [depth, diffuse, specular, ids] = &images[k];
                 let aspect = w as f32 / h as f32;
+                // Layers: view `index` reads layer `index` of the layered inputs.
+                let input = |i: usize, name: &str| match into {
+                    ViewOutputs::Layers => {
+                        let image = &layered[i];
+                        let mut host = described(image, name, sampled);
+                        host.view = layer_view(&test, image, index as u32);
+                        host.at(0, index as u32)
+                    }
+                    _ => described(&images[k][i], name, sampled),
+                };
+                let inputs = [
+                    input(0, "depth"),
+                    input(1, "diffuse"),
+                    input(2, "specular"),
+                    input(3, "ids"),
+                ];
+                input_views.extend(
+                    inputs
+                        .iter()
+                        .filter(|_| matches!(into, ViewOutputs::Layers))
+                        .map(|i| i.view),
+                );
                 let frame_images = SssImages {
-                    depth: &described(depth, "depth", sampled),
-                    diffuse: &described(diffuse, "diffuse", sampled),
-                    specular: Some(&described(specular, "specular", sampled)),
+                    depth: &inputs[0],
+                    diffuse: &inputs[1],
+                    specular: Some(&inputs[2]),
                     albedo: None,
-                    material_ids: &described(ids, "ids", sampled),
+                    material_ids: &inputs[3],
                 };
                 effect
                     .record(
@@ -2448,6 +2473,10 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                 unsafe { gpu.device.destroy_image_view(view, None) };
             }
         }
+        for view in input_views {
+            // SAFETY: as above.
+            unsafe { gpu.device.destroy_image_view(view, None) };
+        }
         for image in targets {
             gpu.destroy_image(image);
         }
@@ -2471,12 +2500,109 @@ fn two_views_per_frame_each_equal_their_view_alone() {
             );
         }
     }
-    for set in images {
-        for image in set {
-            gpu.destroy_image(image);
-        }
+    for image in images.into_iter().flatten().chain(layered) {
+        gpu.destroy_image(image);
     }
     test.finish();
+}
+
+/// An image like `desc` with one layer per entry of `layers` (texels tightly packed, the
+/// depth aspect of a depth format), left in the sampled state.
+fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuImage {
+    let gpu = &test.gpu;
+    let usage = desc.usage | vk::ImageUsageFlags::TRANSFER_DST;
+    let layered = ImageDesc {
+        usage,
+        ..*desc
+    }
+    .with_layers(layers.len() as u32);
+    let image = gpu.create_image(&layered, "layered input").unwrap();
+    let bytes: Vec<u8> = layers.concat();
+    let mut staging = gpu
+        .create_buffer(
+            bytes.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+            "layered input staging",
+        )
+        .unwrap();
+    staging.mapped_mut().unwrap()[..bytes.len()].copy_from_slice(&bytes);
+    let range = layered.subresource_range();
+    let regions: Vec<vk::BufferImageCopy> = (0..layers.len())
+        .map(|k| vk::BufferImageCopy {
+            buffer_offset: (k * layers[0].len()) as u64,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: desc.aspect,
+                mip_level: 0,
+                base_array_layer: k as u32,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            },
+        })
+        .collect();
+    gpu.submit_and_wait(|cmd| {
+        let to_dst = [vk::ImageMemoryBarrier2::default()
+            .old_layout(vk::ImageLayout::UNDEFINED)
+            .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .dst_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+            .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .image(image.image)
+            .subresource_range(range)];
+        let to_read = [vk::ImageMemoryBarrier2::default()
+            .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+            .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+            .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
+            .image(image.image)
+            .subresource_range(range)];
+        // SAFETY: the test's command buffer; the image and buffer are alive.
+        unsafe {
+            gpu.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_dst),
+            );
+            gpu.device.cmd_copy_buffer_to_image(
+                cmd,
+                staging.buffer,
+                image.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &regions,
+            );
+            gpu.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_read),
+            );
+        }
+    })
+    .unwrap();
+    gpu.destroy_buffer(staging);
+    image
+}
+
+/// A 2-D view of layer `layer` of `image` (its format and aspect).
+fn layer_view(test: &TestGpu, image: &GpuImage, layer: u32) -> vk::ImageView {
+    let info = vk::ImageViewCreateInfo::default()
+        .image(image.image)
+        .view_type(vk::ImageViewType::TYPE_2D)
+        .format(image.desc.format)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: image.desc.aspect,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: layer,
+            layer_count: 1,
+        });
+    // SAFETY: the image is live, made with this format and at least `layer + 1` layers.
+    unsafe { test.gpu.device.create_image_view(&info, None) }.unwrap()
 }
 
 /// A scene a host builds itself: its own meshes (handed over for lucent to upload), transforms,

@@ -2511,11 +2511,7 @@ fn two_views_per_frame_each_equal_their_view_alone() {
 fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuImage {
     let gpu = &test.gpu;
     let usage = desc.usage | vk::ImageUsageFlags::TRANSFER_DST;
-    let layered = ImageDesc {
-        usage,
-        ..*desc
-    }
-    .with_layers(layers.len() as u32);
+    let layered = ImageDesc { usage, ..*desc }.with_layers(layers.len() as u32);
     let image = gpu.create_image(&layered, "layered input").unwrap();
     let bytes: Vec<u8> = layers.concat();
     let mut staging = gpu

@@ -532,27 +532,7 @@ fn depth_stencil_image(
             .collect(),
         _ => bytemuck::cast_slice(depth).to_vec(),
     };
-    let total = (depth_bytes.len() + stencil.len()) as u64;
-    let mut staging = gpu
-        .create_buffer(
-            total,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-            "depth-stencil staging",
-        )
-        .unwrap();
-    {
-        let mapped = staging.mapped_mut().unwrap();
-        mapped[..depth_bytes.len()].copy_from_slice(&depth_bytes);
-        mapped[depth_bytes.len()..total as usize].copy_from_slice(stencil);
-    }
-    let range = vk::ImageSubresourceRange {
-        aspect_mask: both,
-        base_mip_level: 0,
-        level_count: 1,
-        base_array_layer: 0,
-        layer_count: 1,
-    };
+    let bytes = [depth_bytes.as_slice(), stencil].concat();
     let region = |aspect, offset| vk::BufferImageCopy {
         buffer_offset: offset,
         buffer_row_length: 0,
@@ -570,58 +550,15 @@ fn depth_stencil_image(
             depth: 1,
         },
     };
-    gpu.submit_and_wait(|cmd| {
-        let barrier = |from, to, src_stage, src, dst_stage, dst| {
-            vk::ImageMemoryBarrier2::default()
-                .old_layout(from)
-                .new_layout(to)
-                .src_stage_mask(src_stage)
-                .src_access_mask(src)
-                .dst_stage_mask(dst_stage)
-                .dst_access_mask(dst)
-                .image(image.image)
-                .subresource_range(range)
-        };
-        let to_dst = [barrier(
-            vk::ImageLayout::UNDEFINED,
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            vk::PipelineStageFlags2::NONE,
-            vk::AccessFlags2::NONE,
-            vk::PipelineStageFlags2::ALL_TRANSFER,
-            vk::AccessFlags2::TRANSFER_WRITE,
-        )];
-        let to_read = [barrier(
-            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            vk::PipelineStageFlags2::ALL_TRANSFER,
-            vk::AccessFlags2::TRANSFER_WRITE,
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-            vk::AccessFlags2::SHADER_SAMPLED_READ,
-        )];
-        // SAFETY: the test's recording command buffer; the image and buffer are alive.
-        unsafe {
-            gpu.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_dst),
-            );
-            gpu.device.cmd_copy_buffer_to_image(
-                cmd,
-                staging.buffer,
-                image.image,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[
-                    region(vk::ImageAspectFlags::DEPTH, 0),
-                    region(vk::ImageAspectFlags::STENCIL, depth_bytes.len() as u64),
-                ],
-            );
-            gpu.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_read),
-            );
-        }
-    })
-    .unwrap();
-    gpu.destroy_buffer(staging);
+    upload_regions(
+        test,
+        &image,
+        &bytes,
+        &[
+            region(vk::ImageAspectFlags::DEPTH, 0),
+            region(vk::ImageAspectFlags::STENCIL, depth_bytes.len() as u64),
+        ],
+    );
     DepthStencil {
         image,
         depth_view,
@@ -2514,16 +2451,6 @@ fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuIma
     let layered = ImageDesc { usage, ..*desc }.with_layers(layers.len() as u32);
     let image = gpu.create_image(&layered, "layered input").unwrap();
     let bytes: Vec<u8> = layers.concat();
-    let mut staging = gpu
-        .create_buffer(
-            bytes.len() as u64,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-            "layered input staging",
-        )
-        .unwrap();
-    staging.mapped_mut().unwrap()[..bytes.len()].copy_from_slice(&bytes);
-    let range = layered.subresource_range();
     let regions: Vec<vk::BufferImageCopy> = (0..layers.len())
         .map(|k| vk::BufferImageCopy {
             buffer_offset: (k * layers[0].len()) as u64,
@@ -2543,6 +2470,24 @@ fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuIma
             },
         })
         .collect();
+    upload_regions(test, &image, &bytes, &regions);
+    image
+}
+
+/// Copies `bytes` into `image` (every subresource from UNDEFINED) through a staging buffer,
+/// `regions` saying where each part goes, and leaves it in SHADER_READ_ONLY_OPTIMAL.
+fn upload_regions(test: &TestGpu, image: &GpuImage, bytes: &[u8], regions: &[vk::BufferImageCopy]) {
+    let gpu = &test.gpu;
+    let mut staging = gpu
+        .create_buffer(
+            bytes.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+            "test upload staging",
+        )
+        .unwrap();
+    staging.mapped_mut().unwrap()[..bytes.len()].copy_from_slice(bytes);
+    let range = image.desc.subresource_range();
     gpu.submit_and_wait(|cmd| {
         let to_dst = [vk::ImageMemoryBarrier2::default()
             .old_layout(vk::ImageLayout::UNDEFINED)
@@ -2571,7 +2516,7 @@ fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuIma
                 staging.buffer,
                 image.image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &regions,
+                regions,
             );
             gpu.device.cmd_pipeline_barrier2(
                 cmd,
@@ -2581,7 +2526,6 @@ fn upload_layers(test: &TestGpu, desc: &ImageDesc, layers: &[Vec<u8>]) -> GpuIma
     })
     .unwrap();
     gpu.destroy_buffer(staging);
-    image
 }
 
 /// A 2-D view of layer `layer` of `image` (its format and aspect).

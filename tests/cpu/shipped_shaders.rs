@@ -85,3 +85,38 @@ fn shipped_spirv_is_what_the_run_time_compiler_makes() {
         assert_eq!(a.stage, b.stage);
     }
 }
+
+/// Every shipped permutation names each resource it declares, and carries neither source text,
+/// line numbers nor member names: passes bind by those names (`lucent::backend::bindings`), so a compiler that
+/// stripped them would leave every pipeline unbindable, and one that kept the source text
+/// would grow the bundle.
+#[test]
+fn every_shipped_resource_keeps_its_name_and_no_source_text_or_lines_are_left() {
+    const OP_SOURCE: u32 = 3;
+    const OP_MEMBER_NAME: u32 = 6;
+    const OP_STRING: u32 = 7;
+    const OP_LINE: u32 = 8;
+    let shipped = ShaderCompiler::shipped().unwrap();
+    for line in ShaderCompiler::shipped_permutations().unwrap() {
+        let mut parts = line.split(' ');
+        let path = parts.next().unwrap();
+        let defines: Vec<(&str, &str)> = parts.map(|p| p.split_once('=').unwrap()).collect();
+        let spirv = shipped.compile(path, &defines).unwrap().spirv;
+        for resource in lucent::backend::bindings::resources(&spirv).unwrap() {
+            assert!(
+                !resource.name.is_empty(),
+                "{line}: the resource at binding {} has no name",
+                resource.binding
+            );
+        }
+        let mut at = 5;
+        while at < spirv.len() {
+            let opcode = spirv[at] & 0xffff;
+            assert!(
+                ![OP_SOURCE, OP_MEMBER_NAME, OP_STRING, OP_LINE].contains(&opcode),
+                "{line}: debug instruction {opcode} left in"
+            );
+            at += (spirv[at] >> 16).max(1) as usize;
+        }
+    }
+}

@@ -5,7 +5,7 @@
 // permutation: LUCENT_COPY_INPUTS=1 LUCENT_COPY_OUTPUTS=1
 // permutation: LUCENT_COPY_INPUTS=0 LUCENT_COPY_OUTPUTS=0 LUCENT_COPY_DEPTH=1
 // The speed-of-light floor of a pass (src/measure/speed_of_light.rs): one texel fetch from each
-// of LUCENT_COPY_INPUTS images (bindings 0..), written to each of LUCENT_COPY_OUTPUTS colour
+// of LUCENT_COPY_INPUTS images (`in0`, `in1`, ...), written to each of LUCENT_COPY_OUTPUTS colour
 // targets, and with LUCENT_COPY_DEPTH to the depth target too. Every fetched value reaches
 // every output, so the compiler can drop no fetch. No ALU work beyond combining them.
 //

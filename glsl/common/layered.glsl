@@ -3,9 +3,9 @@
 // function has its f64 twin in src/reference/layered.rs (and the dipole in
 // src/reference/dipole.rs): change both together.
 //
-// Set 0: 0 the frame uniforms, 1 the layered table, 2 depth, 3 GB1 (normal), 4 the layered IDs;
-// then the pass's own bindings. With LUCENT_HOST_GBUFFER (src/embed/layered.rs
-// `LayeredEffect`) bindings 2 to 4 are a host's depth, normals and material IDs, decoded as
+// Set 0: the frame uniforms, the layered table, depth, GB1 (normal), the layered IDs; then the
+// pass's own bindings (each bound by its name). With LUCENT_HOST_GBUFFER (src/embed/layered.rs
+// `LayeredEffect`) the depth, GB1 and IDs are a host's depth, normals and material IDs, decoded as
 // the host describes them (the table's host fields: the ID bit field, the normal encoding
 // and each host ID's layered material); LUCENT_HOST_IDS_UINT when the IDs are an
 // unsigned-integer image, LUCENT_HOST_LINEAR_DEPTH when the depth is linear view depth (a

@@ -1,7 +1,7 @@
 // Screen-space SSS: the profile table (src/features/sss.rs `ProfileTableGpu`, std140) and the
 // per-pixel profile ID the G-buffer pass writes (R8: ID / 255, 0 = does not scatter).
-// Binding 1 of every SSS pass (binding 0 is the frame uniforms); a region of the per-frame
-// buffer, so a frame in flight reads its own copy.
+// Every SSS pass binds it after the frame uniforms; a region of the per-frame buffer, so a
+// frame in flight reads its own copy.
 #ifndef LUCENT_SSS_GLSL
 #define LUCENT_SSS_GLSL
 
@@ -157,8 +157,8 @@ vec3 sss_profile_at(int id, float d2) {
 #ifdef LUCENT_SSS_KERNELS
 #define MAX_KERNEL_SAMPLES 25
 #define FALLOFF_ENTRIES 25
-// The two-pass blurs' kernels (src/features/sss/kernel.rs `KernelTableGpu`), binding 2 of
-// their passes: per profile x the sample count, y one over the kernel's reach (world units),
+// The two-pass blurs' kernels (src/features/sss/kernel.rs `KernelTableGpu`), bound after the
+// profile table: per profile x the sample count, y one over the kernel's reach (world units),
 // z that reach, w one over the falloff table's reach.
 layout(std140, set = 0) uniform SssKernels {
     vec4 info[MAX_SSS_PROFILES];

@@ -18,8 +18,8 @@
 #include "../common/color.glsl"
 #include "../common/gbuffer.glsl"
 #ifdef LUCENT_VIEW_TERM
-// The GDC 2011 translucency term alone: `source` is GB0, then GB1, GB2 and depth; binding 5 is
-// the material table (glsl/common/translucency.glsl).
+// The GDC 2011 translucency term alone: `source` is GB0, then GB1, GB2 and depth, and the
+// material table (glsl/common/translucency.glsl).
 #include "../common/translucency.glsl"
 layout(set = 0) uniform sampler2D gb1_tex;
 layout(set = 0) uniform sampler2D gb2_tex;

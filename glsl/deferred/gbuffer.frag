@@ -54,7 +54,7 @@ layout(location = 3) in vec4 in_tangent;
 layout(set = 0) uniform sampler2D albedo_map;
 #endif
 #ifdef LUCENT_NORMAL_MAP
-// Tangent-space normal map, stored as n * 0.5 + 0.5 (binding 0 is the frame uniforms).
+// Tangent-space normal map, stored as n * 0.5 + 0.5.
 layout(set = 0) uniform sampler2D normal_map;
 
 // The shading normal: the map's normal in the interpolated tangent frame. A degenerate frame
@@ -71,8 +71,8 @@ vec3 mapped_normal(vec3 n) {
     return t * m.x + b * m.y + n * m.z;
 }
 #ifdef LUCENT_LEAN
-// In LEAN frames binding 1 holds LEAN map 1 (slope mean xy, moments xx yy) instead of the
-// normal map, and binding 2 LEAN map 2 (moment xy), mip-filtered like any texture: filtering
+// In LEAN frames `normal_map` holds LEAN map 1 (slope mean xy, moments xx yy) instead of the
+// normal map, and `lean2_map` LEAN map 2 (moment xy), mip-filtered like any texture: filtering
 // moments is what LEAN mapping is for.
 layout(set = 0) uniform sampler2D lean2_map;
 #endif

@@ -3,7 +3,7 @@
 // Li et al.'s multiple scattering (eqs. 12-13), added into the lit image weighted by eq. 3's
 // λ5 (src/features/layered.rs, `multiple scattering`): Jensen's dipole of the first layer
 // gathered over M pixel lights of the irradiance image. Set 0 as glsl/common/layered.glsl,
-// then the irradiance image (binding 5). It stores the weighted term with the material ID in
+// then the irradiance image (`irradiance_tex`). It stores the weighted term with the material ID in
 // alpha, twice (the second copy is what the term's blur overwrites where it blurs), which
 // single scattering reads back (glsl/common/layered_upsample.glsl): at full
 // resolution the spiral is rotated by one of nine angles per 3x3 block

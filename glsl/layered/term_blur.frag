@@ -12,7 +12,7 @@
 // the blur (jade's red), which a blur would wash out. The pass draws only over objects whose
 // medium reaches that at their nearest point (src/features/layered/mod.rs `blurs_on_screen`,
 // whose BLUR_MIN_KERNEL_TEXELS is the same number); elsewhere its target keeps the gather's
-// copy of the term. Set 0 as glsl/common/layered.glsl, then the term (binding 5: rgb the
+// copy of the term. Set 0 as glsl/common/layered.glsl, then the term (`term_tex`: rgb the
 // weighted term, alpha the material ID). With LUCENT_HALF_GATHER the term is at half
 // resolution and texel k holds pixel 2k.
 #include "../common/layered.glsl"

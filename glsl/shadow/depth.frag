@@ -8,7 +8,7 @@
 // (the GDC 2011 term is not shadowed by its own material: glsl/common/shadows.glsl), frames
 // with layered media its normal and layered material ID (where light enters: single
 // scattering, src/features/layered.rs), and with TexDep media the entry's depth texels
-// (set 0 bindings 1 and 2: the draw's depth textures; binding 0 is the maps' table).
+// (`depth_map0` and `depth_map1`: the draw's depth textures, bound after the maps' table).
 #include "../common/shadows.glsl"
 
 #ifdef LUCENT_SHADOW_IDS

@@ -18,6 +18,11 @@
 
 use ash::vk;
 
+use super::shader_files::{
+    spirv_instructions, DECORATION_DESCRIPTOR_SET, OP_DECORATE, OP_NAME, OP_TYPE_POINTER,
+    OP_VARIABLE, SPIRV_HEADER_WORDS,
+};
+
 /// One binding of a pass's descriptor set 0, as the pass declares it: binding `i` of the set
 /// is the `i`-th of the list.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,23 +50,17 @@ pub struct ShaderResource {
     binding_word: usize,
 }
 
-const OP_NAME: u32 = 5;
 const OP_TYPE_IMAGE: u32 = 25;
 const OP_TYPE_SAMPLER: u32 = 26;
 const OP_TYPE_SAMPLED_IMAGE: u32 = 27;
 const OP_TYPE_ARRAY: u32 = 28;
 const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
 const OP_TYPE_STRUCT: u32 = 30;
-const OP_TYPE_POINTER: u32 = 32;
-const OP_VARIABLE: u32 = 59;
-const OP_DECORATE: u32 = 71;
 const DECORATION_BINDING: u32 = 33;
-const DECORATION_DESCRIPTOR_SET: u32 = 34;
 const STORAGE_UNIFORM_CONSTANT: u32 = 0;
 const STORAGE_UNIFORM: u32 = 2;
 const STORAGE_STORAGE_BUFFER: u32 = 12;
 const DIM_SUBPASS_DATA: u32 = 6;
-const HEADER_WORDS: usize = 5;
 
 /// A type as far as a descriptor's kind depends on it.
 #[derive(Clone, Copy)]
@@ -92,7 +91,7 @@ fn literal_string(words: &[u32]) -> String {
 
 /// The resources `spirv` declares in descriptor sets. Errors say what is malformed.
 pub fn resources(spirv: &[u32]) -> Result<Vec<ShaderResource>, String> {
-    if spirv.len() < HEADER_WORDS || spirv[0] != super::spirv::SPIRV_MAGIC {
+    if spirv.len() < SPIRV_HEADER_WORDS || spirv[0] != super::spirv::SPIRV_MAGIC {
         return Err("not a SPIR-V module (no magic number)".into());
     }
     let mut names = std::collections::HashMap::new();
@@ -100,16 +99,10 @@ pub fn resources(spirv: &[u32]) -> Result<Vec<ShaderResource>, String> {
     let mut bindings = std::collections::HashMap::new();
     let mut sets = std::collections::HashMap::new();
     let mut variables = Vec::new();
-    let mut at = HEADER_WORDS;
-    while at < spirv.len() {
-        let count = (spirv[at] >> 16) as usize;
-        let opcode = spirv[at] & 0xffff;
-        if count == 0 || at + count > spirv.len() {
-            return Err(format!(
-                "instruction at word {at} runs past the module's end"
-            ));
-        }
-        let ops = &spirv[at + 1..at + count];
+    for instruction in spirv_instructions(spirv) {
+        let (at, instruction) = instruction?;
+        let opcode = instruction[0] & 0xffff;
+        let ops = &instruction[1..];
         let operand = |i: usize| {
             ops.get(i)
                 .copied()
@@ -150,7 +143,6 @@ pub fn resources(spirv: &[u32]) -> Result<Vec<ShaderResource>, String> {
             OP_VARIABLE => variables.push((operand(0)?, operand(1)?, operand(2)?)),
             _ => {}
         }
-        at += count;
     }
     let mut out = Vec::new();
     for (pointer, id, storage) in variables {

@@ -35,6 +35,7 @@ pub struct DynamicUniform {
 }
 
 /// What one descriptor binding points at.
+#[derive(Clone, Copy, Debug)]
 pub enum Binding {
     /// A uniform buffer (whole range).
     Uniform(vk::Buffer),

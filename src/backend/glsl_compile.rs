@@ -10,7 +10,10 @@ use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Component, Path, PathBuf};
 
-use super::shader_files::{normalize_relative, path_to_name};
+use super::shader_files::{
+    normalize_relative, path_to_name, spirv_instructions, DECORATION_DESCRIPTOR_SET, OP_DECORATE,
+    OP_NAME, OP_TYPE_POINTER, OP_VARIABLE, SPIRV_HEADER_WORDS,
+};
 
 /// Everything besides the inputs that changes the SPIR-V; part of every run-time cache key.
 /// Change it when an option of [`compile_glsl`] changes, so old cache entries stop matching. (A
@@ -128,47 +131,35 @@ pub fn compile_glsl(
 /// and member names) but the names of the variables in descriptor sets and of the blocks they
 /// point at: what binding by name needs, a few words per resource. The code is untouched.
 pub fn keep_resource_names(spirv: &[u32]) -> Vec<u32> {
-    const HEADER_WORDS: usize = 5;
     const OP_SOURCE_CONTINUED: u32 = 2;
     const OP_SOURCE: u32 = 3;
     const OP_SOURCE_EXTENSION: u32 = 4;
-    const OP_NAME: u32 = 5;
     const OP_MEMBER_NAME: u32 = 6;
     const OP_STRING: u32 = 7;
     const OP_LINE: u32 = 8;
-    const OP_TYPE_POINTER: u32 = 32;
-    const OP_VARIABLE: u32 = 59;
-    const OP_DECORATE: u32 = 71;
     const OP_NO_LINE: u32 = 317;
     const OP_MODULE_PROCESSED: u32 = 330;
-    const DECORATION_DESCRIPTOR_SET: u32 = 34;
-    let instructions = || {
-        let mut at = HEADER_WORDS.min(spirv.len());
-        std::iter::from_fn(move || {
-            let count = (*spirv.get(at)? >> 16) as usize;
-            let instruction = spirv.get(at..at + count.max(1))?;
-            at += count.max(1);
-            Some(instruction)
-        })
-    };
+    // shaderc's own output: well formed.
+    let instructions = || spirv_instructions(spirv).map_while(|i| i.ok().map(|(_, words)| words));
+    let opcode = |i: &[u32]| i[0] & 0xffff;
     // Variables in a descriptor set, and what their pointer types point at.
     let in_sets: Vec<u32> = instructions()
-        .filter(|i| i[0] & 0xffff == OP_DECORATE && i.get(2) == Some(&DECORATION_DESCRIPTOR_SET))
+        .filter(|i| opcode(i) == OP_DECORATE && i.get(2) == Some(&DECORATION_DESCRIPTOR_SET))
         .filter_map(|i| i.get(1).copied())
         .collect();
     let pointees: BTreeMap<u32, u32> = instructions()
-        .filter(|i| i[0] & 0xffff == OP_TYPE_POINTER && i.len() > 3)
+        .filter(|i| opcode(i) == OP_TYPE_POINTER && i.len() > 3)
         .map(|i| (i[1], i[3]))
         .collect();
     let mut named: Vec<u32> = in_sets.clone();
-    for i in instructions().filter(|i| i[0] & 0xffff == OP_VARIABLE && i.len() > 2) {
+    for i in instructions().filter(|i| opcode(i) == OP_VARIABLE && i.len() > 2) {
         if in_sets.contains(&i[2]) {
             named.extend(pointees.get(&i[1]));
         }
     }
-    let mut out = spirv[..HEADER_WORDS.min(spirv.len())].to_vec();
+    let mut out = spirv[..SPIRV_HEADER_WORDS.min(spirv.len())].to_vec();
     for instruction in instructions() {
-        let keep = match instruction[0] & 0xffff {
+        let keep = match opcode(instruction) {
             OP_SOURCE_CONTINUED | OP_SOURCE | OP_SOURCE_EXTENSION | OP_STRING | OP_LINE
             | OP_NO_LINE | OP_MODULE_PROCESSED | OP_MEMBER_NAME => false,
             OP_NAME => instruction.get(1).is_some_and(|id| named.contains(id)),

@@ -1,5 +1,6 @@
 //! What the library and `build.rs` must agree on about shader files: shader names, permutation
-//! lines and the shipped SPIR-V bundle's byte layout.
+//! lines, the shipped SPIR-V bundle's byte layout and a SPIR-V module's instruction stream
+//! ([`spirv_instructions`], which both read the resources' names through).
 //!
 //! `build.rs` cannot call the library, so it includes this file (`#[path]`): one copy of the
 //! code, compiled twice. It depends on `std` only.
@@ -212,4 +213,45 @@ impl<'a> Reader<'a> {
         let b = self.take(4)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
+}
+
+/// Words before a SPIR-V module's first instruction (magic, version, generator, bound, schema).
+pub const SPIRV_HEADER_WORDS: usize = 5;
+/// `OpName`.
+pub const OP_NAME: u32 = 5;
+/// `OpTypePointer`.
+pub const OP_TYPE_POINTER: u32 = 32;
+/// `OpVariable`.
+pub const OP_VARIABLE: u32 = 59;
+/// `OpDecorate`.
+pub const OP_DECORATE: u32 = 71;
+/// The `DescriptorSet` decoration.
+pub const DECORATION_DESCRIPTOR_SET: u32 = 34;
+
+/// The instructions of SPIR-V module `spirv` in order, each as the index of its first word and
+/// its words (the first holds the word count in its high half, the opcode in its low half). An
+/// instruction of length 0 or one that
+/// runs past the module's end is an `Err` naming its word, and ends the stream.
+pub fn spirv_instructions(spirv: &[u32]) -> impl Iterator<Item = Result<(usize, &[u32]), String>> {
+    let mut at = SPIRV_HEADER_WORDS.min(spirv.len());
+    let mut failed = false;
+    std::iter::from_fn(move || {
+        if failed || at >= spirv.len() {
+            return None;
+        }
+        let count = (spirv[at] >> 16) as usize;
+        match spirv.get(at..at + count).filter(|_| count > 0) {
+            Some(instruction) => {
+                let first = at;
+                at += count;
+                Some(Ok((first, instruction)))
+            }
+            None => {
+                failed = true;
+                Some(Err(format!(
+                    "instruction at word {at} runs past the module's end"
+                )))
+            }
+        }
+    })
 }

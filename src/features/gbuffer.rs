@@ -507,11 +507,9 @@ impl GBufferPass {
 
 impl PassExec for GBufferPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let (names, bindings): (Vec<_>, Vec<_>) = self.bindings(0).into_iter().unzip();
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &bindings,
-            &names,
+            &self.bindings(0),
             &GraphicsPipelineDesc {
                 vertex: GBUFFER_VERTEX,
                 fragment: GBUFFER_FRAGMENT,

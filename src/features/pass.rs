@@ -354,10 +354,9 @@ fn sampler(
 impl PassExec for FullscreenExec {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
         let views = ctx.descriptor_views;
-        let names: Vec<&'static str> = self.slots.iter().map(Slot::name).collect();
         let mut bindings = Vec::with_capacity(self.slots.len());
         for slot in &self.slots {
-            bindings.push(match *slot {
+            let binding = match *slot {
                 Slot::PerFrame(region) => {
                     let scene = self.scene.as_ref().ok_or_else(|| {
                         crate::LucentError::Graph(format!(
@@ -377,7 +376,8 @@ impl PassExec for FullscreenExec {
                     }
                 }
                 Slot::Input(_, id, layout) => Binding::InputAttachment(views[id], layout),
-            });
+            };
+            bindings.push((slot.name(), binding));
         }
         let desc = GraphicsPipelineDesc {
             additive_attachments: self.additive,
@@ -391,7 +391,7 @@ impl PassExec for FullscreenExec {
             self.bare = Some(GraphicsPipeline::new(ctx, &desc)?);
             return Ok(());
         }
-        let mut pipeline = PassPipeline::new(ctx, &bindings, &names, &desc)?;
+        let mut pipeline = PassPipeline::new(ctx, &bindings, &desc)?;
         if let Some(variant) = &self.variant {
             let name = format!("{} ({})", self.name, variant.label);
             let (main, variant) = pipeline.with_variant(ctx, &desc, &variant.extra, &name)?;

@@ -515,11 +515,9 @@ impl PassExec for ShadowPass {
             self.desc.entry,
             self.desc.layer_depth_textures,
         );
-        let (names, bindings): (Vec<_>, Vec<_>) = self.bindings(0).into_iter().unzip();
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &bindings,
-            &names,
+            &self.bindings(0),
             &GraphicsPipelineDesc {
                 vertex: SHADOW_VERTEX,
                 fragment: SHADOW_FRAGMENT,
@@ -699,10 +697,10 @@ impl PassExec for HostShadowPass {
         let defines = shadow_map_defines(false, true, 0);
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[Binding::PerFrame(
-                self.scene.per_frame.binding(&TABLE_REGION),
+            &[(
+                TABLE_REGION.block,
+                Binding::PerFrame(self.scene.per_frame.binding(&TABLE_REGION)),
             )],
-            &[TABLE_REGION.block],
             &GraphicsPipelineDesc {
                 vertex: SHADOW_VERTEX,
                 fragment: SHADOW_FRAGMENT,

@@ -76,27 +76,26 @@ pub struct PassPipeline {
 }
 
 impl PassPipeline {
-    /// Creates the descriptor set from `bindings` (visible to vertex and fragment stages) and
-    /// the pipeline described by `desc` with that set as set 0. `names` gives the name each
-    /// binding has in the shaders, which numbers them ([`crate::backend::bindings`]); a
-    /// binding past its end (or every binding, when it is empty) is numbered by the shaders.
+    /// Creates the descriptor set from `bindings` (visible to vertex and fragment stages), each
+    /// with the name the shaders give it, which numbers it there
+    /// ([`crate::backend::bindings`]), and the pipeline described by `desc` with that set as
+    /// set 0.
     pub fn new(
         ctx: &PrepareContext<'_>,
-        bindings: &[Binding],
-        names: &[&'static str],
+        bindings: &[(&'static str, Binding)],
         desc: &GraphicsPipelineDesc<'_>,
     ) -> Result<Self> {
         let declared: Vec<SetBinding<'static>> = bindings
             .iter()
-            .enumerate()
-            .map(|(i, b)| SetBinding {
-                name: names.get(i).copied(),
+            .map(|(name, b)| SetBinding {
+                name: Some(name),
                 kind: b.kind(),
             })
             .collect();
+        let resources: Vec<Binding> = bindings.iter().map(|(_, b)| *b).collect();
         let mut set = DescriptorSet::new(
             ctx,
-            bindings,
+            &resources,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             desc.name,
             ctx.slots,

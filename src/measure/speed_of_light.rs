@@ -545,8 +545,10 @@ impl PassExec for MeshFloorPass {
         let defines = floor_defines(self.outputs, shadow_faces);
         self.pipeline = Some(PassPipeline::new(
             ctx,
-            &[Binding::PerFrame(self.scene.per_frame.binding(region))],
-            &[region.block],
+            &[(
+                region.block,
+                Binding::PerFrame(self.scene.per_frame.binding(region)),
+            )],
             &GraphicsPipelineDesc {
                 vertex: FLOOR_VERTEX,
                 fragment: FLOOR_FRAGMENT,

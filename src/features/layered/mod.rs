@@ -749,34 +749,34 @@ impl LayeredShape {
 /// The pipelines the layered passes of any frame build: every kind with every set of inputs.
 fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
     for kind in Kind::ALL {
-        for flags in 0u32..1 << 8 {
+        for flags in 0u32..1 << 7 {
             let bit = |i: u32| flags & (1 << i) != 0;
             // The full-resolution term only tells a single scattering pass that reads one apart.
-            if bit(6) && !(kind == Kind::Single && bit(2) && !bit(0)) {
+            if bit(5) && !(kind == Kind::Single && bit(1) && !bit(0)) {
                 continue;
             }
             // Only single scattering applies the film.
-            if bit(7) && kind != Kind::Single {
+            if bit(6) && kind != Kind::Single {
                 continue;
             }
             for layer_depths in [None, Some(1), Some(2)] {
                 for host in std::iter::once(None).chain(LayeredHost::ALL.map(Some)) {
                     // A host's G-buffer: lucent draws the maps with their entry target, and
                     // depth textures are not embedded (the film is the host's albedo image).
-                    let embedded = layer_depths.is_none() && bit(3) && bit(4) && !bit(5);
+                    let embedded = layer_depths.is_none() && bit(2) && bit(3) && !bit(4);
                     if host.is_some() && !embedded {
                         continue;
                     }
                     let shape = LayeredShape {
                         kind,
                         half_res: bit(0),
-                        half_term: bit(2),
-                        full_res_term: bit(6),
+                        half_term: bit(1),
+                        full_res_term: bit(5),
                         layer_depths,
-                        shadows: bit(3),
-                        entry: bit(4),
-                        entry_depths: bit(5),
-                        film: bit(7),
+                        shadows: bit(2),
+                        entry: bit(3),
+                        entry_depths: bit(4),
+                        film: bit(6),
                         host,
                     };
                     out.push(crate::backend::shader::PipelineShaders::fullscreen(
@@ -853,7 +853,7 @@ mod tests {
     }
 
     #[test]
-    fn passes_number_their_bindings_as_the_shipped_enumeration_does() {
+    fn passes_declare_the_defines_the_shipped_enumeration_lists() {
         let info = ImageInfo {
             width: 8,
             height: 8,

@@ -94,6 +94,8 @@ pub(super) fn chain_passes(
         } else {
             current.iter().collect()
         };
+        // The light and the LEAN texel come packed in one image (packed ping-pong targets).
+        let packed_in = packed && source_handles.len() == 1;
         let constants = |direction: [f32; 2]| BlurConstants {
             step: [direction[0], direction[1], step as f32, chain.index as f32],
         };
@@ -104,7 +106,7 @@ pub(super) fn chain_passes(
             chain,
             constants([1.0, 0.0]),
             &source_handles,
-            packed && source_handles.len() == 1,
+            packed_in,
             inputs,
         );
         pass.taps(fetches(source_handles.len() as u32))
@@ -112,7 +114,7 @@ pub(super) fn chain_passes(
                 blur.technique(),
                 knobs.taps,
                 chain.edges,
-                packed && source_handles.len() == 1,
+                packed_in,
                 packed,
                 false,
             ));
@@ -122,6 +124,7 @@ pub(super) fn chain_passes(
         pass.finish();
         // Vertical: back into the current result, and its weighted share into the sum.
         let temps: Vec<&Handle<Image>> = temp.iter().collect();
+        let packed_in = packed && temps.len() == 1;
         let mut pass = blur_pass(
             graph,
             &format!("{}vertical blur #{n}", chain.prefix),
@@ -129,7 +132,7 @@ pub(super) fn chain_passes(
             chain,
             constants([0.0, 1.0]),
             &temps,
-            packed && temps.len() == 1,
+            packed_in,
             inputs,
         );
         pass.taps(fetches(temps.len() as u32))
@@ -137,7 +140,7 @@ pub(super) fn chain_passes(
                 blur.technique(),
                 knobs.taps,
                 chain.edges,
-                packed && temps.len() == 1,
+                packed_in,
                 packed,
                 true,
             ));
@@ -235,9 +238,9 @@ pub(super) fn chain_passes(
 }
 
 /// Starts a blur pass of an iterative chain reading `colors` (the light, packed with the LEAN
-/// texel when `packed_in`, or with LCB and LBB the LEAN texel beside it). The control's taps fall between texels (linear); depth, profile IDs
-/// and the bilateral blur's whole-texel taps are read nearest (texelFetch; depth formats need
-/// not support linear filtering). It draws only where objects of its chain (and their blur's
+/// texel when `packed_in`, or with LCB and LBB the LEAN texel beside it). The control's taps
+/// fall between texels (linear); depth, profile IDs and the bilateral blur's whole-texel taps
+/// are read nearest (texelFetch; depth formats need not support linear filtering). It draws only where objects of its chain (and their blur's
 /// reach) can be: every pixel a tap of a scattering pixel reads is written; the rest is never
 /// read.
 #[allow(clippy::too_many_arguments)]

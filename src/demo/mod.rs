@@ -736,9 +736,9 @@ impl Demo<'_> {
         };
         match view {
             DebugView::Thickness | DebugView::MaterialId | DebugView::TranslucencyTerm => {
-                features.translucency.is_some()
+                features.translucency().is_some()
             }
-            DebugView::LitBeforeSss => features.sss.is_some(),
+            DebugView::LitBeforeSss => features.sss().is_some(),
             DebugView::Albedo | DebugView::Normal | DebugView::Depth => true,
         }
     }

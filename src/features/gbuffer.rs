@@ -19,7 +19,6 @@ use crate::graph::{
 use crate::Result;
 
 use super::layer_depth::{depth_map_bindings, layer_depth_format, layer_depths_define};
-use super::translucency::ThicknessPacking;
 use super::util::PassPipeline;
 use crate::backend::descriptor::{Binding, DescriptorSet};
 use crate::backend::pipeline::{GraphicsPipelineDesc, VertexInput};
@@ -60,6 +59,27 @@ impl GBufferPrecision {
             .iter()
             .find(|(_, p)| *p == self)
             .map_or("?", |(n, _)| n)
+    }
+}
+
+/// How local thickness is packed into `GB2` (GDC 2011 translucency, [`super::translucency`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ThicknessPacking {
+    /// One channel (the talk's Fig. 20): `R8G8` = thickness, material ID. A coloured
+    /// thickness is reduced to its Rec. 709 luminance.
+    Grayscale,
+    /// Three channels (the talk's coloured variant, unpacked): `R8G8B8A8` = thickness RGB,
+    /// material ID.
+    Colored,
+}
+
+impl ThicknessPacking {
+    /// Shader define value and name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ThicknessPacking::Grayscale => "grayscale",
+            ThicknessPacking::Colored => "colored",
+        }
     }
 }
 

@@ -21,8 +21,9 @@
 //! - [`pass`]: the fullscreen pass builder: each input stated once, for the graph and the
 //!   shader's bindings.
 //! - [`util`]: pass-level pipeline helpers (a pipeline with its descriptor set, tile draws).
-//! - [`technique`] and [`registry`]: the contract a technique module implements and the one
-//!   list of them, which everything that names techniques iterates.
+//! - [`technique`] and [`registry`]: the contract a technique module implements (with the part
+//!   of a frame each family of techniques declares: its G-buffer needs, tables, uploads and
+//!   passes) and the one list of them, which everything that names techniques iterates.
 
 pub mod antialias;
 pub mod copy_pass;

@@ -3,8 +3,8 @@
 //!
 //! A technique module (for example [`super::sss::separable`]) is a unit struct with a static
 //! instance that implements [`TechniqueModule`]: its name (what `--technique NAME` and a
-//! scene's `blur = "NAME"` say), a one-line summary, which materials it shades
-//! ([`Shades`]), the command-line knobs that act on it, the built-in scene it is measured on,
+//! scene's `blur = "NAME"` say), a one-line summary, the part of a frame it belongs to
+//! ([`super::technique::PartKind`]: which materials it shades), the command-line knobs that act on it, the built-in scene it is measured on,
 //! and the shader permutations its passes compile. Everything that lists techniques iterates
 //! [`TECHNIQUES`]: the `--technique` names and their help ([`crate::frame::Technique`]), the
 //! warnings for knobs that do nothing in a frame, the demo's picker, bench and report, the
@@ -12,9 +12,9 @@
 //! hand-written list elsewhere names a technique.
 //!
 //! Screen-space SSS techniques are blur chains: their module also implements
-//! [`super::sss::SssBlurTechnique`] (how its chain of passes is declared), and
-//! [`Shades::Scattering`] carries the [`super::sss::SssBlur`] handle a material's profile is
-//! diffused with. Chains run in registry order, so the order of [`TECHNIQUES`] is also the
+//! [`super::sss::SssBlurTechnique`] (how its chain of passes is declared), which its
+//! `sss_chain` hands out: the registry makes it the [`super::sss::SssBlur`] handle a
+//! material's profile is diffused with. Chains run in registry order, so the order of [`TECHNIQUES`] is also the
 //! order of a frame's SSS chains (and of its passes in `lucent plan`).
 //!
 //! Adding a technique is its module, its shader, one line here and its goldens:
@@ -22,7 +22,8 @@
 
 use super::knob::Knob;
 use super::sss::SssBlur;
-pub use super::technique::{Shades, TechniqueModule};
+pub use super::technique::TechniqueModule;
+use super::technique::{same_kind, Lookup, PartKind};
 use crate::scene::material::SssProfile;
 use crate::{LucentError, Result};
 
@@ -56,7 +57,33 @@ pub fn sss_techniques() -> impl Iterator<Item = &'static dyn TechniqueModule> {
     TECHNIQUES
         .iter()
         .copied()
-        .filter(|t| matches!(t.shades(), Shades::Scattering(_)))
+        .filter(|t| t.sss_chain().is_some())
+}
+
+/// The parts of a frame the techniques belong to, each once, in registry order (the order a
+/// frame describes them in and runs their passes in).
+pub fn part_kinds() -> Vec<&'static dyn PartKind> {
+    let mut kinds: Vec<&'static dyn PartKind> = Vec::new();
+    for technique in TECHNIQUES {
+        let kind = technique.part();
+        if !kinds.iter().any(|k| same_kind(*k, kind)) {
+            kinds.push(kind);
+        }
+    }
+    kinds
+}
+
+/// The registry's lookups, as a frame's parts receive them ([`Lookup`]).
+pub struct Registry;
+
+impl Lookup for Registry {
+    fn blur_of(&self, profile: &SssProfile) -> Result<SssBlur> {
+        blur_of(profile)
+    }
+
+    fn blur_of_technique(&self, technique: &'static dyn TechniqueModule) -> Option<SssBlur> {
+        blur_of_technique(technique)
+    }
 }
 
 /// The SSS blur of `technique` (`None` when it is not a screen-space blur).
@@ -66,10 +93,8 @@ pub fn blur_of_technique(technique: &'static dyn TechniqueModule) -> Option<SssB
 }
 
 fn blur_at(rank: usize, technique: &'static dyn TechniqueModule) -> Option<SssBlur> {
-    match technique.shades() {
-        Shades::Scattering(chain) => Some(SssBlur::new(technique.name(), rank, chain)),
-        _ => None,
-    }
+    let chain = technique.sss_chain()?;
+    Some(SssBlur::new(technique.name(), rank, chain))
 }
 
 /// The blur of materials whose profile names none: the one measured best for its error at

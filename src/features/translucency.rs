@@ -14,12 +14,22 @@
 //! [`crate::gpu_scene::tiles`]: the projected bounds of translucent objects, recomputed every
 //! frame, so pixels no translucent object can cover never run its code.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
+use super::gbuffer::{GBufferLayout, TranslucencyLayout};
 use super::knob::{Knob, Takes};
-use super::technique::{Shades, TechniqueModule};
+use super::shadows::ShadowDesc;
+use super::technique::TechniqueModule;
+use super::technique::{
+    downcast, part_value_methods, same_kind, Describe, FrameImages, FramePart, PartKind, PartKnobs,
+    SlotWrite,
+};
 use crate::backend::shader::PipelineShaders;
-use crate::gpu_scene::{Region, TableRegion};
+use crate::gpu_scene::tiles::{tile_rects, translucent_tiles};
+use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion};
+use crate::graph::{Handle, Image, RenderGraph};
 use crate::scene::material::{PowMode, Translucency};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
@@ -28,26 +38,7 @@ use crate::{LucentError, Result};
 /// fit in one frame.
 pub const MAX_TRANSLUCENT_MATERIALS: usize = 255;
 
-/// How local thickness is packed into `GB2`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ThicknessPacking {
-    /// One channel (the talk's Fig. 20): `R8G8` = thickness, material ID. A coloured
-    /// thickness is reduced to its Rec. 709 luminance.
-    Grayscale,
-    /// Three channels (the talk's coloured variant, unpacked): `R8G8B8A8` = thickness RGB,
-    /// material ID.
-    Colored,
-}
-
-impl ThicknessPacking {
-    /// Shader define value and name.
-    pub fn name(self) -> &'static str {
-        match self {
-            ThicknessPacking::Grayscale => "grayscale",
-            ThicknessPacking::Colored => "colored",
-        }
-    }
-}
+pub use super::gbuffer::ThicknessPacking;
 
 /// Rec. 709 luminance: how a coloured thickness becomes grayscale.
 pub fn luminance(c: Vec3) -> f32 {
@@ -232,8 +223,8 @@ impl TechniqueModule for Gdc2011Translucency {
          deferred lighting pass"
     }
 
-    fn shades(&'static self) -> Shades {
-        Shades::Translucent
+    fn part(&self) -> &'static dyn PartKind {
+        &TRANSLUCENCY_PART
     }
 
     fn knobs(&self) -> &'static [&'static Knob] {
@@ -248,6 +239,117 @@ impl TechniqueModule for Gdc2011Translucency {
     /// None of its own: its term is compiled into the lighting pass, whose permutations
     /// ([`super::lighting`]) walk every translucency layout.
     fn shader_permutations(&self, _out: &mut Vec<PipelineShaders>) {}
+}
+
+/// GDC 2011's part of a frame ([`super::technique`]): the translucent materials' table and how
+/// GB2 packs thickness. Its shading runs inside the lighting pass, so it declares no pass.
+pub static TRANSLUCENCY_PART: TranslucencyPart = TranslucencyPart;
+
+/// The kind of [`TRANSLUCENCY_PART`].
+pub struct TranslucencyPart;
+
+impl PartKind for TranslucencyPart {
+    fn name(&self) -> &'static str {
+        "translucency"
+    }
+
+    fn describe(&'static self, context: &Describe<'_>) -> Result<Option<Box<dyn FramePart>>> {
+        // Forced (not `auto`): media without a term of their own derive one.
+        let table = MaterialTable::new(context.scene, context.forced.is_some())?;
+        let packing = if context.knobs.force_grayscale {
+            ThicknessPacking::Grayscale
+        } else {
+            table.packing()
+        };
+        Ok((!table.is_empty())
+            .then(|| Box::new(TranslucencyDesc { table, packing }) as Box<dyn FramePart>))
+    }
+}
+
+/// The translucency part of a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TranslucencyDesc {
+    /// The translucent materials with their IDs.
+    pub table: MaterialTable,
+    /// How GB2 packs thickness.
+    pub packing: ThicknessPacking,
+}
+
+impl FramePart for TranslucencyDesc {
+    part_value_methods!();
+
+    fn kind(&self) -> &'static dyn PartKind {
+        &TRANSLUCENCY_PART
+    }
+
+    fn same_shape(&self, other: &dyn FramePart) -> bool {
+        downcast::<Self>(other).is_some_and(|o| o.table.object_ids == self.table.object_ids)
+    }
+
+    fn runs(&self, technique: &dyn TechniqueModule) -> bool {
+        same_kind(technique.part(), &TRANSLUCENCY_PART)
+    }
+
+    fn names(&self, out: &mut Vec<String>) {
+        let n = self.table.rows.len();
+        out.push(format!(
+            "translucency ({n} material{}, {})",
+            if n == 1 { "" } else { "s" },
+            self.packing.name()
+        ));
+    }
+
+    fn gbuffer(&self, layout: &mut GBufferLayout) {
+        layout.translucency = Some(TranslucencyLayout {
+            packing: self.packing,
+            pow_modes: self.table.pow_modes(),
+            single_material: self.table.rows.len() == 1,
+        });
+    }
+
+    fn shadows(&self, maps: &mut ShadowDesc) {
+        // The atlas stores each texel's translucency material only for materials whose
+        // transmitted light other objects shadow (the talk's term needs no lookup).
+        maps.transmission_ids = self.table.any_shadowed();
+    }
+
+    fn tables(&self, out: &mut Vec<TableRegion>) {
+        out.push(table_region());
+    }
+
+    fn upload<'a>(&'a self, upload: &mut SceneUpload<'a>) {
+        upload.translucency_ids = Some(&self.table.object_ids);
+    }
+
+    fn declare(
+        &self,
+        _graph: &mut RenderGraph,
+        _images: &FrameImages<'_>,
+        hdr: Handle<Image>,
+        _knobs: &PartKnobs<'_>,
+        _scene_gpu: Option<&Arc<SceneGpu>>,
+    ) -> Handle<Image> {
+        hdr
+    }
+
+    fn write_slot(&self, slot: &mut SlotWrite<'_>) -> Result<()> {
+        slot.per_frame.write(
+            slot.slot,
+            &TABLE_REGION,
+            bytemuck::bytes_of(&self.table.gpu()),
+        )?;
+        // The lighting pass runs the translucency variant only where translucent objects
+        // may be.
+        let (columns, _, marked) = translucent_tiles(
+            slot.scene,
+            &self.table.object_ids,
+            slot.mesh_bounds,
+            slot.width,
+            slot.height,
+        );
+        slot.tiles.lighting = tile_rects(columns, &marked, slot.width, slot.height);
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -11,7 +11,8 @@ use crate::backend::access::Access;
 use crate::features::antialias::{self, Antialias};
 use crate::features::debug_view;
 use crate::features::gbuffer::{self, GBufferLayout};
-use crate::features::{layered, lighting, shadows, sss, tonemap};
+use crate::features::technique::FrameImages;
+use crate::features::{lighting, shadows, sss, tonemap};
 use crate::gpu_scene::SceneGpu;
 use crate::graph::{CompileOptions, ImageInfo, ImportedImage, Plan, RenderGraph, ResourceId};
 use crate::Result;
@@ -105,9 +106,10 @@ pub fn declare_frame(
     let debug_display = settings.debug_view.and_then(|view| {
         debug_view::debug_view_pass(graph, view, &gb, &lit, new_display, scene_gpu)
     });
-    // Exported before the blurs are declared; they only read the two images, so the
-    // exported contents are the lighting pass's.
-    let lit_ids = match (&lit.specular, settings.export_lit && desc.sss.is_some()) {
+    // Exported before the parts' passes are declared; they only read the two images, so
+    // the exported contents are the lighting pass's (the specular is apart only in frames
+    // with SSS).
+    let lit_ids = match (&lit.specular, settings.export_lit) {
         (Some(specular), true) => {
             graph.export_image(&lit.color, Access::TransferRead);
             graph.export_image(specular, Access::TransferRead);
@@ -115,55 +117,22 @@ pub fn declare_frame(
         }
         _ => None,
     };
-    let hdr = match (&desc.sss, &lit.specular, &gb.sss) {
-        (Some(profiles), Some(specular), Some(profile_ids)) => sss::sss_passes(
-            graph,
-            &sss::SssInputs {
-                diffuse: &lit.color,
-                specular,
-                depth: &gb.depth,
-                profile_ids,
-                lean: gb.lean.as_ref().map(|view_plane| sss::LeanInputs {
-                    view_plane,
-                    gb0: &gb.gb0,
-                    gb1: &gb.gb1,
-                }),
-                shadow_depth: shadow_maps.as_ref().map(|m| &m.depth),
-                // lucent's own light-space maps are one atlas.
-                shadow_array: false,
-                albedo: layout.sss_texturing.then_some(&gb.gb0),
-                depth_in_alpha: profiles.depth_in_alpha(),
-                id_defines: profiles.id_map.defines(),
-            },
-            profiles,
-            &settings.sss,
-            scene_gpu,
-            None,
-        ),
-        _ => lit.color,
+    // Each part's passes after the lighting pass, in registry order (GDC 2011's term runs
+    // inside the lighting pass; the SSS chains blur the lit diffuse light; Li et al.'s terms
+    // add into the result).
+    let lighting::Lit {
+        color: mut hdr,
+        specular,
+    } = lit;
+    let images = FrameImages {
+        gbuffer: &gb,
+        specular: specular.as_ref(),
+        shadow_maps: shadow_maps.as_ref(),
     };
-    // Li et al.'s terms add into the lit image after the SSS blurs (layered pixels have no
-    // SSS profile, so the blurs left them as lit).
-    let hdr = match (&desc.layered, &gb.layered) {
-        (Some(_), Some(ids)) => layered::layered_passes(
-            graph,
-            hdr,
-            &layered::LayeredInputs {
-                depth: &gb.depth,
-                gb1: &gb.gb1,
-                ids,
-                layer_depths: gb.layer_depths.as_ref(),
-                layer_depth_textures: gb.layout.layer_depth_textures,
-                shadows: shadow_maps.as_ref(),
-                film: gb.layout.layered_film,
-                host: None,
-                host_film: None,
-            },
-            &settings.layered,
-            scene_gpu,
-        ),
-        _ => hdr,
-    };
+    let knobs = settings.part_knobs();
+    for part in desc.parts() {
+        hdr = part.declare(graph, &images, hdr, &knobs, scene_gpu);
+    }
     let mut ldr_id = None;
     let display = match (debug_display, settings.antialias) {
         (Some(display), _) => display,

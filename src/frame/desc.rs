@@ -1,281 +1,188 @@
 //! The frame description: what a frame of a scene shades, derived from the scene's materials.
 //!
 //! A feature is in the frame exactly when some object's material asks for it (and the
-//! [`super::Technique`] override does not leave it out): GB2 and the GDC 2011 term when some material
-//! is translucent, one SSS chain per blur the SSS materials use with every profile in the
-//! profile table, the LEAN targets when some chain is LCB or LBB, normal and albedo maps when
-//! some material has one, light-space maps when some light casts shadows, Li et al.'s
-//! scattering passes (and the G-buffer and light-space targets they read) when some material
-//! is layered. Everything else
-//! costs nothing: [`super::declare_frame`] declares
-//! no pass, image or shader permutation for it, and [`crate::gpu_scene`] uploads no stream,
-//! texture or table.
+//! [`super::Technique`] override does not leave it out). The techniques' parts are described
+//! by their own families ([`crate::features::technique::FramePart`]): GB2 and the GDC 2011 term
+//! when some material is translucent, one SSS chain per blur the SSS materials use with every
+//! profile in the profile table (and the LEAN targets when some chain is LCB or LBB), Li et
+//! al.'s scattering passes (and the G-buffer and light-space targets they read) when some
+//! material is layered. The frame's own features are normal and albedo maps when some material
+//! has one and light-space maps when some light casts shadows. Everything else costs nothing:
+//! [`super::declare_frame`] declares no pass, image or shader permutation for it, and
+//! [`crate::gpu_scene`] uploads no stream, texture or table.
 
 use super::FrameSettings;
-use crate::features::gbuffer::{GBufferLayout, TranslucencyLayout};
+use crate::features::gbuffer::GBufferLayout;
 use crate::features::layered::LayeredDesc;
-use crate::features::registry::{self, Shades, TechniqueModule};
+use crate::features::registry::{self, TechniqueModule};
 use crate::features::shadows::ShadowDesc;
 use crate::features::sss::SssProfiles;
-use crate::features::translucency::{MaterialTable, ThicknessPacking};
+use crate::features::technique::{downcast, Describe, FramePart};
 use crate::gpu_scene::{SceneUpload, TableRegion};
-use crate::scene::material::Texturing;
 use crate::scene::Scene;
 use crate::Result;
 
-/// The translucency part of a frame.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TranslucencyDesc {
-    /// The translucent materials with their IDs.
-    pub table: MaterialTable,
-    /// How GB2 packs thickness.
-    pub packing: ThicknessPacking,
-}
+pub use crate::features::translucency::TranslucencyDesc;
 
 /// What a frame of a scene shades beyond plain deferred lighting (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameDesc {
-    /// GDC 2011 translucency, when some object is translucent (and the technique keeps it).
-    pub translucency: Option<TranslucencyDesc>,
-    /// Screen-space SSS: every profile of the SSS materials with its blur, when some object
-    /// scatters (and the technique keeps it).
-    pub sss: Option<SssProfiles>,
+    /// The parts the materials ask for (and the technique keeps), in registry order: each
+    /// family of techniques describes its own ([`crate::features::technique`]).
+    parts: Vec<Box<dyn FramePart>>,
     /// Some object has a normal map.
     pub normal_maps: bool,
     /// Some object has an albedo texture.
     pub albedo_maps: bool,
     /// Light-space maps, when some light casts shadows.
     pub shadows: Option<ShadowDesc>,
-    /// Li et al.'s layered media, when some object is layered (and the technique keeps it).
-    pub layered: Option<LayeredDesc>,
 }
 
 impl FrameDesc {
-    /// What `scene` asks for under `settings` (its technique and knobs).
+    /// What `scene` asks for under `settings` (its technique and knobs): each part kind of
+    /// the registry describes its part, when the technique keeps it.
     pub fn new(scene: &Scene, settings: &FrameSettings) -> Result<Self> {
-        let technique = settings.technique;
         // Every technique a material names must exist, whichever technique this frame runs.
         registry::check_names(scene)?;
-        let sss = if technique.sss() {
-            SssProfiles::new(
-                scene,
-                technique.sss_blur(),
-                settings.sss.gaussians,
-                settings.sss.texturing,
-                &registry::blur_of,
-            )?
-        } else {
-            None
+        let context = Describe {
+            scene,
+            forced: settings.technique.module(),
+            knobs: settings.part_knobs(),
+            lookup: &registry::Registry,
         };
-        let translucency = if technique.translucency() {
-            // Forced (not `auto`): media without a term of their own derive one.
-            let table = MaterialTable::new(scene, technique != crate::frame::Technique::Auto)?;
-            let packing = if settings.force_grayscale {
-                ThicknessPacking::Grayscale
-            } else {
-                table.packing()
-            };
-            (!table.is_empty()).then_some(TranslucencyDesc { table, packing })
-        } else {
-            None
-        };
+        let mut parts = Vec::new();
+        for kind in registry::part_kinds() {
+            if settings.technique.keeps(kind) {
+                parts.extend(kind.describe(&context)?);
+            }
+        }
+        let mut shadows = ShadowDesc::new(scene, &settings.shadows, false);
+        if let Some(maps) = &mut shadows {
+            for part in &parts {
+                part.shadows(maps);
+            }
+        }
         let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
             scene.objects.iter().any(|o| f(&o.material))
         };
-        let layered = if technique.layered() {
-            LayeredDesc::new(scene)?
-        } else {
-            None
-        };
-        // The atlas stores each texel's translucency material only for materials whose
-        // transmitted light other objects shadow (the talk's term needs no lookup).
-        let shadowed_transmission = translucency
-            .as_ref()
-            .is_some_and(|t| t.table.any_shadowed());
-        let mut shadows = ShadowDesc::new(scene, &settings.shadows, shadowed_transmission);
-        if let Some(s) = &mut shadows {
-            // Single scattering reads each map texel's entry normal and layered material, and
-            // with TexDep media its depth texels.
-            s.entry = layered.is_some();
-            s.layer_depth_textures = layered.as_ref().map_or(0, LayeredDesc::depth_textures);
-        }
         Ok(Self {
+            parts,
             shadows,
-            layered,
-            translucency,
-            sss,
             normal_maps: any(&|m| m.normal_texture.is_some()),
             albedo_maps: any(&|m| m.albedo_texture.is_some()),
         })
     }
 
-    /// `TexDep` depth textures the frame's layered media read per object (0, 1 or 2).
-    pub fn layer_depth_textures(&self) -> usize {
-        self.layered.as_ref().map_or(0, LayeredDesc::depth_textures)
+    /// The frame's parts, in registry order.
+    pub fn parts(&self) -> impl Iterator<Item = &dyn FramePart> {
+        self.parts.iter().map(|p| p.as_ref())
     }
 
-    /// Whether the frame blurs the LEAN G-buffer (some SSS chain is LCB, LBB or bilateral).
-    pub fn lean(&self) -> bool {
-        self.sss.as_ref().is_some_and(SssProfiles::lean)
+    /// The frame's part of type `T`, when it has one.
+    pub fn part<T: FramePart>(&self) -> Option<&T> {
+        self.parts().find_map(downcast::<T>)
     }
 
-    /// Whether some SSS chain is a two-pass blur (separable or bilateral): the frame needs
-    /// the kernel table those passes read their weights from.
-    pub fn two_pass(&self) -> bool {
-        self.sss.as_ref().is_some_and(|s| s.two_pass())
+    /// GDC 2011 translucency, when some object is translucent (and the technique keeps it).
+    pub fn translucency(&self) -> Option<&TranslucencyDesc> {
+        self.part()
     }
 
-    /// The G-buffer layout this description and `settings` call for.
+    /// Screen-space SSS: every profile of the SSS materials with its blur, when some object
+    /// scatters (and the technique keeps it).
+    pub fn sss(&self) -> Option<&SssProfiles> {
+        self.part()
+    }
+
+    /// Li et al.'s layered media, when some object is layered (and the technique keeps it).
+    pub fn layered(&self) -> Option<&LayeredDesc> {
+        self.part()
+    }
+
+    /// The G-buffer layout this description and `settings` call for: plain deferred
+    /// lighting's, with what each part needs.
     pub fn gbuffer_layout(&self, settings: &FrameSettings) -> GBufferLayout {
-        let chains = self
-            .sss
-            .as_ref()
-            .map(SssProfiles::chains)
-            .unwrap_or_default();
-        GBufferLayout {
+        let mut layout = GBufferLayout {
             precision: settings.gbuffer,
-            translucency: self.translucency.as_ref().map(|t| TranslucencyLayout {
-                packing: t.packing,
-                pow_modes: t.table.pow_modes(),
-                single_material: t.table.rows.len() == 1,
-            }),
-            sss: self.sss.is_some(),
-            sss_texturing: self.sss.as_ref().is_some_and(|p| {
-                p.profiles
-                    .iter()
-                    .any(|(profile, _)| profile.texturing != Texturing::Pre)
-            }),
-            // Some profile's material has a medium: the lighting pass shades it as its medium
-            // reflects, and (with light-space maps and unless the knob is off) transmits.
-            sss_medium: self.sss.as_ref().is_some_and(SssProfiles::transmits),
-            lean: self.lean(),
-            // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
-            lean_clear: chains.iter().any(|b| b.lean() && !b.bilateral()),
+            translucency: None,
+            sss: false,
+            sss_texturing: false,
+            sss_medium: false,
+            lean: false,
+            lean_clear: false,
             normal_maps: self.normal_maps,
             albedo_maps: self.albedo_maps,
-            depth_in_alpha: self.sss.as_ref().is_some_and(SssProfiles::depth_in_alpha),
-            layered: self.layered.is_some(),
-            layered_film: self.layered.as_ref().is_some_and(|l| l.film),
-            layer_depth_textures: self.layer_depth_textures(),
+            depth_in_alpha: false,
+            layered: false,
+            layered_film: false,
+            layer_depth_textures: 0,
             fault_injection: settings.fault.is_some(),
+        };
+        for part in self.parts() {
+            part.gbuffer(&mut layout);
         }
+        layout
     }
 
-    /// The per-frame tables of this frame's features, each registered by its feature.
+    /// The per-frame tables of this frame's parts and features, each registered by its owner.
     pub fn tables(&self) -> Vec<TableRegion> {
         let mut tables = Vec::new();
-        if self.translucency.is_some() {
-            tables.push(crate::features::translucency::table_region());
-        }
-        if let Some(profiles) = &self.sss {
-            tables.extend(crate::features::sss::tables::regions(profiles));
+        for part in self.parts() {
+            part.tables(&mut tables);
         }
         if self.shadows.is_some() {
             tables.push(crate::features::shadows::table_region());
-        }
-        if self.layered.is_some() {
-            tables.push(crate::features::layered::table_region());
         }
         tables
     }
 
     /// What the scene's GPU data must hold for this frame.
     pub fn upload(&self, frames_in_flight: usize) -> SceneUpload<'_> {
-        SceneUpload {
-            translucency_ids: self.translucency.as_ref().map(|t| &t.table.object_ids[..]),
-            profile_ids: self.sss.as_ref().map(|s| &s.object_ids[..]),
+        let mut upload = SceneUpload {
+            translucency_ids: None,
+            profile_ids: None,
             normal_maps: self.normal_maps,
-            lean: self.lean(),
+            lean: false,
             albedo_maps: self.albedo_maps,
             frames_in_flight,
             tables: self.tables(),
-            layered_ids: self.layered.as_ref().map(|l| &l.object_ids[..]),
-            layer_depth_textures: self.layer_depth_textures(),
+            layered_ids: None,
+            layer_depth_textures: 0,
+        };
+        for part in self.parts() {
+            part.upload(&mut upload);
         }
+        upload
     }
 
     /// Whether a frame built for `self` can show `other` by rewriting only its per-frame
     /// tables: the same passes, images, permutations and per-object IDs (a knob changed a
     /// value, not which features or profiles exist).
     pub fn same_shape(&self, other: &FrameDesc, settings: &FrameSettings) -> bool {
-        let ids = |d: &FrameDesc| {
-            (
-                d.translucency.as_ref().map(|t| t.table.object_ids.clone()),
-                d.sss.as_ref().map(|s| s.object_ids.clone()),
-                d.layered.as_ref().map(|l| l.object_ids.clone()),
-            )
-        };
-        let steps = |d: &FrameDesc| {
-            d.sss.as_ref().map(|s| {
-                s.chains()
-                    .into_iter()
-                    .map(|c| (c, s.steps(c)))
-                    .collect::<Vec<_>>()
-            })
-        };
         self.gbuffer_layout(settings) == other.gbuffer_layout(settings)
             && self.shadows == other.shadows
-            && ids(self) == ids(other)
-            && steps(self) == steps(other)
-            && self.sss.as_ref().map(|s| s.profiles.len())
-                == other.sss.as_ref().map(|s| s.profiles.len())
-            && self.layered.as_ref().map(|l| l.materials.len())
-                == other.layered.as_ref().map(|l| l.materials.len())
+            && self.parts.len() == other.parts.len()
+            && self
+                .parts()
+                .zip(other.parts())
+                .all(|(a, b)| a.same_shape(b))
     }
 
     /// The registered techniques this frame runs, in registry order: GDC 2011 translucency,
     /// each SSS chain's blur, Li et al.'s layered media, as far as the frame has them.
     pub fn techniques(&self) -> Vec<&'static dyn TechniqueModule> {
-        let chains = self
-            .sss
-            .as_ref()
-            .map(SssProfiles::chains)
-            .unwrap_or_default();
         registry::TECHNIQUES
             .iter()
             .copied()
-            .filter(|t| match t.shades() {
-                Shades::Translucent => self.translucency.is_some(),
-                Shades::Scattering(_) => chains.iter().any(|c| c.name() == t.name()),
-                Shades::Layered => self.layered.is_some(),
-            })
+            .filter(|t| self.parts().any(|p| p.runs(*t)))
             .collect()
     }
 
     /// The features in the frame, for messages and the plan dump's header.
     pub fn names(&self) -> Vec<String> {
         let mut names = Vec::new();
-        if let Some(t) = &self.translucency {
-            names.push(format!(
-                "translucency ({} material{}, {})",
-                t.table.rows.len(),
-                if t.table.rows.len() == 1 { "" } else { "s" },
-                t.packing.name()
-            ));
-        }
-        if let Some(s) = &self.sss {
-            for chain in s.chains() {
-                let profiles: Vec<&str> = s
-                    .profiles
-                    .iter()
-                    .filter(|(_, b)| *b == chain)
-                    .map(|(p, _)| p.name.as_str())
-                    .collect();
-                names.push(format!("sss {} ({})", chain.name(), profiles.join(", ")));
-            }
-            if s.transmits() {
-                names.push("sss transmission through thickness (media)".into());
-            }
-        }
-        if let Some(l) = &self.layered {
-            let media: Vec<&str> = l.materials.iter().map(|m| m.name.as_str()).collect();
-            names.push(format!("layered ({})", media.join(", ")));
-            if l.depth_textures() > 0 {
-                names.push(format!(
-                    "layer depth textures ({} per object)",
-                    l.depth_textures()
-                ));
-            }
+        for part in self.parts() {
+            part.names(&mut names);
         }
         if let Some(s) = &self.shadows {
             names.push(s.name());
@@ -287,5 +194,109 @@ impl FrameDesc {
             names.push("albedo maps".into());
         }
         names
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::features::registry::{part_kinds, TECHNIQUES};
+    use crate::features::technique::same_kind;
+    use crate::frame::Technique;
+    use crate::scene::builtin::{builtin, BUILTIN_SCENES};
+
+    fn kinds(desc: &FrameDesc) -> Vec<&'static str> {
+        desc.parts().map(|p| p.kind().name()).collect()
+    }
+
+    /// Every built-in scene under every technique: the frame holds the parts its technique
+    /// keeps, each once, in registry order; a part runs exactly the techniques of its kind
+    /// that the frame lists.
+    #[test]
+    fn parts_follow_the_registry_and_the_technique() {
+        let order: Vec<&str> = part_kinds().iter().map(|k| k.name()).collect();
+        let mut seen = std::collections::BTreeSet::new();
+        for (name, _) in BUILTIN_SCENES {
+            let scene = builtin(name).unwrap();
+            for (_, technique) in Technique::all() {
+                let mut settings = FrameSettings::new(64, 48);
+                settings.technique = technique;
+                let desc = FrameDesc::new(&scene, &settings).unwrap();
+                let names = kinds(&desc);
+                let positions: Vec<usize> = names
+                    .iter()
+                    .map(|n| order.iter().position(|o| o == n).unwrap())
+                    .collect();
+                assert!(
+                    positions.windows(2).all(|w| w[0] < w[1]),
+                    "{name}: {names:?}"
+                );
+                for part in desc.parts() {
+                    assert!(
+                        technique.keeps(part.kind()),
+                        "{name} {technique:?}: {names:?}"
+                    );
+                    seen.insert(part.kind().name());
+                }
+                if technique == Technique::None {
+                    assert!(names.is_empty(), "{name}: {names:?}");
+                }
+                for t in desc.techniques() {
+                    let part = desc.parts().find(|p| same_kind(p.kind(), t.part()));
+                    assert!(part.is_some_and(|p| p.runs(t)), "{name}: {}", t.name());
+                }
+            }
+        }
+        // The built-in scenes between them have every part.
+        assert_eq!(seen.len(), order.len(), "{seen:?}");
+    }
+
+    /// Part kinds are told apart by name (their statics are zero-sized): each is unique, and
+    /// a technique keeps only its own.
+    #[test]
+    fn part_kinds_are_distinct() {
+        let kinds = part_kinds();
+        for (i, k) in kinds.iter().enumerate() {
+            assert!(
+                kinds[..i].iter().all(|o| !same_kind(*o, *k)),
+                "{}",
+                k.name()
+            );
+        }
+        for t in TECHNIQUES {
+            let keeps: Vec<&str> = kinds
+                .iter()
+                .filter(|k| Technique::Only(*t).keeps(**k))
+                .map(|k| k.name())
+                .collect();
+            assert_eq!(keeps, [t.part().name()], "{}", t.name());
+            assert!(kinds.iter().all(|k| Technique::Auto.keeps(*k)));
+            assert!(kinds.iter().all(|k| !Technique::None.keeps(*k)));
+        }
+    }
+
+    /// A frame without parts is plain deferred lighting: no G-buffer target, table or upload
+    /// of any technique.
+    #[test]
+    fn a_frame_without_parts_asks_for_nothing_of_them() {
+        let scene = builtin("mixed").unwrap();
+        let mut settings = FrameSettings::new(64, 48);
+        settings.technique = Technique::None;
+        settings.shadows.enabled = false;
+        let desc = FrameDesc::new(&scene, &settings).unwrap();
+        assert!(desc.tables().is_empty());
+        let layout = desc.gbuffer_layout(&settings);
+        assert!(layout.translucency.is_none() && !layout.sss && !layout.lean && !layout.layered);
+        let upload = desc.upload(1);
+        assert!(upload.translucency_ids.is_none() && upload.profile_ids.is_none());
+        assert!(upload.layered_ids.is_none() && !upload.lean);
+        // With every part the materials ask for, each sets its own.
+        settings.technique = Technique::Auto;
+        let desc = FrameDesc::new(&scene, &settings).unwrap();
+        assert!(desc.translucency().is_some() && desc.sss().is_some());
+        let layout = desc.gbuffer_layout(&settings);
+        assert!(layout.translucency.is_some() && layout.sss);
+        assert_eq!(desc.tables().len(), desc.upload(1).tables.len());
+        assert!(desc.same_shape(&desc.clone(), &settings));
     }
 }

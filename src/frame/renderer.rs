@@ -12,10 +12,8 @@ use super::{
 };
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
-use crate::features::sss;
-use crate::gpu_scene::tiles::{
-    bounds_of, mesh_bounds, object_tiles, object_tiles_at_depth, tile_rects, translucent_tiles,
-};
+use crate::features::technique::SlotWrite;
+use crate::gpu_scene::tiles::{bounds_of, mesh_bounds};
 use crate::gpu_scene::{FrameUniforms, SceneGpu, SlotTiles, FRAME};
 use crate::graph::{Executable, RenderGraph, ResourceId, Subresources};
 use crate::scene::{Scene, MAX_LIGHTS};
@@ -209,61 +207,18 @@ impl Renderer {
             )?;
         }
         let mut tiles = SlotTiles::default();
-        if let Some(t) = &desc.translucency {
-            per_frame.write(
-                slot,
-                &crate::features::translucency::TABLE_REGION,
-                bytemuck::bytes_of(&t.table.gpu()),
-            )?;
-            let (columns, _, marked) =
-                translucent_tiles(scene, &t.table.object_ids, mesh_bounds, width, height);
-            tiles.lighting = tile_rects(columns, &marked, width, height);
-        }
-        if let Some(profiles) = &desc.sss {
-            sss::tables::write(per_frame, slot, profiles, &self.settings.sss)?;
-            for chain in profiles.chains() {
-                let rects = self.settings.sss_tiles.then(|| {
-                    let (columns, _, marked) =
-                        object_tiles(scene, mesh_bounds, width, height, |i, _| {
-                            // The frame's profile: the material's own, refitted, or the
-                            // one fitted to its medium.
-                            let (profile, blur) = profiles.of_object(i)?;
-                            (*blur == chain).then(|| sss::profile_reach(profile))
-                        });
-                    // All rectangles: the blurs draw the marked ones, LCB's and LBB's final
-                    // pass its LEAN variant there and the pass-through variant elsewhere.
-                    tile_rects(columns, &marked, width, height)
-                });
-                tiles.sss.push(rects);
-            }
-        }
-        if let Some(layered) = &desc.layered {
-            let table = layered.table(&self.settings.layered);
-            per_frame.write(
-                slot,
-                &crate::features::layered::TABLE_REGION,
-                bytemuck::bytes_of(&table),
-            )?;
-            // The scattering passes stay on the object (the gather rejects other materials).
-            let (columns, _, marked) = object_tiles(scene, mesh_bounds, width, height, |i, _| {
-                (layered.object_ids.get(i).copied().unwrap_or(0) > 0).then_some(0.0)
-            });
-            tiles.layered = tile_rects(columns, &marked, width, height);
-            // The term's blur only over objects whose medium it acts on at their distance.
-            let focal_px = scene.camera.focal_px(height);
-            let texel_px = if self.settings.layered.half_gather {
-                2.0
-            } else {
-                1.0
-            };
-            let (columns, _, marked) =
-                object_tiles_at_depth(scene, mesh_bounds, width, height, |i, _, nearest| {
-                    let id = usize::from(layered.object_ids.get(i).copied().unwrap_or(0));
-                    let medium = layered.materials.get(id.checked_sub(1)?)?;
-                    crate::features::layered::blurs_on_screen(medium, nearest, focal_px, texel_px)
-                        .then_some(0.0)
-                });
-            tiles.layered_blur = tile_rects(columns, &marked, width, height);
+        let mut write = SlotWrite {
+            scene,
+            mesh_bounds,
+            width,
+            height,
+            knobs: self.settings.part_knobs(),
+            per_frame,
+            slot,
+            tiles: &mut tiles,
+        };
+        for part in desc.parts() {
+            part.write_slot(&mut write)?;
         }
         *per_frame.tiles(slot) = tiles;
         Ok(())

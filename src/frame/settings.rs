@@ -6,10 +6,11 @@ use crate::features::debug_view::DebugView;
 use crate::features::gbuffer::GBufferPrecision;
 use crate::features::knob::{Given, Knob, KnobTargets};
 use crate::features::layered::LayeredKnobs;
-use crate::features::registry::{self, Shades, TechniqueModule};
+use crate::features::registry::{self, TechniqueModule};
 use crate::features::shadows::ShadowSettings;
 use crate::features::sss;
 use crate::features::sss::SssBlur;
+use crate::features::technique::{same_kind, PartKind, PartKnobs};
 use crate::graph::CompileOptions;
 use crate::Result;
 
@@ -88,28 +89,19 @@ impl Technique {
         }
     }
 
-    fn shades(self) -> Option<Shades> {
-        self.module().map(|t| t.shades())
-    }
-
     /// The screen-space SSS blur this technique forces on every SSS material, if any.
     pub fn sss_blur(self) -> Option<SssBlur> {
         self.module().and_then(registry::blur_of_technique)
     }
 
-    /// Whether translucent materials get GDC 2011 translucency.
-    pub fn translucency(self) -> bool {
-        self == Technique::Auto || matches!(self.shades(), Some(Shades::Translucent))
-    }
-
-    /// Whether SSS materials get their screen-space blur.
-    pub fn sss(self) -> bool {
-        self == Technique::Auto || matches!(self.shades(), Some(Shades::Scattering(_)))
-    }
-
-    /// Whether layered materials get Li et al.'s scattering passes.
-    pub fn layered(self) -> bool {
-        self == Technique::Auto || matches!(self.shades(), Some(Shades::Layered))
+    /// Whether the frame keeps the part `kind` of its materials: `auto` keeps every part, a
+    /// registered technique only its own, `none` none.
+    pub fn keeps(self, kind: &dyn PartKind) -> bool {
+        match self {
+            Technique::Auto => true,
+            Technique::None => false,
+            Technique::Only(t) => same_kind(t.part(), kind),
+        }
     }
 }
 
@@ -238,6 +230,16 @@ impl FrameSettings {
             layered: &mut self.layered,
             force_grayscale: &mut self.force_grayscale,
             sss_tiles: &mut self.sss_tiles,
+        }
+    }
+
+    /// The knobs a frame's parts read ([`crate::features::technique`]).
+    pub fn part_knobs(&self) -> PartKnobs<'_> {
+        PartKnobs {
+            sss: &self.sss,
+            layered: &self.layered,
+            force_grayscale: self.force_grayscale,
+            sss_tiles: self.sss_tiles,
         }
     }
 

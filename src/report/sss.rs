@@ -280,8 +280,8 @@ pub fn run(
         .ok_or_else(|| LucentError::InvalidInput("reference G-buffer not exported".into()))?;
     // The edges scene has one profile (its skin): the reference convolves with it.
     let (profile, _) = FrameDesc::new(&edges, &reference_frame)?
-        .sss
-        .and_then(|s| s.profiles.into_iter().next())
+        .sss()
+        .and_then(|s| s.profiles.first().cloned())
         .ok_or_else(|| LucentError::InvalidInput("the edges scene has no SSS profile".into()))?;
     // Specular is off on the SSS objects: both specular models add nothing there. One
     // reference per texturing mode the variants use (the profile's own unless a variant

@@ -304,8 +304,7 @@ fn image_error(
         &LightingInputs {
             scene: &exact,
             translucency: features
-                .translucency
-                .as_ref()
+                .translucency()
                 .map(|t| (t.table.rows.as_slice(), t.packing)),
         },
     );

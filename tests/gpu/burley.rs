@@ -64,10 +64,10 @@ fn errors(test: &TestGpu, name: &str, budget: Option<u32>, half_res: bool) -> (f
     let gbuffer = frame.gbuffer.as_ref().unwrap();
     let (profile, _) = FrameDesc::new(&scene, &burley)
         .unwrap()
-        .sss
+        .sss()
         .unwrap()
-        .profiles
-        .remove(0);
+        .profiles[0]
+        .clone();
     let d = profile.burley_d(burley.sss.burley_fit);
     let reference = lucent::reference::sss::burley_reference_image(
         &scene,

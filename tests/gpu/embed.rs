@@ -2662,7 +2662,7 @@ fn a_host_built_scene_renders_with_three_frames_in_flight_like_frames_one_at_a_t
     })
     .unwrap();
     let desc = &renderer.renderer().desc;
-    assert!(desc.sss.is_some() && desc.translucency.is_some() && desc.shadows.is_some());
+    assert!(desc.sss().is_some() && desc.translucency().is_some() && desc.shadows.is_some());
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
     let images: Vec<GpuImage> = (0..3)
         .map(|_| output_image(&test, w, h, vk::Format::R8G8B8A8_UNORM, usage))

@@ -3,7 +3,7 @@
 //! plan of a layered frame, and what a frame without layered materials leaves out.
 
 use glam::Vec3;
-use lucent::features::layered::{LayeredKnobs, PhaseForm};
+use lucent::features::layered::{LayeredKnobs, PhaseForm, LAYERED_PART};
 use lucent::frame::{FrameDesc, FrameSettings, Technique};
 use lucent::graph::Plan;
 use lucent::measure::layered_error::{
@@ -232,7 +232,10 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
     assert!(passes(&p).iter().any(|n| n == "single scattering"));
     assert!(!images(&p).iter().any(|n| n.starts_with("light-space")));
     // --technique none (and every other technique but auto and layered) leave layered media out.
-    for technique in common::techniques().into_iter().filter(|t| !t.layered()) {
+    for technique in common::techniques()
+        .into_iter()
+        .filter(|t| !t.keeps(&LAYERED_PART))
+    {
         let mut t = s;
         t.technique = technique;
         let p = common::plan(&layered, &t);
@@ -268,7 +271,7 @@ fn a_layered_frame_has_the_scattering_passes_and_others_leave_them_out() {
             );
         }
         let desc = FrameDesc::new(&scene, &s).unwrap();
-        assert!(desc.layered.is_none());
+        assert!(desc.layered().is_none());
         assert!(!desc
             .tables()
             .iter()

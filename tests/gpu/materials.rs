@@ -288,7 +288,7 @@ fn each_sss_material_is_diffused_with_its_own_profile_without_bleeding() {
     let mixed = load_scene_baked("mixed").unwrap();
     let s = exported(Technique::Auto, w, h);
     let desc = FrameDesc::new(&mixed, &s).unwrap();
-    let profiles = desc.sss.as_ref().unwrap();
+    let profiles = desc.sss().unwrap();
     let id_of = |name: &str| {
         let i = mixed
             .objects
@@ -321,7 +321,7 @@ fn each_sss_material_is_diffused_with_its_own_profile_without_bleeding() {
                 .iter()
                 .position(|o| o.material.name == names[0])
                 .unwrap();
-            f32::from(d.sss.unwrap().object_ids[i])
+            f32::from(d.sss().unwrap().object_ids[i])
         };
         let (in_mixed, n) = mean_change(&together, &plain, id);
         let (by_itself, m) = mean_change(&alone, &plain, alone_id);
@@ -412,7 +412,7 @@ fn two_blur_chains_compose_in_one_frame() {
         assert!(hdr.iter().all(|v| v.is_finite()), "non-finite output");
         let ids = both.gbuffer.as_ref().unwrap().sss.as_ref().unwrap();
         let desc = FrameDesc::new(&two, &s).unwrap();
-        let profiles = desc.sss.as_ref().unwrap();
+        let profiles = desc.sss().unwrap();
         assert_eq!(profiles.chains(), chains);
         let skin = {
             let i = two
@@ -456,7 +456,7 @@ fn mixed_translucent_pixels_match_the_f64_reference() {
     let s = exported(Technique::Auto, 320, 200);
     let images = test.render(&mixed, s);
     let desc = FrameDesc::new(&mixed, &s).unwrap();
-    let t = desc.translucency.as_ref().unwrap();
+    let t = desc.translucency().unwrap();
     let gbuffer = images.gbuffer.as_ref().unwrap();
     let reference = shade_gbuffer(
         gbuffer,

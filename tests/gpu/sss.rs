@@ -57,12 +57,7 @@ fn brute_force_reference(
     gbuffer: &GBufferReadback,
     specular: ReferenceSpecular,
 ) -> Vec<glam::DVec3> {
-    let (profile, _) = FrameDesc::new(scene, s)
-        .unwrap()
-        .sss
-        .unwrap()
-        .profiles
-        .remove(0);
+    let (profile, _) = FrameDesc::new(scene, s).unwrap().sss().unwrap().profiles[0].clone();
     lucent::reference::sss::reference_image(scene, gbuffer, &profile, specular)
 }
 

@@ -38,7 +38,7 @@ fn compare_with_reference(
     images: &FrameImages,
 ) -> (f64, f64) {
     let features = FrameDesc::new(scene, settings).unwrap();
-    let t = features.translucency.as_ref().expect("translucent scene");
+    let t = features.translucency().expect("translucent scene");
     let gbuffer = images.gbuffer.as_ref().unwrap();
     let reference = shade_gbuffer(
         gbuffer,
@@ -130,7 +130,7 @@ fn translucency_lights_only_translucent_pixels_and_costs_nothing_where_unused() 
     let settings = translucency_settings(size.0, size.1);
     assert!(FrameDesc::new(&smoke, &settings)
         .unwrap()
-        .translucency
+        .translucency()
         .is_none());
     let plain = FrameSettings {
         technique: Technique::None,

@@ -94,7 +94,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
         isolate: args.isolate,
     };
     with_renderer(&args.frame, &args.gpu, false, |session, renderer, scene| {
-        if seeds.li && FrameDesc::new(scene, &renderer.settings)?.layered.is_none() {
+        if seeds.li
+            && FrameDesc::new(scene, &renderer.settings)?
+                .layered()
+                .is_none()
+        {
             return Err(LucentError::InvalidInput(format!(
                 "--compare-seeds with --technique {}: scene '{}' has no layered material, so \
                  Li et al.'s Table 1 has nothing to compare (try --scene scaling:N or layered)",

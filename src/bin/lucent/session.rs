@@ -128,10 +128,11 @@ fn check_device_fits(
 ) -> Result<()> {
     let info = &gpu.info;
     let textures = scene::texture::scene_texture_sizes(scene, Some(info.max_image_dimension_2d))?;
-    let plan = plan_frame(settings, &FrameDesc::new(scene, settings)?)?;
+    let desc = FrameDesc::new(scene, settings)?;
+    let plan = plan_frame(settings, &desc)?;
     let (frame_bytes, largest) = plan.frame_memory();
     // Maps go up as RGBA16F with mips (4/3); in LEAN frames a normal map as two such maps.
-    let lean = FrameDesc::new(scene, settings)?.lean();
+    let lean = desc.upload(1).lean;
     let texture_bytes: u64 = textures
         .iter()
         .map(|(_, w, h, normal)| {

@@ -49,7 +49,7 @@ use ash::vk;
 use super::knob::Knob;
 use super::pass::FullscreenPass;
 use super::shadows::{self, ShadowMaps};
-use super::technique::{Shades, TechniqueModule};
+use super::technique::{PartKind, TechniqueModule};
 use crate::gpu_scene::{Region, SceneGpu, TableRegion, TileRect, FRAME};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
 use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
@@ -57,11 +57,13 @@ use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 pub mod knobs;
+mod part;
 pub mod settings;
 
 pub use knobs::{
     GATHER_KNOB, HALF_IRRADIANCE_KNOB, PHASE_KNOB, PIXEL_LIGHTS_KNOB, SINGLE_DEPTH_KNOB, STEPS_KNOB,
 };
+pub use part::{LayeredPart, LAYERED_PART};
 pub use settings::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
 
 /// The transmitted irradiance image.
@@ -805,8 +807,8 @@ impl TechniqueModule for LiLayeredMedia {
          layered materials"
     }
 
-    fn shades(&'static self) -> Shades {
-        Shades::Layered
+    fn part(&self) -> &'static dyn PartKind {
+        &LAYERED_PART
     }
 
     fn knobs(&self) -> &'static [&'static Knob] {

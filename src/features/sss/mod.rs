@@ -55,8 +55,14 @@ macro_rules! chain_technique_module {
                 self.summary
             }
 
-            fn shades(&'static self) -> $crate::features::technique::Shades {
-                $crate::features::technique::Shades::Scattering(self)
+            fn part(&self) -> &'static dyn $crate::features::technique::PartKind {
+                &$crate::features::sss::SSS_PART
+            }
+
+            fn sss_chain(
+                &'static self,
+            ) -> Option<&'static dyn $crate::features::sss::SssBlurTechnique> {
+                Some(self)
             }
 
             fn knobs(&self) -> &'static [&'static $crate::features::knob::Knob] {
@@ -87,12 +93,14 @@ pub mod kernel;
 pub mod knobs;
 pub mod lbb;
 pub mod lcb;
+mod part;
 pub mod separable;
 pub mod settings;
 pub mod tables;
 pub mod transmission;
 mod two_pass;
 
+pub use part::{SssPart, SSS_PART};
 pub use settings::{SssKnobs, SssPrecision, DEFAULT_SENSITIVITY};
 
 use super::pass::FullscreenPass;
@@ -104,8 +112,7 @@ pub const MAX_SSS_PROFILES: usize = 32;
 pub const MAX_SSS_STEPS: usize = 8;
 
 /// A screen-space SSS technique's chain of passes: what its module implements besides
-/// [`super::technique::TechniqueModule`] (whose [`Shades::Scattering`](super::technique::Shades)
-/// returns it). The two kinds of chain are built by shared code (`iterative.rs`: one blur pair
+/// [`super::technique::TechniqueModule`] (whose `sss_chain` returns it). The two kinds of chain are built by shared code (`iterative.rs`: one blur pair
 /// per Gaussian; `two_pass.rs`: one pair for the whole profile), parametrised by the
 /// properties below, never by a technique's name.
 pub trait SssBlurTechnique: Sync {

@@ -650,11 +650,11 @@ units_per_mm = 0.05
             ..FrameSettings::new(64, 64)
         };
         let auto = FrameDesc::new(&scene, &settings("auto")).unwrap();
-        assert!(auto.layered.is_some() && auto.sss.is_none());
+        assert!(auto.layered().is_some() && auto.sss().is_none());
         for blur in ["separable", "bilateral", "burley", "control"] {
             let d = FrameDesc::new(&scene, &settings(blur)).unwrap();
-            let sss = d.sss.as_ref().unwrap_or_else(|| panic!("{blur}: no SSS"));
-            assert!(d.layered.is_none(), "{blur}");
+            let sss = d.sss().unwrap_or_else(|| panic!("{blur}: no SSS"));
+            assert!(d.layered().is_none(), "{blur}");
             let (profile, _) = sss.of_object(0).unwrap();
             assert!(
                 profile.name.contains("fitted to its dipole"),
@@ -671,8 +671,8 @@ units_per_mm = 0.05
         let m = &with_sss.objects[0].material;
         assert!(m.layers.is_none() && m.sss.is_some() && m.medium.is_some());
         let auto = FrameDesc::new(&with_sss, &settings("auto")).unwrap();
-        assert!(auto.layered.is_none());
-        assert_eq!(auto.sss.unwrap().of_object(0).unwrap().0.name, "skin");
+        assert!(auto.layered().is_none());
+        assert_eq!(auto.sss().unwrap().of_object(0).unwrap().0.name, "skin");
     }
 
     #[test]

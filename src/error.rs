@@ -59,7 +59,7 @@ pub enum LucentError {
     )]
     ShaderNotShipped { permutation: String },
     /// A shader's descriptor bindings disagree with what its pass declares
-    /// ([`crate::backend::bindings`]): a resource the pass binds under no name or number, or
+    /// (`crate::backend::bindings`): a resource the pass binds under no name or number, or
     /// of another kind.
     #[error("pipeline '{pipeline}': {shader}: {message}")]
     ShaderBindings {
@@ -210,8 +210,8 @@ impl LucentError {
     }
 }
 
-/// The value named `name` in a table of command-line names (`ALL` of [`crate::frame::Technique`],
-/// the benchmark's formats, [`crate::features::antialias::Antialias`]), or the error
+/// The value named `name` in a table of command-line names (`ALL` of `crate::frame::Technique`,
+/// the benchmark's formats, `crate::features::antialias::Antialias`), or the error
 /// `unknown WHAT 'NAME'; available: a, b, c`.
 pub fn parse_named<T: Copy>(table: &[(&str, T)], name: &str, what: &str) -> Result<T> {
     table

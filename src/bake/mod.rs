@@ -93,7 +93,7 @@ pub struct BakeOptions {
     /// Width and height of a baked texture in texels (default 512; 1 ..= [`MAX_TEXTURE_SIZE`]).
     pub texture_size: u32,
     /// Draw a progress bar on stderr (hidden when stderr is not a terminal); without the
-    /// `report` feature, log the count at info level instead ([`crate::progress`]).
+    /// `report` feature, log the count at info level instead (`crate::progress`).
     pub progress: bool,
     /// What a sample's value measures: the talk's occlusion (default) or a distance.
     pub measure: BakeMeasure,

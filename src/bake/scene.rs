@@ -13,7 +13,7 @@ use crate::scene::material::ThicknessSource;
 use crate::scene::{self, material, texture, Scene};
 
 /// The thickness bake cache used when the caller names none: `thickness` in
-/// [`crate::files::default_cache_dir`].
+/// `crate::files::default_cache_dir`.
 pub fn default_thickness_cache_dir() -> std::path::PathBuf {
     crate::files::default_cache_dir().join("thickness")
 }

@@ -396,7 +396,7 @@ pub struct LayeredFrame<'a> {
     /// The environment whose light enters the media (Li et al.'s ambient term; `None`: none).
     pub environment: Option<&'a Environment>,
     /// The faces lucent draws its light-space maps with (at most
-    /// [`crate::features::shadows::MAX_SHADOW_FACES`]), each light's together and in order,
+    /// `crate::features::shadows::MAX_SHADOW_FACES`), each light's together and in order,
     /// their rectangles inside [`LayeredEffectDesc::light_space`]. A light without faces
     /// lights the media unshadowed, and its entry points are the shaded surface's plane.
     pub light_faces: &'a [ShadowFace],

@@ -214,10 +214,12 @@ pub use uploads::{leaked, Uploads};
 // The types a host names in its descriptions, and the versions of the crates it must build its
 // handles with.
 pub use crate::error::{HostError, ImageFault};
-pub use crate::features::layered::{LayeredKnobs, PhaseForm};
-pub use crate::features::sss::SssKnobs;
+pub use crate::features::layered::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
+pub use crate::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
+pub use crate::features::sss::{SssKnobs, SssPrecision, DEFAULT_SENSITIVITY};
 pub use crate::scene::layered::{Layer, LayeredMedium, Thickness};
 pub use crate::scene::material::{Medium, PowMode, SssProfile, Texturing, Translucency};
+pub use crate::scene::profile::BurleyFit;
 pub use crate::scene::{Environment, Light, LightKind};
 pub use ash;
 pub use glam;
@@ -241,8 +243,11 @@ pub use glam;
 /// [`TransmissionMaterial::rows`] and the shadow-map lookup (`lucent_shadow_texels`,
 /// [`ShadowFace::terms_rows`]); [`GBufferDesc::metres_per_unit`] at most
 /// [`MAX_METRES_PER_UNIT`]; host images that are one mip level or layer of a larger image
-/// ([`HostImage::at`]).
-pub const API_VERSION: u32 = 9;
+/// ([`HostImage::at`]). 10: lucent's internal modules are crate-private in a build without
+/// the `internals` feature (a host's `default-features = false`): a host names only
+/// `lucent::embed` and what it re-exports (now also the knobs' value types: [`SssPrecision`],
+/// [`KernelShape`], [`BurleyFit`] and their ranges), `scene`, `bake`, `images` and `error`.
+pub const API_VERSION: u32 = 10;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
@@ -350,11 +355,11 @@ pub struct EmbedOptions {
     /// Where lucent keeps what it caches between runs (the thickness bake; shaders come
     /// compiled with the crate):
     /// a directory the host chooses. `None`: the platform's per-user cache
-    /// ([`crate::files::default_cache_dir`]: `$LUCENT_CACHE_DIR`, else e.g.
+    /// (`crate::files::default_cache_dir`: `$LUCENT_CACHE_DIR`, else e.g.
     /// `~/.cache/lucent`), never the source tree.
     pub cache_dir: Option<PathBuf>,
     /// Install lucent's own debug messenger on the host's instance (when it has
-    /// `VK_EXT_debug_utils`), so [`crate::backend::GpuContext::validation_error_count`] counts
+    /// `VK_EXT_debug_utils`), so `crate::backend::GpuContext::validation_error_count` counts
     /// the messages the layers send while lucent is alive. Off by default: a host with its own
     /// messenger would see every message twice, and lucent's count would include the host's.
     pub debug_messenger: bool,
@@ -437,7 +442,7 @@ impl Lucent {
     }
 
     /// The wrapped context (for lucent's lower layers, debug names, validation counts).
-    pub fn gpu(&self) -> &GpuContext {
+    pub(crate) fn gpu(&self) -> &GpuContext {
         &self.gpu
     }
 

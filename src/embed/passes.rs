@@ -23,7 +23,10 @@ use crate::Result;
 /// what one frame's recording does), `record_timed` and `destroy`.
 macro_rules! effect_methods {
     ($frame:ident, $does:literal) => {
-        /// The passes the effect records (their plan, for tables and tests).
+        /// The passes the effect records (their plan, for lucent's tables and tests): an
+        /// internal type, not part of the surface a host relies on (hidden from the docs;
+        /// [`Self::record_timed`] names each pass with its time).
+        #[doc(hidden)]
         pub fn plan(&self) -> &crate::graph::Plan {
             self.passes.plan()
         }

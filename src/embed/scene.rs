@@ -15,7 +15,7 @@ use crate::Result;
 /// tonemapped) rendered into a host image.
 ///
 /// Built once per scene shape and output size and format; between frames the host may change
-/// whatever [`Renderer::can_update`] allows (camera, lights, material values, the time of a
+/// whatever `Renderer::can_update` allows (camera, lights, material values, the time of a
 /// deforming scene) by passing the changed scene to [`SceneRenderer::record`]. A scene with
 /// other objects, features or profiles needs a new renderer.
 pub struct SceneRenderer {
@@ -98,7 +98,9 @@ impl SceneRenderer {
         })
     }
 
-    /// The renderer underneath (its plan, passes and settings).
+    /// The renderer underneath (its plan, passes and settings): lucent's internals, for its
+    /// own tests; not part of the surface a host relies on (hidden from the docs).
+    #[doc(hidden)]
     pub fn renderer(&self) -> &Renderer {
         &self.renderer
     }

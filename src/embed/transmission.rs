@@ -178,7 +178,7 @@ pub struct TransmissionFrame<'a> {
     pub camera: HostCamera,
     /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
     pub lights: &'a [Light],
-    /// The faces of the lights' shadow maps this frame (at most [`crate::features::shadows::MAX_SHADOW_FACES`]), each
+    /// The faces of the lights' shadow maps this frame (at most `crate::features::shadows::MAX_SHADOW_FACES`), each
     /// light's together and in order.
     pub shadow_faces: &'a [ShadowFace],
     /// The images.

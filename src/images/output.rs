@@ -6,7 +6,7 @@
 //! - [`read_png_rgba8`]: load a PNG (golden images) as tightly packed RGBA8.
 //! - [`f16_bytes_to_f32`]: turn an `R16G16B16A16_SFLOAT` readback into `f32`s for EXR or checks.
 //!
-//! Every writer writes through [`crate::files::write_file_atomic`] (never half a file, missing
+//! Every writer writes through `crate::files::write_file_atomic` (never half a file, missing
 //! parent directories created); every error names the file.
 
 use std::io::Cursor;

@@ -4,7 +4,7 @@
 //! as the medium does, so it is the albedo `[material.medium]` derives
 //! ([`crate::scene::material::Medium`]).
 //!
-//! Jensen's dipole `R_d` ([`crate::reference::dipole`]) is not it: it leaves out single scattering and,
+//! Jensen's dipole `R_d` (`crate::reference::dipole`) is not it: it leaves out single scattering and,
 //! being a diffusion approximation, underestimates media of moderate albedo. Against Monte
 //! Carlo, skin1's `R_d` (0.547, 0.291, 0.161) is 13-34% below its white-sky albedo (0.625,
 //! 0.385, 0.241); for a medium of albedo near 1 (marble) they differ by 2-3%.

@@ -1,5 +1,5 @@
 //! The files a scene reads, named before it is loaded: what a command's outputs are checked
-//! against ([`crate::files::check_outputs`]), so `render --scene s.toml --out s.toml` or an
+//! against (`crate::files::check_outputs`), so `render --scene s.toml --out s.toml` or an
 //! output onto the scene's normal map is refused before any work.
 //!
 //! This reads only the keys that name files (`[[mesh]] obj` and `gltf`, `[[material]] albedo_texture`,

@@ -1,7 +1,7 @@
 //! What is drawn: meshes, materials, lights, camera, and the built-in scenes by name.
 //!
 //! Every mesh keeps the analytic shape it was generated from (when it has one), so the CPU
-//! reference in [`crate::reference`] can ray-trace the exact surface the GPU rasterises an
+//! reference in `crate::reference` can ray-trace the exact surface the GPU rasterises an
 //! approximation of.
 
 pub mod albedo;

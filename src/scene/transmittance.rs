@@ -63,13 +63,13 @@ pub fn most(dipole: &Dipole) -> f64 {
 }
 
 /// The medium's diffuse transmittance through `a` (its unit), relative to its total diffuse
-/// reflectance (glsl `sss_transmittance`, [`crate::features::sss::transmission`] says why):
+/// reflectance (glsl `sss_transmittance`, `crate::features::sss::transmission` says why):
 /// `max(multipole, dipole beyond a) / (dipole beyond 0)`, in `[0, most]`; 1 at `a = 0` for a
 /// medium that scatters (the multipole is negative there), not for a pure absorber, whose
 /// albedo (`R_d = 0`) zeroes the light anyway. Written
 /// as the ratio of sums, so a medium that scatters nothing (`alpha' = 0`) still has a finite
 /// shape: its albedo, `R_d = 0`, is what zeroes its light. The sum at 0 is at least
-/// `e^-sqrt(3)` ([`crate::features::sss::transmission::SssTransmission::rows`]).
+/// `e^-sqrt(3)` (`crate::features::sss::transmission::SssTransmission::rows`).
 pub fn transmittance(dipole: &Dipole, a: f64) -> f64 {
     let a = a.max(0.0);
     let through = beyond_sum(dipole, a).max(multipole_sum(dipole, a));

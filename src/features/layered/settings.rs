@@ -36,9 +36,9 @@ impl PhaseForm {
 /// The layered passes' knobs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LayeredKnobs {
-    /// Single scattering's march steps `K` ([`STEP_RANGE`]).
+    /// Single scattering's march steps `K` (`STEP_RANGE`).
     pub steps: u32,
-    /// Multiple scattering's pixel lights `M` ([`PIXEL_LIGHT_RANGE`]).
+    /// Multiple scattering's pixel lights `M` (`PIXEL_LIGHT_RANGE`).
     pub pixel_lights: u32,
     /// The phase function.
     pub phase: PhaseForm,

@@ -60,7 +60,7 @@ pub struct SssKnobs {
     /// Precision of the sum targets.
     pub precision: SssPrecision,
     /// Bilateral blur: sensitivity to depth differences, relative to each Gaussian's own
-    /// width ([`DEFAULT_SENSITIVITY`]).
+    /// width (`DEFAULT_SENSITIVITY`).
     pub sensitivity: f32,
     /// LBB: carry the two blurred texels (light + slope x, slope y + moments) between passes
     /// as one RGBA32UI texel of eight fp16 halves, so each tap is one fetch and each pass one
@@ -73,9 +73,9 @@ pub struct SssKnobs {
     /// is Jimenez's 7 taps.
     pub taps: u32,
     /// The two-pass blurs (separable, bilateral): samples per direction, 11, 17 or 25
-    /// ([`kernel::SAMPLE_COUNTS`]).
+    /// (`kernel::SAMPLE_COUNTS`).
     pub samples: u32,
-    /// The separable blur's 1-D kernel function ([`kernel::KernelShape`]).
+    /// The separable blur's 1-D kernel function (`kernel::KernelShape`).
     pub shape: kernel::KernelShape,
     /// The separable blur at half resolution per side (a quarter of the pixels), upsampled
     /// depth-aware in a combine pass.
@@ -98,7 +98,7 @@ pub struct SssKnobs {
     /// Every SSS material's texturing mode instead of its own (`--sss-texturing`).
     pub texturing: Option<crate::scene::material::Texturing>,
     /// SSS materials with a medium add the light diffused through their thickness
-    /// ([`super::transmission`]; on by default, `--no-sss-transmission` for A/B).
+    /// (`super::transmission`; on by default, `--no-sss-transmission` for A/B).
     pub transmission: bool,
 }
 

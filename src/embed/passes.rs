@@ -24,9 +24,9 @@ use crate::Result;
 macro_rules! effect_methods {
     ($frame:ident, $does:literal) => {
         /// The passes the effect records (their plan, for lucent's tables and tests): an
-        /// internal type, not part of the surface a host relies on (hidden from the docs;
-        /// [`Self::record_timed`] names each pass with its time).
-        #[doc(hidden)]
+        /// internal type, only with the `internals` feature ([`Self::record_timed`] names
+        /// each pass with its time).
+        #[cfg(feature = "internals")]
         pub fn plan(&self) -> &crate::graph::Plan {
             self.passes.plan()
         }

@@ -99,8 +99,8 @@ impl SceneRenderer {
     }
 
     /// The renderer underneath (its plan, passes and settings): lucent's internals, for its
-    /// own tests; not part of the surface a host relies on (hidden from the docs).
-    #[doc(hidden)]
+    /// own tests (only with the `internals` feature).
+    #[cfg(feature = "internals")]
     pub fn renderer(&self) -> &Renderer {
         &self.renderer
     }

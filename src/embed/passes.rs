@@ -346,7 +346,8 @@ impl EffectPasses {
         self.frames_in_flight * self.views
     }
 
-    /// The passes (their plan).
+    /// The passes (their plan; the effects hand it out with `internals`).
+    #[cfg(feature = "internals")]
     pub(crate) fn plan(&self) -> &crate::graph::Plan {
         &self.executable.as_ref().expect("alive until destroy").plan
     }

@@ -40,21 +40,11 @@ layout(set = 0) uniform sampler2D base_tex;      // the previous chain's result
 #endif
 #ifdef LUCENT_SSS_ALBEDO
 // GB0: the albedo the lighting pass left out of the light (sss_albedo_after).
-#ifdef LUCENT_SSS_BASE
 layout(set = 0) uniform sampler2D albedo_tex;
-#else
-layout(set = 0) uniform sampler2D albedo_tex;
-#endif
 #endif
 #ifdef LUCENT_SSS_HALF_RES
-// Device depth, the last binding.
-#if defined(LUCENT_SSS_BASE) && defined(LUCENT_SSS_ALBEDO)
+// Device depth.
 layout(set = 0) uniform sampler2D depth_tex;
-#elif defined(LUCENT_SSS_BASE) || defined(LUCENT_SSS_ALBEDO)
-layout(set = 0) uniform sampler2D depth_tex;
-#else
-layout(set = 0) uniform sampler2D depth_tex;
-#endif
 #endif
 
 layout(push_constant) uniform Blur {

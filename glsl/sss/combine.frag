@@ -15,12 +15,8 @@ layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;
 layout(set = 0) uniform sampler2D base_tex;
 #endif
 #ifdef LUCENT_SSS_ALBEDO
-// GB0, the last binding: the albedo the lighting pass left out of the light (sss_albedo_after).
-#ifdef LUCENT_SSS_BASE
+// GB0: the albedo the lighting pass left out of the light (sss_albedo_after).
 layout(set = 0) uniform sampler2D albedo_tex;
-#else
-layout(set = 0) uniform sampler2D albedo_tex;
-#endif
 #endif
 
 layout(push_constant) uniform Chain {

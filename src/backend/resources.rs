@@ -128,6 +128,11 @@ pub struct GpuImage {
 }
 
 impl GpuImage {
+    /// Bytes of its own memory (0 when its memory is owned elsewhere).
+    pub fn memory_bytes(&self) -> u64 {
+        self.allocation.as_ref().map_or(0, Allocation::size)
+    }
+
     /// Wraps an image whose memory is owned elsewhere (e.g. bound into a [`MemoryBlock`] with
     /// [`GpuContext::bind_image`]). [`GpuContext::destroy_image`] then destroys the view and the
     /// image but leaves the memory alone.

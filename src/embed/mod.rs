@@ -192,6 +192,7 @@ pub use layered::{
     IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages, LayeredMaterial,
     MeshDraw, VertexAttribute, VertexLayout,
 };
+pub use passes::EffectMemory;
 pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
 pub use shadow_faces::ShadowFace;
@@ -246,7 +247,8 @@ pub use glam;
 /// ([`HostImage::at`]). 10: lucent's internal modules are crate-private in a build without
 /// the `internals` feature (a host's `default-features = false`): a host names only
 /// `lucent::embed` and what it re-exports (now also the knobs' value types: [`SssPrecision`],
-/// [`KernelShape`], [`BurleyFit`] and their ranges), `scene`, `bake`, `images` and `error`.
+/// [`KernelShape`], [`BurleyFit`] and their ranges), `scene`, `bake`, `images` and `error`;
+/// each effect says what it holds in memory (`memory`, [`EffectMemory`]).
 pub const API_VERSION: u32 = 10;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

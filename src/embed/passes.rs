@@ -61,6 +61,13 @@ macro_rules! effect_methods {
             self.record_with(lucent, cmd, frame, Some(timer))
         }
 
+        /// The GPU memory the effect holds while it exists (its intermediate images and its
+        /// per-frame parameters), for a host's memory budget. Allocated when the effect is
+        /// built, freed by [`Self::destroy`]; recording allocates nothing.
+        pub fn memory(&self) -> super::EffectMemory {
+            self.passes.memory()
+        }
+
         /// Destroys the passes and their buffers. The GPU must be done with every frame that
         /// recorded them (the host's fences).
         pub fn destroy(self, lucent: &Lucent) {
@@ -69,6 +76,28 @@ macro_rules! effect_methods {
     };
 }
 pub(crate) use effect_methods;
+
+/// The GPU memory an effect holds while it exists ([`super::SssEffect::memory`] and the
+/// other effects' `memory`): what a host counts against its budget. Both parts are allocated
+/// when the effect is built (in the host's allocator) and freed when it is destroyed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct EffectMemory {
+    /// Its intermediate images (the targets its passes write and read between them, at the
+    /// G-buffer's size; images whose lifetimes do not overlap share memory), bytes of device
+    /// memory. The host's own images count nothing.
+    pub images: u64,
+    /// Its per-frame parameters (tables, camera, lights: one slot per frame in flight and
+    /// view), bytes of host-visible memory.
+    pub parameters: u64,
+}
+
+impl EffectMemory {
+    /// Both parts, bytes.
+    pub fn total(&self) -> u64 {
+        self.images + self.parameters
+    }
+}
 
 /// A host image of `gbuffer`'s size imported into `graph` as `name` (bound to the host's
 /// image when each frame records), first used as `initial`.
@@ -329,6 +358,18 @@ impl EffectPasses {
                 }
                 Err(e)
             }
+        }
+    }
+
+    /// The memory the passes hold ([`super::EffectMemory`]).
+    pub(crate) fn memory(&self) -> super::EffectMemory {
+        super::EffectMemory {
+            images: self
+                .executable
+                .as_ref()
+                .expect("alive until destroy")
+                .memory_bytes(),
+            parameters: self.per_frame().bytes(),
         }
     }
 

@@ -354,6 +354,11 @@ impl PerFrame {
         })
     }
 
+    /// Bytes of the buffer: every slot's regions.
+    pub fn bytes(&self) -> u64 {
+        self.stride * self.slots as u64
+    }
+
     /// Frames in flight (slots).
     pub fn slots(&self) -> usize {
         self.slots

@@ -624,6 +624,22 @@ impl Executable {
         unsafe { gpu.device.cmd_pipeline_barrier2(cmd, &dependency) };
     }
 
+    /// Bytes of device memory its images hold: each shared memory slot's block once (the
+    /// images aliased into it share it) and each image with memory of its own. Imported
+    /// images are the host's and count nothing.
+    pub fn memory_bytes(&self) -> u64 {
+        let blocks: u64 = self.blocks.iter().map(MemoryBlock::size).sum();
+        let owned: u64 = self
+            .physical
+            .iter()
+            .map(|p| match p {
+                Physical::Owned(image) => image.memory_bytes(),
+                _ => 0,
+            })
+            .sum();
+        blocks + owned
+    }
+
     /// The physical image of a resource (null if it has no memory).
     pub fn image(&self, id: ResourceId) -> vk::Image {
         self.images[id]

@@ -40,14 +40,15 @@ use ash::vk;
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::{GpuContext, GpuImage, ImageDesc};
 use crate::embed::{
-    DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, EnvironmentEffect, EnvironmentEffectDesc,
-    EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera, HostDevice, HostImage, IdDesc,
-    ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc, LayeredFrame, LayeredImages,
-    LayeredMaterial, LeanLighting, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace,
-    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssRegion,
-    ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
-    TranslucencyImages, TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc,
-    TransmissionFrame, TransmissionImages, TransmissionMaterial, VertexLayout,
+    DepthDesc, DiffuseDesc, EffectMemory, EffectTimer, EmbedOptions, EnvironmentEffect,
+    EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera,
+    HostDevice, HostImage, IdDesc, ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc,
+    LayeredFrame, LayeredImages, LayeredMaterial, LeanLighting, Lucent, MeshDraw, NormalDesc,
+    OptionalFeatures, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages,
+    SssMaterial, SssRegion, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
+    TranslucencyFrame, TranslucencyImages, TranslucentMaterial, TransmissionEffect,
+    TransmissionEffectDesc, TransmissionFrame, TransmissionImages, TransmissionMaterial,
+    VertexLayout,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -78,6 +79,9 @@ pub struct EmbedCost {
     pub setup: String,
     /// Per pass.
     pub rows: Vec<EmbedCostRow>,
+    /// What each effect measured held in memory ([`EffectMemory`]), by its type.
+    #[serde(skip)]
+    pub memory: Vec<(&'static str, EffectMemory)>,
 }
 
 impl EmbedCost {
@@ -100,6 +104,14 @@ impl EmbedCost {
                 row.pass,
                 ms(row.lucent_ms),
                 ms(row.host_ms)
+            ));
+        }
+        for (effect, memory) in &self.memory {
+            out.push_str(&format!(
+                "\n{effect} holds {:.2} MiB of intermediate images and {:.1} KiB of per-frame \
+                 parameters (`memory()`).\n",
+                memory.images as f64 / (1024.0 * 1024.0),
+                memory.parameters as f64 / 1024.0
             ));
         }
         out
@@ -191,6 +203,7 @@ pub fn embed_cost(
         },
         technique.name()
     );
+    let mut memory = Vec::new();
     let rows = if layered {
         measure_layered(
             gpu,
@@ -201,6 +214,7 @@ pub fn embed_cost(
             technique,
             (width, height),
             (frames, warmup),
+            &mut memory,
         )
     } else if environment {
         measure_environment(
@@ -211,6 +225,7 @@ pub fn embed_cost(
             scene,
             (width, height),
             (frames, warmup),
+            &mut memory,
         )
     } else if translucency {
         measure_translucency(
@@ -221,6 +236,7 @@ pub fn embed_cost(
             scene,
             (width, height),
             (frames, warmup),
+            &mut memory,
         )
     } else {
         measure_sss(
@@ -232,6 +248,7 @@ pub fn embed_cost(
             technique,
             (width, height),
             (frames, warmup),
+            &mut memory,
         )
     };
     // An SSS blur on a scene with media also times their transmission.
@@ -245,6 +262,7 @@ pub fn embed_cost(
             technique,
             (width, height),
             (frames, warmup),
+            &mut memory,
         )
         .map(|more| {
             rows.extend(more.unwrap_or_default());
@@ -259,6 +277,7 @@ pub fn embed_cost(
         device: gpu.info.describe(),
         setup,
         rows: rows?,
+        memory,
     })
 }
 
@@ -373,6 +392,7 @@ fn measure_sss(
     technique: Technique,
     (width, height): (u32, u32),
     (frames, warmup): (usize, usize),
+    memory: &mut Vec<(&'static str, EffectMemory)>,
 ) -> Result<Vec<EmbedCostRow>> {
     let module = technique.module().expect("checked by the caller");
     let blur = registry::sss_blur(module.name())?;
@@ -509,6 +529,7 @@ fn measure_sss(
             desc = desc.with_shadow_maps(vk::Format::D32_SFLOAT);
         }
         let mut effect = build(gpu, lucent, |u| SssEffect::new(lucent, u, desc))?;
+        memory.push(("SssEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -569,6 +590,7 @@ fn measure_sss(
     measured
 }
 
+#[allow(clippy::too_many_arguments)]
 fn measure_translucency(
     gpu: &GpuContext,
     shaders: &ShaderCompiler,
@@ -577,6 +599,7 @@ fn measure_translucency(
     scene: &Scene,
     size: (u32, u32),
     frames: (usize, usize),
+    memory: &mut Vec<(&'static str, EffectMemory)>,
 ) -> Result<Vec<EmbedCostRow>> {
     let with = Technique::Only(&crate::features::translucency::TRANSLUCENCY);
     let pair = RendererPair::new(
@@ -652,6 +675,7 @@ fn measure_translucency(
         let mut effect = build(gpu, lucent, |u| {
             TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
         })?;
+        memory.push(("TranslucencyEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -707,6 +731,7 @@ fn measure_translucency(
 /// with its environment minus with none) against the `EnvironmentEffect`'s pass over the
 /// whole screen (every surface has the ambient), on a host G-buffer of lucent's own frame
 /// (D32, world RGBA16F normals, RGBA8 albedo, RGBA16F light with the albedo).
+#[allow(clippy::too_many_arguments)]
 fn measure_environment(
     gpu: &GpuContext,
     shaders: &ShaderCompiler,
@@ -715,6 +740,7 @@ fn measure_environment(
     scene: &Scene,
     size: (u32, u32),
     frames: (usize, usize),
+    memory: &mut Vec<(&'static str, EffectMemory)>,
 ) -> Result<Vec<EmbedCostRow>> {
     let dark = Scene {
         environment: crate::scene::Environment::constant(glam::Vec3::ZERO),
@@ -733,6 +759,7 @@ fn measure_environment(
         let mut effect = build(gpu, lucent, |u| {
             EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(host.desc.clone()))
         })?;
+        memory.push(("EnvironmentEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(size.0 as f32 / size.1 as f32),
@@ -795,6 +822,7 @@ fn measure_transmission(
     technique: Technique,
     size: (u32, u32),
     frames: (usize, usize),
+    memory: &mut Vec<(&'static str, EffectMemory)>,
 ) -> Result<Option<Vec<EmbedCostRow>>> {
     let settings = |transmission: bool| {
         let mut s = FrameSettings {
@@ -877,6 +905,7 @@ fn measure_transmission(
                 TransmissionEffectDesc::new(gbuffer, materials, vk::Format::D32_SFLOAT),
             )
         })?;
+        memory.push(("TransmissionEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),
@@ -944,6 +973,7 @@ fn measure_layered(
     technique: Technique,
     size: (u32, u32),
     (frames, warmup): (usize, usize),
+    memory: &mut Vec<(&'static str, EffectMemory)>,
 ) -> Result<Vec<EmbedCostRow>> {
     let settings = FrameSettings {
         export_shadows: true,
@@ -1050,6 +1080,7 @@ fn measure_layered(
             effect_desc
         };
         let mut effect = build(gpu, lucent, |u| LayeredEffect::new(lucent, u, effect_desc))?;
+        memory.push(("LayeredEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
             scene.camera.projection(width as f32 / height as f32),

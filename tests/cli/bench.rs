@@ -374,6 +374,11 @@ fn embed_times_each_kind_of_effect_under_validation() {
                 && text.contains(effect),
             "{technique}: {text}"
         );
+        // And what the effect holds in memory.
+        assert!(
+            text.contains(&format!("{effect} holds ")) && text.contains("KiB of per-frame"),
+            "{technique}: {text}"
+        );
         let line = text
             .lines()
             .find(|l| l.starts_with(row))

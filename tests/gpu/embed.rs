@@ -2293,11 +2293,14 @@ fn two_views_per_frame_each_equal_their_view_alone() {
         // SAFETY: the image is live, made with this format and these levels and layers.
         unsafe { gpu.device.create_image_view(&info, None) }.unwrap()
     };
+    // What each effect holds in memory, by views per frame.
+    let memory = std::cell::RefCell::new(Vec::new());
     let render = |views_per_frame: usize, which: &[usize], into: ViewOutputs| -> Vec<Vec<u8>> {
         let lucent = wrap(&test, options(1));
         let desc = SssEffectDesc::new(gbuffer.clone(), materials.clone(), format)
             .with_views_per_frame(views_per_frame);
         let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
+        memory.borrow_mut().push((views_per_frame, effect.memory()));
         // Per view: the image, the view of what it writes, its mip and layer.
         let targets: Vec<GpuImage> = match into {
             ViewOutputs::Separate => which
@@ -2436,6 +2439,23 @@ fn two_views_per_frame_each_equal_their_view_alone() {
                 "view {k} recorded beside the other ({into:?}) differs from alone"
             );
         }
+    }
+    // The views share the intermediate images (a frame's views record one after the other)
+    // and each has its own parameter slot: memory says so. The separable blur's intermediate
+    // is the horizontal pass's RGBA16F target at the G-buffer's size; the host's images count
+    // nothing.
+    let memory = memory.into_inner();
+    let one = memory.iter().find(|(v, _)| *v == 1).unwrap().1;
+    let target = u64::from(w * h) * 8;
+    assert!(one.images >= target && one.images < 2 * target, "{one:?}");
+    assert!(one.parameters > 0 && one.total() == one.images + one.parameters);
+    for (views, m) in &memory {
+        assert_eq!(m.images, one.images, "{views} views: {m:?} against {one:?}");
+        assert_eq!(
+            m.parameters,
+            *views as u64 * one.parameters,
+            "{views} views: {m:?}"
+        );
     }
     for image in images.into_iter().flatten().chain(layered) {
         gpu.destroy_image(image);

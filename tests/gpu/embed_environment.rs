@@ -167,6 +167,9 @@ fn the_environment_effect_on_host_layouts_equals_lucents_own_frame_and_the_f64_t
         })
         .unwrap();
         assert_eq!(effect.plan().passes.len(), 1, "one pass");
+        // It blends into the host's light: no image of its own.
+        assert_eq!(effect.memory().images, 0, "{:?}", effect.memory());
+        assert!(effect.memory().parameters > 0);
         let start: Vec<u8> = match lit {
             Lit::WithAlbedo => bytemuck::cast_slice(without.hdr.as_ref().unwrap()).to_vec(),
             Lit::WithoutAlbedo => vec![0; (w * h * 16) as usize],

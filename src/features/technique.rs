@@ -214,8 +214,11 @@ pub trait FramePart: Any + Debug + Send + Sync {
     /// which materials or profiles exist).
     fn same_shape(&self, other: &dyn FramePart) -> bool;
 
-    /// Whether the frame runs `technique` for this part.
-    fn runs(&self, technique: &dyn TechniqueModule) -> bool;
+    /// Whether the frame runs `technique` for this part: by default every technique of its
+    /// kind (a part whose techniques are its materials' choice, the SSS chains, says which).
+    fn runs(&self, technique: &dyn TechniqueModule) -> bool {
+        same_kind(technique.part(), self.kind())
+    }
 
     /// Its lines in the list of a frame's features (messages, `lucent plan`'s header).
     fn names(&self, out: &mut Vec<String>);

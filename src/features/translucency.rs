@@ -23,7 +23,7 @@ use super::knob::{Knob, Takes};
 use super::shadows::ShadowDesc;
 use super::technique::TechniqueModule;
 use super::technique::{
-    downcast, part_value_methods, same_kind, Describe, FrameImages, FramePart, PartKind, PartKnobs,
+    downcast, part_value_methods, Describe, FrameImages, FramePart, PartKind, PartKnobs,
     SlotWrite,
 };
 use crate::backend::shader::PipelineShaders;
@@ -284,10 +284,6 @@ impl FramePart for TranslucencyDesc {
 
     fn same_shape(&self, other: &dyn FramePart) -> bool {
         downcast::<Self>(other).is_some_and(|o| o.table.object_ids == self.table.object_ids)
-    }
-
-    fn runs(&self, technique: &dyn TechniqueModule) -> bool {
-        same_kind(technique.part(), &TRANSLUCENCY_PART)
     }
 
     fn names(&self, out: &mut Vec<String>) {

@@ -8,9 +8,8 @@ use super::TABLE_REGION;
 use super::{blurs_on_screen, layered_passes, table_region, LayeredDesc, LayeredInputs};
 use crate::features::gbuffer::GBufferLayout;
 use crate::features::shadows::ShadowDesc;
-use crate::features::technique::TechniqueModule;
 use crate::features::technique::{
-    downcast, part_value_methods, same_kind, Describe, FrameImages, FramePart, PartKind, PartKnobs,
+    downcast, part_value_methods, Describe, FrameImages, FramePart, PartKind, PartKnobs,
     SlotWrite,
 };
 use crate::gpu_scene::tiles::{object_tiles, object_tiles_at_depth, tile_rects};
@@ -45,10 +44,6 @@ impl FramePart for LayeredDesc {
         downcast::<Self>(other).is_some_and(|o| {
             o.object_ids == self.object_ids && o.materials.len() == self.materials.len()
         })
-    }
-
-    fn runs(&self, technique: &dyn TechniqueModule) -> bool {
-        same_kind(technique.part(), &LAYERED_PART)
     }
 
     fn names(&self, out: &mut Vec<String>) {

@@ -104,6 +104,10 @@ pub struct GraphicsPipelineDesc<'a> {
     pub bindings: &'a [SetBinding<'a>],
     /// Push constant bytes visible to vertex and fragment stages.
     pub push_constant_bytes: u32,
+    /// The fragment shader's specialization constants: value `i` for `constant_id = i`
+    /// (empty: the shader's defaults). For what is fixed when a pipeline is made but varies
+    /// too much to be a define (a host's ID decode): the driver folds them into the code.
+    pub specialization: &'a [u32],
     /// Name for debug tools.
     pub name: &'a str,
 }
@@ -124,6 +128,7 @@ impl<'a> GraphicsPipelineDesc<'a> {
             set_layouts: &[],
             bindings: &[],
             push_constant_bytes: 0,
+            specialization: &[],
             name,
         }
     }
@@ -191,15 +196,34 @@ impl GraphicsPipeline {
         let layout = unsafe { device.create_pipeline_layout(&layout_info, None) }
             .vk("vkCreatePipelineLayout")?;
         let entry = c"main";
+        let entries: Vec<vk::SpecializationMapEntry> = (0..desc.specialization.len() as u32)
+            .map(|id| vk::SpecializationMapEntry {
+                constant_id: id,
+                offset: id * 4,
+                size: 4,
+            })
+            .collect();
+        let constant_bytes: Vec<u8> = desc
+            .specialization
+            .iter()
+            .flat_map(|v| v.to_ne_bytes())
+            .collect();
+        let specialization = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(&constant_bytes);
+        let mut fragment_stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(frag)
+            .name(entry);
+        if !desc.specialization.is_empty() {
+            fragment_stage = fragment_stage.specialization_info(&specialization);
+        }
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
                 .module(vert)
                 .name(entry),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(frag)
-                .name(entry),
+            fragment_stage,
         ];
         // Mesh streams: binding 0 position + normal (locations 0, 1); binding 1 the thickness
         // colour (location 2), a buffer of its own so frames without translucency neither

@@ -545,6 +545,7 @@ impl PassExec for GBufferPass {
                 bindings: &[],
                 push_constant_bytes: std::mem::size_of::<crate::gpu_scene::ObjectConstants>()
                     as u32,
+                specialization: &[],
                 name: "gbuffer",
             },
         )?);

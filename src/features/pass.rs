@@ -76,6 +76,8 @@ pub struct FullscreenPass<'g> {
     fragment: &'static str,
     slots: Vec<Slot>,
     defines: Defines,
+    /// The fragment shader's specialization constants ([`Self::specialize`]).
+    specialization: Vec<u32>,
     /// Colour attachments (bit i = location i) that add the shader's output.
     additive: u32,
     /// Colour attachments declared so far.
@@ -114,6 +116,7 @@ impl<'g> FullscreenPass<'g> {
             fragment,
             slots: Vec::new(),
             defines: Vec::new(),
+            specialization: Vec::new(),
             additive: 0,
             colors: 0,
             push_constants: Vec::new(),
@@ -223,6 +226,14 @@ impl<'g> FullscreenPass<'g> {
         self
     }
 
+    /// Sets the fragment shader's specialization constants (value `i` for `constant_id = i`),
+    /// for what is fixed when the pass's pipeline is made: the driver folds them into the
+    /// code, as it does defines, without a shader permutation per value.
+    pub fn specialize(&mut self, constants: &[u32]) -> &mut Self {
+        self.specialization = constants.to_vec();
+        self
+    }
+
     /// Samples the light-space maps' depth atlas: their defines (glsl/common/shadows.glsl),
     /// the shadow table and the atlas.
     pub fn shadows(&mut self, depth: &Handle<Image>) -> &mut Self {
@@ -305,6 +316,7 @@ impl<'g> FullscreenPass<'g> {
             fragment: self.fragment,
             slots: self.slots,
             defines: self.defines,
+            specialization: self.specialization,
             additive: self.additive,
             push_constants: self.push_constants,
             tiles: self.tiles,
@@ -325,6 +337,7 @@ struct FullscreenExec {
     fragment: &'static str,
     slots: Vec<Slot>,
     defines: Defines,
+    specialization: Vec<u32>,
     additive: u32,
     push_constants: Vec<u8>,
     tiles: Option<Tiles>,
@@ -383,6 +396,7 @@ impl PassExec for FullscreenExec {
             additive_attachments: self.additive,
             push_constant_bytes: self.push_constants.len() as u32,
             depth_test: self.depth_test,
+            specialization: &self.specialization,
             ..GraphicsPipelineDesc::fullscreen(self.fragment, &self.defines, &self.name)
         };
         // Nothing to bind, push or tile: a pipeline without a descriptor set.

@@ -539,6 +539,7 @@ impl PassExec for ShadowPass {
                 set_layouts: &[],
                 bindings: &[],
                 push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+                specialization: &[],
                 name: "light-space maps",
             },
         )?);
@@ -713,6 +714,7 @@ impl PassExec for HostShadowPass {
                 set_layouts: &[],
                 bindings: &[],
                 push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+                specialization: &[],
                 name: "light-space maps",
             },
         )?);

@@ -560,6 +560,7 @@ impl PassExec for MeshFloorPass {
                 set_layouts: &[],
                 bindings: &[],
                 push_constant_bytes: std::mem::size_of::<FloorConstants>() as u32,
+                specialization: &[],
                 name: "mesh floor",
             },
         )?);

@@ -52,8 +52,62 @@ int sss_profile_id(float stored) {
 #define SSS_ID_SAMPLER sampler2D
 #endif
 
+#ifdef LUCENT_SSS_HOST_IDS
+// A host's ID decode (host_ids.glsl's `decode`) and its SSS materials as specialization
+// constants (src/features/sss/mod.rs `IdMap::specialization`), fixed when the effect is made:
+// the driver folds them into the pass's code.
+// - The decode: the channel, the bit field's shift and mask, a UNORM channel's largest value.
+// - Up to eight materials: SSS_IDS_LISTED of them, material k's host ID in SSS_ID_k and its
+//   profile number in SSS_PROFILE_k. A pixel's profile is then found by comparisons with
+//   constants, where the ID-to-profile table (id_profiles) costs a load from a per-pixel
+//   address: with the table the control's combine was 1.10-1.16x lucent's own pass, with the
+//   comparisons 0.87-0.91x (lucent bench --embed, skin, 1024x768). A host with more SSS
+//   materials (SSS_IDS_LISTED = 0) reads the table.
+layout(constant_id = 0) const uint SSS_ID_CHANNEL = 0u;
+layout(constant_id = 1) const uint SSS_ID_SHIFT = 0u;
+layout(constant_id = 2) const uint SSS_ID_MASK = 255u;
+layout(constant_id = 3) const uint SSS_ID_UNORM_MAX = 255u;
+#define SSS_ID_DECODE uvec4(SSS_ID_CHANNEL, SSS_ID_SHIFT, SSS_ID_MASK, SSS_ID_UNORM_MAX)
+layout(constant_id = 4) const uint SSS_IDS_LISTED = 0u;
+// (256: no ID; a decoded ID is at most 255.)
+layout(constant_id = 5) const uint SSS_ID_1 = 256u;
+layout(constant_id = 6) const uint SSS_ID_2 = 256u;
+layout(constant_id = 7) const uint SSS_ID_3 = 256u;
+layout(constant_id = 8) const uint SSS_ID_4 = 256u;
+layout(constant_id = 9) const uint SSS_ID_5 = 256u;
+layout(constant_id = 10) const uint SSS_ID_6 = 256u;
+layout(constant_id = 11) const uint SSS_ID_7 = 256u;
+layout(constant_id = 12) const uint SSS_ID_8 = 256u;
+layout(constant_id = 13) const int SSS_PROFILE_1 = 0;
+layout(constant_id = 14) const int SSS_PROFILE_2 = 0;
+layout(constant_id = 15) const int SSS_PROFILE_3 = 0;
+layout(constant_id = 16) const int SSS_PROFILE_4 = 0;
+layout(constant_id = 17) const int SSS_PROFILE_5 = 0;
+layout(constant_id = 18) const int SSS_PROFILE_6 = 0;
+layout(constant_id = 19) const int SSS_PROFILE_7 = 0;
+layout(constant_id = 20) const int SSS_PROFILE_8 = 0;
+#else
+// (Only the unsigned overloads below name it outside a host's passes, which never call them.)
+#define SSS_ID_DECODE sss_profiles.id_decode
+#endif
+
 // The profile number of a host's material ID (0: does not scatter); IDs past 255 have none.
 int sss_host_profile(uint host_id) {
+#ifdef LUCENT_SSS_HOST_IDS
+    if (SSS_IDS_LISTED > 0u) {
+        // Unlisted slots hold ID 256, which no decoded ID equals.
+        int p = 0;
+        p = host_id == SSS_ID_1 ? SSS_PROFILE_1 : p;
+        p = host_id == SSS_ID_2 ? SSS_PROFILE_2 : p;
+        p = host_id == SSS_ID_3 ? SSS_PROFILE_3 : p;
+        p = host_id == SSS_ID_4 ? SSS_PROFILE_4 : p;
+        p = host_id == SSS_ID_5 ? SSS_PROFILE_5 : p;
+        p = host_id == SSS_ID_6 ? SSS_PROFILE_6 : p;
+        p = host_id == SSS_ID_7 ? SSS_PROFILE_7 : p;
+        p = host_id == SSS_ID_8 ? SSS_PROFILE_8 : p;
+        return p;
+    }
+#endif
     if (host_id > 255u) {
         return 0;
     }
@@ -69,7 +123,7 @@ int sss_host_profile(uint host_id) {
 // tap, 1.05x without).
 int sss_id_key(vec4 t) {
 #ifdef LUCENT_SSS_HOST_IDS
-    return int(host_material_id(t, sss_profiles.id_decode));
+    return int(host_material_id(t, SSS_ID_DECODE));
 #else
     return sss_profile_id(t.r);
 #endif
@@ -77,7 +131,7 @@ int sss_id_key(vec4 t) {
 
 int sss_id_key(uvec4 t) {
     // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
-    return int(host_material_id(t, sss_profiles.id_decode));
+    return int(host_material_id(t, SSS_ID_DECODE));
 }
 
 // The profile number of the texel `t` of the profile ID image.

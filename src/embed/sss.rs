@@ -961,7 +961,6 @@ fn declare(
             &cleared
         }
     };
-    let id_defines = profiles.id_map.defines();
     let mut inputs = sss::SssInputs {
         diffuse: &diffuse,
         specular,
@@ -974,7 +973,7 @@ fn declare(
         // The host's alpha is its own unless it holds linear depth: then the taps read it
         // there, as in lucent's own frames; otherwise they read the depth image.
         depth_in_alpha: gbuffer.diffuse.depth_in_alpha,
-        id_defines,
+        ids: &profiles.id_map,
     };
     let adjusted;
     let lean_targets;

@@ -295,6 +295,10 @@ pub struct HostIdMap {
     pub profile_of: Vec<u8>,
 }
 
+/// How many of a host's SSS materials the passes tell apart by comparisons with constants
+/// ([`IdMap::specialization`]); more are looked up in the profile table.
+pub const LISTED_HOST_IDS: usize = 8;
+
 impl IdMap {
     /// The defines the passes reading the ID image are built with.
     pub fn defines(&self) -> &'static [(&'static str, &'static str)] {
@@ -305,6 +309,40 @@ impl IdMap {
             }
             IdMap::Host(_) => &[("LUCENT_SSS_HOST_IDS", "1")],
         }
+    }
+
+    /// The specialization constants of the passes reading a host's ID image
+    /// (glsl/common/sss.glsl, `constant_id` 0-20), fixed when the effect is made: the decode
+    /// (channel, shift, mask, UNORM maximum), then how many SSS materials are listed, their
+    /// IDs and their profile numbers. Up to [`LISTED_HOST_IDS`] materials are listed: the
+    /// passes compare a pixel's ID with each instead of loading its profile from the table
+    /// (the table's load made the control's combine 1.10-1.16x lucent's own pass). Empty for
+    /// lucent's own IDs.
+    pub fn specialization(&self) -> Vec<u32> {
+        let IdMap::Host(h) = self else {
+            return Vec::new();
+        };
+        let scattering: Vec<(u32, u32)> = h
+            .profile_of
+            .iter()
+            .enumerate()
+            .take(256)
+            .filter(|&(_, &p)| p != 0)
+            .map(|(id, &p)| (id as u32, u32::from(p)))
+            .collect();
+        let listed = if scattering.len() <= LISTED_HOST_IDS {
+            scattering.as_slice()
+        } else {
+            &[]
+        };
+        // An unlisted slot holds ID 256, which no decoded ID (at most 255) equals.
+        let ids = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(256, |&(id, _)| id));
+        let profiles = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(0, |&(_, p)| p));
+        [h.channel, h.shift, h.mask, h.unorm_max, listed.len() as u32]
+            .into_iter()
+            .chain(ids)
+            .chain(profiles)
+            .collect()
     }
 
     /// The profile table's `id_decode` and `id_profiles` rows.
@@ -642,8 +680,9 @@ pub struct SssInputs<'a> {
     /// The lit diffuse's alpha holds linear depth for the separable chain's taps (the lighting
     /// pass wrote it: [`SssProfiles::depth_in_alpha`]); otherwise the taps read `depth`.
     pub depth_in_alpha: bool,
-    /// How the passes read `profile_ids` ([`IdMap::defines`] of the profiles' map).
-    pub id_defines: &'static [(&'static str, &'static str)],
+    /// How the passes read `profile_ids` (its [`IdMap::defines`] and
+    /// [`IdMap::specialization`]).
+    pub ids: &'a IdMap,
 }
 
 /// The G-buffer images LCB's and LBB's chains read besides the lit light.
@@ -750,7 +789,8 @@ fn sss_pass<'g>(
     pass.per_frame(&FRAME)
         .per_frame(&tables::PROFILES)
         .push_constants(&constants)
-        .defines(inputs.id_defines);
+        .defines(inputs.ids.defines())
+        .specialize(&inputs.ids.specialization());
     pass
 }
 
@@ -796,7 +836,8 @@ pub fn host_albedo_pass(
         .sample("diffuse_tex", inputs.diffuse)
         .sample("albedo_tex", albedo)
         .sample("profile_tex", inputs.profile_ids)
-        .defines(&host_albedo_defines(inputs.id_defines, included))
+        .defines(&host_albedo_defines(inputs.ids.defines(), included))
+        .specialize(&inputs.ids.specialization())
         .color(&mut out, crate::graph::LoadOp::DontCare);
     pass.finish();
     out
@@ -890,7 +931,8 @@ pub fn host_lean_pass(
     if let Some((albedo, _)) = albedo {
         pass.sample("albedo_tex", albedo);
     }
-    pass.defines(&host_lean_defines(inputs.id_defines, mode))
+    pass.defines(&host_lean_defines(inputs.ids.defines(), mode))
+        .specialize(&inputs.ids.specialization())
         // The LEAN texels only where a chain blurs (its tiles: the host's regions); elsewhere
         // the light alone, which the chains' final passes pass through.
         .variant(HOST_LEAN_PASSTHROUGH.to_vec())
@@ -1048,6 +1090,51 @@ mod tests {
             // A 16-bit ID image's IDs past 255 have no profile.
             assert_eq!(host_profile(&rows, 256 + 17), 0);
             assert_eq!(host_profile(&rows, 4096), 0);
+        }
+    }
+
+    /// glsl/common/sss.glsl `sss_host_profile` with the specialization constants, step for
+    /// step: the listed IDs compared in order, or the table when none are listed.
+    fn specialized_profile(constants: &[u32], rows: &[[u32; 4]; 16], host_id: u32) -> usize {
+        let listed = constants[4];
+        if listed == 0 {
+            return host_profile(rows, host_id);
+        }
+        let mut p = 0;
+        for k in 0..LISTED_HOST_IDS {
+            if host_id == constants[5 + k] {
+                p = constants[5 + LISTED_HOST_IDS + k] as usize;
+            }
+        }
+        p
+    }
+
+    #[test]
+    fn listed_host_ids_find_the_profiles_the_table_holds() {
+        assert!(IdMap::Lucent.specialization().is_empty());
+        let eight: Vec<u8> = vec![200, 3, 1, 77, 255, 0x40, 9, 128];
+        let nine: Vec<u8> = (1..10).collect();
+        for (materials, listed) in [(vec![1u8], 1), (vec![17, 42, 5], 3), (eight, 8), (nine, 0)] {
+            let mut profile_of = vec![0u8; 256];
+            for (index, &id) in materials.iter().enumerate() {
+                profile_of[usize::from(id)] = index as u8 + 1;
+            }
+            let map = IdMap::Host(HostIdMap {
+                uint: false,
+                channel: 3,
+                shift: 4,
+                mask: 0xf,
+                unorm_max: 255,
+                profile_of: profile_of.clone(),
+            });
+            let constants = map.specialization();
+            assert_eq!(constants.len(), 5 + 2 * LISTED_HOST_IDS);
+            assert_eq!(constants[..5], [3, 4, 0xf, 255, listed]);
+            let (_, rows) = map.rows();
+            for id in 0..=256u32 {
+                let want = profile_of.get(id as usize).map_or(0, |&p| usize::from(p));
+                assert_eq!(specialized_profile(&constants, &rows, id), want, "ID {id}");
+            }
         }
     }
 

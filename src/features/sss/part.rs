@@ -139,7 +139,7 @@ impl FramePart for SssProfiles {
                 shadow_array: false,
                 albedo: gb.layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: self.depth_in_alpha(),
-                id_defines: self.id_map.defines(),
+                ids: &self.id_map,
             },
             self,
             knobs.sss,

@@ -295,6 +295,14 @@ pub struct HostIdMap {
     pub profile_of: Vec<u8>,
 }
 
+impl HostIdMap {
+    /// The decode as the shaders take it (glsl/common/host_ids.glsl `decode`): channel,
+    /// shift, mask, UNORM maximum.
+    fn decode(&self) -> [u32; 4] {
+        [self.channel, self.shift, self.mask, self.unorm_max]
+    }
+}
+
 /// How many of a host's SSS materials the passes tell apart by comparisons with constants
 /// ([`IdMap::specialization`]); more are looked up in the profile table.
 pub const LISTED_HOST_IDS: usize = 8;
@@ -338,8 +346,9 @@ impl IdMap {
         // An unlisted slot holds ID 256, which no decoded ID (at most 255) equals.
         let ids = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(256, |&(id, _)| id));
         let profiles = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(0, |&(_, p)| p));
-        [h.channel, h.shift, h.mask, h.unorm_max, listed.len() as u32]
+        h.decode()
             .into_iter()
+            .chain([listed.len() as u32])
             .chain(ids)
             .chain(profiles)
             .collect()
@@ -363,7 +372,7 @@ impl IdMap {
                 for (id, &p) in h.profile_of.iter().enumerate().take(256) {
                     put(id, p);
                 }
-                ([h.channel, h.shift, h.mask, h.unorm_max], profiles)
+                (h.decode(), profiles)
             }
         }
     }
@@ -1064,13 +1073,20 @@ mod tests {
         }
     }
 
+    /// Each host ID's profile number when material `i` of `materials` (its host ID) has
+    /// profile i + 1, as `lucent::embed` numbers them.
+    fn profile_of(materials: &[u8]) -> Vec<u8> {
+        let mut profile_of = vec![0u8; 256];
+        for (index, &id) in materials.iter().enumerate() {
+            profile_of[usize::from(id)] = index as u8 + 1;
+        }
+        profile_of
+    }
+
     #[test]
     fn host_ids_map_to_their_profiles_and_every_other_id_to_none() {
         for materials in [vec![17u8], vec![17, 42, 5, 255, 1], (1..32).rev().collect()] {
-            let mut profile_of = vec![0u8; 256];
-            for (index, &id) in materials.iter().enumerate() {
-                profile_of[usize::from(id)] = index as u8 + 1;
-            }
+            let profile_of = profile_of(&materials);
             let map = IdMap::Host(HostIdMap {
                 uint: true,
                 channel: 0,
@@ -1115,10 +1131,7 @@ mod tests {
         let eight: Vec<u8> = vec![200, 3, 1, 77, 255, 0x40, 9, 128];
         let nine: Vec<u8> = (1..10).collect();
         for (materials, listed) in [(vec![1u8], 1), (vec![17, 42, 5], 3), (eight, 8), (nine, 0)] {
-            let mut profile_of = vec![0u8; 256];
-            for (index, &id) in materials.iter().enumerate() {
-                profile_of[usize::from(id)] = index as u8 + 1;
-            }
+            let profile_of = profile_of(&materials);
             let map = IdMap::Host(HostIdMap {
                 uint: false,
                 channel: 3,

@@ -83,8 +83,8 @@ use lucent::embed::{
     capabilities, requirements, DepthDesc, DiffuseDesc, EffectTimer, EmbedOptions, Environment,
     EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc,
     HostCamera, HostDevice, HostImage, IdDesc, ImageState, LayeredEffect, LayeredEffectDesc,
-    LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, LeanLighting, Light, Lucent,
-    MeshDraw, NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace,
+    LayeredFrame, LayeredImages, LayeredMaterial, LayeredMedium, LeanLighting, LeanSurface, Light,
+    Lucent, MeshDraw, NormalDesc, NormalSpace, OptionalFeatures, SceneRenderer, ShadowFace,
     SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial, SssProfile,
     SssRegion, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc, TranslucencyFrame,
     TranslucencyImages, TranslucentMaterial, TransmissionEffect, TransmissionEffectDesc,
@@ -2836,7 +2836,7 @@ fn record_frame(
                 // A LEAN blur's LEAN moments come from the engine's normals, its specular is
                 // relit with the engine's lights, shadowed in the engine's shadow atlas.
                 lean: effects.sss_lean.then(|| LeanLighting {
-                    normals: &normals,
+                    surface: LeanSurface::Normals(&normals),
                     lights: &lights,
                     shadow_map: sss_shadow_map.as_ref(),
                     shadow_faces: if sss_shadow_map.is_some() {

@@ -22,23 +22,17 @@
 #include "shadows.glsl"
 #endif
 
-// Smallest view-space n.z (relative to |n|) a slope is taken from: grazing and back-facing
-// normals (normal maps tilt some past the silhouette) are clamped so slopes stay within +-20.
-const float LEAN_MIN_NZ = 0.05;
+// The LEAN texel's functions are lucent::embed::glsl::TERMS' (glsl/embed/lucent_terms.glsl), which
+// a host's G-buffer pass calls to write the LEAN targets the blurs read
+// (lucent::embed::GBufferDesc::with_lean_targets): one source.
+const float LEAN_MIN_NZ = LUCENT_LEAN_MIN_NZ;
 
-// Slope of a view-space direction (not necessarily unit).
 vec2 view_slope(vec3 n_view) {
-    float z = max(n_view.z, LEAN_MIN_NZ * length(n_view));
-    return n_view.xy / z;
+    return lucent_view_slope(n_view);
 }
 
-// Covariance (xx, yy, xy) of moments `m` about mean `b`: diagonal clamped at 0 and the
-// off-diagonal shrunk so the determinant stays >= 0 (rounding and blurring can break both).
 vec3 lean_covariance(vec2 b, vec3 m) {
-    float xx = max(m.x - b.x * b.x, 0.0);
-    float yy = max(m.y - b.y * b.y, 0.0);
-    float limit = sqrt(xx * yy);
-    return vec3(xx, yy, clamp(m.z - b.x * b.y, -limit, limit));
+    return lucent_lean_covariance(b, m);
 }
 
 // A covariance held to at least `c_base` (the material's own roughness): a blur mixes slope
@@ -105,10 +99,10 @@ float lean_lobe(vec2 b, vec3 c, float base, vec3 h, float v_dot_h, float n_dot_v
     return fresnel * g * density / (4.0 * max(n_dot_v, 0.1));
 }
 
-// The base variance of the material's own roughness (the thesis adds 1 / (s + 2) for
-// specular power s): the Blinn-Phong lobe of the lighting pass, as a slope variance.
+// The base variance of the material's own roughness: the Blinn-Phong lobe of the lighting
+// pass, as a slope variance (lucent_roughness_variance).
 float roughness_variance(float roughness) {
-    return 1.0 / (shininess(roughness) + 2.0);
+    return lucent_roughness_variance(roughness);
 }
 
 // Slopes further apart than this (normals about 45 degrees apart and more) are a crease (a face
@@ -141,29 +135,12 @@ float lean_crease(vec2 b_tap, vec3 m_tap, vec2 b_center, vec3 m_center, bool fil
     return max(apart, spread);
 }
 
-// A pixel's LEAN data projected to the view plane. `n` is the unit world-space geometric
-// normal, `t` and `bt` a world-space tangent frame around it, `b_t` and `m_t` the tangent-space
-// slope mean and moments (from the LEAN maps), `base` the roughness variance. Returns the mean
-// world normal in `n_world` and writes the view-plane slope mean `b_v` and moments `m_v`.
-// Slopes map from tangent plane to view plane non-linearly (u = R (s, 1), s' = u.xy / u.z):
-// the covariance is carried through the mapping's Jacobian at the mean.
+// A pixel's LEAN data projected to this frame's view plane (lucent_view_plane_lean: `n` the
+// unit world normal, `t` and `bt` a tangent frame, `b_t` and `m_t` the tangent-space slope
+// mean and moments, `base` the roughness variance).
 void view_plane_lean(vec3 n, vec3 t, vec3 bt, vec2 b_t, vec3 m_t, float base,
                      out vec3 n_world, out vec2 b_v, out vec3 m_v) {
-    vec3 c_t = lean_covariance(b_t, m_t) + vec3(base, base, 0.0);
-    mat3 view = mat3(frame.view);
-    vec3 t_v = view * t, bt_v = view * bt, n_v = view * n;
-    vec3 u = t_v * b_t.x + bt_v * b_t.y + n_v;
-    n_world = normalize(t * b_t.x + bt * b_t.y + n);
-    float z = max(u.z, LEAN_MIN_NZ * length(u));
-    b_v = u.xy / z;
-    // Jacobian columns d(s')/d(s_x), d(s')/d(s_y).
-    vec2 j0 = (t_v.xy * z - u.xy * t_v.z) / (z * z);
-    vec2 j1 = (bt_v.xy * z - u.xy * bt_v.z) / (z * z);
-    mat2 j = mat2(j0, j1);
-    mat2 c = j * mat2(c_t.x, c_t.z, c_t.z, c_t.y) * transpose(j);
-    m_v = vec3(c[0][0] + b_v.x * b_v.x, c[1][1] + b_v.y * b_v.y, c[1][0] + b_v.x * b_v.y);
-    // fp16 targets: moments beyond its range mean a surface seen edge-on; keep them finite.
-    m_v = clamp(m_v, vec3(0.0, 0.0, -60000.0), vec3(60000.0));
+    lucent_view_plane_lean(mat3(frame.view), n, t, bt, b_t, m_t, base, n_world, b_v, m_v);
 }
 
 // The final lighting's LEAN specular at window position `frag_coord` (device depth `d`), for

@@ -7,9 +7,9 @@
 
 const float PI = 3.14159265358979;
 
-// Blinn-Phong exponent from roughness: 2^(11 - 10 r), in [2, 2048].
+// Blinn-Phong exponent from roughness: 2^(11 - 10 r), in [2, 2048] (glsl/embed/lucent_terms.glsl).
 float shininess(float roughness) {
-    return exp2(11.0 - 10.0 * clamp(roughness, 0.0, 1.0));
+    return lucent_shininess(roughness);
 }
 
 // Direction towards the light (normalised) and its attenuation at `pos`.

@@ -5,9 +5,10 @@
 // glsl/common/sss_transmission.glsl). The data comes from the Rust side: an environment's nine
 // coefficients (`Environment::coefficients`), a translucent material's row
 // (`TranslucentMaterial::row`), each light's translucency scale (`Light::translucency_scale`),
-// a transmitting material's medium rows (`TransmissionMaterial::rows`). The f64 twins are
-// src/scene/environment.rs (`Environment::ambient_radiance`), src/reference/translucency.rs and
-// src/scene/transmittance.rs: change them together.
+// a transmitting material's medium rows (`TransmissionMaterial::rows`). The LEAN texel's
+// functions at the end are for a host's G-buffer pass (`GBufferDesc::with_lean_targets`).
+// The f64 twins are src/scene/environment.rs (`Environment::ambient_radiance`),
+// src/reference/translucency.rs and src/scene/transmittance.rs: change them together.
 #ifndef LUCENT_TERMS_GLSL
 #define LUCENT_TERMS_GLSL
 
@@ -276,6 +277,74 @@ bool lucent_shadow_texels(sampler2D map, mat4 view_proj, vec4 rect, vec4 params,
     texel_distances = vec4(lucent_face_distance(params, d.x), lucent_face_distance(params, d.y),
                            lucent_face_distance(params, d.z), lucent_face_distance(params, d.w));
     return true;
+}
+
+// ---- LEAN texels: what LCB, LBB and the bilateral blur read of a G-buffer ----
+// A host whose G-buffer pass writes LEAN targets (lucent::embed::GBufferDesc::with_lean_targets)
+// writes, per pixel, what lucent's own G-buffer and lighting passes write (glsl/common/lean.glsl,
+// glsl/deferred/gbuffer.frag and lighting.frag call these functions):
+// - the moments target: vec4(b_v.y, m_v) from lucent_view_plane_lean;
+// - the albedo target: vec4(albedo, specular intensity);
+// - the normal target: vec4(n_world, roughness);
+// - its lit diffuse's alpha: lucent_view_slope(view * n_world).x.
+// The view-plane slope mean `b_v` and second moments `m_v` are the LEAN-mapping SSS thesis's
+// (section 4.3.1); the f64 twins are src/reference/sss.rs (`view_plane_lean`) and
+// src/scene/lean.rs (`covariance_of`): change them together.
+
+// Smallest view-space n.z (relative to |n|) a slope is taken from: grazing and back-facing
+// normals (normal maps tilt some past the silhouette) are clamped so slopes stay within +-20.
+const float LUCENT_LEAN_MIN_NZ = 0.05;
+
+// The Blinn-Phong exponent of a roughness: 2^(11 - 10 r), in [2, 2048].
+float lucent_shininess(float roughness) {
+    return exp2(11.0 - 10.0 * clamp(roughness, 0.0, 1.0));
+}
+
+// The slope variance of a roughness's own lobe (the thesis adds 1 / (s + 2) for specular
+// power s): what lucent_view_plane_lean's `base` takes.
+float lucent_roughness_variance(float roughness) {
+    return 1.0 / (lucent_shininess(roughness) + 2.0);
+}
+
+// Slope of a view-space direction (not necessarily unit).
+vec2 lucent_view_slope(vec3 n_view) {
+    float z = max(n_view.z, LUCENT_LEAN_MIN_NZ * length(n_view));
+    return n_view.xy / z;
+}
+
+// Covariance (xx, yy, xy) of moments `m` about mean `b`: diagonal clamped at 0 and the
+// off-diagonal shrunk so the determinant stays >= 0 (rounding and blurring can break both).
+vec3 lucent_lean_covariance(vec2 b, vec3 m) {
+    float xx = max(m.x - b.x * b.x, 0.0);
+    float yy = max(m.y - b.y * b.y, 0.0);
+    float limit = sqrt(xx * yy);
+    return vec3(xx, yy, clamp(m.z - b.x * b.y, -limit, limit));
+}
+
+// A pixel's LEAN data projected to the view plane. `view` is the world-to-view rotation
+// (mat3 of the view matrix), `n` the unit world-space geometric normal, `t` and `bt` a
+// world-space tangent frame around it (any frame when there is no LEAN or normal map: the
+// slopes are then 0), `b_t` and `m_t` the tangent-space slope mean and moments (from LEAN
+// maps; 0 without), `base` the roughness variance (lucent_roughness_variance). Returns the
+// mean world normal in `n_world` and writes the view-plane slope mean `b_v` and moments `m_v`.
+// Slopes map from tangent plane to view plane non-linearly (u = R (s, 1), s' = u.xy / u.z):
+// the covariance is carried through the mapping's Jacobian at the mean.
+void lucent_view_plane_lean(mat3 view, vec3 n, vec3 t, vec3 bt, vec2 b_t, vec3 m_t,
+                            float base, out vec3 n_world, out vec2 b_v, out vec3 m_v) {
+    vec3 c_t = lucent_lean_covariance(b_t, m_t) + vec3(base, base, 0.0);
+    vec3 t_v = view * t, bt_v = view * bt, n_v = view * n;
+    vec3 u = t_v * b_t.x + bt_v * b_t.y + n_v;
+    n_world = normalize(t * b_t.x + bt * b_t.y + n);
+    float z = max(u.z, LUCENT_LEAN_MIN_NZ * length(u));
+    b_v = u.xy / z;
+    // Jacobian columns d(s')/d(s_x), d(s')/d(s_y).
+    vec2 j0 = (t_v.xy * z - u.xy * t_v.z) / (z * z);
+    vec2 j1 = (bt_v.xy * z - u.xy * bt_v.z) / (z * z);
+    mat2 j = mat2(j0, j1);
+    mat2 c = j * mat2(c_t.x, c_t.z, c_t.z, c_t.y) * transpose(j);
+    m_v = vec3(c[0][0] + b_v.x * b_v.x, c[1][1] + b_v.y * b_v.y, c[1][0] + b_v.x * b_v.y);
+    // fp16 targets: moments beyond its range mean a surface seen edge-on; keep them finite.
+    m_v = clamp(m_v, vec3(0.0, 0.0, -60000.0), vec3(60000.0));
 }
 
 #endif

@@ -27,7 +27,8 @@ pub enum Effect {
     Environment,
     /// Screen-space SSS with the LEAN-mapping thesis's blurs (LCB, LBB, the bilateral blur:
     /// [`super::SssEffect`] with materials of those blurs), which blur LEAN moments made from
-    /// the host's normals with the light and relight the specular from them.
+    /// the host's normals (or its own LEAN targets) with the light and relight the specular
+    /// from them.
     LeanSss,
 }
 
@@ -143,11 +144,12 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                      (GBufferDesc::with_material_ids)",
                 ));
             }
-            if gbuffer.normals.is_none() {
+            if gbuffer.normals.is_none() && gbuffer.lean_targets.is_none() {
                 out.push(lack(
                     "normals",
                     "LCB, LBB and the bilateral blur blur LEAN moments made from each pixel's \
-                     normal and relight the specular from them (GBufferDesc::with_normals)",
+                     normal (GBufferDesc::with_normals), or the LEAN targets the host writes \
+                     (GBufferDesc::with_lean_targets), and relight the specular from them",
                 ));
             }
         }

@@ -461,6 +461,84 @@ impl ThicknessDesc {
     }
 }
 
+/// The LEAN targets a host's G-buffer pass writes for LCB, LBB and the bilateral blur, as
+/// lucent's own G-buffer pass writes them ([`GBufferDesc::with_lean_targets`]). With them the
+/// [`super::SssEffect`] reads the host's LEAN moments, albedo and normals as they are, instead of
+/// building them from the normals in a pass of its own (`sss lean in`): the same work as
+/// lucent's own frame, and the LEAN maps' spread inside a pixel is kept. The values are those
+/// of [`super::glsl::TERMS`]' `lucent_view_plane_lean` (which lucent's own passes call):
+///
+/// | image | rgba |
+/// |---|---|
+/// | `moments` | view-plane slope mean y, second moments xx, yy, xy (`vec4(b_v.y, m_v)`) |
+/// | `albedo_specular` | albedo, specular intensity |
+/// | `normal_roughness` | mean world normal (`n_world`, unit), roughness |
+/// | the lit diffuse's alpha | view-plane slope mean x (`lucent_view_slope(view * n_world).x`) |
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LeanTargetsDesc {
+    /// The slope y and moments: a float format with four channels (`R16G16B16A16_SFLOAT`,
+    /// `R32G32B32A32_SFLOAT`; moments reach 60000).
+    pub moments: vk::Format,
+    /// The albedo and specular intensity: a float, UNORM or SRGB format with four channels.
+    pub albedo_specular: vk::Format,
+    /// The world normal and roughness: a float or SNORM format with four channels (the
+    /// normal is signed).
+    pub normal_roughness: vk::Format,
+}
+
+impl LeanTargetsDesc {
+    /// The three targets' formats.
+    pub fn new(
+        moments: vk::Format,
+        albedo_specular: vk::Format,
+        normal_roughness: vk::Format,
+    ) -> Self {
+        Self {
+            moments,
+            albedo_specular,
+            normal_roughness,
+        }
+    }
+
+    /// Checks each format against what its target holds.
+    fn check(&self) -> Result<()> {
+        let four = |format: vk::Format, kinds: &[FormatKind]| {
+            format_info(format).is_some_and(|f| f.channels == 4 && kinds.contains(&f.kind))
+        };
+        for (input, format, kinds, accepted) in [
+            (
+                "lean targets: moments",
+                self.moments,
+                &[FormatKind::Float][..],
+                "a float format with four channels (R16G16B16A16_SFLOAT, R32G32B32A32_SFLOAT)",
+            ),
+            (
+                "lean targets: albedo and specular",
+                self.albedo_specular,
+                &[FormatKind::Unorm, FormatKind::Srgb, FormatKind::Float][..],
+                "a float, UNORM or SRGB format with four channels",
+            ),
+            (
+                "lean targets: normal and roughness",
+                self.normal_roughness,
+                &[FormatKind::Float, FormatKind::Snorm][..],
+                "a float or SNORM format with four channels (the normal is signed)",
+            ),
+        ] {
+            if !four(format, kinds) {
+                return Err(HostError::Unsupported {
+                    input: input.into(),
+                    found: format!("format {}", format_name(format)),
+                    accepted: accepted.into(),
+                }
+                .into());
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The host's G-buffer: what each of its images holds and how, its size and its world's scale.
 ///
 /// ```
@@ -500,6 +578,10 @@ pub struct GBufferDesc {
     pub normals: Option<NormalDesc>,
     /// The local thickness, when the host has it (GDC 2011 translucency reads it).
     pub thickness: Option<ThicknessDesc>,
+    /// The LEAN targets its G-buffer pass writes, when it writes them (LCB, LBB and the
+    /// bilateral blur read them instead of building them from the normals); the lit
+    /// diffuse's alpha then holds the LEAN slope x ([`LeanTargetsDesc`]).
+    pub lean_targets: Option<LeanTargetsDesc>,
     /// The size of the host's world unit in metres (1: metres, 0.01: centimetres): the SSS
     /// profiles' millimetres are converted with it. Finite, above 0 and at most
     /// [`MAX_METRES_PER_UNIT`].
@@ -538,6 +620,7 @@ impl GBufferDesc {
             material_ids: None,
             normals: None,
             thickness: None,
+            lean_targets: None,
             metres_per_unit: 1.0,
         }
     }
@@ -569,6 +652,13 @@ impl GBufferDesc {
     /// With the thickness image.
     pub fn with_thickness(mut self, thickness: ThicknessDesc) -> Self {
         self.thickness = Some(thickness);
+        self
+    }
+
+    /// With the LEAN targets of [`LeanTargetsDesc`] (the lit diffuse's alpha holding the LEAN
+    /// slope x).
+    pub fn with_lean_targets(mut self, targets: LeanTargetsDesc) -> Self {
+        self.lean_targets = Some(targets);
         self
     }
 
@@ -674,6 +764,29 @@ impl GBufferDesc {
         }
         if let Some(thickness) = &self.thickness {
             thickness.decode()?;
+        }
+        if let Some(targets) = &self.lean_targets {
+            targets.check()?;
+            // The LEAN slope x travels in the diffuse's alpha, signed: lucent's own layout.
+            if !float_alpha || self.diffuse.depth_in_alpha {
+                return Err(HostError::Unsupported {
+                    input: "diffuse".into(),
+                    found: format!(
+                        "format {}{} with LEAN targets",
+                        format_name(self.diffuse.format),
+                        if self.diffuse.depth_in_alpha {
+                            " and depth in alpha"
+                        } else {
+                            ""
+                        }
+                    ),
+                    accepted: "a float format with alpha (R16G16B16A16_SFLOAT, \
+                               R32G32B32A32_SFLOAT) whose alpha holds the LEAN slope x, not \
+                               depth"
+                        .into(),
+                }
+                .into());
+            }
         }
         Ok(())
     }

@@ -10,6 +10,7 @@
 //! | `vec3 lucent_translucency(albedo, thickness, material, to_eye, v_dot_n, to_light, radiance, attenuation, translucency_scale)` | [`super::TranslucencyEffect`] | `material`: [`super::TranslucentMaterial::row`]; `translucency_scale`: [`super::Light::translucency_scale`]; per light, added to the diffuse |
 //! | `vec3 lucent_sss_transmitted(vec4 medium[4], normal, to_light, thickness, light_at_entry)` (and `lucent_sss_transmittance(medium, thickness)` under it) | [`super::TransmissionEffect`] | `medium`: [`super::TransmissionMaterial::rows`] in the host's unit; per light and map texel, weighted bilinearly, times albedo / pi |
 //! | `bool lucent_shadow_texels(map, view_proj, rect, params, pos, normal, out inner, out inner_distance, out texel_distances, out weights)`, `vec3 lucent_map_entry_point(params, light_position, inner, to_light, inner_distance, texel_distance)` | the thickness [`super::TransmissionEffect`] measures | the host's shadow map (a `sampler2D`) and each face's rows, [`super::ShadowFace::terms_rows`]: the texels around the point and where the light enters through each (docs/embedding.md) |
+//! | `void lucent_view_plane_lean(mat3 view, n, t, bt, b_t, m_t, base, out n_world, out b_v, out m_v)`, `float lucent_roughness_variance(roughness)`, `vec2 lucent_view_slope(n_view)` | `sss lean in`, the pass [`super::SssEffect`]'s LEAN blurs build their targets with from the host's normals | in the host's **G-buffer** pass, not its lighting: the LEAN targets of [`super::LeanTargetsDesc`] (`vec4(b_v.y, m_v)`, albedo and specular, `n_world` and roughness; the slope x `lucent_view_slope(view * n_world).x` in the lit diffuse's alpha) |
 //!
 //! The text is self-contained (no bindings, no includes; every name starts with `lucent_`),
 //! GLSL 450. lucent's own shaders include the same file (`glsl/embed/lucent_terms.glsl`), so
@@ -22,6 +23,7 @@
 //! assert!(source.contains("vec3 lucent_translucency("));
 //! assert!(source.contains("vec3 lucent_sss_transmitted("));
 //! assert!(source.contains("bool lucent_shadow_texels("));
+//! assert!(source.contains("void lucent_view_plane_lean("));
 //! ```
 
 /// lucent's lighting terms as GLSL functions (see the module docs).

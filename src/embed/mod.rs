@@ -29,7 +29,8 @@
 //!   ([`VertexLayout`], [`MeshDraw`]) with the faces the host gives ([`ShadowFace`]).
 //! - [`glsl::TERMS`]: the environment's, GDC 2011's and the transmission's terms as GLSL for
 //!   the host's own lighting pass, with no pass of their own (docs/embedding.md measures
-//!   what each costs there).
+//!   what each costs there), and the LEAN texel a host's G-buffer pass writes for the LEAN
+//!   blurs ([`LeanTargetsDesc`]).
 //! - [`SceneRenderer`] (*whole frame*): a lucent [`Scene`] (the host's meshes handed over as
 //!   [`crate::scene::Mesh`]es, transforms, lucent materials and lights) drawn into a host
 //!   colour image with every feature its materials ask for (translucency, screen-space SSS,
@@ -184,8 +185,8 @@ pub use environment::{
 };
 pub use gbuffer::{
     DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
-    IdEncoding, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels, ThicknessDesc,
-    MAX_METRES_PER_UNIT,
+    IdEncoding, LeanTargetsDesc, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels,
+    ThicknessDesc, MAX_METRES_PER_UNIT,
 };
 pub use image::{HostImage, ImageState};
 pub use layered::{
@@ -197,8 +198,8 @@ pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
 pub use shadow_faces::ShadowFace;
 pub use sss::{
-    LeanLighting, SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
-    SssRegion, MAX_VIEWS_PER_FRAME,
+    LeanLighting, LeanSurface, LeanTargetImages, SpecularSurface, SssEffect, SssEffectDesc,
+    SssFrame, SssImages, SssMaterial, SssRegion, MAX_VIEWS_PER_FRAME,
 };
 pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;
@@ -248,8 +249,11 @@ pub use glam;
 /// the `internals` feature (a host's `default-features = false`): a host names only
 /// `lucent::embed` and what it re-exports (now also the knobs' value types: [`SssPrecision`],
 /// [`KernelShape`], [`BurleyFit`] and their ranges), `scene`, `bake`, `images` and `error`;
-/// each effect says what it holds in memory (`memory`, [`EffectMemory`]).
-pub const API_VERSION: u32 = 10;
+/// each effect says what it holds in memory (`memory`, [`EffectMemory`]). 11: a host's G-buffer
+/// pass may write the LEAN blurs' targets itself ([`GBufferDesc::with_lean_targets`],
+/// [`LeanTargetsDesc`], the LEAN texel's functions in [`glsl::TERMS`]); [`LeanLighting`]'s
+/// `normals` became `surface` ([`LeanSurface`]: the normals or the [`LeanTargetImages`]).
+pub const API_VERSION: u32 = 11;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -15,12 +15,14 @@
 //!
 //! LCB, LBB and the bilateral blur blur LEAN moments with the light and relight the specular
 //! from the blurred moments, for the host's lights ([`LeanLighting`]; shadowed by the host's
-//! shadow maps when it describes them). A host's G-buffer has no LEAN target, so one pass
-//! (`sss lean in`) builds it from the host's normals and its materials' roughness
-//! ([`SpecularSurface`]), with the albedo adjustment above folded in: a host normal is one
-//! direction per pixel, so the LEAN texel is that of a surface without a LEAN map (the spread
-//! of a normal map inside one pixel is lost; the spread the blur mixes across pixels is kept).
-//! On those materials' pixels the host's specular is replaced by the LEAN specular.
+//! shadow maps when it describes them). A host whose G-buffer pass writes lucent's LEAN
+//! targets ([`super::LeanTargetsDesc`], with the functions of [`super::glsl::TERMS`]) hands
+//! them over as they are ([`LeanSurface::Targets`]). Otherwise one pass (`sss lean in`) builds
+//! them from the host's normals and its materials' roughness ([`SpecularSurface`]), with the
+//! albedo adjustment above folded in: a host normal is one direction per pixel, so the LEAN
+//! texel is that of a surface without a LEAN map (the spread of a normal map inside one pixel
+//! is lost; the spread the blur mixes across pixels is kept). On those materials' pixels the
+//! host's specular is replaced by the LEAN specular.
 //!
 //! Images are bound when a frame records, into that frame's slot and view: any number of
 //! different images over time, a view recreated between frames (even with a reused handle
@@ -228,13 +230,14 @@ pub struct SssImages<'a> {
     pub material_ids: &'a HostImage,
 }
 
-/// What the LEAN blurs (LCB, LBB, bilateral) read besides the G-buffer's images: the normals
-/// their LEAN moments are made from, and the lights (and shadow maps) they relight the
-/// specular with.
+/// What the LEAN blurs (LCB, LBB, bilateral) read besides the G-buffer's images: the surface
+/// their LEAN moments come from, and the lights (and shadow maps) they relight the specular
+/// with.
 #[derive(Clone, Copy, Debug)]
 pub struct LeanLighting<'a> {
-    /// The normals (as [`GBufferDesc::normals`] describes them).
-    pub normals: &'a HostImage,
+    /// The normals the LEAN moments are made from, or the LEAN targets the host wrote (as the
+    /// G-buffer description has them).
+    pub surface: LeanSurface<'a>,
     /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
     pub lights: &'a [Light],
     /// The shadow map holding every face of `shadow_faces`, when the description has a
@@ -243,6 +246,27 @@ pub struct LeanLighting<'a> {
     /// The faces of the lights' shadow maps (as [`super::TransmissionFrame::shadow_faces`]):
     /// a light without one is unshadowed.
     pub shadow_faces: &'a [ShadowFace],
+}
+
+/// Where the LEAN blurs' moments, albedo and normals come from in a frame.
+#[derive(Clone, Copy, Debug)]
+pub enum LeanSurface<'a> {
+    /// The host's normals ([`GBufferDesc::normals`]): lucent builds the LEAN targets from them
+    /// and each material's [`SpecularSurface`] in one pass (`sss lean in`).
+    Normals(&'a HostImage),
+    /// The LEAN targets the host's G-buffer pass wrote ([`GBufferDesc::with_lean_targets`]).
+    Targets(LeanTargetImages<'a>),
+}
+
+/// The LEAN targets of one frame, as [`super::LeanTargetsDesc`] describes them.
+#[derive(Clone, Copy, Debug)]
+pub struct LeanTargetImages<'a> {
+    /// The view-plane slope y and second moments.
+    pub moments: &'a HostImage,
+    /// The albedo and specular intensity.
+    pub albedo_specular: &'a HostImage,
+    /// The world normal and roughness.
+    pub normal_roughness: &'a HostImage,
 }
 
 /// A screen rectangle where scattered light may reach this frame ([`SssFrame::regions`]): for
@@ -312,8 +336,11 @@ struct Imports {
     albedo: Option<ResourceId>,
     material_ids: ResourceId,
     output: ResourceId,
-    /// With LEAN blurs: the normals.
+    /// With LEAN blurs built from the normals: the normals.
     normals: Option<ResourceId>,
+    /// With the host's LEAN targets: the moments, the albedo and specular, the normal and
+    /// roughness.
+    lean_targets: Option<[ResourceId; 3]>,
     /// With LEAN blurs and a shadow format: the shadow map.
     shadow_map: Option<ResourceId>,
 }
@@ -340,7 +367,10 @@ pub struct SssEffect {
     chains: usize,
     /// Each material's host ID, reach and chain, in the description's order.
     materials: Vec<MaterialChain>,
-    /// With LEAN blurs: the host LEAN pass's constants but for the view (written per frame).
+    /// Whether a material has a LEAN blur (the frame then gives [`SssFrame::lean`]).
+    lean_blur: bool,
+    /// With LEAN blurs built from the normals: the host LEAN pass's constants but for the view
+    /// (written per frame).
     lean: Option<HostLeanGpu>,
 }
 
@@ -416,7 +446,18 @@ impl SssEffect {
                 require(Effect::LeanSss, gbuffer)?;
             }
             match (blur.lean(), &material.surface) {
+                (true, Some(_)) if gbuffer.lean_targets.is_some() => {
+                    return Err(HostError::Unsupported {
+                        input: format!("{field}.surface"),
+                        found: "a specular surface with the host's LEAN targets".into(),
+                        accepted: "no surface: the roughness and specular intensity are the \
+                                   LEAN targets' (GBufferDesc::with_lean_targets)"
+                            .into(),
+                    }
+                    .into())
+                }
                 (true, Some(surface)) => surface.check(&format!("materials[{index}]"))?,
+                (true, None) if gbuffer.lean_targets.is_some() => {}
                 (true, None) => {
                     return Err(HostError::Missing {
                         input: format!("{field}.surface"),
@@ -495,7 +536,8 @@ impl SssEffect {
             }
             check_shadow_format(format)?;
         }
-        let lean_constants = if lean {
+        // Without the host's LEAN targets, the LEAN pass builds them from the normals.
+        let lean_constants = if lean && gbuffer.lean_targets.is_none() {
             let normals = gbuffer.normals.expect("require(LeanSss) checked them");
             let mut constants: HostLeanGpu = bytemuck::Zeroable::zeroed();
             constants.normals = normals.decode()?;
@@ -567,6 +609,7 @@ impl SssEffect {
             chains: chains.len(),
             materials,
             desc,
+            lean_blur: lean,
             lean: lean_constants,
         };
         // The tables do not change between frames: written once into every slot.
@@ -656,8 +699,18 @@ impl SssEffect {
             binds.push((id, image));
         }
         if let Some(lean) = &frame.lean {
-            if let Some(id) = self.imports.normals {
-                binds.push((id, lean.normals));
+            match (
+                lean.surface,
+                self.imports.normals,
+                self.imports.lean_targets,
+            ) {
+                (LeanSurface::Normals(normals), Some(id), _) => binds.push((id, normals)),
+                (LeanSurface::Targets(targets), _, Some([moments, albedo, normal])) => {
+                    binds.push((moments, targets.moments));
+                    binds.push((albedo, targets.albedo_specular));
+                    binds.push((normal, targets.normal_roughness));
+                }
+                _ => unreachable!("check_images matched the surface with the description"),
             }
             if let (Some(id), Some(map)) = (self.imports.shadow_map, lean.shadow_map) {
                 binds.push((id, map));
@@ -795,31 +848,25 @@ impl SssEffect {
                 }
             }
         }
-        let (normals, shadow_map) = self.check_lean(lucent, frame)?;
+        let lean = self.check_lean(lucent, frame)?;
         let all = [
             Some(images.depth),
             Some(images.diffuse),
             Some(images.material_ids),
             images.specular,
             images.albedo,
-            normals,
-            shadow_map,
         ];
-        distinct_inputs(all.into_iter().flatten(), frame.output)
+        distinct_inputs(all.into_iter().flatten().chain(lean), frame.output)
     }
 
     /// Checks `frame.lean` against the effect: there exactly when a LEAN blur is, its
-    /// normals as described, its shadow map there exactly when the description has a shadow
-    /// format. Returns the normals and the shadow map.
-    fn check_lean<'a>(
-        &self,
-        lucent: &Lucent,
-        frame: &SssFrame<'a>,
-    ) -> Result<(Option<&'a HostImage>, Option<&'a HostImage>)> {
-        let lean = match (&self.lean, &frame.lean) {
-            (None, None) => return Ok((None, None)),
-            (Some(_), Some(lean)) => lean,
-            (Some(_), None) => {
+    /// normals or LEAN targets as described, its shadow map there exactly when the
+    /// description has a shadow format. Returns those images.
+    fn check_lean<'a>(&self, lucent: &Lucent, frame: &SssFrame<'a>) -> Result<Vec<&'a HostImage>> {
+        let lean = match (self.lean_blur, &frame.lean) {
+            (false, None) => return Ok(Vec::new()),
+            (true, Some(lean)) => lean,
+            (true, None) => {
                 return Err(HostError::Missing {
                     input: "lean".into(),
                     needed_by: "a material of LCB, LBB or the bilateral blur: their LEAN \
@@ -829,7 +876,7 @@ impl SssEffect {
                 }
                 .into())
             }
-            (None, Some(_)) => {
+            (false, Some(_)) => {
                 return Err(HostError::Unsupported {
                     input: "lean".into(),
                     found: "normals and lights for an effect without a LEAN blur".into(),
@@ -841,16 +888,62 @@ impl SssEffect {
             }
         };
         let gbuffer = &self.desc.gbuffer;
-        let normal_format = gbuffer.normals.expect("checked at new").format;
-        check_image(
-            lucent.gpu(),
-            lean.normals,
-            "normals",
-            Role::SampledColor,
-            gbuffer.extent(),
-            |f| f == normal_format,
-            &format!("{} (the description's)", format_name(normal_format)),
-        )?;
+        let check = |image: &HostImage, input: &str, format: vk::Format| {
+            check_image(
+                lucent.gpu(),
+                image,
+                input,
+                Role::SampledColor,
+                gbuffer.extent(),
+                |f| f == format,
+                &format!("{} (the description's)", format_name(format)),
+            )
+        };
+        let mut images = match (lean.surface, &gbuffer.lean_targets) {
+            (LeanSurface::Targets(targets), Some(desc)) => {
+                check(targets.moments, "lean targets: moments", desc.moments)?;
+                check(
+                    targets.albedo_specular,
+                    "lean targets: albedo and specular",
+                    desc.albedo_specular,
+                )?;
+                check(
+                    targets.normal_roughness,
+                    "lean targets: normal and roughness",
+                    desc.normal_roughness,
+                )?;
+                vec![
+                    targets.moments,
+                    targets.albedo_specular,
+                    targets.normal_roughness,
+                ]
+            }
+            (LeanSurface::Normals(normals), None) => {
+                let format = gbuffer.normals.expect("checked at new").format;
+                check(normals, "normals", format)?;
+                vec![normals]
+            }
+            (LeanSurface::Normals(normals), Some(_)) => {
+                return Err(HostError::Image {
+                    image: normals.name.clone(),
+                    kind: ImageFault::Aliased,
+                    problem: "given as the LEAN blurs' normals, but the description has LEAN \
+                              targets (LeanSurface::Targets)"
+                        .into(),
+                }
+                .into())
+            }
+            (LeanSurface::Targets(_), None) => {
+                return Err(HostError::Unsupported {
+                    input: "lean.surface".into(),
+                    found: "LEAN targets, which the description has none of".into(),
+                    accepted: "the normals (LeanSurface::Normals), or LEAN targets described \
+                               by GBufferDesc::with_lean_targets"
+                        .into(),
+                }
+                .into())
+            }
+        };
         let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
             (Some(format), Some(map)) => {
                 check_shadow_map(lucent.gpu(), map, format, self.desc.shadow_array)?;
@@ -887,7 +980,8 @@ impl SssEffect {
                 .into())
             }
         };
-        Ok((Some(lean.normals), shadow_map))
+        images.extend(shadow_map);
+        Ok(images)
     }
 }
 
@@ -936,9 +1030,27 @@ fn declare(
         desc.output_format,
         Access::ColorAttachmentWrite,
     );
-    let normals = lean.then(|| {
+    let targets = gbuffer.lean_targets.filter(|_| lean);
+    let normals = (lean && targets.is_none()).then(|| {
         let format = gbuffer.normals.expect("checked at new").format;
         import(&mut graph, "host normals", format, sampled)
+    });
+    let lean_targets = targets.map(|t| {
+        [
+            import(&mut graph, "host LEAN moments", t.moments, sampled),
+            import(
+                &mut graph,
+                "host albedo and specular",
+                t.albedo_specular,
+                sampled,
+            ),
+            import(
+                &mut graph,
+                "host normal and roughness",
+                t.normal_roughness,
+                sampled,
+            ),
+        ]
     });
     let shadow_map = desc
         .shadow_format
@@ -951,6 +1063,7 @@ fn declare(
         material_ids: material_ids.id(),
         output: output.id(),
         normals: normals.as_ref().map(Handle::id),
+        lean_targets: lean_targets.as_ref().map(|t| t.each_ref().map(Handle::id)),
         shadow_map: shadow_map.as_ref().map(Handle::id),
     };
     let cleared;
@@ -976,36 +1089,11 @@ fn declare(
         ids: &profiles.id_map,
     };
     let adjusted;
-    let lean_targets;
-    if let Some(normals) = &normals {
-        // The LEAN chains' G-buffer targets, the albedo put right in the same pass.
-        let mode = match (albedo_pass, gbuffer.diffuse.albedo) {
-            (false, _) => None,
-            (true, DiffuseAlbedo::Included) => Some(HostAlbedo::Included),
-            (true, DiffuseAlbedo::Excluded) => Some(HostAlbedo::Excluded),
-        };
-        let host_albedo = mode.map(|mode| (albedo.as_ref().expect("checked at new"), mode));
-        lean_targets = sss::host_lean_pass(
-            &mut graph,
-            &inputs,
-            normals,
-            host_albedo,
-            &HOST_LEAN,
-            width,
-            height,
-            Some(scene_gpu),
-        );
-        inputs.diffuse = &lean_targets.diffuse;
-        inputs.lean = Some(LeanInputs {
-            view_plane: &lean_targets.view_plane,
-            gb0: &lean_targets.gb0,
-            gb1: &lean_targets.gb1,
-        });
-        // The LEAN chains' diffuse carries the slope in its alpha, not depth.
-        inputs.depth_in_alpha = false;
-        inputs.shadow_depth = shadow_map.as_ref();
-        inputs.shadow_array = desc.shadow_array;
-    } else if albedo_pass {
+    let built_targets;
+    // The diffuse put right where a profile wants its albedo otherwise (`sss albedo in`, which
+    // keeps the alpha: the LEAN slope x of a host's LEAN targets), unless the LEAN pass that
+    // builds the targets from the normals does it.
+    if albedo_pass && normals.is_none() {
         let albedo = albedo.as_ref().expect("checked at new");
         let included = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
         adjusted = sss::host_albedo_pass(
@@ -1018,6 +1106,46 @@ fn declare(
             Some(scene_gpu),
         );
         inputs.diffuse = &adjusted;
+    }
+    if let Some([moments, albedo_specular, normal_roughness]) = &lean_targets {
+        // The host wrote the LEAN targets: the chains read them as lucent's own frame reads
+        // its G-buffer's.
+        inputs.lean = Some(LeanInputs {
+            view_plane: moments,
+            gb0: albedo_specular,
+            gb1: normal_roughness,
+        });
+    } else if let Some(normals) = &normals {
+        // The LEAN chains' G-buffer targets, the albedo put right in the same pass.
+        let mode = match (albedo_pass, gbuffer.diffuse.albedo) {
+            (false, _) => None,
+            (true, DiffuseAlbedo::Included) => Some(HostAlbedo::Included),
+            (true, DiffuseAlbedo::Excluded) => Some(HostAlbedo::Excluded),
+        };
+        let host_albedo = mode.map(|mode| (albedo.as_ref().expect("checked at new"), mode));
+        built_targets = sss::host_lean_pass(
+            &mut graph,
+            &inputs,
+            normals,
+            host_albedo,
+            &HOST_LEAN,
+            width,
+            height,
+            Some(scene_gpu),
+        );
+        inputs.diffuse = &built_targets.diffuse;
+        inputs.lean = Some(LeanInputs {
+            view_plane: &built_targets.view_plane,
+            gb0: &built_targets.gb0,
+            gb1: &built_targets.gb1,
+        });
+    }
+    if inputs.lean.is_some() {
+        // The LEAN chains' diffuse carries the slope in its alpha, not depth; their specular
+        // is shadowed by the host's maps.
+        inputs.depth_in_alpha = false;
+        inputs.shadow_depth = shadow_map.as_ref();
+        inputs.shadow_array = desc.shadow_array;
     }
     if post_albedo {
         inputs.albedo = albedo.as_ref();

@@ -8,11 +8,13 @@
 //! host's effect alone are each submitted and timed with GPU timestamps; the table gives each
 //! pass's median in both and their ratio.
 //!
-//! - **Screen-space SSS** (`--technique separable|control|burley`): each pass of the
-//!   `SssEffect` (its regions the scattering objects' screen bounds widened by the blurs'
+//! - **Screen-space SSS** (`--technique separable|control|burley|lcb|lbb|bilateral`): each
+//!   pass of the `SssEffect` (its regions the scattering objects' screen bounds widened by the blurs'
 //!   reach; its diffuse with linear depth in the alpha where lucent's own frame has it)
 //!   against lucent's pass of the same name (the host's diffuse and
-//!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM).
+//!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM). For the
+//!   LEAN blurs (`lcb|lbb|bilateral`) the host writes the LEAN targets as lucent's G-buffer
+//!   pass does (`GBufferDesc::with_lean_targets`: lucent's own targets, uploaded once).
 //! - **SSS transmission** (with an SSS blur, on a scene with a `[material.medium]` and a
 //!   light casting shadows): lucent's term inside its lighting pass (the lighting with
 //!   transmission minus without) against the `TransmissionEffect`'s pass over the media's
@@ -43,12 +45,12 @@ use crate::embed::{
     DepthDesc, DiffuseDesc, EffectMemory, EffectTimer, EmbedOptions, EnvironmentEffect,
     EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages, GBufferDesc, HostCamera,
     HostDevice, HostImage, IdDesc, ImageState, IndexBuffer, LayeredEffect, LayeredEffectDesc,
-    LayeredFrame, LayeredImages, LayeredMaterial, LeanLighting, Lucent, MeshDraw, NormalDesc,
-    OptionalFeatures, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages,
-    SssMaterial, SssRegion, ThicknessDesc, TranslucencyEffect, TranslucencyEffectDesc,
-    TranslucencyFrame, TranslucencyImages, TranslucentMaterial, TransmissionEffect,
-    TransmissionEffectDesc, TransmissionFrame, TransmissionImages, TransmissionMaterial,
-    VertexLayout,
+    LayeredFrame, LayeredImages, LayeredMaterial, LeanLighting, LeanSurface, LeanTargetImages,
+    LeanTargetsDesc, Lucent, MeshDraw, NormalDesc, OptionalFeatures, ShadowFace, SssEffect,
+    SssEffectDesc, SssFrame, SssImages, SssMaterial, SssRegion, ThicknessDesc, TranslucencyEffect,
+    TranslucencyEffectDesc, TranslucencyFrame, TranslucencyImages, TranslucentMaterial,
+    TransmissionEffect, TransmissionEffectDesc, TransmissionFrame, TransmissionImages,
+    TransmissionMaterial, VertexLayout,
 };
 use crate::features::registry;
 use crate::features::sss::SssProfiles;
@@ -489,40 +491,42 @@ fn measure_sss(
         .with_specular(hdr)
         .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
         .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
-        // The LEAN blurs: lucent's normals (GB1), each material's surface, the scene's lights
-        // and, where they cast, lucent's light-space atlas with each face's matrices.
+        // The LEAN blurs: the host writes the LEAN targets in its G-buffer pass as lucent's
+        // own frame does (lucent's targets; the diffuse's alpha holds the slope x), with the
+        // scene's lights and, where they cast, lucent's light-space atlas with each face's
+        // matrices.
         let lean = if blur.lean() {
-            gbuffer = gbuffer.with_normals(NormalDesc::world(hdr));
-            let normals = images.upload(gpu, &colour, rgba16f(&gb.gb1), "host normals")?;
-            let normals = host_image(normals, "host normals", hdr, size, sampled);
+            let gb0 = vk::Format::R8G8B8A8_UNORM;
+            gbuffer = gbuffer.with_lean_targets(LeanTargetsDesc::new(hdr, gb0, hdr));
+            let moments = gb.lean.as_deref().ok_or_else(|| {
+                LucentError::InvalidInput("lucent's LEAN frame has no LEAN target".into())
+            })?;
+            let moments = images.upload(gpu, &colour, rgba16f(moments), "host LEAN moments")?;
+            let albedo = images.upload(
+                gpu,
+                &ImageDesc::color(width, height, gb0, sampled),
+                rgba8(&gb.gb0),
+                "host albedo and specular",
+            )?;
+            let normal = images.upload(gpu, &colour, rgba16f(&gb.gb1), "host normal")?;
+            let targets = [
+                host_image(moments, "host LEAN moments", hdr, size, sampled),
+                host_image(albedo, "host albedo and specular", gb0, size, sampled),
+                host_image(normal, "host normal and roughness", hdr, size, sampled),
+            ];
             let shadows =
                 crate::features::shadows::ShadowDesc::new(scene, &settings.shadows, false)
                     .map(|desc| atlas_as_host_map(gpu, &renderer, scene, &desc, &mut images))
                     .transpose()?;
-            Some((normals, shadows))
+            Some((targets, shadows))
         } else {
             None
         };
-        let surface_of = |profile: usize| {
-            frame_profiles
-                .object_ids
-                .iter()
-                .position(|&id| usize::from(id) == profile)
-                .map(|object| {
-                    let m = &scene.objects[object].material;
-                    SpecularSurface::new(m.roughness, m.specular)
-                })
-        };
+        // (The LEAN blurs' surfaces are the targets' roughness and specular intensity.)
         let materials = profiles
             .into_iter()
             .enumerate()
-            .map(|(i, p)| {
-                let material = SssMaterial::new(i as u8 + 1, p);
-                match surface_of(i + 1).filter(|_| lean.is_some()) {
-                    Some(surface) => material.with_surface(surface),
-                    None => material,
-                }
-            })
+            .map(|(i, p)| SssMaterial::new(i as u8 + 1, p))
             .collect();
         let mut desc = SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss);
         if let Some((_, Some(_))) = &lean {
@@ -570,8 +574,12 @@ fn measure_sss(
                     },
                     regions: &regions,
                     output: &output,
-                    lean: lean.as_ref().map(|(normals, shadows)| LeanLighting {
-                        normals,
+                    lean: lean.as_ref().map(|(targets, shadows)| LeanLighting {
+                        surface: LeanSurface::Targets(LeanTargetImages {
+                            moments: &targets[0],
+                            albedo_specular: &targets[1],
+                            normal_roughness: &targets[2],
+                        }),
                         lights: &scene.lights,
                         shadow_map: shadows.as_ref().map(|(map, _)| map),
                         shadow_faces: shadows.as_ref().map_or(&[], |(_, faces)| faces),

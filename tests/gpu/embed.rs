@@ -1619,7 +1619,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
         regions: &[],
         output: &out_host,
         lean: Some(lucent::embed::LeanLighting {
-            normals: &diffuse_host,
+            surface: lucent::embed::LeanSurface::Normals(&diffuse_host),
             lights: &scene.lights,
             shadow_map: None,
             shadow_faces: &[],

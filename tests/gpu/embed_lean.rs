@@ -21,8 +21,8 @@ use ash::vk;
 use lucent::backend::ImageDesc;
 use lucent::embed::{
     capabilities, DepthDesc, DiffuseDesc, Effect, GBufferDesc, HostError, IdDesc, ImageState,
-    LeanLighting, NormalDesc, ShadowFace, SpecularSurface, SssEffect, SssEffectDesc, SssFrame,
-    SssImages, SssMaterial,
+    LeanLighting, LeanSurface, LeanTargetImages, LeanTargetsDesc, NormalDesc, ShadowFace,
+    SpecularSurface, SssEffect, SssEffectDesc, SssFrame, SssImages, SssMaterial,
 };
 use lucent::features::registry;
 use lucent::features::shadows::ShadowDesc;
@@ -119,12 +119,59 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
     let test = TestGpu::new();
     let mut report = Vec::new();
     for blur in ["lbb", "lcb", "bilateral"] {
-        compare_lean(&test, blur, Texturing::Pre, &LAYOUTS, &mut report);
+        compare_lean(
+            &test,
+            blur,
+            Texturing::Pre,
+            &LAYOUTS,
+            Surface::Normals,
+            &mut report,
+        );
     }
     for line in &report {
         println!("{line}");
     }
     test.finish();
+}
+
+/// A host whose G-buffer pass writes the LEAN targets itself (`GBufferDesc::with_lean_targets`:
+/// here lucent's own, in the host's formats): no `sss lean in` pass, and the LEAN maps' spread
+/// inside a pixel is kept, so the frame is lucent's own within 1/255 everywhere.
+#[test]
+fn the_lean_blurs_on_a_hosts_own_lean_targets_equal_lucents_own_lean_frames() {
+    let test = TestGpu::new();
+    let mut report = Vec::new();
+    for blur in ["lbb", "lcb", "bilateral"] {
+        compare_lean(
+            &test,
+            blur,
+            Texturing::Pre,
+            &LAYOUTS,
+            Surface::Targets,
+            &mut report,
+        );
+    }
+    compare_lean(
+        &test,
+        "lbb",
+        Texturing::Post,
+        &LAYOUTS[1..2],
+        Surface::Targets,
+        &mut report,
+    );
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
+/// Where a host's LEAN blurs get their moments.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Surface {
+    /// Made by the effect from the host's normals and each material's surface.
+    Normals,
+    /// The LEAN targets the host's G-buffer pass wrote.
+    Targets,
 }
 
 /// The albedo after the scatter (`Texturing::Post`): the host's light holds the whole albedo,
@@ -134,7 +181,14 @@ fn the_lean_blurs_on_host_layouts_equal_lucents_own_lean_frames() {
 fn a_lean_blur_with_the_albedo_after_the_scatter_equals_lucents_own_frame() {
     let test = TestGpu::new();
     let mut report = Vec::new();
-    compare_lean(&test, "lbb", Texturing::Post, &LAYOUTS[1..2], &mut report);
+    compare_lean(
+        &test,
+        "lbb",
+        Texturing::Post,
+        &LAYOUTS[1..2],
+        Surface::Normals,
+        &mut report,
+    );
     for line in &report {
         println!("{line}");
     }
@@ -142,15 +196,17 @@ fn a_lean_blur_with_the_albedo_after_the_scatter_equals_lucents_own_frame() {
 }
 
 /// Renders `scene()` with `blur` and `texturing` in lucent's own frame and through a host's
-/// `SssEffect` on each of `layouts` (three frames in flight, views recreated), and compares
-/// them, pushing a line per frame into `report`.
+/// `SssEffect` on each of `layouts` (three frames in flight, views recreated) with the LEAN
+/// moments from `surface`, and compares them, pushing a line per frame into `report`.
 fn compare_lean(
     test: &TestGpu,
     blur: &str,
     texturing: Texturing,
     layouts: &[Layout],
+    surface: Surface,
     report: &mut Vec<String>,
 ) {
+    let targets = surface == Surface::Targets;
     let gpu = &test.gpu;
     let (w, h) = (192, 144);
     let scene = scene();
@@ -246,8 +302,8 @@ fn compare_lean(
             .unwrap()
         };
         // The host's light holds the whole albedo (lucent's leaves it out of a scattering
-        // pixel's light when it goes after the scatter); its alpha is its own (lucent's holds
-        // the LEAN slope x there).
+        // pixel's light when it goes after the scatter); its alpha is its own, or with LEAN
+        // targets the LEAN slope x, as lucent's.
         let post = texturing != Texturing::Pre;
         let albedo_bytes = rgba8(&gb.gb0);
         let diffuse_rgb: Vec<[f32; 4]> = lit
@@ -263,7 +319,8 @@ fn compare_lean(
                         1.0
                     }
                 };
-                [d[0] * f(0), d[1] * f(1), d[2] * f(2), 0.25]
+                let alpha = if targets { d[3] } else { 0.25 };
+                [d[0] * f(0), d[1] * f(1), d[2] * f(2), alpha]
             })
             .collect();
         let albedo = gpu
@@ -275,6 +332,10 @@ fn compare_lean(
             .unwrap();
         let diffuse = rgba32(&diffuse_rgb, "host diffuse");
         let specular = rgba32(&lit.specular, "host specular");
+        // The LEAN targets as the host's G-buffer pass writes them: lucent's, the albedo and
+        // specular intensity in the albedo image above.
+        let moments = rgba32(gb.lean.as_ref().unwrap(), "host LEAN moments");
+        let normal_roughness = rgba32(&gb.gb1, "host normal and roughness");
 
         for &(name, depth_kind, ids_kind, normals_kind) in layouts {
             // The reversed-Z G-buffer's host stores its shadow map reversed too, the
@@ -307,7 +368,17 @@ fn compare_lean(
             }
             let (normals, normal_desc) =
                 normal_image(test, normals_kind, w, h, &gb.gb1, layout.camera.view);
-            let mut desc = layout.desc.clone().with_normals(normal_desc);
+            let mut desc = layout.desc.clone();
+            desc = if targets {
+                let float = vk::Format::R32G32B32A32_SFLOAT;
+                desc.with_lean_targets(LeanTargetsDesc::new(
+                    float,
+                    vk::Format::R8G8B8A8_UNORM,
+                    float,
+                ))
+            } else {
+                desc.with_normals(normal_desc)
+            };
             if post {
                 desc = desc.with_albedo(vk::Format::R8G8B8A8_UNORM);
             }
@@ -317,7 +388,13 @@ fn compare_lean(
                 .enumerate()
                 .map(|(i, p)| {
                     let k = i as u8 + 1;
-                    SssMaterial::new(host_id(ids_kind, k), p.clone()).with_surface(surface_of(k))
+                    let material = SssMaterial::new(host_id(ids_kind, k), p.clone());
+                    // With LEAN targets the surface is theirs.
+                    if targets {
+                        material
+                    } else {
+                        material.with_surface(surface_of(k))
+                    }
                 })
                 .collect();
             let lucent = wrap(test, options(3));
@@ -336,6 +413,18 @@ fn compare_lean(
             let diffuse_host = described(&diffuse, "host diffuse", usage);
             let specular_host = described(&specular, "host specular", usage);
             let albedo_host = described(&albedo, "host albedo", usage);
+            let moments_host = described(&moments, "host LEAN moments", usage);
+            let normal_roughness_host =
+                described(&normal_roughness, "host normal and roughness", usage);
+            let lean_surface = if targets {
+                LeanSurface::Targets(LeanTargetImages {
+                    moments: &moments_host,
+                    albedo_specular: &albedo_host,
+                    normal_roughness: &normal_roughness_host,
+                })
+            } else {
+                LeanSurface::Normals(&normals_host)
+            };
             // The frames' output is host_frames' lighting image (its start is overwritten).
             let frames = host_frames(
                 test,
@@ -362,7 +451,7 @@ fn compare_lean(
                                 regions: &[],
                                 output: &output,
                                 lean: Some(LeanLighting {
-                                    normals: &normals_host,
+                                    surface: lean_surface,
                                     lights: &scene.lights,
                                     shadow_map: Some(&shadow_map.host),
                                     shadow_faces: &shadow_map.faces,
@@ -376,14 +465,20 @@ fn compare_lean(
                 let have = tonemapped(texels, exposure);
                 // The normals come re-encoded (octahedral, 16-bit) and the positions through
                 // another depth: the LEAN slopes move by a hair, and the specular with them
-                // where it is steep. At most 0.1% of the channel values over 1/255.
+                // where it is steep. At most 0.1% of the channel values over 1/255. The
+                // host's own LEAN targets are lucent's: none.
+                let over = if targets { 0 } else { want.len() / 1000 };
+                let source = if targets { "targets" } else { "normals" };
                 report.push(compare_host_frame(
                     &want,
                     &have,
                     (w, h),
-                    want.len() / 1000,
-                    &format!("{blur} ({}) on {name}, frame {k}", texturing.name()),
-                    &format!("embed-lean-{blur}-{}-{k}", texturing.name()),
+                    over,
+                    &format!(
+                        "{blur} ({}, from {source}) on {name}, frame {k}",
+                        texturing.name()
+                    ),
+                    &format!("embed-lean-{blur}-{}-{source}-{k}", texturing.name()),
                 ));
             }
             effect.destroy(&lucent);
@@ -395,6 +490,8 @@ fn compare_lean(
         gpu.destroy_image(diffuse);
         gpu.destroy_image(specular);
         gpu.destroy_image(albedo);
+        gpu.destroy_image(moments);
+        gpu.destroy_image(normal_roughness);
     }
 }
 
@@ -438,8 +535,9 @@ fn a_lean_blur_without_normals_a_surface_or_its_lighting_is_a_typed_error() {
         panic!("the LEAN blurs' entry")
     };
     assert!(!support.runs());
-    let with_normals =
-        gbuffer.with_normals(NormalDesc::world(vk::Format::A2B10G10R10_UNORM_PACK32));
+    let with_normals = gbuffer
+        .clone()
+        .with_normals(NormalDesc::world(vk::Format::A2B10G10R10_UNORM_PACK32));
     // A LEAN blur without a surface; a surface with a blur that keeps the host's specular; a
     // roughness out of range; a shadow format without a LEAN blur, and one that is not depth.
     let e = host_error(build(SssEffectDesc::new(
@@ -506,14 +604,78 @@ fn a_lean_blur_without_normals_a_surface_or_its_lighting_is_a_typed_error() {
     );
     // Built right, it has its LEAN pass.
     let effect = build(SssEffectDesc::new(with_normals, vec![lbb(true)], format)).unwrap();
-    let passes: Vec<String> = effect
+    let passes = pass_names(&effect);
+    assert!(passes.iter().any(|p| p == "sss lean in"), "{passes:?}");
+    effect.destroy(&lucent);
+
+    // The host's own LEAN targets: no normals needed, no surface taken (the targets hold the
+    // roughness and specular), each target's format checked, the diffuse's alpha a float.
+    let (rgba16f, rgba8) = (format, vk::Format::R8G8B8A8_UNORM);
+    let with_targets = gbuffer
+        .clone()
+        .with_lean_targets(LeanTargetsDesc::new(rgba16f, rgba8, rgba16f));
+    assert!(capabilities(&with_targets).unwrap()[5].1.runs());
+    let e = host_error(build(SssEffectDesc::new(
+        with_targets.clone(),
+        vec![lbb(true)],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input.ends_with(".surface")),
+        "{e}"
+    );
+    for (targets, input) in [
+        (
+            LeanTargetsDesc::new(rgba8, rgba8, rgba16f),
+            "lean targets: moments",
+        ),
+        (
+            LeanTargetsDesc::new(rgba16f, vk::Format::R8G8_UNORM, rgba16f),
+            "lean targets: albedo and specular",
+        ),
+        (
+            LeanTargetsDesc::new(rgba16f, rgba8, rgba8),
+            "lean targets: normal and roughness",
+        ),
+    ] {
+        let e = host_error(build(SssEffectDesc::new(
+            gbuffer.clone().with_lean_targets(targets),
+            vec![lbb(false)],
+            format,
+        )));
+        assert!(
+            matches!(&e, HostError::Unsupported { input: i, .. } if i == input),
+            "{e}"
+        );
+    }
+    let mut packed_light = with_targets.clone();
+    packed_light.diffuse = DiffuseDesc::with_albedo(vk::Format::B10G11R11_UFLOAT_PACK32);
+    let e = host_error(build(SssEffectDesc::new(
+        packed_light,
+        vec![lbb(false)],
+        format,
+    )));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "diffuse"),
+        "{e}"
+    );
+    // Built right, it reads the targets as they are: no LEAN pass of its own, the LEAN
+    // final lighting.
+    let effect = build(SssEffectDesc::new(with_targets, vec![lbb(false)], format)).unwrap();
+    let passes = pass_names(&effect);
+    assert!(!passes.iter().any(|p| p == "sss lean in"), "{passes:?}");
+    assert!(passes.iter().any(|p| p == "final lighting"), "{passes:?}");
+    effect.destroy(&lucent);
+    drop(lucent);
+    test.finish();
+}
+
+/// The names of the passes `effect` records.
+fn pass_names(effect: &SssEffect) -> Vec<String> {
+    effect
         .plan()
         .passes
         .iter()
         .map(|p| p.name.clone())
-        .collect();
-    assert!(passes.iter().any(|p| p == "sss lean in"), "{passes:?}");
-    effect.destroy(&lucent);
-    drop(lucent);
-    test.finish();
+        .collect()
 }

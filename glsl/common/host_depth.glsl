@@ -6,6 +6,11 @@
 #ifndef LUCENT_HOST_DEPTH_GLSL
 #define LUCENT_HOST_DEPTH_GLSL
 
+// The host's depth image holds linear view depth (DepthEncoding::LinearView): a specialization
+// constant of the SSS passes (src/features/sss/mod.rs `SssInputs::specialization`), folded by
+// the driver; the other effects' passes leave it false and pass `linear_view` themselves.
+layout(constant_id = 21) const bool HOST_DEPTH_LINEAR = false;
+
 // The view-space point on the ray through `frag_coord` at view depth `z`: the ray's direction
 // from the frame's inverse view-projection (its point at device depth 0.5 is finite for
 // standard, reversed and infinite projections alike).

@@ -157,12 +157,15 @@ vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughne
     float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
     mat3 view = mat3(frame.view);
 #ifdef LUCENT_SSS_HOST_IDS
-    // A host's frame (lucent::embed): its depth image may hold linear view depth, which
-    // world_position cannot unproject; the point on the pixel's ray at its view depth serves
-    // every encoding (host_depth.glsl), brought back to the world through the view matrix
-    // inverted as the rotation and translation it is.
-    vec3 pos = transpose(view) * (view_point_at_depth(frag_coord, linear_depth(d)) -
-                                  frame.view[3].xyz);
+    // A host's frame (lucent::embed): a device depth of any projection unprojects as lucent's
+    // own does; linear view depth (a constant of the pipeline) cannot be, and the point on the
+    // pixel's ray at its view depth (host_depth.glsl) is brought back to the world through the
+    // view matrix inverted as the rotation and translation it is. (That path for every
+    // encoding made the final lighting 1.04-1.08x lucent's own pass.)
+    vec3 pos = HOST_DEPTH_LINEAR
+                   ? transpose(view) * (view_point_at_depth(frag_coord, linear_depth(d)) -
+                                        frame.view[3].xyz)
+                   : world_position(frag_coord, d);
 #else
     vec3 pos = world_position(frag_coord, d);
 #endif

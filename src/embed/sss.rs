@@ -34,7 +34,9 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding};
+use super::gbuffer::{
+    sampled_float, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding,
+};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::tiles_marked_by;
@@ -1087,6 +1089,7 @@ fn declare(
         // there, as in lucent's own frames; otherwise they read the depth image.
         depth_in_alpha: gbuffer.diffuse.depth_in_alpha,
         ids: &profiles.id_map,
+        linear_depth: gbuffer.depth.encoding == DepthEncoding::LinearView,
     };
     let adjusted;
     let built_targets;

@@ -692,6 +692,25 @@ pub struct SssInputs<'a> {
     /// How the passes read `profile_ids` (its [`IdMap::defines`] and
     /// [`IdMap::specialization`]).
     pub ids: &'a IdMap,
+    /// `depth` holds linear view depth (a host's `DepthEncoding::LinearView`), which the LEAN
+    /// specular's position cannot be unprojected from: a host's passes take it as a
+    /// specialization constant ([`SssInputs::specialization`]). Always false in lucent's own
+    /// frames.
+    pub linear_depth: bool,
+}
+
+impl SssInputs<'_> {
+    /// The SSS passes' specialization constants (`glsl/common/sss.glsl`): a host's ID map
+    /// ([`IdMap::specialization`], `constant_id` 0-20) and whether its depth is linear
+    /// (`constant_id` 21, `glsl/common/host_depth.glsl`). Empty for lucent's own frames, whose
+    /// passes compile the constants' defaults.
+    pub fn specialization(&self) -> Vec<u32> {
+        let mut constants = self.ids.specialization();
+        if !constants.is_empty() {
+            constants.push(u32::from(self.linear_depth));
+        }
+        constants
+    }
 }
 
 /// The G-buffer images LCB's and LBB's chains read besides the lit light.
@@ -799,7 +818,7 @@ fn sss_pass<'g>(
         .per_frame(&tables::PROFILES)
         .push_constants(&constants)
         .defines(inputs.ids.defines())
-        .specialize(&inputs.ids.specialization());
+        .specialize(&inputs.specialization());
     pass
 }
 
@@ -846,7 +865,7 @@ pub fn host_albedo_pass(
         .sample("albedo_tex", albedo)
         .sample("profile_tex", inputs.profile_ids)
         .defines(&host_albedo_defines(inputs.ids.defines(), included))
-        .specialize(&inputs.ids.specialization())
+        .specialize(&inputs.specialization())
         .color(&mut out, crate::graph::LoadOp::DontCare);
     pass.finish();
     out
@@ -941,7 +960,7 @@ pub fn host_lean_pass(
         pass.sample("albedo_tex", albedo);
     }
     pass.defines(&host_lean_defines(inputs.ids.defines(), mode))
-        .specialize(&inputs.ids.specialization())
+        .specialize(&inputs.specialization())
         // The LEAN texels only where a chain blurs (its tiles: the host's regions); elsewhere
         // the light alone, which the chains' final passes pass through.
         .variant(HOST_LEAN_PASSTHROUGH.to_vec())

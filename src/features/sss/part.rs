@@ -140,6 +140,7 @@ impl FramePart for SssProfiles {
                 albedo: gb.layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: self.depth_in_alpha(),
                 ids: &self.id_map,
+                linear_depth: false,
             },
             self,
             knobs.sss,

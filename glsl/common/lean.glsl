@@ -11,14 +11,10 @@
 
 #include "gbuffer.glsl"
 #include "lighting.glsl"
-#ifdef LUCENT_SSS_HOST_IDS
 #include "host_depth.glsl"
-#endif
 #ifdef LUCENT_SHADOWS
-#ifdef LUCENT_SSS_HOST_IDS
-// A host's shadow map may store reversed Z (shadows.glsl shadow_stored_depth).
-#define LUCENT_SHADOW_REVERSIBLE 1
-#endif
+// (A host's shadow map may store reversed Z: its passes define LUCENT_SHADOW_REVERSIBLE,
+// shadows.glsl shadow_stored_depth.)
 #include "shadows.glsl"
 #endif
 
@@ -156,19 +152,17 @@ vec3 lean_final_specular(vec2 frag_coord, float d, vec2 b, vec3 m, float roughne
     float base = roughness_variance(roughness);
     float peak = ks * (shininess(roughness) + 8.0) / (8.0 * PI);
     mat3 view = mat3(frame.view);
-#ifdef LUCENT_SSS_HOST_IDS
-    // A host's frame (lucent::embed): a device depth of any projection unprojects as lucent's
-    // own does; linear view depth (a constant of the pipeline) cannot be, and the point on the
-    // pixel's ray at its view depth (host_depth.glsl) is brought back to the world through the
-    // view matrix inverted as the rotation and translation it is. (That path for every
-    // encoding made the final lighting 1.04-1.08x lucent's own pass.)
+    // A device depth of any projection (lucent's own, a host's standard, reversed or
+    // infinite) unprojects through the frame's inverse view-projection; a host's linear view
+    // depth (HOST_DEPTH_LINEAR, a constant of the pipeline: false for lucent's own frames)
+    // cannot be, and the point on the pixel's ray at its view depth (host_depth.glsl) is
+    // brought back to the world through the view matrix inverted as the rotation and
+    // translation it is. (That path for every encoding made the final lighting 1.04-1.08x
+    // lucent's own pass.)
     vec3 pos = HOST_DEPTH_LINEAR
                    ? transpose(view) * (view_point_at_depth(frag_coord, linear_depth(d)) -
                                         frame.view[3].xyz)
                    : world_position(frag_coord, d);
-#else
-    vec3 pos = world_position(frag_coord, d);
-#endif
     vec3 to_eye = view * normalize(frame.camera_pos.xyz - pos);
     vec3 n = normalize(vec3(b, 1.0));
     float n_dot_v = dot(n, to_eye);

@@ -30,7 +30,8 @@ layout(std140, set = 0) uniform SssProfiles {
     // omega) (a: 1 = the profile has a medium), omega / (4 A_1). Read by the lighting pass
     // (sss_medium.glsl, sss_transmission.glsl).
     vec4 medium[MAX_SSS_PROFILES * 6];
-    // A host's material IDs (LUCENT_SSS_HOST_IDS; src/embed/gbuffer.rs `IdEncoding`): x the
+    // The ID image's decode (src/features/sss/mod.rs `IdMap`; a host's: src/embed/gbuffer.rs
+    // `IdEncoding`), for the passes that read it without constants: x the
     // channel that holds them, y the bit field's shift, z its mask, w the largest value of a
     // UNORM channel (its integer is value * w). The field is the host's ID; id_profiles maps
     // it to a profile number, one byte per ID (ID i: byte i % 4 of id_profiles[i / 16][i / 4 % 4]).
@@ -52,17 +53,22 @@ int sss_profile_id(float stored) {
 #define SSS_ID_SAMPLER sampler2D
 #endif
 
-#ifdef LUCENT_SSS_HOST_IDS
-// A host's ID decode (host_ids.glsl's `decode`) and its SSS materials as specialization
-// constants (src/features/sss/mod.rs `IdMap::specialization`), fixed when the effect is made:
-// the driver folds them into the pass's code.
-// - The decode: the channel, the bit field's shift and mask, a UNORM channel's largest value.
-// - Up to eight materials: SSS_IDS_LISTED of them, material k's host ID in SSS_ID_k and its
-//   profile number in SSS_PROFILE_k. A pixel's profile is then found by comparisons with
+// How a pixel's profile is read from the ID image (src/features/sss/mod.rs `IdMap`): the decode
+// and the ID-to-profile map as specialization constants (`IdMap::specialization`), fixed when
+// the pass is made: the driver folds them into the pass's code. lucent's own G-buffer and a
+// host's are read by the same code; only the constants differ.
+// - The decode: the channel, the bit field's shift and mask, a UNORM channel's largest value
+//   (lucent's own G-buffer: R8_UNORM, the profile number k stored as k / 255).
+// - IDs that are the profile numbers (SSS_IDS_PROFILES_UP_TO = n > 0: IDs 1 to n are profiles 1
+//   to n, every other ID none): a host whose SSS materials have IDs 1 to n in the
+//   description's order, and lucent's own G-buffer (SSS_IDS_ONLY_PROFILES: it holds nothing
+//   else).
+// - Otherwise up to eight materials: SSS_IDS_LISTED of them, material k's ID in SSS_ID_k and
+//   its profile number in SSS_PROFILE_k. A pixel's profile is then found by comparisons with
 //   constants, where the ID-to-profile table (id_profiles) costs a load from a per-pixel
 //   address: with the table the control's combine was 1.10-1.16x lucent's own pass, with the
-//   comparisons 0.87-0.91x (lucent bench --embed, skin, 1024x768). A host with more SSS
-//   materials (SSS_IDS_LISTED = 0) reads the table.
+//   comparisons 0.87-0.91x (lucent bench --embed, skin, 1024x768). More materials
+//   (SSS_IDS_LISTED = 0) read the table.
 layout(constant_id = 0) const uint SSS_ID_CHANNEL = 0u;
 layout(constant_id = 1) const uint SSS_ID_SHIFT = 0u;
 layout(constant_id = 2) const uint SSS_ID_MASK = 255u;
@@ -86,14 +92,18 @@ layout(constant_id = 17) const int SSS_PROFILE_5 = 0;
 layout(constant_id = 18) const int SSS_PROFILE_6 = 0;
 layout(constant_id = 19) const int SSS_PROFILE_7 = 0;
 layout(constant_id = 20) const int SSS_PROFILE_8 = 0;
-#else
-// (Only the unsigned overloads below name it outside a host's passes, which never call them.)
-#define SSS_ID_DECODE sss_profiles.id_decode
-#endif
+// (constant_id 21 is host_depth.glsl's HOST_DEPTH_LINEAR.)
+layout(constant_id = 22) const uint SSS_IDS_PROFILES_UP_TO = 0u;
+// SSS_IDS_PROFILES_UP_TO's value for an image that holds nothing but profile numbers (lucent's
+// own G-buffer writes each pixel's): no other ID needs telling apart.
+#define SSS_IDS_ONLY_PROFILES 256
 
 // The profile number of a host's material ID (0: does not scatter); IDs past 255 have none.
 int sss_host_profile(uint host_id) {
-#ifdef LUCENT_SSS_HOST_IDS
+    if (SSS_IDS_PROFILES_UP_TO > 0u) {
+        return host_id <= min(SSS_IDS_PROFILES_UP_TO, uint(MAX_SSS_PROFILES - 1)) ? int(host_id)
+                                                                                    : 0;
+    }
     if (SSS_IDS_LISTED > 0u) {
         // Unlisted slots hold ID 256, which no decoded ID equals.
         int p = 0;
@@ -107,7 +117,6 @@ int sss_host_profile(uint host_id) {
         p = host_id == SSS_ID_8 ? SSS_PROFILE_8 : p;
         return p;
     }
-#endif
     if (host_id > 255u) {
         return 0;
     }
@@ -122,25 +131,28 @@ int sss_host_profile(uint host_id) {
 // skips the ID-to-profile table (Burley's gather: 1.08x lucent's own pass with the table per
 // tap, 1.05x without).
 int sss_id_key(vec4 t) {
-#ifdef LUCENT_SSS_HOST_IDS
     return int(host_material_id(t, SSS_ID_DECODE));
-#else
-    return sss_profile_id(t.r);
-#endif
 }
 
 int sss_id_key(uvec4 t) {
-    // Unsigned IDs are only a host's (lucent's own G-buffer stores UNORM).
     return int(host_material_id(t, SSS_ID_DECODE));
 }
 
 // The profile number of the texel `t` of the profile ID image.
 int sss_decode_id(vec4 t) {
-#ifdef LUCENT_SSS_HOST_IDS
+    if (SSS_IDS_PROFILES_UP_TO > 0u && SSS_ID_UNORM_MAX == 255u && SSS_ID_SHIFT == 0u &&
+        SSS_ID_MASK == 255u) {
+        // A whole 8-bit UNORM channel of profile numbers (lucent's own G-buffer): its value is
+        // in [0, 1], so the general decode's clamp and mask are left out (they made the blurs'
+        // taps 2% dearer). Negative values (a float channel) read 0, as NaN's do.
+        int k = int(t[min(SSS_ID_CHANNEL, 3u)] * 255.0 + 0.5);
+        if (SSS_IDS_PROFILES_UP_TO >= uint(SSS_IDS_ONLY_PROFILES)) {
+            // Nothing but profile numbers (lucent's own G-buffer): no ID to tell apart.
+            return clamp(k, 0, MAX_SSS_PROFILES - 1);
+        }
+        return k >= 0 && k <= int(min(SSS_IDS_PROFILES_UP_TO, uint(MAX_SSS_PROFILES - 1))) ? k : 0;
+    }
     return sss_host_profile(uint(sss_id_key(t)));
-#else
-    return sss_id_key(t);
-#endif
 }
 
 int sss_decode_id(uvec4 t) {

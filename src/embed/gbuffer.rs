@@ -15,7 +15,7 @@ use glam::Mat4;
 
 use crate::backend::format::{format_info, format_name, FormatKind};
 use crate::error::HostError;
-use crate::features::sss::HostIdMap;
+use crate::features::sss::IdMap;
 use crate::Result;
 
 /// How the depth image's values encode depth.
@@ -183,7 +183,7 @@ impl IdDesc {
     }
 
     /// How the passes decode it, with each host ID's profile number from `profile_of`.
-    pub(crate) fn decode(&self, profile_of: Vec<u8>) -> Result<HostIdMap> {
+    pub(crate) fn decode(&self, profile_of: Vec<u8>) -> Result<IdMap> {
         let refuse = |found: String, accepted: &str| -> crate::LucentError {
             HostError::Unsupported {
                 input: "material IDs".into(),
@@ -212,7 +212,7 @@ impl IdDesc {
                 }
                 // The whole channel is the ID; IDs past 255 have no profile (the shader's
                 // sss_host_profile), so a 16-bit ID image works for the IDs it can map.
-                return Ok(HostIdMap {
+                return Ok(IdMap {
                     uint: info.kind == FormatKind::Uint,
                     channel: 0,
                     shift: 0,
@@ -227,6 +227,7 @@ impl IdDesc {
                         ((1u64 << bits) - 1) as u32
                     },
                     profile_of,
+                    only_profiles: false,
                 });
             }
             IdEncoding::Stencil { shift, count } => {
@@ -270,13 +271,14 @@ impl IdDesc {
                 "1 to 8 bits (IDs 0 to 255) inside the channel",
             ));
         }
-        Ok(HostIdMap {
+        Ok(IdMap {
             uint,
             channel: u32::from(channel),
             shift: u32::from(shift),
             mask: (1u32 << count) - 1,
             unorm_max: if uint { 0 } else { (1u32 << channel_bits) - 1 },
             profile_of,
+            only_profiles: false,
         })
     }
 }

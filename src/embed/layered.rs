@@ -527,7 +527,7 @@ impl LayeredEffect {
             media.push(medium);
         }
         let uint_ids = id_map.uint;
-        let (host_ids, _) = crate::features::sss::IdMap::Host(id_map).rows();
+        let (host_ids, _) = id_map.rows();
         let layered = LayeredDesc {
             materials: media,
             object_ids: Vec::new(),

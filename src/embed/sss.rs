@@ -46,7 +46,7 @@ use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
 use crate::features::registry;
-use crate::features::sss::{self, HostAlbedo, IdMap, LeanInputs, SssKnobs, SssProfiles};
+use crate::features::sss::{self, HostAlbedo, LeanInputs, SssKnobs, SssProfiles};
 use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
 use crate::graph::{
     Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
@@ -514,7 +514,6 @@ impl SssEffect {
             .into());
         }
         id_map.profile_of = profile_of;
-        let id_map = IdMap::Host(id_map);
         let lean = profiles.iter().any(|(_, b)| b.lean());
         if desc.shadow_array && desc.shadow_format.is_none() {
             return Err(HostError::Description {
@@ -1084,6 +1083,7 @@ fn declare(
         lean: None,
         shadow_depth: None,
         shadow_array: false,
+        shadow_reversible: false,
         albedo: None,
         // The host's alpha is its own unless it holds linear depth: then the taps read it
         // there, as in lucent's own frames; otherwise they read the depth image.
@@ -1149,6 +1149,8 @@ fn declare(
         inputs.depth_in_alpha = false;
         inputs.shadow_depth = shadow_map.as_ref();
         inputs.shadow_array = desc.shadow_array;
+        // A host's map may store reversed Z (its faces say: ShadowFace).
+        inputs.shadow_reversible = true;
     }
     if post_albedo {
         inputs.albedo = albedo.as_ref();

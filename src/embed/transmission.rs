@@ -47,7 +47,7 @@ use crate::error::HostError;
 use crate::features::pass::FullscreenPass;
 use crate::features::shadows::ShadowUniforms;
 use crate::features::sss::transmission::{SssTransmission, MEDIUM_ROWS};
-use crate::features::sss::{IdMap, ProfileTableGpu, MAX_SSS_PROFILES};
+use crate::features::sss::{ProfileTableGpu, MAX_SSS_PROFILES};
 use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};
 use crate::graph::{LoadOp, RenderGraph, ResourceId};
 use crate::scene::material::Medium;
@@ -300,7 +300,7 @@ impl TransmissionEffect {
         }
         id_map.profile_of = profile_of;
         let uint_ids = id_map.uint;
-        (table.id_decode, table.id_profiles) = IdMap::Host(id_map).rows();
+        (table.id_decode, table.id_profiles) = id_map.rows();
         let normals = normals.decode()?;
         let region = |region: &'static Region, bytes: usize| TableRegion {
             region,

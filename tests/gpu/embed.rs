@@ -1064,11 +1064,18 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
                 .enumerate()
                 .map(|(i, p)| SssMaterial::new(host_id(ids_kind, i as u8 + 1), p.clone()))
                 .collect();
-            // The R8_UINT host has eight SSS materials more, which no pixel shows: past the
-            // eight that its passes tell apart by constants (IdMap::specialization), so they
-            // look their profiles up in the table; the other hosts' passes compare constants.
+            // Each way a host ID finds its profile (IdMap::specialization): the R8_UINT host
+            // has eight SSS materials more, which no pixel shows, past the eight its passes
+            // tell apart by constants, so they look their profiles up in the table; the
+            // stencil host has one more, ID 9, which no pixel shows either: its IDs are then
+            // not the profile numbers, so its passes compare them with constants; the
+            // others' IDs are 1 to n in order, the profile numbers themselves.
             if ids_kind == HostIds::Uint {
                 materials.extend((0..8).map(|k| SssMaterial::new(100 + k, profiles[0].clone())));
+            }
+            if ids_kind == HostIds::Stencil {
+                assert!(materials.iter().all(|m| m.id < 9));
+                materials.push(SssMaterial::new(9, profiles[0].clone()));
             }
             let lucent = wrap(&test, options(3));
             let desc = SssEffectDesc::new(

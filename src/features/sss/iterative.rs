@@ -220,9 +220,7 @@ pub(super) fn chain_passes(
     // LEAN specular is direct light: the light-space maps shadow it.
     if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some()) {
         pass.shadows(depth);
-        if inputs.shadow_array {
-            pass.defines(super::SHADOW_ARRAY);
-        }
+        pass.defines(&super::shadow_defines(inputs));
     }
     pass.color(&mut hdr, LoadOp::DontCare);
     // With SSS tiles, `final lighting` evaluates LEAN only on the rectangles its chain may

@@ -260,26 +260,17 @@ pub struct SssProfiles {
     pub transmission: Vec<Option<transmission::SssTransmission>>,
     /// Per scene object: its profile ID (0: the object does not scatter).
     pub object_ids: Vec<u8>,
-    /// How the passes read a pixel's profile from the ID image: lucent's own (`R8_UNORM`,
-    /// the profile number / 255) or a host's encoding and ID-to-profile map ([`IdMap`]).
+    /// How the passes read a pixel's profile from the ID image ([`IdMap`]: lucent's own
+    /// `R8_UNORM` profile numbers, or a host's encoding and ID-to-profile map).
     pub id_map: IdMap,
 }
 
-/// How the SSS passes find a pixel's profile in the profile ID image.
-#[derive(Clone, Debug, PartialEq, Eq, Default)]
-pub enum IdMap {
-    /// lucent's own G-buffer: `R8_UNORM`, the profile number `k` stored as `k / 255`.
-    #[default]
-    Lucent,
-    /// A host's material IDs (`LUCENT_SSS_HOST_IDS`): a bit field of one channel of the
-    /// image, and the profile number of each ID.
-    Host(HostIdMap),
-}
-
-/// A host's material IDs as the SSS passes decode them (built by `lucent::embed` from the
-/// host's description of its ID image).
+/// How the SSS passes find a pixel's profile in the ID image: a bit field of one channel of
+/// the image, and the profile number of each ID. lucent's own G-buffer ([`IdMap::lucent`]) and
+/// a host's (built by `lucent::embed` from its description of its ID image) are read by the
+/// same passes with different specialization constants ([`IdMap::specialization`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct HostIdMap {
+pub struct IdMap {
     /// The image is read as unsigned integers (a UINT format or a stencil aspect; define
     /// `LUCENT_SSS_IDS_UINT`), else as UNORM floats turned back into their integers.
     pub uint: bool,
@@ -291,46 +282,76 @@ pub struct HostIdMap {
     pub mask: u32,
     /// For UNORM channels, the largest integer (`2^bits - 1`).
     pub unorm_max: u32,
-    /// The profile number (1 to the number of profiles; 0: none) of each host ID 0 to 255.
+    /// The profile number (1 to the number of profiles; 0: none) of each ID 0 to 255.
     pub profile_of: Vec<u8>,
+    /// The image holds nothing but profile numbers (lucent's own G-buffer writes each
+    /// pixel's): the passes need not tell other IDs apart.
+    pub only_profiles: bool,
 }
 
-impl HostIdMap {
+/// How many SSS materials with IDs other than their profile numbers the passes tell apart by
+/// comparisons with constants ([`IdMap::specialization`]); more are looked up in the profile
+/// table.
+pub const LISTED_HOST_IDS: usize = 8;
+
+impl IdMap {
+    /// lucent's own G-buffer's IDs: `R8_UNORM`, each pixel's profile number `k` stored as
+    /// `k / 255` (its image holds nothing else: [`Self::only_profiles`]).
+    pub fn lucent() -> Self {
+        Self {
+            uint: false,
+            channel: 0,
+            shift: 0,
+            mask: 0xff,
+            unorm_max: 255,
+            profile_of: (0..256usize)
+                .map(|id| if id < MAX_SSS_PROFILES { id as u8 } else { 0 })
+                .collect(),
+            only_profiles: true,
+        }
+    }
+
     /// The decode as the shaders take it (glsl/common/host_ids.glsl `decode`): channel,
     /// shift, mask, UNORM maximum.
     fn decode(&self) -> [u32; 4] {
         [self.channel, self.shift, self.mask, self.unorm_max]
     }
-}
 
-/// How many of a host's SSS materials the passes tell apart by comparisons with constants
-/// ([`IdMap::specialization`]); more are looked up in the profile table.
-pub const LISTED_HOST_IDS: usize = 8;
-
-impl IdMap {
-    /// The defines the passes reading the ID image are built with.
+    /// The defines the passes reading the ID image are built with (the image's sampler type).
     pub fn defines(&self) -> &'static [(&'static str, &'static str)] {
-        match self {
-            IdMap::Lucent => &[],
-            IdMap::Host(h) if h.uint => {
-                &[("LUCENT_SSS_HOST_IDS", "1"), ("LUCENT_SSS_IDS_UINT", "1")]
-            }
-            IdMap::Host(_) => &[("LUCENT_SSS_HOST_IDS", "1")],
+        if self.uint {
+            &[("LUCENT_SSS_IDS_UINT", "1")]
+        } else {
+            &[]
         }
     }
 
-    /// The specialization constants of the passes reading a host's ID image
-    /// (glsl/common/sss.glsl, `constant_id` 0-20), fixed when the effect is made: the decode
-    /// (channel, shift, mask, UNORM maximum), then how many SSS materials are listed, their
-    /// IDs and their profile numbers. Up to [`LISTED_HOST_IDS`] materials are listed: the
-    /// passes compare a pixel's ID with each instead of loading its profile from the table
-    /// (the table's load made the control's combine 1.10-1.16x lucent's own pass). Empty for
-    /// lucent's own IDs.
+    /// The value of the passes' `SSS_IDS_PROFILES_UP_TO` (glsl/common/sss.glsl): `n` when
+    /// the IDs are the profile numbers, IDs 1 to `n` having profiles 1 to `n` and every other
+    /// ID none (a host whose SSS materials have IDs 1 to `n` in order), 256 when the image
+    /// holds nothing but profile numbers ([`Self::only_profiles`]), else `None`. The passes
+    /// then take a pixel's profile from its ID with no lookup.
+    fn profiles_up_to(&self) -> Option<u32> {
+        if self.only_profiles {
+            return Some(256);
+        }
+        let n = self.profile_of.iter().filter(|&&p| p != 0).count();
+        let identity = (0..256usize).all(|id| {
+            let want = if (1..=n).contains(&id) { id } else { 0 };
+            usize::from(self.profile_of.get(id).copied().unwrap_or(0)) == want
+        });
+        (n > 0 && n < MAX_SSS_PROFILES && identity).then_some(n as u32)
+    }
+
+    /// The ID constants of the SSS passes (glsl/common/sss.glsl, `constant_id` 0-20; the
+    /// passes add 21 and 22, [`SssInputs::specialization`]), fixed when the passes are made:
+    /// the decode (channel, shift, mask, UNORM maximum), then how many SSS materials are
+    /// listed, their IDs and their profile numbers. Up to [`LISTED_HOST_IDS`] materials are
+    /// listed unless the IDs are the profile numbers (`profiles_up_to`): the passes
+    /// compare a pixel's ID with each instead of loading its profile from the table (the
+    /// table's load made the control's combine 1.10-1.16x lucent's own pass).
     pub fn specialization(&self) -> Vec<u32> {
-        let IdMap::Host(h) = self else {
-            return Vec::new();
-        };
-        let scattering: Vec<(u32, u32)> = h
+        let scattering: Vec<(u32, u32)> = self
             .profile_of
             .iter()
             .enumerate()
@@ -338,7 +359,7 @@ impl IdMap {
             .filter(|&(_, &p)| p != 0)
             .map(|(id, &p)| (id as u32, u32::from(p)))
             .collect();
-        let listed = if scattering.len() <= LISTED_HOST_IDS {
+        let listed = if self.profiles_up_to().is_none() && scattering.len() <= LISTED_HOST_IDS {
             scattering.as_slice()
         } else {
             &[]
@@ -346,7 +367,7 @@ impl IdMap {
         // An unlisted slot holds ID 256, which no decoded ID (at most 255) equals.
         let ids = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(256, |&(id, _)| id));
         let profiles = (0..LISTED_HOST_IDS).map(|k| listed.get(k).map_or(0, |&(_, p)| p));
-        h.decode()
+        self.decode()
             .into_iter()
             .chain([listed.len() as u32])
             .chain(ids)
@@ -357,24 +378,10 @@ impl IdMap {
     /// The profile table's `id_decode` and `id_profiles` rows.
     pub(crate) fn rows(&self) -> ([u32; 4], [[u32; 4]; 16]) {
         let mut profiles = [[0u32; 4]; 16];
-        let mut put = |id: usize, profile: u8| {
-            profiles[id / 16][(id / 4) % 4] |= u32::from(profile) << (8 * (id % 4));
-        };
-        match self {
-            IdMap::Lucent => {
-                // Unused by lucent's own passes; the identity, for completeness.
-                for id in 0..MAX_SSS_PROFILES {
-                    put(id, id as u8);
-                }
-                ([0, 0, 0xff, 255], profiles)
-            }
-            IdMap::Host(h) => {
-                for (id, &p) in h.profile_of.iter().enumerate().take(256) {
-                    put(id, p);
-                }
-                (h.decode(), profiles)
-            }
+        for (id, &p) in self.profile_of.iter().enumerate().take(256) {
+            profiles[id / 16][(id / 4) % 4] |= u32::from(p) << (8 * (id % 4));
         }
+        (self.decode(), profiles)
     }
 }
 
@@ -447,10 +454,10 @@ impl SssProfiles {
             object_ids.push(index as u8 + 1);
         }
         Ok((!profiles.is_empty()).then_some(Self {
+            id_map: IdMap::lucent(),
             profiles,
             transmission: transmissions,
             object_ids,
-            id_map: IdMap::Lucent,
         }))
     }
 
@@ -592,9 +599,9 @@ pub struct ProfileTableGpu {
     /// diffuse transmission ([`transmission::SssTransmission::rows`]) and reflectance
     /// ([`transmission::SssTransmission::reflectance_rows`]); zero where the profile has none.
     pub medium: [[f32; 4]; MAX_SSS_PROFILES * transmission::MEDIUM_ROWS],
-    /// A host's ID decode ([`IdMap::Host`]): channel, shift, mask, UNORM maximum.
+    /// The ID decode ([`IdMap`]): channel, shift, mask, UNORM maximum.
     pub id_decode: [u32; 4],
-    /// A host's ID-to-profile map, a byte per ID 0 to 255.
+    /// The ID-to-profile map, a byte per ID 0 to 255.
     pub id_profiles: [[u32; 4]; 16],
 }
 
@@ -681,6 +688,10 @@ pub struct SssInputs<'a> {
     /// `shadow_depth` is an array of layers (a host's cascades or cube faces, each face in its
     /// layer: define `LUCENT_SHADOW_ARRAY`); lucent's own maps are one atlas.
     pub shadow_array: bool,
+    /// `shadow_depth` is a host's map, whose faces may store reversed Z (define
+    /// `LUCENT_SHADOW_REVERSIBLE`: the shadow table says per face); lucent's own maps store
+    /// standard Z.
+    pub shadow_reversible: bool,
     /// G-buffer albedo (GB0), when some profile applies its albedo after the blur
     /// ([`Texturing`]): the lighting pass left it out of `diffuse`, and each chain's last pass
     /// multiplies it back in (define `LUCENT_SSS_ALBEDO`). `None`: the light carries its
@@ -700,17 +711,21 @@ pub struct SssInputs<'a> {
 }
 
 impl SssInputs<'_> {
-    /// The SSS passes' specialization constants (`glsl/common/sss.glsl`): a host's ID map
-    /// ([`IdMap::specialization`], `constant_id` 0-20) and whether its depth is linear
-    /// (`constant_id` 21, `glsl/common/host_depth.glsl`). Empty for lucent's own frames, whose
-    /// passes compile the constants' defaults.
+    /// The SSS passes' specialization constants (`glsl/common/sss.glsl`): the ID map's
+    /// ([`IdMap::specialization`], `constant_id` 0-20), whether the depth is a host's linear
+    /// view depth (21, `glsl/common/host_depth.glsl`) and how many IDs are the profile numbers
+    /// (22; 0: none, the IDs are listed or looked up).
     pub fn specialization(&self) -> Vec<u32> {
-        let mut constants = self.ids.specialization();
-        if !constants.is_empty() {
-            constants.push(u32::from(self.linear_depth));
-        }
-        constants
+        pass_specialization(self.ids, self.linear_depth)
     }
+}
+
+/// [`SssInputs::specialization`] of `ids`, with a host's linear depth or not.
+fn pass_specialization(ids: &IdMap, linear_depth: bool) -> Vec<u32> {
+    let mut constants = ids.specialization();
+    constants.push(u32::from(linear_depth));
+    constants.push(ids.profiles_up_to().unwrap_or(0));
+    constants
 }
 
 /// The G-buffer images LCB's and LBB's chains read besides the lit light.
@@ -874,6 +889,21 @@ pub fn host_albedo_pass(
 /// The define of a pass reading a host's shadow map that is an array of layers.
 const SHADOW_ARRAY: &[(&str, &str)] = &[("LUCENT_SHADOW_ARRAY", "1")];
 
+/// The define of passes reading a host's shadow map ([`SssInputs::shadow_reversible`]).
+const SHADOW_REVERSIBLE: &[(&str, &str)] = &[("LUCENT_SHADOW_REVERSIBLE", "1")];
+
+/// The defines of an SSS pass that reads the shadow map of `inputs`.
+fn shadow_defines(inputs: &SssInputs<'_>) -> Vec<(&'static str, &'static str)> {
+    let mut defines = Vec::new();
+    if inputs.shadow_array {
+        defines.extend_from_slice(SHADOW_ARRAY);
+    }
+    if inputs.shadow_reversible {
+        defines.extend_from_slice(SHADOW_REVERSIBLE);
+    }
+    defines
+}
+
 /// The host LEAN pass's shader (lucent::embed).
 const HOST_LEAN_FRAGMENT: &str = "sss/host_lean.frag";
 
@@ -993,42 +1023,44 @@ const HOST_LEAN_PASSTHROUGH: &[(&str, &str)] = &[("LUCENT_SSS_PASSTHROUGH", "1")
 const HOST_GB0_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 const HOST_GB1_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
-/// Adds, for every SSS pass permutation in `out` a host's frame can have, its two host-ID
-/// variants ([`IdMap::defines`]: UNORM and unsigned IDs), for the shipped SPIR-V.
+/// Adds the SSS pass permutations a host's frame has beyond lucent's own, for the shipped
+/// SPIR-V: its shadow map read with reversed Z and as an array, its unsigned IDs
+/// ([`IdMap::defines`]), and the host albedo and LEAN passes.
 pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
-    let host: Vec<crate::backend::shader::PipelineShaders> = out
+    type Shaders = crate::backend::shader::PipelineShaders;
+    let with = |p: &Shaders, defines: &[(&str, &str)]| {
+        let mut p = p.clone();
+        p.defines.extend(
+            defines
+                .iter()
+                .map(|(name, value)| (name.to_string(), value.to_string())),
+        );
+        p
+    };
+    let own: Vec<Shaders> = out
         .iter()
         .filter(|p| p.fragment.starts_with("sss/"))
         .cloned()
         .collect();
-    // A host's shadow map may be an array (its cascades, a cube's faces).
-    let arrays: Vec<crate::backend::shader::PipelineShaders> = host
-        .iter()
-        .filter(|p| p.defines.iter().any(|(name, _)| name == "LUCENT_SHADOWS"))
-        .map(|p| {
-            let mut p = p.clone();
-            p.defines.extend(
-                SHADOW_ARRAY
-                    .iter()
-                    .map(|(name, value)| (name.to_string(), value.to_string())),
-            );
-            p
-        })
-        .collect();
-    let host: Vec<crate::backend::shader::PipelineShaders> =
-        host.into_iter().chain(arrays).collect();
+    // A host's shadow map may store reversed Z, and may be an array (its cascades, a cube's
+    // faces); its passes without shadows are lucent's own.
+    let mut host: Vec<Shaders> = Vec::new();
+    for p in &own {
+        if p.defines.iter().any(|(name, _)| name == "LUCENT_SHADOWS") {
+            let reversible = with(p, SHADOW_REVERSIBLE);
+            host.push(with(&reversible, SHADOW_ARRAY));
+            host.push(reversible);
+        }
+    }
+    out.extend(host.iter().cloned());
     for uint in [false, true] {
-        let map = IdMap::Host(HostIdMap {
+        let map = IdMap {
             uint,
-            channel: 0,
-            shift: 0,
-            mask: 0xff,
-            unorm_max: 255,
-            profile_of: Vec::new(),
-        });
+            ..IdMap::lucent()
+        };
         let ids = map.defines();
         for included in [false, true] {
-            out.push(crate::backend::shader::PipelineShaders::new(
+            out.push(Shaders::new(
                 "fullscreen.vert",
                 HOST_ALBEDO_FRAGMENT,
                 &host_albedo_defines(ids, included),
@@ -1036,27 +1068,22 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
         }
         for albedo in HostAlbedo::ALL {
             let defines = host_lean_defines(ids, albedo);
-            out.push(crate::backend::shader::PipelineShaders::new(
-                "fullscreen.vert",
-                HOST_LEAN_FRAGMENT,
-                &defines,
-            ));
+            out.push(Shaders::new("fullscreen.vert", HOST_LEAN_FRAGMENT, &defines));
             let with_passthrough: Vec<_> = defines
                 .iter()
                 .chain(HOST_LEAN_PASSTHROUGH)
                 .copied()
                 .collect();
-            out.push(crate::backend::shader::PipelineShaders::new(
+            out.push(Shaders::new(
                 "fullscreen.vert",
                 HOST_LEAN_FRAGMENT,
                 &with_passthrough,
             ));
         }
-        for p in &host {
-            let mut p = p.clone();
-            p.defines
-                .extend(ids.iter().map(|(n, v)| (n.to_string(), v.to_string())));
-            out.push(p);
+        if uint {
+            for p in own.iter().chain(&host) {
+                out.push(with(p, ids));
+            }
         }
     }
 }
@@ -1106,14 +1133,15 @@ mod tests {
     fn host_ids_map_to_their_profiles_and_every_other_id_to_none() {
         for materials in [vec![17u8], vec![17, 42, 5, 255, 1], (1..32).rev().collect()] {
             let profile_of = profile_of(&materials);
-            let map = IdMap::Host(HostIdMap {
+            let map = IdMap {
                 uint: true,
                 channel: 0,
                 shift: 0,
                 mask: 0xff,
                 unorm_max: 0,
                 profile_of: profile_of.clone(),
-            });
+                only_profiles: false,
+            };
             let (_, rows) = map.rows();
             for id in 0..256u32 {
                 assert_eq!(
@@ -1128,9 +1156,18 @@ mod tests {
         }
     }
 
-    /// glsl/common/sss.glsl `sss_host_profile` with the specialization constants, step for
-    /// step: the listed IDs compared in order, or the table when none are listed.
+    /// glsl/common/sss.glsl `sss_host_profile` with the specialization constants
+    /// ([`SssInputs::specialization`]), step for step: IDs that are the profile numbers, the
+    /// listed IDs compared in order, or the table when none are listed.
     fn specialized_profile(constants: &[u32], rows: &[[u32; 4]; 16], host_id: u32) -> usize {
+        let up_to = constants[22];
+        if up_to >= 256 {
+            return (host_id as usize).min(MAX_SSS_PROFILES - 1);
+        }
+        if up_to > 0 {
+            let up_to = up_to.min(MAX_SSS_PROFILES as u32 - 1);
+            return if host_id <= up_to { host_id as usize } else { 0 };
+        }
         let listed = constants[4];
         if listed == 0 {
             return host_profile(rows, host_id);
@@ -1144,24 +1181,60 @@ mod tests {
         p
     }
 
+    /// The constants of [`SssInputs::specialization`] for `map`.
+    fn constants_of(map: &IdMap) -> Vec<u32> {
+        pass_specialization(map, false)
+    }
+
+    #[test]
+    fn ids_that_are_the_profile_numbers_need_no_lookup() {
+        // lucent's own G-buffer: every stored value is a profile number.
+        let own = IdMap::lucent();
+        assert_eq!(constants_of(&own)[22], 256);
+        assert_eq!(constants_of(&own)[4], 0, "nothing listed");
+        // Hosts with more materials than are listed, numbered 1 to n in order.
+        for n in [1u8, 12, 31] {
+            let mut map = IdMap::lucent();
+            map.uint = true;
+            map.only_profiles = false;
+            map.profile_of = profile_of(&(1..=n).collect::<Vec<u8>>());
+            let constants = constants_of(&map);
+            assert_eq!(constants[22], u32::from(n));
+            assert_eq!(constants[4], 0, "nothing listed");
+            let (_, rows) = map.rows();
+            for id in 0..=300u32 {
+                let want = map.profile_of.get(id as usize).map_or(0, |&p| usize::from(p));
+                assert_eq!(specialized_profile(&constants, &rows, id), want, "ID {id}");
+                assert_eq!(host_profile(&rows, id), want, "the table's ID {id}");
+            }
+        }
+        // One ID out of order: the IDs are listed instead.
+        let mut map = IdMap::lucent();
+        map.only_profiles = false;
+        map.profile_of = profile_of(&[1, 3, 2]);
+        assert_eq!(constants_of(&map)[22], 0);
+        assert_eq!(constants_of(&map)[4], 3);
+    }
+
     #[test]
     fn listed_host_ids_find_the_profiles_the_table_holds() {
-        assert!(IdMap::Lucent.specialization().is_empty());
         let eight: Vec<u8> = vec![200, 3, 1, 77, 255, 0x40, 9, 128];
-        let nine: Vec<u8> = (1..10).collect();
-        for (materials, listed) in [(vec![1u8], 1), (vec![17, 42, 5], 3), (eight, 8), (nine, 0)] {
+        let nine: Vec<u8> = vec![1, 2, 3, 4, 5, 6, 7, 8, 10];
+        for (materials, listed) in [(vec![17u8], 1), (vec![17, 42, 5], 3), (eight, 8), (nine, 0)] {
             let profile_of = profile_of(&materials);
-            let map = IdMap::Host(HostIdMap {
+            let map = IdMap {
                 uint: false,
                 channel: 3,
                 shift: 4,
                 mask: 0xf,
                 unorm_max: 255,
                 profile_of: profile_of.clone(),
-            });
-            let constants = map.specialization();
-            assert_eq!(constants.len(), 5 + 2 * LISTED_HOST_IDS);
+                only_profiles: false,
+            };
+            let constants = constants_of(&map);
+            assert_eq!(constants.len(), 23);
             assert_eq!(constants[..5], [3, 4, 0xf, 255, listed]);
+            assert_eq!(constants[22], 0, "{materials:?}: not the profile numbers");
             let (_, rows) = map.rows();
             for id in 0..=256u32 {
                 let want = profile_of.get(id as usize).map_or(0, |&p| usize::from(p));

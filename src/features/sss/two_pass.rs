@@ -151,9 +151,7 @@ pub(super) fn chain_passes(
     // The bilateral chain's LEAN specular is direct light: the light-space maps shadow it.
     if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some() && !half_res) {
         pass.shadows(depth);
-        if inputs.shadow_array {
-            pass.defines(super::SHADOW_ARRAY);
-        }
+        pass.defines(&super::shadow_defines(inputs));
     }
     pass.taps(fetches(texels, blur.bilateral()));
     pass.color(&mut vertical_out, LoadOp::DontCare);

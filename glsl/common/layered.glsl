@@ -4,13 +4,14 @@
 // src/reference/dipole.rs): change both together.
 //
 // Set 0: the frame uniforms, the layered table, depth, GB1 (normal), the layered IDs; then the
-// pass's own bindings (each bound by its name). With LUCENT_HOST_GBUFFER (src/embed/layered.rs
-// `LayeredEffect`) the depth, GB1 and IDs are a host's depth, normals and material IDs, decoded as
-// the host describes them (the table's host fields: the ID bit field, the normal encoding
-// and each host ID's layered material); LUCENT_HOST_IDS_UINT when the IDs are an
-// unsigned-integer image, LUCENT_HOST_LINEAR_DEPTH when the depth is linear view depth (a
-// define, not a constant: a CPU driver runs both sides of a branch, and the gather rebuilds a
-// position per sample). Every pass reads the G-buffer through layered_id_at,
+// pass's own bindings (each bound by its name). lucent's own G-buffer and a host's
+// (src/embed/layered.rs `LayeredEffect`: its depth, normals and material IDs) are read by the
+// same code: the ID decode, how IDs map to materials and the normal encoding are
+// specialization constants (below; their defaults are lucent's own G-buffer), the ID-to-material
+// table and the inverse view matrix are in the layered table; LUCENT_HOST_IDS_UINT when the
+// IDs are an unsigned-integer image, LUCENT_HOST_LINEAR_DEPTH when the depth is linear view
+// depth (a define, not a constant: a CPU driver runs both sides of a branch, and the gather
+// rebuilds a position per sample). Every pass reads the G-buffer through layered_id_at,
 // layered_position_at, layered_normal_at and layered_view_depth_at.
 #ifndef LUCENT_LAYERED_GLSL
 #define LUCENT_LAYERED_GLSL
@@ -22,11 +23,9 @@
 #ifdef LUCENT_SHADOWS
 #include "shadows.glsl"
 #endif
-#ifdef LUCENT_HOST_GBUFFER
 #include "host_ids.glsl"
 #include "host_normals.glsl"
 #include "host_depth.glsl"
-#endif
 
 #define MAX_LAYERED_MATERIALS 16
 #define MAX_MEDIUM_LAYERS 8
@@ -51,17 +50,34 @@ struct LayeredMaterial {
 layout(std140, set = 0) uniform Layered {
     ivec4 knobs;  // x march steps, y pixel lights, z phase (0 HG, 1 Schlick), w downscale
     LayeredMaterial materials[MAX_LAYERED_MATERIALS];
-#ifdef LUCENT_HOST_GBUFFER
-    uvec4 host_ids;        // host_ids.glsl's decode of the host's material IDs
-    uvec4 host_normals;    // host_normals.glsl's encoding
     mat4 view_to_world;    // the inverse of the frame's view matrix
-    uvec4 host_materials[64];  // host ID k's layered material at [k / 4][k % 4] (0: none)
-#endif
+    uvec4 id_materials[64];  // ID k's layered material at [k / 4][k % 4] (0: none)
 } layered;
+
+// How the G-buffer is read (src/features/layered/mod.rs `LayeredDecode`), fixed when the pass
+// is made: the driver folds them. (The layered passes include no other constants but
+// host_depth.glsl's, constant_id 21.)
+// - The ID decode (host_ids.glsl): channel, bit field shift and mask, a UNORM channel's largest
+//   value.
+// - LAYERED_IDS_UP_TO: n (1 to 16) when IDs 1 to n are layered materials 1 to n and every other
+//   ID none; LAYERED_IDS_ONLY_MATERIALS when the image holds nothing but material numbers
+//   (lucent's own G-buffer); 0: each ID's material is in id_materials.
+// - The normal encoding (host_normals.glsl): octahedral, view space, UNORM channels.
+#define LAYERED_IDS_ONLY_MATERIALS 256
+layout(constant_id = 0) const uint LAYERED_ID_CHANNEL = 0u;
+layout(constant_id = 1) const uint LAYERED_ID_SHIFT = 0u;
+layout(constant_id = 2) const uint LAYERED_ID_MASK = 255u;
+layout(constant_id = 3) const uint LAYERED_ID_UNORM_MAX = 255u;
+layout(constant_id = 4) const uint LAYERED_IDS_UP_TO = LAYERED_IDS_ONLY_MATERIALS;
+layout(constant_id = 5) const uint LAYERED_NORMALS_OCTAHEDRAL = 0u;
+layout(constant_id = 6) const uint LAYERED_NORMALS_VIEW = 0u;
+layout(constant_id = 7) const uint LAYERED_NORMALS_UNORM = 0u;
+#define LAYERED_ID_DECODE \
+    uvec4(LAYERED_ID_CHANNEL, LAYERED_ID_SHIFT, LAYERED_ID_MASK, LAYERED_ID_UNORM_MAX)
 
 layout(set = 0) uniform sampler2D gbuffer_depth;
 layout(set = 0) uniform sampler2D gbuffer_normal;
-#if defined(LUCENT_HOST_GBUFFER) && defined(LUCENT_HOST_IDS_UINT)
+#ifdef LUCENT_HOST_IDS_UINT
 layout(set = 0) uniform usampler2D gbuffer_layered;
 #else
 layout(set = 0) uniform sampler2D gbuffer_layered;
@@ -69,13 +85,23 @@ layout(set = 0) uniform sampler2D gbuffer_layered;
 
 // The layered material ID at a full-resolution pixel (0: not layered).
 int layered_id_at(ivec2 px) {
-#ifdef LUCENT_HOST_GBUFFER
-    // The host's ID (at most 255 after its bit field: the table has 256 entries).
-    uint host = min(host_material_id(texelFetch(gbuffer_layered, px, 0), layered.host_ids), 255u);
-    return int(layered.host_materials[host >> 2u][host & 3u]);
-#else
-    return int(texelFetch(gbuffer_layered, px, 0).r * 255.0 + 0.5);
+#ifndef LUCENT_HOST_IDS_UINT
+    if (LAYERED_IDS_UP_TO >= uint(LAYERED_IDS_ONLY_MATERIALS) && LAYERED_ID_UNORM_MAX == 255u &&
+        LAYERED_ID_SHIFT == 0u && LAYERED_ID_MASK == 255u) {
+        // Nothing but material numbers in a whole 8-bit UNORM channel (lucent's own G-buffer):
+        // the number itself (layered_row clamps it).
+        return int(texelFetch(gbuffer_layered, px, 0)[min(LAYERED_ID_CHANNEL, 3u)] * 255.0 + 0.5);
+    }
 #endif
+    // The ID (at most 255 after its bit field: the table has 256 entries).
+    uint id = min(host_material_id(texelFetch(gbuffer_layered, px, 0), LAYERED_ID_DECODE), 255u);
+    if (LAYERED_IDS_UP_TO >= uint(LAYERED_IDS_ONLY_MATERIALS)) {
+        return int(id);
+    }
+    if (LAYERED_IDS_UP_TO > 0u) {
+        return id <= LAYERED_IDS_UP_TO ? int(id) : 0;
+    }
+    return int(layered.id_materials[id >> 2u][id & 3u]);
 }
 
 // The view depth (along the view axis) of the surface at a full-resolution pixel.
@@ -95,12 +121,8 @@ vec3 layered_position_at(ivec2 px) {
 
 // The unit world normal at a full-resolution pixel (a NaN, Inf or zero normal: +Y).
 vec3 layered_normal_at(ivec2 px) {
-#ifdef LUCENT_HOST_GBUFFER
-    return host_normal(texelFetch(gbuffer_normal, px, 0), layered.host_normals,
-                       layered.view_to_world);
-#else
-    return sanitize_normal(texelFetch(gbuffer_normal, px, 0).xyz);
-#endif
+    uvec4 encoding = uvec4(LAYERED_NORMALS_OCTAHEDRAL, LAYERED_NORMALS_VIEW, LAYERED_NORMALS_UNORM, 0u);
+    return host_normal(texelFetch(gbuffer_normal, px, 0), encoding, layered.view_to_world);
 }
 
 // The table row of material `id` (read fields through it: copying a row into a local

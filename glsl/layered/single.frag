@@ -23,7 +23,7 @@
 layout(set = 0) uniform usampler2D gbuffer_layer_depths;
 #endif
 
-#if defined(LUCENT_LAYERED_FILM) && defined(LUCENT_HOST_GBUFFER)
+#if defined(LUCENT_LAYERED_FILM) && defined(LUCENT_HOST_FILM)
 // A host's film: its albedo image (src/embed/layered.rs `LayeredEffectDesc::with_film`).
 layout(set = 0) uniform sampler2D host_film;
 #endif
@@ -411,7 +411,7 @@ void main() {
     // blurs' `post` texturing): every term here leaves through x_o, while the light entering
     // (the irradiance gathered, the entry points) is left alone. The G-buffer stores the
     // texel beside the material ID (white for untextured draws).
-#ifdef LUCENT_HOST_GBUFFER
+#ifdef LUCENT_HOST_FILM
     // The host's albedo texel; a NaN or out-of-range one is guarded here.
     vec3 film = texelFetch(host_film, px, 0).rgb;
     terms *= clamp(mix(film, vec3(0.0), isnan(film)), 0.0, 1.0);

@@ -16,9 +16,10 @@
 //!    maps already passes the same faces).
 //! 2. The passes of lucent's own frame (src/features/layered): the transmitted irradiance,
 //!    the dipole's gather over it, its blur, and single scattering, which adds
-//!    `λ3 L_t + λ4 L_ss + λ5 L_ms` into the host's lit diffuse. The same GLSL, reading the
-//!    host's G-buffer as it is encoded (`LUCENT_HOST_GBUFFER`: the ID bit field, the normal
-//!    encoding and the depth encoding are per-frame constants in the layered table).
+//!    `λ3 L_t + λ4 L_ss + λ5 L_ms` into the host's lit diffuse. The same shaders, reading the
+//!    host's G-buffer as it is encoded: the ID bit field, each ID's material and the normal
+//!    encoding are specialization constants (`LayeredDecode`, whose defaults are lucent's own
+//!    G-buffer), unsigned IDs and linear depth defines (`LayeredHost`).
 //!
 //! Eq. 3's `λ1 L_d + λ2 L_s` is the host's own lighting: a host weights its diffuse and
 //! specular light of a layered material by the medium's `weights[0]` and `weights[1]`, as
@@ -50,8 +51,8 @@ use crate::backend::format::format_name;
 use crate::backend::pipeline::HostVertexInput;
 use crate::error::HostError;
 use crate::features::layered::{
-    blurs_on_screen, layered_passes, LayeredDesc, LayeredHost, LayeredInputs, LayeredKnobs,
-    LayeredTableGpu, MAX_LAYERED_MATERIALS, TABLE_REGION,
+    blurs_on_screen, layered_passes, LayeredDecode, LayeredDesc, LayeredHost, LayeredInputs,
+    LayeredKnobs, LayeredTableGpu, MAX_LAYERED_MATERIALS, TABLE_REGION,
 };
 use crate::features::shadows::{
     self, host_shadow_pass, HostShadowDraw, HostShadowFrame, ShadowUniforms, MAX_ATLAS_EXTENT,
@@ -413,19 +414,6 @@ pub struct LayeredFrame<'a> {
     pub lighting: &'a HostImage,
 }
 
-/// The layered table with the host's decode (glsl/common/layered.glsl `Layered` under
-/// `LUCENT_HOST_GBUFFER`, std140).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct HostLayeredTableGpu {
-    table: LayeredTableGpu,
-    host_ids: [u32; 4],
-    host_normals: [u32; 4],
-    view_to_world: [[f32; 4]; 4],
-    /// Host ID k's layered material at `[k / 4][k % 4]`.
-    host_materials: [[u32; 4]; 64],
-}
-
 /// The graph's imports, by input.
 #[derive(Clone, Copy, Debug)]
 struct Imports {
@@ -442,7 +430,7 @@ pub struct LayeredEffect {
     imports: Imports,
     desc: LayeredEffectDesc,
     /// The table every frame shares; each frame adds its view.
-    table: HostLayeredTableGpu,
+    table: LayeredTableGpu,
     /// The media, layered material `k` at `k - 1` (lengths in the G-buffer's units).
     media: Vec<LayeredMedium>,
     /// What the light-space maps pass draws: filled just before each frame records.
@@ -495,14 +483,14 @@ impl LayeredEffect {
         }
         let id_map = ids.decode(Vec::new())?;
         let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
-        let mut host_materials = [[0u32; 4]; 64];
+        let mut id_materials = [[0u32; 4]; 64];
         let mut media = Vec::with_capacity(desc.materials.len());
         for (index, material) in desc.materials.iter().enumerate() {
             let id = usize::from(material.id);
             check_material_id(
                 index,
                 material.id,
-                host_materials[id / 4][id % 4] != 0,
+                id_materials[id / 4][id % 4] != 0,
                 id_map.mask,
             )?;
             let field = format!("materials[{index}] (ID {id})");
@@ -523,7 +511,7 @@ impl LayeredEffect {
                 field: field.clone(),
                 problem: e.to_string(),
             })?;
-            host_materials[id / 4][id % 4] = index as u32 + 1;
+            id_materials[id / 4][id % 4] = index as u32 + 1;
             media.push(medium);
         }
         let uint_ids = id_map.uint;
@@ -533,13 +521,12 @@ impl LayeredEffect {
             object_ids: Vec::new(),
             film: false,
         };
-        let table = HostLayeredTableGpu {
-            table: layered.table(&desc.knobs),
-            host_ids,
-            host_normals: normals.decode()?,
-            view_to_world: Mat4::IDENTITY.to_cols_array_2d(),
-            host_materials,
+        let table = LayeredTableGpu {
+            id_materials,
+            ..layered.table(&desc.knobs)
         };
+        let [octahedral, view_space, unorm, _] = normals.decode()?;
+        let decode = LayeredDecode::new(host_ids, &id_materials, [octahedral, view_space, unorm]);
         let upload = SceneUpload {
             translucency_ids: None,
             profile_ids: None,
@@ -550,7 +537,7 @@ impl LayeredEffect {
             tables: vec![
                 TableRegion {
                     region: &TABLE_REGION,
-                    bytes: std::mem::size_of::<HostLayeredTableGpu>() as u64,
+                    bytes: std::mem::size_of::<LayeredTableGpu>() as u64,
                 },
                 shadows::table_region(),
             ],
@@ -564,7 +551,16 @@ impl LayeredEffect {
             "LayeredEffect",
             upload,
             desc.views_per_frame,
-            |scene_gpu| declare(&desc, uint_ids, input, shadow_frame.clone(), scene_gpu),
+            |scene_gpu| {
+                declare(
+                    &desc,
+                    uint_ids,
+                    decode,
+                    input,
+                    shadow_frame.clone(),
+                    scene_gpu,
+                )
+            },
         )?;
         Ok(Self {
             passes,
@@ -603,7 +599,7 @@ impl LayeredEffect {
             .view_uniforms(&frame.camera)?
             .with_lights(frame.lights)
             .with_environment(coefficients);
-        let table = HostLayeredTableGpu {
+        let table = LayeredTableGpu {
             view_to_world: frame.camera.view.inverse().to_cols_array_2d(),
             ..self.table
         };
@@ -750,7 +746,7 @@ impl LayeredEffect {
                     first: mesh.first,
                     vertex_offset: mesh.vertex_offset,
                     model: mesh.transform,
-                    layered_id: self.table.host_materials[id / 4][id % 4] as u8,
+                    layered_id: self.table.id_materials[id / 4][id % 4] as u8,
                 })
             })
             .collect()
@@ -832,6 +828,7 @@ fn face_tiles(table: &ShadowUniforms, faces: usize) -> Vec<((u32, u32), u32)> {
 fn declare(
     desc: &LayeredEffectDesc,
     uint_ids: bool,
+    decode: LayeredDecode,
     input: HostVertexInput,
     shadow_frame: Arc<Mutex<HostShadowFrame>>,
     scene_gpu: &Arc<SceneGpu>,
@@ -880,6 +877,7 @@ fn declare(
             uint_ids,
             linear_depth: gbuffer.depth.encoding == DepthEncoding::LinearView,
         }),
+        decode: Some(decode),
         host_film: albedo.as_ref(),
     };
     let lighting = layered_passes(&mut graph, lighting, &inputs, &desc.knobs, Some(scene_gpu));

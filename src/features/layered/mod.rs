@@ -159,6 +159,11 @@ impl LayeredDesc {
         for (row, m) in t.materials.iter_mut().zip(&self.materials) {
             *row = material_row(m, knobs);
         }
+        t.view_to_world = glam::Mat4::IDENTITY.to_cols_array_2d();
+        // lucent's own IDs are the material numbers.
+        for id in 0..=MAX_LAYERED_MATERIALS {
+            t.id_materials[id / 4][id % 4] = id as u32;
+        }
         t
     }
 }
@@ -282,6 +287,11 @@ pub struct LayeredTableGpu {
     pub knobs: [i32; 4],
     /// The materials (ID - 1).
     pub materials: [LayeredMaterialGpu; MAX_LAYERED_MATERIALS],
+    /// The inverse of the frame's view matrix (a host's view-space normals and linear depth).
+    pub view_to_world: [[f32; 4]; 4],
+    /// ID k's layered material at `[k / 4][k % 4]` (0: none), read by passes whose IDs are
+    /// not the material numbers ([`LayeredDecode::ids_up_to`] 0).
+    pub id_materials: [[u32; 4]; 64],
 }
 
 /// Bytes of the per-frame layered region.
@@ -314,12 +324,52 @@ pub struct LayeredInputs<'a> {
     pub shadows: Option<&'a ShadowMaps>,
     /// The ID target holds each pixel's albedo texel too ([`LayeredDesc::film`]).
     pub film: bool,
-    /// `None`: lucent's own G-buffer. `Some`: a host's (`lucent::embed::LayeredEffect`), its
-    /// depth, normals and material IDs decoded as the table's host fields and these say.
+    /// `None`: lucent's own G-buffer. `Some`: a host's (`lucent::embed::LayeredEffect`): the
+    /// shaders' permutation for its IDs' sampler and its depth.
     pub host: Option<LayeredHost>,
+    /// How the passes read the G-buffer's IDs and normals (`None`: lucent's own, the
+    /// constants' defaults).
+    pub decode: Option<LayeredDecode>,
     /// A host's film (its albedo image), which single scattering multiplies the light leaving
     /// the surface by when `film` is set on a host's G-buffer.
     pub host_film: Option<&'a Handle<Image>>,
+}
+
+/// How the layered passes read a G-buffer's material IDs and normals: their specialization
+/// constants (glsl/common/layered.glsl, `constant_id` 0-7), whose defaults are lucent's own
+/// G-buffer (R8_UNORM material numbers, world-space float normals).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LayeredDecode {
+    /// The ID decode (glsl/common/host_ids.glsl): channel, shift, mask, UNORM maximum.
+    pub ids: [u32; 4],
+    /// `n` (1 to [`MAX_LAYERED_MATERIALS`]) when IDs 1 to `n` are materials 1 to `n` and every
+    /// other ID none; 0: each ID's material is read from the table's `id_materials`.
+    pub ids_up_to: u32,
+    /// The normal encoding (glsl/common/host_normals.glsl): octahedral, view space, UNORM.
+    pub normals: [u32; 3],
+}
+
+impl LayeredDecode {
+    /// The decode of IDs `ids` (channel, shift, mask, UNORM maximum) mapped to materials by
+    /// `id_materials` (as the table holds it), and normals encoded as `normals`.
+    pub fn new(ids: [u32; 4], id_materials: &[[u32; 4]; 64], normals: [u32; 3]) -> Self {
+        let material = |id: usize| id_materials[id / 4][id % 4] as usize;
+        let n = (0..256).filter(|&id| material(id) != 0).count();
+        let numbered = (0..256).all(|id| material(id) == if (1..=n).contains(&id) { id } else { 0 });
+        Self {
+            ids,
+            ids_up_to: if numbered { n as u32 } else { 0 },
+            normals,
+        }
+    }
+
+    /// The constants, value `i` for `constant_id = i`.
+    fn specialization(&self) -> Vec<u32> {
+        let mut constants = self.ids.to_vec();
+        constants.push(self.ids_up_to);
+        constants.extend(self.normals);
+        constants
+    }
 }
 
 /// What a host's G-buffer changes in the layered passes' shaders (their permutation).
@@ -354,7 +404,7 @@ impl LayeredHost {
 
     /// Its defines.
     fn defines(self) -> Vec<(&'static str, &'static str)> {
-        let mut defines = vec![("LUCENT_HOST_GBUFFER", "1")];
+        let mut defines = Vec::new();
         if self.uint_ids {
             defines.push(("LUCENT_HOST_IDS_UINT", "1"));
         }
@@ -528,6 +578,9 @@ fn layered_pass<'g>(
     if let Some(host) = inputs.host {
         pass.defines(&host.defines());
     }
+    if let Some(decode) = &inputs.decode {
+        pass.specialize(&decode.specialization());
+    }
     pass.per_frame(&FRAME)
         .per_frame(&TABLE_REGION)
         .sample("gbuffer_depth", inputs.depth)
@@ -578,6 +631,9 @@ fn layered_pass<'g>(
     }
     if single && inputs.film {
         pass.define("LUCENT_LAYERED_FILM", "1");
+        if host_film.is_some() {
+            pass.define("LUCENT_HOST_FILM", "1");
+        }
     }
     if let Some(depths) = layer_depths {
         pass.define(
@@ -722,6 +778,9 @@ impl LayeredShape {
         }
         if single && self.film {
             defines.push(("LUCENT_LAYERED_FILM", "1"));
+            if self.host.is_some() {
+                defines.push(("LUCENT_HOST_FILM", "1"));
+            }
         }
         let texdep = single && self.layer_depths.is_some();
         if let (true, Some(textures)) = (texdep, self.layer_depths) {
@@ -838,6 +897,40 @@ mod tests {
     use crate::scene::builtin;
 
     #[test]
+    fn ids_numbered_from_one_in_order_are_read_as_the_material_numbers() {
+        let table = |ids: &[(usize, u32)]| {
+            let mut t = [[0u32; 4]; 64];
+            for &(id, material) in ids {
+                t[id / 4][id % 4] = material;
+            }
+            t
+        };
+        let decode = [0, 4, 0xf, 255];
+        let numbered = LayeredDecode::new(decode, &table(&[(1, 1), (2, 2), (3, 3)]), [1, 1, 1]);
+        assert_eq!(numbered.ids_up_to, 3);
+        assert_eq!(numbered.specialization(), [0, 4, 0xf, 255, 3, 1, 1, 1]);
+        // Out of order, a gap, or an ID past 255's table: each ID looked up.
+        for ids in [
+            vec![(1, 2), (2, 1)],
+            vec![(1, 1), (3, 2)],
+            vec![(13, 1), (16, 2), (19, 3)],
+        ] {
+            assert_eq!(LayeredDecode::new(decode, &table(&ids), [0; 3]).ids_up_to, 0, "{ids:?}");
+        }
+        // lucent's own table maps every material number to itself, ID 0 to none.
+        let own = LayeredDesc {
+            materials: Vec::new(),
+            object_ids: Vec::new(),
+            film: false,
+        }
+        .table(&LayeredKnobs::default());
+        for id in 0..=MAX_LAYERED_MATERIALS {
+            assert_eq!(own.id_materials[id / 4][id % 4] as usize, id);
+        }
+        assert_eq!(own.view_to_world, glam::Mat4::IDENTITY.to_cols_array_2d());
+    }
+
+    #[test]
     fn the_layered_scene_gets_one_row_per_medium() {
         let scene = builtin::builtin("layered").unwrap();
         let desc = LayeredDesc::new(&scene).unwrap().unwrap();
@@ -895,6 +988,7 @@ mod tests {
                         shadows: maps.as_ref(),
                         film: bit(7),
                         host,
+                        decode: None,
                         host_film: host.map(|_| &film),
                     };
                     let scale = if bit(0) { 2 } else { 1 };

@@ -106,6 +106,7 @@ impl FramePart for LayeredDesc {
                 shadows: images.shadow_maps,
                 film: gb.layout.layered_film,
                 host: None,
+                decode: None,
                 host_film: None,
             },
             knobs.layered,

@@ -69,9 +69,8 @@ float lean_lobe(vec2 b, vec3 c, float base, vec3 h, float v_dot_h, float n_dot_v
     if (!(n_dot_h > 0.0)) {
         return 0.0;
     }
-    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    vec3 t = normalize(cross(helper, n));
-    vec3 bt = cross(n, t);
+    vec3 t, bt;
+    lucent_any_tangent_frame(n, t, bt);
     // Jacobian of the view-plane slope with respect to the normal-frame slope, at the mean.
     float z = max(n.z, LEAN_MIN_NZ);
     vec2 j0 = (t.xy * z - n.xy * t.z) / (z * z);

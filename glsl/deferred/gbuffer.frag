@@ -137,8 +137,9 @@ void main() {
 #endif
     // Without a map (or a usable tangent) any frame around n serves: the slopes are 0 and the
     // roughness variance is isotropic.
-    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    t = frame_ok ? normalize(t) : normalize(cross(helper, n));
+    vec3 any_t, any_bt;
+    lucent_any_tangent_frame(n, any_t, any_bt);
+    t = frame_ok ? normalize(t) : any_t;
     bt = cross(n, t);
 #ifdef LUCENT_NORMAL_MAP
     bt *= in_tangent.w < 0.0 ? -1.0 : 1.0;

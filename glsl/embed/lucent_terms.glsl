@@ -321,10 +321,19 @@ vec3 lucent_lean_covariance(vec2 b, vec3 m) {
     return vec3(xx, yy, clamp(m.z - b.x * b.y, -limit, limit));
 }
 
+// A right-handed unit tangent frame (`t`, `bt`, `n`) around the unit normal `n`, any one: for
+// a surface without a LEAN or normal map (its slopes are 0 and its roughness isotropic, so the
+// frame's turn about `n` changes nothing), and wherever a frame is only a basis to work in.
+void lucent_any_tangent_frame(vec3 n, out vec3 t, out vec3 bt) {
+    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    t = normalize(cross(helper, n));
+    bt = cross(n, t);
+}
+
 // A pixel's LEAN data projected to the view plane. `view` is the world-to-view rotation
 // (mat3 of the view matrix), `n` the unit world-space geometric normal, `t` and `bt` a
-// world-space tangent frame around it (any frame when there is no LEAN or normal map: the
-// slopes are then 0), `b_t` and `m_t` the tangent-space slope mean and moments (from LEAN
+// world-space tangent frame around it (lucent_any_tangent_frame when there is no LEAN or normal
+// map: the slopes are then 0), `b_t` and `m_t` the tangent-space slope mean and moments (from LEAN
 // maps; 0 without), `base` the roughness variance (lucent_roughness_variance). Returns the
 // mean world normal in `n_world` and writes the view-plane slope mean `b_v` and moments `m_v`.
 // Slopes map from tangent plane to view plane non-linearly (u = R (s, 1), s' = u.xy / u.z):

@@ -44,9 +44,8 @@ void main() {
     n_o = facing_normal(n_o, view_dir);
     float cos_o = dot(-view_dir, n_o);
     float radius = MAT.info.w;
-    vec3 helper = abs(n_o.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    vec3 t = normalize(cross(helper, n_o));
-    vec3 b = cross(n_o, t);
+    vec3 t, b;
+    lucent_any_tangent_frame(n_o, t, b);
     // Radii drawn from p(r) ~ e^(-sigma r) on [0, radius] (sigma: the green channel's
     // sigma_tr, at least 1 / radius, so a clear medium is sampled nearly uniformly in r).
     float sigma = max(MAT.sigma_tr.g, 1.0 / radius);

@@ -71,9 +71,8 @@ void main() {
     float specular = clamp(surface.y, 0.0, 1.0);
     vec3 n = host_normal(texelFetch(normal_tex, px, 0), host.normals, host.view_to_world);
     // Any frame around n: the tangent-space slopes are 0 and the variance isotropic.
-    vec3 helper = abs(n.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-    vec3 t = normalize(cross(helper, n));
-    vec3 bt = cross(n, t);
+    vec3 t, bt;
+    lucent_any_tangent_frame(n, t, bt);
     vec3 n_world;
     vec2 b_v;
     vec3 m_v;

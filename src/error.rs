@@ -7,8 +7,10 @@
 
 use std::path::PathBuf;
 
-/// Everything that can go wrong in lucent.
+/// Everything that can go wrong in lucent. New kinds of error may be added: match it with a
+/// wildcard arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum LucentError {
     /// The Vulkan loader library (libvulkan) could not be loaded at all.
     #[error(
@@ -58,6 +60,16 @@ pub enum LucentError {
         MANIFEST_COMMAND
     )]
     ShaderNotShipped { permutation: String },
+    /// The shipped SPIR-V bundle holds no shader at all: this build was made while
+    /// `glsl/permutations.txt` was being regenerated (`LUCENT_WRITE_MANIFEST` set, which makes
+    /// `build.rs` compile nothing), so every permutation is missing until the next build.
+    #[error(
+        "shader permutation {permutation}: this build of lucent ships no SPIR-V at all; it was \
+         built with LUCENT_WRITE_MANIFEST set (`{}` regenerates glsl/permutations.txt and \
+         compiles no shader): rebuild without it",
+        MANIFEST_COMMAND
+    )]
+    ShadersNotBuilt { permutation: String },
     /// A shader's descriptor bindings disagree with what its pass declares
     /// (`crate::backend::bindings`): a resource the pass binds under no name or number, or
     /// of another kind.

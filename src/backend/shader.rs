@@ -84,6 +84,16 @@ fn shipped_bundle() -> Result<&'static ShippedBundle> {
         })
 }
 
+/// The error for a permutation the shipped bundle lacks: a stale manifest, or (`empty`: the
+/// bundle holds nothing) a build made while the manifest was being regenerated.
+fn not_shipped(empty: bool, permutation: String) -> LucentError {
+    if empty {
+        LucentError::ShadersNotBuilt { permutation }
+    } else {
+        LucentError::ShaderNotShipped { permutation }
+    }
+}
+
 /// Where a [`ShaderCompiler`] gets SPIR-V.
 #[derive(Debug)]
 enum Source {
@@ -209,13 +219,10 @@ impl ShaderCompiler {
             Source::Shipped => {
                 let bundle = shipped_bundle()?;
                 let line = permutation_line(&name, defines.iter().map(|(n, v)| (*n, *v)));
-                let module =
-                    bundle
-                        .index
-                        .get(&line)
-                        .ok_or_else(|| LucentError::ShaderNotShipped {
-                            permutation: line.clone(),
-                        })?;
+                let module = bundle
+                    .index
+                    .get(&line)
+                    .ok_or_else(|| not_shipped(bundle.index.is_empty(), line.clone()))?;
                 Ok(CompiledShader {
                     spirv: bundle.modules[*module as usize].clone(),
                     stage,
@@ -502,6 +509,19 @@ mod tests {
         ] {
             assert!(parse_permutation_line(bad).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn a_bundle_built_while_regenerating_the_manifest_says_to_rebuild() {
+        let empty = not_shipped(true, "a.frag".into()).to_string();
+        assert!(
+            empty.contains("a.frag") && empty.contains("LUCENT_WRITE_MANIFEST"),
+            "{empty}"
+        );
+        assert!(matches!(
+            not_shipped(false, "a.frag".into()),
+            LucentError::ShaderNotShipped { .. }
+        ));
     }
 
     #[test]

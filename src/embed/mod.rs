@@ -252,8 +252,11 @@ pub use glam;
 /// each effect says what it holds in memory (`memory`, [`EffectMemory`]). 11: a host's G-buffer
 /// pass may write the LEAN blurs' targets itself ([`GBufferDesc::with_lean_targets`],
 /// [`LeanTargetsDesc`], the LEAN texel's functions in [`glsl::TERMS`]); [`LeanLighting`]'s
-/// `normals` became `surface` ([`LeanSurface`]: the normals or the [`LeanTargetImages`]).
-pub const API_VERSION: u32 = 11;
+/// `normals` became `surface` ([`LeanSurface`]: the normals or the [`LeanTargetImages`]). 12:
+/// [`crate::LucentError`] is `#[non_exhaustive]` (a host matches it with a wildcard arm), and
+/// a build that ships no SPIR-V says so (`LucentError::ShadersNotBuilt`); the TERMS function
+/// `lucent_any_tangent_frame`.
+pub const API_VERSION: u32 = 12;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

@@ -1,7 +1,8 @@
 //! Pass-level helpers: a pass's pipeline with its descriptor set ([`PassPipeline`]) and its
 //! fullscreen draws over tile rectangles, and the render graph's contexts as the backend's
 //! pipeline targets. The ash-level pipeline and descriptor code is [`crate::backend::pipeline`]
-//! and [`crate::backend::descriptor`]; passes that draw meshes use it from there.
+//! and [`crate::backend::descriptor`]; passes that draw meshes use it from there. Also
+//! [`numbered_from_one`], which the SSS and layered passes' ID maps share.
 
 use ash::vk;
 
@@ -244,4 +245,13 @@ pub fn set_tile_viewport(ctx: &RecordContext<'_>, origin: (u32, u32), edge: u32)
         ctx.gpu.device.cmd_set_viewport(ctx.cmd, 0, &[viewport]);
         ctx.gpu.device.cmd_set_scissor(ctx.cmd, 0, &[scissor]);
     }
+}
+
+/// `n` when IDs 1 to `n` (of 0 to 255) are numbers 1 to `n` of `number_of` and every other ID is
+/// 0, `n` at least 1: a G-buffer whose material IDs are the SSS profile or layered material
+/// numbers themselves, which the passes then read with no lookup.
+pub fn numbered_from_one(number_of: impl Fn(usize) -> usize) -> Option<usize> {
+    let n = (0..256).filter(|&id| number_of(id) != 0).count();
+    let numbered = (0..256).all(|id| number_of(id) == if (1..=n).contains(&id) { id } else { 0 });
+    (n > 0 && numbered).then_some(n)
 }

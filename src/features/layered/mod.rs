@@ -354,11 +354,9 @@ impl LayeredDecode {
     /// `id_materials` (as the table holds it), and normals encoded as `normals`.
     pub fn new(ids: [u32; 4], id_materials: &[[u32; 4]; 64], normals: [u32; 3]) -> Self {
         let material = |id: usize| id_materials[id / 4][id % 4] as usize;
-        let n = (0..256).filter(|&id| material(id) != 0).count();
-        let numbered = (0..256).all(|id| material(id) == if (1..=n).contains(&id) { id } else { 0 });
         Self {
             ids,
-            ids_up_to: if numbered { n as u32 } else { 0 },
+            ids_up_to: crate::features::util::numbered_from_one(material).unwrap_or(0) as u32,
             normals,
         }
     }

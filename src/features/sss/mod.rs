@@ -335,12 +335,11 @@ impl IdMap {
         if self.only_profiles {
             return Some(256);
         }
-        let n = self.profile_of.iter().filter(|&&p| p != 0).count();
-        let identity = (0..256usize).all(|id| {
-            let want = if (1..=n).contains(&id) { id } else { 0 };
-            usize::from(self.profile_of.get(id).copied().unwrap_or(0)) == want
-        });
-        (n > 0 && n < MAX_SSS_PROFILES && identity).then_some(n as u32)
+        crate::features::util::numbered_from_one(|id| {
+            usize::from(self.profile_of.get(id).copied().unwrap_or(0))
+        })
+        .filter(|&n| n < MAX_SSS_PROFILES)
+        .map(|n| n as u32)
     }
 
     /// The ID constants of the SSS passes (glsl/common/sss.glsl, `constant_id` 0-20; the

@@ -63,7 +63,8 @@ pub enum Support {
     /// The description has every input the effect reads.
     Runs,
     /// Inputs the description lacks, each a [`HostError::Missing`] naming the input and why
-    /// the effect needs it (what the effect's constructor would refuse with).
+    /// the effect needs it, or a [`HostError::Unsupported`] for an input it describes in a
+    /// form the effect cannot read (what the effect's constructor would refuse with).
     Lacks(Vec<HostError>),
 }
 
@@ -124,6 +125,18 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
     let lack = |input: &str, needed_by: &str| HostError::Missing {
         input: input.into(),
         needed_by: needed_by.into(),
+    };
+    // An effect that adds light to the host's diffuse gives it the albedo the diffuse has:
+    // with the albedo as each SSS material's texturing asks, that depends on which pixels
+    // scatter with which profile, which only the SSS effect knows.
+    let as_texturing = |term: &str| HostError::Unsupported {
+        input: "diffuse".into(),
+        found: "the albedo as each SSS material's texturing asks (DiffuseAlbedo::AsTexturing)"
+            .into(),
+        accepted: format!(
+            "a diffuse light with the albedo or without it (DiffuseAlbedo::Included, \
+             Excluded), which {term} is added to as it is"
+        ),
     };
     let mut out = Vec::new();
     match effect {
@@ -200,6 +213,9 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                      light without the albedo: DiffuseDesc::without_albedo)",
                 ));
             }
+            if gbuffer.diffuse.albedo == DiffuseAlbedo::AsTexturing {
+                out.push(as_texturing("the environment's light"));
+            }
         }
         Effect::SssTransmission => {
             if gbuffer.material_ids.is_none() {
@@ -223,6 +239,9 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
                      transmitted light needs it too (GBufferDesc::with_albedo, or \
                      DiffuseDesc::without_albedo)",
                 ));
+            }
+            if gbuffer.diffuse.albedo == DiffuseAlbedo::AsTexturing {
+                out.push(as_texturing("the transmitted light"));
             }
         }
         Effect::LayeredMedia => {
@@ -310,6 +329,26 @@ mod tests {
             .with_thickness(ThicknessDesc::channel(vk::Format::R8_UNORM, 0));
         let support = capabilities(&full).unwrap();
         assert!(support.iter().all(|(_, s)| s.runs()));
+        // The albedo as each SSS material's texturing asks: the SSS blurs run; the effects
+        // adding light to the diffuse cannot tell which pixels hold it and say so.
+        let as_texturing = GBufferDesc {
+            diffuse: DiffuseDesc::with_albedo_as_texturing(vk::Format::R16G16B16A16_SFLOAT),
+            ..full.clone()
+        };
+        let support = capabilities(&as_texturing).unwrap();
+        for (effect, support) in &support {
+            let refused = matches!(effect, Effect::Environment | Effect::SssTransmission);
+            match support {
+                Support::Runs => assert!(!refused, "{effect:?}"),
+                Support::Lacks(lacks) => {
+                    assert!(refused, "{effect:?}: {lacks:?}");
+                    assert!(
+                        matches!(&lacks[..], [HostError::Unsupported { input, .. }] if input == "diffuse"),
+                        "{effect:?}: {lacks:?}"
+                    );
+                }
+            }
+        }
         // An invalid description is its own error, not a list.
         assert!(capabilities(&full.with_metres_per_unit(-1.0)).is_err());
     }

@@ -72,6 +72,14 @@ pub enum DiffuseAlbedo {
     /// The light alone (irradiance / pi), the albedo kept apart in the albedo image (as
     /// engines that apply the albedo after their SSS do).
     Excluded,
+    /// Each screen-space SSS material's pixels hold the part of the albedo its profile's
+    /// texturing puts before the blur ([`crate::scene::material::Texturing`]: all of it for
+    /// `pre`, none for `post`, its square root for `pre-post`); every other pixel all of it.
+    /// HDRP's lighting pass writes its diffuse so, and lucent's own does: [`super::SssEffect`]
+    /// then needs no pass to put the albedo right (the albedo image only for the profiles
+    /// that apply it after the blur). The effects that add light of their own to the diffuse
+    /// (the environment, SSS transmission) refuse it: they do not know which pixels scatter.
+    AsTexturing,
 }
 
 /// The host's lit diffuse light.
@@ -105,6 +113,16 @@ impl DiffuseDesc {
         Self {
             format,
             albedo: DiffuseAlbedo::Excluded,
+            depth_in_alpha: false,
+        }
+    }
+
+    /// Diffuse light with the albedo as each SSS material's texturing asks
+    /// ([`DiffuseAlbedo::AsTexturing`]).
+    pub fn with_albedo_as_texturing(format: vk::Format) -> Self {
+        Self {
+            format,
+            albedo: DiffuseAlbedo::AsTexturing,
             depth_in_alpha: false,
         }
     }
@@ -595,13 +613,14 @@ pub struct GBufferDesc {
 /// thickness by it.
 pub const MAX_METRES_PER_UNIT: f32 = 1e9;
 
-/// Checks a world unit's size in metres: finite, above 0, at most [`MAX_METRES_PER_UNIT`].
-pub(crate) fn check_metres_per_unit(metres: f32) -> crate::Result<()> {
+/// Checks a world unit's size in metres: finite, above 0, at most [`MAX_METRES_PER_UNIT`]
+/// (`field`: where the description gives it, for the error).
+pub(crate) fn check_metres_per_unit(metres: f32, field: &str) -> crate::Result<()> {
     if metres.is_finite() && metres > 0.0 && metres <= MAX_METRES_PER_UNIT {
         return Ok(());
     }
     Err(HostError::Description {
-        field: "metres_per_unit".into(),
+        field: field.into(),
         problem: format!(
             "{metres} must be a finite number above 0 and at most {MAX_METRES_PER_UNIT}"
         ),
@@ -697,7 +716,7 @@ impl GBufferDesc {
                 ),
             ));
         }
-        check_metres_per_unit(self.metres_per_unit)?;
+        check_metres_per_unit(self.metres_per_unit, "metres_per_unit")?;
         let depth_ok = match self.depth.encoding {
             DepthEncoding::Device => matches!(
                 self.depth.format,

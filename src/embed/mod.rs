@@ -255,8 +255,11 @@ pub use glam;
 /// `normals` became `surface` ([`LeanSurface`]: the normals or the [`LeanTargetImages`]). 12:
 /// [`crate::LucentError`] is `#[non_exhaustive]` (a host matches it with a wildcard arm), and
 /// a build that ships no SPIR-V says so (`LucentError::ShadersNotBuilt`); the TERMS function
-/// `lucent_any_tangent_frame`.
-pub const API_VERSION: u32 = 12;
+/// `lucent_any_tangent_frame`. 13: a diffuse light with the albedo as each SSS material's
+/// texturing asks ([`DiffuseAlbedo::AsTexturing`], [`DiffuseDesc::with_albedo_as_texturing`]),
+/// a world scale per SSS material ([`SssMaterial::with_metres_per_unit`]);
+/// [`Support::Lacks`] may hold [`HostError::Unsupported`].
+pub const API_VERSION: u32 = 13;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;

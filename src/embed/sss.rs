@@ -35,7 +35,8 @@ use ash::vk;
 
 use super::capabilities::{require, Effect};
 use super::gbuffer::{
-    sampled_float, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding,
+    check_metres_per_unit, sampled_float, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
+    IdEncoding,
 };
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
@@ -65,11 +66,16 @@ pub const MAX_VIEWS_PER_FRAME: usize = 4;
 pub struct SssMaterial {
     /// The host's ID (1 to 255; 0 is taken to mean "does not scatter" and cannot have one).
     pub id: u8,
-    /// Its profile: the Gaussians in millimetres (its `units_per_mm` is set from the
-    /// G-buffer's [`GBufferDesc::metres_per_unit`]), the blur ([`SssProfile::blur`]: the
-    /// control, separable, Burley, or a LEAN blur: LCB, LBB, bilateral) and where the albedo
-    /// goes ([`SssProfile::texturing`]).
+    /// Its profile: the Gaussians in millimetres (its `units_per_mm` is set from
+    /// [`Self::metres_per_unit`], or the G-buffer's [`GBufferDesc::metres_per_unit`]), the
+    /// blur ([`SssProfile::blur`]: the control, separable, Burley, or a LEAN blur: LCB, LBB,
+    /// bilateral) and where the albedo goes ([`SssProfile::texturing`]).
     pub profile: SssProfile,
+    /// The world scale of this material's objects, metres per world unit, when it is not the
+    /// G-buffer's ([`Self::with_metres_per_unit`]; as HDRP's diffusion profiles each have a
+    /// world scale): a profile in millimetres spans as many world units on an object
+    /// modelled at another scale.
+    pub metres_per_unit: Option<f32>,
     /// The specular surface the LEAN blurs relight (required with them, refused with the
     /// others, whose specular is the host's own).
     pub surface: Option<SpecularSurface>,
@@ -82,7 +88,15 @@ impl SssMaterial {
             id,
             profile,
             surface: None,
+            metres_per_unit: None,
         }
+    }
+
+    /// With its own world scale ([`Self::metres_per_unit`]: positive, finite, at most
+    /// [`super::MAX_METRES_PER_UNIT`]).
+    pub fn with_metres_per_unit(mut self, metres: f32) -> Self {
+        self.metres_per_unit = Some(metres);
+        self
     }
 
     /// With the specular surface a LEAN blur (LCB, LBB, bilateral) relights.
@@ -392,6 +406,8 @@ fn needs_albedo_pass(albedo: DiffuseAlbedo, profiles: &[SssProfile]) -> bool {
         // Pixels that do not scatter need the albedo in their light too.
         DiffuseAlbedo::Excluded => true,
         DiffuseAlbedo::Included => profiles.iter().any(|p| p.texturing != Texturing::Pre),
+        // The host's light holds what each profile wants before the blur already.
+        DiffuseAlbedo::AsTexturing => false,
     }
 }
 
@@ -440,7 +456,13 @@ impl SssEffect {
                 .into());
             }
             let mut profile = material.profile.clone();
-            profile.units_per_mm = units_per_mm;
+            profile.units_per_mm = match material.metres_per_unit {
+                None => units_per_mm,
+                Some(metres) => {
+                    check_metres_per_unit(metres, &format!("{field}.metres_per_unit"))?;
+                    1.0 / (1000.0 * metres)
+                }
+            };
             profile.validate()?;
             let blur = registry::blur_of(&profile)?;
             if blur.lean() {
@@ -501,7 +523,7 @@ impl SssEffect {
                          (GBufferDesc::with_albedo)"
                             .into()
                     }
-                    DiffuseAlbedo::Included => format!(
+                    DiffuseAlbedo::Included | DiffuseAlbedo::AsTexturing => format!(
                         "a profile applies its albedo after the scatter (texturing '{}'): \
                          describe the albedo image, or use texturing 'pre'",
                         profiles
@@ -1124,6 +1146,9 @@ fn declare(
             (false, _) => None,
             (true, DiffuseAlbedo::Included) => Some(HostAlbedo::Included),
             (true, DiffuseAlbedo::Excluded) => Some(HostAlbedo::Excluded),
+            (true, DiffuseAlbedo::AsTexturing) => {
+                unreachable!("needs_albedo_pass: the host's light is as the profiles want it")
+            }
         };
         let host_albedo = mode.map(|mode| (albedo.as_ref().expect("checked at new"), mode));
         built_targets = sss::host_lean_pass(

@@ -90,7 +90,7 @@ impl TransmissionMaterial {
     /// The medium's transmission with its lengths in the host's world at `metres_per_unit`
     /// (checked as [`Self::rows`] says).
     fn transmission(&self, metres_per_unit: f32) -> Result<SssTransmission> {
-        check_metres_per_unit(metres_per_unit)?;
+        check_metres_per_unit(metres_per_unit, "metres_per_unit")?;
         Ok(SssTransmission {
             mm_per_unit: 1000.0 * f64::from(metres_per_unit),
             ..SssTransmission::of(&self.medium)

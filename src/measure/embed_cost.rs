@@ -12,7 +12,11 @@
 //!   pass of the `SssEffect` (its regions the scattering objects' screen bounds widened by the blurs'
 //!   reach; its diffuse with linear depth in the alpha where lucent's own frame has it)
 //!   against lucent's pass of the same name (the host's diffuse and
-//!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM). For the
+//!   specular in RGBA16F, lucent's own HDR format; its depth D32; its IDs R8_UNORM). The
+//!   host's diffuse is lucent's as its lighting pass writes it for the scene's own texturing
+//!   (`DiffuseAlbedo::AsTexturing`), with GB0 as the albedo image where a profile applies
+//!   the albedo after the scatter; each material at its own profile's scale
+//!   (`SssMaterial::with_metres_per_unit`). For the
 //!   LEAN blurs (`lcb|lbb|bilateral`) the host writes the LEAN targets as lucent's G-buffer
 //!   pass does (`GBufferDesc::with_lean_targets`: lucent's own targets, uploaded once).
 //! - **SSS transmission** (with an SSS blur, on a scene with a `[material.medium]` and a
@@ -398,7 +402,7 @@ fn measure_sss(
 ) -> Result<Vec<EmbedCostRow>> {
     let module = technique.module().expect("checked by the caller");
     let blur = registry::sss_blur(module.name())?;
-    let mut settings = FrameSettings {
+    let settings = FrameSettings {
         technique,
         export_gbuffer: true,
         export_lit: true,
@@ -406,8 +410,6 @@ fn measure_sss(
         export_shadows: blur.lean(),
         ..FrameSettings::new(width, height)
     };
-    // A host's lit diffuse carries its albedo: blurred with the light.
-    settings.sss.texturing = Some(Texturing::Pre);
     let renderer = Renderer::new(gpu, shaders, pipeline_cache, scene, settings)?;
     let mut images = Images::default();
     let measured = (|| {
@@ -426,14 +428,9 @@ fn measure_sss(
             .iter()
             .map(|&v| v as u8)
             .collect();
-        let frame_profiles = SssProfiles::new(
-            scene,
-            Some(blur),
-            None,
-            Some(Texturing::Pre),
-            &registry::blur_of,
-        )?
-        .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?;
+        let frame_profiles =
+            SssProfiles::new(scene, Some(blur), None, None, &registry::blur_of)?
+                .ok_or_else(|| LucentError::InvalidInput("the scene has no SSS profile".into()))?;
         // lucent's lighting pass writes linear depth in the diffuse's alpha for the blurs
         // that read it there; the host's light then holds it too (the export keeps it).
         let depth_in_alpha = frame_profiles.depth_in_alpha();
@@ -445,14 +442,10 @@ fn measure_sss(
                 p
             })
             .collect();
-        let units_per_mm = profiles[0].units_per_mm;
-        if profiles.iter().any(|p| p.units_per_mm != units_per_mm) {
-            return Err(LucentError::InvalidInput(
-                "--embed: the scene's SSS profiles have different scales; a host's G-buffer \
-                 has one world scale"
-                    .into(),
-            ));
-        }
+        // lucent's lighting pass writes each SSS pixel's light with the albedo as its
+        // profile's texturing asks (the host describes its light so), and the blurs apply
+        // the rest of the albedo from GB0 after the scatter.
+        let post_albedo = profiles.iter().any(|p| p.texturing != Texturing::Pre);
         let sampled = vk::ImageUsageFlags::SAMPLED;
         let size = (width, height);
         let hdr = vk::Format::R16G16B16A16_SFLOAT;
@@ -478,25 +471,37 @@ fn measure_sss(
             rgba16f(&lit.diffuse),
             "host output",
         )?;
+        let diffuse_desc = DiffuseDesc::with_albedo_as_texturing(hdr);
         let mut gbuffer = GBufferDesc::new(
             width,
             height,
             DepthDesc::device(vk::Format::D32_SFLOAT),
             if depth_in_alpha {
-                DiffuseDesc::with_albedo(hdr).with_depth_in_alpha()
+                diffuse_desc.with_depth_in_alpha()
             } else {
-                DiffuseDesc::with_albedo(hdr)
+                diffuse_desc
             },
         )
         .with_specular(hdr)
-        .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
-        .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        .with_material_ids(IdDesc::value(vk::Format::R8_UNORM));
+        let gb0 = vk::Format::R8G8B8A8_UNORM;
+        let albedo_image = if post_albedo {
+            gbuffer = gbuffer.with_albedo(gb0);
+            let image = images.upload(
+                gpu,
+                &ImageDesc::color(width, height, gb0, sampled),
+                rgba8(&gb.gb0),
+                "host albedo",
+            )?;
+            Some(host_image(image, "host albedo", gb0, size, sampled))
+        } else {
+            None
+        };
         // The LEAN blurs: the host writes the LEAN targets in its G-buffer pass as lucent's
         // own frame does (lucent's targets; the diffuse's alpha holds the slope x), with the
         // scene's lights and, where they cast, lucent's light-space atlas with each face's
         // matrices.
         let lean = if blur.lean() {
-            let gb0 = vk::Format::R8G8B8A8_UNORM;
             gbuffer = gbuffer.with_lean_targets(LeanTargetsDesc::new(hdr, gb0, hdr));
             let moments = gb.lean.as_deref().ok_or_else(|| {
                 LucentError::InvalidInput("lucent's LEAN frame has no LEAN target".into())
@@ -522,11 +527,15 @@ fn measure_sss(
         } else {
             None
         };
-        // (The LEAN blurs' surfaces are the targets' roughness and specular intensity.)
+        // (The LEAN blurs' surfaces are the targets' roughness and specular intensity.) Each
+        // material at its own profile's scale, as the scene's materials are.
         let materials = profiles
             .into_iter()
             .enumerate()
-            .map(|(i, p)| SssMaterial::new(i as u8 + 1, p))
+            .map(|(i, p)| {
+                let metres_per_unit = 1.0 / (1000.0 * p.units_per_mm);
+                SssMaterial::new(i as u8 + 1, p).with_metres_per_unit(metres_per_unit)
+            })
             .collect();
         let mut desc = SssEffectDesc::new(gbuffer, materials, hdr).with_knobs(settings.sss);
         if let Some((_, Some(_))) = &lean {
@@ -569,7 +578,7 @@ fn measure_sss(
                         depth: &depth,
                         diffuse: &diffuse,
                         specular: Some(&specular),
-                        albedo: None,
+                        albedo: albedo_image.as_ref(),
                         material_ids: &id_image,
                     },
                     regions: &regions,

@@ -1214,6 +1214,170 @@ fn the_sss_effect_on_host_layouts_equals_lucents_own_sss_frame() {
     test.finish();
 }
 
+/// A host whose lighting pass writes each SSS material's light with the albedo as its
+/// profile's texturing asks (`DiffuseAlbedo::AsTexturing`, as HDRP's and lucent's own do),
+/// its materials each at their own world scale (`SssMaterial::with_metres_per_unit`), equals
+/// lucent's own frame of veined marble with the albedo applied after the scatter, before and
+/// after it, and before it alone: the albedo image multiplies in after the blur what the
+/// light left out, with no pass to put the light right first.
+#[test]
+fn a_host_light_with_the_albedo_as_each_texturing_asks_equals_lucents_post_and_pre_post_frames() {
+    let test = TestGpu::new();
+    let gpu = &test.gpu;
+    let (w, h) = (240, 180);
+    let mut scene = lucent::bake::scene::load_scene_baked("showcase-marble").unwrap();
+    let mut scattering = 0;
+    for object in &mut scene.objects {
+        if let Some(p) = &mut object.material.sss {
+            // Each material its own texturing and its own scale (wide enough to see here).
+            let k = scattering % 3;
+            p.texturing = [Texturing::Post, Texturing::PrePost, Texturing::Pre][k];
+            p.units_per_mm *= [2.0, 4.0, 3.0][k];
+            scattering += 1;
+        }
+    }
+    assert!(
+        scattering >= 2,
+        "showcase-marble has several veined materials"
+    );
+    let mut report = Vec::new();
+    for technique in [
+        &lucent::features::sss::separable::SEPARABLE
+            as &'static dyn lucent::features::registry::TechniqueModule,
+        &lucent::features::sss::control::CONTROL,
+        &lucent::features::sss::burley::BURLEY,
+    ] {
+        let settings = FrameSettings {
+            technique: Technique::Only(technique),
+            export_hdr: true,
+            export_gbuffer: true,
+            export_lit: true,
+            ..FrameSettings::new(w, h)
+        };
+        let renderer = Renderer::new(gpu, &test.shaders, &test.cache, &scene, settings).unwrap();
+        let images = renderer.render_once(gpu).unwrap();
+        let lit = renderer.read_lit(gpu).unwrap();
+        gpu.wait_idle().unwrap();
+        renderer.destroy(gpu);
+        let gb = images.gbuffer.unwrap();
+        let ids: Vec<u8> = gb.sss.unwrap().iter().map(|&v| v as u8).collect();
+        let frame_profiles = SssProfiles::new(
+            &scene,
+            Some(blur(technique)),
+            None,
+            None,
+            &lucent::features::registry::blur_of,
+        )
+        .unwrap()
+        .unwrap();
+        let texturings: Vec<Texturing> = frame_profiles
+            .profiles
+            .iter()
+            .map(|(p, _)| p.texturing)
+            .collect();
+        assert!(
+            texturings.contains(&Texturing::Post) && texturings.contains(&Texturing::PrePost),
+            "{texturings:?}"
+        );
+        let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
+        let usage = vk::ImageUsageFlags::SAMPLED;
+        let upload = |texels: &[[f32; 4]], name| {
+            gpu.upload_image(
+                &ImageDesc::color(w, h, rgba32, usage),
+                &[f32_bytes(texels)],
+                name,
+            )
+            .unwrap()
+        };
+        // The diffuse as lucent's lighting pass wrote it: for the separable and Burley blurs,
+        // linear depth in the alpha, which the taps read there (lucent's own frame reads it
+        // at RGBA16F's precision, so does the host: a depth image's differs at depth edges).
+        let diffuse = upload(&lit.diffuse, "host diffuse");
+        let specular = upload(&lit.specular, "host specular");
+        let albedo = upload(&gb.gb0, "host albedo");
+        let exposure = f64::from(scene.exposure);
+        let want = tonemapped(&images.hdr.unwrap(), exposure);
+        for (name, depth_kind, ids_kind) in [
+            ("D32, R8_UNORM IDs", HostDepth::Standard, HostIds::Unorm),
+            (
+                "reversed-Z infinite D32, R8_UINT IDs",
+                HostDepth::ReversedInfinite,
+                HostIds::Uint,
+            ),
+        ] {
+            let mut layout = host_layout(
+                &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids,
+                // Every material has its own scale: the G-buffer's is none of theirs.
+                1.0,
+            );
+            layout.desc.diffuse = DiffuseDesc::with_albedo_as_texturing(rgba32);
+            if frame_profiles.depth_in_alpha() {
+                layout.desc.diffuse = layout.desc.diffuse.with_depth_in_alpha();
+            }
+            layout.desc = layout.desc.clone().with_albedo(rgba32);
+            let materials: Vec<SssMaterial> = frame_profiles
+                .profiles
+                .iter()
+                .enumerate()
+                .map(|(i, (p, b))| {
+                    let mut profile = p.clone();
+                    profile.blur = Some(b.name().into());
+                    SssMaterial::new(host_id(ids_kind, i as u8 + 1), profile)
+                        .with_metres_per_unit(1.0 / (1000.0 * p.units_per_mm))
+                })
+                .collect();
+            let lucent = wrap(&test, options(3));
+            let desc =
+                SssEffectDesc::new(layout.desc.clone(), materials, rgba32).with_knobs(settings.sss);
+            let mut effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
+            let start = vec![0u8; (w * h * 16) as usize];
+            let frames = host_frames(&test, &layout, &layout.desc, &start, |k, cmd, images| {
+                effect
+                    .record(
+                        &lucent,
+                        cmd,
+                        &SssFrame {
+                            slot: k,
+                            view: 0,
+                            camera: layout.camera,
+                            images: SssImages {
+                                depth: images.depth,
+                                diffuse: &described(&diffuse, "host diffuse", usage),
+                                specular: Some(&described(&specular, "host specular", usage)),
+                                albedo: Some(&described(&albedo, "host albedo", usage)),
+                                material_ids: images.ids.expect("the IDs are an image"),
+                            },
+                            regions: &[],
+                            output: images.lighting,
+                            lean: None,
+                        },
+                    )
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            });
+            for (k, frame) in frames.iter().enumerate() {
+                report.push(compare_host_frame(
+                    &want,
+                    &tonemapped(frame, exposure),
+                    (w, h),
+                    over_allowed(&want),
+                    &format!("{} on {name}, frame {k}", technique.name()),
+                    &format!("embed-as-texturing-{}-{k}", technique.name()),
+                ));
+            }
+            effect.destroy(&lucent);
+            drop(lucent);
+            layout.destroy(&test);
+        }
+        for image in [diffuse, specular, albedo] {
+            gpu.destroy_image(image);
+        }
+    }
+    for line in &report {
+        println!("{line}");
+    }
+    test.finish();
+}
+
 #[test]
 fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_errors() {
     let test = TestGpu::new();
@@ -1482,7 +1646,10 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
         texturing: Texturing::Post,
         ..skin.clone()
     };
-    let e = refused(desc(gbuffer.clone(), vec![SssMaterial::new(1, post)]));
+    let e = refused(desc(
+        gbuffer.clone(),
+        vec![SssMaterial::new(1, post.clone())],
+    ));
     assert!(
         matches!(&e, HostError::Missing { input, .. } if input == "albedo"),
         "{e}"
@@ -1498,6 +1665,30 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
         matches!(&e, HostError::Missing { input, .. } if input == "albedo"),
         "{e}"
     );
+    // The albedo as each texturing asks, a profile applying it after the scatter and no
+    // albedo image.
+    let e = refused(desc(
+        changed(&gbuffer, |g| {
+            g.diffuse = DiffuseDesc::with_albedo_as_texturing(vk::Format::R16G16B16A16_SFLOAT)
+        }),
+        vec![SssMaterial::new(1, post.clone())],
+    ));
+    assert!(
+        matches!(&e, HostError::Missing { input, .. } if input == "albedo"),
+        "{e}"
+    );
+    // A material's own world scale that is no size.
+    for metres in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        let e = refused(desc(
+            gbuffer.clone(),
+            vec![material(1), material(2).with_metres_per_unit(metres)],
+        ));
+        assert!(
+            matches!(&e, HostError::Description { field, .. }
+                if field == "materials[1] (ID 2).metres_per_unit"),
+            "{metres}: {e}"
+        );
+    }
 
     // Built correctly, then given wrong images.
     let mut effect = built(&test, &lucent, |u| {

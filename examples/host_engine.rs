@@ -2781,6 +2781,7 @@ fn record_frame(
                         material_ids: &ids,
                         albedo: Some(&albedo),
                         shadow_map: &shadow_map,
+                        second_shadow_map: None,
                     },
                     // The skin's and the marble's projected bounds.
                     regions: &transmission_regions(&camera, extent, effects.whole_screen),
@@ -2839,6 +2840,7 @@ fn record_frame(
                     surface: LeanSurface::Normals(&normals),
                     lights: &lights,
                     shadow_map: sss_shadow_map.as_ref(),
+                    second_shadow_map: None,
                     shadow_faces: if sss_shadow_map.is_some() {
                         &faces
                     } else {

@@ -19,7 +19,9 @@ struct ShadowFace {
     mat4 view_proj;  // world to the face's clip space (standard Z: depth 0 near, 1 far)
     vec4 rect;       // xy: the tile's top-left texel in the atlas; z: its edge in texels;
                      // w: a host's map's (LUCENT_SHADOW_REVERSIBLE): 1 if it stores reversed
-                     // Z, plus 2 x its array layer (LUCENT_SHADOW_ARRAY)
+                     // Z, plus 2 x its array layer (LUCENT_SHADOW_ARRAY); with a second map
+                     // (LUCENT_SHADOW_SECOND_MAP), a face in it has -1 minus those flags
+                     // (its layer of the second map, an array)
     vec4 params;     // a map texel's world size at a point: x * clip.w + y
 };
 
@@ -42,9 +44,41 @@ layout(set = 0) uniform sampler2DArray shadow_depth;
 #else
 layout(set = 0) uniform sampler2D shadow_depth;
 #endif
+#ifdef LUCENT_SHADOW_SECOND_MAP
+// A host's second shadow map beside the first (an atlas): an array of layers (a cube array's
+// faces, cascades) of its own size. Faces in it have a negative rect.w.
+layout(set = 0) uniform sampler2DArray shadow_layers;
+#endif
 #ifdef LUCENT_SHADOW_IDS
 layout(set = 0) uniform usampler2D shadow_ids;
 #endif
+
+// Whether face `face` lies in the second map (LUCENT_SHADOW_SECOND_MAP; never otherwise).
+bool shadow_in_second_map(int face) {
+#ifdef LUCENT_SHADOW_SECOND_MAP
+    return shadows.faces[face].rect.w < 0.0;
+#else
+    return false;
+#endif
+}
+
+// Face `face`'s flags (rect.w as lucent_stored_depth reads it: 1 for reversed Z, plus 2 x its
+// layer), whichever map it lies in.
+float shadow_face_flags(int face) {
+    float w = shadows.faces[face].rect.w;
+    return shadow_in_second_map(face) ? -w - 1.0 : w;
+}
+
+// One over the size in texels of the map face `face` lies in: the first map's (the table's
+// atlas), or the second's.
+vec2 shadow_inv_map_size(int face) {
+#ifdef LUCENT_SHADOW_SECOND_MAP
+    if (shadow_in_second_map(face)) {
+        return 1.0 / vec2(textureSize(shadow_layers, 0).xy);
+    }
+#endif
+    return shadows.atlas.zw;
+}
 
 // The standard-Z depths of stored texels `d` of face `face`'s map. lucent's own maps store
 // standard Z. A host's map may store reversed Z (src/embed/shadow_faces.rs): its face's
@@ -53,7 +87,7 @@ layout(set = 0) uniform usampler2D shadow_ids;
 // define LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
 vec4 shadow_stored_depth(int face, vec4 d) {
 #ifdef LUCENT_SHADOW_REVERSIBLE
-    return lucent_stored_depth(shadows.faces[face].rect, d);
+    return lucent_stored_depth(vec4(shadows.faces[face].rect.xyz, shadow_face_flags(face)), d);
 #else
     return d;
 #endif
@@ -62,6 +96,12 @@ vec4 shadow_stored_depth(int face, vec4 d) {
 // The depth texels of face `face`'s map around atlas coordinate `corner` (textureGather's
 // order), from its layer where the map is an array (LUCENT_SHADOW_ARRAY), as standard Z.
 vec4 shadow_gather_depth(int face, vec2 corner) {
+#ifdef LUCENT_SHADOW_SECOND_MAP
+    if (shadow_in_second_map(face)) {
+        float layer = floor(shadow_face_flags(face) * 0.5);
+        return shadow_stored_depth(face, textureGather(shadow_layers, vec3(corner, layer), 0));
+    }
+#endif
 #ifdef LUCENT_SHADOW_ARRAY
     float layer = floor(shadows.faces[face].rect.w * 0.5);
     vec4 d = textureGather(shadow_depth, vec3(corner, layer), 0);
@@ -131,7 +171,7 @@ ivec2 map_texel(int face, vec2 t) {
 // the tile): the textureGather coordinate that returns them and their bilinear weights, in
 // gather order (x0 y1, x1 y1, x1 y0, x0 y0).
 void map_bilinear(int face, vec2 t, out vec2 corner, out vec4 weights) {
-    lucent_map_bilinear(shadows.faces[face].rect, shadows.atlas.zw, t, corner, weights);
+    lucent_map_bilinear(shadows.faces[face].rect, shadow_inv_map_size(face), t, corner, weights);
 }
 
 // Where light `light`'s ray to `p` (at distance `d_p` along face `face`'s axis) meets a
@@ -187,7 +227,7 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
         for (int bx = 0; bx < 2; ++bx) {
             // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
             // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
-            vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadows.atlas.zw;
+            vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadow_inv_map_size(index);
             vec4 occluder = shadow_gather_depth(index, corner);
             vec4 lit = step(vec4(reference), occluder);
             float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];

@@ -592,7 +592,11 @@ impl LayeredEffect {
             .transpose()?
             .unwrap_or([[0.0; 4]; 9]);
         let inputs = self.check_images(lucent, frame)?;
-        let light_table = shadow_table(frame.lights, frame.light_faces, self.desc.light_space, 1)?;
+        let light_table = shadow_table(
+            frame.lights,
+            frame.light_faces,
+            &[(self.desc.light_space, 1)],
+        )?;
         let draws = self.draws(frame.meshes)?;
         let gbuffer = &self.desc.gbuffer;
         let uniforms = gbuffer

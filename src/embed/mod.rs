@@ -258,7 +258,10 @@ pub use glam;
 /// `lucent_any_tangent_frame`. 13: a diffuse light with the albedo as each SSS material's
 /// texturing asks ([`DiffuseAlbedo::AsTexturing`], [`DiffuseDesc::with_albedo_as_texturing`]),
 /// a world scale per SSS material ([`SssMaterial::with_metres_per_unit`]);
-/// [`Support::Lacks`] may hold [`HostError::Unsupported`].
+/// [`Support::Lacks`] may hold [`HostError::Unsupported`]; a second shadow map, an array
+/// beside an atlas (`with_second_shadow_map` of [`TransmissionEffectDesc`] and
+/// [`SssEffectDesc`], [`TransmissionImages::second_shadow_map`],
+/// [`LeanLighting::second_shadow_map`], [`ShadowFace::map`]).
 pub const API_VERSION: u32 = 13;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

@@ -35,6 +35,10 @@ pub struct ShadowFace {
     /// The array layer it lies in, for a shadow map that is an array of layers (cascades, a
     /// cube's faces: [`super::HostImage::with_layers`]); 0 in an atlas.
     pub layer: u32,
+    /// The shadow map it lies in: 0 the frame's shadow map, 1 the second one (an array of
+    /// layers beside a first map that is an atlas: a cube array's faces beside a spot and
+    /// sun atlas; `with_second_shadow_map` of the effect's description).
+    pub map: u32,
 }
 
 impl ShadowFace {
@@ -46,11 +50,20 @@ impl ShadowFace {
             projection,
             rect,
             layer: 0,
+            map: 0,
         }
     }
 
     /// The face in array layer `layer` of the shadow map.
     pub fn in_layer(mut self, layer: u32) -> Self {
+        self.layer = layer;
+        self
+    }
+
+    /// The face in layer `layer` of the second shadow map (an array beside an atlas:
+    /// [`Self::map`] 1).
+    pub fn in_second_map(mut self, layer: u32) -> Self {
+        self.map = 1;
         self.layer = layer;
         self
     }
@@ -107,6 +120,105 @@ const CUBE_AXES: [Vec3; 6] = [
     Vec3::NEG_Z,
 ];
 
+/// How an effect's host shadow maps are laid out, from its description: one 2-D atlas, one
+/// array of layers, or an atlas with an array beside it (the second map, each of its faces
+/// [`ShadowFace::in_second_map`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ShadowMaps {
+    /// One 2-D image.
+    Atlas,
+    /// One array of layers (its view a 2-D array view).
+    Array,
+    /// An atlas and, beside it, an array of layers of its own size.
+    AtlasAndArray,
+}
+
+impl ShadowMaps {
+    /// The layout a description asks for (`array`: its first map is an array; `second`: the
+    /// format of a second map, checked), or why it cannot be read.
+    pub(crate) fn described(array: bool, second: Option<vk::Format>) -> Result<Self> {
+        match (array, second) {
+            (false, None) => Ok(Self::Atlas),
+            (true, None) => Ok(Self::Array),
+            (false, Some(format)) => {
+                check_shadow_format(format, "second shadow map")?;
+                Ok(Self::AtlasAndArray)
+            }
+            (true, Some(_)) => Err(HostError::Unsupported {
+                input: "second shadow map".into(),
+                found: "a second shadow map beside a first that is an array".into(),
+                accepted: "a second map (an array of layers) beside a first that is an atlas \
+                           (one 2-D image); or one array holding every face"
+                    .into(),
+            }
+            .into()),
+        }
+    }
+
+    /// The defines of the passes reading them (glsl/common/shadows.glsl).
+    pub(crate) fn defines(self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            Self::Atlas => &[],
+            Self::Array => &[("LUCENT_SHADOW_ARRAY", "1")],
+            Self::AtlasAndArray => &[("LUCENT_SHADOW_SECOND_MAP", "1")],
+        }
+    }
+
+    /// Every layout, for the shipped SPIR-V.
+    pub(crate) const ALL: [Self; 3] = [Self::Atlas, Self::Array, Self::AtlasAndArray];
+
+    /// Checks a frame's shadow maps against the layout and their formats (`formats`: the
+    /// first map's, the second's when described); returns each map's size and layers, as
+    /// [`shadow_table`] takes them.
+    pub(crate) fn check_frame(
+        self,
+        gpu: &crate::backend::GpuContext,
+        first: &HostImage,
+        second: Option<&HostImage>,
+        formats: (vk::Format, Option<vk::Format>),
+    ) -> Result<Vec<(vk::Extent2D, u32)>> {
+        check_shadow_map(gpu, first, formats.0, self == Self::Array)?;
+        let mut maps = vec![(first.extent, first.layers)];
+        match (formats.1, second) {
+            (Some(format), Some(map)) => {
+                check_image(
+                    gpu,
+                    map,
+                    "second shadow map",
+                    Role::ShadowMap,
+                    map.extent,
+                    |f| f == format,
+                    &format!(
+                        "{} (the description's)",
+                        crate::backend::format::format_name(format)
+                    ),
+                )?;
+                maps.push((map.extent, map.layers));
+            }
+            (None, None) => {}
+            (Some(_), None) => {
+                return Err(HostError::Missing {
+                    input: "second shadow map".into(),
+                    needed_by: "the description has a second shadow map (with_second_shadow_map)"
+                        .into(),
+                }
+                .into())
+            }
+            (None, Some(map)) => {
+                return Err(HostError::Image {
+                    image: map.name.clone(),
+                    kind: crate::error::ImageFault::Aliased,
+                    problem: "given as the second shadow map, which the description has none \
+                              of (with_second_shadow_map)"
+                        .into(),
+                }
+                .into())
+            }
+        }
+        Ok(maps)
+    }
+}
+
 /// Checks a frame's host shadow map against the effect's description: its layers (an array,
 /// `array`, may have any number; an atlas is one 2-D image), then as an image of the
 /// description's `format` ([`check_image`], its own size).
@@ -149,14 +261,15 @@ fn check_shadow_layers(map: &HostImage, array: bool) -> Result<()> {
     .into())
 }
 
-/// A host's shadow map must be a depth format (the shadow lookups compare its depth).
-pub(crate) fn check_shadow_format(format: vk::Format) -> Result<()> {
+/// A host's shadow map (`input`: which, for the error) must be a depth format (the shadow
+/// lookups compare its depth).
+pub(crate) fn check_shadow_format(format: vk::Format, input: &str) -> Result<()> {
     use crate::backend::format::{format_info, format_name, FormatKind};
     if format_info(format).is_some_and(|f| f.kind == FormatKind::Depth) {
         return Ok(());
     }
     Err(HostError::Unsupported {
-        input: "shadow map".into(),
+        input: input.into(),
         found: format!("format {}", format_name(format)),
         accepted: "a depth format (D32_SFLOAT, D16_UNORM, D24_UNORM_S8_UINT, \
                    D32_SFLOAT_S8_UINT, X8_D24_UNORM_PACK32)"
@@ -166,14 +279,16 @@ pub(crate) fn check_shadow_format(format: vk::Format) -> Result<()> {
 }
 
 /// The shadow table (glsl/common/shadows.glsl `Shadows`, what lucent's own light-space maps
-/// fill) of the host's faces in a shadow map of `extent`, each checked: its light exists and
-/// has one face (six for a point light, in [`CUBE_AXES`] order, together), its matrices are
-/// finite with a standard- or reversed-Z projection, its rectangle square and inside the map.
+/// fill) of the host's faces in its shadow maps (`maps`: each one's size and layers, the
+/// second an array beside an atlas), each checked: its light exists and has one face (six
+/// for a point light, in [`CUBE_AXES`] order, together), its map is one of the frame's and
+/// its layer one of the map's, its matrices are finite with a standard- or reversed-Z
+/// projection, its rectangle square and inside the map. A face of the second map is written
+/// with `-1 -` its flags (glsl `shadow_in_second_map`).
 pub(crate) fn shadow_table(
     lights: &[Light],
     faces: &[ShadowFace],
-    extent: vk::Extent2D,
-    layers: u32,
+    maps: &[(vk::Extent2D, u32)],
 ) -> Result<ShadowUniforms> {
     let bad = |index: usize, problem: String| -> crate::LucentError {
         HostError::Description {
@@ -190,6 +305,7 @@ pub(crate) fn shadow_table(
         .into());
     }
     let mut table: ShadowUniforms = bytemuck::Zeroable::zeroed();
+    let (extent, _) = maps.first().copied().unwrap_or_default();
     let (w, h) = (extent.width.max(1) as f32, extent.height.max(1) as f32);
     table.atlas = [w, h, 1.0 / w, 1.0 / h];
     for light in table.lights.iter_mut() {
@@ -233,19 +349,36 @@ pub(crate) fn shadow_table(
         table.lights[light] = [index as i32, count as i32, 0, 0];
         for k in 0..count {
             let face = &faces[index + k];
+            let Some(&(extent, layers)) = maps.get(face.map as usize) else {
+                return Err(bad(
+                    index + k,
+                    format!(
+                        "map {}: the frame has {} shadow map{} (a second one is described \
+                         with with_second_shadow_map)",
+                        face.map,
+                        maps.len(),
+                        if maps.len() == 1 { "" } else { "s" }
+                    ),
+                ));
+            };
             if face.layer >= layers.max(1) {
                 return Err(bad(
                     index + k,
                     format!(
-                        "layer {}: the shadow map has {} layer{}",
+                        "layer {}: shadow map {} has {} layer{}",
                         face.layer,
+                        face.map,
                         layers.max(1),
                         if layers > 1 { "s" } else { "" }
                     ),
                 ));
             }
-            table.faces[index + k] =
-                face_row(face, extent).map_err(|problem| bad(index + k, problem))?;
+            let mut row = face_row(face, extent).map_err(|problem| bad(index + k, problem))?;
+            if face.map == 1 {
+                // The second map: its flags negated (glsl shadow_in_second_map).
+                row.rect[3] = -1.0 - row.rect[3];
+            }
+            table.faces[index + k] = row;
             if count == 6 {
                 // The face's view axis in the world: -z of its view space.
                 let forward = face
@@ -405,7 +538,7 @@ mod tests {
             ..Light::point(Vec3::ZERO, Vec3::ONE, 1.0, 1.0)
         };
         let face = ShadowFace::new(0, view, projection, rect(256, 0, 256));
-        let table = shadow_table(&[spot], &[face], extent, 1).unwrap();
+        let table = shadow_table(&[spot], &[face], &[(extent, 1)]).unwrap();
         assert_eq!(table.lights[0], [0, 1, 0, 0]);
         assert_eq!(table.lights[1][0], -1);
         let row = table.faces[0];
@@ -439,7 +572,10 @@ mod tests {
             ),
             ShadowFace::new(0, Mat4::ZERO, projection, rect(0, 0, 64)),
         ] {
-            assert!(shadow_table(&[spot], &[bad], extent, 1).is_err(), "{bad:?}");
+            assert!(
+                shadow_table(&[spot], &[bad], &[(extent, 1)]).is_err(),
+                "{bad:?}"
+            );
         }
         // Reversed Z (near and far swapped): the same row read through z flipped, flagged;
         // and with an infinite far plane, a far one f32 cannot tell from it.
@@ -449,7 +585,9 @@ mod tests {
             Mat4::perspective_rh(1.0, 1.0, 20.0, 0.1),
             rect(256, 0, 256),
         );
-        let flipped = shadow_table(&[spot], &[reversed], extent, 1).unwrap().faces[0];
+        let flipped = shadow_table(&[spot], &[reversed], &[(extent, 1)])
+            .unwrap()
+            .faces[0];
         assert_eq!(flipped.rect, [256.0, 0.0, 256.0, 1.0]);
         for (a, b) in flipped.params.iter().zip(&row.params) {
             assert!(
@@ -472,10 +610,38 @@ mod tests {
             rect(0, 0, 64),
         );
         // In layer 2 of a three-layer array: the layer above the reversed bit; no layer 3.
-        let layered = shadow_table(&[spot], &[infinite.in_layer(2)], extent, 3).unwrap();
+        let layered = shadow_table(&[spot], &[infinite.in_layer(2)], &[(extent, 3)]).unwrap();
         assert_eq!(layered.faces[0].rect[3], 5.0);
-        assert!(shadow_table(&[spot], &[infinite.in_layer(3)], extent, 3).is_err());
-        let far = shadow_table(&[spot], &[infinite], extent, 1).unwrap().faces[0];
+        assert!(shadow_table(&[spot], &[infinite.in_layer(3)], &[(extent, 3)]).is_err());
+        // In layer 2 of a second map (an array beside the atlas, its own size): the flags
+        // negated; refused where the frame has no second map, or past its layers or size.
+        let edge_64 = vk::Extent2D {
+            width: 64,
+            height: 64,
+        };
+        let second = shadow_table(
+            &[spot],
+            &[infinite.in_second_map(2)],
+            &[(extent, 1), (edge_64, 3)],
+        )
+        .unwrap();
+        assert_eq!(second.faces[0].rect[3], -6.0);
+        assert_eq!(second.atlas[0], extent.width as f32, "the first map's size");
+        assert!(shadow_table(&[spot], &[infinite.in_second_map(0)], &[(extent, 1)]).is_err());
+        assert!(shadow_table(
+            &[spot],
+            &[infinite.in_second_map(3)],
+            &[(extent, 1), (edge_64, 3)]
+        )
+        .is_err());
+        let beyond = ShadowFace {
+            rect: rect(32, 0, 64),
+            ..infinite.in_second_map(0)
+        };
+        assert!(shadow_table(&[spot], &[beyond], &[(extent, 1), (edge_64, 3)]).is_err());
+        let far = shadow_table(&[spot], &[infinite], &[(extent, 1)])
+            .unwrap()
+            .faces[0];
         assert_eq!(far.rect[3], 1.0);
         assert!(
             (far.params[2] - 0.1).abs() < 1e-6 && far.params[3] >= 1e29,
@@ -493,11 +659,11 @@ mod tests {
                 ShadowFace::new(0, view, projection, rect(64 * k as i32, 0, 64))
             })
             .collect();
-        let table = shadow_table(&[point], &cube, extent, 1).unwrap();
+        let table = shadow_table(&[point], &cube, &[(extent, 1)]).unwrap();
         assert_eq!(table.lights[0], [0, 6, 0, 0]);
         let mut swapped = cube.clone();
         swapped.swap(0, 1);
-        assert!(shadow_table(&[point], &swapped, extent, 1).is_err());
-        assert!(shadow_table(&[point], &cube[..3], extent, 1).is_err());
+        assert!(shadow_table(&[point], &swapped, &[(extent, 1)]).is_err());
+        assert!(shadow_table(&[point], &cube[..3], &[(extent, 1)]).is_err());
     }
 }

@@ -41,7 +41,7 @@ use super::gbuffer::{
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::tiles_marked_by;
-use super::shadow_faces::{check_shadow_format, check_shadow_map, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace, ShadowMaps};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
@@ -183,6 +183,10 @@ pub struct SssEffectDesc {
     /// That shadow map is an array of layers (its view a 2-D array view), each face in its
     /// [`ShadowFace::layer`] ([`Self::with_shadow_array`]); else one 2-D image (an atlas).
     pub shadow_array: bool,
+    /// The format of a second shadow map beside the first (an atlas): an array of layers of
+    /// its own size, each of its faces [`ShadowFace::in_second_map`]
+    /// ([`Self::with_second_shadow_map`], [`LeanLighting::second_shadow_map`]).
+    pub second_shadow_format: Option<vk::Format>,
 }
 
 impl SssEffectDesc {
@@ -201,7 +205,15 @@ impl SssEffectDesc {
             views_per_frame: 1,
             shadow_format: None,
             shadow_array: false,
+            second_shadow_format: None,
         }
+    }
+
+    /// With a second shadow map of `format` beside the first, an atlas
+    /// ([`Self::second_shadow_format`]).
+    pub fn with_second_shadow_map(mut self, format: vk::Format) -> Self {
+        self.second_shadow_format = Some(format);
+        self
     }
 
     /// The shadow map of [`Self::with_shadow_maps`] is an array of layers
@@ -257,8 +269,13 @@ pub struct LeanLighting<'a> {
     /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
     pub lights: &'a [Light],
     /// The shadow map holding every face of `shadow_faces`, when the description has a
-    /// shadow format ([`SssEffectDesc::with_shadow_maps`]).
+    /// shadow format ([`SssEffectDesc::with_shadow_maps`]): every face, or those not in the
+    /// second map.
     pub shadow_map: Option<&'a HostImage>,
+    /// The second shadow map, an array of layers holding the faces
+    /// [`ShadowFace::in_second_map`], exactly when the description has one
+    /// ([`SssEffectDesc::with_second_shadow_map`]).
+    pub second_shadow_map: Option<&'a HostImage>,
     /// The faces of the lights' shadow maps (as [`super::TransmissionFrame::shadow_faces`]):
     /// a light without one is unshadowed.
     pub shadow_faces: &'a [ShadowFace],
@@ -359,6 +376,8 @@ struct Imports {
     lean_targets: Option<[ResourceId; 3]>,
     /// With LEAN blurs and a shadow format: the shadow map.
     shadow_map: Option<ResourceId>,
+    /// And the second shadow map, when described.
+    second_shadow_map: Option<ResourceId>,
 }
 
 /// The host LEAN pass's per-frame constants (glsl/sss/host_lean.frag `HostLean`, std140).
@@ -388,6 +407,8 @@ pub struct SssEffect {
     /// With LEAN blurs built from the normals: the host LEAN pass's constants but for the view
     /// (written per frame).
     lean: Option<HostLeanGpu>,
+    /// How the host's shadow maps are laid out, when it describes them.
+    shadow_maps: Option<ShadowMaps>,
 }
 
 /// One of an [`SssEffect`]'s materials: its host ID, its reach ([`SssEffect::reach_of`]) and
@@ -557,8 +578,19 @@ impl SssEffect {
                 }
                 .into());
             }
-            check_shadow_format(format)?;
+            check_shadow_format(format, "shadow map")?;
+        } else if desc.second_shadow_format.is_some() {
+            return Err(HostError::Description {
+                field: "second_shadow_format".into(),
+                problem: "a second shadow map without a first (SssEffectDesc::with_shadow_maps)"
+                    .into(),
+            }
+            .into());
         }
+        let shadow_maps = desc
+            .shadow_format
+            .map(|_| ShadowMaps::described(desc.shadow_array, desc.second_shadow_format))
+            .transpose()?;
         // Without the host's LEAN targets, the LEAN pass builds them from the normals.
         let lean_constants = if lean && gbuffer.lean_targets.is_none() {
             let normals = gbuffer.normals.expect("require(LeanSss) checked them");
@@ -629,6 +661,7 @@ impl SssEffect {
         let out = Self {
             passes,
             imports,
+            shadow_maps,
             chains: chains.len(),
             materials,
             desc,
@@ -683,12 +716,12 @@ impl SssEffect {
             check_lights(lean.lights)?;
             uniforms = uniforms.with_lights(lean.lights);
             if let Some(map) = lean.shadow_map {
-                shadows = Some(shadow_table(
-                    lean.lights,
-                    lean.shadow_faces,
-                    map.extent,
-                    map.layers,
-                )?);
+                // (check_images checked each map against the description.)
+                let maps: Vec<(vk::Extent2D, u32)> = std::iter::once(map)
+                    .chain(lean.second_shadow_map)
+                    .map(|m| (m.extent, m.layers))
+                    .collect();
+                shadows = Some(shadow_table(lean.lights, lean.shadow_faces, &maps)?);
             }
         }
         let per_frame = self.passes.per_frame();
@@ -736,6 +769,10 @@ impl SssEffect {
                 _ => unreachable!("check_images matched the surface with the description"),
             }
             if let (Some(id), Some(map)) = (self.imports.shadow_map, lean.shadow_map) {
+                binds.push((id, map));
+            }
+            if let (Some(id), Some(map)) = (self.imports.second_shadow_map, lean.second_shadow_map)
+            {
                 binds.push((id, map));
             }
         }
@@ -969,10 +1006,28 @@ impl SssEffect {
         };
         let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
             (Some(format), Some(map)) => {
-                check_shadow_map(lucent.gpu(), map, format, self.desc.shadow_array)?;
+                self.shadow_maps
+                    .expect("described with the shadow format")
+                    .check_frame(
+                        lucent.gpu(),
+                        map,
+                        lean.second_shadow_map,
+                        (format, self.desc.second_shadow_format),
+                    )?;
+                images.extend(lean.second_shadow_map);
                 Some(map)
             }
             (None, None) => {
+                if let Some(map) = lean.second_shadow_map {
+                    return Err(HostError::Image {
+                        image: map.name.clone(),
+                        kind: ImageFault::Aliased,
+                        problem: "given as the second shadow map, which the description has \
+                                  none of (SssEffectDesc::with_second_shadow_map)"
+                            .into(),
+                    }
+                    .into());
+                }
                 if !lean.shadow_faces.is_empty() {
                     return Err(HostError::Description {
                         field: "lean.shadow_faces".into(),
@@ -1078,6 +1133,9 @@ fn declare(
     let shadow_map = desc
         .shadow_format
         .map(|format| import(&mut graph, "host shadow map", format, sampled));
+    let second_shadow_map = desc
+        .second_shadow_format
+        .map(|format| import(&mut graph, "host second shadow map", format, sampled));
     let imports = Imports {
         depth: depth.id(),
         diffuse: diffuse.id(),
@@ -1088,6 +1146,7 @@ fn declare(
         normals: normals.as_ref().map(Handle::id),
         lean_targets: lean_targets.as_ref().map(|t| t.each_ref().map(Handle::id)),
         shadow_map: shadow_map.as_ref().map(Handle::id),
+        second_shadow_map: second_shadow_map.as_ref().map(Handle::id),
     };
     let cleared;
     let specular = match &specular {
@@ -1105,6 +1164,7 @@ fn declare(
         lean: None,
         shadow_depth: None,
         shadow_array: false,
+        second_shadow_depth: None,
         shadow_reversible: false,
         albedo: None,
         // The host's alpha is its own unless it holds linear depth: then the taps read it
@@ -1174,6 +1234,7 @@ fn declare(
         inputs.depth_in_alpha = false;
         inputs.shadow_depth = shadow_map.as_ref();
         inputs.shadow_array = desc.shadow_array;
+        inputs.second_shadow_depth = second_shadow_map.as_ref();
         // A host's map may store reversed Z (its faces say: ShadowFace).
         inputs.shadow_reversible = true;
     }

@@ -39,7 +39,7 @@ use super::passes::{
     id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
-use super::shadow_faces::{check_shadow_format, check_shadow_map, shadow_table, ShadowFace};
+use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace, ShadowMaps};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
@@ -114,6 +114,11 @@ pub struct TransmissionEffectDesc {
     /// view, each face in its [`ShadowFace::layer`] ([`Self::with_shadow_array`]); else one
     /// 2-D image (an atlas).
     pub shadow_array: bool,
+    /// The format of a second shadow map beside the first (an atlas): an array of layers of
+    /// its own size, its view a 2-D array view (a point light's cube faces beside the spot
+    /// and sun faces of an atlas), each of its faces [`ShadowFace::in_second_map`]
+    /// ([`Self::with_second_shadow_map`]).
+    pub second_shadow_format: Option<vk::Format>,
     /// Views recorded per frame (1 to [`super::MAX_VIEWS_PER_FRAME`]).
     pub views_per_frame: usize,
 }
@@ -131,8 +136,16 @@ impl TransmissionEffectDesc {
             materials,
             shadow_format,
             shadow_array: false,
+            second_shadow_format: None,
             views_per_frame: 1,
         }
+    }
+
+    /// With a second shadow map of `format` beside the first, an atlas
+    /// ([`Self::second_shadow_format`]; [`TransmissionImages::second_shadow_map`]).
+    pub fn with_second_shadow_map(mut self, format: vk::Format) -> Self {
+        self.second_shadow_format = Some(format);
+        self
     }
 
     /// The shadow map is an array of layers (its view a 2-D array view,
@@ -162,9 +175,13 @@ pub struct TransmissionImages<'a> {
     /// The albedo: required when the description's diffuse light has the albedo multiplied
     /// in, refused when it is kept apart.
     pub albedo: Option<&'a HostImage>,
-    /// The shadow map holding every [`TransmissionFrame::shadow_faces`] face (a view of its
-    /// depth aspect, sampled).
+    /// The shadow map holding the [`TransmissionFrame::shadow_faces`] faces (a view of its
+    /// depth aspect, sampled): every face, or those not in the second map.
     pub shadow_map: &'a HostImage,
+    /// The second shadow map, an array of layers (a 2-D array view of its depth aspect),
+    /// holding the faces [`ShadowFace::in_second_map`]: given exactly when the description
+    /// has one ([`TransmissionEffectDesc::with_second_shadow_map`]).
+    pub second_shadow_map: Option<&'a HostImage>,
 }
 
 /// One view of one frame: what [`TransmissionEffect::record`] reads and adds to.
@@ -216,6 +233,7 @@ struct Imports {
     material_ids: ResourceId,
     albedo: Option<ResourceId>,
     shadow_map: ResourceId,
+    second_shadow_map: Option<ResourceId>,
     lighting: ResourceId,
 }
 
@@ -226,10 +244,17 @@ pub struct TransmissionEffect {
     desc: TransmissionEffectDesc,
     /// The normal decode every frame shares; each frame adds its view.
     normals: [u32; 4],
+    /// How the host's shadow maps are laid out.
+    shadow_maps: ShadowMaps,
 }
 
-/// The shader defines of a host's ID image (unsigned or UNORM) and whether the albedo is read.
-fn defines(uint_ids: bool, albedo: bool, array: bool) -> Vec<(&'static str, &'static str)> {
+/// The shader defines of a host's ID image (unsigned or UNORM), whether the albedo is read and
+/// how the shadow maps are laid out.
+fn defines(
+    uint_ids: bool,
+    albedo: bool,
+    shadow_maps: ShadowMaps,
+) -> Vec<(&'static str, &'static str)> {
     let mut defines = Vec::new();
     if albedo {
         defines.push(("LUCENT_HOST_ALBEDO", "1"));
@@ -237,9 +262,7 @@ fn defines(uint_ids: bool, albedo: bool, array: bool) -> Vec<(&'static str, &'st
     if uint_ids {
         defines.push(("LUCENT_HOST_IDS_UINT", "1"));
     }
-    if array {
-        defines.push(("LUCENT_SHADOW_ARRAY", "1"));
-    }
+    defines.extend_from_slice(shadow_maps.defines());
     defines
 }
 
@@ -247,10 +270,10 @@ fn defines(uint_ids: bool, albedo: bool, array: bool) -> Vec<(&'static str, &'st
 pub(crate) fn shader_permutations(out: &mut Vec<PipelineShaders>) {
     for uint in [false, true] {
         for albedo in [false, true] {
-            for array in [false, true] {
+            for maps in ShadowMaps::ALL {
                 out.push(PipelineShaders::fullscreen(
                     FRAGMENT,
-                    &defines(uint, albedo, array),
+                    &defines(uint, albedo, maps),
                 ));
             }
         }
@@ -273,7 +296,8 @@ impl TransmissionEffect {
             unreachable!("missing() lists each input the effect reads");
         };
         check_views(desc.views_per_frame)?;
-        check_shadow_format(desc.shadow_format)?;
+        check_shadow_format(desc.shadow_format, "shadow map")?;
+        let shadow_maps = ShadowMaps::described(desc.shadow_array, desc.second_shadow_format)?;
         if desc.materials.is_empty() || desc.materials.len() >= MAX_SSS_PROFILES {
             return Err(HostError::Description {
                 field: "materials".into(),
@@ -330,13 +354,14 @@ impl TransmissionEffect {
             "TransmissionEffect",
             upload,
             desc.views_per_frame,
-            |scene_gpu| declare(&desc, uint_ids, scene_gpu),
+            |scene_gpu| declare(&desc, uint_ids, shadow_maps, scene_gpu),
         )?;
         let out = Self {
             passes,
             imports,
             desc,
             normals,
+            shadow_maps,
         };
         // The media do not change between frames: written once into every slot.
         for slot in 0..out.passes.slots() {
@@ -363,13 +388,8 @@ impl TransmissionEffect {
     ) -> Result<()> {
         let ring = self.passes.slot(frame.slot, frame.view)?;
         check_lights(frame.lights)?;
-        let inputs = self.check_images(lucent, frame)?;
-        let shadows = shadow_table(
-            frame.lights,
-            frame.shadow_faces,
-            frame.images.shadow_map.extent,
-            frame.images.shadow_map.layers,
-        )?;
+        let (inputs, maps) = self.check_images(lucent, frame)?;
+        let shadows = shadow_table(frame.lights, frame.shadow_faces, &maps)?;
         let gbuffer = &self.desc.gbuffer;
         let uniforms = gbuffer
             .view_uniforms(&frame.camera)?
@@ -401,6 +421,9 @@ impl TransmissionEffect {
         if let (Some(id), Some(albedo)) = (self.imports.albedo, images.albedo) {
             binds.push((id, albedo));
         }
+        if let (Some(id), Some(map)) = (self.imports.second_shadow_map, images.second_shadow_map) {
+            binds.push((id, map));
+        }
         self.passes.record(
             lucent,
             cmd,
@@ -413,12 +436,13 @@ impl TransmissionEffect {
     }
 
     /// Checks every image of `frame` against the description; returns the inputs, one per
-    /// distinct Vulkan image.
+    /// distinct Vulkan image, and the shadow maps' sizes and layers.
+    #[allow(clippy::type_complexity)]
     fn check_images<'a>(
         &self,
         lucent: &Lucent,
         frame: &TransmissionFrame<'a>,
-    ) -> Result<Vec<&'a HostImage>> {
+    ) -> Result<(Vec<&'a HostImage>, Vec<(vk::Extent2D, u32)>)> {
         let gbuffer = &self.desc.gbuffer;
         let images = &frame.images;
         let ids = gbuffer.material_ids.expect("checked at new");
@@ -446,14 +470,14 @@ impl TransmissionEffect {
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
         check_described(lucent, gbuffer.extent(), &checks)?;
-        // The shadow map has a size (and maybe layers) of its own.
-        check_shadow_map(
+        // The shadow maps have a size (and maybe layers) of their own.
+        let maps = self.shadow_maps.check_frame(
             lucent.gpu(),
             images.shadow_map,
-            self.desc.shadow_format,
-            self.desc.shadow_array,
+            images.second_shadow_map,
+            (self.desc.shadow_format, self.desc.second_shadow_format),
         )?;
-        distinct_inputs(
+        let inputs = distinct_inputs(
             [
                 images.depth,
                 images.normals,
@@ -461,9 +485,11 @@ impl TransmissionEffect {
                 images.shadow_map,
             ]
             .into_iter()
+            .chain(images.second_shadow_map)
             .chain(albedo),
             frame.lighting,
-        )
+        )?;
+        Ok((inputs, maps))
     }
 }
 
@@ -472,6 +498,7 @@ impl TransmissionEffect {
 fn declare(
     desc: &TransmissionEffectDesc,
     uint_ids: bool,
+    shadow_maps: ShadowMaps,
     scene_gpu: &Arc<SceneGpu>,
 ) -> (RenderGraph, Imports) {
     let gbuffer = &desc.gbuffer;
@@ -482,6 +509,9 @@ fn declare(
     };
     let sampled = Access::FragmentSampledRead;
     let shadow_map = import("host shadow map", desc.shadow_format, sampled);
+    let second_shadow_map = desc
+        .second_shadow_format
+        .map(|format| import("host second shadow map", format, sampled));
     let depth = import("host depth", gbuffer.depth.format, sampled);
     let normal_format = gbuffer.normals.expect("checked at new").format;
     let normals = import("host normals", normal_format, sampled);
@@ -505,6 +535,7 @@ fn declare(
         material_ids: material_ids.id(),
         albedo: albedo.as_ref().map(|a| a.id()),
         shadow_map: shadow_map.id(),
+        second_shadow_map: second_shadow_map.as_ref().map(|m| m.id()),
         lighting: lighting.id(),
     };
     let mut pass = FullscreenPass::new(&mut graph, "host transmission", FRAGMENT, Some(scene_gpu));
@@ -519,7 +550,10 @@ fn declare(
     if let Some(albedo) = &albedo {
         pass.sample("albedo_image", albedo);
     }
-    pass.defines(&defines(uint_ids, reads_albedo, desc.shadow_array))
+    if let Some(map) = &second_shadow_map {
+        pass.sample("shadow_layers", map);
+    }
+    pass.defines(&defines(uint_ids, reads_albedo, shadow_maps))
         .tiles(|scene, ctx| {
             let regions = &scene.per_frame.tiles(ctx.frame).lighting;
             (!regions.is_empty()).then(|| regions.clone())

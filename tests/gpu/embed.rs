@@ -1820,6 +1820,7 @@ fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_err
             surface: lucent::embed::LeanSurface::Normals(&diffuse_host),
             lights: &scene.lights,
             shadow_map: None,
+            second_shadow_map: None,
             shadow_faces: &[],
         }),
     };
@@ -2209,6 +2210,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                         material_ids: images.material_ids,
                         albedo: Some(&colour_in),
                         shadow_map: &shadow_map,
+                        second_shadow_map: None,
                     },
                     regions: &[],
                     lighting: &lighting,

@@ -15,7 +15,7 @@ use crate::embed::{
     tonemapped, wrap, HostDepth, HostIds,
 };
 use crate::embed_translucency::{normal_image, rgba8, HostNormals};
-use crate::embed_transmission::{upload_host_shadow_map, HostShadowZ};
+use crate::embed_transmission::{upload_host_shadow_map, upload_split_shadow_maps, HostShadowZ};
 
 use ash::vk;
 use lucent::backend::ImageDesc;
@@ -345,10 +345,30 @@ fn compare_lean(
                 HostDepth::Linear => HostShadowZ::ReversedInfinite,
                 _ => HostShadowZ::Standard,
             };
-            // The D24S8 one keeps each face in a layer of an array.
+            // The D24S8 one keeps each face in a layer of an array; the reversed-Z one writing
+            // its own LEAN targets keeps the sun's face (standard Z) in an array beside its
+            // atlas of the point light's six (a second map).
             let array = depth_kind == HostDepth::D24Stencil;
-            let shadow_map =
-                upload_host_shadow_map(test, &shadow_depths, (sw, sh), &faces, shadow_z, array);
+            let split = targets && depth_kind == HostDepth::ReversedInfinite;
+            let (shadow_map, second) = if split {
+                let maps = upload_split_shadow_maps(
+                    test,
+                    &shadow_depths,
+                    (sw, sh),
+                    &faces,
+                    &scene.lights,
+                    |l| matches!(l.kind, lucent::scene::LightKind::Directional { .. }),
+                    shadow_z,
+                );
+                (
+                    maps.atlas,
+                    Some((maps.array, maps.array_view, maps.array_host)),
+                )
+            } else {
+                let map =
+                    upload_host_shadow_map(test, &shadow_depths, (sw, sh), &faces, shadow_z, array);
+                (map, None)
+            };
             let mut layout = host_layout(
                 test,
                 depth_kind,
@@ -404,6 +424,8 @@ fn compare_lean(
                     .with_shadow_maps(vk::Format::D32_SFLOAT);
             let effect_desc = if array {
                 effect_desc.with_shadow_array()
+            } else if split {
+                effect_desc.with_second_shadow_map(vk::Format::D32_SFLOAT)
             } else {
                 effect_desc
             };
@@ -454,6 +476,7 @@ fn compare_lean(
                                     surface: lean_surface,
                                     lights: &scene.lights,
                                     shadow_map: Some(&shadow_map.host),
+                                    second_shadow_map: second.as_ref().map(|(_, _, host)| host),
                                     shadow_faces: &shadow_map.faces,
                                 }),
                             },
@@ -485,6 +508,11 @@ fn compare_lean(
             drop(lucent);
             gpu.destroy_image(normals);
             gpu.destroy_image(shadow_map.image);
+            if let Some((array, view, _)) = second {
+                // SAFETY: made for this test; the frames that read it completed.
+                unsafe { gpu.device.destroy_image_view(view, None) };
+                gpu.destroy_image(array);
+            }
             layout.destroy(test);
         }
         gpu.destroy_image(diffuse);
@@ -600,6 +628,23 @@ fn a_lean_blur_without_normals_a_surface_or_its_lighting_is_a_typed_error() {
     ));
     assert!(
         matches!(&e, HostError::Unsupported { input, .. } if input == "shadow map"),
+        "{e}"
+    );
+    // A second shadow map without a first, or beside a first that is an array.
+    let second = SssEffectDesc::new(with_normals.clone(), vec![lbb(true)], format)
+        .with_second_shadow_map(vk::Format::D32_SFLOAT);
+    let e = host_error(build(second.clone()));
+    assert!(
+        matches!(&e, HostError::Description { field, .. } if field == "second_shadow_format"),
+        "{e}"
+    );
+    let e = host_error(build(
+        second
+            .with_shadow_maps(vk::Format::D32_SFLOAT)
+            .with_shadow_array(),
+    ));
+    assert!(
+        matches!(&e, HostError::Unsupported { input, .. } if input == "second shadow map"),
         "{e}"
     );
     // Built right, it has its LEAN pass.

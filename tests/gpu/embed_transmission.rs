@@ -92,6 +92,17 @@ intensity = 1.5
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// How a host lays out its shadow maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Maps {
+    /// One atlas.
+    Atlas,
+    /// One array, a face per layer.
+    Array,
+    /// An atlas and an array beside it (`with_second_shadow_map`).
+    AtlasAndArray,
+}
+
 /// How a host's shadow map stores depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum HostShadowZ {
@@ -244,6 +255,86 @@ pub(crate) fn upload_host_shadow_map(
     HostShadowMap { image, host, faces }
 }
 
+/// lucent's atlas (`depths`, `size`) and its `faces` as a host keeping the faces of the lights
+/// `in_array` picks (a point light's cube faces, say) in an array beside an atlas of its
+/// other faces hands them over: the atlas stored as `z` (the moved faces' tiles unread), and
+/// a second map, an array with each moved face in a layer of its own ([`host_shadow_array`],
+/// standard Z), its faces [`ShadowFace::in_second_map`].
+pub(crate) struct SplitShadowMaps {
+    pub(crate) atlas: HostShadowMap,
+    pub(crate) array: GpuImage,
+    /// The array's 2-D array view (one even for a single layer, as the host must make it).
+    pub(crate) array_view: vk::ImageView,
+    pub(crate) array_host: HostImage,
+}
+
+pub(crate) fn upload_split_shadow_maps(
+    test: &TestGpu,
+    depths: &[f32],
+    size: (u32, u32),
+    faces: &[ShadowFace],
+    lights: &[lucent::scene::Light],
+    in_array: impl Fn(&lucent::scene::Light) -> bool,
+    z: HostShadowZ,
+) -> SplitShadowMaps {
+    let is_cube = |f: &ShadowFace| in_array(&lights[f.light]);
+    let cube: Vec<ShadowFace> = faces.iter().filter(|f| is_cube(f)).copied().collect();
+    assert!(!cube.is_empty() && cube.len() < faces.len());
+    let (texels, edge, cube_faces) = host_shadow_array(depths, size, &cube);
+    let usage = vk::ImageUsageFlags::SAMPLED;
+    let layers = cube_faces.len() as u32;
+    let array = test
+        .gpu
+        .upload_image(
+            &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage).with_layers(layers),
+            &[bytemuck::cast_slice(&texels).to_vec()],
+            "host cube array",
+        )
+        .unwrap();
+    let info = vk::ImageViewCreateInfo::default()
+        .image(array.image)
+        .view_type(vk::ImageViewType::TYPE_2D_ARRAY)
+        .format(vk::Format::D32_SFLOAT)
+        .subresource_range(array.desc.subresource_range());
+    // SAFETY: a live image of this device, its whole range.
+    let array_view = unsafe { test.gpu.device.create_image_view(&info, None) }.unwrap();
+    let array_host = HostImage::new(
+        "host cube array",
+        array.image,
+        array_view,
+        vk::Format::D32_SFLOAT,
+        vk::Extent2D {
+            width: edge,
+            height: edge,
+        },
+        usage,
+    )
+    .with_layers(layers)
+    .in_state(ImageState::fragment_sampled());
+    let mut atlas = upload_host_shadow_map(test, depths, size, faces, z, false);
+    // The faces in the frame's order: each cube face in its layer of the second map (standard
+    // Z), the others in the atlas as `z` stores them.
+    let mut in_array = cube_faces.into_iter();
+    atlas.faces = faces
+        .iter()
+        .zip(atlas.faces.clone())
+        .map(|(f, in_atlas)| {
+            if is_cube(f) {
+                let face = in_array.next().unwrap();
+                face.in_second_map(face.layer)
+            } else {
+                in_atlas
+            }
+        })
+        .collect();
+    SplitShadowMaps {
+        atlas,
+        array,
+        array_view,
+        array_host,
+    }
+}
+
 #[test]
 fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
     let test = TestGpu::new();
@@ -339,14 +430,14 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         )
         .unwrap();
     let mut report = Vec::new();
-    for (name, depth_kind, ids_kind, normals_kind, shadow_z, array) in [
+    for (name, depth_kind, ids_kind, normals_kind, shadow_z, maps) in [
         (
             "D32, world RGBA16F normals, R8_UNORM IDs",
             HostDepth::Standard,
             HostIds::Unorm,
             HostNormals::WorldHalf,
             HostShadowZ::Standard,
-            false,
+            Maps::Atlas,
         ),
         (
             "reversed-Z infinite D32, view-space octahedral RG16 normals, R8_UINT IDs, a \
@@ -355,7 +446,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::Uint,
             HostNormals::ViewOctahedralUnorm,
             HostShadowZ::Reversed,
-            false,
+            Maps::Atlas,
         ),
         (
             "D24S8 with IDs in stencil bits 4-7, world RGBA16_UNORM normals",
@@ -363,7 +454,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::Stencil,
             HostNormals::WorldUnorm,
             HostShadowZ::Standard,
-            false,
+            Maps::Atlas,
         ),
         (
             "linear R32F depth, IDs in bits of a packed RGBA8 alpha, world octahedral RG32F \
@@ -372,7 +463,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::AlphaBits,
             HostNormals::WorldOctahedralFloat,
             HostShadowZ::ReversedInfinite,
-            false,
+            Maps::Atlas,
         ),
         (
             "D32, world RGBA16F normals, R8_UNORM IDs, each shadow face in a layer of an array",
@@ -380,10 +471,37 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             HostIds::Unorm,
             HostNormals::WorldHalf,
             HostShadowZ::Standard,
-            true,
+            Maps::Array,
+        ),
+        (
+            "D32, world RGBA16F normals, R8_UNORM IDs, the spot's and sun's faces in an atlas, \
+             the point light's six in a second map, an array",
+            HostDepth::Standard,
+            HostIds::Unorm,
+            HostNormals::WorldHalf,
+            HostShadowZ::Standard,
+            Maps::AtlasAndArray,
         ),
     ] {
-        let shadow_map = upload_host_shadow_map(&test, &depths, (sw, sh), &faces, shadow_z, array);
+        let (shadow_map, second) = if maps == Maps::AtlasAndArray {
+            let split = upload_split_shadow_maps(
+                &test,
+                &depths,
+                (sw, sh),
+                &faces,
+                &scene.lights,
+                |l| matches!(l.kind, lucent::scene::LightKind::Point { .. }),
+                shadow_z,
+            );
+            (
+                split.atlas,
+                Some((split.array, split.array_view, split.array_host)),
+            )
+        } else {
+            let array = maps == Maps::Array;
+            let map = upload_host_shadow_map(&test, &depths, (sw, sh), &faces, shadow_z, array);
+            (map, None)
+        };
         let mut layout = host_layout(
             &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
         );
@@ -409,10 +527,10 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             TransmissionEffect::new(&lucent, u, {
                 let effect =
                     TransmissionEffectDesc::new(desc.clone(), materials, vk::Format::D32_SFLOAT);
-                if array {
-                    effect.with_shadow_array()
-                } else {
-                    effect
+                match maps {
+                    Maps::Atlas => effect,
+                    Maps::Array => effect.with_shadow_array(),
+                    Maps::AtlasAndArray => effect.with_second_shadow_map(vk::Format::D32_SFLOAT),
                 }
             })
         })
@@ -424,27 +542,48 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
             &desc,
             bytemuck::cast_slice(&without.diffuse),
             |k, cmd, images| {
+                let normals = described(&normals, "host normals", usage);
+                let albedo = described(&albedo, "host albedo", usage);
+                let frame = TransmissionFrame {
+                    slot: k,
+                    view: 0,
+                    camera: layout.camera,
+                    lights: &scene.lights,
+                    shadow_faces: &shadow_map.faces,
+                    images: TransmissionImages {
+                        depth: images.depth,
+                        normals: &normals,
+                        material_ids: images.ids.unwrap(),
+                        albedo: Some(&albedo),
+                        shadow_map: &shadow_map.host,
+                        second_shadow_map: second.as_ref().map(|(_, _, host)| host),
+                    },
+                    regions: &[],
+                    lighting: images.lighting,
+                };
+                if k == 0 && maps == Maps::AtlasAndArray {
+                    // Without the second map, or with the cube faces said to be in the
+                    // first: typed errors, before anything is recorded.
+                    let mut without = frame;
+                    without.images.second_shadow_map = None;
+                    let e = host_error(effect.record(&lucent, cmd, &without));
+                    assert!(
+                        matches!(&e, HostError::Missing { input, .. } if input == "second shadow map"),
+                        "{e}"
+                    );
+                    let in_first: Vec<ShadowFace> = shadow_map
+                        .faces
+                        .iter()
+                        .map(|f| changed(f, |f| f.map = 0))
+                        .collect();
+                    let mut misplaced = frame;
+                    misplaced.shadow_faces = &in_first;
+                    // (The cube faces' layers 1 to 5 are past the atlas's one layer.)
+                    let e = host_error(effect.record(&lucent, cmd, &misplaced));
+                    assert!(matches!(&e, HostError::Description { .. }), "{e}");
+                }
                 effect
-                    .record(
-                        &lucent,
-                        cmd,
-                        &TransmissionFrame {
-                            slot: k,
-                            view: 0,
-                            camera: layout.camera,
-                            lights: &scene.lights,
-                            shadow_faces: &shadow_map.faces,
-                            images: TransmissionImages {
-                                depth: images.depth,
-                                normals: &described(&normals, "host normals", usage),
-                                material_ids: images.ids.unwrap(),
-                                albedo: Some(&described(&albedo, "host albedo", usage)),
-                                shadow_map: &shadow_map.host,
-                            },
-                            regions: &[],
-                            lighting: images.lighting,
-                        },
-                    )
+                    .record(&lucent, cmd, &frame)
                     .unwrap_or_else(|e| panic!("{name}: {e}"));
             },
         );
@@ -468,6 +607,11 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         drop(lucent);
         gpu.destroy_image(normals);
         gpu.destroy_image(shadow_map.image);
+        if let Some((array, view, _)) = second {
+            // SAFETY: made for this test; the frames that read it completed.
+            unsafe { gpu.device.destroy_image_view(view, None) };
+            gpu.destroy_image(array);
+        }
         layout.destroy(&test);
     }
     gpu.destroy_image(albedo);
@@ -532,6 +676,35 @@ fn a_transmission_description_missing_an_input_or_with_bad_faces_is_a_typed_erro
     for materials in [vec![], vec![material.clone(), material.clone()]] {
         let e = host_error(build(gbuffer.clone(), materials, d32));
         assert!(matches!(&e, HostError::Description { .. }), "{e}");
+    }
+    // A second shadow map beside a first that is an array; one that is not a depth format;
+    // the albedo as each SSS texturing asks, which the transmitted light cannot follow.
+    let desc = |second| {
+        TransmissionEffectDesc::new(gbuffer.clone(), vec![material.clone()], d32)
+            .with_second_shadow_map(second)
+    };
+    for (desc, input) in [
+        (desc(d32).with_shadow_array(), "second shadow map"),
+        (desc(vk::Format::R32_SFLOAT), "second shadow map"),
+        (
+            TransmissionEffectDesc::new(
+                changed(&gbuffer, |g| {
+                    g.diffuse =
+                        DiffuseDesc::with_albedo_as_texturing(vk::Format::R16G16B16A16_SFLOAT)
+                }),
+                vec![material.clone()],
+                d32,
+            ),
+            "diffuse",
+        ),
+    ] {
+        let e = host_error(built(&test, &lucent, |u| {
+            TransmissionEffect::new(&lucent, u, desc)
+        }));
+        assert!(
+            matches!(&e, HostError::Unsupported { input: i, .. } if i == input),
+            "{input}: {e}"
+        );
     }
     let effect = build(gbuffer, vec![material], d32).unwrap();
     effect.destroy(&lucent);

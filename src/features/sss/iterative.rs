@@ -219,8 +219,7 @@ pub(super) fn chain_passes(
     }
     // LEAN specular is direct light: the light-space maps shadow it.
     if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some()) {
-        pass.shadows(depth);
-        pass.defines(&super::shadow_defines(inputs));
+        super::bind_shadow_maps(&mut pass, inputs, depth);
     }
     pass.color(&mut hdr, LoadOp::DontCare);
     // With SSS tiles, `final lighting` evaluates LEAN only on the rectangles its chain may

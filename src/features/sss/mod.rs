@@ -687,6 +687,10 @@ pub struct SssInputs<'a> {
     /// `shadow_depth` is an array of layers (a host's cascades or cube faces, each face in its
     /// layer: define `LUCENT_SHADOW_ARRAY`); lucent's own maps are one atlas.
     pub shadow_array: bool,
+    /// A host's second shadow map beside `shadow_depth` (an atlas): an array of layers,
+    /// sampled as `shadow_layers` (define `LUCENT_SHADOW_SECOND_MAP`; its faces are marked
+    /// in the shadow table). lucent's own maps are one atlas.
+    pub second_shadow_depth: Option<&'a Handle<Image>>,
     /// `shadow_depth` is a host's map, whose faces may store reversed Z (define
     /// `LUCENT_SHADOW_REVERSIBLE`: the shadow table says per face); lucent's own maps store
     /// standard Z.
@@ -891,6 +895,20 @@ const SHADOW_ARRAY: &[(&str, &str)] = &[("LUCENT_SHADOW_ARRAY", "1")];
 /// The define of passes reading a host's shadow map ([`SssInputs::shadow_reversible`]).
 const SHADOW_REVERSIBLE: &[(&str, &str)] = &[("LUCENT_SHADOW_REVERSIBLE", "1")];
 
+/// The define of a pass reading a host's second shadow map, an array beside an atlas
+/// ([`SssInputs::second_shadow_depth`]).
+const SHADOW_SECOND_MAP: &[(&str, &str)] = &[("LUCENT_SHADOW_SECOND_MAP", "1")];
+
+/// Binds the shadow maps of `inputs` to a pass reading them (the first map's depth `depth`):
+/// the light-space atlas, a host's second map beside it, and their defines.
+fn bind_shadow_maps(pass: &mut FullscreenPass<'_>, inputs: &SssInputs<'_>, depth: &Handle<Image>) {
+    pass.shadows(depth);
+    if let Some(second) = inputs.second_shadow_depth {
+        pass.sample("shadow_layers", second);
+    }
+    pass.defines(&shadow_defines(inputs));
+}
+
 /// The defines of an SSS pass that reads the shadow map of `inputs`.
 fn shadow_defines(inputs: &SssInputs<'_>) -> Vec<(&'static str, &'static str)> {
     let mut defines = Vec::new();
@@ -899,6 +917,9 @@ fn shadow_defines(inputs: &SssInputs<'_>) -> Vec<(&'static str, &'static str)> {
     }
     if inputs.shadow_reversible {
         defines.extend_from_slice(SHADOW_REVERSIBLE);
+    }
+    if inputs.second_shadow_depth.is_some() {
+        defines.extend_from_slice(SHADOW_SECOND_MAP);
     }
     defines
 }
@@ -1042,12 +1063,14 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
         .cloned()
         .collect();
     // A host's shadow map may store reversed Z, and may be an array (its cascades, a cube's
-    // faces); its passes without shadows are lucent's own.
+    // faces), or an atlas with an array beside it; its passes without shadows are lucent's
+    // own.
     let mut host: Vec<Shaders> = Vec::new();
     for p in &own {
         if p.defines.iter().any(|(name, _)| name == "LUCENT_SHADOWS") {
             let reversible = with(p, SHADOW_REVERSIBLE);
             host.push(with(&reversible, SHADOW_ARRAY));
+            host.push(with(&reversible, SHADOW_SECOND_MAP));
             host.push(reversible);
         }
     }

@@ -137,6 +137,7 @@ impl FramePart for SssProfiles {
                 shadow_depth: images.shadow_maps.map(|m| &m.depth),
                 // lucent's own light-space maps are one atlas.
                 shadow_array: false,
+                second_shadow_depth: None,
                 shadow_reversible: false,
                 albedo: gb.layout.sss_texturing.then_some(&gb.gb0),
                 depth_in_alpha: self.depth_in_alpha(),

@@ -150,8 +150,7 @@ pub(super) fn chain_passes(
     );
     // The bilateral chain's LEAN specular is direct light: the light-space maps shadow it.
     if let Some(depth) = inputs.shadow_depth.filter(|_| lean.is_some() && !half_res) {
-        pass.shadows(depth);
-        pass.defines(&super::shadow_defines(inputs));
+        super::bind_shadow_maps(&mut pass, inputs, depth);
     }
     pass.taps(fetches(texels, blur.bilateral()));
     pass.color(&mut vertical_out, LoadOp::DontCare);

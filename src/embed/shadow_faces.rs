@@ -177,22 +177,11 @@ impl ShadowMaps {
         second: Option<&HostImage>,
         formats: (vk::Format, Option<vk::Format>),
     ) -> Result<Vec<(vk::Extent2D, u32)>> {
-        check_shadow_map(gpu, first, formats.0, self == Self::Array)?;
+        check_shadow_map(gpu, first, "shadow map", formats.0, self == Self::Array)?;
         let mut maps = vec![(first.extent, first.layers)];
         match (formats.1, second) {
             (Some(format), Some(map)) => {
-                check_image(
-                    gpu,
-                    map,
-                    "second shadow map",
-                    Role::ShadowMap,
-                    map.extent,
-                    |f| f == format,
-                    &format!(
-                        "{} (the description's)",
-                        crate::backend::format::format_name(format)
-                    ),
-                )?;
+                check_shadow_map(gpu, map, "second shadow map", format, true)?;
                 maps.push((map.extent, map.layers));
             }
             (None, None) => {}
@@ -219,12 +208,13 @@ impl ShadowMaps {
     }
 }
 
-/// Checks a frame's host shadow map against the effect's description: its layers (an array,
-/// `array`, may have any number; an atlas is one 2-D image), then as an image of the
-/// description's `format` ([`check_image`], its own size).
-pub(crate) fn check_shadow_map(
+/// Checks a frame's host shadow map (`input`: which, for the errors) against the effect's
+/// description: its layers (an array, `array`, may have any number; an atlas is one 2-D
+/// image), then as an image of the description's `format` ([`check_image`], its own size).
+fn check_shadow_map(
     gpu: &crate::backend::GpuContext,
     map: &HostImage,
+    input: &str,
     format: vk::Format,
     array: bool,
 ) -> Result<()> {
@@ -232,7 +222,7 @@ pub(crate) fn check_shadow_map(
     check_image(
         gpu,
         map,
-        "shadow map",
+        input,
         Role::ShadowMap,
         map.extent,
         |f| f == format,

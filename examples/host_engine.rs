@@ -31,12 +31,14 @@
 //!    sphere and a floor quad, f32 positions and R16G16B16A16_SNORM normals, 20 bytes a
 //!    vertex, not indexed), each object placed by its model matrix, with the faces the engine
 //!    gives: the sun's orthographic one and the back light's six.
-//!    The engine renders its own shadow maps of the same faces (depth only, standard Z, one
-//!    D32 atlas drawn from the same vertex buffer) for:
+//!    The engine renders its own shadow maps of the same faces (depth only, standard Z, drawn
+//!    from the same vertex buffer: the sun's face in a D32 atlas, the back light's six in the
+//!    layers of a D32 cube array beside it) for:
 //! 6. **lucent's SSS transmission** (`TransmissionEffect`): the light of both lights diffused
 //!    through the skin's and the marble's thin parts (their rims seen against the lights),
-//!    measured in the engine's shadow atlas, added to the lit diffuse (`--no-transmission`
-//!    leaves it and the engine's shadow maps out).
+//!    measured in the engine's shadow atlas and cube array (lucent's second shadow map:
+//!    `with_second_shadow_map`, `ShadowFace::in_second_map`), added to the lit diffuse
+//!    (`--no-transmission` leaves it and the engine's shadow maps out).
 //! 7. **lucent's SSS** (`SssEffect`): reads the engine's depth, lit diffuse, specular, albedo
 //!    and material IDs as they are, blurs the skin and marble pixels and writes diffuse +
 //!    specular into the engine's HDR target. With `--without-lucent` the engine composes
@@ -47,8 +49,9 @@
 //!    `lucent_sh_ambient`, `lucent_translucency`, `lucent_sss_transmitted`) and lucent's data
 //!    (the environment's coefficients, the leaf's material row, the lights' translucency
 //!    scales, the skin's and marble's medium rows), the transmission's thickness measured in
-//!    the engine's own shadow atlas with lucent's lookup (`lucent_shadow_texels`, the faces'
-//!    rows from `ShadowFace::terms_rows`): no pass of lucent's but the layered media and the
+//!    the engine's own shadow atlas and cube array with lucent's lookup (`lucent_shadow_texels`
+//!    on a `sampler2D` or a `sampler2DArray`, the faces' rows from `ShadowFace::terms_rows`):
+//!    no pass of lucent's but the layered media and the
 //!    SSS, the same picture within the target's rounding.
 //! 8. **Tonemap** (fullscreen) into an RGBA8 sRGB image, which the last frame copies out as PNG.
 //!
@@ -144,9 +147,19 @@ const LIGHT_SPACE: vk::Extent2D = vk::Extent2D {
     height: 768,
 };
 const SUN_FACE_EDGE: u32 = 512;
-/// The engine's shadow atlas: depth, standard Z (lucent reads shadow maps so).
+/// The engine's shadow maps: depth, standard Z (lucent reads shadow maps so). Its atlas holds
+/// the sun's face; its back light's six faces are the layers of a cube array beside it (lucent
+/// reads the array as the effects' second shadow map).
 const SHADOW_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 const POINT_FACE_EDGE: u32 = 256;
+const SHADOW_ATLAS: vk::Extent2D = vk::Extent2D {
+    width: SUN_FACE_EDGE,
+    height: SUN_FACE_EDGE,
+};
+const SHADOW_CUBE: vk::Extent2D = vk::Extent2D {
+    width: POINT_FACE_EDGE,
+    height: POINT_FACE_EDGE,
+};
 /// The procedural sphere's tessellation (its vertex count is `6 * STACKS * SLICES`).
 const STACKS: u32 = 48;
 const SLICES: u32 = 64;
@@ -420,9 +433,9 @@ void main() {{
     pub struct FusedTransmission {
         /// The skin's and the marble's rows.
         pub media: [[[f32; 4]; 4]; 2],
-        /// The engine's shadow faces as its lighting reads its atlas
+        /// The engine's shadow faces as its lighting reads its atlas and cube array
         /// (`ShadowFace::terms_rows`): the sun's, then the back light's six (+X, -X, +Y, -Y,
-        /// +Z, -Z).
+        /// +Z, -Z), each in its layer.
         pub faces: Vec<[[f32; 4]; 6]>,
     }
 
@@ -467,9 +480,10 @@ void main() {{
     }
 
     /// lucent's transmission on the engine's shadow maps: its atlas (binding 5, standard
-    /// Z), each face's constants, and lucent's recipe for the thickness a map measures (the
-    /// point one map texel inside, the four texels around it, lucent's transmission term per
-    /// texel weighted bilinearly: `lucent_sss_transmitted`).
+    /// Z: the sun's face) and cube array (binding 6: the back light's faces, one a layer),
+    /// each face's constants, and lucent's recipe for the thickness a map measures (the point
+    /// one map texel inside, the four texels around it, lucent's transmission term per texel
+    /// weighted bilinearly: `lucent_sss_transmitted`).
     fn transmission_glsl(t: &FusedTransmission, vec4: &dyn Fn([f32; 4]) -> String) -> String {
         let mat4 = |m: &[[f32; 4]; 4]| format!("mat4({})", m.map(vec4).join(", "));
         format!(
@@ -477,6 +491,7 @@ void main() {{
 const vec4 SKIN_MEDIUM[4] = vec4[4]({SKIN_MEDIUM});
 const vec4 MARBLE_MEDIUM[4] = vec4[4]({MARBLE_MEDIUM});
 layout(set = 0, binding = 5) uniform sampler2D shadow_atlas;   // the engine's, standard Z
+layout(set = 0, binding = 6) uniform sampler2DArray shadow_cube;  // its back light's faces
 // Face f's rows (lucent::embed::ShadowFace::terms_rows: its world-to-clip matrix, standard
 // Z; its rectangle in the atlas; its texel size, near and far). Chosen by comparisons, not
 // read from a constant array: a CPU driver copies a dynamically indexed constant array per
@@ -487,7 +502,8 @@ void face_data(int f, out mat4 view_proj, out vec4 rect, out vec4 params) {{
 
 // The light that reaches p (normal n, towards the light l) through the object from face f's
 // light (at light_pos; `point` lights fall off as the engine's back light, the sun does not):
-// lucent's recipe (lucent_shadow_texels) on the engine's atlas and lucent's term per entry.
+// lucent's recipe (lucent_shadow_texels) on the engine's atlas (face 0, the sun's) or cube
+// array (the others) and lucent's term per entry.
 vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 radiance,
                          bool point, vec3 light_pos) {{
     if (!(dot(n, l) < 0.0)) {{
@@ -499,8 +515,15 @@ vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 rad
     vec3 inner;
     float inner_distance;
     vec4 texel_distances, w;
-    if (!lucent_shadow_texels(shadow_atlas, view_proj, rect, params, p, n, inner,
-                              inner_distance, texel_distances, w)) {{
+    bool seen;
+    if (f == 0) {{
+        seen = lucent_shadow_texels(shadow_atlas, view_proj, rect, params, p, n, inner,
+                                    inner_distance, texel_distances, w);
+    }} else {{
+        seen = lucent_shadow_texels(shadow_cube, view_proj, rect, params, p, n, inner,
+                                    inner_distance, texel_distances, w);
+    }}
+    if (!seen) {{
         return vec3(0.0);  // outside the face: nothing measures the thickness
     }}
     vec3 sum = vec3(0.0);
@@ -571,7 +594,7 @@ vec3 transmitted_through(vec4 medium[4], int f, vec3 p, vec3 n, vec3 l, vec3 rad
                     added += &format!(
                         r#"
     // SSS transmission through the skin and the marble, from both lights, measured in the
-    // engine's shadow atlas: lucent's term (what its TransmissionEffect adds).
+    // engine's shadow atlas and cube array: lucent's term (what its TransmissionEffect adds).
     uint medium_id = texelFetch(id_tex, px, 0).r;
     if (medium_id == {SKIN}u || medium_id == {MARBLE}u) {{
         vec4 medium[4] = medium_id == {SKIN}u ? SKIN_MEDIUM : MARBLE_MEDIUM;
@@ -911,7 +934,11 @@ fn check(what: &str, r: Result<(), vk::Result>) -> Result<(), String> {
 /// it tells lucent, and the one lucent hands back).
 struct Target {
     image: vk::Image,
+    /// The whole image's view (a 2-D array view for an array).
     view: vk::ImageView,
+    /// Its array layers (1: a 2-D image), and for an array a 2-D view of each to render into.
+    layers: u32,
+    layer_views: Vec<vk::ImageView>,
     memory: Option<Allocation>,
     format: vk::Format,
     usage: vk::ImageUsageFlags,
@@ -924,6 +951,19 @@ fn create_target(
     engine: &Engine,
     allocator: &Mutex<Allocator>,
     extent: vk::Extent2D,
+    format: vk::Format,
+    usage: vk::ImageUsageFlags,
+    name: String,
+) -> Result<Target, String> {
+    create_layered_target(engine, allocator, (extent, 1), format, usage, name)
+}
+
+/// [`create_target`] with `layers` array layers (more than 1: an array, its view a 2-D array
+/// view, each layer with a 2-D view of its own to render into).
+fn create_layered_target(
+    engine: &Engine,
+    allocator: &Mutex<Allocator>,
+    (extent, layers): (vk::Extent2D, u32),
     format: vk::Format,
     usage: vk::ImageUsageFlags,
     name: String,
@@ -947,7 +987,7 @@ fn create_target(
                         depth: 1,
                     })
                     .mip_levels(1)
-                    .array_layers(1)
+                    .array_layers(layers)
                     .samples(vk::SampleCountFlags::TYPE_1)
                     .tiling(vk::ImageTiling::OPTIMAL)
                     .usage(usage),
@@ -969,19 +1009,35 @@ fn create_target(
             "vkBindImageMemory",
             device.bind_image_memory(image, memory.memory(), memory.offset()),
         )?;
-        let view = device
-            .create_image_view(
-                &vk::ImageViewCreateInfo::default()
-                    .image(image)
-                    .view_type(vk::ImageViewType::TYPE_2D)
-                    .format(format)
-                    .subresource_range(range(aspect)),
-                None,
-            )
-            .map_err(|e| format!("vkCreateImageView ({name}): {e}"))?;
+        let view_of = |first: u32, count: u32, view_type| {
+            device
+                .create_image_view(
+                    &vk::ImageViewCreateInfo::default()
+                        .image(image)
+                        .view_type(view_type)
+                        .format(format)
+                        .subresource_range(vk::ImageSubresourceRange {
+                            base_array_layer: first,
+                            layer_count: count,
+                            ..range(aspect, 1)
+                        }),
+                    None,
+                )
+                .map_err(|e| format!("vkCreateImageView ({name}): {e}"))
+        };
+        let (view, layer_views) = if layers > 1 {
+            let views = (0..layers)
+                .map(|layer| view_of(layer, 1, vk::ImageViewType::TYPE_2D))
+                .collect::<Result<Vec<_>, _>>()?;
+            (view_of(0, layers, vk::ImageViewType::TYPE_2D_ARRAY)?, views)
+        } else {
+            (view_of(0, 1, vk::ImageViewType::TYPE_2D)?, Vec::new())
+        };
         Ok(Target {
             image,
             view,
+            layers,
+            layer_views,
             memory: Some(memory),
             format,
             usage,
@@ -992,19 +1048,22 @@ fn create_target(
     }
 }
 
-fn range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+fn range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange {
         aspect_mask: aspect,
         base_mip_level: 0,
         level_count: 1,
         base_array_layer: 0,
-        layer_count: 1,
+        layer_count: layers,
     }
 }
 
 fn destroy_target(engine: &Engine, allocator: &Mutex<Allocator>, mut target: Target) {
     // SAFETY: the device is idle (the caller waited) and the handles are the target's own.
     unsafe {
+        for view in target.layer_views.drain(..) {
+            engine.device.destroy_image_view(view, None);
+        }
         engine.device.destroy_image_view(target.view, None);
         engine.device.destroy_image(target.image, None);
     }
@@ -1040,7 +1099,7 @@ impl Target {
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.image)
-            .subresource_range(range(self.aspect))];
+            .subresource_range(range(self.aspect, self.layers))];
         // SAFETY: `cmd` is recording, outside any rendering.
         unsafe {
             device.cmd_pipeline_barrier2(
@@ -1061,6 +1120,7 @@ impl Target {
             extent,
             self.usage,
         )
+        .with_layers(self.layers)
         .in_state(self.state)
     }
 }
@@ -1080,9 +1140,11 @@ struct FrameSlot {
     specular: Target,
     hdr: Target,
     ldr: Target,
-    /// The engine's shadow atlas (the faces of `light_faces`; none with `--no-transmission`
+    /// The engine's shadow atlas (the sun's face of `shadow_faces`) and cube array (the back
+    /// light's six faces, one a layer; both none with `--no-transmission`
     /// or without lucent).
     shadow: Option<Target>,
+    cube: Option<Target>,
     /// Lighting (depth, normals, albedo), compose (diffuse, specular), tonemap (HDR).
     lighting_set: vk::DescriptorSet,
     compose_set: vk::DescriptorSet,
@@ -1238,9 +1300,9 @@ fn pipeline(
 }
 
 /// The combined image samplers of the engine's one set layout: the lighting reads depth,
-/// normals, albedo, IDs, thickness and (with `--fused` transmission) its shadow atlas; the
-/// other passes' sets read fewer.
-const BINDINGS: u32 = 6;
+/// normals, albedo, IDs, thickness and (with `--fused` transmission) its shadow atlas and cube
+/// array; the other passes' sets read fewer.
+const BINDINGS: u32 = 7;
 
 fn create_pipelines(
     engine: &Engine,
@@ -1544,17 +1606,28 @@ fn create_slot(
     let specular = target(light_format, attachment_sampled, "lit specular")?;
     let hdr = target(HDR_FORMAT, attachment_sampled, "hdr")?;
     let ldr = target(LDR_FORMAT, U::COLOR_ATTACHMENT | U::TRANSFER_SRC, "ldr")?;
-    let shadow = if shadow_maps {
-        Some(create_target(
-            engine,
-            allocator,
-            LIGHT_SPACE,
-            SHADOW_FORMAT,
-            U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED,
-            format!("shadow atlas {index}"),
-        )?)
+    let (shadow, cube) = if shadow_maps {
+        let usage = U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED;
+        (
+            Some(create_target(
+                engine,
+                allocator,
+                SHADOW_ATLAS,
+                SHADOW_FORMAT,
+                usage,
+                format!("shadow atlas {index}"),
+            )?),
+            Some(create_layered_target(
+                engine,
+                allocator,
+                (SHADOW_CUBE, 6),
+                SHADOW_FORMAT,
+                usage,
+                format!("shadow cube array {index}"),
+            )?),
+        )
     } else {
-        None
+        (None, None)
     };
     // SAFETY: plain object creation on the engine's device; destroyed in `destroy_slot`.
     unsafe {
@@ -1620,6 +1693,15 @@ fn create_slot(
             ),
             (sets[1], 5, diffuse.view, sampled),
             (sets[2], 5, hdr.view, sampled),
+            // The cube array (its 2-D array view) likewise.
+            (
+                sets[0],
+                6,
+                cube.as_ref().map_or(depth.view, |c| c.view),
+                ImageState::depth_sampled().layout,
+            ),
+            (sets[1], 6, diffuse.view, sampled),
+            (sets[2], 6, hdr.view, sampled),
         ];
         let infos: Vec<[vk::DescriptorImageInfo; 1]> = writes
             .iter()
@@ -1656,6 +1738,7 @@ fn create_slot(
             hdr,
             ldr,
             shadow,
+            cube,
             lighting_set: sets[0],
             compose_set: sets[1],
             tonemap_set: sets[2],
@@ -1699,6 +1782,7 @@ fn destroy_slot(engine: &Engine, allocator: &Mutex<Allocator>, slot: FrameSlot) 
     ]
     .into_iter()
     .chain(slot.shadow)
+    .chain(slot.cube)
     {
         destroy_target(engine, allocator, target);
     }
@@ -1856,9 +1940,16 @@ fn fused_transmission() -> Result<shaders::FusedTransmission, String> {
         .map_err(|_| "two transmitting materials".to_string())?;
     Ok(shaders::FusedTransmission {
         media: [rows(&skin)?, rows(&marble)?],
-        faces: light_faces(sun_direction())
+        faces: shadow_faces(sun_direction())
             .iter()
-            .map(|face| face.terms_rows(LIGHT_SPACE).map_err(|e| e.to_string()))
+            .map(|face| {
+                let map = if face.map == 0 {
+                    SHADOW_ATLAS
+                } else {
+                    SHADOW_CUBE
+                };
+                face.terms_rows(map).map_err(|e| e.to_string())
+            })
             .collect::<Result<_, _>>()?,
     })
 }
@@ -2002,6 +2093,29 @@ fn light_faces(sun: Vec3) -> Vec<ShadowFace> {
         ));
     }
     faces
+}
+
+/// The faces of the engine's own shadow maps, as it hands them to lucent's transmission and
+/// LEAN blurs: the sun's in its atlas ([`SHADOW_ATLAS`], the same tile as in
+/// [`light_faces`]), the back light's six each filling its layer of the cube array
+/// ([`SHADOW_CUBE`], lucent's second shadow map).
+fn shadow_faces(sun: Vec3) -> Vec<ShadowFace> {
+    let whole = vk::Rect2D {
+        offset: vk::Offset2D::default(),
+        extent: SHADOW_CUBE,
+    };
+    light_faces(sun)
+        .into_iter()
+        .map(|face| match face.light {
+            0 => face,
+            _ => ShadowFace::new(face.light, face.view, face.projection, whole),
+        })
+        .enumerate()
+        .map(|(k, face)| match k {
+            0 => face,
+            _ => face.in_second_map(k as u32 - 1),
+        })
+        .collect()
 }
 
 /// The sun's direction (towards it).
@@ -2484,25 +2598,25 @@ fn record_frame(
     // lucent's layered media and transmission.
     let draws = mesh_draws(meshes);
     let faces = light_faces(sun);
+    let engine_faces = shadow_faces(sun);
 
     // 0. The shadow maps lucent's transmission reads (when it is inserted): every object into
-    // each face's tile of the atlas, depth only, standard Z.
-    if let Some(shadow) = &mut slot.shadow {
+    // the sun's tile of the atlas and into each of the back light's layers of the cube array,
+    // depth only, standard Z.
+    if let (Some(shadow), Some(cube)) = (&mut slot.shadow, &mut slot.cube) {
         let depth_attachment = ImageState {
             layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
             ..ImageState::depth_attachment()
         };
         shadow.transition(device, cmd, depth_attachment, true);
-        begin_rendering(
-            device,
-            cmd,
-            LIGHT_SPACE,
-            &[],
-            Some((shadow.view, 1.0)),
-            true,
-        );
-        for face in &faces {
-            // SAFETY: inside the atlas's rendering.
+        cube.transition(device, cmd, depth_attachment, true);
+        for face in &engine_faces {
+            let (view, extent) = match face.map {
+                0 => (shadow.view, SHADOW_ATLAS),
+                _ => (cube.layer_views[face.layer as usize], SHADOW_CUBE),
+            };
+            begin_rendering(device, cmd, extent, &[], Some((view, 1.0)), true);
+            // SAFETY: inside the map's rendering.
             unsafe {
                 device.cmd_set_viewport(
                     cmd,
@@ -2524,16 +2638,17 @@ fn record_frame(
                     None,
                     face.projection * face.view * draw.transform,
                 );
-                // SAFETY: inside the atlas's rendering, the shadow pipeline bound.
+                // SAFETY: inside the map's rendering, the shadow pipeline bound.
                 unsafe {
                     device.cmd_bind_vertex_buffers(cmd, 0, &[meshes], &[0]);
                     device.cmd_draw(cmd, draw.count, 1, draw.first, 0);
                 }
             }
+            // SAFETY: inside the map's rendering.
+            unsafe { device.cmd_end_rendering(cmd) };
         }
-        // SAFETY: inside the atlas's rendering.
-        unsafe { device.cmd_end_rendering(cmd) };
         shadow.transition(device, cmd, ImageState::depth_sampled(), false);
+        cube.transition(device, cmd, ImageState::depth_sampled(), false);
     }
 
     // 1. The G-buffer.
@@ -2766,22 +2881,25 @@ fn record_frame(
             }
             .map_err(|e| format!("lucent: {e}"))?;
             // SSS transmission through the skin and the marble, measured in the engine's own
-            // shadow atlas (rendered above with the same faces).
-            if let (Some(transmission), Some(shadow)) = (transmission, &slot.shadow) {
-                let shadow_map = shadow.host_image(LIGHT_SPACE);
+            // shadow atlas and cube array (rendered above with the same faces).
+            if let (Some(transmission), Some(shadow), Some(cube)) =
+                (transmission, &slot.shadow, &slot.cube)
+            {
+                let shadow_map = shadow.host_image(SHADOW_ATLAS);
+                let cube_map = cube.host_image(SHADOW_CUBE);
                 let transmission_frame = TransmissionFrame {
                     slot: slot_index,
                     view: 0,
                     camera,
                     lights: &lights,
-                    shadow_faces: &faces,
+                    shadow_faces: &engine_faces,
                     images: TransmissionImages {
                         depth: &depth,
                         normals: &normals,
                         material_ids: &ids,
                         albedo: Some(&albedo),
                         shadow_map: &shadow_map,
-                        second_shadow_map: None,
+                        second_shadow_map: Some(&cube_map),
                     },
                     // The skin's and the marble's projected bounds.
                     regions: &transmission_regions(&camera, extent, effects.whole_screen),
@@ -2813,12 +2931,18 @@ fn record_frame(
                     ..slot.hdr.state
                 })
                 .then(fragment_sampled);
-            // The engine's shadow atlas (when it renders one), as the transmission left it.
+            // The engine's shadow atlas and cube array (when it renders them), as the
+            // transmission left them.
             let sss_shadow_map = slot
                 .shadow
                 .as_ref()
                 .filter(|_| effects.sss_lean)
-                .map(|shadow| shadow.host_image(LIGHT_SPACE));
+                .map(|shadow| shadow.host_image(SHADOW_ATLAS));
+            let sss_cube_map = slot
+                .cube
+                .as_ref()
+                .filter(|_| effects.sss_lean)
+                .map(|cube| cube.host_image(SHADOW_CUBE));
             let frame = SssFrame {
                 slot: slot_index,
                 view: 0,
@@ -2835,14 +2959,14 @@ fn record_frame(
                 regions: &sss_regions(&camera, extent, sss, effects.whole_screen),
                 output: &output,
                 // A LEAN blur's LEAN moments come from the engine's normals, its specular is
-                // relit with the engine's lights, shadowed in the engine's shadow atlas.
+                // relit with the engine's lights, shadowed in the engine's shadow maps.
                 lean: effects.sss_lean.then(|| LeanLighting {
                     surface: LeanSurface::Normals(&normals),
                     lights: &lights,
                     shadow_map: sss_shadow_map.as_ref(),
-                    second_shadow_map: None,
+                    second_shadow_map: sss_cube_map.as_ref(),
                     shadow_faces: if sss_shadow_map.is_some() {
-                        &faces
+                        &engine_faces
                     } else {
                         &[]
                     },
@@ -3022,11 +3146,10 @@ fn create_effects(
         LIGHT_SPACE,
     );
     let transmission_desc = if transmission_effect_on(args) {
-        Some(TransmissionEffectDesc::new(
-            gbuffer.clone(),
-            transmission_materials()?,
-            SHADOW_FORMAT,
-        ))
+        Some(
+            TransmissionEffectDesc::new(gbuffer.clone(), transmission_materials()?, SHADOW_FORMAT)
+                .with_second_shadow_map(SHADOW_FORMAT),
+        )
     } else {
         None
     };
@@ -3048,6 +3171,7 @@ fn create_effects(
     let sss_lean = desc.materials.iter().any(|m| m.surface.is_some());
     let desc = if sss_lean && transmission_on(args) {
         desc.with_shadow_maps(SHADOW_FORMAT)
+            .with_second_shadow_map(SHADOW_FORMAT)
     } else {
         desc
     };
@@ -3104,7 +3228,7 @@ fn create_effects(
                      (lucent::embed::glsl::TERMS), ",
                     if transmission_on(args) {
                         " and transmission (skin and marble, lucent's lookup of the engine's \
-                         shadow atlas)"
+                         shadow atlas and cube array)"
                     } else {
                         ""
                     }

@@ -247,6 +247,33 @@ vec3 lucent_map_entry_point(vec4 params, vec3 light_position, vec3 p, vec3 to_li
     return light_position + (p - light_position) * min(d_map / max(d_p, 1e-12), 1.0);
 }
 
+// lucent_shadow_texels' lookup before the map's read: `pos` moved one map texel inside
+// (`inner`, at `inner_distance`), the gather coordinate of the four texels around it in a map
+// of `map_size` texels and their bilinear weights; false where the face does not see it.
+bool lucent_shadow_corner(mat4 view_proj, vec4 rect, vec4 params, vec2 map_size, vec3 pos,
+                          vec3 normal, out vec3 inner, out float inner_distance,
+                          out vec2 corner, out vec4 weights) {
+    inner = pos - normal * lucent_map_texel_size(view_proj, params, pos);
+    corner = vec2(0.0);
+    weights = vec4(0.0);
+    vec2 t;
+    if (!lucent_map_position(view_proj, rect, params, inner, t, inner_distance)) {
+        return false;
+    }
+    lucent_map_bilinear(rect, 1.0 / map_size, t, corner, weights);
+    return true;
+}
+
+// And after it: the four texels' stored depths `stored` as distances along the face's axis,
+// the weight of a texel holding the far plane (nothing between the light and it) zeroed.
+void lucent_texel_distances(vec4 rect, vec4 params, vec4 stored, inout vec4 weights,
+                            out vec4 texel_distances) {
+    vec4 d = lucent_stored_depth(rect, stored);
+    weights *= vec4(lessThan(d, vec4(1.0)));
+    texel_distances = vec4(lucent_face_distance(params, d.x), lucent_face_distance(params, d.y),
+                           lucent_face_distance(params, d.z), lucent_face_distance(params, d.w));
+}
+
 // lucent's recipe for the thickness a shadow map measures, which SSS transmission diffuses
 // through: from `pos` (outward normal `normal`) moved one map texel inside (`inner`, at
 // `inner_distance` along the face's axis), the four texels of the face's map around it, the
@@ -262,20 +289,31 @@ vec3 lucent_map_entry_point(vec4 params, vec3 light_position, vec3 p, vec3 to_li
 bool lucent_shadow_texels(sampler2D map, mat4 view_proj, vec4 rect, vec4 params, vec3 pos,
                           vec3 normal, out vec3 inner, out float inner_distance,
                           out vec4 texel_distances, out vec4 weights) {
-    inner = pos - normal * lucent_map_texel_size(view_proj, params, pos);
-    texel_distances = vec4(0.0);
-    weights = vec4(0.0);
-    vec2 t;
-    if (!lucent_map_position(view_proj, rect, params, inner, t, inner_distance)) {
+    vec2 corner;
+    if (!lucent_shadow_corner(view_proj, rect, params, vec2(textureSize(map, 0)), pos, normal,
+                              inner, inner_distance, corner, weights)) {
+        texel_distances = vec4(0.0);
         return false;
     }
+    lucent_texel_distances(rect, params, textureGather(map, corner, 0), weights,
+                           texel_distances);
+    return true;
+}
+
+// The same for a face in a layer of an array map (cascades, a cube's faces: `map` a 2-D array
+// view; the layer is in the face's rect.w, ShadowFace::terms_rows).
+bool lucent_shadow_texels(sampler2DArray map, mat4 view_proj, vec4 rect, vec4 params,
+                          vec3 pos, vec3 normal, out vec3 inner, out float inner_distance,
+                          out vec4 texel_distances, out vec4 weights) {
     vec2 corner;
-    lucent_map_bilinear(rect, 1.0 / vec2(textureSize(map, 0)), t, corner, weights);
-    vec4 d = lucent_stored_depth(rect, textureGather(map, corner, 0));
-    // The far plane: nothing between the light and it, no entry.
-    weights *= vec4(lessThan(d, vec4(1.0)));
-    texel_distances = vec4(lucent_face_distance(params, d.x), lucent_face_distance(params, d.y),
-                           lucent_face_distance(params, d.z), lucent_face_distance(params, d.w));
+    if (!lucent_shadow_corner(view_proj, rect, params, vec2(textureSize(map, 0).xy), pos,
+                              normal, inner, inner_distance, corner, weights)) {
+        texel_distances = vec4(0.0);
+        return false;
+    }
+    float layer = floor(rect.w * 0.5);
+    lucent_texel_distances(rect, params, textureGather(map, vec3(corner, layer), 0), weights,
+                           texel_distances);
     return true;
 }
 

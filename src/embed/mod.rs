@@ -261,7 +261,8 @@ pub use glam;
 /// [`Support::Lacks`] may hold [`HostError::Unsupported`]; a second shadow map, an array
 /// beside an atlas (`with_second_shadow_map` of [`TransmissionEffectDesc`] and
 /// [`SssEffectDesc`], [`TransmissionImages::second_shadow_map`],
-/// [`LeanLighting::second_shadow_map`], [`ShadowFace::map`]).
+/// [`LeanLighting::second_shadow_map`], [`ShadowFace::map`]); TERMS'
+/// `lucent_shadow_texels` on a `sampler2DArray` too.
 pub const API_VERSION: u32 = 13;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

@@ -256,7 +256,7 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
     );
     // The engine's lighting pass adds lucent's environment, translucency and transmission
     // terms itself (lucent::embed::glsl::TERMS; the transmission's thickness from the
-    // engine's own shadow atlas, read with lucent's lookup): the same frame within its B10G11R11 light's
+    // engine's own shadow atlas and cube array, read with lucent's lookup): the same frame within its B10G11R11 light's
     // rounding, with no pass of lucent's but the layered media and the SSS. (The transmission
     // alone changes more than 1,000 pixels by up to 154/255: a fused frame without it, or
     // with its thickness measured wrong, fails this.)
@@ -266,7 +266,8 @@ fn host_engine_example_runs_under_validation_and_its_frame_scatters_and_lets_lig
         fused_log.contains("lucent::embed::glsl::TERMS")
             && fused_log.contains("engine: lighting")
             && fused_log.contains(
-                "transmission (skin and marble, lucent's lookup of the engine's shadow atlas)"
+                "transmission (skin and marble, lucent's lookup of the engine's shadow atlas and \
+                 cube array)"
             )
             && !fused_log.contains("host translucency")
             && !fused_log.contains("host environment")

@@ -14,7 +14,7 @@
 #include "host_depth.glsl"
 #ifdef LUCENT_SHADOWS
 // (A host's shadow map may store reversed Z: its passes define LUCENT_SHADOW_REVERSIBLE,
-// shadows.glsl shadow_stored_depth.)
+// shadows.glsl shadow_gather_flagged.)
 #include "shadows.glsl"
 #endif
 

@@ -80,35 +80,38 @@ vec2 shadow_inv_map_size(int face) {
     return shadows.atlas.zw;
 }
 
-// The standard-Z depths of stored texels `d` of face `face`'s map. lucent's own maps store
-// standard Z. A host's map may store reversed Z (src/embed/shadow_faces.rs): its face's
-// view_proj is then the host's projection with z flipped (depth 1 - d), so positions project
-// to standard Z, and only the stored texels are flipped here. Passes reading a host's maps
-// define LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
-vec4 shadow_stored_depth(int face, vec4 d) {
-#ifdef LUCENT_SHADOW_REVERSIBLE
-    return lucent_stored_depth(vec4(shadows.faces[face].rect.xyz, shadow_face_flags(face)), d);
-#else
-    return d;
+// The depth texels around map coordinate `corner` (textureGather's order) of a face with flags
+// `flags` (shadow_face_flags) in the second map (`second`, LUCENT_SHADOW_SECOND_MAP) or the
+// first, from its layer where the map is an array, as standard Z. A lookup of several gathers
+// decodes the face once and calls this for each. lucent's own maps store standard Z. A host's
+// map may store reversed Z (src/embed/shadow_faces.rs): its face's view_proj is then the
+// host's projection with z flipped (depth 1 - d), so positions project to standard Z, and only
+// the stored texels are flipped here. Passes reading a host's maps define
+// LUCENT_SHADOW_REVERSIBLE; lucent's own compile the identity.
+vec4 shadow_gather_flagged(bool second, float flags, vec2 corner) {
+    vec4 d;
+#ifdef LUCENT_SHADOW_SECOND_MAP
+    if (second) {
+        d = textureGather(shadow_layers, vec3(corner, floor(flags * 0.5)), 0);
+    } else
 #endif
+    {
+#ifdef LUCENT_SHADOW_ARRAY
+        d = textureGather(shadow_depth, vec3(corner, floor(flags * 0.5)), 0);
+#else
+        d = textureGather(shadow_depth, corner, 0);
+#endif
+    }
+#ifdef LUCENT_SHADOW_REVERSIBLE
+    d = lucent_stored_depth(vec4(0.0, 0.0, 0.0, flags), d);
+#endif
+    return d;
 }
 
-// The depth texels of face `face`'s map around atlas coordinate `corner` (textureGather's
+// The depth texels of face `face`'s map around map coordinate `corner` (textureGather's
 // order), from its layer where the map is an array (LUCENT_SHADOW_ARRAY), as standard Z.
 vec4 shadow_gather_depth(int face, vec2 corner) {
-#ifdef LUCENT_SHADOW_SECOND_MAP
-    if (shadow_in_second_map(face)) {
-        float layer = floor(shadow_face_flags(face) * 0.5);
-        return shadow_stored_depth(face, textureGather(shadow_layers, vec3(corner, layer), 0));
-    }
-#endif
-#ifdef LUCENT_SHADOW_ARRAY
-    float layer = floor(shadows.faces[face].rect.w * 0.5);
-    vec4 d = textureGather(shadow_depth, vec3(corner, layer), 0);
-#else
-    vec4 d = textureGather(shadow_depth, corner, 0);
-#endif
-    return shadow_stored_depth(face, d);
+    return shadow_gather_flagged(shadow_in_second_map(face), shadow_face_flags(face), corner);
 }
 
 // The face of `light`'s map that sees `pos` (-1: the light casts no shadow). A point light's
@@ -222,13 +225,17 @@ vec2 shadow_visibility(int light, vec3 pos, vec3 normal, vec3 to_light, int mate
     vec2 first = clamp(base - 1.0, face.rect.xy, face.rect.xy + face.rect.z - 4.0);
     vec4 wx = vec4(1.0 - f.x, 1.0, 1.0, f.x);
     vec4 wy = vec4(1.0 - f.y, 1.0, 1.0, f.y);
+    // The face's map, layer and depth encoding, decoded once for the four gathers.
+    vec2 inv_map_size = shadow_inv_map_size(index);
+    bool second = shadow_in_second_map(index);
+    float flags = shadow_face_flags(index);
     vec2 visible = vec2(0.0);
     for (int by = 0; by < 2; ++by) {
         for (int bx = 0; bx < 2; ++bx) {
             // The corner shared by texels (first + 2 bx, first + 2 by) .. (+1, +1): a gather
             // there returns them as (x0 y1, x1 y1, x1 y0, x0 y0).
-            vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * shadow_inv_map_size(index);
-            vec4 occluder = shadow_gather_depth(index, corner);
+            vec2 corner = (first + vec2(2 * bx + 1, 2 * by + 1)) * inv_map_size;
+            vec4 occluder = shadow_gather_flagged(second, flags, corner);
             vec4 lit = step(vec4(reference), occluder);
             float x0 = wx[2 * bx], x1 = wx[2 * bx + 1];
             float y0 = wy[2 * by], y1 = wy[2 * by + 1];

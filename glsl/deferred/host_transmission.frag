@@ -17,7 +17,7 @@
 // The media (lucent's SSS profile table, only its medium rows and host ID map filled) and
 // the shadow table and map (src/embed/transmission.rs `declare`).
 #define LUCENT_SHADOWS 1
-// The host's shadow map may store reversed Z (glsl/common/shadows.glsl shadow_stored_depth).
+// The host's shadow map may store reversed Z (glsl/common/shadows.glsl shadow_gather_flagged).
 #define LUCENT_SHADOW_REVERSIBLE 1
 #include "../common/sss_transmission.glsl"
 #include "../common/host_ids.glsl"

@@ -423,7 +423,7 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
     // Reversed Z stores 1 at the near plane: 1 - d is the standard depth of the same planes
     // (exactly, for every perspective or orthographic mapping with those planes, an infinite
     // far plane included), so the face is read through the projection with z flipped and its
-    // texels flipped in the shader (glsl/common/shadows.glsl shadow_stored_depth).
+    // texels flipped in the shader (glsl/common/shadows.glsl shadow_gather_flagged).
     let reversed = at_0 > at_1;
     let (near, far) = if reversed { (at_1, at_0) } else { (at_0, at_1) };
     if !(near > 0.0 && far > near && near.is_finite()) {
@@ -459,7 +459,7 @@ fn face_row(face: &ShadowFace, extent: vk::Extent2D) -> std::result::Result<Shad
     Ok(ShadowFaceGpu {
         view_proj: (projection * view).to_cols_array_2d(),
         // w: reversed Z in its lowest bit, the array layer above (glsl/common/shadows.glsl
-        // shadow_stored_depth, shadow_gather_depth).
+        // shadow_gather_flagged, shadow_gather_depth).
         rect: [
             r.offset.x as f32,
             r.offset.y as f32,

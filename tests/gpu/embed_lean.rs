@@ -372,10 +372,7 @@ fn compare_lean(
                     |l| matches!(l.kind, lucent::scene::LightKind::Point { .. }),
                     shadow_z,
                 );
-                (
-                    maps.atlas,
-                    Some((maps.array, maps.array_view, maps.array_host)),
-                )
+                (maps.0, Some(maps.1))
             } else {
                 let map =
                     upload_host_shadow_map(test, &shadow_depths, (sw, sh), &faces, shadow_z, array);
@@ -488,7 +485,7 @@ fn compare_lean(
                                     surface: lean_surface,
                                     lights: &scene.lights,
                                     shadow_map: Some(&shadow_map.host),
-                                    second_shadow_map: second.as_ref().map(|(_, _, host)| host),
+                                    second_shadow_map: second.as_ref().map(|array| &array.host),
                                     shadow_faces: &shadow_map.faces,
                                 }),
                             },
@@ -520,10 +517,8 @@ fn compare_lean(
             drop(lucent);
             gpu.destroy_image(normals);
             gpu.destroy_image(shadow_map.image);
-            if let Some((array, view, _)) = second {
-                // SAFETY: made for this test; the frames that read it completed.
-                unsafe { gpu.device.destroy_image_view(view, None) };
-                gpu.destroy_image(array);
+            if let Some(array) = second {
+                gpu.destroy_image(array.image);
             }
             layout.destroy(test);
         }

@@ -259,15 +259,8 @@ pub(crate) fn upload_host_shadow_map(
 /// `in_array` picks (a point light's cube faces, say) in an array beside an atlas of its
 /// other faces hands them over: the atlas stored as `z` (the moved faces' tiles unread), and
 /// a second map, an array with each moved face in a layer of its own ([`host_shadow_array`],
-/// standard Z), its faces [`ShadowFace::in_second_map`].
-pub(crate) struct SplitShadowMaps {
-    pub(crate) atlas: HostShadowMap,
-    pub(crate) array: GpuImage,
-    /// The array's 2-D array view (one even for a single layer, as the host must make it).
-    pub(crate) array_view: vk::ImageView,
-    pub(crate) array_host: HostImage,
-}
-
+/// standard Z; at least two faces, so that its view is a 2-D array view), its faces
+/// [`ShadowFace::in_second_map`]. Returns the atlas (with every face) and the array.
 pub(crate) fn upload_split_shadow_maps(
     test: &TestGpu,
     depths: &[f32],
@@ -276,63 +269,27 @@ pub(crate) fn upload_split_shadow_maps(
     lights: &[lucent::scene::Light],
     in_array: impl Fn(&lucent::scene::Light) -> bool,
     z: HostShadowZ,
-) -> SplitShadowMaps {
-    let is_cube = |f: &ShadowFace| in_array(&lights[f.light]);
-    let cube: Vec<ShadowFace> = faces.iter().filter(|f| is_cube(f)).copied().collect();
-    assert!(!cube.is_empty() && cube.len() < faces.len());
-    let (texels, edge, cube_faces) = host_shadow_array(depths, size, &cube);
-    let usage = vk::ImageUsageFlags::SAMPLED;
-    let layers = cube_faces.len() as u32;
-    let array = test
-        .gpu
-        .upload_image(
-            &ImageDesc::depth(edge, edge, vk::Format::D32_SFLOAT, usage).with_layers(layers),
-            &[bytemuck::cast_slice(&texels).to_vec()],
-            "host cube array",
-        )
-        .unwrap();
-    let info = vk::ImageViewCreateInfo::default()
-        .image(array.image)
-        .view_type(vk::ImageViewType::TYPE_2D_ARRAY)
-        .format(vk::Format::D32_SFLOAT)
-        .subresource_range(array.desc.subresource_range());
-    // SAFETY: a live image of this device, its whole range.
-    let array_view = unsafe { test.gpu.device.create_image_view(&info, None) }.unwrap();
-    let array_host = HostImage::new(
-        "host cube array",
-        array.image,
-        array_view,
-        vk::Format::D32_SFLOAT,
-        vk::Extent2D {
-            width: edge,
-            height: edge,
-        },
-        usage,
-    )
-    .with_layers(layers)
-    .in_state(ImageState::fragment_sampled());
+) -> (HostShadowMap, HostShadowMap) {
+    let moved = |f: &ShadowFace| in_array(&lights[f.light]);
+    let cube: Vec<ShadowFace> = faces.iter().filter(|f| moved(f)).copied().collect();
+    assert!(cube.len() > 1 && cube.len() < faces.len());
+    let array = upload_host_shadow_map(test, depths, size, &cube, HostShadowZ::Standard, true);
     let mut atlas = upload_host_shadow_map(test, depths, size, faces, z, false);
-    // The faces in the frame's order: each cube face in its layer of the second map (standard
-    // Z), the others in the atlas as `z` stores them.
-    let mut in_array = cube_faces.into_iter();
+    // The faces in the frame's order: each moved face in its layer of the second map, the
+    // others in the atlas as `z` stores them.
+    let mut in_second = array.faces.iter();
     atlas.faces = faces
         .iter()
         .zip(atlas.faces.clone())
-        .map(|(f, in_atlas)| {
-            if is_cube(f) {
-                let face = in_array.next().unwrap();
+        .map(|(f, in_atlas)| match moved(f) {
+            true => {
+                let face = in_second.next().unwrap();
                 face.in_second_map(face.layer)
-            } else {
-                in_atlas
             }
+            false => in_atlas,
         })
         .collect();
-    SplitShadowMaps {
-        atlas,
-        array,
-        array_view,
-        array_host,
-    }
+    (atlas, array)
 }
 
 #[test]
@@ -493,10 +450,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
                 |l| matches!(l.kind, lucent::scene::LightKind::Point { .. }),
                 shadow_z,
             );
-            (
-                split.atlas,
-                Some((split.array, split.array_view, split.array_host)),
-            )
+            (split.0, Some(split.1))
         } else {
             let array = maps == Maps::Array;
             let map = upload_host_shadow_map(&test, &depths, (sw, sh), &faces, shadow_z, array);
@@ -556,7 +510,7 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
                         material_ids: images.ids.unwrap(),
                         albedo: Some(&albedo),
                         shadow_map: &shadow_map.host,
-                        second_shadow_map: second.as_ref().map(|(_, _, host)| host),
+                        second_shadow_map: second.as_ref().map(|array| &array.host),
                     },
                     regions: &[],
                     lighting: images.lighting,
@@ -607,10 +561,8 @@ fn the_transmission_effect_on_host_layouts_equals_lucents_own_frame() {
         drop(lucent);
         gpu.destroy_image(normals);
         gpu.destroy_image(shadow_map.image);
-        if let Some((array, view, _)) = second {
-            // SAFETY: made for this test; the frames that read it completed.
-            unsafe { gpu.device.destroy_image_view(view, None) };
-            gpu.destroy_image(array);
+        if let Some(array) = second {
+            gpu.destroy_image(array.image);
         }
         layout.destroy(&test);
     }

@@ -120,6 +120,9 @@ const CUBE_AXES: [Vec3; 6] = [
     Vec3::NEG_Z,
 ];
 
+/// Each of a frame's host shadow maps' size and layers, as [`shadow_table`] takes them.
+pub(crate) type MapSizes = Vec<(vk::Extent2D, u32)>;
+
 /// How an effect's host shadow maps are laid out, from its description: one 2-D atlas, one
 /// array of layers, or an atlas with an array beside it (the second map, each of its faces
 /// [`ShadowFace::in_second_map`]).
@@ -176,7 +179,7 @@ impl ShadowMaps {
         first: &HostImage,
         second: Option<&HostImage>,
         formats: (vk::Format, Option<vk::Format>),
-    ) -> Result<Vec<(vk::Extent2D, u32)>> {
+    ) -> Result<MapSizes> {
         check_shadow_map(gpu, first, "shadow map", formats.0, self == Self::Array)?;
         let mut maps = vec![(first.extent, first.layers)];
         match (formats.1, second) {
@@ -193,19 +196,23 @@ impl ShadowMaps {
                 }
                 .into())
             }
-            (None, Some(map)) => {
-                return Err(HostError::Image {
-                    image: map.name.clone(),
-                    kind: crate::error::ImageFault::Aliased,
-                    problem: "given as the second shadow map, which the description has none \
-                              of (with_second_shadow_map)"
-                        .into(),
-                }
-                .into())
-            }
+            (None, Some(map)) => return Err(undescribed_second_map(map)),
         }
         Ok(maps)
     }
+}
+
+/// The error for a second shadow map a frame gives although the effect's description has
+/// none.
+pub(crate) fn undescribed_second_map(map: &HostImage) -> crate::LucentError {
+    HostError::Image {
+        image: map.name.clone(),
+        kind: crate::error::ImageFault::Aliased,
+        problem: "given as the second shadow map, which the description has none of \
+                  (with_second_shadow_map)"
+            .into(),
+    }
+    .into()
 }
 
 /// Checks a frame's host shadow map (`input`: which, for the errors) against the effect's

@@ -41,7 +41,9 @@ use super::gbuffer::{
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::tiles_marked_by;
-use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace, ShadowMaps};
+use super::shadow_faces::{
+    check_shadow_format, shadow_table, undescribed_second_map, MapSizes, ShadowFace, ShadowMaps,
+};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
@@ -710,17 +712,12 @@ impl SssEffect {
         let ring = self.passes.slot(frame.slot, frame.view)?;
         let gbuffer = &self.desc.gbuffer;
         let mut uniforms = gbuffer.view_uniforms(&frame.camera)?;
-        let inputs = self.check_images(lucent, frame)?;
+        let (inputs, maps) = self.check_images(lucent, frame)?;
         let mut shadows = None;
         if let Some(lean) = &frame.lean {
             check_lights(lean.lights)?;
             uniforms = uniforms.with_lights(lean.lights);
-            if let Some(map) = lean.shadow_map {
-                // (check_images checked each map against the description.)
-                let maps: Vec<(vk::Extent2D, u32)> = std::iter::once(map)
-                    .chain(lean.second_shadow_map)
-                    .map(|m| (m.extent, m.layers))
-                    .collect();
+            if !maps.is_empty() {
                 shadows = Some(shadow_table(lean.lights, lean.shadow_faces, &maps)?);
             }
         }
@@ -825,12 +822,13 @@ impl SssEffect {
 
     /// Checks every image of `frame` against the description; returns the inputs, one per
     /// distinct Vulkan image (the depth and the stencil IDs may share one: it is transitioned
-    /// once, and both must declare the same states).
+    /// once, and both must declare the same states), and the shadow maps' sizes and layers
+    /// (none without shadow maps).
     fn check_images<'a>(
         &self,
         lucent: &Lucent,
         frame: &SssFrame<'a>,
-    ) -> Result<Vec<&'a HostImage>> {
+    ) -> Result<(Vec<&'a HostImage>, MapSizes)> {
         let gbuffer = &self.desc.gbuffer;
         let extent = gbuffer.extent();
         let gpu = lucent.gpu();
@@ -908,7 +906,7 @@ impl SssEffect {
                 }
             }
         }
-        let lean = self.check_lean(lucent, frame)?;
+        let (lean, maps) = self.check_lean(lucent, frame)?;
         let all = [
             Some(images.depth),
             Some(images.diffuse),
@@ -916,15 +914,21 @@ impl SssEffect {
             images.specular,
             images.albedo,
         ];
-        distinct_inputs(all.into_iter().flatten().chain(lean), frame.output)
+        let inputs = distinct_inputs(all.into_iter().flatten().chain(lean), frame.output)?;
+        Ok((inputs, maps))
     }
 
     /// Checks `frame.lean` against the effect: there exactly when a LEAN blur is, its
     /// normals or LEAN targets as described, its shadow map there exactly when the
-    /// description has a shadow format. Returns those images.
-    fn check_lean<'a>(&self, lucent: &Lucent, frame: &SssFrame<'a>) -> Result<Vec<&'a HostImage>> {
+    /// description has a shadow format. Returns those images, and the shadow maps' sizes and
+    /// layers.
+    fn check_lean<'a>(
+        &self,
+        lucent: &Lucent,
+        frame: &SssFrame<'a>,
+    ) -> Result<(Vec<&'a HostImage>, MapSizes)> {
         let lean = match (self.lean_blur, &frame.lean) {
-            (false, None) => return Ok(Vec::new()),
+            (false, None) => return Ok((Vec::new(), Vec::new())),
             (true, Some(lean)) => lean,
             (true, None) => {
                 return Err(HostError::Missing {
@@ -1004,9 +1008,11 @@ impl SssEffect {
                 .into())
             }
         };
+        let mut maps = Vec::new();
         let shadow_map = match (self.desc.shadow_format, lean.shadow_map) {
             (Some(format), Some(map)) => {
-                self.shadow_maps
+                maps = self
+                    .shadow_maps
                     .expect("described with the shadow format")
                     .check_frame(
                         lucent.gpu(),
@@ -1019,14 +1025,7 @@ impl SssEffect {
             }
             (None, None) => {
                 if let Some(map) = lean.second_shadow_map {
-                    return Err(HostError::Image {
-                        image: map.name.clone(),
-                        kind: ImageFault::Aliased,
-                        problem: "given as the second shadow map, which the description has \
-                                  none of (SssEffectDesc::with_second_shadow_map)"
-                            .into(),
-                    }
-                    .into());
+                    return Err(undescribed_second_map(map));
                 }
                 if !lean.shadow_faces.is_empty() {
                     return Err(HostError::Description {
@@ -1059,7 +1058,7 @@ impl SssEffect {
             }
         };
         images.extend(shadow_map);
-        Ok(images)
+        Ok((images, maps))
     }
 }
 

@@ -39,7 +39,7 @@ use super::passes::{
     id_role, import_host_image, EffectPasses,
 };
 use super::regions::clipped;
-use super::shadow_faces::{check_shadow_format, shadow_table, ShadowFace, ShadowMaps};
+use super::shadow_faces::{check_shadow_format, shadow_table, MapSizes, ShadowFace, ShadowMaps};
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
@@ -437,12 +437,11 @@ impl TransmissionEffect {
 
     /// Checks every image of `frame` against the description; returns the inputs, one per
     /// distinct Vulkan image, and the shadow maps' sizes and layers.
-    #[allow(clippy::type_complexity)]
     fn check_images<'a>(
         &self,
         lucent: &Lucent,
         frame: &TransmissionFrame<'a>,
-    ) -> Result<(Vec<&'a HostImage>, Vec<(vk::Extent2D, u32)>)> {
+    ) -> Result<(Vec<&'a HostImage>, MapSizes)> {
         let gbuffer = &self.desc.gbuffer;
         let images = &frame.images;
         let ids = gbuffer.material_ids.expect("checked at new");

@@ -484,19 +484,25 @@ fn measure_sss(
         )
         .with_specular(hdr)
         .with_material_ids(IdDesc::value(vk::Format::R8_UNORM));
+        // GB0 (albedo and specular intensity), uploaded once: the albedo the blurs apply after
+        // the scatter, and the LEAN blurs' albedo and specular target.
         let gb0 = vk::Format::R8G8B8A8_UNORM;
-        let albedo_image = if post_albedo {
+        let gb0_image = (post_albedo || blur.lean())
+            .then(|| {
+                images.upload(
+                    gpu,
+                    &ImageDesc::color(width, height, gb0, sampled),
+                    rgba8(&gb.gb0),
+                    "host GB0",
+                )
+            })
+            .transpose()?;
+        if post_albedo {
             gbuffer = gbuffer.with_albedo(gb0);
-            let image = images.upload(
-                gpu,
-                &ImageDesc::color(width, height, gb0, sampled),
-                rgba8(&gb.gb0),
-                "host albedo",
-            )?;
-            Some(host_image(image, "host albedo", gb0, size, sampled))
-        } else {
-            None
-        };
+        }
+        let albedo_image = gb0_image
+            .filter(|_| post_albedo)
+            .map(|image| host_image(image, "host albedo", gb0, size, sampled));
         // The LEAN blurs: the host writes the LEAN targets in its G-buffer pass as lucent's
         // own frame does (lucent's targets; the diffuse's alpha holds the slope x), with the
         // scene's lights and, where they cast, lucent's light-space atlas with each face's
@@ -507,12 +513,7 @@ fn measure_sss(
                 LucentError::InvalidInput("lucent's LEAN frame has no LEAN target".into())
             })?;
             let moments = images.upload(gpu, &colour, rgba16f(moments), "host LEAN moments")?;
-            let albedo = images.upload(
-                gpu,
-                &ImageDesc::color(width, height, gb0, sampled),
-                rgba8(&gb.gb0),
-                "host albedo and specular",
-            )?;
+            let albedo = gb0_image.expect("uploaded for the LEAN blurs");
             let normal = images.upload(gpu, &colour, rgba16f(&gb.gb1), "host normal")?;
             let targets = [
                 host_image(moments, "host LEAN moments", hdr, size, sampled),

@@ -2,8 +2,8 @@
 //! ([`capabilities`]): asked before building anything, answered from the description alone.
 //! The effects' own constructors refuse with the same errors.
 
-use super::gbuffer::{DiffuseAlbedo, GBufferDesc};
 use crate::error::HostError;
+use crate::features::gbuffer_desc::{DiffuseAlbedo, GBufferDesc};
 use crate::Result;
 
 /// One of the techniques lucent can add to a host's frame.

@@ -164,7 +164,7 @@ use crate::{LucentError, Result};
 
 mod capabilities;
 mod environment;
-mod gbuffer;
+
 pub mod glsl;
 mod image;
 mod layered;
@@ -178,15 +178,15 @@ mod translucency;
 mod transmission;
 mod uploads;
 
+pub use crate::features::gbuffer_desc::{
+    DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
+    IdEncoding, LeanTargetsDesc, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels,
+    ThicknessDesc, MAX_METRES_PER_UNIT,
+};
 pub use capabilities::{capabilities, Effect, Support};
 pub(crate) use environment::shader_permutations as environment_permutations;
 pub use environment::{
     EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages,
-};
-pub use gbuffer::{
-    DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
-    IdEncoding, LeanTargetsDesc, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels,
-    ThicknessDesc, MAX_METRES_PER_UNIT,
 };
 pub use image::{HostImage, ImageState};
 pub use layered::{

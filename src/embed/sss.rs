@@ -34,10 +34,6 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{
-    check_metres_per_unit, sampled_float, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
-    IdEncoding,
-};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::tiles_marked_by;
@@ -48,12 +44,17 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
-use crate::features::registry;
-use crate::features::sss::{self, HostAlbedo, LeanInputs, SssKnobs, SssProfiles};
-use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
-use crate::graph::{
-    Handle, Image, ImageInfo, ImportedImage, LoadOp, PassKind, RenderGraph, ResourceId,
+use crate::features::gbuffer_desc::{
+    check_metres_per_unit, sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding,
 };
+use crate::features::registry;
+use crate::features::sss::described::{
+    applies_albedo_after, needs_albedo_pass, sss_on_gbuffer, DescribedImages, DescribedShadows,
+    HOST_LEAN,
+};
+use crate::features::sss::{self, SssKnobs, SssProfiles};
+use crate::gpu_scene::{SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
+use crate::graph::{Handle, ImageInfo, ImportedImage, RenderGraph, ResourceId};
 use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::Light;
 use crate::Result;
@@ -392,9 +393,6 @@ struct HostLeanGpu {
     surface: [[f32; 4]; sss::MAX_SSS_PROFILES],
 }
 
-/// The host LEAN pass's constants in the per-frame buffer.
-static HOST_LEAN: Region = Region::new("host LEAN decode", "HostLean");
-
 /// Screen-space SSS over a host's G-buffer (see the module docs).
 pub struct SssEffect {
     passes: EffectPasses,
@@ -420,18 +418,6 @@ struct MaterialChain {
     id: u8,
     reach: f32,
     chain: usize,
-}
-
-/// Whether the host's diffuse must pass through `sss albedo in` for these profiles: when some
-/// pixel's light must hold a different part of the albedo than the host's light does.
-fn needs_albedo_pass(albedo: DiffuseAlbedo, profiles: &[SssProfile]) -> bool {
-    match albedo {
-        // Pixels that do not scatter need the albedo in their light too.
-        DiffuseAlbedo::Excluded => true,
-        DiffuseAlbedo::Included => profiles.iter().any(|p| p.texturing != Texturing::Pre),
-        // The host's light holds what each profile wants before the blur already.
-        DiffuseAlbedo::AsTexturing => false,
-    }
 }
 
 impl SssEffect {
@@ -532,11 +518,9 @@ impl SssEffect {
             profile_of[usize::from(material.id)] = index as u8 + 1;
             profiles.push((profile, blur));
         }
-        let albedo_pass = needs_albedo_pass(
-            gbuffer.diffuse.albedo,
-            &profiles.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>(),
-        );
-        let post_albedo = profiles.iter().any(|(p, _)| p.texturing != Texturing::Pre);
+        let albedo_pass =
+            needs_albedo_pass(gbuffer.diffuse.albedo, profiles.iter().map(|(p, _)| p));
+        let post_albedo = applies_albedo_after(profiles.iter().map(|(p, _)| p));
         if (albedo_pass || post_albedo) && gbuffer.albedo.is_none() {
             return Err(HostError::Missing {
                 input: "albedo".into(),
@@ -643,7 +627,7 @@ impl SssEffect {
             "SssEffect",
             upload,
             desc.views_per_frame,
-            |scene_gpu| declare(&desc, &profiles, scene_gpu, albedo_pass, post_albedo, lean),
+            |scene_gpu| declare(&desc, &profiles, scene_gpu, lean),
         )?;
         let chains = profiles.chains();
         // Material i has profile i + 1 (profile_of above).
@@ -836,8 +820,8 @@ impl SssEffect {
         let same = |format: vk::Format| move |f: vk::Format| f == format;
         let named = |format: vk::Format| format!("{} (the description's)", format_name(format));
         let depth_role = match gbuffer.depth.encoding {
-            super::gbuffer::DepthEncoding::Device => Role::SampledDepth,
-            super::gbuffer::DepthEncoding::LinearView => Role::SampledColor,
+            crate::features::gbuffer_desc::DepthEncoding::Device => Role::SampledDepth,
+            crate::features::gbuffer_desc::DepthEncoding::LinearView => Role::SampledColor,
         };
         let ids = gbuffer.material_ids.expect("checked at new");
         let id_role = if matches!(ids.encoding, IdEncoding::Stencil { .. }) {
@@ -1068,8 +1052,6 @@ fn declare(
     desc: &SssEffectDesc,
     profiles: &SssProfiles,
     scene_gpu: &Arc<SceneGpu>,
-    albedo_pass: bool,
-    post_albedo: bool,
     lean: bool,
 ) -> (RenderGraph, Imports) {
     let gbuffer = &desc.gbuffer;
@@ -1147,102 +1129,26 @@ fn declare(
         shadow_map: shadow_map.as_ref().map(Handle::id),
         second_shadow_map: second_shadow_map.as_ref().map(Handle::id),
     };
-    let cleared;
-    let specular = match &specular {
-        Some(s) => s,
-        None => {
-            cleared = cleared_image(&mut graph, width, height);
-            &cleared
-        }
-    };
-    let mut inputs = sss::SssInputs {
-        diffuse: &diffuse,
-        specular,
+    let images = DescribedImages {
         depth: &depth,
-        profile_ids: &material_ids,
-        lean: None,
-        shadow_depth: None,
-        shadow_array: false,
-        second_shadow_depth: None,
-        shadow_reversible: false,
-        albedo: None,
-        // The host's alpha is its own unless it holds linear depth: then the taps read it
-        // there, as in lucent's own frames; otherwise they read the depth image.
-        depth_in_alpha: gbuffer.diffuse.depth_in_alpha,
-        ids: &profiles.id_map,
-        linear_depth: gbuffer.depth.encoding == DepthEncoding::LinearView,
+        diffuse: &diffuse,
+        material_ids: &material_ids,
+        specular: specular.as_ref(),
+        albedo: albedo.as_ref(),
+        normals: normals.as_ref(),
+        lean_targets: lean_targets.as_ref().map(|t| t.each_ref()),
+        shadows: shadow_map.as_ref().map(|depth| DescribedShadows {
+            depth,
+            array: desc.shadow_array,
+            second: second_shadow_map.as_ref(),
+            // A host's map may store reversed Z (its faces say: ShadowFace).
+            reversible: true,
+        }),
     };
-    let adjusted;
-    let built_targets;
-    // The diffuse put right where a profile wants its albedo otherwise (`sss albedo in`, which
-    // keeps the alpha: the LEAN slope x of a host's LEAN targets), unless the LEAN pass that
-    // builds the targets from the normals does it.
-    if albedo_pass && normals.is_none() {
-        let albedo = albedo.as_ref().expect("checked at new");
-        let included = gbuffer.diffuse.albedo == DiffuseAlbedo::Included;
-        adjusted = sss::host_albedo_pass(
-            &mut graph,
-            &inputs,
-            albedo,
-            included,
-            width,
-            height,
-            Some(scene_gpu),
-        );
-        inputs.diffuse = &adjusted;
-    }
-    if let Some([moments, albedo_specular, normal_roughness]) = &lean_targets {
-        // The host wrote the LEAN targets: the chains read them as lucent's own frame reads
-        // its G-buffer's.
-        inputs.lean = Some(LeanInputs {
-            view_plane: moments,
-            gb0: albedo_specular,
-            gb1: normal_roughness,
-        });
-    } else if let Some(normals) = &normals {
-        // The LEAN chains' G-buffer targets, the albedo put right in the same pass.
-        let mode = match (albedo_pass, gbuffer.diffuse.albedo) {
-            (false, _) => None,
-            (true, DiffuseAlbedo::Included) => Some(HostAlbedo::Included),
-            (true, DiffuseAlbedo::Excluded) => Some(HostAlbedo::Excluded),
-            (true, DiffuseAlbedo::AsTexturing) => {
-                unreachable!("needs_albedo_pass: the host's light is as the profiles want it")
-            }
-        };
-        let host_albedo = mode.map(|mode| (albedo.as_ref().expect("checked at new"), mode));
-        built_targets = sss::host_lean_pass(
-            &mut graph,
-            &inputs,
-            normals,
-            host_albedo,
-            &HOST_LEAN,
-            width,
-            height,
-            Some(scene_gpu),
-        );
-        inputs.diffuse = &built_targets.diffuse;
-        inputs.lean = Some(LeanInputs {
-            view_plane: &built_targets.view_plane,
-            gb0: &built_targets.gb0,
-            gb1: &built_targets.gb1,
-        });
-    }
-    if inputs.lean.is_some() {
-        // The LEAN chains' diffuse carries the slope in its alpha, not depth; their specular
-        // is shadowed by the host's maps.
-        inputs.depth_in_alpha = false;
-        inputs.shadow_depth = shadow_map.as_ref();
-        inputs.shadow_array = desc.shadow_array;
-        inputs.second_shadow_depth = second_shadow_map.as_ref();
-        // A host's map may store reversed Z (its faces say: ShadowFace).
-        inputs.shadow_reversible = true;
-    }
-    if post_albedo {
-        inputs.albedo = albedo.as_ref();
-    }
-    let result = sss::sss_passes(
+    let result = sss_on_gbuffer(
         &mut graph,
-        &inputs,
+        gbuffer,
+        &images,
         profiles,
         &desc.knobs,
         Some(scene_gpu),
@@ -1266,23 +1172,6 @@ fn check_output_format(format: vk::Format) -> Result<()> {
     }
 }
 
-/// A transient image cleared to black by a pass that draws nothing (the specular a host did
-/// not keep apart).
-fn cleared_image(graph: &mut RenderGraph, width: u32, height: u32) -> Handle<Image> {
-    let mut image = graph.create_image(
-        "specular (none)",
-        ImageInfo {
-            width,
-            height,
-            format: crate::features::lighting::HDR_FORMAT,
-        },
-    );
-    let mut pass = graph.add_pass("clear specular", PassKind::Raster);
-    pass.color(&mut image, LoadOp::Clear([0.0; 4]));
-    pass.clears_only();
-    image
-}
-
 // Renderers move to a loader thread and back.
 const _: () = {
     const fn send<T: Send>() {}
@@ -1301,19 +1190,6 @@ mod tests {
         assert!(check_output_format(vk::Format::R32G32B32A32_UINT).is_err());
         assert!(check_output_format(vk::Format::D32_SFLOAT).is_err());
         assert!(check_output_format(vk::Format::R8_UNORM).is_err());
-    }
-
-    #[test]
-    fn the_albedo_pass_runs_only_when_the_hosts_light_and_the_profiles_differ() {
-        let profile = |texturing| SssProfile {
-            texturing,
-            ..SssProfile::preset("skin").expect("a preset")
-        };
-        let pre = [profile(Texturing::Pre)];
-        let post = [profile(Texturing::Post), profile(Texturing::Pre)];
-        assert!(!needs_albedo_pass(DiffuseAlbedo::Included, &pre));
-        assert!(needs_albedo_pass(DiffuseAlbedo::Included, &post));
-        assert!(needs_albedo_pass(DiffuseAlbedo::Excluded, &pre));
     }
 
     #[test]

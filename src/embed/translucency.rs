@@ -25,7 +25,6 @@ use ash::vk;
 use glam::Vec3;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{DepthEncoding, GBufferDesc, HostCamera};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_views, depth_role, id_role, import_host_image,
@@ -36,6 +35,7 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
+use crate::features::gbuffer_desc::{DepthEncoding, GBufferDesc, HostCamera};
 use crate::features::pass::FullscreenPass;
 use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION};
 use crate::gpu_scene::{Region, SceneGpu, SceneUpload, TableRegion, FRAME};

@@ -30,9 +30,6 @@ use std::sync::Arc;
 use ash::vk;
 
 use super::capabilities::{require, Effect};
-use super::gbuffer::{
-    check_metres_per_unit, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
-};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_material_id, check_views, depth_role, frame_albedo,
@@ -44,6 +41,9 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
+use crate::features::gbuffer_desc::{
+    check_metres_per_unit, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
+};
 use crate::features::pass::FullscreenPass;
 use crate::features::shadows::ShadowUniforms;
 use crate::features::sss::transmission::{SssTransmission, MEDIUM_ROWS};
@@ -81,7 +81,7 @@ impl TransmissionMaterial {
     /// `lucent_sss_transmitted`), its lengths in the host's world at `metres_per_unit`
     /// ([`GBufferDesc::metres_per_unit`]): the same rows [`TransmissionEffect`] and lucent's
     /// own frames read from the SSS profile table. Every value is finite; a unit that is not
-    /// finite, above 0 and at most [`super::gbuffer::MAX_METRES_PER_UNIT`] is refused
+    /// finite, above 0 and at most [`crate::features::gbuffer_desc::MAX_METRES_PER_UNIT`] is refused
     /// ([`HostError::Description`], field `metres_per_unit`).
     pub fn rows(&self, metres_per_unit: f32) -> Result<[[f32; 4]; 4]> {
         Ok(self.transmission(metres_per_unit)?.rows())

@@ -10,6 +10,10 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::gbuffer_desc::{
+    DepthDesc, DiffuseDesc, GBufferDesc, IdDesc, LeanTargetsDesc, NormalDesc, ThicknessDesc,
+};
+use super::util::HDR_FORMAT;
 use crate::backend::shader::PipelineShaders;
 use crate::gpu_scene::{SceneGpu, FRAME};
 use crate::graph::{
@@ -205,6 +209,52 @@ impl GBufferLayout {
     /// The G-buffer stores `TexDep` texels.
     pub fn layer_depths(&self) -> bool {
         self.layered && self.layer_depth_textures > 0
+    }
+
+    /// This G-buffer, and the lighting pass's images of a frame with it, described as a host
+    /// describes its own to the effects (`lucent::embed`): the effects' passes read lucent's
+    /// frame through the same description and the same declaration as a host's.
+    ///
+    /// | input | lucent's image |
+    /// |---|---|
+    /// | depth | `gbuffer.depth`, D32 with standard Z |
+    /// | diffuse | the lighting pass's RGBA16F, the albedo as each SSS material's texturing asks, linear depth in alpha when a blur reads it there ([`Self::depth_in_alpha`]) |
+    /// | specular | the lighting pass's RGBA16F (frames with SSS) |
+    /// | albedo | GB0 |
+    /// | material IDs | `gbuffer.sss`, the SSS profile numbers as `R8_UNORM` (frames with SSS) |
+    /// | normals | GB1's world normal |
+    /// | thickness | GB2's (frames with GDC 2011 translucency) |
+    /// | LEAN targets | `gbuffer.lean`, GB0 and GB1 (frames with LCB or LBB) |
+    ///
+    /// The world scale is left at a metre: lucent's profiles each carry their own
+    /// (`units_per_mm`), as a host's materials may (`SssMaterial::with_metres_per_unit`).
+    pub fn described(&self, width: u32, height: u32) -> GBufferDesc {
+        let mut diffuse = DiffuseDesc::with_albedo_as_texturing(HDR_FORMAT);
+        if self.depth_in_alpha {
+            diffuse = diffuse.with_depth_in_alpha();
+        }
+        let mut desc = GBufferDesc::new(width, height, DepthDesc::device(DEPTH_FORMAT), diffuse)
+            .with_albedo(self.gb0_format())
+            .with_normals(NormalDesc::world(self.gb1_format()));
+        if self.sss {
+            desc = desc
+                .with_specular(HDR_FORMAT)
+                .with_material_ids(IdDesc::value(SSS_PROFILE_FORMAT));
+        }
+        if let (Some(format), Some(t)) = (self.gb2_format(), self.translucency) {
+            desc = desc.with_thickness(match t.packing {
+                ThicknessPacking::Grayscale => ThicknessDesc::channel(format, 0),
+                ThicknessPacking::Colored => ThicknessDesc::rgb(format),
+            });
+        }
+        if self.lean {
+            desc = desc.with_lean_targets(LeanTargetsDesc::new(
+                LEAN_FORMAT,
+                self.gb0_format(),
+                self.gb1_format(),
+            ));
+        }
+        desc
     }
 
     /// GB0: albedo rgb + specular.
@@ -609,5 +659,40 @@ impl PassExec for GBufferPass {
         for mut set in self.map_sets.drain(..) {
             set.destroy(&gpu.device);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every layout lucent's frames declare is a G-buffer the effects' checks accept, so its
+    /// passes read it through the description a host gives.
+    #[test]
+    fn lucents_own_gbuffer_is_a_valid_host_description() {
+        // A LEAN chain keeps its slope in the diffuse's alpha: no frame has depth there too
+        // (`SssProfiles::depth_in_alpha`).
+        let layouts = all_layouts()
+            .into_iter()
+            .filter(|l| !(l.lean && l.depth_in_alpha));
+        let mut checked = 0;
+        for layout in layouts {
+            for &(_, precision) in GBufferPrecision::ALL {
+                let layout = GBufferLayout {
+                    precision,
+                    ..layout
+                };
+                let desc = layout.described(640, 360);
+                desc.check()
+                    .unwrap_or_else(|e| panic!("{layout:?}: {e}"));
+                assert_eq!(desc.material_ids.is_some(), layout.sss);
+                assert_eq!(desc.specular.is_some(), layout.sss);
+                assert_eq!(desc.lean_targets.is_some(), layout.lean);
+                assert_eq!(desc.diffuse.depth_in_alpha, layout.depth_in_alpha);
+                assert_eq!(desc.thickness.is_some(), layout.translucency.is_some());
+                checked += 1;
+            }
+        }
+        assert!(checked > 1000, "{checked} layouts");
     }
 }

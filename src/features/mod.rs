@@ -4,6 +4,9 @@
 //! or the f64 reference, only what [`crate::gpu_scene`] put on the GPU.
 //!
 //! - [`gbuffer`]: the MRT G-buffer: its targets, their formats, the pass that fills them.
+//! - [`gbuffer_desc`]: a G-buffer described as the effects read it (formats, encodings, world
+//!   scale): a host's, as `lucent::embed` takes it, or lucent's own
+//!   ([`gbuffer::GBufferLayout::described`]), so both are read through one description.
 //! - [`lighting`]: per-light deferred lighting at each G-buffer pixel (merged with the
 //!   G-buffer pass as subpasses).
 //! - [`translucency`]: GDC 2011 thickness-based translucency: its material table and thickness
@@ -29,6 +32,7 @@ pub mod antialias;
 pub mod copy_pass;
 pub mod debug_view;
 pub mod gbuffer;
+pub mod gbuffer_desc;
 pub mod knob;
 pub mod layer_depth;
 pub mod layered;

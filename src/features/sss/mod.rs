@@ -88,6 +88,7 @@ use chain_technique_module;
 pub mod bilateral;
 pub mod burley;
 pub mod control;
+pub mod described;
 mod iterative;
 pub mod kernel;
 pub mod knobs;
@@ -100,6 +101,7 @@ pub mod tables;
 pub mod transmission;
 mod two_pass;
 
+pub use crate::features::gbuffer_desc::IdMap;
 pub use part::{SssPart, SSS_PART};
 pub use settings::{SssKnobs, SssPrecision, DEFAULT_SENSITIVITY};
 
@@ -263,30 +265,6 @@ pub struct SssProfiles {
     /// How the passes read a pixel's profile from the ID image ([`IdMap`]: lucent's own
     /// `R8_UNORM` profile numbers, or a host's encoding and ID-to-profile map).
     pub id_map: IdMap,
-}
-
-/// How the SSS passes find a pixel's profile in the ID image: a bit field of one channel of
-/// the image, and the profile number of each ID. lucent's own G-buffer ([`IdMap::lucent`]) and
-/// a host's (built by `lucent::embed` from its description of its ID image) are read by the
-/// same passes with different specialization constants ([`IdMap::specialization`]).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct IdMap {
-    /// The image is read as unsigned integers (a UINT format or a stencil aspect; define
-    /// `LUCENT_SSS_IDS_UINT`), else as UNORM floats turned back into their integers.
-    pub uint: bool,
-    /// The channel holding the IDs (0 = R).
-    pub channel: u32,
-    /// The ID's bit field: `(value >> shift) & mask`.
-    pub shift: u32,
-    /// Its mask (at most 8 bits: IDs 0 to 255).
-    pub mask: u32,
-    /// For UNORM channels, the largest integer (`2^bits - 1`).
-    pub unorm_max: u32,
-    /// The profile number (1 to the number of profiles; 0: none) of each ID 0 to 255.
-    pub profile_of: Vec<u8>,
-    /// The image holds nothing but profile numbers (lucent's own G-buffer writes each
-    /// pixel's): the passes need not tell other IDs apart.
-    pub only_profiles: bool,
 }
 
 /// How many SSS materials with IDs other than their profile numbers the passes tell apart by

@@ -4,7 +4,8 @@
 
 use std::sync::Arc;
 
-use super::{profile_reach, sss_passes, tables, LeanInputs, SssInputs, SssProfiles};
+use super::described::{sss_on_gbuffer, DescribedImages, DescribedShadows};
+use super::{profile_reach, tables, SssProfiles};
 use crate::features::gbuffer::GBufferLayout;
 use crate::features::technique::TechniqueModule;
 use crate::features::technique::{
@@ -122,28 +123,30 @@ impl FramePart for SssProfiles {
             // The G-buffer and lighting pass of a frame with this part always have both.
             return hdr;
         };
-        sss_passes(
+        // lucent's G-buffer described as a host describes its own, through the declaration
+        // a host's SssEffect makes.
+        let info = graph.image_info(&hdr);
+        let described = gb.layout.described(info.width, info.height);
+        let images = DescribedImages {
+            depth: &gb.depth,
+            diffuse: &hdr,
+            material_ids: profile_ids,
+            specular: Some(specular),
+            albedo: Some(&gb.gb0),
+            normals: Some(&gb.gb1),
+            lean_targets: gb.lean.as_ref().map(|moments| [moments, &gb.gb0, &gb.gb1]),
+            shadows: images.shadow_maps.map(|maps| DescribedShadows {
+                depth: &maps.depth,
+                // lucent's own light-space maps are one atlas of standard Z.
+                array: false,
+                second: None,
+                reversible: false,
+            }),
+        };
+        sss_on_gbuffer(
             graph,
-            &SssInputs {
-                diffuse: &hdr,
-                specular,
-                depth: &gb.depth,
-                profile_ids,
-                lean: gb.lean.as_ref().map(|view_plane| LeanInputs {
-                    view_plane,
-                    gb0: &gb.gb0,
-                    gb1: &gb.gb1,
-                }),
-                shadow_depth: images.shadow_maps.map(|m| &m.depth),
-                // lucent's own light-space maps are one atlas.
-                shadow_array: false,
-                second_shadow_depth: None,
-                shadow_reversible: false,
-                albedo: gb.layout.sss_texturing.then_some(&gb.gb0),
-                depth_in_alpha: self.depth_in_alpha(),
-                ids: &self.id_map,
-                linear_depth: false,
-            },
+            &described,
+            &images,
             self,
             knobs.sss,
             scene_gpu,

@@ -1,6 +1,6 @@
-//! A host's G-buffer as lucent's effects read it: each image's format and encoding, the
+//! A G-buffer as lucent's effects read it (a host's, or lucent's own: [`super::gbuffer::GBufferLayout::described`]): each image's format and encoding, the
 //! camera as the host's own matrices, and the world's scale. A description holds no handles;
-//! the images themselves come with each frame ([`super::HostImage`]).
+//! the images themselves come with each frame ([`crate::embed::HostImage`]).
 //!
 //! lucent adapts to the host's layout rather than asking for its own: depth in any depth
 //! format with any perspective (standard or reversed Z, finite or infinite far: the depth is
@@ -15,7 +15,6 @@ use glam::Mat4;
 
 use crate::backend::format::{format_info, format_name, FormatKind};
 use crate::error::HostError;
-use crate::features::sss::IdMap;
 use crate::Result;
 
 /// How the depth image's values encode depth.
@@ -75,7 +74,7 @@ pub enum DiffuseAlbedo {
     /// Each screen-space SSS material's pixels hold the part of the albedo its profile's
     /// texturing puts before the blur ([`crate::scene::material::Texturing`]: all of it for
     /// `pre`, none for `post`, its square root for `pre-post`); every other pixel all of it.
-    /// HDRP's lighting pass writes its diffuse so, and lucent's own does: [`super::SssEffect`]
+    /// HDRP's lighting pass writes its diffuse so, and lucent's own does: [`crate::embed::SssEffect`]
     /// then needs no pass to put the albedo right (the albedo image only for the profiles
     /// that apply it after the blur). The effects that add light of their own to the diffuse
     /// (the environment, SSS transmission) refuse it: they do not know which pixels scatter.
@@ -159,6 +158,31 @@ pub enum IdEncoding {
         /// How many bits (1 to 8).
         count: u8,
     },
+}
+
+/// How the passes find a pixel's material in an ID image (`IdDesc::decode`): a bit field of
+/// one channel of the image, and the profile number of each ID. lucent's own G-buffer
+/// (`IdMap::lucent`) and a host's are read by the same passes with different specialization
+/// constants (`IdMap::specialization`); those methods, which only the SSS passes use, are in
+/// `crate::features::sss`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IdMap {
+    /// The image is read as unsigned integers (a UINT format or a stencil aspect; define
+    /// `LUCENT_SSS_IDS_UINT`), else as UNORM floats turned back into their integers.
+    pub uint: bool,
+    /// The channel holding the IDs (0 = R).
+    pub channel: u32,
+    /// The ID's bit field: `(value >> shift) & mask`.
+    pub shift: u32,
+    /// Its mask (at most 8 bits: IDs 0 to 255).
+    pub mask: u32,
+    /// For UNORM channels, the largest integer (`2^bits - 1`).
+    pub unorm_max: u32,
+    /// The profile number (1 to the number of profiles; 0: none) of each ID 0 to 255.
+    pub profile_of: Vec<u8>,
+    /// The image holds nothing but profile numbers (lucent's own G-buffer writes each
+    /// pixel's): the passes need not tell other IDs apart.
+    pub only_profiles: bool,
 }
 
 /// The host's per-pixel material ID image.
@@ -483,10 +507,10 @@ impl ThicknessDesc {
 
 /// The LEAN targets a host's G-buffer pass writes for LCB, LBB and the bilateral blur, as
 /// lucent's own G-buffer pass writes them ([`GBufferDesc::with_lean_targets`]). With them the
-/// [`super::SssEffect`] reads the host's LEAN moments, albedo and normals as they are, instead of
+/// [`crate::embed::SssEffect`] reads the host's LEAN moments, albedo and normals as they are, instead of
 /// building them from the normals in a pass of its own (`sss lean in`): the same work as
 /// lucent's own frame, and the LEAN maps' spread inside a pixel is kept. The values are those
-/// of [`super::glsl::TERMS`]' `lucent_view_plane_lean` (which lucent's own passes call):
+/// of [`crate::embed::glsl::TERMS`]' `lucent_view_plane_lean` (which lucent's own passes call):
 ///
 /// | image | rgba |
 /// |---|---|

@@ -1379,6 +1379,120 @@ fn a_host_light_with_the_albedo_as_each_texturing_asks_equals_lucents_post_and_p
     test.finish();
 }
 
+/// The SSS passes of a plan between the lighting pass and the tonemap, in execution order:
+/// each pass's name, taps, and how many images it reads and writes.
+fn sss_passes_of(
+    plan: &lucent::graph::Plan,
+    from_lighting: bool,
+) -> Vec<(String, Option<u32>, usize, usize)> {
+    let ordered = plan
+        .physical
+        .iter()
+        .flat_map(|p| p.passes.iter().map(|&i| &plan.passes[i]));
+    let mut after_lighting = !from_lighting;
+    let mut out = Vec::new();
+    for pass in ordered {
+        if pass.name == "tonemap" {
+            break;
+        }
+        if after_lighting {
+            out.push((
+                pass.name.clone(),
+                pass.taps,
+                pass.reads.len(),
+                pass.writes.len(),
+            ));
+        }
+        after_lighting |= pass.name == "lighting";
+    }
+    out
+}
+
+/// lucent's own frames declare their SSS passes through the declaration an `SssEffect`
+/// makes, over lucent's G-buffer described as a host describes its own
+/// (`GBufferLayout::described`): an effect built on that description, with lucent's profiles
+/// as its materials, plans the frame's SSS passes one for one (names, taps, reads and writes),
+/// for every blur and for scenes with several profiles and chains.
+#[test]
+fn an_sss_effect_on_lucents_described_gbuffer_plans_lucents_own_sss_passes() {
+    let test = TestGpu::new();
+    let lucent = wrap(&test, options(1));
+    let (w, h) = (320, 240);
+    let blurs: Vec<Option<&'static dyn lucent::features::registry::TechniqueModule>> = vec![
+        None,
+        Some(&lucent::features::sss::control::CONTROL),
+        Some(&lucent::features::sss::separable::SEPARABLE),
+        Some(&lucent::features::sss::burley::BURLEY),
+        Some(&lucent::features::sss::lcb::LCB),
+        Some(&lucent::features::sss::lbb::LBB),
+        Some(&lucent::features::sss::bilateral::BILATERAL),
+    ];
+    let mut cases = Vec::new();
+    for blur in blurs {
+        cases.push(("skin", blur));
+    }
+    cases.push(("showcase-marble", None));
+    cases.push(("mixed", None));
+    let mut compared = Vec::new();
+    for (name, technique) in cases {
+        let scene = lucent::bake::scene::load_scene_baked(name).unwrap();
+        let settings = FrameSettings {
+            technique: technique.map_or(Technique::Auto, Technique::Only),
+            ..FrameSettings::new(w, h)
+        };
+        let frame = lucent::frame::FrameDesc::new(&scene, &settings).unwrap();
+        let profiles = frame.sss().expect("an SSS frame").clone();
+        let layout = frame.gbuffer_layout(&settings);
+        let frame_plan = lucent::frame::plan_frame(&settings, &frame).unwrap();
+        let shadows = frame_plan
+            .passes
+            .iter()
+            .any(|p| p.name == "light-space maps");
+        // lucent's profiles as the host's materials: IDs 1 to n (the profile numbers lucent's
+        // G-buffer writes), each with its blur and its own scale.
+        let materials = profiles
+            .profiles
+            .iter()
+            .enumerate()
+            .map(|(i, (p, b))| {
+                let mut p = p.clone();
+                p.blur = Some(b.name().into());
+                let metres = 1.0 / (1000.0 * p.units_per_mm);
+                SssMaterial::new(i as u8 + 1, p).with_metres_per_unit(metres)
+            })
+            .collect();
+        let mut desc = SssEffectDesc::new(
+            layout.described(w, h),
+            materials,
+            vk::Format::R16G16B16A16_SFLOAT,
+        )
+        .with_knobs(settings.sss);
+        if shadows && layout.lean {
+            desc = desc.with_shadow_maps(vk::Format::D32_SFLOAT);
+        }
+        let effect = built(&test, &lucent, |u| SssEffect::new(&lucent, u, desc)).unwrap();
+        let want = sss_passes_of(&frame_plan, true);
+        let got = sss_passes_of(effect.plan(), false);
+        effect.destroy(&lucent);
+        assert!(!want.is_empty(), "{name}: the frame has SSS passes");
+        assert_eq!(
+            got,
+            want,
+            "{name} ({}): the effect on lucent's described G-buffer plans other passes than \
+             lucent's frame",
+            technique.map_or("auto", |t| t.name())
+        );
+        compared.push(format!(
+            "{name}/{}: {} passes",
+            technique.map_or("auto", |t| t.name()),
+            want.len()
+        ));
+    }
+    eprintln!("{}", compared.join("; "));
+    drop(lucent);
+    test.finish();
+}
+
 #[test]
 fn wrong_layouts_missing_usage_and_bad_slots_are_typed_errors_not_validation_errors() {
     let test = TestGpu::new();

@@ -24,7 +24,6 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::capabilities::{require, Effect};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_environment, check_views, depth_role, frame_albedo, import_host_image,
@@ -34,6 +33,7 @@ use super::regions::clipped;
 use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
+use crate::features::capabilities::{require, Effect};
 use crate::features::gbuffer_desc::{DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera};
 use crate::features::pass::FullscreenPass;
 use crate::gpu_scene::{projection_depth_ends, Region, SceneGpu, SceneUpload, TableRegion, FRAME};

@@ -36,7 +36,6 @@ use std::sync::{Arc, Mutex};
 use ash::vk;
 use glam::Mat4;
 
-use super::capabilities::{require, Effect};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_environment, check_lights, check_material_id, check_views, depth_role,
@@ -49,6 +48,7 @@ use crate::backend::access::Access;
 use crate::backend::format::format_name;
 use crate::backend::pipeline::HostVertexInput;
 use crate::error::HostError;
+use crate::features::capabilities::{require, Effect};
 use crate::features::gbuffer_desc::{DepthEncoding, GBufferDesc, HostCamera};
 use crate::features::layered::{
     blurs_on_screen, layered_passes, LayeredDecode, LayeredDesc, LayeredHost, LayeredInputs,

@@ -162,7 +162,6 @@ use crate::backend::GpuContext;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
-mod capabilities;
 mod environment;
 
 pub mod glsl;
@@ -178,12 +177,13 @@ mod translucency;
 mod transmission;
 mod uploads;
 
+pub use crate::features::capabilities::{capabilities, Effect, Support};
 pub use crate::features::gbuffer_desc::{
     DepthDesc, DepthEncoding, DiffuseAlbedo, DiffuseDesc, GBufferDesc, HostCamera, IdDesc,
     IdEncoding, LeanTargetsDesc, NormalDesc, NormalEncoding, NormalSpace, ThicknessChannels,
     ThicknessDesc, MAX_METRES_PER_UNIT,
 };
-pub use capabilities::{capabilities, Effect, Support};
+pub use crate::features::sss::described::{SpecularSurface, SssEffectDesc, SssMaterial};
 pub(crate) use environment::shader_permutations as environment_permutations;
 pub use environment::{
     EnvironmentEffect, EnvironmentEffectDesc, EnvironmentFrame, EnvironmentImages,
@@ -198,8 +198,8 @@ pub use regions::{box_screen_region, screen_region};
 pub use scene::SceneRenderer;
 pub use shadow_faces::ShadowFace;
 pub use sss::{
-    LeanLighting, LeanSurface, LeanTargetImages, SpecularSurface, SssEffect, SssEffectDesc,
-    SssFrame, SssImages, SssMaterial, SssRegion, MAX_VIEWS_PER_FRAME,
+    LeanLighting, LeanSurface, LeanTargetImages, SssEffect, SssFrame, SssImages, SssRegion,
+    MAX_VIEWS_PER_FRAME,
 };
 pub use timing::{EffectTimer, PassTime};
 pub(crate) use translucency::shader_permutations as translucency_permutations;

@@ -1,6 +1,6 @@
 //! [`SssEffect`]: lucent's screen-space SSS (the control, the separable blur, 2-D Burley,
 //! and the LEAN-mapping thesis's LCB, LBB and bilateral blur) inserted into a host's frame, on
-//! the host's own G-buffer ([`GBufferDesc`]).
+//! the host's own G-buffer ([`GBufferDesc`](super::GBufferDesc)).
 //!
 //! The host renders its G-buffer and lighting as usual, keeping the lit diffuse apart (and,
 //! ideally, the specular), and writes a material ID per pixel. lucent blurs the diffuse of
@@ -10,7 +10,7 @@
 //! shader permutations and per-frame constants (the ID decode, the depth decode of the host's
 //! projection), not as copies into lucent's layout. The one exception: when the host's
 //! diffuse holds its albedo differently from how a profile wants it before the blur
-//! ([`DiffuseAlbedo`] against [`Texturing`]), one fullscreen pass puts it right first
+//! ([`DiffuseAlbedo`](super::DiffuseAlbedo) against [`Texturing`](super::Texturing)), one fullscreen pass puts it right first
 //! (`sss albedo in`).
 //!
 //! LCB, LBB and the bilateral blur blur LEAN moments with the light and relight the specular
@@ -33,7 +33,6 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::capabilities::{require, Effect};
 use super::image::{check_image, distinct_inputs, HostImage, Role};
 use super::passes::{check_lights, check_views, EffectPasses};
 use super::regions::tiles_marked_by;
@@ -44,70 +43,23 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::format::{format_info, format_name};
 use crate::error::{HostError, ImageFault};
-use crate::features::gbuffer_desc::{
-    check_metres_per_unit, sampled_float, DiffuseAlbedo, GBufferDesc, HostCamera, IdEncoding,
-};
+use crate::features::gbuffer_desc::{sampled_float, HostCamera, IdEncoding};
 use crate::features::registry;
 use crate::features::sss::described::{
-    applies_albedo_after, needs_albedo_pass, sss_on_gbuffer, DescribedImages, DescribedShadows,
-    HOST_LEAN,
+    sss_on_gbuffer, CheckedMaterials, DescribedImages, DescribedShadows, SpecularSurface,
+    SssEffectDesc, SssMaterial, HOST_LEAN,
 };
-use crate::features::sss::{self, SssKnobs, SssProfiles};
+use crate::features::sss::{self, SssProfiles};
 use crate::gpu_scene::{SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
 use crate::graph::{Handle, ImageInfo, ImportedImage, RenderGraph, ResourceId};
-use crate::scene::material::{SssProfile, Texturing};
 use crate::scene::Light;
 use crate::Result;
 
 /// Most views one frame may record ([`SssEffectDesc::views_per_frame`]).
 pub const MAX_VIEWS_PER_FRAME: usize = 4;
 
-/// One scattering material of the host: its ID in the host's material ID image and the
-/// profile its pixels are blurred with.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct SssMaterial {
-    /// The host's ID (1 to 255; 0 is taken to mean "does not scatter" and cannot have one).
-    pub id: u8,
-    /// Its profile: the Gaussians in millimetres (its `units_per_mm` is set from
-    /// [`Self::metres_per_unit`], or the G-buffer's [`GBufferDesc::metres_per_unit`]), the
-    /// blur ([`SssProfile::blur`]: the control, separable, Burley, or a LEAN blur: LCB, LBB,
-    /// bilateral) and where the albedo goes ([`SssProfile::texturing`]).
-    pub profile: SssProfile,
-    /// The world scale of this material's objects, metres per world unit, when it is not the
-    /// G-buffer's ([`Self::with_metres_per_unit`]; as HDRP's diffusion profiles each have a
-    /// world scale): a profile in millimetres spans as many world units on an object
-    /// modelled at another scale.
-    pub metres_per_unit: Option<f32>,
-    /// The specular surface the LEAN blurs relight (required with them, refused with the
-    /// others, whose specular is the host's own).
-    pub surface: Option<SpecularSurface>,
-}
-
+/// The [`SssMaterial`] methods that look a profile's blur up in the technique registry.
 impl SssMaterial {
-    /// Material `id` scattering with `profile`.
-    pub fn new(id: u8, profile: SssProfile) -> Self {
-        Self {
-            id,
-            profile,
-            surface: None,
-            metres_per_unit: None,
-        }
-    }
-
-    /// With its own world scale ([`Self::metres_per_unit`]: positive, finite, at most
-    /// [`super::MAX_METRES_PER_UNIT`]).
-    pub fn with_metres_per_unit(mut self, metres: f32) -> Self {
-        self.metres_per_unit = Some(metres);
-        self
-    }
-
-    /// With the specular surface a LEAN blur (LCB, LBB, bilateral) relights.
-    pub fn with_surface(mut self, surface: SpecularSurface) -> Self {
-        self.surface = Some(surface);
-        self
-    }
-
     /// Whether its profile's blur relights the specular (LCB, LBB, the bilateral blur): the
     /// material then needs a [`SpecularSurface`] ([`Self::with_surface`]), and the effect the
     /// normals and the lights ([`SssFrame::lean`]). The blur named by the profile, or the
@@ -125,123 +77,6 @@ impl SssMaterial {
         } else {
             self
         })
-    }
-}
-
-/// A material's specular as lucent's own materials describe it (`roughness`, `specular` of a
-/// scene's `[material]`): what LCB, LBB and the bilateral blur evaluate their LEAN specular
-/// with, in place of the host's specular, on the material's pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct SpecularSurface {
-    /// Roughness, 0 to 1 (lucent's Blinn-Phong exponent `2 / r^4 - 2` and the LEAN lobe's base
-    /// variance come from it).
-    pub roughness: f32,
-    /// Specular intensity: reflectance at normal incidence, 0 to 1.
-    pub specular: f32,
-}
-
-impl SpecularSurface {
-    /// A surface of `roughness` reflecting `specular` at normal incidence.
-    pub fn new(roughness: f32, specular: f32) -> Self {
-        Self {
-            roughness,
-            specular,
-        }
-    }
-
-    /// Both finite and in 0..=1.
-    fn check(&self, field: &str) -> Result<()> {
-        for (name, value) in [("roughness", self.roughness), ("specular", self.specular)] {
-            if !(0.0..=1.0).contains(&value) {
-                return Err(HostError::Description {
-                    field: format!("{field}.surface.{name}"),
-                    problem: format!("{value} is not in 0 to 1"),
-                }
-                .into());
-            }
-        }
-        Ok(())
-    }
-}
-
-/// What an [`SssEffect`] is built for.
-#[derive(Clone, Debug)]
-#[non_exhaustive]
-pub struct SssEffectDesc {
-    /// The host's G-buffer (it must describe its material IDs).
-    pub gbuffer: GBufferDesc,
-    /// The scattering materials (1 to 31 of them).
-    pub materials: Vec<SssMaterial>,
-    /// The blurs' knobs (samples, kernel shape, precision, half resolution...).
-    pub knobs: SssKnobs,
-    /// The output's format (an RGB(A) float, UNORM or SRGB colour format).
-    pub output_format: vk::Format,
-    /// Views recorded per frame (1 to [`MAX_VIEWS_PER_FRAME`]): each view of a frame has its
-    /// own camera and images.
-    pub views_per_frame: usize,
-    /// The format of the host's shadow map that shadows the LEAN blurs' specular (a depth
-    /// format), when it has one ([`LeanLighting::shadow_map`]). Only with a LEAN blur.
-    pub shadow_format: Option<vk::Format>,
-    /// That shadow map is an array of layers (its view a 2-D array view), each face in its
-    /// [`ShadowFace::layer`] ([`Self::with_shadow_array`]); else one 2-D image (an atlas).
-    pub shadow_array: bool,
-    /// The format of a second shadow map beside the first (an atlas): an array of layers of
-    /// its own size, each of its faces [`ShadowFace::in_second_map`]
-    /// ([`Self::with_second_shadow_map`], [`LeanLighting::second_shadow_map`]).
-    pub second_shadow_format: Option<vk::Format>,
-}
-
-impl SssEffectDesc {
-    /// The effect over `gbuffer` for `materials`, writing `output_format`, one view a frame,
-    /// the default knobs.
-    pub fn new(
-        gbuffer: GBufferDesc,
-        materials: Vec<SssMaterial>,
-        output_format: vk::Format,
-    ) -> Self {
-        Self {
-            gbuffer,
-            materials,
-            knobs: SssKnobs::default(),
-            output_format,
-            views_per_frame: 1,
-            shadow_format: None,
-            shadow_array: false,
-            second_shadow_format: None,
-        }
-    }
-
-    /// With a second shadow map of `format` beside the first, an atlas
-    /// ([`Self::second_shadow_format`]).
-    pub fn with_second_shadow_map(mut self, format: vk::Format) -> Self {
-        self.second_shadow_format = Some(format);
-        self
-    }
-
-    /// The shadow map of [`Self::with_shadow_maps`] is an array of layers
-    /// ([`HostImage::with_layers`]), each face in its own ([`ShadowFace::in_layer`]).
-    pub fn with_shadow_array(mut self) -> Self {
-        self.shadow_array = true;
-        self
-    }
-
-    /// With a shadow map of `format` shadowing the LEAN blurs' specular.
-    pub fn with_shadow_maps(mut self, format: vk::Format) -> Self {
-        self.shadow_format = Some(format);
-        self
-    }
-
-    /// With these knobs.
-    pub fn with_knobs(mut self, knobs: SssKnobs) -> Self {
-        self.knobs = knobs;
-        self
-    }
-
-    /// With this many views per frame.
-    pub fn with_views_per_frame(mut self, views: usize) -> Self {
-        self.views_per_frame = views;
-        self
     }
 }
 
@@ -287,10 +122,10 @@ pub struct LeanLighting<'a> {
 /// Where the LEAN blurs' moments, albedo and normals come from in a frame.
 #[derive(Clone, Copy, Debug)]
 pub enum LeanSurface<'a> {
-    /// The host's normals ([`GBufferDesc::normals`]): lucent builds the LEAN targets from them
+    /// The host's normals ([`GBufferDesc::normals`](super::GBufferDesc::normals)): lucent builds the LEAN targets from them
     /// and each material's [`SpecularSurface`] in one pass (`sss lean in`).
     Normals(&'a HostImage),
-    /// The LEAN targets the host's G-buffer pass wrote ([`GBufferDesc::with_lean_targets`]).
+    /// The LEAN targets the host's G-buffer pass wrote ([`GBufferDesc::with_lean_targets`](super::GBufferDesc::with_lean_targets)).
     Targets(LeanTargetImages<'a>),
 }
 
@@ -425,124 +260,11 @@ impl SssEffect {
     /// (the host submits it before the first frame); nothing is submitted or waited for.
     /// Everything about the description is checked here.
     pub fn new(lucent: &Lucent, uploads: &mut Uploads, desc: SssEffectDesc) -> Result<Self> {
-        let gbuffer = &desc.gbuffer;
-        gbuffer.check()?;
-        require(Effect::Sss, gbuffer)?;
-        let ids = gbuffer
-            .material_ids
-            .expect("missing() lists the material IDs");
         check_views(desc.views_per_frame)?;
-        if desc.materials.is_empty() || desc.materials.len() >= sss::MAX_SSS_PROFILES {
-            return Err(HostError::Description {
-                field: "materials".into(),
-                problem: format!(
-                    "{} scattering materials; 1 to {} are supported",
-                    desc.materials.len(),
-                    sss::MAX_SSS_PROFILES - 1
-                ),
-            }
-            .into());
-        }
         check_output_format(desc.output_format)?;
-        let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
-        let mut id_map = ids.decode(Vec::new())?;
-        let mut profile_of = vec![0u8; 256];
-        let mut profiles = Vec::with_capacity(desc.materials.len());
-        for (index, material) in desc.materials.iter().enumerate() {
-            let field = format!("materials[{index}] (ID {})", material.id);
-            if material.id == 0 || profile_of[usize::from(material.id)] != 0 {
-                return Err(HostError::Description {
-                    field,
-                    problem: "IDs are 1 to 255 (0: does not scatter), each once".into(),
-                }
-                .into());
-            }
-            if u32::from(material.id) > id_map.mask {
-                return Err(HostError::Description {
-                    field,
-                    problem: "the ID does not fit the material ID image's bit field".into(),
-                }
-                .into());
-            }
-            let mut profile = material.profile.clone();
-            profile.units_per_mm = match material.metres_per_unit {
-                None => units_per_mm,
-                Some(metres) => {
-                    check_metres_per_unit(metres, &format!("{field}.metres_per_unit"))?;
-                    1.0 / (1000.0 * metres)
-                }
-            };
-            profile.validate()?;
-            let blur = registry::blur_of(&profile)?;
-            if blur.lean() {
-                // The normals first: what capabilities says the LEAN blurs lack.
-                require(Effect::LeanSss, gbuffer)?;
-            }
-            match (blur.lean(), &material.surface) {
-                (true, Some(_)) if gbuffer.lean_targets.is_some() => {
-                    return Err(HostError::Unsupported {
-                        input: format!("{field}.surface"),
-                        found: "a specular surface with the host's LEAN targets".into(),
-                        accepted: "no surface: the roughness and specular intensity are the \
-                                   LEAN targets' (GBufferDesc::with_lean_targets)"
-                            .into(),
-                    }
-                    .into())
-                }
-                (true, Some(surface)) => surface.check(&format!("materials[{index}]"))?,
-                (true, None) if gbuffer.lean_targets.is_some() => {}
-                (true, None) => {
-                    return Err(HostError::Missing {
-                        input: format!("{field}.surface"),
-                        needed_by: format!(
-                            "the {} blur relights the specular from the blurred LEAN moments \
-                             with the material's roughness and specular intensity \
-                             (SssMaterial::with_surface)",
-                            blur.name()
-                        ),
-                    }
-                    .into())
-                }
-                (false, Some(_)) => {
-                    return Err(HostError::Unsupported {
-                        input: format!("{field}.surface"),
-                        found: format!("a specular surface with the {} blur", blur.name()),
-                        accepted: "a surface only with LCB, LBB or the bilateral blur, which \
-                                   relight the specular; the other blurs keep the host's"
-                            .into(),
-                    }
-                    .into())
-                }
-                (false, None) => {}
-            }
-            profile_of[usize::from(material.id)] = index as u8 + 1;
-            profiles.push((profile, blur));
-        }
-        let albedo_pass =
-            needs_albedo_pass(gbuffer.diffuse.albedo, profiles.iter().map(|(p, _)| p));
-        let post_albedo = applies_albedo_after(profiles.iter().map(|(p, _)| p));
-        if (albedo_pass || post_albedo) && gbuffer.albedo.is_none() {
-            return Err(HostError::Missing {
-                input: "albedo".into(),
-                needed_by: match gbuffer.diffuse.albedo {
-                    DiffuseAlbedo::Excluded => {
-                        "the diffuse light is described without its albedo, so lucent applies it \
-                         (GBufferDesc::with_albedo)"
-                            .into()
-                    }
-                    DiffuseAlbedo::Included | DiffuseAlbedo::AsTexturing => format!(
-                        "a profile applies its albedo after the scatter (texturing '{}'): \
-                         describe the albedo image, or use texturing 'pre'",
-                        profiles
-                            .iter()
-                            .find(|(p, _)| p.texturing != Texturing::Pre)
-                            .map_or("post", |(p, _)| p.texturing.name())
-                    ),
-                },
-            }
-            .into());
-        }
-        id_map.profile_of = profile_of;
+        // The checks every path of the SSS passes makes (lucent's own frames too).
+        let CheckedMaterials { profiles, id_map } = desc.check_materials(&registry::blur_of)?;
+        let gbuffer = &desc.gbuffer;
         let lean = profiles.iter().any(|(_, b)| b.lean());
         if desc.shadow_array && desc.shadow_format.is_none() {
             return Err(HostError::Description {
@@ -1181,6 +903,7 @@ const _: () = {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::material::SssProfile;
 
     #[test]
     fn output_formats_are_colour_the_final_pass_can_write() {

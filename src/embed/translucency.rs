@@ -24,7 +24,6 @@ use std::sync::Arc;
 use ash::vk;
 use glam::Vec3;
 
-use super::capabilities::{require, Effect};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_views, depth_role, id_role, import_host_image,
@@ -35,6 +34,7 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
+use crate::features::capabilities::{require, Effect};
 use crate::features::gbuffer_desc::{DepthEncoding, GBufferDesc, HostCamera};
 use crate::features::pass::FullscreenPass;
 use crate::features::translucency::{material_row, MaterialTableGpu, TABLE_REGION};

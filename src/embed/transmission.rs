@@ -29,7 +29,6 @@ use std::sync::Arc;
 
 use ash::vk;
 
-use super::capabilities::{require, Effect};
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_lights, check_material_id, check_views, depth_role, frame_albedo,
@@ -41,6 +40,7 @@ use super::{Lucent, Uploads};
 use crate::backend::access::Access;
 use crate::backend::shader::PipelineShaders;
 use crate::error::HostError;
+use crate::features::capabilities::{require, Effect};
 use crate::features::gbuffer_desc::{
     check_metres_per_unit, DepthEncoding, DiffuseAlbedo, GBufferDesc, HostCamera,
 };

@@ -4,6 +4,7 @@
 //! or the f64 reference, only what [`crate::gpu_scene`] put on the GPU.
 //!
 //! - [`gbuffer`]: the MRT G-buffer: its targets, their formats, the pass that fills them.
+//! - [`capabilities`]: which effects a described G-buffer can run, and what each lacks.
 //! - [`gbuffer_desc`]: a G-buffer described as the effects read it (formats, encodings, world
 //!   scale): a host's, as `lucent::embed` takes it, or lucent's own
 //!   ([`gbuffer::GBufferLayout::described`]), so both are read through one description.
@@ -29,6 +30,7 @@
 //!   passes) and the one list of them, which everything that names techniques iterates.
 
 pub mod antialias;
+pub mod capabilities;
 pub mod copy_pass;
 pub mod debug_view;
 pub mod gbuffer;

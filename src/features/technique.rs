@@ -35,6 +35,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::gbuffer::{GBuffer, GBufferLayout};
+use super::gbuffer_desc::GBufferDesc;
 use super::knob::Knob;
 use super::layered::settings::LayeredKnobs;
 use super::shadows::{ShadowDesc, ShadowMaps};
@@ -229,6 +230,14 @@ pub trait FramePart: Any + Debug + Send + Sync {
 
     /// Sets what the light-space maps must store for it.
     fn shadows(&self, _maps: &mut ShadowDesc) {}
+
+    /// Checks it against the frame's G-buffer described as a host describes its own
+    /// ([`GBufferLayout::described`]) with the checks a host's effect makes on its
+    /// description: a part whose passes are declared as an effect declares a host's (the SSS
+    /// chains) is held to what the effect accepts. Nothing for the others.
+    fn check_described(&self, _gbuffer: &GBufferDesc, _lookup: &dyn Lookup) -> Result<()> {
+        Ok(())
+    }
 
     /// Adds its per-frame tables, in the order the per-frame buffer lays them out.
     fn tables(&self, out: &mut Vec<TableRegion>);

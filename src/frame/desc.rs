@@ -65,12 +65,22 @@ impl FrameDesc {
         let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
             scene.objects.iter().any(|o| f(&o.material))
         };
-        Ok(Self {
+        let desc = Self {
             parts,
             shadows,
             normal_maps: any(&|m| m.normal_texture.is_some()),
             albedo_maps: any(&|m| m.albedo_texture.is_some()),
-        })
+        };
+        // lucent's G-buffer as a host describes its own: each part is held to what the
+        // effects accept of a host (the SSS chains are declared as SssEffect declares a
+        // host's).
+        let described = desc
+            .gbuffer_layout(settings)
+            .described(settings.width, settings.height);
+        for part in desc.parts() {
+            part.check_described(&described, &registry::Registry)?;
+        }
+        Ok(desc)
     }
 
     /// The frame's parts, in registry order.
@@ -207,6 +217,43 @@ mod tests {
 
     fn kinds(desc: &FrameDesc) -> Vec<&'static str> {
         desc.parts().map(|p| p.kind().name()).collect()
+    }
+
+    /// lucent's SSS part is held to the checks a host's SssEffect makes on its description:
+    /// every built-in frame passes them (`FrameDesc::new` runs them, above), and a G-buffer
+    /// that lacked what the chains read would be refused as a host's is.
+    #[test]
+    fn the_sss_part_is_checked_as_a_hosts_effect_is() {
+        let scene = builtin("skin").unwrap();
+        let mut settings = FrameSettings::new(64, 48);
+        settings.technique = Technique::parse("lbb").unwrap();
+        let desc = FrameDesc::new(&scene, &settings).unwrap();
+        let part = desc.sss().expect("skin scatters");
+        let layout = desc.gbuffer_layout(&settings);
+        part.check_described(&layout.described(64, 48), &registry::Registry)
+            .unwrap();
+        let refused = |layout: GBufferLayout| {
+            let e = part
+                .check_described(&layout.described(64, 48), &registry::Registry)
+                .unwrap_err();
+            match e {
+                crate::LucentError::Host(e) => e.to_string(),
+                e => panic!("not a host error: {e}"),
+            }
+        };
+        // Without the LEAN targets, LBB's material must bring its specular surface.
+        let no_lean = refused(GBufferLayout {
+            lean: false,
+            ..layout
+        });
+        assert!(no_lean.contains("surface"), "{no_lean}");
+        // Without the profile IDs, SSS cannot run at all.
+        let no_ids = refused(GBufferLayout {
+            sss: false,
+            lean: false,
+            ..layout
+        });
+        assert!(no_ids.contains("material IDs"), "{no_ids}");
     }
 
     /// Every built-in scene under every technique: the frame holds the parts its technique

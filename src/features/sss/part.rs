@@ -4,18 +4,24 @@
 
 use std::sync::Arc;
 
-use super::described::{sss_on_gbuffer, DescribedImages, DescribedShadows};
+use super::described::{
+    sss_on_gbuffer, DescribedImages, DescribedShadows, SssEffectDesc, SssMaterial,
+};
+use super::SssBlur;
+use crate::features::gbuffer_desc::GBufferDesc;
+use crate::features::lighting::HDR_FORMAT;
 use super::{profile_reach, tables, SssProfiles};
 use crate::features::gbuffer::GBufferLayout;
 use crate::features::technique::TechniqueModule;
 use crate::features::technique::{
-    downcast, part_value_methods, Describe, FrameImages, FramePart, PartKind, PartKnobs, SlotWrite,
+    downcast, part_value_methods, Describe, FrameImages, FramePart, Lookup, PartKind, PartKnobs,
+    SlotWrite,
 };
 use crate::gpu_scene::tiles::{object_tiles, tile_rects};
 use crate::gpu_scene::{SceneGpu, SceneUpload, TableRegion};
 use crate::graph::{Handle, Image, RenderGraph};
-use crate::scene::material::Texturing;
-use crate::Result;
+use crate::scene::material::{SssProfile, Texturing};
+use crate::{LucentError, Result};
 
 /// The screen-space SSS chains' part of a frame, which every blur technique belongs to.
 pub static SSS_PART: SssPart = SssPart;
@@ -98,6 +104,33 @@ impl FramePart for SssProfiles {
         // LCB's control-style taps straddle silhouettes: its LEAN target must be cleared.
         layout.lean_clear = self.chains().iter().any(|b| b.lean() && !b.bilateral());
         layout.depth_in_alpha = self.depth_in_alpha();
+    }
+
+    fn check_described(&self, gbuffer: &GBufferDesc, lookup: &dyn Lookup) -> Result<()> {
+        // The profiles as a host's materials: IDs 1 to n (the profile numbers lucent's
+        // G-buffer writes), each naming its blur, at its own scale.
+        let named = |(profile, blur): &(SssProfile, SssBlur)| {
+            let mut profile = profile.clone();
+            profile.blur = Some(blur.name().into());
+            (profile, *blur)
+        };
+        let want: Vec<(SssProfile, SssBlur)> = self.profiles.iter().map(named).collect();
+        let materials = want
+            .iter()
+            .enumerate()
+            .map(|(i, (profile, _))| SssMaterial::at_profile_scale(i as u8 + 1, profile.clone()))
+            .collect();
+        let desc = SssEffectDesc::new(gbuffer.clone(), materials, HDR_FORMAT);
+        let checked = desc.check_materials(&|p| lookup.blur_of(p))?;
+        // A check, not a conversion: every profile and blur comes back as it went in.
+        if checked.profiles != want {
+            return Err(LucentError::InvalidInput(format!(
+                "the SSS profiles of this frame and their host description differ: {:?} \
+                 against {:?}",
+                self.profiles, checked.profiles
+            )));
+        }
+        Ok(())
     }
 
     fn tables(&self, out: &mut Vec<TableRegion>) {

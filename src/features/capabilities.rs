@@ -10,23 +10,23 @@ use crate::Result;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Effect {
-    /// Screen-space SSS on the host's lit diffuse ([`super::SssEffect`]: the control, the
+    /// Screen-space SSS on the host's lit diffuse ([`crate::embed::SssEffect`]: the control, the
     /// separable blur, 2-D Burley).
     Sss,
     /// GDC 2011 thickness-based translucency added to the host's light
-    /// ([`super::TranslucencyEffect`]).
+    /// ([`crate::embed::TranslucencyEffect`]).
     Translucency,
     /// Screen-space SSS's transmission through thin parts: a medium's diffusion through the
-    /// thickness the host's shadow maps measure ([`super::TransmissionEffect`]).
+    /// thickness the host's shadow maps measure ([`crate::embed::TransmissionEffect`]).
     SssTransmission,
     /// Li et al.'s multi-layer single + dipole multiple scattering, drawn from the host's
-    /// meshes ([`super::LayeredEffect`]).
+    /// meshes ([`crate::embed::LayeredEffect`]).
     LayeredMedia,
     /// The SH environment's diffuse light added to the host's light
-    /// ([`super::EnvironmentEffect`]).
+    /// ([`crate::embed::EnvironmentEffect`]).
     Environment,
     /// Screen-space SSS with the LEAN-mapping thesis's blurs (LCB, LBB, the bilateral blur:
-    /// [`super::SssEffect`] with materials of those blurs), which blur LEAN moments made from
+    /// [`crate::embed::SssEffect`] with materials of those blurs), which blur LEAN moments made from
     /// the host's normals (or its own LEAN targets) with the light and relight the specular
     /// from them.
     LeanSss,
@@ -267,7 +267,7 @@ pub(crate) fn missing(effect: Effect, gbuffer: &GBufferDesc) -> Vec<HostError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::embed::{DepthDesc, DiffuseDesc, IdDesc, NormalDesc, ThicknessDesc};
+    use crate::features::gbuffer_desc::{DepthDesc, DiffuseDesc, IdDesc, NormalDesc, ThicknessDesc};
     use ash::vk;
 
     #[test]

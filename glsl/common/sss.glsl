@@ -60,9 +60,8 @@ int sss_profile_id(float stored) {
 // - The decode: the channel, the bit field's shift and mask, a UNORM channel's largest value
 //   (lucent's own G-buffer: R8_UNORM, the profile number k stored as k / 255).
 // - IDs that are the profile numbers (SSS_IDS_PROFILES_UP_TO = n > 0: IDs 1 to n are profiles 1
-//   to n, every other ID none): a host whose SSS materials have IDs 1 to n in the
-//   description's order, and lucent's own G-buffer (SSS_IDS_ONLY_PROFILES: it holds nothing
-//   else).
+//   to n, every other ID none): lucent's own G-buffer, and a host whose SSS materials have
+//   IDs 1 to n in the description's order.
 // - Otherwise up to eight materials: SSS_IDS_LISTED of them, material k's ID in SSS_ID_k and
 //   its profile number in SSS_PROFILE_k. A pixel's profile is then found by comparisons with
 //   constants, where the ID-to-profile table (id_profiles) costs a load from a per-pixel
@@ -94,9 +93,6 @@ layout(constant_id = 19) const int SSS_PROFILE_7 = 0;
 layout(constant_id = 20) const int SSS_PROFILE_8 = 0;
 // (constant_id 21 is host_depth.glsl's HOST_DEPTH_LINEAR.)
 layout(constant_id = 22) const uint SSS_IDS_PROFILES_UP_TO = 0u;
-// SSS_IDS_PROFILES_UP_TO's value for an image that holds nothing but profile numbers (lucent's
-// own G-buffer writes each pixel's): no other ID needs telling apart.
-#define SSS_IDS_ONLY_PROFILES 256
 
 // The profile number of a host's material ID (0: does not scatter); IDs past 255 have none.
 int sss_host_profile(uint host_id) {
@@ -146,10 +142,6 @@ int sss_decode_id(vec4 t) {
         // in [0, 1], so the general decode's clamp and mask are left out (they made the blurs'
         // taps 2% dearer). Negative values (a float channel) read 0, as NaN's do.
         int k = int(t[min(SSS_ID_CHANNEL, 3u)] * 255.0 + 0.5);
-        if (SSS_IDS_PROFILES_UP_TO >= uint(SSS_IDS_ONLY_PROFILES)) {
-            // Nothing but profile numbers (lucent's own G-buffer): no ID to tell apart.
-            return clamp(k, 0, MAX_SSS_PROFILES - 1);
-        }
         return k >= 0 && k <= int(min(SSS_IDS_PROFILES_UP_TO, uint(MAX_SSS_PROFILES - 1))) ? k : 0;
     }
     return sss_host_profile(uint(sss_id_key(t)));

@@ -162,8 +162,8 @@ pub enum IdEncoding {
 
 /// How the passes find a pixel's material in an ID image (`IdDesc::decode`): a bit field of
 /// one channel of the image, and the profile number of each ID. lucent's own G-buffer
-/// (`IdMap::lucent`) and a host's are read by the same passes with different specialization
-/// constants (`IdMap::specialization`); those methods, which only the SSS passes use, are in
+/// (`IdMap::lucent`, its description's decode) and a host's are read by the same passes with
+/// their specialization constants (`IdMap::specialization`); those methods, which only the SSS passes use, are in
 /// `crate::features::sss`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct IdMap {
@@ -180,9 +180,6 @@ pub struct IdMap {
     pub unorm_max: u32,
     /// The profile number (1 to the number of profiles; 0: none) of each ID 0 to 255.
     pub profile_of: Vec<u8>,
-    /// The image holds nothing but profile numbers (lucent's own G-buffer writes each
-    /// pixel's): the passes need not tell other IDs apart.
-    pub only_profiles: bool,
 }
 
 /// The host's per-pixel material ID image.
@@ -269,7 +266,6 @@ impl IdDesc {
                         ((1u64 << bits) - 1) as u32
                     },
                     profile_of,
-                    only_profiles: false,
                 });
             }
             IdEncoding::Stencil { shift, count } => {
@@ -320,7 +316,6 @@ impl IdDesc {
             mask: (1u32 << count) - 1,
             unorm_max: if uint { 0 } else { (1u32 << channel_bits) - 1 },
             profile_of,
-            only_profiles: false,
         })
     }
 }

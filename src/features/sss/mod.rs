@@ -102,6 +102,7 @@ pub mod transmission;
 mod two_pass;
 
 pub use crate::features::gbuffer_desc::IdMap;
+use crate::features::gbuffer_desc::IdDesc;
 pub use part::{SssPart, SSS_PART};
 pub use settings::{SssKnobs, SssPrecision, DEFAULT_SENSITIVITY};
 
@@ -272,21 +273,20 @@ pub struct SssProfiles {
 /// table.
 pub const LISTED_HOST_IDS: usize = 8;
 
+/// The define of passes reading an ID image of unsigned integers ([`IdMap::uint`]).
+const HOST_IDS_UINT: &[(&str, &str)] = &[("LUCENT_SSS_IDS_UINT", "1")];
+
 impl IdMap {
-    /// lucent's own G-buffer's IDs: `R8_UNORM`, each pixel's profile number `k` stored as
-    /// `k / 255` (its image holds nothing else: [`Self::only_profiles`]).
-    pub fn lucent() -> Self {
-        Self {
-            uint: false,
-            channel: 0,
-            shift: 0,
-            mask: 0xff,
-            unorm_max: 255,
-            profile_of: (0..256usize)
-                .map(|id| if id < MAX_SSS_PROFILES { id as u8 } else { 0 })
-                .collect(),
-            only_profiles: true,
+    /// lucent's own G-buffer's IDs, decoded as its description says
+    /// ([`crate::features::gbuffer::GBufferLayout::described`]: `R8_UNORM`, each pixel's
+    /// profile number `k` stored as `k / 255`) for `profiles` profiles numbered 1 to
+    /// `profiles`: the decode a host whose SSS materials have IDs 1 to n gets.
+    pub fn lucent(profiles: usize) -> Result<Self> {
+        let mut profile_of = vec![0u8; 256];
+        for (id, p) in profile_of.iter_mut().enumerate().take(profiles + 1).skip(1) {
+            *p = id as u8;
         }
+        IdDesc::value(crate::features::gbuffer::SSS_PROFILE_FORMAT).decode(profile_of)
     }
 
     /// The decode as the shaders take it (glsl/common/host_ids.glsl `decode`): channel,
@@ -298,7 +298,7 @@ impl IdMap {
     /// The defines the passes reading the ID image are built with (the image's sampler type).
     pub fn defines(&self) -> &'static [(&'static str, &'static str)] {
         if self.uint {
-            &[("LUCENT_SSS_IDS_UINT", "1")]
+            HOST_IDS_UINT
         } else {
             &[]
         }
@@ -306,13 +306,10 @@ impl IdMap {
 
     /// The value of the passes' `SSS_IDS_PROFILES_UP_TO` (glsl/common/sss.glsl): `n` when
     /// the IDs are the profile numbers, IDs 1 to `n` having profiles 1 to `n` and every other
-    /// ID none (a host whose SSS materials have IDs 1 to `n` in order), 256 when the image
-    /// holds nothing but profile numbers ([`Self::only_profiles`]), else `None`. The passes
-    /// then take a pixel's profile from its ID with no lookup.
+    /// ID none (lucent's own G-buffer, and a host whose SSS materials have IDs 1 to `n` in
+    /// order), else `None`. The passes then take a pixel's profile from its ID with no
+    /// lookup.
     fn profiles_up_to(&self) -> Option<u32> {
-        if self.only_profiles {
-            return Some(256);
-        }
         crate::features::util::numbered_from_one(|id| {
             usize::from(self.profile_of.get(id).copied().unwrap_or(0))
         })
@@ -430,8 +427,11 @@ impl SssProfiles {
             };
             object_ids.push(index as u8 + 1);
         }
-        Ok((!profiles.is_empty()).then_some(Self {
-            id_map: IdMap::lucent(),
+        if profiles.is_empty() {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            id_map: IdMap::lucent(profiles.len())?,
             profiles,
             transmission: transmissions,
             object_ids,
@@ -1054,11 +1054,7 @@ pub fn host_id_permutations(out: &mut Vec<crate::backend::shader::PipelineShader
     }
     out.extend(host.iter().cloned());
     for uint in [false, true] {
-        let map = IdMap {
-            uint,
-            ..IdMap::lucent()
-        };
-        let ids = map.defines();
+        let ids = if uint { HOST_IDS_UINT } else { &[] };
         for included in [false, true] {
             out.push(Shaders::new(
                 "fullscreen.vert",
@@ -1140,7 +1136,6 @@ mod tests {
                 mask: 0xff,
                 unorm_max: 0,
                 profile_of: profile_of.clone(),
-                only_profiles: false,
             };
             let (_, rows) = map.rows();
             for id in 0..256u32 {
@@ -1161,9 +1156,6 @@ mod tests {
     /// listed IDs compared in order, or the table when none are listed.
     fn specialized_profile(constants: &[u32], rows: &[[u32; 4]; 16], host_id: u32) -> usize {
         let up_to = constants[22];
-        if up_to >= 256 {
-            return (host_id as usize).min(MAX_SSS_PROFILES - 1);
-        }
         if up_to > 0 {
             let up_to = up_to.min(MAX_SSS_PROFILES as u32 - 1);
             return if host_id <= up_to { host_id as usize } else { 0 };
@@ -1188,15 +1180,17 @@ mod tests {
 
     #[test]
     fn ids_that_are_the_profile_numbers_need_no_lookup() {
-        // lucent's own G-buffer: every stored value is a profile number.
-        let own = IdMap::lucent();
-        assert_eq!(constants_of(&own)[22], 256);
-        assert_eq!(constants_of(&own)[4], 0, "nothing listed");
+        // lucent's own G-buffer: its profile numbers 1 to n, as its description decodes them.
+        for n in [1usize, 3, 31] {
+            let own = IdMap::lucent(n).unwrap();
+            assert_eq!(constants_of(&own)[..4], [0, 0, 0xff, 255], "R8_UNORM");
+            assert_eq!(constants_of(&own)[22], n as u32);
+            assert_eq!(constants_of(&own)[4], 0, "nothing listed");
+        }
         // Hosts with more materials than are listed, numbered 1 to n in order.
         for n in [1u8, 12, 31] {
-            let mut map = IdMap::lucent();
+            let mut map = IdMap::lucent(1).unwrap();
             map.uint = true;
-            map.only_profiles = false;
             map.profile_of = profile_of(&(1..=n).collect::<Vec<u8>>());
             let constants = constants_of(&map);
             assert_eq!(constants[22], u32::from(n));
@@ -1209,8 +1203,7 @@ mod tests {
             }
         }
         // One ID out of order: the IDs are listed instead.
-        let mut map = IdMap::lucent();
-        map.only_profiles = false;
+        let mut map = IdMap::lucent(3).unwrap();
         map.profile_of = profile_of(&[1, 3, 2]);
         assert_eq!(constants_of(&map)[22], 0);
         assert_eq!(constants_of(&map)[4], 3);
@@ -1229,7 +1222,6 @@ mod tests {
                 mask: 0xf,
                 unorm_max: 255,
                 profile_of: profile_of.clone(),
-                only_profiles: false,
             };
             let constants = constants_of(&map);
             assert_eq!(constants.len(), 23);

@@ -122,12 +122,13 @@ impl FramePart for SssProfiles {
             .collect();
         let desc = SssEffectDesc::new(gbuffer.clone(), materials, HDR_FORMAT);
         let checked = desc.check_materials(&|p| lookup.blur_of(p))?;
-        // A check, not a conversion: every profile and blur comes back as it went in.
-        if checked.profiles != want {
+        // A check, not a conversion: every profile and blur comes back as it went in, and the
+        // passes read lucent's ID image with the decode the description gives a host.
+        if checked.profiles != want || checked.id_map != self.id_map {
             return Err(LucentError::InvalidInput(format!(
                 "the SSS profiles of this frame and their host description differ: {:?} \
-                 against {:?}",
-                self.profiles, checked.profiles
+                 ({:?}) against {:?} ({:?})",
+                self.profiles, self.id_map, checked.profiles, checked.id_map
             )));
         }
         Ok(())

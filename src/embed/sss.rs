@@ -304,7 +304,7 @@ impl SssEffect {
             let normals = gbuffer.normals.expect("require(LeanSss) checked them");
             let mut constants: HostLeanGpu = bytemuck::Zeroable::zeroed();
             constants.normals = normals.decode()?;
-            // Material i has profile i + 1 (profile_of above).
+            // Material i has profile i + 1 (as check_materials numbers them).
             for (index, material) in desc.materials.iter().enumerate() {
                 if let Some(surface) = material.surface {
                     constants.surface[index + 1] = [surface.roughness, surface.specular, 0.0, 0.0];
@@ -352,7 +352,7 @@ impl SssEffect {
             |scene_gpu| declare(&desc, &profiles, scene_gpu, lean),
         )?;
         let chains = profiles.chains();
-        // Material i has profile i + 1 (profile_of above).
+        // Material i has profile i + 1 (as check_materials numbers them).
         let materials = desc
             .materials
             .iter()

@@ -220,6 +220,7 @@ pub fn compile_options(settings: &FrameSettings) -> CompileOptions {
 
 /// Compiles the plan of a frame without a GPU (for `lucent plan` and tests).
 pub fn plan_frame(settings: &FrameSettings, desc: &FrameDesc) -> Result<Plan> {
+    desc.check_described(settings)?;
     let mut graph = RenderGraph::new();
     declare_frame(&mut graph, settings, desc, None);
     graph.plan(compile_options(settings))

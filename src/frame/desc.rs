@@ -65,22 +65,27 @@ impl FrameDesc {
         let any = |f: &dyn Fn(&crate::scene::Material) -> bool| {
             scene.objects.iter().any(|o| f(&o.material))
         };
-        let desc = Self {
+        Ok(Self {
             parts,
             shadows,
             normal_maps: any(&|m| m.normal_texture.is_some()),
             albedo_maps: any(&|m| m.albedo_texture.is_some()),
-        };
-        // lucent's G-buffer as a host describes its own: each part is held to what the
-        // effects accept of a host (the SSS chains are declared as SssEffect declares a
-        // host's).
-        let described = desc
+        })
+    }
+
+    /// Holds each part to what the effects accept of a host, on lucent's G-buffer described
+    /// as a host describes its own under `settings` (the SSS chains are declared as
+    /// `SssEffect` declares a host's): run where a frame is built ([`super::Renderer::new`],
+    /// [`super::plan_frame`]), not on every description (`Renderer::update_slot` describes
+    /// the scene every frame).
+    pub fn check_described(&self, settings: &FrameSettings) -> Result<()> {
+        let described = self
             .gbuffer_layout(settings)
             .described(settings.width, settings.height);
-        for part in desc.parts() {
+        for part in self.parts() {
             part.check_described(&described, &registry::Registry)?;
         }
-        Ok(desc)
+        Ok(())
     }
 
     /// The frame's parts, in registry order.
@@ -220,7 +225,7 @@ mod tests {
     }
 
     /// lucent's SSS part is held to the checks a host's SssEffect makes on its description:
-    /// every built-in frame passes them (`FrameDesc::new` runs them, above), and a G-buffer
+    /// every built-in frame passes them (`FrameDesc::check_described`, above), and a G-buffer
     /// that lacked what the chains read would be refused as a host's is.
     #[test]
     fn the_sss_part_is_checked_as_a_hosts_effect_is() {
@@ -269,6 +274,7 @@ mod tests {
                 let mut settings = FrameSettings::new(64, 48);
                 settings.technique = technique;
                 let desc = FrameDesc::new(&scene, &settings).unwrap();
+                desc.check_described(&settings).unwrap();
                 let names = kinds(&desc);
                 let positions: Vec<usize> = names
                     .iter()

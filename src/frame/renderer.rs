@@ -72,6 +72,7 @@ impl Renderer {
             check_target_format(target.format)?;
         }
         let desc = FrameDesc::new(scene, &settings)?;
+        desc.check_described(&settings)?;
         let scene_gpu = Arc::new(SceneGpu::new(
             gpu,
             scene,

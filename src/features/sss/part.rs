@@ -7,11 +7,10 @@ use std::sync::Arc;
 use super::described::{
     sss_on_gbuffer, DescribedImages, DescribedShadows, SssEffectDesc, SssMaterial,
 };
-use super::SssBlur;
+use super::{profile_reach, tables, SssBlur, SssProfiles};
+use crate::features::gbuffer::GBufferLayout;
 use crate::features::gbuffer_desc::GBufferDesc;
 use crate::features::lighting::HDR_FORMAT;
-use super::{profile_reach, tables, SssProfiles};
-use crate::features::gbuffer::GBufferLayout;
 use crate::features::technique::TechniqueModule;
 use crate::features::technique::{
     downcast, part_value_methods, Describe, FrameImages, FramePart, Lookup, PartKind, PartKnobs,

@@ -1,17 +1,25 @@
 #version 450
 // permutation: LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_LEAN
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=1 LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=1 LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_OUT
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT
 // permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_PACKED_IN LUCENT_SSS_PACKED_OUT LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE
+// permutation: LUCENT_SSS_PROFILE_EDGES LUCENT_SSS_LEAN LUCENT_SSS_BILATERAL LUCENT_SSS_HALF_TAPS=2 LUCENT_SSS_ACCUMULATE LUCENT_SSS_SUM_IN
 // One direction of a separable screen-space SSS blur (src/features/sss.rs), for one step (one
 // Gaussian) of each pixel's own profile: the pixel's profile ID picks its sigma and weight from
 // the profile table. The Gaussian's world-space sigma is projected to the screen at the pixel's
@@ -33,9 +41,13 @@
 //   diffuse + view slope x and the G-buffer's LEAN slope y + moments.
 // - LUCENT_SSS_PACKED_IN / _OUT (LBB): the two texels travel between passes as one RGBA32UI
 //   texel of eight fp16 halves: one fetch per tap and one write per pass instead of two.
-// The vertical pass (LUCENT_SSS_ACCUMULATE) also adds its result times the Gaussian's weight
-// into the sum-of-Gaussians targets (additive blending): RGB weights for the diffuse light, their
-// mean (which sums to 1 over the profile too) for the LEAN moments.
+// The vertical pass (LUCENT_SSS_ACCUMULATE) also writes the sum of Gaussians so far: its result
+// times the Gaussian's weight (RGB weights for the diffuse light, their mean, which sums to 1
+// over the profile too, for the LEAN moments), plus the previous steps' sum read at the pixel
+// (LUCENT_SSS_SUM_IN: every step after the first). The sums ping-pong between two targets
+// instead of blending into one: a pass that blends one target and overwrites another needs
+// per-attachment blend states (`independentBlend`, optional in Vulkan; lavapipe in Mesa 25.0
+// applies the first attachment's state to all, see docs/lavapipe-facts.md).
 #include "../common/scene.glsl"
 #include "../common/sss.glsl"
 #ifdef LUCENT_SSS_LEAN
@@ -51,6 +63,12 @@ layout(set = 0) uniform sampler2D depth_tex;    // device depth, read with texel
 layout(set = 0) uniform SSS_ID_SAMPLER profile_tex;  // SSS profile ID, 0 = not SSS
 #if defined(LUCENT_SSS_LEAN) && !defined(LUCENT_SSS_PACKED_IN)
 layout(set = 0) uniform sampler2D lean_tex;     // slope y, moments (same filter)
+#endif
+#ifdef LUCENT_SSS_SUM_IN
+layout(set = 0) uniform sampler2D sum_in_tex;   // the previous steps' sum (texelFetch)
+#ifdef LUCENT_SSS_LEAN
+layout(set = 0) uniform sampler2D lean_sum_in_tex;
+#endif
 #endif
 
 layout(push_constant) uniform Blur {
@@ -235,9 +253,16 @@ void main() {
     vec4 weight = strength > 0.0 ? profile_step.weight : vec4(0.0);
     out_sum = vec4(blurred.rgb * weight.rgb, blurred.a * weight.a);
     out_lean_sum = blurred_lean * weight.a;
+#ifdef LUCENT_SSS_SUM_IN
+    out_sum += texelFetch(sum_in_tex, px, 0);
+    out_lean_sum += texelFetch(lean_sum_in_tex, px, 0);
+#endif
 #else
     vec4 weight = strength > 0.0 ? profile_step.weight : vec4(0.0);
     out_sum = vec4(blurred.rgb * weight.rgb, 0.0);
+#ifdef LUCENT_SSS_SUM_IN
+    out_sum += texelFetch(sum_in_tex, px, 0);
+#endif
 #endif
 #endif
 }

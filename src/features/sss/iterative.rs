@@ -72,8 +72,20 @@ pub(super) fn chain_passes(
             )
         })
         .collect();
-    let mut sum: Vec<Handle<Image>> = (0..targets)
-        .map(|t| graph.create_image(&chain.image_name(&format!("sum{}", names[t])), sum_info))
+    // The sums of Gaussians so far ping-pong between two sets of targets: each vertical pass
+    // reads the previous steps' sum and writes its own step added (no blending, see
+    // glsl/sss/blur.frag). A one-step chain needs one set.
+    let sets = if chain.steps > 1 { 2 } else { 1 };
+    let mut sums: Vec<Vec<Handle<Image>>> = ["", ".b"][..sets]
+        .iter()
+        .map(|set| {
+            (0..targets)
+                .map(|t| {
+                    let name = chain.image_name(&format!("sum{set}{}", names[t]));
+                    graph.create_image(&name, sum_info)
+                })
+                .collect()
+        })
         .collect();
     // Texture fetches per pixel of a pass reading `texels` colour images, for the benchmark's
     // cost per tap: the centre texels, depth and profile ID, then each kernel tap's texels and
@@ -135,30 +147,37 @@ pub(super) fn chain_passes(
             packed_in,
             inputs,
         );
-        pass.taps(fetches(temps.len() as u32))
-            .defines(&blur_defines(
-                blur.technique(),
-                knobs.taps,
-                chain.edges,
-                packed_in,
-                packed,
-                true,
-            ));
+        let (written, read) = (step % sets, (step + 1) % sets);
+        let sum_in = step > 0;
+        let mut defines = blur_defines(
+            blur.technique(),
+            knobs.taps,
+            chain.edges,
+            packed_in,
+            packed,
+            true,
+        );
+        if sum_in {
+            defines.push(SUM_IN);
+            for (name, s) in ["sum_in_tex", "lean_sum_in_tex"].into_iter().zip(&sums[read]) {
+                pass.sample(name, s);
+            }
+        }
+        // The previous sum is one more fetch per target.
+        let sum_fetches = if sum_in { targets as u32 } else { 0 };
+        pass.taps(fetches(temps.len() as u32) + sum_fetches)
+            .defines(&defines);
         for c in &mut current {
             pass.color(c, LoadOp::DontCare);
         }
-        for s in &mut sum {
-            pass.color_add(
-                s,
-                if step == 0 {
-                    LoadOp::Clear([0.0; 4])
-                } else {
-                    LoadOp::Load
-                },
-            );
+        // Every pixel of the chain's tiles is written (zero where nothing scatters); the
+        // final pass reads only its profiles' pixels, all inside the tiles.
+        for s in &mut sums[written] {
+            pass.color(s, LoadOp::DontCare);
         }
         pass.finish();
     }
+    let sum = &sums[(chain.steps + sets - 1) % sets];
     let mut hdr = output.unwrap_or_else(|| {
         graph.create_image(
             &if chain.last {
@@ -177,7 +196,7 @@ pub(super) fn chain_passes(
     // profiles it writes the blurred light; elsewhere the previous chain's result (`base`), or
     // the lighting pass's diffuse + specular. Each input with the shaders' name for it.
     let mut reads: Vec<(&'static str, &Handle<Image>)> =
-        ["sum_tex", "lean_sum_tex"].into_iter().zip(&sum).collect();
+        ["sum_tex", "lean_sum_tex"].into_iter().zip(sum).collect();
     reads.extend([
         ("diffuse_tex", inputs.diffuse),
         ("specular_tex", inputs.specular),
@@ -271,6 +290,8 @@ fn blur_pass<'g>(
 
 /// The iterative blur's fragment shader.
 const BLUR_FRAGMENT: &str = "sss/blur.frag";
+/// The vertical blur's define for every step after the first: it reads the previous sum.
+const SUM_IN: (&str, &str) = ("LUCENT_SSS_SUM_IN", "1");
 /// The control chain's final pass.
 const COMBINE_FRAGMENT: &str = "sss/combine.frag";
 
@@ -353,10 +374,14 @@ pub(super) fn shader_permutations(blur: &dyn SssBlurTechnique, out: &mut Vec<Pip
             let packed = packed_pingpong(blur, blur.lean() && bit(2), bit(3));
             // A packed chain's first horizontal pass reads the unpacked light.
             let packed_in = packed && bit(4);
-            out.push(PipelineShaders::fullscreen(
-                BLUR_FRAGMENT,
-                &blur_defines(blur, taps, edges, packed_in, packed, accumulate),
-            ));
+            let defines = blur_defines(blur, taps, edges, packed_in, packed, accumulate);
+            // Vertical passes after the first read the previous sum.
+            if accumulate {
+                let mut sum_in = defines.clone();
+                sum_in.push(SUM_IN);
+                out.push(PipelineShaders::fullscreen(BLUR_FRAGMENT, &sum_in));
+            }
+            out.push(PipelineShaders::fullscreen(BLUR_FRAGMENT, &defines));
         }
     }
     for lean in [false, true] {

@@ -882,12 +882,10 @@ fn create_engine() -> Result<Engine, String> {
     };
     let enabled = OptionalFeatures {
         host_query_reset: supported12 == vk::TRUE,
-        independent_blend: supported.independent_blend == vk::TRUE,
         storage_image_write_without_format: supported.shader_storage_image_write_without_format
             == vk::TRUE,
     };
     let core = vk::PhysicalDeviceFeatures::default()
-        .independent_blend(enabled.independent_blend)
         .shader_storage_image_write_without_format(enabled.storage_image_write_without_format);
     let mut v12 =
         vk::PhysicalDeviceVulkan12Features::default().host_query_reset(enabled.host_query_reset);

@@ -216,9 +216,9 @@ impl GpuContext {
     /// The device's support for lucent's requirements (Vulkan 1.3, `synchronization2`,
     /// `maintenance4`, a graphics + compute queue family with timestamps) is checked and a
     /// [`LucentError::MissingFeature`] returned otherwise. Whether optional features were enabled
-    /// cannot be queried from a `VkDevice`, so [`DeviceInfo::host_query_reset`],
-    /// [`DeviceInfo::independent_blend`] and [`DeviceInfo::storage_image_write_without_format`]
-    /// start out `false`; a host that enabled them may set them in [`GpuContext::info`].
+    /// cannot be queried from a `VkDevice`, so [`DeviceInfo::host_query_reset`] and
+    /// [`DeviceInfo::storage_image_write_without_format`] start out `false`; a host that
+    /// enabled them may set them in [`GpuContext::info`].
     ///
     /// # Safety
     ///
@@ -299,7 +299,6 @@ impl GpuContext {
         probe.queue_family = queue_family;
         probe.info.timestamp_valid_bits = family.timestamp_valid_bits;
         probe.info.host_query_reset = false;
-        probe.info.independent_blend = false;
         probe.info.storage_image_write_without_format = false;
         probe.info.swapchain = false;
 

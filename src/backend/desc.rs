@@ -77,8 +77,6 @@ pub struct DeviceInfo {
     pub uniform_offset_alignment: u64,
     /// `hostQueryReset` (Vulkan 1.2) is enabled: query pools may be reset from the host.
     pub host_query_reset: bool,
-    /// `independentBlend` is enabled: colour attachments may use different blend states.
-    pub independent_blend: bool,
     /// `shaderStorageImageWriteWithoutFormat` is enabled.
     pub storage_image_write_without_format: bool,
     /// `VK_KHR_swapchain` is enabled (asked for with [`ContextDesc::swapchain`]).

@@ -124,7 +124,6 @@ pub(crate) fn probe_device(
         timestamp_valid_bits: family.timestamp_valid_bits,
         uniform_offset_alignment: props.limits.min_uniform_buffer_offset_alignment.max(1),
         host_query_reset: v12.host_query_reset == vk::TRUE,
-        independent_blend: core.independent_blend == vk::TRUE,
         storage_image_write_without_format: core.shader_storage_image_write_without_format
             == vk::TRUE,
         swapchain,
@@ -225,7 +224,6 @@ pub(super) fn create_device(
         .queue_family_index(probe.queue_family)
         .queue_priorities(&priorities)];
     let core = vk::PhysicalDeviceFeatures::default()
-        .independent_blend(probe.info.independent_blend)
         .shader_storage_image_write_without_format(probe.info.storage_image_write_without_format);
     let mut v12 =
         vk::PhysicalDeviceVulkan12Features::default().host_query_reset(probe.info.host_query_reset);

@@ -262,8 +262,10 @@ pub use glam;
 /// beside an atlas (`with_second_shadow_map` of [`TransmissionEffectDesc`] and
 /// [`SssEffectDesc`], [`TransmissionImages::second_shadow_map`],
 /// [`LeanLighting::second_shadow_map`], [`ShadowFace::map`]); TERMS'
-/// `lucent_shadow_texels` on a `sampler2DArray` too.
-pub const API_VERSION: u32 = 13;
+/// `lucent_shadow_texels` on a `sampler2DArray` too. 14: `OptionalFeatures::independent_blend`
+/// is gone (no effect blends one target and overwrites another any more: the SSS chains add
+/// their sum of Gaussians in the shader), and `requirements().optional` no longer lists it.
+pub const API_VERSION: u32 = 14;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
@@ -295,7 +297,6 @@ pub fn requirements() -> Requirements {
         queue_flags: vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE,
         optional: vec![
             "hostQueryReset (Vulkan 1.2): timer queries reset from the CPU (lucent's timer only)",
-            "independentBlend: per-target blend states",
             "shaderStorageImageWriteWithoutFormat: storage writes without a declared format",
         ],
     }
@@ -332,8 +333,6 @@ impl Requirements {
 pub struct OptionalFeatures {
     /// `hostQueryReset` (Vulkan 1.2 features).
     pub host_query_reset: bool,
-    /// `independentBlend` (core features).
-    pub independent_blend: bool,
     /// `shaderStorageImageWriteWithoutFormat` (core features).
     pub storage_image_write_without_format: bool,
 }
@@ -433,7 +432,6 @@ impl Lucent {
             )
         }?;
         gpu.info.host_query_reset = enabled.host_query_reset;
-        gpu.info.independent_blend = enabled.independent_blend;
         gpu.info.storage_image_write_without_format = enabled.storage_image_write_without_format;
         let cache_dir = options
             .cache_dir

@@ -135,7 +135,6 @@ fn host_device(gpu: &GpuContext) -> HostDevice {
         queue_family: gpu.queue_family,
         enabled: OptionalFeatures {
             host_query_reset: gpu.info.host_query_reset,
-            independent_blend: gpu.info.independent_blend,
             storage_image_write_without_format: gpu.info.storage_image_write_without_format,
         },
     }

@@ -58,7 +58,6 @@ fn host_device(test: &TestGpu, device: ash::Device) -> HostDevice {
         queue_family: gpu.queue_family,
         enabled: OptionalFeatures {
             host_query_reset: gpu.info.host_query_reset,
-            independent_blend: gpu.info.independent_blend,
             storage_image_write_without_format: gpu.info.storage_image_write_without_format,
         },
     }

@@ -81,9 +81,8 @@ impl TestGpu {
         frame
     }
 
-    /// Tears down and fails if validation reported any error.
+    /// Fails if validation reported any error (the cache and device go when `self` drops).
     pub fn finish(self) {
-        self.cache.destroy(&self.gpu.device);
         let errors = self.gpu.validation_error_count();
         assert_eq!(
             errors,
@@ -91,6 +90,21 @@ impl TestGpu {
             "validation errors:\n{}",
             self.gpu.take_validation_messages().join("\n")
         );
+    }
+}
+
+impl Drop for TestGpu {
+    /// Destroys the pipeline cache before the device goes, also when a test panics (a device
+    /// destroyed with its cache alive is a validation error of its own, which would bury the
+    /// test's message).
+    fn drop(&mut self) {
+        // SAFETY: the tests create pipelines on this cache only on this thread, and none is
+        // being created while the harness drops; a null handle is ignored.
+        unsafe {
+            self.gpu
+                .device
+                .destroy_pipeline_cache(self.cache.handle, None)
+        };
     }
 }
 

@@ -83,6 +83,10 @@ pub struct MachineTable {
     pub machine: &'static str,
     /// Text the benchmark's `device` contains on that machine kind (`llvmpipe`).
     pub device: &'static str,
+    /// Text the benchmark's `driver` contains (`Mesa 25.0`): a new driver compiles every
+    /// shader anew, and Mesa 25's lavapipe reads the merged G-buffer + lighting 4.4-4.6x its
+    /// floor where Mesa 22's read 6.0-6.6x (docs/lavapipe-facts.md).
+    pub driver: &'static str,
     /// The CPU's vendor as `/proc/cpuinfo` names it (`vendor_id`): lavapipe's code is the
     /// CPU's.
     pub cpu_vendor: &'static str,
@@ -103,6 +107,7 @@ pub const MACHINES: &[MachineTable] = &[
         machine: "lavapipe (Mesa 22.3.6, LLVM 15) on an AMD EPYC (family and model not \
                   recorded), 2 cores (stop 39's machine)",
         device: "llvmpipe",
+        driver: "Mesa 22.3.6",
         cpu_vendor: "AuthenticAMD",
         cpu_family_model: None,
         baseline: BASELINE_AMD,
@@ -110,6 +115,7 @@ pub const MACHINES: &[MachineTable] = &[
     MachineTable {
         machine: "lavapipe (Mesa 22.3.6, LLVM 15) on an Intel Xeon (family 6, model 207), 2 cores",
         device: "llvmpipe",
+        driver: "Mesa 22.3.6",
         cpu_vendor: "GenuineIntel",
         cpu_family_model: Some((6, 207)),
         baseline: BASELINE_INTEL,
@@ -118,9 +124,19 @@ pub const MACHINES: &[MachineTable] = &[
         machine: "lavapipe (Mesa 22.3.6, LLVM 15) on an AMD EPYC (family 25, model 17, \
                   AVX-512), 2 cores (stop 44's machine)",
         device: "llvmpipe",
+        driver: "Mesa 22.3.6",
         cpu_vendor: "AuthenticAMD",
         cpu_family_model: Some((25, 17)),
         baseline: BASELINE_AMD_25_17,
+    },
+    MachineTable {
+        machine: "lavapipe (Mesa 25.0.7 from bookworm-backports, LLVM 15) on an Intel Xeon \
+                  (family 6, model 167), 2 cores (stop 58's machine)",
+        device: "llvmpipe",
+        driver: "Mesa 25.0",
+        cpu_vendor: "GenuineIntel",
+        cpu_family_model: Some((6, 167)),
+        baseline: BASELINE_INTEL_6_167_MESA25,
     },
 ];
 
@@ -130,37 +146,55 @@ pub enum TableChoice {
     /// The table measured on this machine's kind.
     Machine(&'static MachineTable),
     /// No table was measured on a machine of this kind: each pass is held to the largest ratio
-    /// any table gives it (a pass that got heavier than on every known machine still fails,
-    /// one that got heavier only here does not).
-    Envelope,
+    /// any table of the machine's driver gives it, or any table at all when none was measured
+    /// on that driver (a pass that got heavier than on every known machine still fails, one
+    /// that got heavier only here does not). The driver's text, as [`MachineTable::driver`]
+    /// names it (`None`: every table).
+    Envelope(Option<&'static str>),
 }
 
 impl TableChoice {
-    /// The table for a machine whose benchmark reports `device` and whose CPU is `cpu`: the
-    /// one measured on the same device and CPU (vendor, family and model), else the envelope.
-    pub fn for_machine(device: &str, cpu: &CpuKind) -> Self {
+    /// The table for a machine whose benchmark reports `device` and `driver` and whose CPU is
+    /// `cpu`: the one measured on the same device, driver and CPU (vendor, family and model),
+    /// else the envelope.
+    pub fn for_machine(device: &str, driver: &str, cpu: &CpuKind) -> Self {
+        let same_driver = MACHINES
+            .iter()
+            .find(|m| device.contains(m.device) && driver.contains(m.driver))
+            .map(|m| m.driver);
         MACHINES
             .iter()
             .find(|m| {
                 device.contains(m.device)
+                    && driver.contains(m.driver)
                     && cpu.vendor == m.cpu_vendor
                     && m.cpu_family_model.is_some()
                     && cpu.family_model == m.cpu_family_model
             })
-            .map_or(TableChoice::Envelope, TableChoice::Machine)
+            .map_or(TableChoice::Envelope(same_driver), TableChoice::Machine)
     }
 
     /// What the gate's output says of the choice.
     pub fn describe(&self) -> String {
         match self {
             TableChoice::Machine(m) => format!("the table measured on {}", m.machine),
-            TableChoice::Envelope => format!(
+            TableChoice::Envelope(driver) => format!(
                 "no table was measured on this machine's kind, so each pass is held to the \
-                 largest ratio of the {} known machines' tables (measure this machine's with \
+                 largest ratio of the {} known machines' tables{} (measure this machine's with \
                  `--gate-baseline 5` and add it to MACHINES in src/measure/gate.rs)",
-                MACHINES.len()
+                TableChoice::envelope_tables(*driver).count(),
+                driver.map_or(String::new(), |d| format!(" on {d}"))
             ),
         }
+    }
+
+    /// The tables an envelope over `driver`'s tables (every table for `None`) is made of.
+    fn envelope_tables(
+        driver: Option<&'static str>,
+    ) -> impl Iterator<Item = &'static MachineTable> {
+        MACHINES
+            .iter()
+            .filter(move |m| driver.is_none_or(|d| m.driver == d))
     }
 
     /// Today's ratios of benchmark `bench`'s passes under this choice.
@@ -174,9 +208,9 @@ impl TableChoice {
         };
         match self {
             TableChoice::Machine(m) => of(m),
-            TableChoice::Envelope => {
+            TableChoice::Envelope(driver) => {
                 let mut table: Vec<(&'static str, f64)> = Vec::new();
-                for m in MACHINES {
+                for m in TableChoice::envelope_tables(*driver) {
                     for (pass, ratio) in of(m) {
                         match table.iter_mut().find(|(p, _)| *p == pass) {
                             Some(entry) => entry.1 = entry.1.max(ratio),
@@ -963,26 +997,265 @@ pub const BASELINE_AMD_25_17: &[Benchmark] = &[
     ),
 ];
 
-/// Today's ratio of the listed passes (and `frame`) of a benchmark under its technique to the
-/// same scene under `none`, alternating frames, with [`AGAINST_BENCH`]'s settings: medians of
-/// five runs on stop 39's machine, as [`BASELINE_AMD`]. One table for every machine: a technique against `none` on the same machine read within 0.1 of it on the Intel Xeon too (docs/performance.md).
-pub const AGAINST: &[Benchmark] = &[
+/// Stop 58's machine on Mesa 25.0.7 (bookworm-backports): an Intel Xeon (family 6, model 167),
+/// 2 cores; the median of five runs (`lucent bench --gate --gate-baseline 5 --validation`).
+pub const BASELINE_INTEL_6_167_MESA25: &[Benchmark] = &[
     (
-        "grid125 --technique translucency",
+        "smoke",
         &[
-            ("light-space maps", 1.00),
-            // Not the five-run median (1.00x): the median of the nine runs of the gate this
-            // table was made in (1.00-1.11x); issue 34 measured +45-63% before.
-            ("gbuffer + lighting", 1.07),
-            ("frame", 1.00),
+            ("gbuffer + lighting", 2.27),
+            ("light-space maps", 0.89),
+            ("tonemap", 1.57),
+        ],
+    ),
+    (
+        "cubes",
+        &[
+            ("gbuffer + lighting", 2.70),
+            ("light-space maps", 0.96),
+            ("tonemap", 1.75),
+        ],
+    ),
+    (
+        "grid125",
+        &[
+            ("gbuffer + lighting", 2.38),
+            ("light-space maps", 0.99),
+            ("tonemap", 1.70),
+        ],
+    ),
+    (
+        "teapot",
+        &[
+            ("gbuffer + lighting", 2.74),
+            ("horizontal blur", 2.98),
+            ("light-space maps", 0.92),
+            ("tonemap", 1.96),
+            ("vertical blur", 1.82),
+        ],
+    ),
+    (
+        "skin",
+        &[
+            ("gbuffer + lighting", 2.00),
+            ("horizontal blur", 2.45),
+            ("light-space maps", 0.91),
+            ("tonemap", 1.75),
+            ("vertical blur", 1.62),
         ],
     ),
     (
         "mixed",
         &[
-            ("light-space maps", 1.08),
-            ("gbuffer + lighting", 1.44),
-            ("frame", 1.52),
+            ("gbuffer + lighting", 2.74),
+            ("horizontal blur", 2.75),
+            ("light-space maps", 0.88),
+            ("tonemap", 1.86),
+            ("vertical blur", 1.84),
+        ],
+    ),
+    (
+        "edges",
+        &[
+            ("gbuffer + lighting", 2.70),
+            ("horizontal blur", 2.73),
+            ("light-space maps", 0.84),
+            ("tonemap", 1.88),
+            ("vertical blur", 1.89),
+        ],
+    ),
+    (
+        "layered",
+        &[
+            ("gbuffer + lighting", 1.84),
+            ("layered irradiance", 0.92),
+            ("light-space maps", 1.18),
+            ("multiple scattering", 2.10),
+            ("multiple scattering blur", 0.15),
+            ("single scattering", 1.72),
+            ("tonemap", 2.11),
+        ],
+    ),
+    (
+        "dynamic",
+        &[
+            ("gbuffer + lighting", 2.69),
+            ("layered irradiance", 1.49),
+            ("light-space maps", 1.00),
+            ("multiple scattering", 3.74),
+            ("multiple scattering blur", 0.19),
+            ("single scattering", 4.35),
+            ("tonemap", 2.03),
+        ],
+    ),
+    (
+        "scaling",
+        &[
+            ("gbuffer + lighting", 1.23),
+            ("layered irradiance", 1.14),
+            ("light-space maps", 1.10),
+            ("multiple scattering", 3.38),
+            ("multiple scattering blur", 0.17),
+            ("single scattering", 2.24),
+            ("tonemap", 2.07),
+        ],
+    ),
+    (
+        "showcase-translucency",
+        &[
+            ("gbuffer + lighting", 2.21),
+            ("light-space maps", 0.92),
+            ("tonemap", 1.79),
+        ],
+    ),
+    (
+        "showcase-skin",
+        &[
+            ("gbuffer + lighting", 3.24),
+            ("horizontal blur", 3.87),
+            ("light-space maps", 0.94),
+            ("tonemap", 1.93),
+            ("vertical blur", 2.19),
+        ],
+    ),
+    (
+        "showcase-marble",
+        &[
+            ("gbuffer + lighting", 2.72),
+            ("horizontal blur", 4.06),
+            ("light-space maps", 0.94),
+            ("tonemap", 2.00),
+            ("vertical blur", 2.42),
+        ],
+    ),
+    (
+        "showcase-layered",
+        &[
+            ("gbuffer + lighting", 2.01),
+            ("layered irradiance", 0.95),
+            ("light-space maps", 1.11),
+            ("multiple scattering", 2.45),
+            ("multiple scattering blur", 0.40),
+            ("single scattering", 2.04),
+            ("tonemap", 2.03),
+        ],
+    ),
+    (
+        "skin --technique burley",
+        &[
+            ("burley", 2.87),
+            ("burley resolve", 1.14),
+            ("gbuffer + lighting", 2.13),
+            ("light-space maps", 0.93),
+            ("tonemap", 1.85),
+        ],
+    ),
+    (
+        "skin --technique bilateral",
+        &[
+            ("horizontal blur", 3.65),
+            ("light-space maps", 0.96),
+            ("projection + lighting", 2.01),
+            ("tonemap", 1.96),
+            ("vertical blur", 3.25),
+        ],
+    ),
+    (
+        "skin --technique lbb",
+        &[
+            ("final lighting", 1.07),
+            ("horizontal blur #1", 1.82),
+            ("horizontal blur #2", 2.06),
+            ("horizontal blur #3", 2.02),
+            ("horizontal blur #4", 2.09),
+            ("horizontal blur #5", 2.11),
+            ("horizontal blur #6", 2.05),
+            ("light-space maps", 0.95),
+            ("projection + lighting", 2.07),
+            ("tonemap", 1.55),
+            ("vertical blur #1", 1.21),
+            ("vertical blur #2", 1.28),
+            ("vertical blur #3", 1.36),
+            ("vertical blur #4", 1.55),
+            ("vertical blur #5", 1.59),
+            ("vertical blur #6", 1.55),
+        ],
+    ),
+    (
+        "skin --technique lcb",
+        &[
+            ("final lighting", 1.41),
+            ("horizontal blur #1", 3.34),
+            ("horizontal blur #2", 4.37),
+            ("horizontal blur #3", 4.47),
+            ("horizontal blur #4", 4.56),
+            ("horizontal blur #5", 4.50),
+            ("horizontal blur #6", 4.56),
+            ("light-space maps", 0.90),
+            ("projection + lighting", 1.90),
+            ("tonemap", 1.84),
+            ("vertical blur #1", 2.12),
+            ("vertical blur #2", 2.07),
+            ("vertical blur #3", 2.44),
+            ("vertical blur #4", 2.91),
+            ("vertical blur #5", 2.99),
+            ("vertical blur #6", 3.05),
+        ],
+    ),
+    (
+        "skin --technique control",
+        &[
+            ("combine", 1.16),
+            ("gbuffer + lighting", 2.09),
+            ("horizontal blur #1", 3.86),
+            ("horizontal blur #2", 3.98),
+            ("horizontal blur #3", 3.61),
+            ("horizontal blur #4", 3.80),
+            ("horizontal blur #5", 3.94),
+            ("horizontal blur #6", 3.94),
+            ("light-space maps", 0.94),
+            ("tonemap", 1.71),
+            ("vertical blur #1", 2.40),
+            ("vertical blur #2", 2.02),
+            ("vertical blur #3", 1.98),
+            ("vertical blur #4", 2.51),
+            ("vertical blur #5", 2.52),
+            ("vertical blur #6", 2.51),
+        ],
+    ),
+    (
+        "smoke --aa fxaa",
+        &[
+            ("fxaa", 2.22),
+            ("gbuffer + lighting", 2.17),
+            ("light-space maps", 0.91),
+            ("tonemap", 1.56),
+        ],
+    ),
+];
+
+/// Today's ratio of the listed passes (and `frame`) of a benchmark under its technique to the
+/// same scene under `none`, alternating frames, with [`AGAINST_BENCH`]'s settings: medians of
+/// five runs on stop 58's machine on Mesa 25.0.7, as [`BASELINE_INTEL_6_167_MESA25`]. One
+/// table for every machine: a technique against `none` on the same machine read within 0.1 of
+/// it on the Intel Xeon and the AMD EPYC on Mesa 22.3.6 (docs/performance.md). On Mesa 22.3.6
+/// (stop 39's machine) this table read 1.00, 1.07 (the median of the nine runs of its gate
+/// run, 1.00-1.11x), 1.00 and 1.08, 1.44, 1.52.
+pub const AGAINST: &[Benchmark] = &[
+    (
+        "grid125 --technique translucency",
+        &[
+            ("light-space maps", 1.02),
+            ("gbuffer + lighting", 1.05),
+            ("frame", 1.03),
+        ],
+    ),
+    (
+        "mixed",
+        &[
+            ("light-space maps", 1.01),
+            ("gbuffer + lighting", 1.28),
+            ("frame", 1.36),
         ],
     ),
 ];
@@ -1133,9 +1406,11 @@ mod tests {
     #[test]
     fn a_machine_gets_its_cpus_table_and_an_unknown_one_the_envelope() {
         let lavapipe = "llvmpipe (LLVM 15.0.6, 256 bits) [CPU]";
-        let intel = TableChoice::for_machine(lavapipe, &cpu("GenuineIntel", Some((6, 207))));
+        let mesa22 = "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)";
+        let intel =
+            TableChoice::for_machine(lavapipe, mesa22, &cpu("GenuineIntel", Some((6, 207))));
         assert!(matches!(intel, TableChoice::Machine(m) if m.cpu_vendor == "GenuineIntel"));
-        let zen4 = TableChoice::for_machine(lavapipe, &cpu("AuthenticAMD", Some((25, 17))));
+        let zen4 = TableChoice::for_machine(lavapipe, mesa22, &cpu("AuthenticAMD", Some((25, 17))));
         assert!(
             matches!(zen4, TableChoice::Machine(m) if m.cpu_family_model == Some((25, 17))),
             "{}",
@@ -1149,14 +1424,18 @@ mod tests {
             cpu("GenuineIntel", Some((6, 143))),
             cpu("unknown", None),
         ] {
-            let choice = TableChoice::for_machine(lavapipe, &other);
-            assert!(matches!(choice, TableChoice::Envelope), "{other}");
+            let choice = TableChoice::for_machine(lavapipe, mesa22, &other);
+            assert!(
+                matches!(choice, TableChoice::Envelope(Some("Mesa 22.3.6"))),
+                "{other}"
+            );
         }
         let gpu = TableChoice::for_machine(
             "NVIDIA H200 [discrete GPU]",
+            "NVIDIA 580.65.06",
             &cpu("GenuineIntel", Some((6, 207))),
         );
-        assert!(matches!(gpu, TableChoice::Envelope));
+        assert!(matches!(gpu, TableChoice::Envelope(None)));
         // The envelope holds each pass to the largest of the tables' ratios.
         let pass = "vertical blur #4";
         let bench = "skin --technique lcb";
@@ -1171,12 +1450,50 @@ mod tests {
             .iter()
             .map(|m| of(&TableChoice::Machine(m)))
             .fold(f64::MIN, f64::max);
-        let envelope = of(&TableChoice::Envelope);
+        let envelope = of(&TableChoice::Envelope(None));
         assert_eq!(envelope, largest);
         assert!(
             envelope > of(&TableChoice::Machine(&MACHINES[0])),
             "another table reads this pass higher than stop 39's"
         );
+    }
+
+    #[test]
+    fn a_machine_gets_its_drivers_table_and_an_envelope_of_its_drivers_tables() {
+        let lavapipe = "llvmpipe (LLVM 15.0.6, 256 bits) [CPU]";
+        let (mesa22, mesa25) = (
+            "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)",
+            "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)",
+        );
+        let xeon = cpu("GenuineIntel", Some((6, 167)));
+        let on_25 = TableChoice::for_machine(lavapipe, mesa25, &xeon);
+        assert!(
+            matches!(on_25, TableChoice::Machine(m) if m.driver == "Mesa 25.0"),
+            "{}",
+            on_25.describe()
+        );
+        // The same CPU on the other driver has no table of its own: the envelope of that
+        // driver's tables, not of Mesa 25's (its merged passes read 2-3x their floors where
+        // Mesa 22's read 5-6x).
+        let on_22 = TableChoice::for_machine(lavapipe, mesa22, &xeon);
+        assert!(matches!(on_22, TableChoice::Envelope(Some("Mesa 22.3.6"))));
+        let other = TableChoice::for_machine(lavapipe, mesa25, &cpu("AuthenticAMD", Some((25, 1))));
+        assert!(matches!(other, TableChoice::Envelope(Some("Mesa 25.0"))));
+        let merged = |t: &TableChoice| {
+            t.baseline("skin")
+                .iter()
+                .find(|(p, _)| *p == "gbuffer + lighting")
+                .unwrap()
+                .1
+        };
+        assert!(
+            merged(&other) < merged(&on_22) / 1.5,
+            "{}",
+            other.describe()
+        );
+        // A driver no table was measured on: every table.
+        let unknown = TableChoice::for_machine(lavapipe, "llvmpipe Mesa 26.1.0", &xeon);
+        assert!(matches!(unknown, TableChoice::Envelope(None)));
     }
 
     #[test]

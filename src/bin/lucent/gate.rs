@@ -90,7 +90,8 @@ fn table_of(bench: &str, held: Held, choice: &gate::TableChoice) -> Vec<(&'stati
 /// the CPU (lavapipe compiles every shader for the CPU).
 fn choose_table(device: &str) -> gate::TableChoice {
     let cpu = gate::CpuKind::this_machine();
-    let choice = gate::TableChoice::for_machine(device, &cpu);
+    let driver = device.split_once(" / ").map_or("", |(_, driver)| driver);
+    let choice = gate::TableChoice::for_machine(device, driver, &cpu);
     println!(
         "Machine: {device}, CPU {cpu}; judged by {}.\n",
         choice.describe()
@@ -110,7 +111,7 @@ pub fn baseline(gpu: &GpuArgs, runs: usize) -> Result<()> {
     let mut table_lines = String::new();
     for (bench, held) in benchmarks() {
         // Only the `none` comparison filters by its table, which is the same on every machine.
-        let table = table_of(bench, held, &gate::TableChoice::Envelope);
+        let table = table_of(bench, held, &gate::TableChoice::Envelope(None));
         let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         for _ in 0..runs {
             // A run the benchmark's timing checks refuse adds nothing.
@@ -156,7 +157,7 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     let mut table_lines = String::new();
     let mut choice = None;
     for (bench, held) in benchmarks() {
-        let against = table_of(bench, held, &gate::TableChoice::Envelope);
+        let against = table_of(bench, held, &gate::TableChoice::Envelope(None));
         let (mut samples, device) = measure(&exe, &forwarded, bench, &against, held)?;
         let choice = *choice.get_or_insert_with(|| {
             let chosen = choose_table(&device);
@@ -316,6 +317,11 @@ fn ratios(
             }
         }
     }
-    let device = json["device"].as_str().unwrap_or("unknown").to_string();
+    // The device and its driver, as the tables are chosen by both.
+    let device = format!(
+        "{} / {}",
+        json["device"].as_str().unwrap_or("unknown"),
+        json["driver"].as_str().unwrap_or("unknown driver")
+    );
     Ok(Ok((ratios, device)))
 }

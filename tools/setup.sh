@@ -7,7 +7,8 @@
 # LLVM 15 as bookworm's 22.3.6): its lavapipe has VK_KHR_acceleration_structure and
 # VK_KHR_ray_query, which the ray-traced techniques need, and runs lucent's frames faster
 # (docs/lavapipe-facts.md). The suite is added as a deb822 file signed by the Debian archive
-# keyring, and only mesa-vulkan-drivers (with the libdrm it needs) is taken from it.
+# keyring, and only mesa-vulkan-drivers is installed from it, with what it needs from there
+# (libdrm 2.4.123, and Mesa 25's libgallium with the installed Mesa packages that share it).
 # Idempotent: when everything is installed it only checks (well under a second).
 set -euo pipefail
 
@@ -60,7 +61,8 @@ if ((${#missing[@]} > 0 || backports)); then
     fi
     if ((backports)); then
         sources=/etc/apt/sources.list.d/lucent-bookworm-backports.sources
-        if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+        # A source that names the suite outside a comment is enough.
+        if ! grep -rqsE '^[^#]*bookworm-backports' /etc/apt/sources.list /etc/apt/sources.list.d/; then
             echo "setup.sh: adding bookworm-backports ($sources)"
             printf '%s\n' "Types: deb" "URIs: http://deb.debian.org/debian" \
                 "Suites: bookworm-backports" "Components: main" \

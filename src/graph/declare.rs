@@ -217,11 +217,6 @@ impl RenderGraph {
         self.push_resource(name, info, Some(import))
     }
 
-    /// Size and format of an image declared so far.
-    pub fn image_info(&self, handle: &Handle<Image>) -> ImageInfo {
-        self.resources[handle.id].info
-    }
-
     /// Marks the handle's version as an output of the frame, left in `final_access`'s state.
     /// Passes whose results reach no export are culled.
     pub fn export_image(&mut self, handle: &Handle<Image>, final_access: Access) {

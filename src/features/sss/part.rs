@@ -158,7 +158,7 @@ impl FramePart for SssProfiles {
         };
         // lucent's G-buffer described as a host describes its own, through the declaration
         // a host's SssEffect makes.
-        let info = graph.image_info(&hdr);
+        let info = graph.resources()[hdr.id()].info;
         let described = gb.layout.described(info.width, info.height);
         let images = DescribedImages {
             depth: &gb.depth,

@@ -86,14 +86,23 @@ fn table_of(bench: &str, held: Held, choice: &gate::TableChoice) -> Vec<(&'stati
     }
 }
 
-/// The table this machine is judged by: its kind's, from the device a benchmark ran on and
-/// the CPU (lavapipe compiles every shader for the CPU).
-fn choose_table(device: &str) -> gate::TableChoice {
+/// The device a benchmark ran on and its driver, as its report names them: a machine's table
+/// is chosen by both.
+#[derive(Clone, Debug, Default)]
+struct RanOn {
+    device: String,
+    driver: String,
+}
+
+/// The table this machine is judged by: its kind's, from the device and driver a benchmark
+/// ran on and the CPU (lavapipe compiles every shader for the CPU).
+fn choose_table(on: &RanOn) -> gate::TableChoice {
     let cpu = gate::CpuKind::this_machine();
-    let driver = device.split_once(" / ").map_or("", |(_, driver)| driver);
-    let choice = gate::TableChoice::for_machine(device, driver, &cpu);
+    let choice = gate::TableChoice::for_machine(&on.device, &on.driver, &cpu);
     println!(
-        "Machine: {device}, CPU {cpu}; judged by {}.\n",
+        "Machine: {} / {}, CPU {cpu}; judged by {}.\n",
+        on.device,
+        on.driver,
         choice.describe()
     );
     choice
@@ -158,9 +167,9 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
     let mut choice = None;
     for (bench, held) in benchmarks() {
         let against = table_of(bench, held, &gate::TableChoice::Envelope(None));
-        let (mut samples, device) = measure(&exe, &forwarded, bench, &against, held)?;
+        let (mut samples, ran_on) = measure(&exe, &forwarded, bench, &against, held)?;
         let choice = *choice.get_or_insert_with(|| {
-            let chosen = choose_table(&device);
+            let chosen = choose_table(&ran_on);
             println!(
                 "| benchmark | pass | against | ratio | limit | verdict |\n\
                  |---|---|---|---:|---:|---|"
@@ -208,22 +217,22 @@ pub fn run(gpu: &GpuArgs) -> Result<()> {
 }
 
 /// Measures `bench` [`gate::RUNS`] times: each run's ratios (the runs the benchmark's timing
-/// checks did not refuse), and the device they ran on.
+/// checks did not refuse), and the device and driver they ran on.
 fn measure(
     exe: &std::path::Path,
     forwarded: &[String],
     bench: &str,
     table: &[(&str, f64)],
     held: Held,
-) -> Result<(Vec<BTreeMap<String, f64>>, String)> {
+) -> Result<(Vec<BTreeMap<String, f64>>, RanOn)> {
     let mut runs = Vec::new();
     let mut refused = Vec::new();
-    let mut device = String::new();
+    let mut ran_on = RanOn::default();
     for _ in 0..gate::RUNS {
         match ratios(exe, forwarded, bench, table, held)? {
             Ok((measured, on)) => {
                 runs.push(measured);
-                device = on;
+                ran_on = on;
             }
             Err(why) => refused.push(why),
         }
@@ -234,16 +243,16 @@ fn measure(
             refused.join("; ")
         )));
     }
-    Ok((runs, device))
+    Ok((runs, ran_on))
 }
 
-/// What one run measured: each pass's ratio, and the device it ran on.
-type OneRun = (BTreeMap<String, f64>, String);
+/// What one run measured: each pass's ratio, and the device and driver it ran on.
+type OneRun = (BTreeMap<String, f64>, RanOn);
 
 /// One run of `bench`: each pass's ratio (to its floor; against `none`, only the passes the
-/// two techniques share and `table` holds) and the device it ran on, or why the run measured
-/// nothing (the benchmark's
-/// own timing checks can refuse a run on a loaded machine).
+/// two techniques share and `table` holds) and the device and driver it ran on, or why the
+/// run measured nothing (the benchmark's own timing checks can refuse a run on a loaded
+/// machine).
 fn ratios(
     exe: &std::path::Path,
     forwarded: &[String],
@@ -317,11 +326,12 @@ fn ratios(
             }
         }
     }
-    // The device and its driver, as the tables are chosen by both.
-    let device = format!(
-        "{} / {}",
-        json["device"].as_str().unwrap_or("unknown"),
-        json["driver"].as_str().unwrap_or("unknown driver")
-    );
-    Ok(Ok((ratios, device)))
+    let ran_on = RanOn {
+        device: json["device"].as_str().unwrap_or("unknown").to_string(),
+        driver: json["driver"]
+            .as_str()
+            .unwrap_or("unknown driver")
+            .to_string(),
+    };
+    Ok(Ok((ratios, ran_on)))
 }

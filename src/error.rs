@@ -48,6 +48,20 @@ pub enum LucentError {
         #[source]
         source: gpu_allocator::AllocationError,
     },
+    /// A host engine's own allocator (`lucent::embed::HostAllocator`) could not give the
+    /// memory of one of lucent's resources.
+    #[error(
+        "the host's allocator could not give '{name}' {size}: {result:?}",
+        size = format_bytes(*.bytes)
+    )]
+    HostAllocation {
+        /// The resource the memory was for.
+        name: String,
+        /// Bytes asked for.
+        bytes: u64,
+        /// What the host's allocator returned.
+        result: ash::vk::Result,
+    },
     /// A shader failed to compile; `message` carries file:line diagnostics from shaderc.
     #[error("shader {path} failed to compile:\n{message}")]
     ShaderCompile { path: String, message: String },
@@ -150,6 +164,16 @@ pub enum HostError {
         index: usize,
         /// How many there are.
         count: usize,
+    },
+    /// Memory a host's own allocator (`lucent::embed::HostAllocator`) returned that the
+    /// resource cannot use (null, too small, misaligned, not mapped where lucent writes or
+    /// reads it); the allocation was handed back to the allocator's `free`.
+    #[error("host allocation for '{allocation}': {problem}")]
+    Memory {
+        /// The resource the memory was for.
+        allocation: String,
+        /// What is wrong with it.
+        problem: String,
     },
     /// A description's value out of range (a size, a count, a scale, a camera matrix).
     #[error("{field}: {problem}")]

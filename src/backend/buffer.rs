@@ -3,7 +3,7 @@
 //! copies, and the resources, which make buffers on the context, do not import each other.
 
 use ash::vk;
-use gpu_allocator::vulkan::Allocation;
+use super::memory::Allocation;
 
 /// A buffer and its memory.
 #[derive(Debug)]
@@ -19,7 +19,7 @@ pub struct GpuBuffer {
 }
 
 impl GpuBuffer {
-    /// The buffer's bytes when its memory is host-visible (`CpuToGpu` / `GpuToCpu`), else `None`.
+    /// The buffer's bytes when its memory is host-visible (`MemoryUse::Upload` / `MemoryUse::Readback`), else `None`.
     ///
     /// Memory from those locations is host-coherent; the caller must make sure the GPU is not
     /// writing the buffer while the slice is read.

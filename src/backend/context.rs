@@ -28,7 +28,7 @@
 use std::fmt;
 use std::mem::ManuallyDrop;
 use std::sync::atomic::Ordering;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::thread::ThreadId;
 
 use ash::vk;
@@ -38,6 +38,7 @@ use gpu_allocator::AllocatorDebugSettings;
 use crate::error::{LucentError, Result, VkResultExt};
 
 use super::buffer::GpuBuffer;
+use super::memory::MemorySource;
 use super::desc::{c_string, lock};
 pub use super::desc::{ContextDesc, DeviceInfo};
 use super::device::{create_device, pick_device, probe_device, queue_family_usable};
@@ -55,8 +56,8 @@ struct OneShot {
 struct SetupRecording {
     thread: ThreadId,
     cmd: vk::CommandBuffer,
-    /// Staging buffers the recorded copies read: freed only after the caller's submission ran.
-    staging: Vec<GpuBuffer>,
+    /// What the recorded copies use: freed only after the caller's submission ran.
+    kept: SetupKept,
 }
 
 /// The Vulkan context every other part of lucent uses (see the module docs).
@@ -78,8 +79,9 @@ pub struct GpuContext {
     pub queue_family: u32,
     /// Names, versions, limits and enabled optional features of the device.
     pub info: DeviceInfo,
-    /// lucent's own allocator, or the host's shared one (an `Arc` either way).
-    allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
+    /// Where buffers' and images' memory comes from: lucent's own allocator, a host's shared
+    /// `gpu-allocator` or a host's own allocator.
+    memory: ManuallyDrop<MemorySource>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -90,6 +92,61 @@ pub struct GpuContext {
     /// Threads whose setup work goes into a caller's command buffer (usually none, at most a
     /// few: one per thread building a renderer at the same time).
     setup_recordings: Mutex<Vec<SetupRecording>>,
+}
+
+/// A destruction put off until a caller's submission of recorded setup work has run.
+type DeferredDestroy = Box<dyn FnOnce(&GpuContext) + Send>;
+
+/// What setup work recorded into a caller's command buffer ([`GpuContext::record_setup_into`])
+/// uses, kept until the caller's submission of it has completed: the staging buffers its
+/// copies read, and the resources the build destroyed meanwhile (a build that failed halfway
+/// destroys what it had made, which its recorded copies write). So the command buffer stays
+/// valid to submit whether the build succeeded or not.
+#[derive(Default)]
+pub struct SetupKept {
+    /// The staging buffers the recorded copies read.
+    pub staging: Vec<GpuBuffer>,
+    /// Destructions put off, in the order they were asked for.
+    destroyed: Vec<DeferredDestroy>,
+}
+
+impl SetupKept {
+    /// Bytes of staging memory held.
+    pub fn staging_bytes(&self) -> u64 {
+        self.staging.iter().map(|b| b.size).sum()
+    }
+
+    /// Whether nothing is held.
+    pub fn is_empty(&self) -> bool {
+        self.staging.is_empty() && self.destroyed.is_empty()
+    }
+
+    /// Adds what another recording kept.
+    pub fn extend(&mut self, other: SetupKept) {
+        self.staging.extend(other.staging);
+        self.destroyed.extend(other.destroyed);
+    }
+
+    /// Frees the staging buffers and carries out the destructions put off. The submission
+    /// holding the recorded work has completed (or was never made).
+    pub fn destroy(self, gpu: &GpuContext) {
+        for buffer in self.staging {
+            gpu.destroy_buffer(buffer);
+        }
+        for destroy in self.destroyed {
+            destroy(gpu);
+        }
+    }
+}
+
+impl fmt::Debug for SetupKept {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SetupKept")
+            .field("staging_buffers", &self.staging.len())
+            .field("staging_bytes", &self.staging_bytes())
+            .field("destructions_put_off", &self.destroyed.len())
+            .finish()
+    }
 }
 
 impl fmt::Debug for GpuContext {
@@ -191,7 +248,7 @@ impl GpuContext {
             queue,
             queue_family: probe.queue_family,
             info: probe.info,
-            allocator: ManuallyDrop::new(parts.allocator),
+            memory: ManuallyDrop::new(parts.memory),
             debug_instance,
             debug_device,
             messenger,
@@ -239,7 +296,7 @@ impl GpuContext {
     ) -> Result<Self> {
         // SAFETY: the caller's contract is this function's.
         unsafe {
-            Self::wrap_with_allocator(
+            Self::wrap_with_memory(
                 entry,
                 instance,
                 physical_device,
@@ -252,9 +309,11 @@ impl GpuContext {
         }
     }
 
-    /// [`GpuContext::wrap`] with the host's own `gpu-allocator` (`Some`), shared with lucent:
-    /// every buffer and image lucent creates is allocated from it and freed back to it;
-    /// dropping the context drops only lucent's reference. `None`: lucent creates its own.
+    /// [`GpuContext::wrap`] with the host's memory (`Some`): its shared `gpu-allocator` or its
+    /// own allocator ([`MemorySource`]). Every buffer and image lucent creates is allocated
+    /// from it and freed back to it; dropping the context drops only lucent's reference (and
+    /// logs, by name, what lucent still holds from a host's own allocator). `None`: lucent
+    /// creates its own `gpu-allocator`.
     ///
     /// `debug_messenger`: whether lucent installs a debug messenger of its own on the host's
     /// instance (when it has `VK_EXT_debug_utils`). A host with its own messenger would see every
@@ -264,17 +323,17 @@ impl GpuContext {
     ///
     /// # Safety
     ///
-    /// As [`GpuContext::wrap`]; a shared allocator must have been created for the same
-    /// instance, physical device and device.
+    /// As [`GpuContext::wrap`]; the host's allocator must allocate memory of the same
+    /// device.
     #[allow(clippy::too_many_arguments)]
-    pub unsafe fn wrap_with_allocator(
+    pub unsafe fn wrap_with_memory(
         entry: ash::Entry,
         instance: ash::Instance,
         physical_device: vk::PhysicalDevice,
         device: ash::Device,
         queue: vk::Queue,
         queue_family: u32,
-        shared_allocator: Option<Arc<Mutex<Allocator>>>,
+        memory: Option<MemorySource>,
         debug_messenger: bool,
     ) -> Result<Self> {
         let mut probe = probe_device(&instance, physical_device, false)?;
@@ -340,7 +399,7 @@ impl GpuContext {
             physical_device,
             &device,
             queue_family,
-            shared_allocator,
+            memory,
         ) {
             Ok(parts) => parts,
             Err(e) => {
@@ -366,7 +425,7 @@ impl GpuContext {
             queue,
             queue_family,
             info: probe.info,
-            allocator: ManuallyDrop::new(parts.allocator),
+            memory: ManuallyDrop::new(parts.memory),
             debug_instance,
             debug_device,
             messenger,
@@ -436,9 +495,9 @@ impl GpuContext {
         unsafe { debug.cmd_end_debug_utils_label(cmd) };
     }
 
-    /// Locks and returns the memory allocator.
-    pub fn allocator(&self) -> MutexGuard<'_, Allocator> {
-        lock(&self.allocator)
+    /// Where buffers' and images' memory comes from.
+    pub fn memory(&self) -> &MemorySource {
+        &self.memory
     }
 
     /// Records commands with `record`, submits them on the queue and waits for completion.
@@ -496,10 +555,11 @@ impl GpuContext {
 
     /// Runs `build` with this thread's setup work (uploads: their copies and barriers)
     /// recorded into `cmd` instead of submitted and waited for, and returns what `build`
-    /// returned with the staging buffers those copies read. The caller frees them
-    /// ([`GpuContext::destroy_buffer`]) once the submission holding `cmd` has completed, on
-    /// success or failure; on failure `cmd` holds copies into resources `build` destroyed, and
-    /// must be reset rather than submitted.
+    /// returned with what those copies use ([`SetupKept`]: the staging buffers they read, and
+    /// every image, buffer and memory block `build` destroyed meanwhile, put off). The caller
+    /// frees it ([`SetupKept::destroy`]) once the submission holding `cmd` has completed, on
+    /// success or failure: a failed build leaves `cmd` valid to submit (its copies write
+    /// resources nothing else uses), so the caller's other work in it is not lost.
     ///
     /// Each recorded copy ends with a full memory barrier, so every later command in the same
     /// queue's submission order sees its result. Other threads keep submitting their setup
@@ -514,30 +574,48 @@ impl GpuContext {
         &self,
         cmd: vk::CommandBuffer,
         build: impl FnOnce() -> Result<T>,
-    ) -> (Result<T>, Vec<GpuBuffer>) {
+    ) -> (Result<T>, SetupKept) {
         let thread = std::thread::current().id();
         if self.recording_setup_cmd().is_some() {
             return (
                 Err(LucentError::InvalidInput(
                     "setup work is already being recorded on this thread".into(),
                 )),
-                Vec::new(),
+                SetupKept::default(),
             );
         }
         lock(&self.setup_recordings).push(SetupRecording {
             thread,
             cmd,
-            staging: Vec::new(),
+            kept: SetupKept::default(),
         });
         // A panic in `build` leaves this thread's entry behind; the next call on the thread
         // would be refused, which is loud rather than wrong.
         let built = build();
         let mut recordings = lock(&self.setup_recordings);
-        let staging = match recordings.iter().position(|r| r.thread == thread) {
-            Some(at) => recordings.swap_remove(at).staging,
-            None => Vec::new(),
+        let kept = match recordings.iter().position(|r| r.thread == thread) {
+            Some(at) => recordings.swap_remove(at).kept,
+            None => SetupKept::default(),
         };
-        (built, staging)
+        (built, kept)
+    }
+
+    /// Puts a destruction off until the caller's submission of this thread's recorded setup
+    /// work has run, when this thread is recording some (its copies may write what is
+    /// destroyed); hands it back, to run now, otherwise.
+    pub(crate) fn defer_while_recording_setup(
+        &self,
+        destroy: DeferredDestroy,
+    ) -> Option<DeferredDestroy> {
+        let thread = std::thread::current().id();
+        let mut recordings = lock(&self.setup_recordings);
+        match recordings.iter_mut().find(|r| r.thread == thread) {
+            Some(recording) => {
+                recording.kept.destroyed.push(destroy);
+                None
+            }
+            None => Some(destroy),
+        }
     }
 
     /// The command buffer this thread's setup work is recorded into, if any.
@@ -562,7 +640,7 @@ impl GpuContext {
             let mut recordings = lock(&self.setup_recordings);
             if let Some(recording) = recordings.iter_mut().find(|r| r.thread == thread) {
                 record(recording.cmd);
-                recording.staging.push(staging);
+                recording.kept.staging.push(staging);
                 return Ok(());
             }
         }
@@ -611,8 +689,8 @@ impl Drop for GpuContext {
                     .get_mut()
                     .unwrap_or_else(|poisoned| poisoned.into_inner()),
             );
-            for staging in recordings.into_iter().flat_map(|r| r.staging) {
-                self.destroy_buffer(staging);
+            for recording in recordings {
+                recording.kept.destroy(self);
             }
             let one_shot = self
                 .one_shot
@@ -621,8 +699,10 @@ impl Drop for GpuContext {
             self.device.destroy_fence(one_shot.fence, None);
             self.device.destroy_command_pool(one_shot.pool, None);
             // lucent's own allocator reports leaked allocations (log_leaks_on_shutdown) and
-            // frees its memory blocks here; a host's shared one only loses this reference.
-            ManuallyDrop::drop(&mut self.allocator);
+            // frees its memory blocks here; a host's shared one only loses this reference,
+            // and what lucent still holds from a host's own allocator is logged by name.
+            self.memory.report_leaks();
+            ManuallyDrop::drop(&mut self.memory);
             if self.owns_handles {
                 self.device.destroy_device(None);
             }
@@ -640,7 +720,7 @@ impl Drop for GpuContext {
 
 /// What lucent creates on any device, owned or wrapped.
 struct OwnedParts {
-    allocator: Arc<Mutex<Allocator>>,
+    memory: MemorySource,
     one_shot: OneShot,
 }
 
@@ -673,11 +753,13 @@ fn create_owned_parts(
     pd: vk::PhysicalDevice,
     device: &ash::Device,
     queue_family: u32,
-    shared_allocator: Option<Arc<Mutex<Allocator>>>,
+    memory: Option<MemorySource>,
 ) -> Result<OwnedParts> {
-    let allocator = match shared_allocator {
-        Some(shared) => shared,
-        None => Arc::new(Mutex::new(own_allocator(instance, pd, device)?)),
+    let memory = match memory {
+        Some(host) => host,
+        None => MemorySource::gpu_allocator(Arc::new(Mutex::new(own_allocator(
+            instance, pd, device,
+        )?))),
     };
     let pool_info = vk::CommandPoolCreateInfo::default()
         .flags(vk::CommandPoolCreateFlags::TRANSIENT)
@@ -720,7 +802,7 @@ fn create_owned_parts(
             }
         };
         Ok(OwnedParts {
-            allocator,
+            memory,
             one_shot: OneShot { pool, cmd, fence },
         })
     }

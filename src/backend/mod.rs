@@ -3,6 +3,7 @@
 //! - [`context`]: the Vulkan context, created by lucent or wrapping a host engine's device.
 //! - [`resources`]: images and buffers with named allocations, readback (a buffer itself,
 //!   [`GpuBuffer`], is its own small module, which the context's staging uses too).
+//! - [`memory`]: where their memory comes from: `gpu-allocator` or a host's own allocator.
 //! - [`access`]: the one access table every barrier is derived from.
 //! - [`pipeline`]: graphics pipelines, made for the render pass and subpass a caller names.
 //! - [`descriptor`]: descriptor sets (one per pass, with its own pool) and samplers.
@@ -21,6 +22,7 @@ mod desc;
 pub mod descriptor;
 pub(crate) mod device;
 pub mod format;
+pub mod memory;
 #[cfg(feature = "runtime-shaders")]
 mod glsl_compile;
 mod instance;

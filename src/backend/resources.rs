@@ -22,8 +22,7 @@
 //! barrier, so later GPU work sees their results without further synchronization.
 
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
-use gpu_allocator::MemoryLocation;
+use super::memory::{Allocation, MemoryUse};
 
 pub use super::buffer::GpuBuffer;
 use super::context::GpuContext;
@@ -159,9 +158,7 @@ pub struct MemoryBlock {
 impl MemoryBlock {
     /// The `VkDeviceMemory` the block lives in (shared with other blocks; never free it directly).
     pub fn memory(&self) -> vk::DeviceMemory {
-        // SAFETY: only the handle is read; gpu-allocator marks this unsafe because freeing or
-        // sub-allocating the memory behind its back would be unsound, which callers must not do.
-        unsafe { self.allocation.memory() }
+        self.allocation.memory()
     }
 
     /// Offset of the block inside [`MemoryBlock::memory`]; resource offsets passed to
@@ -186,12 +183,11 @@ impl GpuContext {
     /// usage is transfer-only).
     pub fn create_image(&self, desc: &ImageDesc, name: &str) -> Result<GpuImage> {
         let (image, requirements) = self.create_image_unbound(desc, name)?;
-        let allocation = match self.allocate(
+        let allocation = match self.memory().allocate(
             name,
             requirements,
-            MemoryLocation::GpuOnly,
+            MemoryUse::DeviceLocal,
             false,
-            AllocationScheme::GpuAllocatorManaged,
         ) {
             Ok(allocation) => allocation,
             Err(e) => {
@@ -201,7 +197,8 @@ impl GpuContext {
             }
         };
         // SAFETY: the allocation satisfies `requirements` of this image (gpu-allocator honours
-        // size, alignment and memory type bits) and the image is not yet bound.
+        // size, alignment and memory type bits; a host allocator's size and alignment were
+        // checked, its memory type is its contract) and the image is not yet bound.
         let bound = unsafe {
             self.device
                 .bind_image_memory(image, allocation.memory(), allocation.offset())
@@ -228,14 +225,24 @@ impl GpuContext {
                 // SAFETY: the image was created above and is unused; it is destroyed before its
                 // memory is freed.
                 unsafe { self.device.destroy_image(image, None) };
-                self.free_allocation(allocation, name);
+                self.memory().free(allocation, name);
                 Err(e)
             }
         }
     }
 
     /// Destroys an image, its view and (if it owns it) its memory. The GPU must be done with it.
+    /// On a thread recording setup work into a caller's command buffer, the destruction waits
+    /// for that submission ([`GpuContext::record_setup_into`]).
     pub fn destroy_image(&self, image: GpuImage) {
+        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
+            gpu.destroy_image_now(image)
+        })) {
+            now(self);
+        }
+    }
+
+    fn destroy_image_now(&self, image: GpuImage) {
         // SAFETY: the caller hands over ownership and guarantees the GPU no longer uses the
         // image; the view is destroyed before the image, the image before its memory.
         unsafe {
@@ -243,17 +250,17 @@ impl GpuContext {
             self.device.destroy_image(image.image, None);
         }
         if let Some(allocation) = image.allocation {
-            self.free_allocation(allocation, &image.name);
+            self.memory().free(allocation, &image.name);
         }
     }
 
-    /// Creates a buffer of `size` bytes in `location` (`GpuOnly`, `CpuToGpu` or `GpuToCpu`; the
+    /// Creates a buffer of `size` bytes for `memory_use` (`DeviceLocal`, `Upload` or `Readback`; the
     /// last two are mapped, see [`GpuBuffer::mapped_slice`]).
     pub fn create_buffer(
         &self,
         size: u64,
         usage: vk::BufferUsageFlags,
-        location: MemoryLocation,
+        memory_use: MemoryUse,
         name: &str,
     ) -> Result<GpuBuffer> {
         if size == 0 {
@@ -271,13 +278,7 @@ impl GpuContext {
         self.set_name(buffer, name);
         // SAFETY: `buffer` was just created from this device.
         let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
-        let allocation = match self.allocate(
-            name,
-            requirements,
-            location,
-            true,
-            AllocationScheme::GpuAllocatorManaged,
-        ) {
+        let allocation = match self.memory().allocate(name, requirements, memory_use, true) {
             Ok(allocation) => allocation,
             Err(e) => {
                 // SAFETY: the buffer was created above, is unbound and unused.
@@ -294,7 +295,7 @@ impl GpuContext {
         if let Err(e) = bound {
             // SAFETY: the buffer is unused; destroyed before its memory is freed.
             unsafe { self.device.destroy_buffer(buffer, None) };
-            self.free_allocation(allocation, name);
+            self.memory().free(allocation, name);
             return Err(e);
         }
         Ok(GpuBuffer {
@@ -305,13 +306,23 @@ impl GpuContext {
         })
     }
 
-    /// Destroys a buffer and frees its memory. The GPU must be done with it.
+    /// Destroys a buffer and frees its memory. The GPU must be done with it. On a thread
+    /// recording setup work into a caller's command buffer, the destruction waits for that
+    /// submission ([`GpuContext::record_setup_into`]).
     pub fn destroy_buffer(&self, buffer: GpuBuffer) {
+        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
+            gpu.destroy_buffer_now(buffer)
+        })) {
+            now(self);
+        }
+    }
+
+    fn destroy_buffer_now(&self, buffer: GpuBuffer) {
         // SAFETY: the caller hands over ownership and guarantees the GPU no longer uses the
         // buffer; it is destroyed before its memory is freed.
         unsafe { self.device.destroy_buffer(buffer.buffer, None) };
         if let Some(allocation) = buffer.allocation {
-            self.free_allocation(allocation, &buffer.name);
+            self.memory().free(allocation, &buffer.name);
         }
     }
 
@@ -334,7 +345,7 @@ impl GpuContext {
         let mut staging = self.create_buffer(
             size,
             vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
+            MemoryUse::Upload,
             &format!("{name} (staging)"),
         )?;
         match staging.mapped_mut() {
@@ -349,7 +360,7 @@ impl GpuContext {
         let buffer = match self.create_buffer(
             size,
             usage | vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuOnly,
+            MemoryUse::DeviceLocal,
             name,
         ) {
             Ok(buffer) => buffer,
@@ -465,7 +476,7 @@ impl GpuContext {
         let mut staging = self.create_buffer(
             total,
             vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
+            MemoryUse::Upload,
             &format!("{name} (staging)"),
         )?;
         let filled = match staging.mapped_mut() {
@@ -575,7 +586,7 @@ impl GpuContext {
         let readback = self.create_buffer(
             buffer.size,
             vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
+            MemoryUse::Readback,
             &format!("{} (readback)", buffer.name),
         )?;
         let copied = self.submit_and_wait(|cmd| {
@@ -690,7 +701,7 @@ impl GpuContext {
         let readback = self.create_buffer(
             size,
             vk::BufferUsageFlags::TRANSFER_DST,
-            MemoryLocation::GpuToCpu,
+            MemoryUse::Readback,
             &format!("{} (readback)", image.name),
         )?;
         let range = vk::ImageSubresourceRange {
@@ -827,13 +838,9 @@ impl GpuContext {
         requirements: vk::MemoryRequirements,
         name: &str,
     ) -> Result<MemoryBlock> {
-        let allocation = self.allocate(
-            name,
-            requirements,
-            MemoryLocation::GpuOnly,
-            false,
-            AllocationScheme::GpuAllocatorManaged,
-        )?;
+        let allocation = self
+            .memory()
+            .allocate(name, requirements, MemoryUse::DeviceLocal, false)?;
         Ok(MemoryBlock {
             allocation,
             name: name.to_string(),
@@ -843,8 +850,15 @@ impl GpuContext {
 
     /// Frees a block from [`GpuContext::allocate_memory_block`]. Every resource bound into it must
     /// be destroyed first (or at least no longer used by the GPU).
+    ///
+    /// On a thread recording setup work into a caller's command buffer, freeing waits for that
+    /// submission ([`GpuContext::record_setup_into`]), as destroying the resources in it does.
     pub fn free_memory_block(&self, block: MemoryBlock) {
-        self.free_allocation(block.allocation, &block.name);
+        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
+            gpu.memory().free(block.allocation, &block.name)
+        })) {
+            now(self);
+        }
     }
 
     /// Binds `image` at byte `offset` inside `block`. The offset must respect the image's
@@ -908,37 +922,6 @@ impl GpuContext {
         let view = unsafe { self.device.create_image_view(&info, None) }.vk("vkCreateImageView")?;
         self.set_name(view, name);
         Ok(view)
-    }
-
-    /// Allocates named memory through gpu-allocator.
-    fn allocate(
-        &self,
-        name: &str,
-        requirements: vk::MemoryRequirements,
-        location: MemoryLocation,
-        linear: bool,
-        allocation_scheme: AllocationScheme,
-    ) -> Result<Allocation> {
-        self.allocator()
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear,
-                allocation_scheme,
-            })
-            .map_err(|source| LucentError::Allocation {
-                name: name.to_string(),
-                bytes: requirements.size,
-                source,
-            })
-    }
-
-    /// Returns memory to gpu-allocator; a failure (double free) is logged, not fatal.
-    fn free_allocation(&self, allocation: Allocation, name: &str) {
-        if let Err(e) = self.allocator().free(allocation) {
-            log::error!("freeing GPU memory '{name}' failed: {e}");
-        }
     }
 }
 

@@ -48,7 +48,7 @@
 //!    enabled them ([`OptionalFeatures`]); [`Requirements::check`] tests a physical device.
 //! 2. **Construction** ([`Lucent::new`]) from the host's instance, physical device, device,
 //!    queue and family, the number of frames in flight, optionally its pipeline cache and its
-//!    `gpu-allocator` ([`EmbedOptions`]). lucent creates its own objects (pipelines, images,
+//!    memory: its `gpu-allocator` or its own allocator ([`HostAllocator`]) ([`EmbedOptions`]). lucent creates its own objects (pipelines, images,
 //!    buffers, descriptor pools) and destroys only those; no handle of the host's is ever
 //!    destroyed. No debug messenger is installed unless [`EmbedOptions::debug_messenger`]
 //!    asks for one.
@@ -157,6 +157,7 @@ use ash::vk;
 pub use gpu_allocator;
 use gpu_allocator::vulkan::Allocator;
 
+use crate::backend::memory::MemorySource;
 use crate::backend::shader::{PipelineCache, ShaderCompiler};
 use crate::backend::GpuContext;
 use crate::scene::Scene;
@@ -215,6 +216,7 @@ pub use transmission::{
 pub use uploads::{leaked, Uploads};
 // The types a host names in its descriptions, and the versions of the crates it must build its
 // handles with.
+pub use crate::backend::memory::{HostAllocation, HostAllocator, MemoryRequest, MemoryUse};
 pub use crate::error::{HostError, ImageFault};
 pub use crate::features::layered::{LayeredKnobs, PhaseForm, PIXEL_LIGHT_RANGE, STEP_RANGE};
 pub use crate::features::sss::kernel::{KernelShape, SAMPLE_COUNTS};
@@ -265,7 +267,10 @@ pub use glam;
 /// `lucent_shadow_texels` on a `sampler2DArray` too. 14: `OptionalFeatures::independent_blend`
 /// is gone (no effect blends one target and overwrites another any more: the SSS chains add
 /// their sum of Gaussians in the shader), and `requirements().optional` no longer lists it.
-pub const API_VERSION: u32 = 14;
+/// 15: a host's own allocator ([`EmbedOptions::memory`], [`HostAllocator`]), errors
+/// `LucentError::HostAllocation` and [`HostError::Memory`]; a failed build leaves its
+/// [`Uploads`]' command buffer valid to submit.
+pub const API_VERSION: u32 = 15;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.
 pub const MAX_FRAMES_IN_FLIGHT: usize = 8;
@@ -365,8 +370,13 @@ pub struct EmbedOptions {
     /// destroyed by lucent). `None`: an in-memory cache of lucent's own.
     pub pipeline_cache: Option<vk::PipelineCache>,
     /// The host's `gpu-allocator` (the same version: [`gpu_allocator`] is re-exported),
-    /// shared for every buffer and image lucent creates. `None`: lucent's own allocator.
+    /// shared for every buffer and image lucent creates. `None` (and no [`Self::memory`]):
+    /// lucent's own allocator.
     pub allocator: Option<Arc<Mutex<Allocator>>>,
+    /// The host's own allocator (VMA behind it, or the engine's own): every buffer's and
+    /// image's memory comes from it and goes back to it ([`HostAllocator`]). Not together
+    /// with [`Self::allocator`]. `None`: the shared `gpu-allocator` or lucent's own.
+    pub memory: Option<Arc<dyn HostAllocator>>,
     /// Where lucent keeps what it caches between runs (the thickness bake; shaders come
     /// compiled with the crate):
     /// a directory the host chooses. `None`: the platform's per-user cache
@@ -417,17 +427,31 @@ impl Lucent {
                 )))
             }
         };
+        let memory = match (options.allocator, options.memory) {
+            (Some(_), Some(_)) => {
+                return Err(crate::HostError::Description {
+                    field: "EmbedOptions::memory".into(),
+                    problem: "given together with EmbedOptions::allocator: lucent takes its \
+                              memory from one allocator, the host's gpu-allocator or its own"
+                        .into(),
+                }
+                .into())
+            }
+            (Some(shared), None) => Some(MemorySource::gpu_allocator(shared)),
+            (None, Some(own)) => Some(MemorySource::host(own)),
+            (None, None) => None,
+        };
         let enabled = host.enabled;
         // SAFETY: the caller's contract covers wrap's.
         let mut gpu = unsafe {
-            GpuContext::wrap_with_allocator(
+            GpuContext::wrap_with_memory(
                 host.entry,
                 host.instance,
                 host.physical_device,
                 host.device,
                 host.queue,
                 host.queue_family,
-                options.allocator,
+                memory,
                 options.debug_messenger,
             )
         }?;

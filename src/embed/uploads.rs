@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use ash::vk;
 
 use super::Lucent;
-use crate::backend::resources::GpuBuffer;
+use crate::backend::SetupKept;
 use crate::{LucentError, Result};
 
 /// How many lucent objects were dropped without their `destroy` / `release` since the process
@@ -82,10 +82,15 @@ pub(crate) fn next_lucent_id() -> u64 {
 /// Each copy ends with a full memory barrier: every later command on the same queue (this
 /// command buffer or a later submission) sees the data. A renderer recorded on another queue
 /// needs the host's semaphore between the two submissions.
+///
+/// A build that fails (a description refused, the host's allocator out of memory) returns its
+/// error and leaves the command buffer valid to submit, with the host's own work in it: the
+/// images and buffers it had made and recorded copies into are destroyed only at
+/// [`Uploads::release`], with the staging memory.
 pub struct Uploads {
     cmd: vk::CommandBuffer,
     lucent_id: u64,
-    staging: Vec<GpuBuffer>,
+    kept: SetupKept,
     guard: Option<LeakGuard>,
 }
 
@@ -93,8 +98,7 @@ impl std::fmt::Debug for Uploads {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Uploads")
             .field("cmd", &self.cmd)
-            .field("staging_buffers", &self.staging.len())
-            .field("staging_bytes", &self.staging_bytes())
+            .field("kept", &self.kept)
             .finish()
     }
 }
@@ -112,7 +116,7 @@ impl Uploads {
         Self {
             cmd,
             lucent_id: lucent.id(),
-            staging: Vec::new(),
+            kept: SetupKept::default(),
             guard: None,
         }
     }
@@ -131,14 +135,14 @@ impl Uploads {
             )));
         }
         // SAFETY: `Uploads::new`'s contract is record_setup_into's.
-        let (built, staging) = unsafe { lucent.gpu().record_setup_into(self.cmd, build) };
-        if !staging.is_empty() && self.guard.is_none() {
+        let (built, kept) = unsafe { lucent.gpu().record_setup_into(self.cmd, build) };
+        if !kept.is_empty() && self.guard.is_none() {
             self.guard = Some(LeakGuard::new(format!(
                 "Uploads (staging memory recorded into command buffer {:?})",
                 self.cmd
             )));
         }
-        self.staging.extend(staging);
+        self.kept.extend(kept);
         built
     }
 
@@ -147,18 +151,18 @@ impl Uploads {
         self.cmd
     }
 
-    /// Whether nothing was recorded (no staging memory to release).
+    /// Whether nothing was recorded (nothing to release).
     pub fn is_empty(&self) -> bool {
-        self.staging.is_empty()
+        self.kept.is_empty()
     }
 
     /// Staging memory held until [`Uploads::release`], in bytes.
     pub fn staging_bytes(&self) -> u64 {
-        self.staging.iter().map(|b| b.size).sum()
+        self.kept.staging_bytes()
     }
 
-    /// Frees the staging memory. On error (another `Lucent`) nothing is freed and `self`
-    /// keeps it.
+    /// Frees the staging memory and destroys what failed builds left (see above). On error
+    /// (another `Lucent`) nothing is freed and `self` keeps it.
     ///
     /// # Safety
     ///
@@ -170,9 +174,7 @@ impl Uploads {
                 "Uploads::release: these uploads belong to another Lucent".into(),
             ));
         }
-        for buffer in self.staging.drain(..) {
-            lucent.gpu().destroy_buffer(buffer);
-        }
+        std::mem::take(&mut self.kept).destroy(lucent.gpu());
         if let Some(guard) = self.guard.take() {
             guard.disarm();
         }

@@ -770,7 +770,7 @@ fn per_slot_vertices(
         let made = gpu.create_buffer(
             bytes.len() as u64,
             vk::BufferUsageFlags::VERTEX_BUFFER,
-            gpu_allocator::MemoryLocation::CpuToGpu,
+            crate::backend::memory::MemoryUse::Upload,
             &format!("{name} vertices (slot {slot})"),
         );
         match made {

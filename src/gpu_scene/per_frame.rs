@@ -339,7 +339,7 @@ impl PerFrame {
         let buffer = gpu.create_buffer(
             stride * slots as u64,
             vk::BufferUsageFlags::UNIFORM_BUFFER,
-            gpu_allocator::MemoryLocation::CpuToGpu,
+            crate::backend::memory::MemoryUse::Upload,
             &format!("{name} per-frame parameters"),
         )?;
         Ok(Self {

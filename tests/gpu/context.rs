@@ -2,8 +2,8 @@
 //! validation layer and synchronization validation on, and fail on any validation error.
 
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 use lucent::backend::format::texel_bytes;
+use lucent::backend::memory::MemoryUse;
 use lucent::backend::{ContextDesc, GpuContext, GpuImage, ImageDesc};
 use lucent::LucentError;
 
@@ -174,7 +174,7 @@ fn create_and_destroy_image_and_buffer() {
         .create_buffer(
             1000,
             vk::BufferUsageFlags::UNIFORM_BUFFER,
-            MemoryLocation::CpuToGpu,
+            MemoryUse::Upload,
             "test uniforms",
         )
         .expect("create buffer");
@@ -190,7 +190,7 @@ fn create_and_destroy_image_and_buffer() {
         .create_buffer(
             256,
             vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuOnly,
+            MemoryUse::DeviceLocal,
             "test storage",
         )
         .expect("create device-local buffer");
@@ -199,7 +199,7 @@ fn create_and_destroy_image_and_buffer() {
         ctx.create_buffer(
             0,
             vk::BufferUsageFlags::UNIFORM_BUFFER,
-            MemoryLocation::CpuToGpu,
+            MemoryUse::Upload,
             "empty"
         ),
         Err(LucentError::InvalidInput(_))

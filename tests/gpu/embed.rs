@@ -16,7 +16,6 @@ use ash::vk;
 use glam::{DVec3, Mat4};
 use lucent::backend::{GpuImage, ImageDesc};
 use lucent::embed::gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use lucent::embed::gpu_allocator::MemoryLocation;
 use lucent::embed::{
     DepthDesc, DiffuseDesc, EmbedOptions, GBufferDesc, HostCamera, HostDevice, HostError,
     HostImage, IdDesc, ImageFault, ImageState, Lucent, NormalDesc, OptionalFeatures, SceneRenderer,
@@ -47,7 +46,7 @@ fn example_binary() -> PathBuf {
 }
 
 /// The host's handles of the test context, with `device` as the device lucent calls through.
-fn host_device(test: &TestGpu, device: ash::Device) -> HostDevice {
+pub(crate) fn host_device(test: &TestGpu, device: ash::Device) -> HostDevice {
     let gpu = &test.gpu;
     HostDevice {
         entry: gpu.entry.clone(),
@@ -2822,7 +2821,7 @@ fn upload_regions(test: &TestGpu, image: &GpuImage, bytes: &[u8], regions: &[vk:
         .create_buffer(
             bytes.len() as u64,
             vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
+            lucent::backend::memory::MemoryUse::Upload,
             "test upload staging",
         )
         .unwrap();
@@ -2887,7 +2886,7 @@ fn layer_view(test: &TestGpu, image: &GpuImage, layer: u32) -> vk::ImageView {
 
 /// A scene a host builds itself: its own meshes (handed over for lucent to upload), transforms,
 /// lucent materials and lights.
-fn host_built_scene() -> lucent::scene::Scene {
+pub(crate) fn host_built_scene() -> lucent::scene::Scene {
     use glam::{Mat4, Vec3};
     use lucent::scene::material::{
         Light, LightKind, Material, SssProfile, ThicknessSource, Translucency,

@@ -19,6 +19,7 @@ mod embed;
 mod embed_environment;
 mod embed_layered;
 mod embed_lean;
+mod embed_memory;
 mod embed_translucency;
 mod embed_transmission;
 mod environment;

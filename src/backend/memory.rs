@@ -364,13 +364,4 @@ impl MemorySource {
             }
         }
     }
-
-    /// How many allocations lucent holds from a host's allocator (`None` for gpu-allocator,
-    /// whose own report counts them).
-    pub fn host_allocations(&self) -> Option<usize> {
-        match &self.0 {
-            Kind::Host { live, .. } => Some(lock(live).len()),
-            Kind::GpuAllocator(_) => None,
-        }
-    }
 }

@@ -164,7 +164,6 @@ use crate::scene::Scene;
 use crate::{LucentError, Result};
 
 mod environment;
-
 pub mod glsl;
 mod image;
 mod layered;

@@ -81,8 +81,8 @@ impl TransmissionMaterial {
     /// `lucent_sss_transmitted`), its lengths in the host's world at `metres_per_unit`
     /// ([`GBufferDesc::metres_per_unit`]): the same rows [`TransmissionEffect`] and lucent's
     /// own frames read from the SSS profile table. Every value is finite; a unit that is not
-    /// finite, above 0 and at most [`crate::features::gbuffer_desc::MAX_METRES_PER_UNIT`] is refused
-    /// ([`HostError::Description`], field `metres_per_unit`).
+    /// finite, above 0 and at most [`crate::features::gbuffer_desc::MAX_METRES_PER_UNIT`] is
+    /// refused ([`HostError::Description`], field `metres_per_unit`).
     pub fn rows(&self, metres_per_unit: f32) -> Result<[[f32; 4]; 4]> {
         Ok(self.transmission(metres_per_unit)?.rows())
     }
@@ -195,8 +195,8 @@ pub struct TransmissionFrame<'a> {
     pub camera: HostCamera,
     /// The host's lights this frame, in its world (at most [`crate::scene::MAX_LIGHTS`]).
     pub lights: &'a [Light],
-    /// The faces of the lights' shadow maps this frame (at most `crate::features::shadows::MAX_SHADOW_FACES`), each
-    /// light's together and in order.
+    /// The faces of the lights' shadow maps this frame (at most
+    /// `crate::features::shadows::MAX_SHADOW_FACES`), each light's together and in order.
     pub shadow_faces: &'a [ShadowFace],
     /// The images.
     pub images: TransmissionImages<'a>,

@@ -265,19 +265,18 @@ impl SssEffectDesc {
         &self,
         blur_of: &dyn Fn(&SssProfile) -> Result<SssBlur>,
     ) -> Result<CheckedMaterials> {
-        let desc = self;
-        let gbuffer = &desc.gbuffer;
+        let gbuffer = &self.gbuffer;
         gbuffer.check()?;
         require(Effect::Sss, gbuffer)?;
         let ids = gbuffer
             .material_ids
             .expect("missing() lists the material IDs");
-        if desc.materials.is_empty() || desc.materials.len() >= MAX_SSS_PROFILES {
+        if self.materials.is_empty() || self.materials.len() >= MAX_SSS_PROFILES {
             return Err(HostError::Description {
                 field: "materials".into(),
                 problem: format!(
                     "{} scattering materials; 1 to {} are supported",
-                    desc.materials.len(),
+                    self.materials.len(),
                     MAX_SSS_PROFILES - 1
                 ),
             }
@@ -286,8 +285,8 @@ impl SssEffectDesc {
         let units_per_mm = 1.0 / (1000.0 * gbuffer.metres_per_unit);
         let mut id_map = ids.decode(Vec::new())?;
         let mut profile_of = vec![0u8; 256];
-        let mut profiles = Vec::with_capacity(desc.materials.len());
-        for (index, material) in desc.materials.iter().enumerate() {
+        let mut profiles = Vec::with_capacity(self.materials.len());
+        for (index, material) in self.materials.iter().enumerate() {
             let field = format!("materials[{index}] (ID {})", material.id);
             if material.id == 0 || profile_of[usize::from(material.id)] != 0 {
                 return Err(HostError::Description {

@@ -7,21 +7,12 @@
 #ifndef LUCENT_LAYER_DEPTHS_GLSL
 #define LUCENT_LAYER_DEPTHS_GLSL
 
-// A texel as the f64 reference reads it (LayeredMedium::thickness_mm): NaN, infinite and
-// negative read 0 (a texture is data from a file), and fp16's largest finite value bounds it,
-// so packing never makes an infinity.
-vec4 sanitize_layer_texels(vec4 t) {
-    bvec4 bad = bvec4(isnan(t.x) || isinf(t.x), isnan(t.y) || isinf(t.y),
-                      isnan(t.z) || isinf(t.z), isnan(t.w) || isinf(t.w));
-    return clamp(mix(t, vec4(0.0), bad), vec4(0.0), vec4(65504.0));
-}
+#include "../embed/lucent_terms.glsl"
 
-// Texture 0's texels (layers 0-3) and texture 1's (layers 4-7) as the target stores them.
+// Texture 0's texels (layers 0-3) and texture 1's (layers 4-7) as the target stores them: the
+// packing a host's G-buffer pass writes too (glsl/embed/lucent_terms.glsl).
 uvec4 pack_layer_texels(vec4 first, vec4 second) {
-    first = sanitize_layer_texels(first);
-    second = sanitize_layer_texels(second);
-    return uvec4(packHalf2x16(first.xy), packHalf2x16(first.zw), packHalf2x16(second.xy),
-                 packHalf2x16(second.zw));
+    return lucent_pack_layer_texels(first, second);
 }
 
 // Layer j's texel (0 <= j < 8) from a packed target value.

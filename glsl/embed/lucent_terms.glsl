@@ -394,4 +394,25 @@ void lucent_view_plane_lean(mat3 view, vec3 n, vec3 t, vec3 bt, vec2 b_t, vec3 m
     m_v = clamp(m_v, vec3(0.0, 0.0, -60000.0), vec3(60000.0));
 }
 
+// Li et al.'s `TexDep` texels, packed as lucent reads them from a G-buffer texel
+// (`GBufferDesc::with_layer_depths`), for a host's G-buffer pass: `first` is the mesh's depth
+// texture 0 sampled at the pixel (layers 0-3 in r, g, b, a), `second` texture 1 (layers 4-7;
+// vec4(0) without one); two fp16 texels per 32-bit component, layer 2k in the low half of
+// component k. Write `.xy` to an R32G32_UINT target (one texture), all four to an
+// R32G32B32A32_UINT one. A texel as the f64 reference reads it (LayeredMedium::thickness_mm):
+// NaN, infinite and negative read 0 (a texture is data from a file), and fp16's largest finite
+// value bounds it, so packing never makes an infinity.
+vec4 lucent_sanitize_layer_texels(vec4 t) {
+    bvec4 bad = bvec4(isnan(t.x) || isinf(t.x), isnan(t.y) || isinf(t.y),
+                      isnan(t.z) || isinf(t.z), isnan(t.w) || isinf(t.w));
+    return clamp(mix(t, vec4(0.0), bad), vec4(0.0), vec4(65504.0));
+}
+
+uvec4 lucent_pack_layer_texels(vec4 first, vec4 second) {
+    first = lucent_sanitize_layer_texels(first);
+    second = lucent_sanitize_layer_texels(second);
+    return uvec4(packHalf2x16(first.xy), packHalf2x16(first.zw), packHalf2x16(second.xy),
+                 packHalf2x16(second.zw));
+}
+
 #endif

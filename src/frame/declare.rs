@@ -32,6 +32,8 @@ pub struct GBufferOutputs {
     pub lean: Option<ResourceId>,
     /// Li et al.'s layered material IDs (frames with layered media).
     pub layered: Option<ResourceId>,
+    /// The `TexDep` texels (frames whose layered media read depth textures).
+    pub layer_depths: Option<ResourceId>,
     /// Depth.
     pub depth: ResourceId,
     /// Its layout.
@@ -177,6 +179,7 @@ pub fn declare_frame(
             .chain(gb.sss.as_ref())
             .chain(gb.lean.as_ref())
             .chain(gb.layered.as_ref())
+            .chain(gb.layer_depths.as_ref())
         {
             graph.export_image(image, Access::TransferRead);
         }
@@ -187,6 +190,7 @@ pub fn declare_frame(
             sss: gb.sss.as_ref().map(|h| h.id()),
             lean: gb.lean.as_ref().map(|h| h.id()),
             layered: gb.layered.as_ref().map(|h| h.id()),
+            layer_depths: gb.layer_depths.as_ref().map(|h| h.id()),
             depth: gb.depth.id(),
             layout,
         }

@@ -53,6 +53,10 @@ pub struct GBufferReadback {
     /// (0: the pixel is not layered) and, in frames with the film, the film texel in green,
     /// blue and alpha.
     pub layered: Option<Vec<[f32; 4]>>,
+    /// The `TexDep` texels as stored (frames whose layered media read depth textures): the
+    /// bytes of the `R32G32_UINT` or `R32G32B32A32_UINT` target, two fp16 texels per 32-bit
+    /// component (glsl/common/layer_depths.glsl).
+    pub layer_depths: Option<Vec<u8>>,
     /// Device depth.
     pub depth: Vec<f32>,
     /// The layout the frame used.

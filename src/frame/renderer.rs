@@ -437,6 +437,11 @@ impl Renderer {
                 .transpose()?,
             lean: outputs.lean.map(read).transpose()?,
             layered: outputs.layered.map(read).transpose()?,
+            // Packed fp16 pairs: raw bytes (as f32 the integers would lose bits).
+            layer_depths: outputs
+                .layer_depths
+                .map(|id| self.read_export(gpu, id))
+                .transpose()?,
             depth: read(outputs.depth)?.into_iter().map(|t| t[0]).collect(),
             layout: outputs.layout,
         })

@@ -484,6 +484,22 @@ impl LayeredMedium {
     /// textures as the layers read; `eta` finite and > 0; weights finite and >= 0;
     /// `units_per_mm` finite and > 0. Errors name the layer and the key (`layer[0].g`).
     pub fn validate(&self) -> Result<()> {
+        self.validate_values()?;
+        let needed = self.depth_textures_needed();
+        if self.depth_textures.len() != needed {
+            return Err(LucentError::InvalidInput(format!(
+                "layered '{}': depth_texture: {} given, the layers read {needed} (layer i with \
+                 thickness \"texture\" reads channel i % 4 of texture i / 4)",
+                self.name,
+                self.depth_textures.len()
+            )));
+        }
+        Ok(())
+    }
+
+    /// [`Self::validate`] but for the depth textures' count: for a medium whose textures come
+    /// from elsewhere (a host engine's per mesh, `lucent::embed::MeshDraw`).
+    pub fn validate_values(&self) -> Result<()> {
         let bad = |m: String| {
             Err(LucentError::InvalidInput(format!(
                 "layered '{}': {m}",
@@ -528,14 +544,6 @@ impl LayeredMedium {
                 }
                 _ => {}
             }
-        }
-        let needed = self.depth_textures_needed();
-        if self.depth_textures.len() != needed {
-            return bad(format!(
-                "depth_texture: {} given, the layers read {needed} (layer i with thickness \
-                 \"texture\" reads channel i % 4 of texture i / 4)",
-                self.depth_textures.len()
-            ));
         }
         if !(self.eta.is_finite() && self.eta > 0.0) {
             return bad(format!("eta {} must be finite and > 0", self.eta));

@@ -2867,6 +2867,7 @@ fn record_frame(
                     normals: &normals,
                     material_ids: &ids,
                     albedo: None,
+                    layer_depths: None,
                 },
                 regions: &layered_region(&camera, extent, effects.whole_screen),
                 lighting: &lighting,

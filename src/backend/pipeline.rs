@@ -77,6 +77,9 @@ pub struct HostVertexInput {
     pub position: (u32, vk::Format, u32),
     /// The normal: its binding, format and byte offset in a vertex.
     pub normal: (u32, vk::Format, u32),
+    /// The texture coordinate, when the pass reads one (location 3, as lucent's own surface
+    /// stream has it): its binding, format and byte offset in a vertex.
+    pub uv: Option<(u32, vk::Format, u32)>,
 }
 
 /// Everything that differs between lucent's graphics pipelines.
@@ -268,6 +271,9 @@ impl GraphicsPipeline {
                 [host.position, host.normal].into_iter().enumerate()
             {
                 vertex_attributes.push(attribute(location as u32, stream, format, offset));
+            }
+            if let Some((stream, format, offset)) = host.uv {
+                vertex_attributes.push(attribute(3, stream, format, offset));
             }
         }
         if let VertexInput::Positions = desc.vertex_input {

@@ -28,14 +28,19 @@
 //!
 //! A host with an albedo image may use it as the layered materials' film
 //! ([`LayeredEffectDesc::with_film`]: lucent's `post` texturing of a layered material, the
-//! albedo texture multiplying the light leaving the surface). Not embedded (refused by name):
-//! layers whose thickness is read from a depth texture (`TexDep`).
+//! albedo texture multiplying the light leaving the surface). Layers whose thickness is read
+//! from depth textures (Li et al.'s `TexDep`) take the texels at each pixel from the host's
+//! G-buffer ([`GBufferDesc::with_layer_depths`], written with TERMS'
+//! `lucent_pack_layer_texels`) and, at each light's entry point, from each mesh's own
+//! textures ([`MeshDraw::with_depth_textures`], read at [`VertexLayout::uv`]) in lucent's
+//! light-space maps (`super::depth_textures`: a set per distinct pair, per frame).
 
 use std::sync::{Arc, Mutex};
 
 use ash::vk;
 use glam::Mat4;
 
+use super::depth_textures::DepthTextureSets;
 use super::image::{distinct_inputs, HostImage, Role};
 use super::passes::{
     check_described, check_environment, check_lights, check_material_id, check_views, depth_role,
@@ -55,7 +60,8 @@ use crate::features::layered::{
     LayeredKnobs, LayeredTableGpu, MAX_LAYERED_MATERIALS, TABLE_REGION,
 };
 use crate::features::shadows::{
-    self, host_shadow_pass, HostShadowDraw, HostShadowFrame, ShadowUniforms, MAX_ATLAS_EXTENT,
+    self, host_shadow_pass, HostDepthTextures, HostShadowDraw, HostShadowFrame, ShadowUniforms,
+    MAX_ATLAS_EXTENT,
 };
 use crate::gpu_scene::{SceneGpu, SceneUpload, TableRegion, TileRect, FRAME};
 use crate::graph::{RenderGraph, ResourceId};
@@ -109,7 +115,8 @@ impl VertexAttribute {
 }
 
 /// How the host's vertex buffers hold the positions and normals lucent draws its light-space
-/// maps with: up to two bindings (a stride each; 0: unused) and where each attribute is.
+/// maps with (and, for depth textures, the texture coordinate): up to two bindings (a stride
+/// each; 0: unused) and where each attribute is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct VertexLayout {
@@ -119,6 +126,11 @@ pub struct VertexLayout {
     pub position: VertexAttribute,
     /// The object-space normal (outward; it need not be unit length).
     pub normal: VertexAttribute,
+    /// The texture coordinate where the mesh's depth textures are read, for layered
+    /// materials whose layers read their thickness from them (Li et al.'s `TexDep`;
+    /// [`MeshDraw::with_depth_textures`]): `R32G32_SFLOAT`, `R16G16_SFLOAT` or
+    /// `R16G16_UNORM`. `None`: no mesh has depth textures.
+    pub uv: Option<VertexAttribute>,
 }
 
 impl VertexLayout {
@@ -130,6 +142,7 @@ impl VertexLayout {
             strides: [stride, 0],
             position: VertexAttribute::new(0, vec3, position_offset),
             normal: VertexAttribute::new(0, vec3, normal_offset),
+            uv: None,
         }
     }
 
@@ -139,7 +152,14 @@ impl VertexLayout {
             strides,
             position,
             normal,
+            uv: None,
         }
+    }
+
+    /// With the texture coordinate the meshes' depth textures are read at.
+    pub fn with_uv(mut self, uv: VertexAttribute) -> Self {
+        self.uv = Some(uv);
+        self
     }
 
     /// The layout as the pipeline takes it, each attribute checked: in a used binding, within
@@ -172,12 +192,18 @@ impl VertexLayout {
             (vk::Format::R16G16B16A16_SNORM, 8),
             (vk::Format::A2B10G10R10_SNORM_PACK32, 4),
         ];
-        let mut attributes = [(0, vec3, 0); 2];
+        let uvs = [
+            (vk::Format::R32G32_SFLOAT, 8),
+            (vk::Format::R16G16_SFLOAT, 4),
+            (vk::Format::R16G16_UNORM, 4),
+        ];
+        let mut attributes = [(0, vec3, 0); 3];
         for (k, (name, attribute, accepted)) in [
             ("vertices.position", self.position, &positions[..]),
             ("vertices.normal", self.normal, &normals[..]),
         ]
         .into_iter()
+        .chain(self.uv.map(|uv| ("vertices.uv", uv, &uvs[..])))
         .enumerate()
         {
             let names: Vec<String> = accepted.iter().map(|&(f, _)| format_name(f)).collect();
@@ -228,6 +254,7 @@ impl VertexLayout {
             strides: self.strides,
             position: attributes[0],
             normal: attributes[1],
+            uv: self.uv.map(|_| attributes[2]),
         })
     }
 }
@@ -331,6 +358,13 @@ pub struct MeshDraw {
     /// of a frame has one, the term's blur draws only over the meshes whose medium it acts on
     /// at their distance, as in lucent's own frames, instead of over every layered region.
     pub bounds: Option<(glam::Vec3, glam::Vec3)>,
+    /// The mesh's depth textures, for a material whose layers read their thickness from
+    /// them (Li et al.'s `TexDep`: layer `i` reads channel `i % 4` of texture `i / 4`, at
+    /// the layout's [`VertexLayout::uv`]): views of sampled images in
+    /// `SHADER_READ_ONLY_OPTIMAL`, written before the frame's submission and valid until it
+    /// completes; the second null when the medium reads one. Required for such a material,
+    /// refused for any other.
+    pub depth_textures: Option<[vk::ImageView; 2]>,
 }
 
 impl MeshDraw {
@@ -346,7 +380,18 @@ impl MeshDraw {
             transform,
             material_id,
             bounds: None,
+            depth_textures: None,
         }
+    }
+
+    /// This draw with its depth textures (`second`: for a medium with more than four layers).
+    pub fn with_depth_textures(
+        mut self,
+        first: vk::ImageView,
+        second: Option<vk::ImageView>,
+    ) -> Self {
+        self.depth_textures = Some([first, second.unwrap_or_default()]);
+        self
     }
 
     /// This draw with its object-space bounding box.
@@ -381,6 +426,9 @@ pub struct LayeredImages<'a> {
     /// The albedo, the layered materials' film: required with
     /// [`LayeredEffectDesc::with_film`], refused without.
     pub albedo: Option<&'a HostImage>,
+    /// The `TexDep` texels ([`GBufferDesc::with_layer_depths`]): required when a material's
+    /// layers read their thickness from depth textures, refused otherwise.
+    pub layer_depths: Option<&'a HostImage>,
 }
 
 /// One view of one frame: what [`LayeredEffect::record`] reads and adds to.
@@ -421,6 +469,7 @@ struct Imports {
     normals: ResourceId,
     material_ids: ResourceId,
     albedo: Option<ResourceId>,
+    layer_depths: Option<ResourceId>,
     lighting: ResourceId,
 }
 
@@ -435,6 +484,10 @@ pub struct LayeredEffect {
     media: Vec<LayeredMedium>,
     /// What the light-space maps pass draws: filled just before each frame records.
     shadow_frame: Arc<Mutex<HostShadowFrame>>,
+    /// With media whose layers read depth textures: the draws' sets of them.
+    depth_sets: Option<DepthTextureSets>,
+    /// Depth textures the media read (0 to 2): the most any medium needs.
+    depth_textures: usize,
 }
 
 impl LayeredEffect {
@@ -498,21 +551,36 @@ impl LayeredEffect {
                 units_per_mm,
                 ..material.medium.clone()
             };
-            if medium.depth_textures_needed() > 0 {
-                return Err(HostError::Unsupported {
-                    input: field,
-                    found: "a layer whose thickness is read from a depth texture (TexDep)".into(),
-                    accepted: "layers of a constant thickness in mm, and the rest of the object"
+            if !medium.depth_textures.is_empty() {
+                return Err(HostError::Description {
+                    field: format!("{field}.medium.depth_textures"),
+                    problem: "a host gives each mesh's own depth textures \
+                              (MeshDraw::with_depth_textures): leave the medium's list empty"
                         .into(),
                 }
                 .into());
             }
-            medium.validate().map_err(|e| HostError::Description {
-                field: field.clone(),
-                problem: e.to_string(),
-            })?;
+            medium
+                .validate_values()
+                .map_err(|e| HostError::Description {
+                    field: field.clone(),
+                    problem: e.to_string(),
+                })?;
             id_materials[id / 4][id % 4] = index as u32 + 1;
             media.push(medium);
+        }
+        let depth_textures = media
+            .iter()
+            .map(LayeredMedium::depth_textures_needed)
+            .max()
+            .unwrap_or(0);
+        if depth_textures > 0 {
+            check_texture_layers(gbuffer, &desc.vertices, depth_textures)?;
+        }
+        let mut input = input;
+        if depth_textures == 0 {
+            // Nothing reads the texture coordinate: the pipeline does not fetch it.
+            input.uv = None;
         }
         let uint_ids = id_map.uint;
         let (host_ids, _) = id_map.rows();
@@ -545,7 +613,16 @@ impl LayeredEffect {
             layer_depth_textures: 0,
         };
         let shadow_frame = Arc::new(Mutex::new(HostShadowFrame::default()));
-        let (passes, imports) = EffectPasses::new(
+        let rings = lucent.frames_in_flight() * desc.views_per_frame;
+        let depth_sets = (depth_textures > 0)
+            .then(|| {
+                uploads.record(lucent, "LayeredEffect", || {
+                    DepthTextureSets::new(lucent.gpu(), depth_textures, rings)
+                })
+            })
+            .transpose()?;
+        let host_depth = depth_sets.as_ref().map(|s| s.host_depth_textures());
+        let built = EffectPasses::new(
             lucent,
             uploads,
             "LayeredEffect",
@@ -557,11 +634,20 @@ impl LayeredEffect {
                     uint_ids,
                     decode,
                     input,
-                    shadow_frame.clone(),
+                    (shadow_frame.clone(), host_depth),
                     scene_gpu,
                 )
             },
-        )?;
+        );
+        let (passes, imports) = match built {
+            Ok(built) => built,
+            Err(e) => {
+                if let Some(sets) = depth_sets {
+                    sets.destroy(lucent.gpu());
+                }
+                return Err(e);
+            }
+        };
         Ok(Self {
             passes,
             imports,
@@ -569,12 +655,24 @@ impl LayeredEffect {
             table,
             media: layered.materials,
             shadow_frame,
+            depth_sets,
+            depth_textures,
         })
+    }
+
+    /// Destroys the passes, their buffers and the draws' depth-texture sets. The GPU must be
+    /// done with every frame that recorded the effect.
+    pub fn destroy(self, lucent: &Lucent) {
+        if let Some(sets) = self.depth_sets {
+            sets.destroy(lucent.gpu());
+        }
+        self.passes.destroy(lucent);
     }
 
     super::passes::effect_methods!(
         LayeredFrame,
-        "`frame.meshes` drawn into lucent's light-space maps with `frame.light_faces`, then Li et al.'s transmitted, single and multiple scattering terms of the layered materials added to `frame.lighting`"
+        "`frame.meshes` drawn into lucent's light-space maps with `frame.light_faces`, then Li et al.'s transmitted, single and multiple scattering terms of the layered materials added to `frame.lighting`",
+        own_destroy
     );
 
     fn record_with(
@@ -597,7 +695,16 @@ impl LayeredEffect {
             frame.light_faces,
             &[(self.desc.light_space, 1)],
         )?;
-        let draws = self.draws(frame.meshes)?;
+        let mut draws = self.draws(frame.meshes)?;
+        if let Some(sets) = &mut self.depth_sets {
+            let textures: Vec<Option<[vk::ImageView; 2]>> =
+                frame.meshes.iter().map(|m| m.depth_textures).collect();
+            let table = self.passes.per_frame().binding(&shadows::TABLE_REGION);
+            let written = sets.write(lucent.gpu(), ring, table, &textures)?;
+            for (draw, set) in draws.iter_mut().zip(written) {
+                draw.depth_set = set;
+            }
+        }
         let gbuffer = &self.desc.gbuffer;
         let uniforms = gbuffer
             .view_uniforms(&frame.camera)?
@@ -636,6 +743,9 @@ impl LayeredEffect {
         ];
         if let (Some(id), Some(albedo)) = (self.imports.albedo, images.albedo) {
             binds.push((id, albedo));
+        }
+        if let (Some(id), Some(depths)) = (self.imports.layer_depths, images.layer_depths) {
+            binds.push((id, depths));
         }
         self.passes.record(
             lucent,
@@ -743,6 +853,41 @@ impl LayeredEffect {
                     Some(i) => Some((i.buffer, i.offset, i.index_type)),
                 };
                 let id = usize::from(mesh.material_id);
+                let layered_id = self.table.id_materials[id / 4][id % 4] as u8;
+                let reads = usize::from(layered_id)
+                    .checked_sub(1)
+                    .and_then(|k| self.media.get(k))
+                    .map_or(0, LayeredMedium::depth_textures_needed);
+                match (reads, mesh.depth_textures) {
+                    (0, None) => {}
+                    (0, Some(_)) => {
+                        return Err(bad(&format!(
+                            "depth textures given, but material ID {} has no layer that reads \
+                             its thickness from one: pass none",
+                            mesh.material_id
+                        )))
+                    }
+                    (_, None) => {
+                        return Err(HostError::Missing {
+                            input: format!("meshes[{index}].depth_textures"),
+                            needed_by: format!(
+                                "material ID {}'s layers read their thickness from {reads} depth \
+                                 texture(s) (MeshDraw::with_depth_textures)",
+                                mesh.material_id
+                            ),
+                        }
+                        .into())
+                    }
+                    (_, Some(views)) => {
+                        if views[..reads].contains(&vk::ImageView::null()) {
+                            return Err(bad(&format!(
+                                "material ID {} reads {reads} depth texture(s); a view given \
+                                 is null",
+                                mesh.material_id
+                            )));
+                        }
+                    }
+                }
                 Ok(HostShadowDraw {
                     vertex_buffers: mesh.vertex_buffers,
                     indices,
@@ -750,7 +895,8 @@ impl LayeredEffect {
                     first: mesh.first,
                     vertex_offset: mesh.vertex_offset,
                     model: mesh.transform,
-                    layered_id: self.table.id_materials[id / 4][id % 4] as u8,
+                    layered_id,
+                    depth_set: vk::DescriptorSet::null(),
                 })
             })
             .collect()
@@ -809,14 +955,78 @@ impl LayeredEffect {
         if let (Some(albedo), Some(format)) = (albedo, gbuffer.albedo) {
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
+        let layer_depths = match (self.depth_textures > 0, images.layer_depths) {
+            (true, Some(depths)) => Some(depths),
+            (false, None) => None,
+            (true, None) => {
+                return Err(HostError::Missing {
+                    input: "layer depths".into(),
+                    needed_by: "a layered material's layers read their thickness from depth \
+                                textures (the G-buffer's TexDep texels)"
+                        .into(),
+                }
+                .into())
+            }
+            (false, Some(_)) => {
+                return Err(HostError::Description {
+                    field: "layer_depths".into(),
+                    problem: "given, but no layered material reads depth textures: pass None"
+                        .into(),
+                }
+                .into())
+            }
+        };
+        if let (Some(depths), Some(format)) = (layer_depths, gbuffer.layer_depths) {
+            checks.push((depths, "layer depths", Role::SampledColor, format));
+        }
         check_described(lucent, gbuffer.extent(), &checks)?;
         distinct_inputs(
             [images.depth, images.normals, images.material_ids]
                 .into_iter()
-                .chain(albedo),
+                .chain(albedo)
+                .chain(layer_depths),
             frame.lighting,
         )
     }
+}
+
+/// What media whose layers read depth textures need of the host: the G-buffer's `TexDep`
+/// texels for `textures` depth textures, and the texture coordinate in its vertices.
+fn check_texture_layers(
+    gbuffer: &GBufferDesc,
+    vertices: &VertexLayout,
+    textures: usize,
+) -> Result<()> {
+    let reason = format!(
+        "a layered material's layers read their thickness from {textures} depth texture(s) \
+         (Li et al.'s TexDep)"
+    );
+    if gbuffer.layer_depths.is_none() {
+        return Err(HostError::Missing {
+            input: "layer depths".into(),
+            needed_by: format!("{reason}: GBufferDesc::with_layer_depths"),
+        }
+        .into());
+    }
+    if gbuffer.layer_depth_textures() < textures {
+        return Err(HostError::Unsupported {
+            input: "layer depths".into(),
+            found: "R32G32_UINT (one texture's four layers)".into(),
+            accepted: format!("R32G32B32A32_UINT (two textures' eight layers): {reason}"),
+        }
+        .into());
+    }
+    if vertices.uv.is_none() {
+        return Err(HostError::Missing {
+            input: "vertices.uv".into(),
+            needed_by: format!(
+                "{reason}: lucent reads them in its light-space maps at the meshes' texture \
+                 coordinate (VertexLayout::with_uv)"
+            ),
+        }
+        .into());
+    }
+    Ok(())
 }
 
 /// Each face's tile (origin, edge) in face order, from the checked shadow table.
@@ -834,7 +1044,7 @@ fn declare(
     uint_ids: bool,
     decode: LayeredDecode,
     input: HostVertexInput,
-    shadow_frame: Arc<Mutex<HostShadowFrame>>,
+    (shadow_frame, depth_textures): (Arc<Mutex<HostShadowFrame>>, Option<HostDepthTextures>),
     scene_gpu: &Arc<SceneGpu>,
 ) -> (RenderGraph, Imports) {
     let gbuffer = &desc.gbuffer;
@@ -855,6 +1065,13 @@ fn declare(
             sampled,
         )
     });
+    let layer_depths = depth_textures.map(|_| {
+        import(
+            "host layer depths",
+            gbuffer.layer_depths.expect("checked at new"),
+            sampled,
+        )
+    });
     let lighting = import(
         "host lighting",
         gbuffer.diffuse.format,
@@ -865,16 +1082,24 @@ fn declare(
         normals: normals.id(),
         material_ids: material_ids.id(),
         albedo: albedo.as_ref().map(|a| a.id()),
+        layer_depths: layer_depths.as_ref().map(|a| a.id()),
         lighting: lighting.id(),
     };
     let extent = (desc.light_space.width, desc.light_space.height);
-    let maps = host_shadow_pass(&mut graph, extent, input, shadow_frame, scene_gpu);
+    let maps = host_shadow_pass(
+        &mut graph,
+        extent,
+        input,
+        shadow_frame,
+        scene_gpu,
+        depth_textures,
+    );
     let inputs = LayeredInputs {
         depth: &depth,
         gb1: &normals,
         ids: &material_ids,
-        layer_depths: None,
-        layer_depth_textures: 0,
+        layer_depths: layer_depths.as_ref(),
+        layer_depth_textures: depth_textures.map_or(0, |d| d.textures),
         shadows: Some(&maps),
         film: desc.film,
         host: Some(LayeredHost {

@@ -26,7 +26,8 @@
 //! - [`LayeredEffect`]: Li et al.'s layered media (transmitted light, single scattering along
 //!   the refracted view ray, the dipole's multiple scattering) added to the host's lit
 //!   diffuse; lucent draws its light-space maps from the host's own vertex and index buffers
-//!   ([`VertexLayout`], [`MeshDraw`]) with the faces the host gives ([`ShadowFace`]).
+//!   ([`VertexLayout`], [`MeshDraw`]) with the faces the host gives ([`ShadowFace`]), and
+//!   reads layers' thicknesses from each mesh's depth textures where a medium asks.
 //! - [`glsl::TERMS`]: the environment's, GDC 2011's and the transmission's terms as GLSL for
 //!   the host's own lighting pass, with no pass of their own (docs/embedding.md measures
 //!   what each costs there), and the LEAN texel a host's G-buffer pass writes for the LEAN
@@ -163,6 +164,7 @@ use crate::backend::GpuContext;
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
+mod depth_textures;
 mod environment;
 pub mod glsl;
 mod image;
@@ -268,7 +270,10 @@ pub use glam;
 /// their sum of Gaussians in the shader), and `requirements().optional` no longer lists it.
 /// 15: a host's own allocator ([`EmbedOptions::memory`], [`HostAllocator`]), errors
 /// `LucentError::HostAllocation` and [`HostError::Memory`]; a failed build leaves its
-/// [`Uploads`]' command buffer valid to submit.
+/// [`Uploads`]' command buffer valid to submit; [`LayeredEffect`] takes media whose layers
+/// read depth textures ([`LayeredImages::layer_depths`], a new field of a frame struct;
+/// [`GBufferDesc::with_layer_depths`], [`VertexLayout::with_uv`],
+/// [`MeshDraw::with_depth_textures`], TERMS' `lucent_pack_layer_texels`).
 pub const API_VERSION: u32 = 15;
 
 /// Most frames in flight a renderer keeps per-frame parameters for.

@@ -20,9 +20,20 @@ use crate::Result;
 
 /// The public methods every effect has alike, over its `passes` ([`EffectPasses`]) and its
 /// own `record_with(lucent, cmd, frame, timer)`: `plan`, `record` (documented with `$does`,
-/// what one frame's recording does), `record_timed` and `destroy`.
+/// what one frame's recording does), `record_timed`, `memory` and (unless `own_destroy`)
+/// `destroy`.
 macro_rules! effect_methods {
     ($frame:ident, $does:literal) => {
+        $crate::embed::passes::effect_methods!($frame, $does, own_destroy);
+
+        /// Destroys the passes and their buffers. The GPU must be done with every frame that
+        /// recorded them (the host's fences).
+        pub fn destroy(self, lucent: &Lucent) {
+            self.passes.destroy(lucent);
+        }
+    };
+    // An effect with more to destroy than its passes writes its own `destroy`.
+    ($frame:ident, $does:literal, own_destroy) => {
         /// The passes the effect records (their plan, for lucent's tables and tests): an
         /// internal type, only with the `internals` feature ([`Self::record_timed`] names
         /// each pass with its time).
@@ -66,12 +77,6 @@ macro_rules! effect_methods {
         /// built, freed by [`Self::destroy`]; recording allocates nothing.
         pub fn memory(&self) -> super::EffectMemory {
             self.passes.memory()
-        }
-
-        /// Destroys the passes and their buffers. The GPU must be done with every frame that
-        /// recorded them (the host's fences).
-        pub fn destroy(self, lucent: &Lucent) {
-            self.passes.destroy(lucent);
         }
     };
 }

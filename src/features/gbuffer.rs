@@ -247,6 +247,9 @@ impl GBufferLayout {
                 ThicknessPacking::Colored => ThicknessDesc::rgb(format),
             });
         }
+        if let Some(format) = layer_depth_format(self.layer_depth_textures).filter(|_| self.layer_depths()) {
+            desc = desc.with_layer_depths(format);
+        }
         if self.lean {
             desc = desc.with_lean_targets(LeanTargetsDesc::new(
                 LEAN_FORMAT,

@@ -621,6 +621,12 @@ pub struct GBufferDesc {
     /// bilateral blur read them instead of building them from the normals); the lit
     /// diffuse's alpha then holds the LEAN slope x ([`LeanTargetsDesc`]).
     pub lean_targets: Option<LeanTargetsDesc>,
+    /// Li et al.'s `TexDep` texels at each pixel, when the host's layered materials read
+    /// layer thicknesses from depth textures: its G-buffer pass samples each mesh's depth
+    /// textures (one per four layers) and writes them packed as [`crate::embed::glsl::TERMS`]'
+    /// `lucent_pack_layer_texels` does, `R32G32_UINT` for one texture (four layers) or
+    /// `R32G32B32A32_UINT` for two (eight).
+    pub layer_depths: Option<vk::Format>,
     /// The size of the host's world unit in metres (1: metres, 0.01: centimetres): the SSS
     /// profiles' millimetres are converted with it. Finite, above 0 and at most
     /// [`MAX_METRES_PER_UNIT`].
@@ -661,6 +667,7 @@ impl GBufferDesc {
             normals: None,
             thickness: None,
             lean_targets: None,
+            layer_depths: None,
             metres_per_unit: 1.0,
         }
     }
@@ -700,6 +707,22 @@ impl GBufferDesc {
     pub fn with_lean_targets(mut self, targets: LeanTargetsDesc) -> Self {
         self.lean_targets = Some(targets);
         self
+    }
+
+    /// With the `TexDep` texels image (`R32G32_UINT`: one depth texture's four layers;
+    /// `R32G32B32A32_UINT`: two textures', eight layers).
+    pub fn with_layer_depths(mut self, format: vk::Format) -> Self {
+        self.layer_depths = Some(format);
+        self
+    }
+
+    /// How many depth textures' texels [`Self::layer_depths`] holds (0 without it).
+    pub fn layer_depth_textures(&self) -> usize {
+        match self.layer_depths {
+            Some(vk::Format::R32G32B32A32_UINT) => 2,
+            Some(_) => 1,
+            None => 0,
+        }
     }
 
     /// With the world unit's size in metres.
@@ -804,6 +827,22 @@ impl GBufferDesc {
         }
         if let Some(thickness) = &self.thickness {
             thickness.decode()?;
+        }
+        if let Some(format) = self.layer_depths {
+            if !matches!(
+                format,
+                vk::Format::R32G32_UINT | vk::Format::R32G32B32A32_UINT
+            ) {
+                return Err(HostError::Unsupported {
+                    input: "layer depths".into(),
+                    found: format!("format {}", format_name(format)),
+                    accepted: "R32G32_UINT (one depth texture's four layers) or \
+                               R32G32B32A32_UINT (two textures', eight layers), packed as \
+                               lucent_pack_layer_texels writes them"
+                        .into(),
+                }
+                .into());
+            }
         }
         if let Some(targets) = &self.lean_targets {
             targets.check()?;

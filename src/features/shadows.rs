@@ -626,7 +626,9 @@ impl PassExec for ShadowPass {
 /// One draw of a host's mesh into the light-space maps ([`host_shadow_pass`]): its vertex
 /// buffers (bindings 0 and 1 of the host's layout, each with its byte offset), its index
 /// buffer (with offset and type; `None`: a non-indexed draw), how many indices (or vertices)
-/// from which first one, the model matrix and its layered material ID (0: it only casts).
+/// from which first one, the model matrix, its layered material ID (0: it only casts) and,
+/// when the maps store `TexDep` texels, the set of [`HostDepthTextures::layout`] binding the
+/// maps' table and its depth textures (null otherwise).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct HostShadowDraw {
     pub vertex_buffers: [(vk::Buffer, vk::DeviceSize); 2],
@@ -636,6 +638,40 @@ pub(crate) struct HostShadowDraw {
     pub vertex_offset: i32,
     pub model: Mat4,
     pub layered_id: u8,
+    pub depth_set: vk::DescriptorSet,
+}
+
+/// The light-space maps of a host's meshes store Li et al.'s `TexDep` texels at each entry
+/// point, read from each draw's own depth textures: the pass's set 0 is laid out as
+/// [`HostDepthTextures::bindings`] says (the maps' table, then `textures` sampled textures),
+/// and every draw binds its own set of that layout ([`HostShadowDraw::depth_set`], written by
+/// the effect before the frame records).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HostDepthTextures {
+    /// The layout of every draw's set.
+    pub layout: vk::DescriptorSetLayout,
+    /// Depth textures per draw (1 or 2).
+    pub textures: usize,
+}
+
+impl HostDepthTextures {
+    /// Set 0's bindings in order (glsl/shadow/depth.frag names them): the maps' table (a
+    /// per-frame uniform), then `depth_map0` and, with two textures, `depth_map1`.
+    pub fn bindings(textures: usize) -> Vec<crate::backend::bindings::SetBinding<'static>> {
+        use crate::backend::bindings::SetBinding;
+        let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+        let mut bindings = vec![SetBinding {
+            name: Some(TABLE_REGION.block),
+            kind: vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
+        }];
+        for name in ["depth_map0", "depth_map1"].into_iter().take(textures.clamp(1, 2)) {
+            bindings.push(SetBinding {
+                name: Some(name),
+                kind: sampled,
+            });
+        }
+        bindings
+    }
 }
 
 /// What [`host_shadow_pass`] draws in the frame being recorded: each face's square tile
@@ -652,12 +688,16 @@ pub(crate) struct HostShadowFrame {
 /// layered material), drawn with the same shaders as lucent's own maps from the host's vertex
 /// and index buffers laid out as `input` says, the draws and faces `frame` holds when the
 /// pass records. Its table is the shadow table region, as lucent's own.
+///
+/// With `depth_textures`, the maps also store each entry point's `TexDep` texels from the
+/// draws' own depth textures, read at the layout's texture coordinate.
 pub(crate) fn host_shadow_pass(
     graph: &mut RenderGraph,
     (width, height): (u32, u32),
     input: crate::backend::pipeline::HostVertexInput,
     frame: Arc<std::sync::Mutex<HostShadowFrame>>,
     scene: &Arc<SceneGpu>,
+    depth_textures: Option<HostDepthTextures>,
 ) -> ShadowMaps {
     let info = |format| ImageInfo {
         width,
@@ -668,7 +708,9 @@ pub(crate) fn host_shadow_pass(
         depth: graph.create_image("light-space.depth", info(SHADOW_DEPTH_FORMAT)),
         ids: None,
         entry: Some(graph.create_image("light-space.entry", info(ENTRY_FORMAT))),
-        layer_depths: None,
+        layer_depths: depth_textures
+            .and_then(|d| super::layer_depth::layer_depth_format(d.textures))
+            .map(|format| graph.create_image("light-space.layer-depth", info(format))),
     };
     let mut pass = graph.add_pass("light-space maps", PassKind::Raster);
     if let Some(entry) = &mut maps.entry {
@@ -676,11 +718,16 @@ pub(crate) fn host_shadow_pass(
         // surface was drawn.
         pass.color(entry, LoadOp::DontCare);
     }
+    if let Some(depths) = &mut maps.layer_depths {
+        // The same: read only where the entry is a surface's.
+        pass.color(depths, LoadOp::DontCare);
+    }
     pass.depth(&mut maps.depth, LoadOp::Clear([1.0; 4]));
     pass.execute(HostShadowPass {
         scene: scene.clone(),
         input,
         frame,
+        depth_textures,
         pipeline: None,
     });
     maps
@@ -690,34 +737,68 @@ struct HostShadowPass {
     scene: Arc<SceneGpu>,
     input: crate::backend::pipeline::HostVertexInput,
     frame: Arc<std::sync::Mutex<HostShadowFrame>>,
-    pipeline: Option<PassPipeline>,
+    depth_textures: Option<HostDepthTextures>,
+    pipeline: Option<HostShadowPipeline>,
+}
+
+/// The host maps pass's pipeline: with its own set (the maps' table), or laid out for the
+/// draws' sets of depth textures.
+enum HostShadowPipeline {
+    Plain(PassPipeline),
+    DepthTextures(crate::backend::pipeline::GraphicsPipeline),
+}
+
+impl HostShadowPipeline {
+    fn layout(&self) -> vk::PipelineLayout {
+        match self {
+            HostShadowPipeline::Plain(p) => p.pipeline.layout,
+            HostShadowPipeline::DepthTextures(p) => p.layout,
+        }
+    }
 }
 
 impl PassExec for HostShadowPass {
     fn prepare(&mut self, ctx: &PrepareContext<'_>) -> Result<()> {
-        let defines = shadow_map_defines(false, true, 0);
-        self.pipeline = Some(PassPipeline::new(
-            ctx,
-            &[(
-                TABLE_REGION.block,
-                Binding::PerFrame(self.scene.per_frame.binding(&TABLE_REGION)),
-            )],
-            &GraphicsPipelineDesc {
-                vertex: SHADOW_VERTEX,
-                fragment: SHADOW_FRAGMENT,
-                defines: &defines,
-                vertex_input: VertexInput::Host(self.input),
-                depth_test: true,
-                // Open meshes cast from both sides, as in lucent's own maps.
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                bindings: &[],
-                push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
-                specialization: &[],
-                name: "light-space maps",
-            },
-        )?);
+        let textures = self.depth_textures.map_or(0, |d| d.textures);
+        let defines = shadow_map_defines(false, true, textures);
+        let input = VertexInput::Host(self.input);
+        let desc = GraphicsPipelineDesc {
+            vertex: SHADOW_VERTEX,
+            fragment: SHADOW_FRAGMENT,
+            defines: &defines,
+            vertex_input: input,
+            depth_test: true,
+            // Open meshes cast from both sides, as in lucent's own maps.
+            cull_back: false,
+            additive_attachments: 0,
+            set_layouts: &[],
+            bindings: &[],
+            push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+            specialization: &[],
+            name: "light-space maps",
+        };
+        self.pipeline = Some(match self.depth_textures {
+            None => HostShadowPipeline::Plain(PassPipeline::new(
+                ctx,
+                &[(
+                    TABLE_REGION.block,
+                    Binding::PerFrame(self.scene.per_frame.binding(&TABLE_REGION)),
+                )],
+                &desc,
+            )?),
+            Some(depth) => {
+                let layouts = [depth.layout];
+                let bindings = HostDepthTextures::bindings(depth.textures);
+                HostShadowPipeline::DepthTextures(crate::backend::pipeline::GraphicsPipeline::new(
+                    ctx,
+                    &GraphicsPipelineDesc {
+                        set_layouts: &layouts,
+                        bindings: &bindings,
+                        ..desc
+                    },
+                )?)
+            }
+        });
         Ok(())
     }
 
@@ -730,12 +811,42 @@ impl PassExec for HostShadowPass {
         let Ok(frame) = self.frame.lock() else {
             return;
         };
-        pipeline.bind(ctx);
         let device = &ctx.gpu.device;
+        match pipeline {
+            HostShadowPipeline::Plain(p) => p.bind(ctx),
+            // SAFETY: the pipeline is alive; the executor began this pass's subpass.
+            HostShadowPipeline::DepthTextures(p) => unsafe {
+                device.cmd_bind_pipeline(ctx.cmd, vk::PipelineBindPoint::GRAPHICS, p.pipeline);
+            },
+        }
+        let layout = pipeline.layout();
+        // The draws' sets bind the table at the recorded slot, as a pass's own set does.
+        let table_offset = [(self.scene.per_frame.binding(&TABLE_REGION).stride
+            * ctx.frame as u64) as u32];
         let streams = 1 + usize::from(self.input.strides[1] > 0);
+        // Bindings outlast the viewport changes between faces.
+        let mut bound = vk::DescriptorSet::null();
         for (face, &(origin, edge)) in frame.tiles.iter().enumerate() {
             super::util::set_tile_viewport(ctx, origin, edge);
             for draw in &frame.draws {
+                if matches!(pipeline, HostShadowPipeline::DepthTextures(_))
+                    && draw.depth_set != bound
+                {
+                    // SAFETY: the draw's set was written for this frame's slot with this
+                    // pipeline's set layout (LayeredEffect) and lives until the slot records
+                    // again.
+                    unsafe {
+                        device.cmd_bind_descriptor_sets(
+                            ctx.cmd,
+                            vk::PipelineBindPoint::GRAPHICS,
+                            layout,
+                            0,
+                            &[draw.depth_set],
+                            &table_offset,
+                        );
+                    }
+                    bound = draw.depth_set;
+                }
                 let constants = ShadowConstants {
                     model: draw.model.to_cols_array_2d(),
                     face_id: [face as i32, 0, i32::from(draw.layered_id), 0],
@@ -747,7 +858,7 @@ impl PassExec for HostShadowPass {
                 unsafe {
                     device.cmd_push_constants(
                         ctx.cmd,
-                        pipeline.pipeline.layout,
+                        layout,
                         vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                         0,
                         bytemuck::bytes_of(&constants),
@@ -778,8 +889,10 @@ impl PassExec for HostShadowPass {
     }
 
     fn destroy(&mut self, gpu: &crate::backend::GpuContext) {
-        if let Some(mut p) = self.pipeline.take() {
-            p.destroy(&gpu.device);
+        match self.pipeline.take() {
+            Some(HostShadowPipeline::Plain(mut p)) => p.destroy(&gpu.device),
+            Some(HostShadowPipeline::DepthTextures(mut p)) => p.destroy(&gpu.device),
+            None => {}
         }
     }
 }

@@ -396,7 +396,7 @@ fn warn_non_finite(what: &str, decoded: &crate::scene::texture::DecodedImage) {
 
 /// Uploads a map of `usage` from `source`: a file or an encoded image decoded as stored, a
 /// procedural texture through [`upload_texture`].
-fn upload_source(
+pub(crate) fn upload_source(
     gpu: &GpuContext,
     source: &TextureSource,
     usage: TextureUsage,
@@ -810,7 +810,9 @@ fn surface_stream(mesh: &crate::scene::Mesh) -> Vec<[f32; 6]> {
         .collect()
 }
 
-fn create_repeat_sampler(gpu: &GpuContext) -> Result<vk::Sampler> {
+/// The trilinear, repeating sampler of material maps (also the host meshes' depth textures in
+/// `lucent::embed::LayeredEffect`'s light-space maps, read as lucent reads its own).
+pub(crate) fn create_repeat_sampler(gpu: &GpuContext) -> Result<vk::Sampler> {
     let info = vk::SamplerCreateInfo::default()
         .mag_filter(vk::Filter::LINEAR)
         .min_filter(vk::Filter::LINEAR)

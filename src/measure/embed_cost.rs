@@ -1021,14 +1021,53 @@ fn measure_layered(
             "host IDs",
         )?;
         let id_image = host_image(id_image, "host IDs", vk::Format::R8_UNORM, size, sampled);
-        // Every mesh in a host vertex buffer and index buffer of its own.
+        // Media whose layers read depth textures (TexDep): the host's G-buffer holds lucent's
+        // texels, its vertices the texture coordinate, and each such draw its medium's
+        // textures, uploaded as lucent uploads its own.
+        let texdep = desc.depth_textures();
+        let layer_depths = match (texdep > 0, &gb.layer_depths) {
+            (true, Some(bytes)) => {
+                let format = crate::features::layer_depth::layer_depth_format(texdep)
+                    .expect("TexDep frames store texels");
+                let (image, view) = images.upload(
+                    gpu,
+                    &ImageDesc::color(width, height, format, sampled),
+                    bytes.clone(),
+                    "host layer depths",
+                )?;
+                Some((
+                    host_image((image, view), "host layer depths", format, size, sampled),
+                    format,
+                ))
+            }
+            _ => None,
+        };
+        let mut medium_textures: Vec<Option<[vk::ImageView; 2]>> = Vec::new();
+        for medium in &desc.materials {
+            let mut views = [vk::ImageView::null(); 2];
+            for (k, source) in medium.depth_textures.iter().take(2).enumerate() {
+                let texture = crate::gpu_scene::upload_source(
+                    gpu,
+                    source,
+                    crate::scene::texture::TextureUsage::Data,
+                    "host depth texture",
+                )?;
+                views[k] = texture.view;
+                images.0.push(texture);
+            }
+            medium_textures.push((!medium.depth_textures.is_empty()).then_some(views));
+        }
+        // Every mesh in a host vertex buffer and index buffer of its own (with the texture
+        // coordinate when a medium reads depth textures).
         let mut meshes = Vec::with_capacity(scene.meshes.len());
         for mesh in &scene.meshes {
-            let vertices: Vec<f32> = mesh
-                .positions
-                .iter()
-                .zip(&mesh.normals)
-                .flat_map(|(p, n)| [p.x, p.y, p.z, n.x, n.y, n.z])
+            let vertices: Vec<f32> = (0..mesh.positions.len())
+                .flat_map(|i| {
+                    let (p, n) = (mesh.positions[i], mesh.normals[i]);
+                    let uv = mesh.uvs.get(i).copied().unwrap_or_default();
+                    let all = [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y];
+                    all.into_iter().take(if texdep > 0 { 8 } else { 6 })
+                })
                 .collect();
             let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
             buffers.push(gpu.upload_buffer(&vertices, usage, "host vertices")?);
@@ -1050,13 +1089,20 @@ fn measure_layered(
             .map(|(o, &id)| {
                 let (vertices, indices, count) = meshes[o.mesh];
                 let (low, high) = bounds[o.mesh];
-                MeshDraw::new(vertices, count as u32, o.transform, id)
+                let draw = MeshDraw::new(vertices, count as u32, o.transform, id)
                     .with_indices(IndexBuffer {
                         buffer: indices,
                         offset: 0,
                         index_type: vk::IndexType::UINT32,
                     })
-                    .with_bounds(low, high)
+                    .with_bounds(low, high);
+                let textures = usize::from(id)
+                    .checked_sub(1)
+                    .and_then(|k| medium_textures.get(k).copied().flatten());
+                match textures {
+                    Some([first, second]) => draw.with_depth_textures(first, Some(second)),
+                    None => draw,
+                }
             })
             .collect();
         let (faces, atlas) = match &shadows {
@@ -1070,21 +1116,38 @@ fn measure_layered(
             None => (Vec::new(), (64, 64)),
         };
         let units_per_mm = desc.materials[0].units_per_mm;
-        let gbuffer = host
+        let mut gbuffer = host
             .desc
             .clone()
             .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
             .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
+        if let Some((_, format)) = &layer_depths {
+            gbuffer = gbuffer.with_layer_depths(*format);
+        }
         let materials = desc
             .materials
             .iter()
             .enumerate()
-            .map(|(k, m)| LayeredMaterial::new(k as u8 + 1, m.clone()))
+            .map(|(k, m)| {
+                // The host gives the textures with its draws.
+                let mut medium = m.clone();
+                medium.depth_textures.clear();
+                LayeredMaterial::new(k as u8 + 1, medium)
+            })
             .collect();
+        let vertices = if texdep > 0 {
+            VertexLayout::interleaved(32, 0, 12).with_uv(crate::embed::VertexAttribute::new(
+                0,
+                vk::Format::R32G32_SFLOAT,
+                24,
+            ))
+        } else {
+            VertexLayout::interleaved(24, 0, 12)
+        };
         let effect_desc = LayeredEffectDesc::new(
             gbuffer,
             materials,
-            VertexLayout::interleaved(24, 0, 12),
+            vertices,
             vk::Extent2D {
                 width: atlas.0,
                 height: atlas.1,
@@ -1124,6 +1187,7 @@ fn measure_layered(
                         normals: &host.normals,
                         material_ids: &id_image,
                         albedo: desc.film.then_some(&host.albedo),
+                        layer_depths: layer_depths.as_ref().map(|(image, _)| image),
                     },
                     regions: &regions,
                     lighting: &host.lighting,

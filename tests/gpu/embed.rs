@@ -2353,6 +2353,7 @@ fn no_embed_path_submits_or_waits_on_the_hosts_device() {
                         normals: &colour_in,
                         material_ids: images.material_ids,
                         albedo: None,
+                        layer_depths: None,
                     },
                     regions: &[],
                     lighting: &lighting,

@@ -821,8 +821,9 @@ fn shader_permutations(out: &mut Vec<crate::backend::shader::PipelineShaders>) {
             for layer_depths in [None, Some(1), Some(2)] {
                 for host in std::iter::once(None).chain(LayeredHost::ALL.map(Some)) {
                     // A host's G-buffer: lucent draws the maps with their entry target, and
-                    // depth textures are not embedded (the film is the host's albedo image).
-                    let embedded = layer_depths.is_none() && bit(2) && bit(3) && !bit(4);
+                    // with depth textures their texels too (the film is the host's albedo
+                    // image).
+                    let embedded = bit(2) && bit(3) && bit(4) == layer_depths.is_some();
                     if host.is_some() && !embedded {
                         continue;
                     }

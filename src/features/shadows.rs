@@ -518,12 +518,10 @@ impl PassExec for ShadowPass {
         self.pipeline = Some(PassPipeline::new(
             ctx,
             &self.bindings(0),
-            &GraphicsPipelineDesc {
-                vertex: SHADOW_VERTEX,
-                fragment: SHADOW_FRAGMENT,
-                defines: &defines,
+            &maps_pipeline(
+                &defines,
                 // The entry target needs the normals.
-                vertex_input: if self.desc.entry {
+                if self.desc.entry {
                     VertexInput::Mesh {
                         thickness: false,
                         // TexDep: the UVs where the depth textures are read.
@@ -532,16 +530,7 @@ impl PassExec for ShadowPass {
                 } else {
                     VertexInput::Positions
                 },
-                depth_test: true,
-                // Open meshes (the floor, a leaf) cast from both sides.
-                cull_back: false,
-                additive_attachments: 0,
-                set_layouts: &[],
-                bindings: &[],
-                push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
-                specialization: &[],
-                name: "light-space maps",
-            },
+            ),
         )?);
         let pairs = if self.layer_depths() {
             self.scene.maps.as_ref().map_or(0, |m| m.depth_sets.len())
@@ -762,21 +751,7 @@ impl PassExec for HostShadowPass {
         let textures = self.depth_textures.map_or(0, |d| d.textures);
         let defines = shadow_map_defines(false, true, textures);
         let input = VertexInput::Host(self.input);
-        let desc = GraphicsPipelineDesc {
-            vertex: SHADOW_VERTEX,
-            fragment: SHADOW_FRAGMENT,
-            defines: &defines,
-            vertex_input: input,
-            depth_test: true,
-            // Open meshes cast from both sides, as in lucent's own maps.
-            cull_back: false,
-            additive_attachments: 0,
-            set_layouts: &[],
-            bindings: &[],
-            push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
-            specialization: &[],
-            name: "light-space maps",
-        };
+        let desc = maps_pipeline(&defines, input);
         self.pipeline = Some(match self.depth_textures {
             None => HostShadowPipeline::Plain(PassPipeline::new(
                 ctx,
@@ -894,6 +869,29 @@ impl PassExec for HostShadowPass {
             Some(HostShadowPipeline::DepthTextures(mut p)) => p.destroy(&gpu.device),
             None => {}
         }
+    }
+}
+
+/// The light-space maps pipeline of lucent's meshes or a host's (`vertex_input`): depth
+/// tested, both faces drawn (open meshes, the floor or a leaf, cast from both sides), each
+/// draw's face and model pushed.
+fn maps_pipeline<'a>(
+    defines: &'a [(&'a str, &'a str)],
+    vertex_input: VertexInput,
+) -> GraphicsPipelineDesc<'a> {
+    GraphicsPipelineDesc {
+        vertex: SHADOW_VERTEX,
+        fragment: SHADOW_FRAGMENT,
+        defines,
+        vertex_input,
+        depth_test: true,
+        cull_back: false,
+        additive_attachments: 0,
+        set_layouts: &[],
+        bindings: &[],
+        push_constant_bytes: std::mem::size_of::<ShadowConstants>() as u32,
+        specialization: &[],
+        name: "light-space maps",
     }
 }
 

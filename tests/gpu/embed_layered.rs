@@ -249,6 +249,35 @@ impl MeshBuffers {
     }
 }
 
+/// lucent's G-buffer `gb` of `scene` (its layered IDs `ids`) as a host's of the layout
+/// `kinds`, 1 unit = 20 mm: the images, the normals image and the description with normals.
+fn host_view(
+    test: &TestGpu,
+    (depth_kind, ids_kind, normals_kind): (HostDepth, HostIds, HostNormals),
+    scene: &lucent::scene::Scene,
+    gb: &lucent::frame::GBufferReadback,
+    ids: &[u8],
+) -> (
+    crate::embed::HostLayout,
+    lucent::backend::GpuImage,
+    GBufferDesc,
+) {
+    let (w, h) = (gb.width, gb.height);
+    let mut layout = host_layout(
+        test, depth_kind, ids_kind, w, h, scene, &gb.depth, ids, 0.02,
+    );
+    if depth_kind == HostDepth::ReversedInfinite {
+        // The same pixels as lucent's frame: its clip-space y convention.
+        let mut projection = layout.camera.projection;
+        projection.y_axis.y = -projection.y_axis.y;
+        layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
+    }
+    let (normals, normal_desc) =
+        normal_image(test, normals_kind, w, h, &gb.gb1, layout.camera.view);
+    let desc = layout.desc.clone().with_normals(normal_desc);
+    (layout, normals, desc)
+}
+
 #[test]
 fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
     let test = TestGpu::new();
@@ -356,22 +385,14 @@ fn the_layered_effect_on_host_layouts_and_meshes_equals_lucents_own_frame() {
             HostMeshes::Interleaved,
         ),
     ] {
-        let mut layout = host_layout(
-            &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
+        let (layout, normals, desc) = host_view(
+            &test,
+            (depth_kind, ids_kind, normals_kind),
+            &scene,
+            &gb,
+            &ids,
         );
-        if depth_kind == HostDepth::ReversedInfinite {
-            // The same pixels as lucent's frame: its clip-space y convention.
-            let mut projection = layout.camera.projection;
-            projection.y_axis.y = -projection.y_axis.y;
-            layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
-        }
-        let (normals, normal_desc) =
-            normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
-        let desc = layout
-            .desc
-            .clone()
-            .with_normals(normal_desc)
-            .with_albedo(vk::Format::R8G8B8A8_UNORM);
+        let desc = desc.with_albedo(vk::Format::R8G8B8A8_UNORM);
         assert!(capabilities(&desc).unwrap()[3].1.runs());
         let materials: Vec<LayeredMaterial> = media
             .iter()
@@ -1009,22 +1030,14 @@ fn the_layered_effect_reads_each_meshs_depth_textures_as_lucents_own_frame_does(
             HostNormals::ViewOctahedralUnorm,
         ),
     ] {
-        let mut layout = host_layout(
-            &test, depth_kind, ids_kind, w, h, &scene, &gb.depth, &ids, 0.02,
+        let (layout, normals, desc) = host_view(
+            &test,
+            (depth_kind, ids_kind, normals_kind),
+            &scene,
+            &gb,
+            &ids,
         );
-        if depth_kind == HostDepth::ReversedInfinite {
-            // The same pixels as lucent's frame: its clip-space y convention.
-            let mut projection = layout.camera.projection;
-            projection.y_axis.y = -projection.y_axis.y;
-            layout.camera = lucent::embed::HostCamera::new(layout.camera.view, projection);
-        }
-        let (normals, normal_desc) =
-            normal_image(&test, normals_kind, w, h, &gb.gb1, layout.camera.view);
-        let desc = layout
-            .desc
-            .clone()
-            .with_normals(normal_desc)
-            .with_layer_depths(vk::Format::R32G32_UINT);
+        let desc = desc.with_layer_depths(vk::Format::R32G32_UINT);
         let materials: Vec<LayeredMaterial> = media
             .iter()
             .enumerate()

@@ -600,22 +600,19 @@ impl GpuContext {
         (built, kept)
     }
 
-    /// Puts a destruction off until the caller's submission of this thread's recorded setup
-    /// work has run, when this thread is recording some (its copies may write what is
-    /// destroyed); hands it back, to run now, otherwise.
-    pub(crate) fn defer_while_recording_setup(
-        &self,
-        destroy: DeferredDestroy,
-    ) -> Option<DeferredDestroy> {
+    /// Runs `destroy` now or, on a thread recording setup work into a caller's command buffer
+    /// (whose copies may write what is destroyed), once the caller's submission of it has run
+    /// ([`SetupKept::destroy`]).
+    pub(crate) fn destroy_after_setup(&self, destroy: impl FnOnce(&GpuContext) + Send + 'static) {
         let thread = std::thread::current().id();
-        let mut recordings = lock(&self.setup_recordings);
-        match recordings.iter_mut().find(|r| r.thread == thread) {
-            Some(recording) => {
-                recording.kept.destroyed.push(destroy);
-                None
+        {
+            let mut recordings = lock(&self.setup_recordings);
+            if let Some(recording) = recordings.iter_mut().find(|r| r.thread == thread) {
+                recording.kept.destroyed.push(Box::new(destroy));
+                return;
             }
-            None => Some(destroy),
         }
+        destroy(self);
     }
 
     /// The command buffer this thread's setup work is recorded into, if any.

@@ -235,11 +235,7 @@ impl GpuContext {
     /// On a thread recording setup work into a caller's command buffer, the destruction waits
     /// for that submission ([`GpuContext::record_setup_into`]).
     pub fn destroy_image(&self, image: GpuImage) {
-        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
-            gpu.destroy_image_now(image)
-        })) {
-            now(self);
-        }
+        self.destroy_after_setup(move |gpu| gpu.destroy_image_now(image));
     }
 
     fn destroy_image_now(&self, image: GpuImage) {
@@ -310,11 +306,7 @@ impl GpuContext {
     /// recording setup work into a caller's command buffer, the destruction waits for that
     /// submission ([`GpuContext::record_setup_into`]).
     pub fn destroy_buffer(&self, buffer: GpuBuffer) {
-        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
-            gpu.destroy_buffer_now(buffer)
-        })) {
-            now(self);
-        }
+        self.destroy_after_setup(move |gpu| gpu.destroy_buffer_now(buffer));
     }
 
     fn destroy_buffer_now(&self, buffer: GpuBuffer) {
@@ -854,11 +846,7 @@ impl GpuContext {
     /// On a thread recording setup work into a caller's command buffer, freeing waits for that
     /// submission ([`GpuContext::record_setup_into`]), as destroying the resources in it does.
     pub fn free_memory_block(&self, block: MemoryBlock) {
-        if let Some(now) = self.defer_while_recording_setup(Box::new(move |gpu: &GpuContext| {
-            gpu.memory().free(block.allocation, &block.name)
-        })) {
-            now(self);
-        }
+        self.destroy_after_setup(move |gpu| gpu.memory().free(block.allocation, &block.name));
     }
 
     /// Binds `image` at byte `offset` inside `block`. The offset must respect the image's

@@ -6,6 +6,8 @@
 //! completed, the host's contract). A pool grows to the most pairs a frame of its slot has
 //! had, so its size is bounded by the host's draws, and nothing outlives the effect.
 
+use std::collections::HashMap;
+
 use ash::vk;
 
 use crate::backend::resources::{GpuImage, ImageDesc};
@@ -115,13 +117,20 @@ impl DepthTextureSets {
         draws: &[Option<[vk::ImageView; 2]>],
     ) -> Result<Vec<vk::DescriptorSet>> {
         let blank = [self.blank.view; 2];
-        let views: Vec<[vk::ImageView; 2]> = draws.iter().map(|d| d.unwrap_or(blank)).collect();
+        // Each draw's pair's index among the distinct pairs, in order of first use (a map: a
+        // host may draw thousands of meshes a frame).
+        let mut index_of: HashMap<[vk::ImageView; 2], usize> = HashMap::new();
         let mut distinct: Vec<[vk::ImageView; 2]> = Vec::new();
-        for pair in &views {
-            if !distinct.contains(pair) {
-                distinct.push(*pair);
-            }
-        }
+        let draw_pairs: Vec<usize> = draws
+            .iter()
+            .map(|d| {
+                let pair = d.unwrap_or(blank);
+                *index_of.entry(pair).or_insert_with(|| {
+                    distinct.push(pair);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
         let needed = distinct.len().max(1) as u32;
         let pool = self.pool_for(gpu, ring, needed)?;
         let layouts = vec![self.layout; distinct.len()];
@@ -180,13 +189,7 @@ impl DepthTextureSets {
         // SAFETY: every set was allocated above and is in no pending command buffer; the
         // views are the host's (valid for the frame, its contract) or the blank texture's.
         unsafe { gpu.device.update_descriptor_sets(&writes, &[]) };
-        Ok(views
-            .iter()
-            .map(|pair| {
-                let at = distinct.iter().position(|p| p == pair).unwrap_or(0);
-                sets[at]
-            })
-            .collect())
+        Ok(draw_pairs.iter().map(|&at| sets[at]).collect())
     }
 
     /// Ring entry `ring`'s pool, reset, with room for `needed` sets: the old one reset, or

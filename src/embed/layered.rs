@@ -486,8 +486,6 @@ pub struct LayeredEffect {
     shadow_frame: Arc<Mutex<HostShadowFrame>>,
     /// With media whose layers read depth textures: the draws' sets of them.
     depth_sets: Option<DepthTextureSets>,
-    /// Depth textures the media read (0 to 2): the most any medium needs.
-    depth_textures: usize,
 }
 
 impl LayeredEffect {
@@ -656,7 +654,6 @@ impl LayeredEffect {
             media: layered.materials,
             shadow_frame,
             depth_sets,
-            depth_textures,
         })
     }
 
@@ -955,7 +952,7 @@ impl LayeredEffect {
         if let (Some(albedo), Some(format)) = (albedo, gbuffer.albedo) {
             checks.push((albedo, "albedo", Role::SampledColor, format));
         }
-        let layer_depths = match (self.depth_textures > 0, images.layer_depths) {
+        let layer_depths = match (self.depth_sets.is_some(), images.layer_depths) {
             (true, Some(depths)) => Some(depths),
             (false, None) => None,
             (true, None) => {

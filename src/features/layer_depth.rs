@@ -27,6 +27,9 @@ pub fn layer_depths_define(textures: usize) -> &'static str {
     }
 }
 
+/// The names the maps pass's shaders give a draw's `TexDep` depth textures (glsl/shadow/depth.frag).
+pub const DEPTH_MAP_NAMES: [&str; 2] = ["depth_map0", "depth_map1"];
+
 /// The bindings of a draw's `TexDep` depth textures (`textures` of them, 1 or 2) from pair
 /// `depth` of [`crate::gpu_scene::MaterialMaps::depth`].
 pub fn depth_map_bindings(
@@ -38,7 +41,7 @@ pub fn depth_map_bindings(
         .iter()
         .take(textures.clamp(1, 2))
         .filter_map(|&i| maps.depth.get(i).or(maps.depth.first()))
-        .zip(["depth_map0", "depth_map1"])
+        .zip(DEPTH_MAP_NAMES)
         .map(|(map, name)| (name, Binding::Sampled(map.view, maps.sampler)))
         .collect()
 }

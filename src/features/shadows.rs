@@ -653,7 +653,10 @@ impl HostDepthTextures {
             name: Some(TABLE_REGION.block),
             kind: vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
         }];
-        for name in ["depth_map0", "depth_map1"].into_iter().take(textures.clamp(1, 2)) {
+        for name in super::layer_depth::DEPTH_MAP_NAMES
+            .into_iter()
+            .take(textures.clamp(1, 2))
+        {
             bindings.push(SetBinding {
                 name: Some(name),
                 kind: sampled,

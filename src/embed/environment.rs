@@ -199,20 +199,10 @@ impl EnvironmentEffect {
         };
         check_views(desc.views_per_frame)?;
         let normals = normals.decode()?;
-        let upload = SceneUpload {
-            translucency_ids: None,
-            profile_ids: None,
-            normal_maps: false,
-            lean: false,
-            albedo_maps: false,
-            frames_in_flight: 1,
-            tables: vec![TableRegion {
-                region: &HOST_ENVIRONMENT,
-                bytes: std::mem::size_of::<HostEnvironmentGpu>() as u64,
-            }],
-            layered_ids: None,
-            layer_depth_textures: 0,
-        };
+        let upload = SceneUpload::tables_only(vec![TableRegion {
+            region: &HOST_ENVIRONMENT,
+            bytes: std::mem::size_of::<HostEnvironmentGpu>() as u64,
+        }]);
         let (passes, imports) = EffectPasses::new(
             lucent,
             uploads,

@@ -593,23 +593,13 @@ impl LayeredEffect {
         };
         let [octahedral, view_space, unorm, _] = normals.decode()?;
         let decode = LayeredDecode::new(host_ids, &id_materials, [octahedral, view_space, unorm]);
-        let upload = SceneUpload {
-            translucency_ids: None,
-            profile_ids: None,
-            normal_maps: false,
-            lean: false,
-            albedo_maps: false,
-            frames_in_flight: 1,
-            tables: vec![
-                TableRegion {
-                    region: &TABLE_REGION,
-                    bytes: std::mem::size_of::<LayeredTableGpu>() as u64,
-                },
-                shadows::table_region(),
-            ],
-            layered_ids: None,
-            layer_depth_textures: 0,
-        };
+        let upload = SceneUpload::tables_only(vec![
+            TableRegion {
+                region: &TABLE_REGION,
+                bytes: std::mem::size_of::<LayeredTableGpu>() as u64,
+            },
+            shadows::table_region(),
+        ]);
         let shadow_frame = Arc::new(Mutex::new(HostShadowFrame::default()));
         let rings = lucent.frames_in_flight() * desc.views_per_frame;
         let depth_sets = (depth_textures > 0)

@@ -321,13 +321,8 @@ impl SssEffect {
             id_map,
         };
         let upload = SceneUpload {
-            translucency_ids: None,
             profile_ids: Some(&[]),
-            normal_maps: false,
-            lean: false,
-            albedo_maps: false,
-            frames_in_flight: 1,
-            tables: {
+            ..SceneUpload::tables_only({
                 let mut tables = sss::tables::regions(&profiles);
                 if lean_constants.is_some() {
                     tables.push(TableRegion {
@@ -339,9 +334,7 @@ impl SssEffect {
                     tables.push(crate::features::shadows::table_region());
                 }
                 tables
-            },
-            layered_ids: None,
-            layer_depth_textures: 0,
+            })
         };
         let (passes, imports) = EffectPasses::new(
             lucent,

@@ -337,23 +337,13 @@ impl TranslucencyEffect {
             translucent,
             view_to_world: glam::Mat4::IDENTITY.to_cols_array_2d(),
         };
-        let upload = SceneUpload {
-            translucency_ids: None,
-            profile_ids: None,
-            normal_maps: false,
-            lean: false,
-            albedo_maps: false,
-            frames_in_flight: 1,
-            tables: vec![
-                crate::features::translucency::table_region(),
-                TableRegion {
-                    region: &HOST_TRANSLUCENCY,
-                    bytes: std::mem::size_of::<HostTranslucencyGpu>() as u64,
-                },
-            ],
-            layered_ids: None,
-            layer_depth_textures: 0,
-        };
+        let upload = SceneUpload::tables_only(vec![
+            crate::features::translucency::table_region(),
+            TableRegion {
+                region: &HOST_TRANSLUCENCY,
+                bytes: std::mem::size_of::<HostTranslucencyGpu>() as u64,
+            },
+        ]);
         let (passes, imports) = EffectPasses::new(
             lucent,
             uploads,

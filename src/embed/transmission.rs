@@ -330,24 +330,14 @@ impl TransmissionEffect {
             region,
             bytes: bytes as u64,
         };
-        let upload = SceneUpload {
-            translucency_ids: None,
-            profile_ids: None,
-            normal_maps: false,
-            lean: false,
-            albedo_maps: false,
-            frames_in_flight: 1,
-            tables: vec![
-                region(&MEDIA, std::mem::size_of::<ProfileTableGpu>()),
-                region(
-                    &HOST_TRANSMISSION,
-                    std::mem::size_of::<HostTransmissionGpu>(),
-                ),
-                region(&SHADOWS, std::mem::size_of::<ShadowUniforms>()),
-            ],
-            layered_ids: None,
-            layer_depth_textures: 0,
-        };
+        let upload = SceneUpload::tables_only(vec![
+            region(&MEDIA, std::mem::size_of::<ProfileTableGpu>()),
+            region(
+                &HOST_TRANSMISSION,
+                std::mem::size_of::<HostTransmissionGpu>(),
+            ),
+            region(&SHADOWS, std::mem::size_of::<ShadowUniforms>()),
+        ]);
         let (passes, imports) = EffectPasses::new(
             lucent,
             uploads,

@@ -232,6 +232,25 @@ pub struct SceneUpload<'a> {
     pub layer_depth_textures: usize,
 }
 
+impl SceneUpload<'_> {
+    /// A per-frame buffer of `tables` and nothing of a scene's (no objects, maps or IDs): what
+    /// an effect on a host's G-buffer uploads (`lucent::embed`; its frames in flight are set
+    /// when the effect is built).
+    pub fn tables_only(tables: Vec<TableRegion>) -> Self {
+        Self {
+            translucency_ids: None,
+            profile_ids: None,
+            normal_maps: false,
+            lean: false,
+            albedo_maps: false,
+            frames_in_flight: 1,
+            tables,
+            layered_ids: None,
+            layer_depth_textures: 0,
+        }
+    }
+}
+
 pub use crate::scene::texture::PROCEDURAL_TEXTURE_SIZE;
 
 /// The scene's GPU data the passes share (see the module docs).

@@ -147,7 +147,7 @@ impl FrameUniforms {
 }
 
 /// One light as glsl/common/scene.glsl's `Light` holds it.
-fn light_rows(light: &Light) -> [[f32; 4]; 4] {
+pub(crate) fn light_rows(light: &Light) -> [[f32; 4]; 4] {
     let radiance = light.radiance();
     let scale = light.translucency_scale;
     match light.kind {

@@ -38,6 +38,12 @@
 //!   `report`'s GDC table measures it), against the `TranslucencyEffect`'s one pass, drawn
 //!   over the translucent objects' screen bounds (`TranslucencyFrame::regions`, from
 //!   `embed::screen_region`, as a host gives them).
+//!
+//! For the three lighting terms (translucency, the environment, the transmission) the table
+//! also times a host's own lighting pass that adds the term through
+//! `lucent::embed::glsl::TERMS` ([`crate::measure::host_lighting`]), with and without it, and
+//! sets the difference beside lucent's own term: what the term costs a host that fuses it, as
+//! docs/embedding.md recommends.
 
 use std::collections::BTreeMap;
 
@@ -60,6 +66,7 @@ use crate::features::registry;
 use crate::features::sss::SssProfiles;
 use crate::features::technique::TechniqueModule;
 use crate::frame::{FrameSettings, Renderer, Technique};
+use crate::measure::host_lighting::{HostLighting, HostLightingFrame, TermData};
 use crate::measure::stats::Stats;
 use crate::scene::material::Texturing;
 use crate::scene::Scene;
@@ -690,9 +697,26 @@ fn measure_translucency(
                 TranslucentMaterial::from_translucency(i as u8 + 1, t)
             })
             .collect::<Result<Vec<_>>>()?;
-        let mut effect = build(gpu, lucent, |u| {
-            TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
+        let rows: Vec<(u8, [f32; 4])> = materials.iter().map(|m| (m.id, m.row())).collect();
+        let term = TermData::Translucency {
+            rows: &rows,
+            id_channel: if coloured { 3 } else { 1 },
+            coloured,
+        };
+        let lit = host_lit_target(gpu, &mut images, size)?;
+        let mut lighting = build(gpu, lucent, |u| {
+            HostLighting::new(lucent, u, &gbuffer, &term, vk::Format::UNDEFINED)
         })?;
+        let effect = build(gpu, lucent, |u| {
+            TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
+        });
+        let mut effect = match effect {
+            Ok(e) => e,
+            Err(e) => {
+                lighting.destroy(lucent);
+                return Err(e);
+            }
+        };
         memory.push(("TranslucencyEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
@@ -738,8 +762,27 @@ fn measure_translucency(
                     timer,
                 )
             },
+            &mut |cmd, timer| {
+                lighting.record_timed(
+                    lucent,
+                    cmd,
+                    &HostLightingFrame {
+                        camera,
+                        lights: &scene.lights,
+                        regions: &regions,
+                        depth: &host.depth,
+                        normals: &host.normals,
+                        albedo: &host.albedo,
+                        ids: Some(&gb2_image),
+                        shadow_map: None,
+                        lit: &lit,
+                    },
+                    timer,
+                )
+            },
         );
         effect.destroy(lucent);
+        lighting.destroy(lucent);
         rows
     })();
     pair.finish(gpu, images, measured)
@@ -774,9 +817,21 @@ fn measure_environment(
     let mut images = Images::default();
     let measured = (|| {
         let (host, _) = HostGBuffer::of(gpu, &pair.lit, &mut images, size)?;
-        let mut effect = build(gpu, lucent, |u| {
-            EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(host.desc.clone()))
+        let term = TermData::Environment(scene.environment.coefficients());
+        let lit = host_lit_target(gpu, &mut images, size)?;
+        let mut lighting = build(gpu, lucent, |u| {
+            HostLighting::new(lucent, u, &host.desc, &term, vk::Format::UNDEFINED)
         })?;
+        let effect = build(gpu, lucent, |u| {
+            EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(host.desc.clone()))
+        });
+        let mut effect = match effect {
+            Ok(e) => e,
+            Err(e) => {
+                lighting.destroy(lucent);
+                return Err(e);
+            }
+        };
         memory.push(("EnvironmentEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
@@ -808,8 +863,27 @@ fn measure_environment(
                     timer,
                 )
             },
+            &mut |cmd, timer| {
+                lighting.record_timed(
+                    lucent,
+                    cmd,
+                    &HostLightingFrame {
+                        camera,
+                        lights: &scene.lights,
+                        regions: &[],
+                        depth: &host.depth,
+                        normals: &host.normals,
+                        albedo: &host.albedo,
+                        ids: None,
+                        shadow_map: None,
+                        lit: &lit,
+                    },
+                    timer,
+                )
+            },
         );
         effect.destroy(lucent);
+        lighting.destroy(lucent);
         rows
     })();
     pair.finish(gpu, images, measured)
@@ -916,13 +990,37 @@ fn measure_transmission(
             .clone()
             .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
             .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
-        let mut effect = build(gpu, lucent, |u| {
+        let metres_per_unit = 1.0 / (1000.0 * units_per_mm);
+        let media_rows = materials
+            .iter()
+            .map(|m| Ok((m.id, m.rows(metres_per_unit)?)))
+            .collect::<Result<Vec<_>>>()?;
+        let face_rows = faces
+            .iter()
+            .map(|f| Ok((f.light, f.terms_rows(shadow_map.extent)?)))
+            .collect::<Result<Vec<_>>>()?;
+        let term = TermData::Transmission {
+            media: &media_rows,
+            faces: &face_rows,
+        };
+        let lit = host_lit_target(gpu, &mut images, size)?;
+        let mut lighting = build(gpu, lucent, |u| {
+            HostLighting::new(lucent, u, &gbuffer, &term, vk::Format::D32_SFLOAT)
+        })?;
+        let effect = build(gpu, lucent, |u| {
             TransmissionEffect::new(
                 lucent,
                 u,
                 TransmissionEffectDesc::new(gbuffer, materials, vk::Format::D32_SFLOAT),
             )
-        })?;
+        });
+        let mut effect = match effect {
+            Ok(e) => e,
+            Err(e) => {
+                lighting.destroy(lucent);
+                return Err(e);
+            }
+        };
         memory.push(("TransmissionEffect", effect.memory()));
         let camera = HostCamera::new(
             scene.camera.view(),
@@ -961,8 +1059,27 @@ fn measure_transmission(
                     timer,
                 )
             },
+            &mut |cmd, timer| {
+                lighting.record_timed(
+                    lucent,
+                    cmd,
+                    &HostLightingFrame {
+                        camera,
+                        lights: &scene.lights,
+                        regions: &regions,
+                        depth: &host.depth,
+                        normals: &host.normals,
+                        albedo: &host.albedo,
+                        ids: Some(&id_image),
+                        shadow_map: Some(&shadow_map),
+                        lit: &lit,
+                    },
+                    timer,
+                )
+            },
         );
         effect.destroy(lucent);
+        lighting.destroy(lucent);
         rows
     })();
     pair.finish(gpu, images, measured).map(|rows| {
@@ -1367,6 +1484,7 @@ fn time_passes(
 /// `labels.0`) minus that of `plain` (without it, `labels.1`), frame by frame; the host's is
 /// each pass `record` times (into the timer it is given, reset in its command buffer). The
 /// three frames alternate; `warmup` rounds are discarded, `frames` measured.
+#[allow(clippy::too_many_arguments)]
 fn time_term(
     gpu: &GpuContext,
     lucent: &Lucent,
@@ -1374,8 +1492,16 @@ fn time_term(
     labels: (&str, &str),
     (frames, warmup): (usize, usize),
     mut record: impl FnMut(vk::CommandBuffer, &mut EffectTimer) -> Result<()>,
+    host_lighting: &mut HostLightingRun<'_>,
 ) -> Result<Vec<EmbedCostRow>> {
     let mut timer = EffectTimer::new(lucent, 8)?;
+    let mut lighting_timer = match EffectTimer::new(lucent, 8) {
+        Ok(t) => t,
+        Err(e) => {
+            timer.destroy(lucent);
+            return Err(e);
+        }
+    };
     let (with_label, without_label) = (
         format!("lighting ({})", labels.0),
         format!("lighting ({})", labels.1),
@@ -1386,8 +1512,16 @@ fn time_term(
             let with_term = lit.render_once(gpu)?;
             let without = plain.render_once(gpu)?;
             host_frame(gpu, |cmd| record(cmd, &mut timer))?;
+            host_frame(gpu, |cmd| host_lighting(cmd, &mut lighting_timer))?;
             if round < warmup {
                 continue;
+            }
+            let passes = lighting_timer.results(lucent)?.unwrap_or_default();
+            let ms = |name: &str| passes.iter().find(|p| p.name == name).map(|p| p.ms);
+            if let (Some(a), Some(b)) = (ms(HOST_WITH_TERM), ms(HOST_PLAIN)) {
+                theirs.push(HOST_WITH_TERM_ROW, a);
+                theirs.push(HOST_PLAIN_ROW, b);
+                theirs.push(HOST_TERM_ROW, a - b);
             }
             let lighting_ms = |frame: &crate::frame::FrameImages| {
                 frame
@@ -1411,15 +1545,57 @@ fn time_term(
     };
     let result = run();
     timer.destroy(lucent);
+    lighting_timer.destroy(lucent);
     result?;
-    Ok([without_label.as_str(), with_label.as_str(), "the term"]
+    let mut rows: Vec<EmbedCostRow> = [without_label.as_str(), with_label.as_str(), "the term"]
         .iter()
         .map(|name| EmbedCostRow {
             pass: name.to_string(),
             lucent_ms: ours.median(name),
             host_ms: theirs.median(name),
         })
-        .collect())
+        .collect();
+    // The host's own lighting: its two passes (nothing of lucent's frame to set beside them),
+    // then the term they differ by beside lucent's.
+    for name in [HOST_PLAIN_ROW, HOST_WITH_TERM_ROW] {
+        rows.push(EmbedCostRow {
+            pass: name.to_string(),
+            lucent_ms: None,
+            host_ms: theirs.median(name),
+        });
+    }
+    rows.push(EmbedCostRow {
+        pass: HOST_TERM_ROW.to_string(),
+        lucent_ms: ours.median("the term"),
+        host_ms: theirs.median(HOST_TERM_ROW),
+    });
+    Ok(rows)
+}
+
+/// Records the benchmark's host lighting (both its passes) into a command buffer, timed into
+/// the timer it is given.
+type HostLightingRun<'a> = dyn FnMut(vk::CommandBuffer, &mut EffectTimer) -> Result<()> + 'a;
+
+/// The host lighting's passes ([`HostLighting`]).
+const HOST_PLAIN: &str = "host lighting";
+const HOST_WITH_TERM: &str = "host lighting with the term";
+/// Their rows, and the row of the term they differ by.
+const HOST_PLAIN_ROW: &str = "host's lighting (TERMS), without the term";
+const HOST_WITH_TERM_ROW: &str = "host's lighting (TERMS), with the term";
+const HOST_TERM_ROW: &str = "the term in the host's lighting (TERMS)";
+
+/// A lit target of the host's (RGBA16F, a colour attachment) for its own lighting pass.
+fn host_lit_target(gpu: &GpuContext, images: &mut Images, size: (u32, u32)) -> Result<HostImage> {
+    let hdr = vk::Format::R16G16B16A16_SFLOAT;
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+    let bytes = vec![0u8; size.0 as usize * size.1 as usize * 8];
+    let image = images.upload(
+        gpu,
+        &ImageDesc::color(size.0, size.1, hdr, usage),
+        bytes,
+        "host lit",
+    )?;
+    Ok(host_image(image, "host lit", hdr, size, usage))
 }
 
 /// The screen regions of the objects `reach` selects, each widened by the reach it gives (the

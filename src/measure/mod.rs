@@ -22,6 +22,7 @@ pub mod bench;
 pub mod embed_cost;
 pub mod gallery;
 pub mod gate;
+pub mod host_lighting;
 pub mod layered_error;
 pub mod look;
 pub mod round_robin;

@@ -338,7 +338,8 @@ fn the_gate_refuses_the_flags_it_sets_itself_naming_them() {
 fn embed_times_each_kind_of_effect_under_validation() {
     // The SH environment (--technique none), GDC 2011 translucency, an SSS blur, SSS
     // transmission and Li et al.'s layered media, each as a host's effect against lucent's own
-    // frame: a table with both columns filled.
+    // frame: a table with both columns filled; the lighting terms also in a host's own
+    // lighting pass.
     for (scene, technique, effect, row) in [
         ("cubes", "none", "EnvironmentEffect", "| the term |"),
         (
@@ -388,6 +389,33 @@ fn embed_times_each_kind_of_effect_under_validation() {
             cells[2].parse::<f64>().is_ok() && cells[3].parse::<f64>().is_ok_and(|v| v > 0.0),
             "{technique}: {line}"
         );
+        // A lighting term is also timed inside a host's own lighting pass through TERMS: the
+        // host's lighting with and without it, both run, and the term they differ by beside
+        // lucent's (a difference of two medians: it may come out negative on a tiny frame).
+        if row.ends_with("the term |") {
+            let prefix = row.trim_end_matches("the term |");
+            for (name, positive) in [
+                ("host's lighting (TERMS), without the term", true),
+                ("host's lighting (TERMS), with the term", true),
+                ("the term in the host's lighting (TERMS)", false),
+            ] {
+                let line = text
+                    .lines()
+                    .find(|l| l.starts_with(&format!("{prefix}{name} |")))
+                    .unwrap_or_else(|| panic!("{technique}: no row {name}: {text}"));
+                let host: f64 = line
+                    .split('|')
+                    .map(str::trim)
+                    .nth(3)
+                    .unwrap()
+                    .parse()
+                    .unwrap();
+                assert!(
+                    host.is_finite() && (!positive || host > 0.0),
+                    "{technique}: {line}"
+                );
+            }
+        }
     }
     // A technique no host can insert is refused, naming those that can.
     let out = common::lucent(&common::words(

@@ -66,7 +66,7 @@ use crate::features::registry;
 use crate::features::sss::SssProfiles;
 use crate::features::technique::TechniqueModule;
 use crate::frame::{FrameSettings, Renderer, Technique};
-use crate::measure::host_lighting::{HostLighting, HostLightingFrame, TermData};
+use crate::measure::host_lighting::{self, HostLighting, HostLightingFrame, TermData};
 use crate::measure::stats::Stats;
 use crate::scene::material::Texturing;
 use crate::scene::Scene;
@@ -705,7 +705,7 @@ fn measure_translucency(
         };
         let lit = host_lit_target(gpu, &mut images, size)?;
         let mut lighting = build(gpu, lucent, |u| {
-            HostLighting::new(lucent, u, &gbuffer, &term, vk::Format::UNDEFINED)
+            HostLighting::new(lucent, u, &gbuffer, &term)
         })?;
         let effect = build(gpu, lucent, |u| {
             TranslucencyEffect::new(lucent, u, TranslucencyEffectDesc::new(gbuffer, materials))
@@ -820,7 +820,7 @@ fn measure_environment(
         let term = TermData::Environment(scene.environment.coefficients());
         let lit = host_lit_target(gpu, &mut images, size)?;
         let mut lighting = build(gpu, lucent, |u| {
-            HostLighting::new(lucent, u, &host.desc, &term, vk::Format::UNDEFINED)
+            HostLighting::new(lucent, u, &host.desc, &term)
         })?;
         let effect = build(gpu, lucent, |u| {
             EnvironmentEffect::new(lucent, u, EnvironmentEffectDesc::new(host.desc.clone()))
@@ -985,12 +985,12 @@ fn measure_transmission(
             })
             .collect::<Vec<_>>();
         let units_per_mm = media[0].layered.units_per_mm;
+        let metres_per_unit = 1.0 / (1000.0 * units_per_mm);
         let gbuffer = host
             .desc
             .clone()
             .with_material_ids(IdDesc::value(vk::Format::R8_UNORM))
-            .with_metres_per_unit(1.0 / (1000.0 * units_per_mm));
-        let metres_per_unit = 1.0 / (1000.0 * units_per_mm);
+            .with_metres_per_unit(metres_per_unit);
         let media_rows = materials
             .iter()
             .map(|m| Ok((m.id, m.rows(metres_per_unit)?)))
@@ -1002,10 +1002,11 @@ fn measure_transmission(
         let term = TermData::Transmission {
             media: &media_rows,
             faces: &face_rows,
+            shadow_format: vk::Format::D32_SFLOAT,
         };
         let lit = host_lit_target(gpu, &mut images, size)?;
         let mut lighting = build(gpu, lucent, |u| {
-            HostLighting::new(lucent, u, &gbuffer, &term, vk::Format::D32_SFLOAT)
+            HostLighting::new(lucent, u, &gbuffer, &term)
         })?;
         let effect = build(gpu, lucent, |u| {
             TransmissionEffect::new(
@@ -1518,7 +1519,9 @@ fn time_term(
             }
             let passes = lighting_timer.results(lucent)?.unwrap_or_default();
             let ms = |name: &str| passes.iter().find(|p| p.name == name).map(|p| p.ms);
-            if let (Some(a), Some(b)) = (ms(HOST_WITH_TERM), ms(HOST_PLAIN)) {
+            if let (Some(a), Some(b)) =
+                (ms(host_lighting::TERM_PASS), ms(host_lighting::PLAIN_PASS))
+            {
                 theirs.push(HOST_WITH_TERM_ROW, a);
                 theirs.push(HOST_PLAIN_ROW, b);
                 theirs.push(HOST_TERM_ROW, a - b);
@@ -1576,10 +1579,7 @@ fn time_term(
 /// the timer it is given.
 type HostLightingRun<'a> = dyn FnMut(vk::CommandBuffer, &mut EffectTimer) -> Result<()> + 'a;
 
-/// The host lighting's passes ([`HostLighting`]).
-const HOST_PLAIN: &str = "host lighting";
-const HOST_WITH_TERM: &str = "host lighting with the term";
-/// Their rows, and the row of the term they differ by.
+/// The host lighting's rows, and the row of the term they differ by.
 const HOST_PLAIN_ROW: &str = "host's lighting (TERMS), without the term";
 const HOST_WITH_TERM_ROW: &str = "host's lighting (TERMS), with the term";
 const HOST_TERM_ROW: &str = "the term in the host's lighting (TERMS)";

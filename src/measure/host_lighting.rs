@@ -40,6 +40,11 @@ use crate::{LucentError, Result};
 /// `BENCH_MAX_MEDIA`).
 pub const MAX_MEDIA: usize = 32;
 
+/// The pass of the plain lighting over the whole screen (its name in the timings).
+pub const PLAIN_PASS: &str = "host lighting";
+/// The pass with the term's variant where the term's objects are.
+pub const TERM_PASS: &str = "host lighting with the term";
+
 /// The shader's constants (`BenchHostLighting`, std140).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -81,6 +86,8 @@ pub enum TermData<'a> {
         /// (light index, `ShadowFace::terms_rows`) per face, a light's faces together (a point
         /// light's six in lucent's order: +X, -X, +Y, -Y, +Z, -Z).
         faces: &'a [(usize, [[f32; 4]; 6])],
+        /// The atlas's depth format.
+        shadow_format: vk::Format,
     },
 }
 
@@ -142,14 +149,13 @@ pub struct HostLighting {
 }
 
 impl HostLighting {
-    /// The host's lighting on `gbuffer` (its diffuse format is the lit target's) with `term`,
-    /// `shadow_format` the atlas's format for transmission.
+    /// The host's lighting on `gbuffer` (its diffuse format is the lit target's; it must
+    /// describe its normals and albedo, and what the term reads) with `term`.
     pub fn new(
         lucent: &Lucent,
         uploads: &mut Uploads,
         gbuffer: &GBufferDesc,
         term: &TermData<'_>,
-        shadow_format: vk::Format,
     ) -> Result<Self> {
         let mut constants: Box<HostLightingGpu> = bytemuck::zeroed_box();
         // A dim constant ambient: the host's own, which the environment variant replaces.
@@ -167,7 +173,7 @@ impl HostLighting {
                 constants.counts[2] = i32::from(*coloured);
             }
             TermData::Environment(sh) => constants.sh = *sh,
-            TermData::Transmission { media, faces } => {
+            TermData::Transmission { media, faces, .. } => {
                 for &(id, rows) in media.iter() {
                     let slot = constants.media.get_mut(usize::from(id)).ok_or_else(|| {
                         LucentError::InvalidInput(format!(
@@ -196,6 +202,32 @@ impl HostLighting {
             }
         }
         let kind = term.term();
+        let read = |what: &str, format: Option<vk::Format>| {
+            format.ok_or_else(|| {
+                LucentError::InvalidInput(format!(
+                    "the benchmark's host lighting reads the G-buffer's {what}, which it does \
+                     not describe"
+                ))
+            })
+        };
+        let formats = Formats {
+            normals: read("normals", gbuffer.normals.map(|n| n.format))?,
+            albedo: read("albedo", gbuffer.albedo)?,
+            ids: match term {
+                TermData::Translucency { .. } => {
+                    Some(read("thickness", gbuffer.thickness.map(|t| t.format))?)
+                }
+                TermData::Transmission { .. } => Some(read(
+                    "material IDs",
+                    gbuffer.material_ids.map(|i| i.format),
+                )?),
+                TermData::Environment(_) => None,
+            },
+            shadow_map: match term {
+                TermData::Transmission { shadow_format, .. } => Some(*shadow_format),
+                _ => None,
+            },
+        };
         let upload = SceneUpload::tables_only(vec![TableRegion {
             region: &HOST_LIGHTING,
             bytes: std::mem::size_of::<HostLightingGpu>() as u64,
@@ -206,7 +238,7 @@ impl HostLighting {
             "the benchmark's host lighting",
             upload,
             1,
-            |scene_gpu| declare(gbuffer, kind, shadow_format, scene_gpu),
+            |scene_gpu| declare(gbuffer, kind, &formats, scene_gpu),
         )?;
         Ok(Self {
             passes,
@@ -274,11 +306,21 @@ impl HostLighting {
     }
 }
 
+/// The formats of the images the host lighting imports besides depth and the lit target.
+struct Formats {
+    normals: vk::Format,
+    albedo: vk::Format,
+    /// The translucency's thickness and ID target, or the transmission's ID image.
+    ids: Option<vk::Format>,
+    /// The transmission's shadow atlas.
+    shadow_map: Option<vk::Format>,
+}
+
 /// The two passes over the host's imported images (see the module docs).
 fn declare(
     gbuffer: &GBufferDesc,
     term: HostTerm,
-    shadow_format: vk::Format,
+    formats: &Formats,
     scene_gpu: &Arc<SceneGpu>,
 ) -> (RenderGraph, Imports) {
     let mut graph = RenderGraph::new();
@@ -287,35 +329,14 @@ fn declare(
         import_host_image(&mut graph, gbuffer, name, format, initial)
     };
     let depth = import("host depth", gbuffer.depth.format, sampled);
-    let normals = import(
-        "host normals",
-        gbuffer.normals.map_or(vk::Format::UNDEFINED, |n| n.format),
-        sampled,
-    );
-    let albedo = import(
-        "host albedo",
-        gbuffer.albedo.unwrap_or(vk::Format::UNDEFINED),
-        sampled,
-    );
-    let ids = match term {
-        HostTerm::Translucency { .. } => Some(import(
-            "host thickness and IDs",
-            gbuffer
-                .thickness
-                .map_or(vk::Format::UNDEFINED, |t| t.format),
-            sampled,
-        )),
-        HostTerm::Transmission => Some(import(
-            "host IDs",
-            gbuffer
-                .material_ids
-                .map_or(vk::Format::UNDEFINED, |i| i.format),
-            sampled,
-        )),
-        _ => None,
-    };
-    let shadow_map =
-        (term == HostTerm::Transmission).then(|| import("host shadow map", shadow_format, sampled));
+    let normals = import("host normals", formats.normals, sampled);
+    let albedo = import("host albedo", formats.albedo, sampled);
+    let ids = formats
+        .ids
+        .map(|format| import("host thickness or IDs", format, sampled));
+    let shadow_map = formats
+        .shadow_map
+        .map(|format| import("host shadow map", format, sampled));
     let mut lit = import(
         "host lit",
         gbuffer.diffuse.format,
@@ -330,11 +351,7 @@ fn declare(
         lit: lit.id(),
     };
     for with_term in [false, true] {
-        let name = if with_term {
-            "host lighting with the term"
-        } else {
-            "host lighting"
-        };
+        let name = if with_term { TERM_PASS } else { PLAIN_PASS };
         let mut pass =
             FullscreenPass::new(&mut graph, name, HOST_LIGHTING_FRAGMENT, Some(scene_gpu));
         pass.per_frame(&HOST_LIGHTING)

@@ -242,6 +242,12 @@ impl DepthTextureSets {
         Ok(grown)
     }
 
+    /// The device memory of the blank texture (the sets themselves are pool memory the
+    /// driver keeps, not an allocation of lucent's).
+    pub(crate) fn image_bytes(&self) -> u64 {
+        self.blank.memory_bytes()
+    }
+
     /// Destroys the pools, the layout, the sampler and the blank texture. The GPU is done
     /// with the effect.
     pub(crate) fn destroy(self, gpu: &GpuContext) {

@@ -656,6 +656,13 @@ impl LayeredEffect {
         self.passes.destroy(lucent);
     }
 
+    /// The draws' depth-texture sets' blank texture (none without `TexDep` media).
+    fn own_image_bytes(&self) -> u64 {
+        self.depth_sets
+            .as_ref()
+            .map_or(0, DepthTextureSets::image_bytes)
+    }
+
     super::passes::effect_methods!(
         LayeredFrame,
         "`frame.meshes` drawn into lucent's light-space maps with `frame.light_faces`, then Li et al.'s transmitted, single and multiple scattering terms of the layered materials added to `frame.lighting`",

@@ -31,8 +31,14 @@ macro_rules! effect_methods {
         pub fn destroy(self, lucent: &Lucent) {
             self.passes.destroy(lucent);
         }
+
+        /// The effect holds no image besides its passes'.
+        fn own_image_bytes(&self) -> u64 {
+            0
+        }
     };
-    // An effect with more to destroy than its passes writes its own `destroy`.
+    // An effect with more to destroy than its passes writes its own `destroy`, and says what
+    // device memory those resources hold (`own_image_bytes`, counted in `memory`).
     ($frame:ident, $does:literal, own_destroy) => {
         /// The passes the effect records (their plan, for lucent's tables and tests): an
         /// internal type, only with the `internals` feature ([`Self::record_timed`] names
@@ -76,7 +82,9 @@ macro_rules! effect_methods {
         /// per-frame parameters), for a host's memory budget. Allocated when the effect is
         /// built, freed by [`Self::destroy`]; recording allocates nothing.
         pub fn memory(&self) -> super::EffectMemory {
-            self.passes.memory()
+            let mut memory = self.passes.memory();
+            memory.images += self.own_image_bytes();
+            memory
         }
     };
 }
@@ -88,9 +96,10 @@ pub(crate) use effect_methods;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct EffectMemory {
-    /// Its intermediate images (the targets its passes write and read between them, at the
-    /// G-buffer's size; images whose lifetimes do not overlap share memory), bytes of device
-    /// memory. The host's own images count nothing.
+    /// Its images, bytes of device memory: the intermediate targets its passes write and read
+    /// between them (at the G-buffer's size; images whose lifetimes do not overlap share
+    /// memory) and any texture of its own (`LayeredEffect`'s blank depth texture for draws
+    /// without one). The host's own images count nothing.
     pub images: u64,
     /// Its per-frame parameters (tables, camera, lights: one slot per frame in flight and
     /// view), bytes of host-visible memory.

@@ -697,9 +697,10 @@ fn measure_translucency(
                 TranslucentMaterial::from_translucency(i as u8 + 1, t)
             })
             .collect::<Result<Vec<_>>>()?;
-        let rows: Vec<(u8, [f32; 4])> = materials.iter().map(|m| (m.id, m.row())).collect();
+        let material_rows: Vec<(u8, [f32; 4])> =
+            materials.iter().map(|m| (m.id, m.row())).collect();
         let term = TermData::Translucency {
-            rows: &rows,
+            rows: &material_rows,
             id_channel: if coloured { 3 } else { 1 },
             coloured,
         };

@@ -35,7 +35,8 @@
 struct LayeredMaterial {
     vec4 info;                                   // x layers, y eta, z D_max, w gather radius
     vec4 weights;                                // x λ3 (transmitted), y λ4 (single), z λ5,
-                                                 // w 1 - F_dr (the ambient let in)
+                                                 // w c: the ambient let in, and how light
+                                                 // leaving diffusely is spread (F_t / (pi c))
     vec4 sigma_t_g[MAX_MEDIUM_LAYERS];           // rgb extinction (1/unit), a: g
     vec4 sigma_s_thickness[MAX_MEDIUM_LAYERS];   // rgb scattering, a: thickness (-1: rest)
     vec4 thickness_scale[2];                     // layer j: units per texel of its TexDep
@@ -44,7 +45,9 @@ struct LayeredMaterial {
     vec4 z_r;
     vec4 z_v;
     vec4 alpha_prime;
-    vec4 total;                                  // its total diffuse reflectance
+    vec4 total;                                  // what multiple scattering scales its
+                                                 // profile to (multiple_scattering_scale)
+    vec4 ambient_single;                         // the ambient's single scattering, S / c
 };
 
 layout(std140, set = 0) uniform Layered {
@@ -292,7 +295,7 @@ vec3 dipole_beyond(int mat, float a) {
 // (transmitted_irradiance).
 vec3 transmitted_irradiance(vec3 p, vec3 n, float eta, float ambient_transmittance) {
     // The environment's irradiance at the normal, pi ambient_radiance(n), of which the
-    // boundary lets 1 - F_dr through (unshadowed, as every pass's ambient).
+    // boundary lets c through (unshadowed, as every pass's ambient).
     vec3 e = ambient_radiance(n) * (PI * ambient_transmittance);
     int count = min(frame.light_count.x, MAX_LIGHTS);
     for (int i = 0; i < count; ++i) {

@@ -87,9 +87,11 @@ void main() {
         weight += rd;
     }
     // Energy normalised: the Rd- and area-weighted mean of the accepted pixel lights' E
-    // times the dipole's total reflectance, so a uniformly lit surface gets exactly
-    // E R_d,total whatever the rejected samples (normalising by the weights at the samples'
-    // own r, not their tangent-plane radii, halved the error on the test spheres).
+    // times the medium's multiple scattering (MAT.total: its white-sky albedo less single
+    // scattering's share, over c^2; src/scene/layered.rs `multiple_scattering_scale`), so a
+    // uniformly lit surface gets exactly that whatever the rejected samples (normalising by
+    // the weights at the samples' own r, not their tangent-plane radii, halved the error on
+    // the test spheres).
     // (No accepted sample: both sums are 0, and so is the term.)
     vec3 l_ms = fresnel_transmittance(cos_o, eta) / PI * MAT.total.rgb * gathered /
                 max(weight, vec3(1e-30));

@@ -392,16 +392,37 @@ void main() {
             if (c <= 1e-4) {
                 continue;
             }
-            vec3 p_in = m + to_light * (max(dot(p_ref - m, n_ref), 0.0) / c);
-            vec3 e = entering(i, p_in, n_ref, to_light, eta);
+            // The light refracts where it enters: it reaches m along `down`, from the point
+            // of the entry plane that path starts at, and the beam it was outside narrows to
+            // cos_in / cos_t of its width (its irradiance across the path rises by that).
+            vec3 down;
+            if (!refract_into(-to_light, n_ref, eta, down)) {
+                continue;
+            }
+            float cos_t = -dot(down, n_ref);
+            if (cos_t <= 1e-4) {
+                continue;
+            }
+            vec3 p_in = m - down * (max(dot(p_ref - m, n_ref), 0.0) / cos_t);
+            vec3 e = entering(i, p_in, n_ref, to_light, eta) * (c / cos_t);
             vec3 tau = optical_depth(mat, p_in, n_ref, p_in, m, texels_ref) +
                        optical_depth(mat, x_o, n_o, m, x_o, texels_o);
-            sum += MAT.sigma_s_thickness[layer].rgb * phase(MAT.sigma_t_g[layer].a, dot(to_light, w)) *
+            sum += MAT.sigma_s_thickness[layer].rgb * phase(MAT.sigma_t_g[layer].a, dot(-down, w)) *
                    e * exp(-tau) * ds;
         }
     }
-    l_t *= t_o / PI;
-    vec3 l_ss = t_o * sum;
+    // Light leaving diffusely through the boundary is spread as F_t(mu_o) / (pi c)
+    // (MAT.weights.w: c, scene::albedo::diffuse_transmittance).
+    l_t *= t_o / (PI * max(MAT.weights.w, 1e-3));
+    // Radiance inside the medium is eta^2 the radiance it leaves as (the solid angle widens
+    // as it leaves): without 1 / eta^2 a skin1 sphere at eta 1.5 came out 1.7-2.3x the
+    // path-traced truth's green and blue (issue 37).
+    vec3 l_ss = t_o * sum / (eta * eta);
+    // The ambient's single scattering, which the march (lights only) leaves out: a white
+    // sky's share of it (src/scene/layered.rs `single_scattering_albedo`), unshadowed as
+    // every pass's ambient. Without it the multiple scattering, scaled to the orders past the
+    // first, left an ambient-lit skin1 sphere 40% too dark.
+    l_ss += t_o * ambient_radiance(n_o) * MAT.ambient_single.rgb;
     vec3 terms = MAT.weights.x * l_t + MAT.weights.y * l_ss;
 #ifdef LUCENT_HALF_TERM
     terms += upsampled_multiple(px, id); // already weighted by λ5

@@ -582,11 +582,7 @@ impl LayeredEffect {
         }
         let uint_ids = id_map.uint;
         let (host_ids, _) = id_map.rows();
-        let layered = LayeredDesc {
-            materials: media,
-            object_ids: Vec::new(),
-            film: false,
-        };
+        let layered = LayeredDesc::of_media(media, Vec::new(), false);
         let table = LayeredTableGpu {
             id_materials,
             ..layered.table(&desc.knobs)

@@ -27,8 +27,9 @@ use std::f64::consts::PI;
 use super::lighting::{light_incidence, radiance};
 use super::raytrace::intersect;
 use super::DVec3;
+use crate::scene::albedo::diffuse_transmittance;
 use crate::scene::layered::{
-    dipole_constants, fresnel_diffuse_reflectance, Dipole, LayeredMedium, Thickness, MAX_ABS_G,
+    dipole_constants, Dipole, LayeredMedium, Thickness, MAX_ABS_G,
 };
 use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::{LucentError, Result};
@@ -408,13 +409,21 @@ impl Default for SingleScatteringOptions {
 /// Single scattering leaving surface point `x_o` of `scene.objects[object]` along `-view_dir`
 /// (`view_dir`: the camera ray's travelling direction), RGB radiance:
 ///
-/// `L_ss = T(x_o) ∫_0^{s_max} sigma_s(M) Σ_lights V(P') T(P') E(P') p(cos θ)
-///         exp(-tau(P' -> M) - tau(M -> x_o)) ds`
+/// `L_ss = T(x_o) L_amb(n_o) S / c
+///       + T(x_o) / eta^2 ∫_0^{s_max} sigma_s(M) Σ_lights V(P') T(P') E(P') (cos_in / cos_t)
+///         p(cos θ) exp(-tau(P_in -> M) - tau(M -> x_o)) ds`
+///
+/// - the first term: the ambient's single scattering, a white sky's share `S`
+///   ([`crate::scene::layered::AlbedoSplit::single`]) spread as `T / (pi c)`, `c`
+///   [`diffuse_transmittance`] (the march takes the lights only);
 ///
 /// - `w = refract(view_dir)` at `x_o` (eta; under total internal reflection nothing enters:
 ///   0), `M = x_o + s w`, `s_max` where the ray leaves the object (exact, analytic);
-/// - `P'` = where the segment from `M` towards the light leaves the object (light travels in
-///   a straight line from `P'` to `M`, as in Jensen's and Li et al.'s single scattering);
+/// - `P'` = where the segment from `M` towards the light leaves the object; the light
+///   refracts there (cosines `cos_in` outside, `cos_t` inside) and reaches `M` along the
+///   refracted direction from `P_in` on `P'`'s tangent plane (Jensen's refracted distance),
+///   its beam narrowed by `cos_in / cos_t`; `1 / eta^2` because radiance inside is `eta^2` the
+///   radiance it leaves as;
 /// - `E(P')` = the light's radiance times [`light_incidence`]'s falloff at `P'` (the GPU's
 ///   light falloff), `V(P')` its visibility ray-traced against every object (shadows);
 /// - `T(x) = fresnel_transmittance(cos, eta)` at `x_o` (the view's angle) and `P'` (the
@@ -493,15 +502,38 @@ pub fn single_scattering(
                 let Some(entry) = entering_light(scene, shape, &transform, light, m, eta) else {
                     continue;
                 };
+                // The light refracts as it enters: it reaches m along `down` from the entry's
+                // tangent plane (Jensen's refracted distance; the GPU's plane too), its beam
+                // narrowed by cos_in / cos_t.
+                let Some(down) = refract(-entry.to_light, entry.normal, eta) else {
+                    continue;
+                };
+                let cos_t = -down.dot(entry.normal);
+                if cos_t <= 1e-4 {
+                    continue;
+                }
+                let cos_in = entry.to_light.dot(entry.normal);
+                let p_in = m - down * ((entry.point - m).dot(entry.normal).max(0.0) / cos_t);
                 // The same stack, placed at the entry point.
-                let tau_light = stack.optical_depth(entry.point, entry.normal, entry.point, m)[c];
-                let phase = options.phase.eval(layer.g, entry.to_light.dot(w));
-                sum += sigma_s * phase * entry.radiance[c] * (-(tau_light + tau_view)).exp() * ds;
+                let tau_light = stack.optical_depth(entry.point, entry.normal, p_in, m)[c];
+                let phase = options.phase.eval(layer.g, (-down).dot(w));
+                sum += sigma_s * phase * entry.radiance[c] * (cos_in / cos_t)
+                    * (-(tau_light + tau_view)).exp()
+                    * ds;
             }
         }
-        *out_c = t_o * sum;
+        // Radiance inside is eta^2 the radiance it leaves as.
+        *out_c = t_o * sum / (eta * eta);
     }
-    Ok(DVec3::from_array(out))
+    // The ambient's single scattering: a white sky's share (S / c of its radiance). Its split
+    // costs milliseconds: only a scene with ambient light pays it, per pixel.
+    let ambient = scene.environment.ambient_radiance(n_o);
+    if ambient == DVec3::ZERO {
+        return Ok(DVec3::from_array(out));
+    }
+    let split = medium.albedo_split();
+    let ambient_single = split.single.as_dvec3() / f64::from(split.diffuse_transmittance);
+    Ok(DVec3::from_array(out) + ambient * ambient_single * t_o)
 }
 
 /// Li et al.'s refraction light `L_t` as lucent reads it (see [`crate::features::layered`]):
@@ -559,7 +591,8 @@ pub fn transmitted(
         };
         sum += entry.radiance * DVec3::new(crossed(0), crossed(1), crossed(2));
     }
-    Ok(sum * (fresnel_transmittance(cos_o, eta) / PI))
+    // Light leaving diffusely through the boundary is spread as F_t(mu_o) / (pi c).
+    Ok(sum * (fresnel_transmittance(cos_o, eta) / (PI * diffuse_transmittance(eta))))
 }
 
 /// GLSL's `smoothstep(edge0, edge1, x)`: 0 below edge0, 1 above edge1, a cubic between.
@@ -591,18 +624,21 @@ pub struct SurfaceSamples {
     pub spacing: f64,
     /// The samples.
     pub samples: Vec<SurfaceSample>,
+    /// The object's medium's [`crate::scene::layered::AlbedoSplit::multiple_scale`], which
+    /// [`multiple_scattering`] scales the dipole to (computed once here, not per pixel).
+    pub multiple_scale: DVec3,
 }
 
 /// Most samples [`SurfaceSamples::new`] makes (about 100 MB); finer spacings are an error.
 pub const MAX_SURFACE_SAMPLES: usize = 1 << 20;
 
 /// Irradiance transmitted into the medium at surface point `p` (outward normal `n`):
-/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the environment's `E(n) (1 - F_dr)`.
+/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the environment's `E(n) c`.
 fn transmitted_irradiance(scene: &Scene, p: DVec3, n: DVec3, eta: f64) -> DVec3 {
     // The environment's irradiance at the normal, E(n) = pi ambient_radiance(n), of which the
-    // boundary lets 1 - F_dr through (diffuse light: the hemispherical average of the Fresnel
+    // boundary lets c through (diffuse light: the cosine-weighted average of the Fresnel
     // transmittance; unshadowed, as every pass's ambient).
-    let ambient_in = PI * (1.0 - fresnel_diffuse_reflectance(eta));
+    let ambient_in = PI * diffuse_transmittance(eta);
     let mut e = scene.environment.ambient_radiance(n) * ambient_in;
     for light in &scene.lights {
         let (to_light, attenuation) = light_incidence(light, p);
@@ -692,16 +728,20 @@ impl SurfaceSamples {
             object,
             spacing,
             samples,
+            multiple_scale: medium.albedo_split().multiple_scale.as_dvec3(),
         })
     }
 }
 
 /// Multiple scattering leaving `x_o` of the samples' object along `-view_dir`, RGB radiance:
 ///
-/// `L_ms = (T(x_o, w_o) / pi) ∫_surface Rd(|x_o - y|) E(y) dA(y)`
+/// `L_ms = (T(x_o, w_o) / pi) (k / R_d,total) ∫_surface Rd(|x_o - y|) E(y) dA(y)`
 ///
-/// with Jensen's dipole `Rd` of the first layer ([`Dipole::rd`], scene units), `E(y)` each
-/// sample's transmitted irradiance. The peak of `Rd` at r -> 0 is narrower than a sample: the
+/// with Jensen's dipole `Rd` of the first layer ([`Dipole::rd`], scene units) for the
+/// profile's shape, rescaled from the dipole's total `R_d,total` to the medium's multiple
+/// scattering `k` ([`crate::scene::layered::AlbedoSplit::multiple_scale`], computed with
+/// the samples), `E(y)` each sample's
+/// transmitted irradiance. The peak of `Rd` at r -> 0 is narrower than a sample: the
 /// disc of radius `2 spacing` around `x_o` is integrated in closed form
 /// ([`Dipole::reflectance_within`]) with `E(x_o)`, the samples beyond it as `Rd E A`.
 pub fn multiple_scattering(
@@ -724,6 +764,9 @@ pub fn multiple_scattering(
         .map(|c| dipole_constants(f64::from(r.sigma_s_prime[c]), f64::from(r.sigma_a[c]), eta));
     let near = 2.0 * samples.spacing;
     let e_o = transmitted_irradiance(scene, x_o, n_o, eta);
+    // The profile's shape is the dipole's, its energy the medium's multiple scattering
+    // (`AlbedoSplit::multiple_scale`, which the GPU's table holds).
+    let scale = samples.multiple_scale;
     let mut out = [0.0; 3];
     for (c, d) in dipoles.iter().enumerate() {
         let mut sum = e_o[c] * d.reflectance_within(near);
@@ -733,7 +776,8 @@ pub fn multiple_scattering(
                 sum += d.rd(dist) * s.irradiance[c] * s.area;
             }
         }
-        out[c] = sum;
+        let total = d.total_reflectance();
+        out[c] = if total > 0.0 { sum * scale[c] / total } else { 0.0 };
     }
     Ok(DVec3::from_array(out) * (fresnel_transmittance(cos_o, eta) / PI))
 }
@@ -933,11 +977,15 @@ mod tests {
         let l = single_scattering(&scene, 0, x_o, view, &options).unwrap();
         let want = f64::from(ss) * p * 2.0 * (1.0 - (-4.0 * st * f64::from(r)).exp()) / (2.0 * st);
         assert!((l.y / want - 1.0).abs() < 1e-3, "{l} vs {want}");
-        // The Fresnel terms: eta 1.5 at normal incidence scales both ends by 0.96 (the
-        // refracted ray stays on the axis).
+        // The boundary: eta 1.5 at normal incidence scales both ends by Fresnel's 0.96 (the
+        // refracted rays stay on the axis, so the beam keeps its width), and the radiance
+        // that leaves is 1 / eta^2 of the radiance inside.
         let scene = sphere_scene(homogeneous(sa, ss, 0.0, 1.5), r, vec![front]);
         let l15 = single_scattering(&scene, 0, x_o, view, &options).unwrap();
-        assert!((l15.z / (want * 0.96 * 0.96) - 1.0).abs() < 1e-3, "{l15}");
+        assert!(
+            (l15.z / (want * 0.96 * 0.96 / 2.25) - 1.0).abs() < 1e-3,
+            "{l15}"
+        );
         // A shadowing sphere between the light and the object leaves nothing.
         let mut shadowed = sphere_scene(homogeneous(sa, ss, 0.0, 1.0), r, vec![front]);
         let mut blocker = shadowed.objects[0].clone();
@@ -989,10 +1037,11 @@ mod tests {
     }
 
     #[test]
-    fn multiple_scattering_of_a_lit_plane_is_the_total_diffuse_reflectance() {
+    fn multiple_scattering_of_a_lit_plane_is_the_medium_s_multiple_scattering() {
         // A large plane under a unit directional light at normal incidence, eta = 1: the
-        // gather at the centre is (E / pi) 2 pi ∫ Rd r dr, between the closed form within the
-        // plane's inscribed disc and the total R_d.
+        // gather at the centre is (E / pi) (k / R_d) 2 pi ∫ Rd r dr, between the closed form
+        // within the plane's inscribed disc and k, the medium's multiple scattering (its
+        // white-sky albedo less single scattering's share).
         let (sp, sa) = (1.0f32, 0.5f32);
         let mut m = homogeneous(sa, sp, 0.0, 1.0);
         m.units_per_mm = 1.0;
@@ -1008,7 +1057,11 @@ mod tests {
         assert!((area - 100.0).abs() < 1e-6, "{area}");
         let l = multiple_scattering(&scene, &samples, DVec3::ZERO, DVec3::NEG_Y).unwrap();
         let d = dipole_constants(f64::from(sp), f64::from(sa), 1.0);
-        let (lo, hi) = (d.reflectance_within(5.0) / PI, d.total_reflectance() / PI);
+        let k = f64::from(medium_of(&scene, 0).unwrap().albedo_split().multiple_scale.x);
+        let (lo, hi) = (
+            d.reflectance_within(5.0) / d.total_reflectance() * k / PI,
+            k / PI,
+        );
         assert!(
             l.x > lo * 0.995 && l.x < hi * 1.005,
             "{} not in [{lo}, {hi}]",

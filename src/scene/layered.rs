@@ -193,6 +193,30 @@ pub fn dipole_constants(sigma_s_prime: f64, sigma_a: f64, eta: f64) -> Dipole {
     }
 }
 
+/// How Li et al.'s terms share a medium's albedo under a white sky
+/// ([`LayeredMedium::albedo_split`]; issue 37). Jensen's dipole counts every order of
+/// scattering, the first too, so beside single scattering its `R_d` reflects more light than
+/// the medium does (skin1: 0.743 / 0.462 / 0.300 of a white sky against 0.625 / 0.385 /
+/// 0.241); the gather scales the dipole's profile to what single scattering leaves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlbedoSplit {
+    /// `c`: the share of a white sky's light the boundary lets in
+    /// ([`crate::scene::albedo::diffuse_transmittance`]), which is also how light leaving
+    /// diffusely is spread, `F_t(mu_o) / (pi c)`. At least 1e-3.
+    pub diffuse_transmittance: f32,
+    /// `S` per channel: the first layer's single scattering under a white sky
+    /// ([`crate::scene::albedo::single_scattering_white_sky_albedo`] with its `sigma_s /
+    /// sigma_t`, `g` and the medium's `eta`). Li et al.'s march takes the lights; the
+    /// ambient's share is this.
+    pub single: Vec3,
+    /// `k = (A - S) / c^2` per channel, what multiple scattering scales the dipole's profile
+    /// to: the radiance it sends out is `F_t(mu_o) / pi` times `k` times the Rd-weighted
+    /// mean of the irradiance that entered. `A` is the white-sky albedo
+    /// ([`LayeredMedium::white_sky_albedo`]); `c^2` because the entering irradiance has
+    /// already passed the boundary once and the light leaving is spread as `F_t / (pi c)`.
+    pub multiple_scale: Vec3,
+}
+
 /// Jensen's dipole constants for one medium, per channel, in scene units (lengths in units,
 /// coefficients in 1/unit).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -343,6 +367,33 @@ impl LayeredMedium {
                 f64::from(eta),
             ) as f32
         }))
+    }
+
+    /// How Li et al.'s terms share this medium's albedo ([`AlbedoSplit`]). A few
+    /// milliseconds (the white-sky albedo's H-functions and single scattering's integral):
+    /// computed once per material, not per frame or pixel.
+    pub fn albedo_split(&self) -> AlbedoSplit {
+        let eta = f64::from(self.eta);
+        let c = crate::scene::albedo::diffuse_transmittance(eta);
+        let (sigma_s, sigma_t) = (self.sigma_s_per_unit(0), self.sigma_t_per_unit(0));
+        let g = f64::from(self.layers.first().map_or(0.0, |l| l.g));
+        let per_albedo = crate::scene::albedo::single_scattering_per_albedo(g, eta);
+        let single = Vec3::from_array(std::array::from_fn(|k| {
+            // sigma_t 0 (a vacuum) scatters nothing: omega 0.
+            let omega = if sigma_t[k] > 0.0 {
+                f64::from(sigma_s[k] / sigma_t[k]).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (omega * per_albedo) as f32
+        }));
+        // c >= 0.75 or so for every eta a medium may have (c -> 0 only as eta -> inf).
+        let c = c.max(1e-3);
+        AlbedoSplit {
+            diffuse_transmittance: c as f32,
+            single,
+            multiple_scale: (self.white_sky_albedo() - single).max(Vec3::ZERO) / (c * c) as f32,
+        }
     }
 
     /// A preset by name (see the module docs): the Jensen 2001 media, `li-teapot` and

@@ -78,9 +78,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "marble-sphere-sidelit",
             technique: Technique::Auto,
-            error: 0.139,
-            energy: (1.0, 1.2),
-            why: "Li et al.'s layered marble, side-lit: 8-14% too bright",
+            error: 0.090,
+            energy: (0.85, 1.02),
+            why: "Li et al.'s layered marble, side-lit: 4-10% too dark (8-14% too bright, error 0.139, until issue 37 took single scattering out of the dipole and the boundary's eta^2 into single scattering)",
         },
         Case {
             scene: "marble-sphere-sidelit",
@@ -99,9 +99,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "marble-medium-sidelit",
             technique: Technique::Auto,
-            error: 0.098,
-            energy: (0.95, 1.15),
-            why: "the medium as Li et al.'s layered material (what auto renders a medium with): 2-6% too bright",
+            error: 0.070,
+            energy: (0.88, 1.02),
+            why: "the medium as Li et al.'s layered material (what auto renders a medium with): 3-7% too dark, the closest of every technique (0.098 and 2-6% too bright before issue 37)",
         },
         Case {
             scene: "marble-medium-sidelit",
@@ -134,9 +134,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "marble-medium-sidelit-eta14",
             technique: Technique::Auto,
-            error: 0.304,
-            energy: (0.6, 0.8),
-            why: "Li et al.'s layered marble at eta 1.4: 28-31% too dark (its Fresnel in and out on top of a model fitted at eta 1)",
+            error: 0.118,
+            energy: (0.82, 0.97),
+            why: "Li et al.'s layered marble at eta 1.4: 9-12% too dark (28-31% too dark, error 0.304, before issue 37: the ambient let in as 1 - F_dr, the share of light inside that gets out, and no 1 / c for the light leaving)",
         },
         Case {
             scene: "marble-medium-sidelit-eta14",
@@ -169,9 +169,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "skin1-medium-sidelit",
             technique: Technique::Auto,
-            error: 0.154,
-            energy: (0.75, 1.0),
-            why: "the skin1 medium as Li et al.'s layered material: 9-16% too dark",
+            error: 0.157,
+            energy: (0.75, 0.98),
+            why: "the skin1 medium as Li et al.'s layered material, lit at 90 degrees: 7-19% too dark, red most (the f64 reference, gathering over the whole surface, is as dark: the model, not the screen-space gather; docs/layered.md); in front light (skin1-medium-front35) it is within 1-3%",
         },
         Case {
             scene: "skin1-medium-sidelit",
@@ -204,9 +204,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "skin1-medium-sidelit-eta14",
             technique: Technique::Auto,
-            error: 0.389,
-            energy: (0.6, 1.4),
-            why: "Li et al.'s layered skin1 at eta 1.4: red 31% too dark, blue 34% too bright",
+            error: 0.196,
+            energy: (0.7, 1.0),
+            why: "Li et al.'s layered skin1 at eta 1.4: 4-24% too dark, red most, as at eta 1 (red 31% too dark and blue 34% too bright, error 0.389, before issue 37)",
         },
         Case {
             scene: "skin1-medium-sidelit-eta14",
@@ -239,8 +239,8 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "skin-layered-sidelit",
             technique: Technique::Auto,
-            error: 0.487,
-            energy: (0.6, 0.75),
+            error: 0.475,
+            energy: (0.68, 0.85),
             why: "Li et al.'s two-layer skin against the nested-media truth (noise 0.16)",
         },
         Case {
@@ -253,7 +253,7 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "jade-medium-sidelit",
             technique: Technique::Auto,
-            error: 0.162,
+            error: 0.153,
             energy: (0.8, 1.05),
             why: "jade as Li et al.'s layered material",
         },
@@ -288,9 +288,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "textured-medium-sidelit",
             technique: Technique::Auto,
-            error: 0.116,
-            energy: (0.85, 1.0),
-            why: "the textured medium under Li et al.'s layered passes, the texture a film on the light leaving (it was not applied at all: error 0.402, 17-34% too bright); the closest of all techniques on this truth",
+            error: 0.165,
+            energy: (0.78, 0.97),
+            why: "the textured medium under Li et al.'s layered passes, the texture a film on the light leaving (it was not applied at all: error 0.402, 17-34% too bright). 0.116 before issue 37: the dipole's second count of single scattering made up for the model's darkness in side light, as on skin1-medium-sidelit, which it is now as far off as",
         },
         Case {
             scene: "textured-medium-sidelit",
@@ -323,9 +323,9 @@ fn cases() -> Vec<Case> {
         Case {
             scene: "mixed-medium",
             technique: Technique::Auto,
-            error: 0.132,
-            energy: (0.8, 1.05),
-            why: "mixed-medium under auto (Li et al.'s layered passes for every medium): the best technique here",
+            error: 0.148,
+            energy: (0.8, 1.0),
+            why: "mixed-medium under auto (Li et al.'s layered passes for every medium): 6-14% too dark; 0.132 before issue 37, whose energy fix takes away the second count of single scattering that made up for the side light's darkness (skin1-medium-sidelit)",
         },
         Case {
             scene: "mixed-medium",
@@ -364,6 +364,62 @@ fn cases() -> Vec<Case> {
             energy: (0.73, 0.99),
             why: "auto renders the material with its [material.sss] table's blur (separable), \
                   not Li et al.'s passes, which would ignore the texture",
+        },
+        Case {
+            scene: "skin1-medium-front35",
+            technique: Technique::Auto,
+            error: 0.054,
+            energy: (0.95, 1.03),
+            why: "skin1 lit 35 degrees off the view, eta 1: Li et al.'s layered passes within 1-3% of the truth's energy (0.150 and 10-16% too bright before issue 37 took single scattering out of the dipole)",
+        },
+        Case {
+            scene: "skin1-medium-front35",
+            technique: Technique::None,
+            error: 0.124,
+            energy: (1.0, 1.09),
+            why: "skin1 in front light as a Lambertian surface of its white-sky albedo: 1-7% too bright",
+        },
+        Case {
+            scene: "skin1-medium-front35-eta15",
+            technique: Technique::Auto,
+            error: 0.077,
+            energy: (0.9, 1.0),
+            why: "skin1 at eta 1.5, lit 35 degrees off the view: 2-8% too dark (0.362, blue 2.0x the truth's, before issue 37 divided single scattering by eta^2, the radiance law at the boundary)",
+        },
+        Case {
+            scene: "skin1-medium-front35-eta15",
+            technique: Technique::None,
+            error: 0.106,
+            energy: (0.86, 0.96),
+            why: "skin1 at eta 1.5 in front light as a Lambertian surface of its white-sky albedo",
+        },
+        Case {
+            scene: "marble-medium-front35",
+            technique: Technique::Auto,
+            error: 0.060,
+            energy: (0.95, 1.0),
+            why: "marble lit 35 degrees off the view, eta 1: 2% too dark (0.139 and 13-14% too bright before issue 37)",
+        },
+        Case {
+            scene: "marble-medium-front35",
+            technique: Technique::None,
+            error: 0.059,
+            energy: (0.97, 1.03),
+            why: "marble in front light as a Lambertian surface of its white-sky albedo: within 1%",
+        },
+        Case {
+            scene: "marble-medium-front35-eta15",
+            technique: Technique::Auto,
+            error: 0.106,
+            energy: (0.92, 1.0),
+            why: "marble at eta 1.5, lit 35 degrees off the view (truth noise 0.047 per 4x4 block): 3-5% too dark",
+        },
+        Case {
+            scene: "marble-medium-front35-eta15",
+            technique: Technique::None,
+            error: 0.122,
+            energy: (0.88, 0.96),
+            why: "marble at eta 1.5 in front light as a Lambertian surface of its white-sky albedo",
         },
     ]
 }

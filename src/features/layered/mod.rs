@@ -6,7 +6,7 @@
 //!   linear in both, so this is exactly eq. 3's weighting, at no cost).
 //! - `layered irradiance`: the light transmitted into the surface per pixel,
 //!   `E = Σ_lights V T(cos, eta) radiance falloff cos` (shadowed) plus the ambient's
-//!   `pi L_a (1 - F_dr)`, at full or half resolution
+//!   `pi L_a c` (`c`: the share of a white sky the boundary lets in), at full or half resolution
 //!   (`layered.irradiance`).
 //! - `single scattering` (eqs. 4-11): the view ray refracted at the surface and marched `K`
 //!   steps up to `D_max / (N . T)`; at each step `M` the light's entry point `P'` comes from
@@ -52,7 +52,7 @@ use super::shadows::{self, ShadowMaps};
 use super::technique::{PartKind, TechniqueModule};
 use crate::gpu_scene::{Region, SceneGpu, TableRegion, TileRect, FRAME};
 use crate::graph::{Handle, Image, ImageInfo, LoadOp, RenderGraph};
-use crate::scene::layered::{LayeredMedium, Thickness, MAX_LAYERS};
+use crate::scene::layered::{AlbedoSplit, LayeredMedium, Thickness, MAX_LAYERS};
 use crate::scene::Scene;
 use crate::{LucentError, Result};
 
@@ -82,9 +82,23 @@ pub struct LayeredDesc {
     /// beside the ID and single scattering multiplies the light leaving the surface by it (a
     /// pigment film, the screen-space blurs' `post` texturing); without one, none of that.
     pub film: bool,
+    /// Each material's [`AlbedoSplit`], computed once here (a few milliseconds each), not in
+    /// every frame's table.
+    splits: Vec<AlbedoSplit>,
 }
 
 impl LayeredDesc {
+    /// These media with their object IDs (per scene object, 0: not layered) and film flag.
+    pub fn of_media(materials: Vec<LayeredMedium>, object_ids: Vec<u8>, film: bool) -> Self {
+        let splits = materials.iter().map(LayeredMedium::albedo_split).collect();
+        Self {
+            materials,
+            object_ids,
+            film,
+            splits,
+        }
+    }
+
     /// The layered materials of `scene`'s objects; `None` when no object is layered. Errors
     /// name the material: more than [`MAX_LAYERED_MATERIALS`] distinct media, a medium that
     /// fails validation, or one that reads layer thickness from a texture (`TexDep`) on a mesh
@@ -128,11 +142,7 @@ impl LayeredDesc {
             };
             object_ids.push(id as u8 + 1);
         }
-        Ok((!materials.is_empty()).then_some(Self {
-            materials,
-            object_ids,
-            film,
-        }))
+        Ok((!materials.is_empty()).then_some(Self::of_media(materials, object_ids, film)))
     }
 
     /// `TexDep` depth textures one object reads at most (0, 1 or 2): the G-buffer and the
@@ -156,8 +166,10 @@ impl LayeredDesc {
             i32::from(knobs.phase == PhaseForm::Schlick),
             if knobs.half_irradiance { 2 } else { 1 },
         ];
-        for (row, m) in t.materials.iter_mut().zip(&self.materials) {
-            *row = material_row(m, knobs);
+        for (i, (row, m)) in t.materials.iter_mut().zip(&self.materials).enumerate() {
+            // A material pushed after construction has no split yet: computed here then.
+            let split = self.splits.get(i).copied().unwrap_or_else(|| m.albedo_split());
+            *row = material_row(m, &split, knobs);
         }
         t.view_to_world = glam::Mat4::IDENTITY.to_cols_array_2d();
         // lucent's own IDs are the material numbers.
@@ -198,14 +210,6 @@ pub fn gather_radius(medium: &LayeredMedium) -> f64 {
     radius.clamp(1e-6, 1e4)
 }
 
-/// The dipole's total diffuse reflectance `R_d = (alpha'/2) (1 + e^(-4/3 A s)) e^(-s)`,
-/// `s = sqrt(3 (1 - alpha'))` (Jensen 2001; [`crate::reference::dipole`]'s
-/// `total_reflectance` is its f64 twin).
-pub fn total_reflectance(alpha_prime: f32, a: f32) -> f32 {
-    let s = (3.0 * (1.0 - alpha_prime).max(0.0)).sqrt();
-    0.5 * alpha_prime * (1.0 + (-4.0 / 3.0 * a * s).exp()) * (-s).exp()
-}
-
 /// Single scattering's depth `D_max` of `medium` in scene units: `mfp` mean free paths of the
 /// first layer's clearest channel (its smallest `sigma_t`), at least a millionth of a unit.
 pub fn single_depth(medium: &LayeredMedium, mfp: f32) -> f64 {
@@ -214,17 +218,21 @@ pub fn single_depth(medium: &LayeredMedium, mfp: f32) -> f64 {
     (f64::from(mfp.max(1e-3)) / clearest).clamp(1e-6, 1e6)
 }
 
-fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
+fn material_row(m: &LayeredMedium, split: &AlbedoSplit, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
     let mut row: LayeredMaterialGpu = bytemuck::Zeroable::zeroed();
     let d = m.dipole_constants();
-    let total = d.alpha_prime.to_array().map(|a| total_reflectance(a, d.a));
+    let total = split.multiple_scale.to_array();
     row.info = [
         m.layers.len().min(MAX_LAYERS) as f32,
         m.eta,
         single_depth(m, knobs.max_depth_mfp) as f32,
         gather_radius(m) as f32,
     ];
-    row.weights = [m.weights[2], m.weights[3], m.weights[4], 1.0 - d.f_dr];
+    // The share of a white sky the boundary lets in, c: the ambient's, and how light leaving
+    // diffusely is spread (not Jensen's 1 - F_dr, the share of light inside that gets out,
+    // c / eta^2). Held off 0 (AlbedoSplit's own bound), as the shaders divide by it.
+    let c = split.diffuse_transmittance;
+    row.weights = [m.weights[2], m.weights[3], m.weights[4], c];
     for (i, l) in m.layers.iter().take(MAX_LAYERS).enumerate() {
         let sigma_t = m.sigma_t_per_unit(i);
         let sigma_s = m.sigma_s_per_unit(i);
@@ -246,6 +254,9 @@ fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
     row.z_v = d.z_v.extend(0.0).to_array();
     row.alpha_prime = d.alpha_prime.extend(0.0).to_array();
     row.total = [total[0], total[1], total[2], 0.0];
+    // The ambient's single scattering leaves as F_t(mu_o) ambient(n) S / c: S / c of a white
+    // sky's radiance (an irradiance pi L, of which S leaves, spread as F_t / (pi c)).
+    row.ambient_single = (split.single / c).extend(0.0).to_array();
     row
 }
 
@@ -255,8 +266,9 @@ fn material_row(m: &LayeredMedium, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
 pub struct LayeredMaterialGpu {
     /// x: layer count; y: eta; z: `D_max` (units); w: gather radius (units).
     pub info: [f32; 4],
-    /// x: λ3 (transmitted); y: λ4 (single); z: λ5 (multiple); w: `1 - F_dr`, the share of
-    /// the ambient the boundary lets in.
+    /// x: λ3 (transmitted); y: λ4 (single); z: λ5 (multiple); w: the share of the ambient
+    /// the boundary lets in (`scene::albedo::diffuse_transmittance`), which is also how light
+    /// leaving diffusely is spread (`F_t(mu_o) / (pi c)`).
     pub weights: [f32; 4],
     /// Per layer: extinction rgb (1/unit), g.
     pub sigma_t_g: [[f32; 4]; MAX_LAYERS],
@@ -274,8 +286,12 @@ pub struct LayeredMaterialGpu {
     pub z_v: [f32; 4],
     /// `alpha'` rgb.
     pub alpha_prime: [f32; 4],
-    /// The dipole's total diffuse reflectance rgb.
+    /// What multiple scattering scales the dipole's profile to, rgb
+    /// ([`AlbedoSplit::multiple_scale`]).
     pub total: [f32; 4],
+    /// The ambient's single scattering: `S / c` rgb
+    /// ([`AlbedoSplit::single`] over the diffuse transmittance).
+    pub ambient_single: [f32; 4],
 }
 
 /// The per-frame layered table, std140 (glsl/common/layered.glsl `Layered`).
@@ -917,12 +933,7 @@ mod tests {
             assert_eq!(LayeredDecode::new(decode, &table(&ids), [0; 3]).ids_up_to, 0, "{ids:?}");
         }
         // lucent's own table maps every material number to itself, ID 0 to none.
-        let own = LayeredDesc {
-            materials: Vec::new(),
-            object_ids: Vec::new(),
-            film: false,
-        }
-        .table(&LayeredKnobs::default());
+        let own = LayeredDesc::of_media(Vec::new(), Vec::new(), false).table(&LayeredKnobs::default());
         for id in 0..=MAX_LAYERED_MATERIALS {
             assert_eq!(own.id_materials[id / 4][id % 4] as usize, id);
         }
@@ -1060,7 +1071,7 @@ mod tests {
                 g,
                 thickness: Thickness::Rest,
             }];
-            let row = material_row(&m, &LayeredKnobs::default());
+            let row = material_row(&m, &m.albedo_split(), &LayeredKnobs::default());
             let all = bytemuck::bytes_of(&row);
             let floats: &[f32] = bytemuck::cast_slice(all);
             assert!(

@@ -514,10 +514,15 @@ pub fn single_scattering(
                 }
                 let cos_in = entry.to_light.dot(entry.normal);
                 let p_in = m - down * ((entry.point - m).dot(entry.normal).max(0.0) / cos_t);
+                // The light's falloff where the refracted path starts, not at P' (a point
+                // light's falls off across the distance between them; the GPU's too).
+                let (_, attenuation) = light_incidence(light, p_in);
+                let (_, at_entry) = light_incidence(light, entry.point);
+                let falloff = if at_entry > 0.0 { attenuation / at_entry } else { 0.0 };
                 // The same stack, placed at the entry point.
                 let tau_light = stack.optical_depth(entry.point, entry.normal, p_in, m)[c];
                 let phase = options.phase.eval(layer.g, (-down).dot(w));
-                sum += sigma_s * phase * entry.radiance[c] * (cos_in / cos_t)
+                sum += sigma_s * phase * entry.radiance[c] * falloff * (cos_in / cos_t)
                     * (-(tau_light + tau_view)).exp()
                     * ds;
             }

@@ -330,6 +330,23 @@ fn fresnel(cos_i: f64, n_i: f64, n_t: f64) -> f64 {
     0.5 * (rs * rs + rp * rp)
 }
 
+/// A Henyey-Greenstein scattering of a direction whose depth cosine is `uz`: the new depth
+/// cosine (the deflection sampled exactly, the azimuth uniformly).
+#[cfg(test)]
+fn scattered_depth_cosine(uz: f64, g: f64, rng: &mut rand::rngs::SmallRng) -> f64 {
+    use rand::Rng;
+    let cos = if g.abs() < 1e-6 {
+        2.0 * rng.gen::<f64>() - 1.0
+    } else {
+        let t = (1.0 - g * g) / (1.0 - g + 2.0 * g * rng.gen::<f64>());
+        ((1.0 + g * g - t * t) / (2.0 * g)).clamp(-1.0, 1.0)
+    };
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * rng.gen::<f64>();
+    let sin_z = (1.0 - uz * uz).max(0.0).sqrt();
+    (uz * cos + sin_z * sin * phi.cos()).clamp(-1.0, 1.0)
+}
+
 /// The same albedo by Monte Carlo: `photons` random walks (seeded, so reproducible) into a
 /// semi-infinite medium of `sigma_s` (not reduced), `sigma_a`, Henyey-Greenstein `g`, behind a
 /// smooth boundary of index `eta` with exact Fresnel reflection both ways. Light arrives
@@ -378,16 +395,7 @@ pub fn monte_carlo_white_sky_albedo(
                 }
                 weight *= 10.0;
             }
-            let cos = if g.abs() < 1e-6 {
-                2.0 * rng.gen::<f64>() - 1.0
-            } else {
-                let t = (1.0 - g * g) / (1.0 - g + 2.0 * g * rng.gen::<f64>());
-                ((1.0 + g * g - t * t) / (2.0 * g)).clamp(-1.0, 1.0)
-            };
-            let sin = (1.0 - cos * cos).max(0.0).sqrt();
-            let phi = std::f64::consts::TAU * rng.gen::<f64>();
-            let sin_z = (1.0 - uz * uz).max(0.0).sqrt();
-            uz = (uz * cos + sin_z * sin * phi.cos()).clamp(-1.0, 1.0);
+            uz = scattered_depth_cosine(uz, g, &mut rng);
         }
     }
     out / photons as f64
@@ -479,16 +487,7 @@ mod tests {
                 .max(0.0)
                 .sqrt();
             let z = -(1.0 - rng.gen::<f64>()).ln() * uz;
-            let cos = if g.abs() < 1e-6 {
-                2.0 * rng.gen::<f64>() - 1.0
-            } else {
-                let t = (1.0 - g * g) / (1.0 - g + 2.0 * g * rng.gen::<f64>());
-                ((1.0 + g * g - t * t) / (2.0 * g)).clamp(-1.0, 1.0)
-            };
-            let sin = (1.0 - cos * cos).max(0.0).sqrt();
-            let phi = std::f64::consts::TAU * rng.gen::<f64>();
-            let sin_z = (1.0 - uz * uz).max(0.0).sqrt();
-            let up = -(uz * cos + sin_z * sin * phi.cos());
+            let up = -scattered_depth_cosine(uz, g, &mut rng);
             if up <= 0.0 {
                 continue;
             }

@@ -379,9 +379,11 @@ impl LayeredMedium {
         let g = f64::from(self.layers.first().map_or(0.0, |l| l.g));
         let per_albedo = crate::scene::albedo::single_scattering_per_albedo(g, eta);
         let single = Vec3::from_array(std::array::from_fn(|k| {
-            // sigma_t 0 (a vacuum) scatters nothing: omega 0.
-            let omega = if sigma_t[k] > 0.0 {
-                f64::from(sigma_s[k] / sigma_t[k]).clamp(0.0, 1.0)
+            // sigma_t 0 (a vacuum) scatters nothing: omega 0; so does a NaN ratio, which no
+            // validated medium has.
+            let ratio = f64::from(sigma_s[k] / sigma_t[k]);
+            let omega = if sigma_t[k] > 0.0 && !ratio.is_nan() {
+                ratio.clamp(0.0, 1.0)
             } else {
                 0.0
             };

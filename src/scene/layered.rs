@@ -369,9 +369,9 @@ impl LayeredMedium {
         }))
     }
 
-    /// How Li et al.'s terms share this medium's albedo ([`AlbedoSplit`]). A few
-    /// milliseconds (the white-sky albedo's H-functions and single scattering's integral):
-    /// computed once per material, not per frame or pixel.
+    /// How Li et al.'s terms share this medium's albedo ([`AlbedoSplit`]). About 0.3 ms
+    /// (the white-sky albedo's H-functions and single scattering's integral): computed once
+    /// per material, not per frame or pixel.
     pub fn albedo_split(&self) -> AlbedoSplit {
         let eta = f64::from(self.eta);
         let c = crate::scene::albedo::diffuse_transmittance(eta);

@@ -531,7 +531,7 @@ pub fn single_scattering(
         *out_c = t_o * sum / (eta * eta);
     }
     // The ambient's single scattering: a white sky's share (S / c of its radiance). Its split
-    // costs milliseconds: only a scene with ambient light pays it, per pixel.
+    // costs about 0.3 ms: only a scene with ambient light pays it, per pixel.
     let ambient = scene.environment.ambient_radiance(n_o);
     if ambient == DVec3::ZERO {
         return Ok(DVec3::from_array(out));

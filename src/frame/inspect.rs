@@ -359,6 +359,18 @@ fn layered_lines(l: &crate::scene::layered::LayeredMedium) -> String {
          {} units/mm",
         l.eta, w[0], w[1], w[2], w[3], w[4], l.units_per_mm
     );
+    // What the passes make of it (docs/layered.md, "The boundary and the energy").
+    let split = l.albedo_split();
+    let v = |x: glam::Vec3| format!("{:.3} / {:.3} / {:.3}", x.x, x.y, x.z);
+    let _ = writeln!(
+        s,
+        "    the boundary lets in {:.3} of a white sky; single scattering carries {} of it, \
+         multiple scattering the dipole's profile scaled to {} (the white-sky albedo less single \
+         scattering, over c^2)",
+        split.diffuse_transmittance,
+        v(split.single),
+        v(split.multiple_scale)
+    );
     for (i, layer) in l.layers.iter().enumerate() {
         let thickness = match layer.thickness {
             Thickness::Mm(t) => format!("{t} mm"),
@@ -451,5 +463,19 @@ mod tests {
             "{s}"
         );
         assert!(s.contains("g 0.9") && s.contains("g 0.8"), "{s}");
+        // The albedo split the passes use: skin1 at eta 1 lets in all of a white sky, and
+        // single scattering carries 0.2046 omega of it (omega 0.959 in red).
+        let skin1 = crate::scene::layered::LayeredMedium::homogeneous(
+            "skin1",
+            glam::Vec3::new(0.74, 0.88, 1.01),
+            glam::Vec3::new(0.032, 0.17, 0.48),
+            0.0,
+            1.0,
+        );
+        let s = layered_lines(&skin1);
+        assert!(
+            s.contains("the boundary lets in 1.000 of a white sky; single scattering carries 0.196 /"),
+            "{s}"
+        );
     }
 }

@@ -46,7 +46,7 @@ struct LayeredMaterial {
     vec4 z_v;
     vec4 alpha_prime;
     vec4 total;                                  // what multiple scattering scales its
-                                                 // profile to (multiple_scattering_scale)
+                                                 // profile to (AlbedoSplit::multiple_scale)
     vec4 ambient_single;                         // the ambient's single scattering, S / c
 };
 

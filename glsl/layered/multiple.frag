@@ -88,7 +88,7 @@ void main() {
     }
     // Energy normalised: the Rd- and area-weighted mean of the accepted pixel lights' E
     // times the medium's multiple scattering (MAT.total: its white-sky albedo less single
-    // scattering's share, over c^2; src/scene/layered.rs `multiple_scattering_scale`), so a
+    // scattering's share, over c^2; src/scene/layered.rs `albedo_split`), so a
     // uniformly lit surface gets exactly that whatever the rejected samples (normalising by
     // the weights at the samples' own r, not their tangent-plane radii, halved the error on
     // the test spheres).

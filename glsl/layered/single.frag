@@ -419,7 +419,7 @@ void main() {
     // path-traced truth's green and blue (issue 37).
     vec3 l_ss = t_o * sum / (eta * eta);
     // The ambient's single scattering, which the march (lights only) leaves out: a white
-    // sky's share of it (src/scene/layered.rs `single_scattering_albedo`), unshadowed as
+    // sky's share of it (src/scene/layered.rs `albedo_split`), unshadowed as
     // every pass's ambient. Without it the multiple scattering, scaled to the orders past the
     // first, left an ambient-lit skin1 sphere 40% too dark.
     l_ss += t_o * ambient_radiance(n_o) * MAT.ambient_single.rgb;

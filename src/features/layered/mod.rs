@@ -221,7 +221,6 @@ pub fn single_depth(medium: &LayeredMedium, mfp: f32) -> f64 {
 fn material_row(m: &LayeredMedium, split: &AlbedoSplit, knobs: &LayeredKnobs) -> LayeredMaterialGpu {
     let mut row: LayeredMaterialGpu = bytemuck::Zeroable::zeroed();
     let d = m.dipole_constants();
-    let total = split.multiple_scale.to_array();
     row.info = [
         m.layers.len().min(MAX_LAYERS) as f32,
         m.eta,
@@ -253,7 +252,7 @@ fn material_row(m: &LayeredMedium, split: &AlbedoSplit, knobs: &LayeredKnobs) ->
     row.z_r = d.z_r.extend(0.0).to_array();
     row.z_v = d.z_v.extend(0.0).to_array();
     row.alpha_prime = d.alpha_prime.extend(0.0).to_array();
-    row.total = [total[0], total[1], total[2], 0.0];
+    row.total = split.multiple_scale.extend(0.0).to_array();
     // The ambient's single scattering leaves as F_t(mu_o) ambient(n) S / c: S / c of a white
     // sky's radiance (an irradiance pi L, of which S leaves, spread as F_t / (pi c)).
     row.ambient_single = (split.single / c).extend(0.0).to_array();

@@ -45,16 +45,9 @@ fn clamp_g(g: f64) -> f64 {
     }
 }
 
-/// Henyey-Greenstein: `(1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2))`, per steradian. The base is
-/// written `(1 - g)^2 + 2 g (1 - cos)`: both terms are exact near `cos = 1`, where
-/// `1 + g^2 - 2g cos` cancels catastrophically for |g| -> 1. |g| is clamped to 0.999.
-pub fn henyey_greenstein(g: f64, cos_theta: f64) -> f64 {
-    let g = clamp_g(g);
-    let c = cos_theta.clamp(-1.0, 1.0);
-    let base = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c);
-    // base >= (1 - |g|)^2 > 0 for |g| <= 0.999 (the clamp keeps it off 0).
-    (1.0 - g * g) / (4.0 * PI * base * base.sqrt())
-}
+/// Henyey-Greenstein per steradian, |g| clamped to 0.999 (the scene's own, which the medium's
+/// albedo split integrates with).
+pub use crate::scene::albedo::henyey_greenstein;
 
 /// Schlick's `k` for a Henyey-Greenstein `g`: `1.55 g - 0.55 g^3`, clamped to |k| <= 0.999
 /// (the cubic exceeds 1 for g above about 0.95, which would make the phase function negative).
@@ -638,12 +631,13 @@ pub struct SurfaceSamples {
 pub const MAX_SURFACE_SAMPLES: usize = 1 << 20;
 
 /// Irradiance transmitted into the medium at surface point `p` (outward normal `n`):
-/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the environment's `E(n) c`.
-fn transmitted_irradiance(scene: &Scene, p: DVec3, n: DVec3, eta: f64) -> DVec3 {
+/// `sum_lights V(p) T(cos, eta) radiance falloff cos`, plus the environment's `E(n) c`, `c`
+/// the boundary's [`diffuse_transmittance`] (the caller's, computed once, not per sample).
+fn transmitted_irradiance(scene: &Scene, p: DVec3, n: DVec3, eta: f64, c: f64) -> DVec3 {
     // The environment's irradiance at the normal, E(n) = pi ambient_radiance(n), of which the
     // boundary lets c through (diffuse light: the cosine-weighted average of the Fresnel
     // transmittance; unshadowed, as every pass's ambient).
-    let ambient_in = PI * diffuse_transmittance(eta);
+    let ambient_in = PI * c;
     let mut e = scene.environment.ambient_radiance(n) * ambient_in;
     for light in &scene.lights {
         let (to_light, attenuation) = light_incidence(light, p);
@@ -685,6 +679,7 @@ impl SurfaceSamples {
     pub fn new(scene: &Scene, object: usize, spacing: f64) -> Result<Self> {
         let medium = medium_of(scene, object)?;
         let eta = f64::from(medium.eta);
+        let boundary = diffuse_transmittance(eta);
         let (shape, transform) = shape_of(scene, object)?;
         if !(spacing.is_finite() && spacing > 0.0) {
             return Err(LucentError::InvalidInput(format!(
@@ -723,7 +718,7 @@ impl SurfaceSamples {
                             position,
                             normal,
                             area,
-                            irradiance: transmitted_irradiance(scene, position, normal, eta),
+                            irradiance: transmitted_irradiance(scene, position, normal, eta, boundary),
                         });
                     }
                 }
@@ -768,7 +763,7 @@ pub fn multiple_scattering(
     let dipoles: [Dipole; 3] = [0, 1, 2]
         .map(|c| dipole_constants(f64::from(r.sigma_s_prime[c]), f64::from(r.sigma_a[c]), eta));
     let near = 2.0 * samples.spacing;
-    let e_o = transmitted_irradiance(scene, x_o, n_o, eta);
+    let e_o = transmitted_irradiance(scene, x_o, n_o, eta, diffuse_transmittance(eta));
     // The profile's shape is the dipole's, its energy the medium's multiple scattering
     // (`AlbedoSplit::multiple_scale`, which the GPU's table holds).
     let scale = samples.multiple_scale;

@@ -21,6 +21,10 @@
 //! in the tests, is `monte_carlo_white_sky_albedo`: a random walk with the true
 //! Henyey-Greenstein phase function and exact Fresnel at the boundary.
 
+/// Largest |g| accepted: HG and Schlick's phase functions peak like 1/(1 - |g|)^2, so |g| = 1
+/// is a delta and 0.999 already a 4e6:1 peak (`scene::layered` re-exports it).
+pub const MAX_ABS_G: f32 = 0.999;
+
 /// Gauss-Legendre nodes on [0, 1]: enough that the H-function's moments are exact to 1e-9.
 const NODES: usize = 32;
 
@@ -157,7 +161,7 @@ pub fn white_sky_albedo(sigma_s_prime: f64, sigma_a: f64, eta: f64) -> f64 {
     (entered * out_fraction / (1.0 - (1.0 - out_fraction) * returned).max(1e-12)).clamp(0.0, 1.0)
 }
 
-/// Midpoints of [0, 1] for the boundary's and single scattering's integrals below: Fresnel's
+/// Midpoints of [0, 1] for the boundary's integral below: Fresnel's
 /// kink at the critical angle (a boundary of `eta` < 1 seen from outside) defeats Gauss's
 /// nodes, midpoints converge on it as 1/n^2.
 const MIDPOINTS: usize = 256;
@@ -210,12 +214,6 @@ pub fn single_scattering_white_sky_albedo(omega: f64, g: f64, eta: f64) -> f64 {
 /// omega, so a medium's three channels, which share `g` and `eta`, need this integral once.
 /// About 0.3 ms (32^3 phase evaluations).
 pub fn single_scattering_per_albedo(g: f64, eta: f64) -> f64 {
-    // |g| -> 1 makes the phase function a spike: held off it, as the shaders hold it.
-    let g = if g.is_nan() {
-        0.0
-    } else {
-        g.clamp(-0.999, 0.999)
-    };
     let eta = if eta.is_finite() && eta > 0.0 {
         eta
     } else {
@@ -265,10 +263,15 @@ pub fn single_scattering_per_albedo(g: f64, eta: f64) -> f64 {
     albedo.clamp(0.0, 1.0)
 }
 
-/// Henyey-Greenstein per steradian at |g| <= 0.999, the base written as
-/// `(1 - g)^2 + 2 g (1 - cos)` (exact near cos 1, where `1 + g^2 - 2 g cos` cancels).
-fn henyey_greenstein(g: f64, cos_theta: f64) -> f64 {
+/// Henyey-Greenstein: `(1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2))`, per steradian. The base is
+/// written `(1 - g)^2 + 2 g (1 - cos)`: both terms are exact near `cos = 1`, where
+/// `1 + g^2 - 2g cos` cancels catastrophically for |g| -> 1. |g| is clamped to
+/// [`MAX_ABS_G`] (|g| -> 1 makes it a spike; the shaders hold it there too), a NaN `g` reads 0.
+pub fn henyey_greenstein(g: f64, cos_theta: f64) -> f64 {
+    let m = f64::from(MAX_ABS_G);
+    let g = if g.is_nan() { 0.0 } else { g.clamp(-m, m) };
     let c = cos_theta.clamp(-1.0, 1.0);
+    // base >= (1 - |g|)^2 > 0 for |g| <= 0.999 (the clamp keeps it off 0).
     let base = (1.0 - g) * (1.0 - g) + 2.0 * g * (1.0 - c);
     (1.0 - g * g) / (4.0 * std::f64::consts::PI * base * base.sqrt())
 }

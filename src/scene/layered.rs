@@ -48,8 +48,9 @@ use crate::{LucentError, Result};
 pub const MAX_LAYERS: usize = 8;
 
 /// Largest |g| accepted: HG and Schlick's phase functions peak like 1/(1 - |g|)^2, so |g| = 1
-/// is a delta and 0.999 already a 4e6:1 peak.
-pub const MAX_ABS_G: f32 = 0.999;
+/// is a delta and 0.999 already a 4e6:1 peak (defined beside the phase function,
+/// [`crate::scene::albedo::henyey_greenstein`]).
+pub use crate::scene::albedo::MAX_ABS_G;
 
 /// Li et al.'s eq. 3 weights of their Fig. 4 (diffuse, specular, transmitted, single, multiple).
 pub const DEFAULT_WEIGHTS: [f32; 5] = [0.3, 0.3, 0.05, 0.05, 0.03];
